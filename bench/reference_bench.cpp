@@ -1,0 +1,114 @@
+// G-buffer and ray-traced ground truth, against a minimal Embree loop that traces the same rays
+// and does nothing else: the limit the reference is measured against (BENCHMARKS.md).
+#include <benchmark/benchmark.h>
+
+#include <array>
+
+#include "ao/core/parallel.h"
+#include "ao/core/sampling.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/reference/packets.h"
+#include "ao/reference/raytraced.h"
+#include "bench_scenes.h"
+
+namespace ao::bench {
+namespace {
+
+constexpr int kWidth = 1280, kHeight = 720, kSamples = 64;
+
+struct Fixture {
+  Scene scene;
+  RayScene rays;
+  GBuffer gbuffer;
+  Falloff falloff;
+
+  explicit Fixture(Scene s) : scene(std::move(s)), rays(scene), gbuffer(render_gbuffer(rays, framed(scene, kWidth, kHeight))) {
+    falloff = {Membership::Step, 0.1f * scene.bounds().diagonal()};
+  }
+};
+
+Fixture* elephant() {
+  static std::optional<Fixture> f = [] {
+    auto s = mesh_on_ground("refined_elephant.off");
+    return s ? std::optional<Fixture>(std::in_place, std::move(*s)) : std::nullopt;
+  }();
+  return f ? &*f : nullptr;
+}
+
+Fixture* demo() {
+  static Fixture f(make_builtin_scene("default"));
+  return &f;
+}
+
+void gbuffer(benchmark::State& state, Fixture* f) {
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const Camera cam = f->gbuffer.camera;
+  for (auto _ : state) benchmark::DoNotOptimize(render_gbuffer(f->rays, cam));
+  state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(cam.width) * cam.height * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+}
+
+// The limit: for every covered pixel, the same 64 cosine-weighted directions the reference uses
+// (same seed, same sequence), 16-wide occlusion packets, a counter of hits. No accumulation of
+// statistics, no early exit, nothing written.
+void minimal_loop(benchmark::State& state, Fixture* f) {
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const GBuffer& g = f->gbuffer;
+  const Frame basis = g.camera.basis();
+  const float offset = f->rays.self_intersection_offset(), R = f->falloff.radius;
+  std::uint64_t rays = 0;
+  for (auto _ : state) {
+    std::atomic<std::uint64_t> hits{0};
+    parallel_for_tiles(g.width(), g.height(), 16, [&](const Tile& t) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      alignas(64) RTCRay16 ray;
+      alignas(64) std::array<int, 16> valid;
+      valid.fill(-1);
+      std::uint64_t local = 0;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x) {
+          if (!g.covered(x, y)) continue;
+          const Vec3 n = basis.to_world(g.normal(x, y));
+          const Vec3 o = basis.to_world(g.position(x, y)) + g.camera.eye + n * offset;
+          const Frame frame = Frame::from_normal(n);
+          const std::uint32_t seed = pixel_seed(1, x, y);
+          for (int first = 0; first < kSamples; first += 16) {
+            for (int k = 0; k < 16; ++k) {
+              const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), seed)));
+              ray.org_x[k] = o.x, ray.org_y[k] = o.y, ray.org_z[k] = o.z;
+              ray.dir_x[k] = d.x, ray.dir_y[k] = d.y, ray.dir_z[k] = d.z;
+              ray.tnear[k] = 0, ray.tfar[k] = R, ray.time[k] = 0, ray.mask[k] = ~0u, ray.id[k] = 0, ray.flags[k] = 0;
+            }
+            rtcOccluded16(valid.data(), f->rays.handle(), &ctx, &ray);
+            for (int k = 0; k < 16; ++k) local += ray.tfar[k] < 0;
+          }
+        }
+      hits += local;
+    });
+    benchmark::DoNotOptimize(hits.load());
+  }
+  for (std::size_t i = 0; i < g.coverage.size(); ++i) rays += g.coverage[i] ? kSamples : 0;
+  state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+}
+
+void raytraced(benchmark::State& state, Fixture* f) {
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  std::uint64_t rays = 0;
+  for (auto _ : state) {
+    const auto img = render_raytraced(f->rays, f->gbuffer, f->falloff, {.samples = kSamples}, 1);
+    rays += img.rays;
+  }
+  state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays) / 1e6, benchmark::Counter::kIsRate);
+}
+
+BENCHMARK_CAPTURE(gbuffer, default_scene, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer, elephant_on_ground, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(minimal_loop, elephant_on_ground_64spp, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(raytraced, elephant_on_ground_64spp, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(minimal_loop, default_scene_64spp, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(raytraced, default_scene_64spp, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+}  // namespace
+}  // namespace ao::bench
+
+BENCHMARK_MAIN();

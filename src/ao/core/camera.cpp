@@ -1,0 +1,71 @@
+#include "ao/core/camera.h"
+
+#include <cmath>
+#include <string>
+
+#include "ao/core/error.h"
+
+namespace ao {
+
+namespace {
+constexpr int kMaxImageSide = 32768;  // 32k x 32k float images are 4 GiB: beyond that is a typo
+}
+
+void Camera::validate() const {
+  if (!is_finite(eye) || !is_finite(target) || !is_finite(up)) throw InputError("camera: eye, target and up must be finite");
+  if (length(target - eye) <= 0) throw InputError("camera: eye and target are the same point");
+  if (length(cross(normalize(target - eye), normalize(up))) < 1e-4f) throw InputError("camera: up is parallel to the view direction");
+  if (!(vertical_fov_deg > 0.0f && vertical_fov_deg < 180.0f))
+    throw InputError("camera: --fov must be in (0, 180) degrees, got " + std::to_string(vertical_fov_deg));
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+    throw InputError("camera: resolution " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1.." +
+                     std::to_string(kMaxImageSide) + " per side");
+}
+
+Frame Camera::basis() const {
+  const Vec3 z = normalize(eye - target);
+  const Vec3 x = normalize(cross(up, z));
+  const Vec3 y = cross(z, x);
+  return {x, y, z};
+}
+
+float Camera::tan_half_fov() const { return std::tan(vertical_fov_deg * kPi / 360.0f); }
+
+Vec3 Camera::camera_direction(float px, float py) const {
+  const float t = tan_half_fov();
+  const float sx = (2.0f * px / static_cast<float>(width) - 1.0f) * t * aspect();
+  const float sy = (1.0f - 2.0f * py / static_cast<float>(height)) * t;
+  return {sx, sy, -1.0f};
+}
+
+Vec2 Camera::project(Vec3 p) const {
+  const float t = tan_half_fov();
+  const float sx = p.x / (-p.z) / (t * aspect());
+  const float sy = p.y / (-p.z) / t;
+  return {(sx + 1.0f) * 0.5f * static_cast<float>(width), (1.0f - sy) * 0.5f * static_cast<float>(height)};
+}
+
+Vec3 Camera::world_to_camera_point(Vec3 p) const { return basis().to_local(p - eye); }
+Vec3 Camera::camera_to_world_point(Vec3 p) const { return basis().to_world(p) + eye; }
+Vec3 Camera::world_to_camera_vector(Vec3 v) const { return basis().to_local(v); }
+Vec3 Camera::camera_to_world_vector(Vec3 v) const { return basis().to_world(v); }
+
+Camera frame_bounds(const Bounds3& bounds, Vec3 direction, float vertical_fov_deg, int width, int height) {
+  Camera c;
+  c.vertical_fov_deg = vertical_fov_deg;
+  c.width = width;
+  c.height = height;
+  const Vec3 dir = normalize(direction);
+  const float radius = std::max(bounds.diagonal() * 0.5f, 1e-6f);
+  const float half_v = vertical_fov_deg * kPi / 360.0f;
+  const float half_h = std::atan(std::tan(half_v) * c.aspect());
+  const float half = std::min(half_v, half_h);
+  // Distance at which the bounding sphere just fits the narrower half-angle, plus a small margin.
+  const float distance = 1.05f * radius / std::sin(half);
+  c.target = bounds.center();
+  c.eye = c.target + dir * distance;
+  c.up = std::abs(dir.y) > 0.999f ? Vec3{0, 0, -1} : Vec3{0, 1, 0};
+  return c;
+}
+
+}  // namespace ao

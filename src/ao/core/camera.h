@@ -1,0 +1,41 @@
+// Pinhole camera. Camera space is right-handed and looks down -z, with +x right and +y up in
+// the image; pixel (0,0) is the top-left corner of the image and pixel centres sit at +0.5.
+#pragma once
+
+#include "ao/core/math.h"
+
+namespace ao {
+
+struct Camera {
+  Vec3 eye{0, 0, 5};                ///< Centre of projection, world units.
+  Vec3 target{0, 0, 0};             ///< Point looked at, world units; must differ from eye.
+  Vec3 up{0, 1, 0};                 ///< Approximate up direction; must not be parallel to target - eye.
+  float vertical_fov_deg = 45.0f;   ///< Full vertical field of view, degrees, in (0, 180).
+  int width = 1280;                 ///< Image width, pixels, >= 1.
+  int height = 720;                 ///< Image height, pixels, >= 1.
+
+  /// Throws InputError naming the bad field (degenerate look-at, fov out of range, absurd size).
+  void validate() const;
+
+  /// Orthonormal camera basis in world space: x right, y up, z backwards (camera looks down -z).
+  Frame basis() const;
+  /// tan(vertical_fov / 2).
+  float tan_half_fov() const;
+  float aspect() const { return static_cast<float>(width) / static_cast<float>(height); }
+
+  /// Camera-space direction (not normalised, z = -1) through continuous pixel coordinate (px, py).
+  Vec3 camera_direction(float px, float py) const;
+  /// Continuous pixel coordinate of a camera-space point in front of the camera (p.z < 0).
+  Vec2 project(Vec3 p_camera) const;
+
+  Vec3 world_to_camera_point(Vec3 p) const;
+  Vec3 camera_to_world_point(Vec3 p) const;
+  Vec3 world_to_camera_vector(Vec3 v) const;
+  Vec3 camera_to_world_vector(Vec3 v) const;
+};
+
+/// Camera that frames the bounds: looks at their centre from `direction` (world, need not be unit)
+/// at the distance where the bounding sphere fills the smaller field of view.
+Camera frame_bounds(const Bounds3& bounds, Vec3 direction, float vertical_fov_deg, int width, int height);
+
+}  // namespace ao

@@ -1,0 +1,37 @@
+// GBuffer: what every screen-space method reads. One entry per pixel, all in camera space
+// (right-handed, looking down -z; see camera.h).
+#pragma once
+
+#include <cstdint>
+
+#include "ao/core/camera.h"
+#include "ao/core/image.h"
+#include "ao/core/math.h"
+
+namespace ao {
+
+struct GBuffer {
+  Camera camera;              ///< Intrinsics (fov, size) and, when known, the world placement.
+  Image<Vec3> position;       ///< Camera-space position of the visible surface; (0,0,0) where not covered.
+  Image<float> depth;         ///< Linear depth = -position.z (> 0); +infinity where not covered.
+  Image<Vec3> normal;         ///< Unit camera-space shading normal, facing the camera; (0,0,0) where not covered.
+  Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered.
+  Image<std::uint32_t> object_id;  ///< 1 + index of the mesh in its scene; 0 where not covered.
+  Image<std::uint8_t> coverage;    ///< 1 where a surface is visible, 0 for background.
+
+  GBuffer() = default;
+  explicit GBuffer(const Camera& cam)
+      : camera(cam),
+        position(cam.width, cam.height),
+        depth(cam.width, cam.height, kInfinity),
+        normal(cam.width, cam.height),
+        albedo(cam.width, cam.height),
+        object_id(cam.width, cam.height, 0u),
+        coverage(cam.width, cam.height, std::uint8_t{0}) {}
+
+  int width() const { return camera.width; }
+  int height() const { return camera.height; }
+  bool covered(int x, int y) const { return coverage(x, y) != 0; }
+};
+
+}  // namespace ao

@@ -1,0 +1,105 @@
+#include "ao/gbuffer/render_gbuffer.h"
+
+#include <array>
+
+#include "ao/core/parallel.h"
+#include "ao/reference/packets.h"
+
+namespace ao {
+
+namespace {
+
+constexpr int kTile = 32;  // pixels per tile side: a tile is one TBB task
+
+// Writes the G-buffer entry of pixel (x, y) for a hit on triangle `prim` of mesh `geom` at
+// barycentric (u, v), or leaves the background values when geom is invalid.
+void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, GBuffer& g, int x, int y, unsigned geom, unsigned prim, float u,
+               float v) {
+  if (geom == RTC_INVALID_GEOMETRY_ID) return;
+  const Mesh& m = scene.meshes[geom];
+  const std::uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1], i2 = m.indices[3 * prim + 2];
+  const float w = 1.0f - u - v;
+  // Interpolating the vertices puts the point on the triangle to float rounding, which is more
+  // accurate than eye + t * direction far from the camera.
+  const Vec3 p = m.positions[i0] * w + m.positions[i1] * u + m.positions[i2] * v;
+  const Vec3 pc = basis.to_local(p - cam.eye);
+  Vec3 ng = basis.to_local(normalize(cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0])));
+  Vec3 ns = basis.to_local(normalize(m.normals[i0] * w + m.normals[i1] * u + m.normals[i2] * v));
+  // Both sides of a surface can be seen (open meshes, rooms): AO is for the side facing the
+  // viewer, so turn the geometric normal towards the camera and the shading normal onto its side.
+  if (dot(ng, pc) > 0) ng = -ng;
+  if (dot(ns, ng) < 0) ns = -ns;
+  if (!(length(ns) > 0.5f)) ns = ng;
+  g.position(x, y) = pc;
+  g.depth(x, y) = -pc.z;
+  g.normal(x, y) = ns;
+  g.albedo(x, y) = m.albedo;
+  g.object_id(x, y) = geom + 1;
+  g.coverage(x, y) = 1;
+}
+
+template <int N>
+void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, GBuffer& g, const Tile& t) {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  const Scene& scene = rs.scene();
+  if constexpr (N == 1) {
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        const Vec3 d = basis.to_world(cam.camera_direction(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f));
+        RTCRayHit rh{};
+        rh.ray = {cam.eye.x, cam.eye.y, cam.eye.z, 0.0f, d.x, d.y, d.z, 0.0f, kInfinity, 0xffffffffu, 0, 0};
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(rs.handle(), &ctx, &rh);
+        shade_hit(scene, cam, basis, g, x, y, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+      }
+  } else {
+    // Blocks of 4 x (N/4) pixels: square-ish footprints keep the packet's rays coherent.
+    constexpr int bw = 4, bh = N / 4;
+    alignas(64) typename detail::Packet<N>::RayHit rh;
+    alignas(64) std::array<int, N> valid;
+    for (int by = t.y0; by < t.y1; by += bh)
+      for (int bx = t.x0; bx < t.x1; bx += bw) {
+        for (int k = 0; k < N; ++k) {
+          const int x = bx + k % bw, y = by + k / bw;
+          valid[k] = (x < t.x1 && y < t.y1) ? -1 : 0;
+          const Vec3 d = basis.to_world(cam.camera_direction(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f));
+          rh.ray.org_x[k] = cam.eye.x;
+          rh.ray.org_y[k] = cam.eye.y;
+          rh.ray.org_z[k] = cam.eye.z;
+          rh.ray.dir_x[k] = d.x;
+          rh.ray.dir_y[k] = d.y;
+          rh.ray.dir_z[k] = d.z;
+          rh.ray.tnear[k] = 0.0f;
+          rh.ray.tfar[k] = kInfinity;
+          rh.ray.time[k] = 0.0f;
+          rh.ray.mask[k] = 0xffffffffu;
+          rh.ray.id[k] = static_cast<unsigned>(k);
+          rh.ray.flags[k] = 0;
+          rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        detail::Packet<N>::intersect(valid.data(), rs.handle(), &ctx, &rh);
+        for (int k = 0; k < N; ++k)
+          if (valid[k]) shade_hit(scene, cam, basis, g, bx + k % bw, by + k / bw, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
+      }
+  }
+}
+
+}  // namespace
+
+GBuffer render_gbuffer(const RayScene& rs, const Camera& camera, const ProgressFn& progress) {
+  camera.validate();
+  GBuffer g(camera);
+  const Frame basis = camera.basis();
+  ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);
+  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
+    parallel_for_tiles(camera.width, camera.height, kTile, [&](const Tile& t) {
+      render_tile<N>(rs, camera, basis, g, t);
+      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
+    });
+  });
+  return g;
+}
+
+}  // namespace ao

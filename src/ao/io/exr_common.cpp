@@ -1,0 +1,150 @@
+#include "ao/io/exr_common.h"
+
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStdIO.h>
+
+#include <cstring>
+#include <fstream>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/io/atomic_file.h"
+
+namespace ao::io_detail {
+
+namespace fs = std::filesystem;
+
+std::string one_line(std::string_view message) {
+  std::string out;
+  out.reserve(message.size());
+  bool pending_separator = false;
+  for (const char c : message) {
+    if (c == '\n' || c == '\r') {
+      pending_separator = !out.empty();
+      continue;
+    }
+    if ((c == ' ' || c == '\t') && (out.empty() || out.back() == ' ')) continue;
+    if (pending_separator) {
+      while (!out.empty() && out.back() == ' ') out.pop_back();
+      if (!out.empty() && out.back() != '.' && out.back() != ';') out += ';';
+      out += ' ';
+      pending_separator = false;
+      if (c == ' ' || c == '\t') continue;
+    }
+    out += (c == '\t') ? ' ' : c;
+  }
+  while (!out.empty() && (out.back() == ' ' || out.back() == ';')) out.pop_back();
+  return out;
+}
+
+void require_input_file(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw InputError(path.string() + ": file does not exist");
+  if (fs::is_directory(status)) throw InputError(path.string() + ": is a directory, not a file");
+  if (!fs::is_regular_file(status)) throw InputError(path.string() + ": not a regular file");
+  const auto size = fs::file_size(path, ec);
+  if (ec) throw InputError(path.string() + ": cannot read: " + ec.message());
+  if (size == 0) throw InputError(path.string() + ": file is empty");
+}
+
+void check_image_size(const fs::path& path, std::int64_t width, std::int64_t height, std::string_view what) {
+  if (width < 1 || height < 1)
+    throw InputError(path.string() + ": " + std::string(what) + " is empty (" + std::to_string(width) + "x" +
+                     std::to_string(height) + ")");
+  if (width > kMaxImageSide || height > kMaxImageSide || width * height > kMaxImagePixels)
+    throw InputError(path.string() + ": " + std::string(what) + " of " + std::to_string(width) + "x" +
+                     std::to_string(height) + " pixels exceeds the limit of " + std::to_string(kMaxImageSide) +
+                     " per side and 2^28 pixels");
+}
+
+std::string read_magic(const fs::path& path, std::size_t count) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open for reading");
+  std::string bytes(count, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(count));
+  bytes.resize(static_cast<std::size_t>(in.gcount()));
+  return bytes;
+}
+
+bool is_exr_magic(std::string_view magic) { return magic.size() >= 4 && magic.substr(0, 4) == std::string_view("\x76\x2f\x31\x01", 4); }
+
+bool is_png_magic(std::string_view magic) {
+  return magic.size() >= 8 && magic.substr(0, 8) == std::string_view("\x89PNG\r\n\x1a\n", 8);
+}
+
+ExrWindows exr_windows(const Imf::Header& header, const fs::path& path) {
+  const Imath::Box2i& display = header.displayWindow();
+  const Imath::Box2i& data = header.dataWindow();
+  // 64-bit arithmetic: a hostile header can hold bounds whose difference overflows int.
+  const auto extent = [](int lo, int hi) { return std::int64_t{hi} - std::int64_t{lo} + 1; };
+  check_image_size(path, extent(display.min.x, display.max.x), extent(display.min.y, display.max.y), "display window");
+  check_image_size(path, extent(data.min.x, data.max.x), extent(data.min.y, data.max.y), "data window");
+  ExrWindows w;
+  w.width = display.max.x - display.min.x + 1;
+  w.height = display.max.y - display.min.y + 1;
+  w.display_x0 = display.min.x;
+  w.display_y0 = display.min.y;
+  w.data_x0 = data.min.x;
+  w.data_y0 = data.min.y;
+  w.data_x1 = data.max.x;
+  w.data_y1 = data.max.y;
+  return w;
+}
+
+void read_exr_channels(Imf::InputFile& file, const ExrWindows& w, std::span<const ExrChannelTarget> targets) {
+  constexpr std::size_t kSample = 4;  // FLOAT and UINT are both 4 bytes
+  const std::size_t data_w = static_cast<std::size_t>(w.data_x1 - w.data_x0 + 1);
+  const std::size_t data_h = static_cast<std::size_t>(w.data_y1 - w.data_y0 + 1);
+  const Imath::Box2i data_box({w.data_x0, w.data_y0}, {w.data_x1, w.data_y1});
+
+  // Read the data window into buffers of its own size, then copy the overlap with the display
+  // window: the two may be offset or differ in size (compositors crop to the bounding box).
+  std::vector<std::vector<unsigned char>> buffers(targets.size());
+  Imf::FrameBuffer frame;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    buffers[i].assign(data_w * data_h * kSample, 0);
+    frame.insert(targets[i].name, Imf::Slice::Make(targets[i].type, buffers[i].data(), data_box, kSample, kSample * data_w));
+  }
+  file.setFrameBuffer(frame);
+  file.readPixels(w.data_y0, w.data_y1);
+
+  const int x0 = std::max(w.data_x0, w.display_x0);
+  const int x1 = std::min(w.data_x1, w.display_x0 + w.width - 1);
+  const int y0 = std::max(w.data_y0, w.display_y0);
+  const int y1 = std::min(w.data_y1, w.display_y0 + w.height - 1);
+  if (x0 > x1 || y0 > y1) return;  // no overlap: everything stays at the caller's fill value
+  const std::size_t row_bytes = static_cast<std::size_t>(x1 - x0 + 1) * kSample;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    auto* out = static_cast<unsigned char*>(targets[i].out);
+    for (int y = y0; y <= y1; ++y) {
+      const std::size_t src = (static_cast<std::size_t>(y - w.data_y0) * data_w + static_cast<std::size_t>(x0 - w.data_x0)) * kSample;
+      const std::size_t dst = (static_cast<std::size_t>(y - w.display_y0) * static_cast<std::size_t>(w.width) +
+                               static_cast<std::size_t>(x0 - w.display_x0)) * kSample;
+      std::memcpy(out + dst, buffers[i].data() + src, row_bytes);
+    }
+  }
+}
+
+void write_exr_atomically(const fs::path& path, const Imf::Header& header, const Imf::FrameBuffer& frame) {
+  write_file_atomically(path, [&](const fs::path& temp) {
+    // Our own stream rather than a file name: OutputFile's destructor writes the line-offset
+    // table and swallows any error, so only the stream's state after closing tells us whether
+    // the whole file reached the disk (a full disk shows up here).
+    std::ofstream os(temp, std::ios::binary | std::ios::trunc);
+    if (!os) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+    try {
+      Imf::StdOFStream stream(os, temp.c_str());
+      Imf::OutputFile out(stream, header);
+      out.setFrameBuffer(frame);
+      const Imath::Box2i& data = header.dataWindow();
+      out.writePixels(data.max.y - data.min.y + 1);
+    } catch (const std::exception& e) {
+      throw SystemError(path.string() + ": cannot write OpenEXR file: " + one_line(e.what()));
+    }
+    os.close();
+    if (!os) throw SystemError(path.string() + ": write failed (disk full?)");
+  });
+}
+
+}  // namespace ao::io_detail

@@ -1,0 +1,281 @@
+#include "ao/io/gbuffer_exr.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFloatAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfMatrixAttribute.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfVecAttribute.h>
+
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/io/exr_common.h"
+
+namespace ao {
+
+namespace fs = std::filesystem;
+using namespace io_detail;
+
+static_assert(sizeof(Vec3) == 3 * sizeof(float), "Vec3 images are handed to OpenEXR as interleaved floats");
+
+namespace {
+
+constexpr const char* kFovAttribute = "ao:verticalFov";
+constexpr const char* kEyeAttribute = "ao:eye";
+constexpr const char* kTargetAttribute = "ao:target";
+constexpr const char* kUpAttribute = "ao:up";
+// Albedo of pixels whose file has no albedo channels: a mid-light grey, neither black (which would
+// remove the bounce term of ambient transfer) nor white.
+constexpr float kDefaultAlbedo = 0.8f;
+
+Imath::V3f to_imath(Vec3 v) { return {v.x, v.y, v.z}; }
+Vec3 from_imath(const Imath::V3f& v) { return {v.x, v.y, v.z}; }
+
+// OpenEXR's worldToCamera maps world points to a left-handed camera space looking down +z
+// (RenderMan's), and Imath multiplies row vectors (p' = p * M, translation in the last row).
+// Ours looks down -z, so its third axis is our basis().z negated.
+Imath::M44f world_to_camera_matrix(const Camera& camera) {
+  const Frame f = camera.basis();
+  const Vec3 axes[3] = {f.t, f.b, -f.n};
+  Imath::M44f m;  // identity
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) m[i][j] = axes[j][i];
+    m[3][j] = -dot(camera.eye, axes[j]);
+  }
+  return m;
+}
+
+// Inverse of world_to_camera_matrix for any rigid (or uniformly scaled) matrix from a renderer.
+bool camera_from_matrix(const Imath::M44f& world_to_camera, Camera& camera) {
+  const Imath::M44f to_world = world_to_camera.inverse();  // identity if singular: caught below
+  const Vec3 eye{to_world[3][0], to_world[3][1], to_world[3][2]};
+  const Vec3 up{to_world[1][0], to_world[1][1], to_world[1][2]};
+  const Vec3 forward{to_world[2][0], to_world[2][1], to_world[2][2]};
+  if (!is_finite(eye) || !is_finite(up) || !is_finite(forward) || length(forward) <= 0) return false;
+  camera.eye = eye;
+  camera.target = eye + normalize(forward);
+  camera.up = normalize(up);
+  return true;
+}
+
+template <class T>
+const T* find_attribute(const Imf::Header& header, const char* name) {
+  return header.findTypedAttribute<T>(name);
+}
+
+std::string format_vec(Vec3 v) {
+  std::ostringstream s;
+  s << '(' << v.x << ", " << v.y << ", " << v.z << ')';
+  return s.str();
+}
+
+[[noreturn]] void bad_pixel(const fs::path& path, int x, int y, const std::string& problem) {
+  throw InputError(path.string() + ": pixel (" + std::to_string(x) + ", " + std::to_string(y) + "): " + problem);
+}
+
+std::string channel_list(const Imf::ChannelList& channels) {
+  std::string names;
+  int count = 0;
+  for (auto it = channels.begin(); it != channels.end(); ++it, ++count) {
+    if (count == 12) return names + ", ...";  // keep the error on one readable line
+    if (!names.empty()) names += ", ";
+    names += it.name();
+  }
+  return names.empty() ? "none" : names;
+}
+
+// Camera placement and fov from the header. Returns whether the placement was in the file.
+bool read_camera(const Imf::Header& header, const fs::path& path, const GBufferReadOptions& opt, Camera& camera) {
+  bool placed = false;
+  const auto* eye = find_attribute<Imf::V3fAttribute>(header, kEyeAttribute);
+  const auto* target = find_attribute<Imf::V3fAttribute>(header, kTargetAttribute);
+  const auto* up = find_attribute<Imf::V3fAttribute>(header, kUpAttribute);
+  if (eye && target && up) {
+    camera.eye = from_imath(eye->value());
+    camera.target = from_imath(target->value());
+    camera.up = from_imath(up->value());
+    placed = true;
+  } else if (Imf::hasWorldToCamera(header)) {
+    if (!camera_from_matrix(Imf::worldToCamera(header), camera))
+      throw InputError(path.string() + ": worldToCamera attribute is not an invertible camera matrix");
+    placed = true;
+  } else {
+    // No placement: world space is camera space.
+    camera.eye = {0, 0, 0};
+    camera.target = {0, 0, -1};
+    camera.up = {0, 1, 0};
+  }
+
+  if (opt.vertical_fov_deg) {
+    camera.vertical_fov_deg = *opt.vertical_fov_deg;
+  } else if (const auto* f = find_attribute<Imf::FloatAttribute>(header, kFovAttribute)) {
+    camera.vertical_fov_deg = f->value();
+  } else if (const auto* d = find_attribute<Imf::DoubleAttribute>(header, kFovAttribute)) {
+    camera.vertical_fov_deg = static_cast<float>(d->value());
+  } else {
+    throw InputError(path.string() + ": no camera field of view (attribute " + kFovAttribute +
+                     "); pass the vertical field of view in degrees with --fov");
+  }
+  try {
+    camera.validate();
+  } catch (const InputError& e) {
+    throw InputError(path.string() + ": " + e.what());
+  }
+  return placed;
+}
+
+GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
+  Imf::InputFile file(path.c_str());
+  const Imf::Header& header = file.header();
+  const ExrWindows w = exr_windows(header, path);
+  const Imf::ChannelList& channels = header.channels();
+  for (auto it = channels.begin(); it != channels.end(); ++it)
+    if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+      throw InputError(path.string() + ": channel '" + it.name() + "' is subsampled, which is not supported");
+
+  const auto has = [&](const char* name) { return channels.findChannel(name) != nullptr; };
+  std::string missing;
+  for (const char* name : {"Z", "N.X", "N.Y", "N.Z"}) {
+    if (has(name)) continue;
+    if (!missing.empty()) missing += ' ';
+    missing += name;
+  }
+  if (!missing.empty())
+    throw InputError(path.string() + ": missing G-buffer channels " + missing + " (the file has: " + channel_list(channels) +
+                     "); at least Z and N.X N.Y N.Z are needed, see docs/gbuffer.md");
+
+  Camera camera;
+  camera.width = w.width;
+  camera.height = w.height;
+  const bool placed = read_camera(header, path, opt, camera);
+  if (opt.world_space && !placed)
+    throw InputError(path.string() + ": world-space passes need the camera placement (ao:eye/target/up or worldToCamera), "
+                     "and the file has none");
+
+  // Planes read from the file. Pixels outside the data window keep these fills: background.
+  const std::size_t n = static_cast<std::size_t>(w.width) * w.height;
+  const bool has_p = has("P.X") && has("P.Y") && has("P.Z");
+  const bool has_albedo = has("albedo.R") && has("albedo.G") && has("albedo.B");
+  const bool has_id = has("id");
+  const bool has_a = has("A");
+  std::vector<float> z(n, kInfinity), nx(n, 0.0f), ny(n, 0.0f), nz(n, 0.0f), px, py, pz, ar, ag, ab, a;
+  std::vector<std::uint32_t> id;
+  std::vector<ExrChannelTarget> targets = {{"Z", Imf::FLOAT, z.data()},
+                                           {"N.X", Imf::FLOAT, nx.data()},
+                                           {"N.Y", Imf::FLOAT, ny.data()},
+                                           {"N.Z", Imf::FLOAT, nz.data()}};
+  const auto add = [&](const char* name, std::vector<float>& plane) {
+    plane.assign(n, 0.0f);
+    targets.push_back({name, Imf::FLOAT, plane.data()});
+  };
+  if (has_p) {
+    add("P.X", px);
+    add("P.Y", py);
+    add("P.Z", pz);
+  }
+  if (has_albedo) {
+    add("albedo.R", ar);
+    add("albedo.G", ag);
+    add("albedo.B", ab);
+  }
+  if (has_a) add("A", a);
+  if (has_id) {
+    id.assign(n, 0u);
+    targets.push_back({"id", Imf::UINT, id.data()});
+  }
+  read_exr_channels(file, w, targets);
+
+  GBuffer g(camera);
+  const Frame basis = camera.basis();
+  for (int y = 0; y < w.height; ++y) {
+    for (int x = 0; x < w.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w.width + x;
+      const float depth = z[i];
+      const bool covered = has_a ? a[i] >= 0.5f : (std::isfinite(depth) && depth > 0.0f && depth < opt.background_depth);
+      if (!covered) continue;  // GBuffer(camera) already holds the background values
+      if (!(std::isfinite(depth) && depth > 0.0f))
+        bad_pixel(path, x, y, "covered (A >= 0.5) but depth Z = " + std::to_string(depth) + " is not finite and positive");
+
+      Vec3 normal{nx[i], ny[i], nz[i]};
+      Vec3 position = has_p ? Vec3{px[i], py[i], pz[i]} : camera.camera_direction(x + 0.5f, y + 0.5f) * depth;
+      if (opt.world_space) {
+        normal = basis.to_local(normal);
+        if (has_p) position = camera.world_to_camera_point(position);
+      }
+      if (!is_finite(normal) || length(normal) <= 0.0f) bad_pixel(path, x, y, "normal N = " + format_vec(normal) + " is not a finite, non-zero vector");
+      if (!is_finite(position)) bad_pixel(path, x, y, "position P = " + format_vec(position) + " is not finite");
+      const Vec3 albedo = has_albedo ? Vec3{ar[i], ag[i], ab[i]} : Vec3{kDefaultAlbedo, kDefaultAlbedo, kDefaultAlbedo};
+      if (!is_finite(albedo)) bad_pixel(path, x, y, "albedo = " + format_vec(albedo) + " is not finite");
+
+      g.position(x, y) = position;
+      g.depth(x, y) = depth;
+      g.normal(x, y) = normalize(normal);  // passes are often filtered or stored as half: renormalise
+      g.albedo(x, y) = albedo;
+      g.object_id(x, y) = has_id ? id[i] : 1u;
+      g.coverage(x, y) = 1;
+    }
+  }
+  return g;
+}
+
+}  // namespace
+
+void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWriteOptions& opt) {
+  const int width = g.width(), height = g.height();
+  const auto same_size = [&](const auto& image) { return image.width() == width && image.height() == height; };
+  if (width < 1 || height < 1 || !same_size(g.position) || !same_size(g.depth) || !same_size(g.normal) || !same_size(g.albedo) ||
+      !same_size(g.object_id) || !same_size(g.coverage))
+    throw InputError(path.string() + ": G-buffer images do not all match the camera's " + std::to_string(width) + "x" +
+                     std::to_string(height) + " pixels");
+
+  Imf::Header header(width, height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  if (opt.camera) {
+    Imf::addWorldToCamera(header, world_to_camera_matrix(g.camera));
+    header.insert(kFovAttribute, Imf::FloatAttribute(g.camera.vertical_fov_deg));
+    header.insert(kEyeAttribute, Imf::V3fAttribute(to_imath(g.camera.eye)));
+    header.insert(kTargetAttribute, Imf::V3fAttribute(to_imath(g.camera.target)));
+    header.insert(kUpAttribute, Imf::V3fAttribute(to_imath(g.camera.up)));
+  }
+
+  // Coverage is stored as a float alpha (what compositors expect in A), so it needs its own plane.
+  std::vector<float> alpha(g.coverage.size());
+  for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = g.coverage[i] != 0 ? 1.0f : 0.0f;
+
+  Imf::FrameBuffer frame;
+  const std::size_t w = static_cast<std::size_t>(width);
+  // OpenEXR's Slice takes a non-const pointer for reading and writing alike; writing only reads it.
+  const auto insert = [&](const char* name, Imf::PixelType type, const void* base, std::size_t x_stride) {
+    header.channels().insert(name, Imf::Channel(type));
+    frame.insert(name, Imf::Slice(type, static_cast<char*>(const_cast<void*>(base)), x_stride, x_stride * w));
+  };
+  const auto insert_vec3 = [&](const char* x, const char* y, const char* z, const Image<Vec3>& image) {
+    const float* base = reinterpret_cast<const float*>(image.data());
+    insert(x, Imf::FLOAT, base, sizeof(Vec3));
+    insert(y, Imf::FLOAT, base + 1, sizeof(Vec3));
+    insert(z, Imf::FLOAT, base + 2, sizeof(Vec3));
+  };
+  if (opt.positions) insert_vec3("P.X", "P.Y", "P.Z", g.position);
+  insert("Z", Imf::FLOAT, g.depth.data(), sizeof(float));
+  insert_vec3("N.X", "N.Y", "N.Z", g.normal);
+  if (opt.albedo) insert_vec3("albedo.R", "albedo.G", "albedo.B", g.albedo);
+  if (opt.object_ids) insert("id", Imf::UINT, g.object_id.data(), sizeof(std::uint32_t));
+  if (opt.coverage) insert("A", Imf::FLOAT, alpha.data(), sizeof(float));
+  write_exr_atomically(path, header, frame);
+}
+
+GBuffer read_gbuffer_exr(const fs::path& path, const GBufferReadOptions& opt) {
+  require_input_file(path);
+  if (!is_exr_magic(read_magic(path, 4))) throw InputError(path.string() + ": not an OpenEXR file");
+  return with_exr_errors(path, "not a readable OpenEXR file", [&] { return read_gbuffer(path, opt); });
+}
+
+}  // namespace ao

@@ -1,0 +1,368 @@
+#include "ao/io/image_io.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <png.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/io/atomic_file.h"
+#include "ao/io/exr_common.h"
+
+namespace ao {
+
+namespace fs = std::filesystem;
+using namespace io_detail;
+
+static_assert(sizeof(Vec3) == 3 * sizeof(float), "Vec3 images are handed to OpenEXR as interleaved floats");
+
+namespace {
+
+enum class Format { Exr, Png };
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Format output_format(const fs::path& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".exr") return Format::Exr;
+  if (ext == ".png") return Format::Png;
+  throw InputError(path.string() + ": unsupported image format '" + ext + "'; supported: " + supported_image_extensions());
+}
+
+// IEC 61966-2-1 transfer functions.
+float srgb_encode(float v) { return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f; }
+float srgb_decode(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+// ---------------------------------------------------------------------------------------------
+// libpng reports errors by longjmp. C++ allows longjmp only where a throw to the same place would
+// run no non-trivial destructors, so the functions that call setjmp below hold no C++ objects of
+// their own: buffers belong to their callers and are sized before or outside the jumps.
+
+struct PngMessage {
+  char text[256] = {};
+};
+
+void on_png_error(png_structp png, png_const_charp message) {
+  auto* m = static_cast<PngMessage*>(png_get_error_ptr(png));
+  std::snprintf(m->text, sizeof m->text, "%s", message);
+  png_longjmp(png, 1);
+}
+void on_png_warning(png_structp, png_const_charp) {}  // benign (bad ancillary chunks): ignore
+
+// Interleaved samples, big-endian when 16-bit, exactly as stored in PNG rows.
+struct PngPixels {
+  png_uint_32 width = 0, height = 0;
+  int channels = 0;  // 1 (grey) or 3 (RGB)
+  int bits = 0;      // 8 or 16
+  std::vector<unsigned char> bytes;
+  std::vector<png_bytep> rows;
+
+  void point_rows() {
+    const std::size_t stride = static_cast<std::size_t>(width) * channels * (bits / 8);
+    rows.resize(height);
+    for (png_uint_32 y = 0; y < height; ++y) rows[y] = bytes.data() + y * stride;
+  }
+};
+
+bool write_png_stream(std::FILE* fp, PngPixels& pixels, bool srgb, PngMessage& message) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, on_png_error, on_png_warning);
+  if (png == nullptr) return false;
+  png_infop info = png_create_info_struct(png);
+  if (info == nullptr) {
+    png_destroy_write_struct(&png, nullptr);
+    return false;
+  }
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, fp);
+  png_set_IHDR(png, info, pixels.width, pixels.height, pixels.bits, pixels.channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  if (srgb) png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  png_write_info(png, info);
+  png_write_image(png, pixels.rows.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+enum class PngReadResult { Ok, Corrupt, TooLarge, OutOfMemory };
+
+PngReadResult read_png_stream(std::FILE* fp, PngPixels& pixels, PngMessage& message) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &message, on_png_error, on_png_warning);
+  if (png == nullptr) return PngReadResult::OutOfMemory;
+  png_infop info = png_create_info_struct(png);
+  if (info == nullptr) {
+    png_destroy_read_struct(&png, nullptr, nullptr);
+    return PngReadResult::OutOfMemory;
+  }
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return PngReadResult::Corrupt;
+  }
+  png_init_io(png, fp);
+  png_read_info(png, info);
+  // Size check from the header, before libpng or we allocate anything in proportion to it.
+  const png_uint_32 w = png_get_image_width(png, info);
+  const png_uint_32 h = png_get_image_height(png, info);
+  if (w > kMaxImageSide || h > kMaxImageSide || std::int64_t{w} * h > kMaxImagePixels) {
+    pixels.width = w;
+    pixels.height = h;
+    png_destroy_read_struct(&png, &info, nullptr);
+    return PngReadResult::TooLarge;
+  }
+  // Normalise every colour type to grey or RGB at 8 or 16 bits: palettes and low bit depths are
+  // expanded, alpha is dropped (AO maps carry no meaning in it).
+  png_set_expand(png);
+  png_set_strip_alpha(png);
+  png_read_update_info(png, info);
+  pixels.width = w;
+  pixels.height = h;
+  pixels.channels = png_get_channels(png, info);
+  pixels.bits = png_get_bit_depth(png, info);
+  const bool supported = (pixels.channels == 1 || pixels.channels == 3) && (pixels.bits == 8 || pixels.bits == 16) &&
+                         png_get_rowbytes(png, info) == static_cast<std::size_t>(w) * pixels.channels * (pixels.bits / 8);
+  if (!supported) png_error(png, "unsupported pixel layout");
+  try {
+    pixels.bytes.resize(static_cast<std::size_t>(h) * png_get_rowbytes(png, info));
+    pixels.point_rows();
+  } catch (const std::bad_alloc&) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return PngReadResult::OutOfMemory;
+  }
+  png_read_image(png, pixels.rows.data());
+  png_read_end(png, nullptr);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return PngReadResult::Ok;
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+// Quantises samples (channels per pixel: 1 or 3) to PNG and writes atomically.
+void write_png(const fs::path& path, int width, int height, int channels, const float* samples, const ImageWriteOptions& opt) {
+  PngPixels pixels;
+  pixels.width = static_cast<png_uint_32>(width);
+  pixels.height = static_cast<png_uint_32>(height);
+  pixels.channels = channels;
+  pixels.bits = opt.png_bits;
+  const std::size_t count = static_cast<std::size_t>(width) * height * channels;
+  const float max_code = opt.png_bits == 16 ? 65535.0f : 255.0f;
+  pixels.bytes.resize(count * (opt.png_bits / 8));
+  for (std::size_t i = 0; i < count; ++i) {
+    // NaN compares false, so it lands on 0 here; the clamp is the documented PNG behaviour.
+    float v = samples[i] > 0.0f ? std::min(samples[i], 1.0f) : 0.0f;
+    if (opt.srgb) v = srgb_encode(v);
+    const auto code = static_cast<unsigned>(std::lround(v * max_code));
+    if (opt.png_bits == 16) {
+      pixels.bytes[2 * i] = static_cast<unsigned char>(code >> 8);  // PNG stores 16-bit samples big-endian
+      pixels.bytes[2 * i + 1] = static_cast<unsigned char>(code & 0xffu);
+    } else {
+      pixels.bytes[i] = static_cast<unsigned char>(code);
+    }
+  }
+  pixels.point_rows();
+
+  write_file_atomically(path, [&](const fs::path& temp) {
+    FilePtr fp(std::fopen(temp.c_str(), "wb"));
+    if (!fp) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+    PngMessage message;
+    if (!write_png_stream(fp.get(), pixels, opt.srgb, message))
+      throw SystemError(path.string() + ": cannot write PNG: " + one_line(message.text[0] ? message.text : "out of memory"));
+    const bool flushed = std::fflush(fp.get()) == 0 && std::ferror(fp.get()) == 0;
+    if (std::fclose(fp.release()) != 0 || !flushed) throw SystemError(path.string() + ": write failed (disk full?)");
+  });
+}
+
+PngPixels read_png(const fs::path& path) {
+  FilePtr fp(std::fopen(path.c_str(), "rb"));
+  if (!fp) throw InputError(path.string() + ": cannot open for reading");
+  PngPixels pixels;
+  PngMessage message;
+  switch (read_png_stream(fp.get(), pixels, message)) {
+    case PngReadResult::Ok:
+      return pixels;
+    case PngReadResult::TooLarge:
+      check_image_size(path, pixels.width, pixels.height, "image");  // throws with the sizes
+      throw InputError(path.string() + ": image too large");
+    case PngReadResult::OutOfMemory:
+      throw SystemError(path.string() + ": out of memory while reading");
+    case PngReadResult::Corrupt:
+      break;
+  }
+  // libpng reports a short file only as "Read Error"; the stream knows better.
+  if (std::feof(fp.get())) throw InputError(path.string() + ": truncated PNG: the file ends before the image does");
+  throw InputError(path.string() + ": corrupt PNG: " + one_line(message.text));
+}
+
+float png_sample(const PngPixels& p, std::size_t index, const ImageReadOptions& opt) {
+  const float v = p.bits == 16 ? static_cast<float>((p.bytes[2 * index] << 8) | p.bytes[2 * index + 1]) / 65535.0f
+                               : static_cast<float>(p.bytes[index]) / 255.0f;
+  return opt.srgb ? srgb_decode(v) : v;
+}
+
+// ---------------------------------------------------------------------------------------------
+// OpenEXR.
+
+void write_exr(const fs::path& path, int width, int height, std::span<const std::string> names, const float* samples) {
+  Imf::Header header(width, height);
+  header.compression() = Imf::ZIP_COMPRESSION;  // lossless, and what compositors expect
+  Imf::FrameBuffer frame;
+  const std::size_t channels = names.size();
+  const std::size_t x_stride = channels * sizeof(float);
+  for (std::size_t c = 0; c < channels; ++c) {
+    header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    // OpenEXR's Slice takes a non-const pointer for reading and writing alike; writing only reads it.
+    frame.insert(names[c], Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(samples + c)), x_stride,
+                                      x_stride * static_cast<std::size_t>(width)));
+  }
+  write_exr_atomically(path, header, frame);
+}
+
+// Channel read_image takes from an EXR: Y, else R, else the first in name order.
+std::string single_channel_name(const Imf::ChannelList& channels) {
+  if (channels.findChannel("Y") != nullptr) return "Y";
+  if (channels.findChannel("R") != nullptr) return "R";
+  return channels.begin().name();
+}
+
+void check_sampling(const Imf::ChannelList& channels, const fs::path& path) {
+  if (channels.begin() == channels.end()) throw InputError(path.string() + ": OpenEXR file has no channels");
+  for (auto it = channels.begin(); it != channels.end(); ++it)
+    if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+      throw InputError(path.string() + ": channel '" + it.name() + "' is subsampled, which is not supported");
+}
+
+Image<float> read_exr_single(const fs::path& path) {
+  return with_exr_errors(path, "not a readable OpenEXR file", [&] {
+    Imf::InputFile file(path.c_str());
+    const ExrWindows w = exr_windows(file.header(), path);
+    check_sampling(file.header().channels(), path);
+    Image<float> image(w.width, w.height, 0.0f);
+    const ExrChannelTarget target{single_channel_name(file.header().channels()), Imf::FLOAT, image.data()};
+    read_exr_channels(file, w, std::span(&target, 1));
+    return image;
+  });
+}
+
+Image<Vec3> read_exr_rgb(const fs::path& path) {
+  return with_exr_errors(path, "not a readable OpenEXR file", [&] {
+    Imf::InputFile file(path.c_str());
+    const ExrWindows w = exr_windows(file.header(), path);
+    const Imf::ChannelList& channels = file.header().channels();
+    check_sampling(channels, path);
+    Image<Vec3> image(w.width, w.height);
+    const bool has_rgb = channels.findChannel("R") || channels.findChannel("G") || channels.findChannel("B");
+    if (!has_rgb) {
+      Image<float> grey(w.width, w.height, 0.0f);
+      const ExrChannelTarget target{single_channel_name(channels), Imf::FLOAT, grey.data()};
+      read_exr_channels(file, w, std::span(&target, 1));
+      for (std::size_t i = 0; i < grey.size(); ++i) image[i] = {grey[i], grey[i], grey[i]};
+      return image;
+    }
+    std::vector<Image<float>> planes;
+    std::vector<ExrChannelTarget> targets;
+    planes.reserve(3);
+    for (const char* name : {"R", "G", "B"}) {
+      planes.emplace_back(w.width, w.height, 0.0f);  // a missing channel reads as 0
+      if (channels.findChannel(name)) targets.push_back({name, Imf::FLOAT, planes.back().data()});
+    }
+    read_exr_channels(file, w, targets);
+    for (std::size_t i = 0; i < image.size(); ++i) image[i] = {planes[0][i], planes[1][i], planes[2][i]};
+    return image;
+  });
+}
+
+// Checks the file and tells which reader to use, by content.
+Format input_format(const fs::path& path) {
+  require_input_file(path);
+  const std::string magic = read_magic(path, 8);
+  if (is_exr_magic(magic)) return Format::Exr;
+  if (is_png_magic(magic)) return Format::Png;
+  throw InputError(path.string() + ": not an image this tool reads (expected OpenEXR or PNG content)");
+}
+
+template <class T>
+void require_nonempty(const fs::path& path, const Image<T>& image) {
+  if (image.width() < 1 || image.height() < 1) throw InputError(path.string() + ": cannot write an empty image");
+}
+
+}  // namespace
+
+void ImageWriteOptions::validate() const {
+  if (png_bits != 8 && png_bits != 16) throw InputError("png_bits must be 8 or 16, got " + std::to_string(png_bits));
+  if (exr_channel.empty()) throw InputError("exr_channel must not be empty");
+}
+
+std::string supported_image_extensions() { return ".exr, .png"; }
+
+bool is_supported_image_path(const fs::path& path) {
+  const std::string ext = lower_extension(path);
+  return ext == ".exr" || ext == ".png";
+}
+
+void write_image(const fs::path& path, const Image<float>& image, const ImageWriteOptions& opt) {
+  const Format format = output_format(path);
+  opt.validate();
+  require_nonempty(path, image);
+  if (format == Format::Exr) {
+    const std::string name = opt.exr_channel;
+    write_exr(path, image.width(), image.height(), std::span(&name, 1), image.data());
+  } else {
+    write_png(path, image.width(), image.height(), 1, image.data(), opt);
+  }
+}
+
+void write_rgb_image(const fs::path& path, const Image<Vec3>& image, const ImageWriteOptions& opt) {
+  const Format format = output_format(path);
+  opt.validate();
+  require_nonempty(path, image);
+  const float* samples = reinterpret_cast<const float*>(image.data());
+  if (format == Format::Exr) {
+    const std::string names[] = {"R", "G", "B"};
+    write_exr(path, image.width(), image.height(), names, samples);
+  } else {
+    write_png(path, image.width(), image.height(), 3, samples, opt);
+  }
+}
+
+Image<float> read_image(const fs::path& path, const ImageReadOptions& opt) {
+  if (input_format(path) == Format::Exr) return read_exr_single(path);
+  const PngPixels p = read_png(path);
+  Image<float> image(static_cast<int>(p.width), static_cast<int>(p.height));
+  for (std::size_t i = 0; i < image.size(); ++i) image[i] = png_sample(p, i * p.channels, opt);  // grey, or R of RGB
+  return image;
+}
+
+Image<Vec3> read_rgb_image(const fs::path& path, const ImageReadOptions& opt) {
+  if (input_format(path) == Format::Exr) return read_exr_rgb(path);
+  const PngPixels p = read_png(path);
+  Image<Vec3> image(static_cast<int>(p.width), static_cast<int>(p.height));
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    if (p.channels == 1) {
+      const float v = png_sample(p, i, opt);
+      image[i] = {v, v, v};
+    } else {
+      image[i] = {png_sample(p, 3 * i, opt), png_sample(p, 3 * i + 1, opt), png_sample(p, 3 * i + 2, opt)};
+    }
+  }
+  return image;
+}
+
+}  // namespace ao

@@ -1,0 +1,68 @@
+// Image files: OpenEXR (float32, lossless) and PNG (8 or 16 bit). Writes are atomic
+// (atomic_file.h). Reads check the size before allocating and turn every library failure into an
+// InputError of one line that names the file.
+//
+// Conventions:
+// - EXR keeps floats exactly, NaN and infinity included (what they mean is the caller's business).
+//   A single-channel image is stored as the luminance channel `Y`, the name OpenEXR and compositors
+//   use for greyscale. Files are scanline, ZIP-compressed.
+// - PNG values are linear (values in [0,1] map to 0..255 or 0..65535) and carry no colour-space
+//   chunk, as AO maps and other data textures conventionally do; with `srgb` they are sRGB-encoded
+//   and tagged with an sRGB chunk. Values are clamped to [0,1] and NaN is written as 0.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "ao/core/image.h"
+#include "ao/core/math.h"
+
+namespace ao {
+
+/// How images are written.
+struct ImageWriteOptions {
+  int png_bits = 8;          ///< PNG sample depth: 8 or 16. Ignored for EXR.
+  bool srgb = false;         ///< PNG only: sRGB-encode the linear values (for viewing, not for data). Default linear.
+  std::string exr_channel = "Y";  ///< EXR channel name of single-channel images; non-empty. Ignored for RGB.
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+
+/// How images are read.
+struct ImageReadOptions {
+  bool srgb = false;  ///< PNG only: the stored values are sRGB-encoded; decode them to linear. Default: stored values as is.
+};
+
+/// Comma-separated list of the supported extensions (".exr, .png"), for errors and --help.
+std::string supported_image_extensions();
+/// True when `path` has an extension write_image understands (case-insensitive).
+bool is_supported_image_path(const std::filesystem::path& path);
+
+/// Writes single-channel values (visibility, error maps) to `.exr` or `.png`, chosen by the
+/// extension (case-insensitive). The image must not be empty. Throws InputError for an unknown
+/// extension (listing the supported ones), bad options or an empty image, and the errors of
+/// write_file_atomically; SystemError when the library fails to write.
+void write_image(const std::filesystem::path& path, const Image<float>& image, const ImageWriteOptions& opt = {});
+
+/// Writes RGB values (linear, nominally [0,1]; shaded images, contact sheets): EXR channels R, G, B
+/// (float32) or PNG RGB. Same rules as write_image.
+void write_rgb_image(const std::filesystem::path& path, const Image<Vec3>& image, const ImageWriteOptions& opt = {});
+
+/// Reads one channel as floats. The format is recognised by content, not by extension.
+/// - EXR: channel `Y`, else `R`, else the first channel in name order; pixel types are converted to
+///   float and values kept as stored. The image is the display window; pixels outside the data
+///   window read as 0, OpenEXR's convention.
+/// - PNG: greyscale value, or for colour images the red channel (glTF's occlusion-texture convention,
+///   so packed occlusion/roughness/metalness maps read correctly); alpha is ignored. Values are
+///   normalised to [0,1] and decoded from sRGB only when `opt.srgb`.
+/// Throws InputError naming the file and the problem: missing, empty, not an EXR or PNG, truncated
+/// or corrupt, more than 32768 pixels per side or 2^28 pixels (checked before allocating).
+Image<float> read_image(const std::filesystem::path& path, const ImageReadOptions& opt = {});
+
+/// Reads RGB values. EXR: channels R, G, B (a missing one reads as 0); a file with none of them
+/// repeats its single channel (as read_image chooses it) in all three. PNG: greyscale is repeated,
+/// alpha ignored. Otherwise as read_image.
+Image<Vec3> read_rgb_image(const std::filesystem::path& path, const ImageReadOptions& opt = {});
+
+}  // namespace ao

@@ -1,0 +1,481 @@
+// Mesh loading. Formats assimp reads well go through assimp; OFF has its own parser and PLY a
+// header check in front of assimp, because assimp 5.2's readers for them fail the SPEC's bad-input
+// rules. Measured with libassimp 5.2.5:
+//  - OFF: a face index past the vertex list loads without complaint, a header claiming 4e8 vertices
+//    allocates 7.8 GB and takes 24 s before failing, a file cut in the face list fails with
+//    "aiMesh::mFaces[2258].mIndices is nullptr", and JoinIdenticalVertices makes cow.off's 2904
+//    vertices 2903, so counts stop matching the header. OFF is a trivial format, so we parse it.
+//  - PLY: a file cut inside its header makes assimp loop forever; a header claiming 3e9 vertices
+//    ends in bad_alloc; an ASCII file missing its last faces loads with invented ones. We check the
+//    header and the size it implies before assimp sees the file.
+// Every other check (non-finite data, index ranges, degenerate triangles) is shared: raw assimp data
+// is checked before post-processing can merge or hide it, then validate_and_prepare runs on all.
+#include "ao/io/mesh_io.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+#include <vector>
+
+#include "ao/core/error.h"
+
+namespace ao {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
+
+/// Messages must be one line; assimp's sometimes are not.
+std::string one_line(std::string_view s) {
+  std::string out;
+  // assimp quotes file content in some messages: keep them printable and short.
+  for (char c : s.substr(0, 200)) out += std::isspace(static_cast<unsigned char>(c)) ? ' ' : std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+  while (!out.empty() && (out.back() == ' ' || out.back() == '.')) out.pop_back();
+  return s.size() > 200 ? out + "..." : out;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// Checks that the path is a readable, non-empty regular file and returns its contents.
+std::string read_whole_file(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!fs::exists(st)) fail(path, "no such file");
+  if (fs::is_directory(st)) fail(path, "is a directory, not a mesh file");
+  if (!fs::is_regular_file(st)) fail(path, "is not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot be opened for reading");
+  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) fail(path, "read error");
+  if (data.empty()) fail(path, "the file is empty");
+  return data;
+}
+
+/// Splits text into lines with '#' comments removed, remembering 1-based line numbers for messages.
+class LineReader {
+ public:
+  explicit LineReader(std::string_view text) : text_(text) {}
+
+  /// Next line that has a token, with comments stripped; false at the end of the text.
+  bool next(std::string_view& line) {
+    while (pos_ < text_.size()) {
+      const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
+      std::string_view l = text_.substr(pos_, end - pos_);
+      pos_ = end + 1;
+      ++line_number_;
+      l = l.substr(0, std::min(l.find('#'), l.size()));
+      if (l.find_first_not_of(" \t\r\f\v") != std::string_view::npos) {
+        line = l;
+        return true;
+      }
+    }
+    return false;
+  }
+  int line_number() const { return line_number_; }
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  int line_number_ = 0;
+};
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> tokens;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+  return tokens;
+}
+
+/// Text from the file for a message: printable and short even if the file is garbage.
+std::string printable(std::string_view token) {
+  std::string out;
+  for (char c : token.substr(0, 24)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+  return token.size() > 24 ? out + "..." : out;
+}
+std::string quote(std::string_view token) {
+  std::string out(1, '\'');  // appended piecewise: "'" + string trips GCC 12's false -Wrestrict
+  out += printable(token);
+  out += '\'';
+  return out;
+}
+
+template <class T>
+bool parse_number(std::string_view token, T& value) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if constexpr (std::is_floating_point_v<T>) {
+    if (first != last && *first == '+') ++first;  // from_chars rejects a leading '+', some writers emit it
+  }
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  return ec == std::errc() && ptr == last;
+}
+
+// ---------------------------------------------------------------------------------------------
+// OFF (Geomview): [C][N]OFF, counts "vertices faces [edges]", one vertex per line (x y z, then
+// nx ny nz for N, then a colour we ignore), one face per line ("n i0 ... in-1", then an ignored
+// colour). '#' starts a comment.
+
+bool looks_like_off(std::string_view data) {
+  const std::size_t start = data.find_first_not_of(" \t\r\n");
+  if (start == std::string_view::npos) return false;
+  const std::string_view head = data.substr(start, 8);
+  for (std::string_view kw : {"OFF", "COFF", "NOFF", "CNOFF", "STOFF", "4OFF", "nOFF"}) {
+    if (head.starts_with(kw) && (head.size() == kw.size() || std::isspace(static_cast<unsigned char>(head[kw.size()]))))
+      return true;
+  }
+  return false;
+}
+
+Scene read_off(const fs::path& path, std::string_view data) {
+  LineReader reader(data);
+  std::string_view line;
+  if (!reader.next(line)) fail(path, "the file has no OFF header");
+  std::vector<std::string_view> tokens = split(line);
+  const std::string keyword(tokens[0]);
+  if (!keyword.ends_with("OFF") || keyword.size() > 8) fail(path, "not an OFF file: it does not start with 'OFF'");
+  if (keyword != "OFF" && keyword != "COFF" && keyword != "NOFF" && keyword != "CNOFF")
+    fail(path, "unsupported OFF variant " + quote(keyword) + " (supported: OFF, COFF, NOFF, CNOFF)");
+  if (tokens.size() > 1 && tokens[1] == "BINARY") fail(path, "binary OFF is not supported, only text OFF");
+  const bool has_normals = keyword.find('N') != std::string::npos;
+
+  // Counts may follow the keyword on its line or stand on the next one.
+  tokens.erase(tokens.begin());
+  if (tokens.empty()) {
+    if (!reader.next(line)) fail(path, "truncated: the header has no vertex and face counts");
+    tokens = split(line);
+  }
+  if (tokens.size() < 2) fail(path, "line " + std::to_string(reader.line_number()) + ": expected vertex and face counts");
+  long long counts[2];
+  for (int k = 0; k < 2; ++k)
+    if (!parse_number(tokens[k], counts[k]))
+      fail(path, "line " + std::to_string(reader.line_number()) + ": " + quote(tokens[k]) + " is not a count");
+  const long long vertex_count = counts[0], face_count = counts[1];
+  if (vertex_count < 0 || face_count < 0)
+    fail(path, "header has negative counts (" + std::to_string(vertex_count) + " vertices, " + std::to_string(face_count) + " faces)");
+  // Check the counts against the size before allocating: the shortest vertex line is "0 0 0\n"
+  // (6 bytes) and the shortest face line "3 0 0 0\n" (8 bytes), so a hostile header cannot make us
+  // reserve more than a small multiple of the file size.
+  const long long min_bytes = 6 * vertex_count + 8 * face_count;  // counts are < 2^63 / 8 after the next check
+  if (vertex_count > std::numeric_limits<std::uint32_t>::max() || face_count > std::numeric_limits<std::uint32_t>::max() ||
+      min_bytes > static_cast<long long>(data.size()))
+    fail(path, "header says " + std::to_string(vertex_count) + " vertices and " + std::to_string(face_count) +
+             " faces but the file has only " + std::to_string(data.size()) + " bytes");
+
+  Mesh mesh;
+  mesh.name = path.stem().string();
+  mesh.positions.reserve(static_cast<std::size_t>(vertex_count));
+  if (has_normals) mesh.normals.reserve(static_cast<std::size_t>(vertex_count));
+  const std::size_t coords_per_vertex = has_normals ? 6 : 3;
+  for (long long v = 0; v < vertex_count; ++v) {
+    if (!reader.next(line))
+      fail(path, "truncated: expected " + std::to_string(vertex_count) + " vertices, found " + std::to_string(v));
+    tokens = split(line);
+    if (tokens.size() < coords_per_vertex)
+      fail(path, "line " + std::to_string(reader.line_number()) + ": vertex " + std::to_string(v) + " has " + std::to_string(tokens.size()) +
+               " numbers, expected " + std::to_string(coords_per_vertex));
+    float c[6];
+    for (std::size_t k = 0; k < coords_per_vertex; ++k) {
+      if (!parse_number(tokens[k], c[k])) {
+        // from_chars reports values beyond float range as out of range rather than as infinity.
+        double d = 0;
+        if (parse_number(tokens[k], d)) fail(path, "vertex " + std::to_string(v) + " has a non-finite coordinate (" + quote(tokens[k]) + ")");
+        fail(path, "line " + std::to_string(reader.line_number()) + ": vertex " + std::to_string(v) + ": " + quote(tokens[k]) + " is not a number");
+      }
+      if (!std::isfinite(c[k]))
+        fail(path, "vertex " + std::to_string(v) + " has a non-finite " + (k < 3 ? "coordinate" : "normal") + " (" + quote(tokens[k]) + ")");
+    }
+    mesh.positions.push_back({c[0], c[1], c[2]});
+    if (has_normals) mesh.normals.push_back({c[3], c[4], c[5]});
+  }
+
+  mesh.indices.reserve(static_cast<std::size_t>(face_count) * 3);
+  std::vector<std::uint32_t> face;
+  for (long long f = 0; f < face_count; ++f) {
+    if (!reader.next(line)) fail(path, "truncated: expected " + std::to_string(face_count) + " faces, found " + std::to_string(f));
+    tokens = split(line);
+    const std::string at = "line " + std::to_string(reader.line_number()) + ": face " + std::to_string(f);
+    long long n = 0;
+    if (!parse_number(tokens[0], n)) fail(path, at + ": " + quote(tokens[0]) + " is not a vertex count");
+    if (n < 3) fail(path, at + " has " + std::to_string(n) + " vertices, at least 3 are needed");
+    if (static_cast<long long>(tokens.size()) - 1 < n)
+      fail(path, at + " says " + std::to_string(n) + " vertices but lists " + std::to_string(tokens.size() - 1));
+    face.clear();
+    for (long long k = 1; k <= n; ++k) {
+      long long index = 0;
+      if (!parse_number(tokens[static_cast<std::size_t>(k)], index))
+        fail(path, at + ": " + quote(tokens[static_cast<std::size_t>(k)]) + " is not a vertex index");
+      if (index < 0 || index >= vertex_count)
+        fail(path, "face " + std::to_string(f) + " uses vertex " + std::to_string(index) + ", the file has " + std::to_string(vertex_count));
+      face.push_back(static_cast<std::uint32_t>(index));
+    }
+    // Fan triangulation keeps the face's winding; it is exact for the convex faces OFF writers emit.
+    for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+      mesh.indices.push_back(face[0]);
+      mesh.indices.push_back(face[k]);
+      mesh.indices.push_back(face[k + 1]);
+    }
+  }
+
+  Scene scene;
+  scene.name = path.filename().string();
+  scene.meshes.push_back(std::move(mesh));
+  validate_and_prepare(scene);
+  return scene;
+}
+
+// ---------------------------------------------------------------------------------------------
+// PLY header check (the data itself is left to assimp).
+
+bool looks_like_ply(std::string_view data) { return data.starts_with("ply\n") || data.starts_with("ply\r\n") || data.starts_with("PLY\n"); }
+
+/// Size in bytes of a PLY scalar type; 0 if unknown.
+int ply_type_size(std::string_view type) {
+  for (std::string_view t : {"char", "uchar", "int8", "uint8"})
+    if (type == t) return 1;
+  for (std::string_view t : {"short", "ushort", "int16", "uint16"})
+    if (type == t) return 2;
+  for (std::string_view t : {"int", "uint", "float", "int32", "uint32", "float32"})
+    if (type == t) return 4;
+  for (std::string_view t : {"double", "float64"})
+    if (type == t) return 8;
+  return 0;
+}
+
+void check_ply_header(const fs::path& path, std::string_view data) {
+  struct Element {
+    std::string name;
+    long long count = 0;
+    long long min_bytes = 0;  ///< Smallest possible size of one element in this file's encoding.
+  };
+  // A PLY header is a few hundred bytes; looking at the first 64 KiB bounds the work on garbage.
+  const std::size_t header_end = data.substr(0, 1 << 16).find("end_header");
+  // assimp 5.2.5 loops forever on a PLY file cut inside its header, so this check is not optional.
+  if (header_end == std::string_view::npos) fail(path, "truncated or malformed PLY header: no end_header line");
+  LineReader reader(data.substr(0, header_end));
+  std::string_view line;
+  std::string format;
+  std::vector<Element> elements;
+  while (reader.next(line)) {
+    const std::vector<std::string_view> t = split(line);
+    const std::string at = "PLY header line " + std::to_string(reader.line_number());
+    if (t[0] == "ply" || t[0] == "comment" || t[0] == "obj_info") {
+      continue;
+    } else if (t[0] == "format" && t.size() >= 2) {
+      format = std::string(t[1]);
+    } else if (t[0] == "element") {
+      Element e;
+      if (t.size() < 3 || !parse_number(t[2], e.count) || e.count < 0) fail(path, at + ": malformed element line");
+      if (e.count > std::numeric_limits<std::uint32_t>::max()) fail(path, at + ": absurd element count " + quote(t[2]));
+      e.name = printable(t[1]);
+      elements.push_back(e);
+    } else if (t[0] == "property") {
+      if (elements.empty()) fail(path, at + ": property before any element");
+      // ASCII: each value takes at least a digit and a separator. Binary: a list takes at least its
+      // count, a scalar its size.
+      const bool is_list = t.size() >= 2 && t[1] == "list";
+      const std::size_t type_at = is_list ? 2 : 1;
+      if (t.size() <= type_at + 1 || ply_type_size(t[type_at]) == 0) fail(path, at + ": malformed property line");
+      elements.back().min_bytes += format == "ascii" ? 2 : ply_type_size(t[type_at]);
+    } else {
+      // assimp skips a line it does not know, which for a damaged "property" line shifts every
+      // value after it (and once ended in an assertion abort); a damaged header is an error.
+      fail(path, at + ": unknown keyword " + quote(t[0]));
+    }
+  }
+  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+    fail(path, "PLY header has no valid format line");
+
+  const std::size_t body_start = std::min(data.find('\n', header_end), data.size() - 1) + 1;
+  const long long body_bytes = static_cast<long long>(data.size() - body_start);
+  long long min_bytes = 0, element_total = 0;
+  std::string summary;
+  for (const Element& e : elements) {
+    min_bytes += e.count * e.min_bytes;  // < 2^32 * 2^16 properties at most: no overflow
+    element_total += e.count;
+    summary += (summary.empty() ? "" : ", ") + std::to_string(e.count) + " x '" + e.name + "'";
+  }
+  if (min_bytes > body_bytes)
+    fail(path, "header declares " + summary + " elements but the data has only " + std::to_string(body_bytes) + " bytes");
+  if (format == "ascii") {
+    // ASCII PLY holds one element per line, so counting lines finds a truncated file exactly,
+    // which assimp does not notice.
+    LineReader body(data.substr(body_start));
+    long long lines = 0;
+    while (lines < element_total && body.next(line)) ++lines;
+    if (lines < element_total)
+      fail(path, "truncated: header declares " + summary + " elements (" + std::to_string(element_total) + " lines) but the file has " +
+                     std::to_string(lines) + " data lines");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// assimp
+
+Vec3 material_albedo(const aiMaterial& material, bool format_has_materials) {
+  const Vec3 fallback = Mesh{}.albedo;
+  if (!format_has_materials) return fallback;
+  aiString name;
+  // assimp invents "DefaultMaterial" (grey 0.6, or white) for files that name no material; that is
+  // not the author's colour, so the Mesh default applies.
+  if (material.Get(AI_MATKEY_NAME, name) == aiReturn_SUCCESS && std::string_view(name.C_Str()) == AI_DEFAULT_MATERIAL_NAME) return fallback;
+  aiColor4D c;
+  // glTF's baseColorFactor arrives as BASE_COLOR (and usually also DIFFUSE); prefer it where present.
+  if (material.Get(AI_MATKEY_BASE_COLOR, c) == aiReturn_SUCCESS || material.Get(AI_MATKEY_COLOR_DIFFUSE, c) == aiReturn_SUCCESS)
+    return {c.r, c.g, c.b};
+  return fallback;
+}
+
+/// Explains assimp's error in the user's terms where we recognise it; keeps assimp's words otherwise.
+std::string explain_assimp_error(std::string_view error) {
+  const std::string e = one_line(error);
+  if (e.find("No suitable reader found") != std::string::npos)
+    return "unknown or unreadable mesh format (supported: OBJ, PLY, OFF, STL, glTF/GLB and other formats assimp reads)";
+  if (e.find("bad_alloc") != std::string::npos) return "out of memory while reading: the file declares absurd sizes";
+  if (e.find("No meshes remaining") != std::string::npos) return "the file has no triangles, only points or lines";
+  if (e.find("mNumMeshes is 0") != std::string::npos) return "the file contains no meshes";
+  return "malformed or truncated file (" + e + ")";
+}
+
+std::string mesh_label(const aiMesh& m, unsigned index) {
+  return m.mName.length > 0 ? "mesh '" + std::string(m.mName.C_Str()) + "'" : "mesh " + std::to_string(index);
+}
+
+/// Faces without indices, and non-finite values, checked before JoinIdenticalVertices can merge or hide them (it joins NaN
+/// vertices with their neighbours, which turns the error into a "degenerate triangle").
+void check_raw_meshes(const fs::path& path, const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene.mMeshes[m];
+    const std::string where = scene.mNumMeshes > 1 ? " of " + mesh_label(mesh, m) : "";
+    // ValidateDataStructure lets faces with no indices through, and assimp's Triangulate step then
+    // aborts the process on an assertion (seen on a corrupted binary PLY), so they stop here.
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices == 0 || face.mIndices == nullptr) fail(path, "face " + std::to_string(f) + where + " has no vertices");
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= mesh.mNumVertices)
+          fail(path, "face " + std::to_string(f) + where + " uses vertex " + std::to_string(face.mIndices[k]) + ", the mesh has " +
+                         std::to_string(mesh.mNumVertices));
+    }
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      const aiVector3D p = mesh.mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        fail(path, "vertex " + std::to_string(v) + where + " has a non-finite coordinate");
+      if (mesh.HasNormals()) {
+        const aiVector3D n = mesh.mNormals[v];
+        if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
+          fail(path, "normal " + std::to_string(v) + where + " is not finite");
+      }
+      if (mesh.HasTextureCoords(0)) {
+        const aiVector3D t = mesh.mTextureCoords[0][v];
+        if (!std::isfinite(t.x) || !std::isfinite(t.y)) fail(path, "UV " + std::to_string(v) + where + " is not finite");
+      }
+    }
+  }
+}
+
+Scene read_with_assimp(const fs::path& path, std::string_view data) {
+  const std::string ext = lower(path.extension().string());
+  const bool is_stl = ext == ".stl" || data.starts_with("solid");
+  // STL, PLY and OFF carry no materials; assimp's stand-in colour for them is white.
+  const bool format_has_materials = !(is_stl || looks_like_ply(data));
+
+  Assimp::Importer importer;
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // STL stores one normal per facet, which would keep every triangle's corners apart; dropping them
+  // lets JoinIdenticalVertices weld the soup, and validate_and_prepare makes smooth normals.
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);
+
+  // Read with validation only, check the raw data, then post-process.
+  const aiScene* raw = nullptr;
+  try {
+    raw = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
+  } catch (const std::bad_alloc&) {
+    fail(path, explain_assimp_error("bad_alloc"));
+  } catch (const std::exception& e) {
+    fail(path, explain_assimp_error(e.what()));
+  }
+  if (raw == nullptr) fail(path, explain_assimp_error(importer.GetErrorString()));
+  check_raw_meshes(path, *raw);
+
+  // No GenNormals / GenSmoothNormals (validate_and_prepare makes normals), and no FindInvalidData or
+  // FixInfacingNormals, which would change the data without telling anyone.
+  unsigned steps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices | aiProcess_SortByPType;
+  if (is_stl) steps |= aiProcess_RemoveComponent;
+  const aiScene* ai = nullptr;
+  try {
+    ai = importer.ApplyPostProcessing(steps);
+  } catch (const std::exception& e) {
+    fail(path, explain_assimp_error(e.what()));
+  }
+  if (ai == nullptr) fail(path, explain_assimp_error(importer.GetErrorString()));
+
+  Scene scene;
+  scene.name = path.filename().string();
+  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+    const aiMesh& in = *ai->mMeshes[m];
+    if ((in.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+    Mesh mesh;
+    mesh.name = in.mName.C_Str();
+    mesh.positions.reserve(in.mNumVertices);
+    for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.positions.push_back({in.mVertices[v].x, in.mVertices[v].y, in.mVertices[v].z});
+    if (in.HasNormals()) {
+      mesh.normals.reserve(in.mNumVertices);
+      for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.normals.push_back({in.mNormals[v].x, in.mNormals[v].y, in.mNormals[v].z});
+    }
+    if (in.HasTextureCoords(0)) {
+      mesh.uvs.reserve(in.mNumVertices);
+      for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.uvs.push_back({in.mTextureCoords[0][v].x, in.mTextureCoords[0][v].y});
+    }
+    mesh.indices.reserve(static_cast<std::size_t>(in.mNumFaces) * 3);
+    for (unsigned f = 0; f < in.mNumFaces; ++f) {
+      const aiFace& face = in.mFaces[f];
+      if (face.mNumIndices != 3) continue;  // SortByPType leaves triangles only; be safe anyway
+      mesh.indices.insert(mesh.indices.end(), face.mIndices, face.mIndices + 3);
+    }
+    if (in.mMaterialIndex < ai->mNumMaterials) mesh.albedo = material_albedo(*ai->mMaterials[in.mMaterialIndex], format_has_materials);
+    scene.meshes.push_back(std::move(mesh));
+  }
+  if (scene.meshes.empty()) fail(path, "the file has no triangles");
+  validate_and_prepare(scene);
+  return scene;
+}
+
+}  // namespace
+
+Scene load_scene_file(const fs::path& path) {
+  // The whole file is read once up front: both our parsers need it, the size check for counts
+  // needs its length, and it is at most a copy of what assimp reads anyway.
+  const std::string data = read_whole_file(path);
+  const std::string ext = lower(path.extension().string());
+  if (ext == ".off" || looks_like_off(data)) return read_off(path, data);
+  if (ext == ".ply" || looks_like_ply(data)) {
+    if (!looks_like_ply(data)) fail(path, "not a PLY file: it does not start with 'ply'");
+    check_ply_header(path, data);
+  }
+  return read_with_assimp(path, data);
+}
+
+}  // namespace ao

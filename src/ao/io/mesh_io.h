@@ -1,0 +1,26 @@
+// Mesh files -> Scene. OFF is read by our own strict parser; everything else goes through assimp,
+// after a cheap header check for PLY (see mesh_io.cpp for why).
+#pragma once
+
+#include <filesystem>
+
+#include "ao/scene/mesh.h"
+
+namespace ao {
+
+/// Loads OBJ, PLY, OFF, STL, glTF/GLB (by content/extension, via assimp) into a Scene: one Mesh per
+/// assimp mesh (so per material), triangulated, with normals when the file has them, the first UV set,
+/// and the material's diffuse colour (or glTF baseColorFactor) as albedo. Node transforms are applied
+/// (pre-transform vertices). Calls validate_and_prepare. Throws InputError with one line naming the
+/// file and problem: missing/unreadable file, unknown format, truncated/malformed content, bad counts,
+/// NaN/inf, indices out of range, empty scene.
+///
+/// Details: OFF keeps the header's vertex count and order (faces of n > 3 vertices are fan-triangulated,
+/// which assumes convex faces); OFF, PLY and STL have no materials, so their albedo is the Mesh default
+/// 0.8, as is that of assimp's stand-in "DefaultMaterial" (an OBJ without .mtl); STL facet normals are
+/// discarded so the triangle soup can be welded into a connected mesh with smooth normals.
+/// Scene::name is the file name without its folder; Mesh::name is the file's mesh name (the file stem
+/// for OFF). The file's cameras are not read.
+Scene load_scene_file(const std::filesystem::path& path);
+
+}  // namespace ao

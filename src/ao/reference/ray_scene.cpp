@@ -1,0 +1,81 @@
+#include "ao/reference/ray_scene.h"
+
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <cstring>
+#include <string>
+
+#include <tbb/task_scheduler_observer.h>
+
+#include "ao/core/error.h"
+
+namespace ao {
+
+namespace {
+
+void on_embree_error(void* /*user*/, RTCError code, const char* message) {
+  // Embree reports allocation failures and API misuse here; they surface as SystemError from
+  // the calls below (rtcGetDeviceError), so nothing is thrown across Embree's C frames.
+  (void)code;
+  (void)message;
+}
+
+void check(RTCDevice device, const char* what) {
+  const RTCError e = rtcGetDeviceError(device);
+  if (e != RTC_ERROR_NONE) throw SystemError(std::string("embree: ") + what + " failed (error " + std::to_string(static_cast<int>(e)) + ")");
+}
+
+// Embree asks for flush-to-zero and denormals-are-zero on every thread that traces: denormal
+// arithmetic in traversal is slow. TBB's worker threads get it when they join the scheduler.
+void set_flush_to_zero() {
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+class FlushToZeroObserver : public tbb::task_scheduler_observer {
+ public:
+  FlushToZeroObserver() { observe(true); }
+  ~FlushToZeroObserver() override { observe(false); }
+  void on_scheduler_entry(bool /*worker*/) override { set_flush_to_zero(); }
+};
+
+}  // namespace
+
+RayScene::RayScene(const Scene& scene) : source_(scene), bounds_(scene.bounds()) {
+  static FlushToZeroObserver observer;
+  set_flush_to_zero();
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw SystemError("embree: cannot create a device (does this CPU support SSE2?)");
+  rtcSetDeviceErrorFunction(device_, on_embree_error, nullptr);
+  if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) packet_width_ = 16;
+  else if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) packet_width_ = 8;
+  else if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED)) packet_width_ = 4;
+
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& m = scene.meshes[i];
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Embree-owned buffers: Embree pads them so its SIMD loads may read past the last element.
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), m.positions.size()));
+    auto* t = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.triangle_count()));
+    check(device_, "allocating geometry buffers");
+    std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(Vec3));
+    std::memcpy(t, m.indices.data(), m.indices.size() * sizeof(unsigned));
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(scene_, geom, static_cast<unsigned>(i));
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(scene_);
+  check(device_, "building the BVH");
+}
+
+RayScene::~RayScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+}  // namespace ao

@@ -1,0 +1,52 @@
+// Indexed triangle meshes and scenes made of several of them.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ao/core/camera.h"
+#include "ao/core/math.h"
+
+namespace ao {
+
+/// One indexed triangle mesh with one material.
+struct Mesh {
+  std::string name;
+  std::vector<Vec3> positions;         ///< World units.
+  std::vector<Vec3> normals;           ///< Per vertex, unit; empty until generated or loaded.
+  std::vector<Vec2> uvs;               ///< Per vertex, first UV set; empty when the mesh has none.
+  std::vector<std::uint32_t> indices;  ///< Three per triangle, counter-clockwise seen from the front.
+  Vec3 albedo{0.8f, 0.8f, 0.8f};       ///< Diffuse albedo of the mesh's material, linear RGB in [0,1].
+
+  std::size_t triangle_count() const { return indices.size() / 3; }
+  Bounds3 bounds() const;
+};
+
+/// A scene: meshes, plus an optional camera the scene was designed to be seen from.
+struct Scene {
+  std::string name;                     ///< File name or built-in scene name, used in messages.
+  std::vector<Mesh> meshes;
+  std::optional<Camera> preferred_view; ///< Eye/target/up/fov only; size comes from the caller.
+  std::vector<std::string> warnings;    ///< Things fixed while loading (dropped triangles, ...).
+
+  Bounds3 bounds() const;
+  std::size_t triangle_count() const;
+  std::size_t vertex_count() const;
+};
+
+/// Smooth per-vertex normals, weighting each face normal by its angle at the vertex, for a mesh
+/// whose `normals` is empty. Vertices used by no triangle get +z.
+void generate_normals(Mesh& mesh);
+
+/// Checks and repairs a scene in place before it is used; `source` names it in messages.
+/// Throws InputError for non-finite coordinates or normals, indices out of range, an index count
+/// not divisible by 3, per-vertex arrays of the wrong length, and a scene with no triangle left.
+/// Drops degenerate (zero-area) triangles, since real meshes carry a few of them, adds a warning
+/// with their count, and generates normals where missing (unit length is restored where loaded
+/// normals are not).
+void validate_and_prepare(Scene& scene);
+
+}  // namespace ao

@@ -1,0 +1,125 @@
+#include "common.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+
+#include "ao/core/error.h"
+#include "ao/io/mesh_io.h"
+#include "ao/scene/procedural.h"
+
+namespace ao::cli {
+
+Scene load_scene_arguments(const std::vector<std::string>& args) {
+  if (args.empty()) return make_builtin_scene("default");
+  // A lone word that is not a file names a built-in scene (an unknown one gets the list of names).
+  const std::filesystem::path first(args[0]);
+  if (args.size() == 1 && !std::filesystem::exists(first) && !first.has_extension()) return make_builtin_scene(args[0]);
+  Scene merged;
+  for (const std::string& a : args) {
+    Scene s = load_scene_file(a);
+    merged.name += (merged.name.empty() ? "" : "+") + s.name;
+    for (Mesh& m : s.meshes) merged.meshes.push_back(std::move(m));
+    for (std::string& w : s.warnings) merged.warnings.push_back(std::move(w));
+  }
+  return merged;
+}
+
+Vec3 parse_vec3(const std::string& text, const char* option) {
+  std::istringstream in(text);
+  Vec3 v;
+  char c1 = 0, c2 = 0;
+  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
+    throw InputError(std::string(option) + ": expected three finite numbers as x,y,z, got '" + text + "'");
+  return v;
+}
+
+Camera choose_camera(const Scene& scene, const CameraOptions& opt) {
+  Camera cam;
+  if (scene.preferred_view) {
+    cam = *scene.preferred_view;
+  } else {
+    // Auto-framing: from the front, a little to the right and above, the usual product shot.
+    cam = frame_bounds(scene.bounds(), {0.55f, 0.5f, 1.0f}, opt.fov.value_or(40.0f), opt.width, opt.height);
+  }
+  cam.width = opt.width;
+  cam.height = opt.height;
+  if (opt.fov) cam.vertical_fov_deg = *opt.fov;
+  if (opt.up) cam.up = parse_vec3(*opt.up, "--up");
+  if (opt.target) cam.target = parse_vec3(*opt.target, "--target");
+  if (opt.eye) {
+    cam.eye = parse_vec3(*opt.eye, "--eye");
+  } else if (opt.target && !scene.preferred_view) {
+    // Keep the framing distance and direction, looking at the new target.
+    const Camera framed = frame_bounds(scene.bounds(), {0.55f, 0.5f, 1.0f}, cam.vertical_fov_deg, cam.width, cam.height);
+    cam.eye = cam.target + (framed.eye - framed.target);
+  }
+  cam.validate();
+  return cam;
+}
+
+Falloff choose_falloff(const FalloffOptions& opt, float scene_diagonal) {
+  const auto m = parse_membership(opt.membership);
+  if (!m) throw InputError("--membership: unknown '" + opt.membership + "' (known: " + membership_names() + ")");
+  if (!opt.radius && !(opt.radius_fraction > 0.0f && opt.radius_fraction <= 10.0f))
+    throw InputError("--radius-fraction must be in (0, 10]");
+  Falloff f{*m, opt.radius ? *opt.radius : opt.radius_fraction * scene_diagonal, opt.tau};
+  f.validate();
+  return f;
+}
+
+bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }
+
+struct ProgressBar::State {
+  std::string label;
+  bool enabled;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_draw{};
+  std::mutex mutex;
+  bool drawn = false;
+};
+
+ProgressBar::ProgressBar(std::string label, bool enabled) : state_(std::make_shared<State>()) {
+  state_->label = std::move(label);
+  state_->enabled = enabled;
+}
+
+ProgressBar::~ProgressBar() {
+  if (state_->drawn) std::fputs("\r\033[K", stderr);
+}
+
+ProgressFn ProgressBar::callback() {
+  if (!state_->enabled) return {};
+  return [s = state_](std::size_t done, std::size_t total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - s->start < std::chrono::seconds(1)) return;
+    std::unique_lock lock(s->mutex, std::try_to_lock);
+    if (!lock.owns_lock() || now - s->last_draw < std::chrono::milliseconds(100)) return;
+    s->last_draw = now;
+    s->drawn = true;
+    const double f = total > 0 ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+    const double elapsed = std::chrono::duration<double>(now - s->start).count();
+    const int width = 30, filled = static_cast<int>(f * width);
+    std::fprintf(stderr, "\r%s [%s%s] %3d%%  %.1fs, ~%.0fs left\033[K", s->label.c_str(), std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), static_cast<int>(f * 100), elapsed, f > 0 ? elapsed * (1 - f) / f : 0.0);
+    std::fflush(stderr);
+  };
+}
+
+double Stopwatch::lap_ms() {
+  const auto now = std::chrono::steady_clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - start_).count();
+  start_ = now;
+  return ms;
+}
+
+nlohmann::json to_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+nlohmann::json to_json(const Camera& c) {
+  return {{"eye", to_json(c.eye)}, {"target", to_json(c.target)}, {"up", to_json(c.up)}, {"fov", c.vertical_fov_deg}};
+}
+
+}  // namespace ao::cli

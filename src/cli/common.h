@@ -1,0 +1,70 @@
+// Pieces every subcommand shares: choosing the scene, the camera and R from options, the
+// progress bar, and timing.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/core/camera.h"
+#include "ao/core/membership.h"
+#include "ao/core/progress.h"
+#include "ao/scene/mesh.h"
+
+namespace ao::cli {
+
+/// Scene from positional arguments: none -> the built-in "default"; one built-in name (when no file
+/// of that name exists) -> that scene; otherwise mesh files, merged into one scene.
+Scene load_scene_arguments(const std::vector<std::string>& args);
+
+/// Camera options as given on the command line; unset ones come from the scene.
+struct CameraOptions {
+  std::optional<std::string> eye, target, up;  ///< "x,y,z" in world units.
+  std::optional<float> fov;                    ///< Vertical, degrees.
+  int width = 1280, height = 720;
+};
+/// The scene's preferred view if it has one, else auto-framing of its bounds from above and in
+/// front; any option given overrides the corresponding field. Validated.
+Camera choose_camera(const Scene& scene, const CameraOptions& opt);
+Vec3 parse_vec3(const std::string& text, const char* option);
+
+/// Falloff options: R in world units, or as a fraction of the scene diagonal.
+struct FalloffOptions {
+  std::string membership = "step";
+  std::optional<float> radius;    ///< World units.
+  float radius_fraction = 0.1f;   ///< Of the bounding-box diagonal, when radius is unset.
+  float tau = 0.0f;
+};
+Falloff choose_falloff(const FalloffOptions& opt, float scene_diagonal);
+
+/// A progress bar on stderr, shown only when stderr is a terminal, not --quiet, and the stage has
+/// run for over a second. Thread-safe; redraws at most ten times a second.
+class ProgressBar {
+ public:
+  ProgressBar(std::string label, bool enabled);
+  ~ProgressBar();
+  ProgressFn callback();
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+bool stderr_is_terminal();
+
+/// Wall-clock stopwatch in milliseconds.
+class Stopwatch {
+ public:
+  double lap_ms();  ///< Milliseconds since construction or the previous lap.
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+nlohmann::json to_json(Vec3 v);
+nlohmann::json to_json(const Camera& c);
+
+}  // namespace ao::cli

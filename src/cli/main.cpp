@@ -1,0 +1,48 @@
+// ao: ambient occlusion on the CPU. The only place errors become exit codes:
+//   0 success, 1 bad input (file, option value), 2 bad usage (unknown option, missing argument),
+//   3 system failure (disk, library), 4 internal error.
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <new>
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include "ao/core/error.h"
+#include "subcommands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app("ao: ambient occlusion on the CPU. Ray-traced ground truth and published AO methods.", "ao");
+  app.require_subcommand(1);
+  ao::cli::GlobalOptions global;
+  app.add_option("--threads", global.threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+  app.add_flag("-q,--quiet", global.quiet, "No progress bar");
+  std::function<int()> action;
+  ao::cli::add_render_command(app, global, action);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  std::unique_ptr<tbb::global_control> limit;
+  if (global.threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(global.threads));
+  try {
+    return action ? action() : 0;
+  } catch (const ao::InputError& e) {
+    std::fprintf(stderr, "ao: error: %s\n", e.what());
+    return 1;
+  } catch (const ao::SystemError& e) {
+    std::fprintf(stderr, "ao: error: %s\n", e.what());
+    return 3;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "ao: error: out of memory\n");
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ao: internal error: %s\n", e.what());
+    return 4;
+  }
+}

@@ -1,0 +1,190 @@
+// ao render: scene (or G-buffer EXR) -> AO image, with optional G-buffer, shaded image and JSON.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "ao/core/error.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/io/gbuffer_exr.h"
+#include "ao/io/image_io.h"
+#include "ao/methods/registry.h"
+#include "ao/reference/ray_scene.h"
+#include "common.h"
+#include "subcommands.h"
+
+namespace ao::cli {
+
+namespace {
+
+struct RenderOptions {
+  std::vector<std::string> scene;
+  std::string method = "raytraced";
+  std::string output;
+  std::string shaded;
+  std::string gbuffer_out;
+  std::string gbuffer_in;
+  CameraOptions camera;
+  FalloffOptions falloff;
+  int samples = 256;
+  float target_error = 0.0f;
+  std::uint32_t seed = 1;
+  int png_bits = 8;
+  bool json = false;
+};
+
+// Albedo x V x (ambient + soft key light): a picture for people, not data. The key light comes
+// from above-left of the camera; wrapping (n.l + w) / (1 + w) keeps faces turned away from it
+// from going black, so the AO stays readable everywhere.
+Image<Vec3> shade(const GBuffer& g, const Image<float>& v) {
+  const Vec3 light = normalize(Vec3{-0.4f, 0.8f, 0.45f});  // camera space
+  constexpr float kAmbient = 0.45f, kKey = 0.75f, kWrap = 0.5f;
+  Image<Vec3> out(g.width(), g.height(), Vec3{1, 1, 1});
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (!g.coverage[i]) continue;
+    const float wrap = std::max(0.0f, (dot(g.normal[i], light) + kWrap) / (1.0f + kWrap));
+    out[i] = g.albedo[i] * (v[i] * (kAmbient + kKey * wrap));
+  }
+  return out;
+}
+
+std::string default_output(const std::string& scene_name, const std::string& method) {
+  std::string stem = std::filesystem::path(scene_name).stem().string();
+  if (stem.empty()) stem = "gbuffer";
+  return stem + "-" + method + ".png";
+}
+
+int run_render(const RenderOptions& o, const GlobalOptions& global) {
+  Stopwatch clock;
+  nlohmann::json timings;
+  const bool progress = !global.quiet && stderr_is_terminal();
+  const MethodInfo& method = find_method(o.method);
+  if (!o.gbuffer_in.empty() && !o.scene.empty()) throw InputError("give either a scene or --gbuffer-in, not both");
+  if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
+  nlohmann::json params = method.default_params();
+  if (params.contains("samples")) params["samples"] = o.samples;
+  if (params.contains("target_error")) params["target_error"] = o.target_error;
+
+  std::optional<Scene> scene;
+  std::unique_ptr<RayScene> rays;
+  GBuffer g;
+  float diagonal = 0;
+  if (!o.gbuffer_in.empty()) {
+    g = read_gbuffer_exr(o.gbuffer_in, {.vertical_fov_deg = o.camera.fov});
+    timings["load_gbuffer_ms"] = clock.lap_ms();
+    Bounds3 b;
+    for (std::size_t i = 0; i < g.position.size(); ++i)
+      if (g.coverage[i]) b.extend(g.position[i]);
+    diagonal = b.diagonal();
+  } else {
+    scene = load_scene_arguments(o.scene);
+    for (const std::string& w : scene->warnings) std::cerr << "warning: " << w << "\n";
+    timings["load_ms"] = clock.lap_ms();
+    rays = std::make_unique<RayScene>(*scene);
+    timings["bvh_ms"] = clock.lap_ms();
+    const Camera cam = choose_camera(*scene, o.camera);
+    {
+      ProgressBar bar("G-buffer", progress);
+      g = render_gbuffer(*rays, cam, bar.callback());
+    }
+    timings["gbuffer_ms"] = clock.lap_ms();
+    diagonal = scene->bounds().diagonal();
+  }
+  const Falloff falloff = choose_falloff(o.falloff, diagonal);
+
+  MethodOutput result;
+  {
+    ProgressBar bar(std::string(method.name), progress);
+    result = method.run(MethodInput{g, rays.get(), falloff, o.seed, bar.callback()}, params);
+  }
+  const double ao_ms = clock.lap_ms();
+  timings["ao_ms"] = ao_ms;
+
+  const std::string output = o.output.empty() ? default_output(scene ? scene->name : o.gbuffer_in, o.method) : o.output;
+  const ImageWriteOptions write_opt{.png_bits = o.png_bits};
+  write_image(output, result.visibility, write_opt);
+  if (!o.shaded.empty()) write_rgb_image(o.shaded, shade(g, result.visibility), {.png_bits = o.png_bits, .srgb = true});
+  if (!o.gbuffer_out.empty()) write_gbuffer_exr(o.gbuffer_out, g);
+  timings["write_ms"] = clock.lap_ms();
+
+  double sum_v = 0;
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < g.coverage.size(); ++i)
+    if (g.coverage[i]) {
+      sum_v += result.visibility[i];
+      ++covered;
+    }
+  const double mean_v = covered ? sum_v / static_cast<double>(covered) : 1.0;
+
+  nlohmann::json summary = {
+      {"scene", scene ? scene->name : o.gbuffer_in},
+      {"method", method.name},
+      {"parameters", params},
+      {"membership", to_string(falloff.membership)},
+      {"radius", falloff.radius},
+      {"seed", o.seed},
+      {"width", g.width()},
+      {"height", g.height()},
+      {"camera", to_json(g.camera)},
+      {"covered_pixels", covered},
+      {"mean_visibility", mean_v},
+      {"timings", timings},
+      {"output", output},
+      {"stats", result.stats},
+  };
+  if (falloff.membership == Membership::Exp) summary["tau"] = falloff.effective_tau();
+  if (scene) {
+    summary["triangles"] = scene->triangle_count();
+    summary["warnings"] = scene->warnings;
+  }
+  if (result.stats.contains("rays") && ao_ms > 0)
+    summary["rays_per_second"] = result.stats["rays"].get<double>() / (ao_ms / 1000.0);
+  if (o.json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, R = %.4g (%s), mean V = %.4f, %.0f ms\n", output.c_str(), summary["scene"].get<std::string>().c_str(),
+                 std::string(method.name).c_str(), g.width(), g.height(), falloff.radius, std::string(to_string(falloff.membership)).c_str(), mean_v,
+                 ao_ms);
+    if (result.stats.contains("mean_std_error"))
+      std::fprintf(stderr, "  standard error: mean %.4f, max %.4f; %.1f M rays/s\n", result.stats["mean_std_error"].get<double>(),
+                   result.stats["max_std_error"].get<double>(), summary.value("rays_per_second", 0.0) / 1e6);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand("render", "Render an AO image of a scene (or of a G-buffer EXR).");
+  cmd->add_option("scene", o->scene, "Mesh file(s) (OBJ, PLY, OFF, STL, glTF/GLB) or a built-in scene: default, plane, wedge, sphere-on-plane, box-room")
+      ->type_name("SCENE");
+  cmd->add_option("-o,--output", o->output, "Visibility image: .png (linear, 8 or 16 bit) or .exr (float). Default: <scene>-<method>.png");
+  std::string methods;
+  for (const MethodInfo& m : all_methods()) methods += "\n  " + std::string(m.name) + ": " + std::string(m.summary);
+  cmd->add_option("-m,--method", o->method, "AO method:" + methods)->capture_default_str();
+  cmd->add_option("--membership", o->falloff.membership, "Falloff mu(d): " + membership_names())->capture_default_str();
+  cmd->add_option("-R,--radius", o->falloff.radius, "Neighbourhood radius R, world units (default: --radius-fraction x scene diagonal)");
+  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal, when --radius is not given")
+      ->capture_default_str();
+  cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
+  cmd->add_option("--spp,--samples", o->samples, "Rays per pixel (raytraced); the maximum with --target-error")->capture_default_str();
+  cmd->add_option("--target-error", o->target_error, "Stop a pixel once its standard error is below this (raytraced; 0 = off)")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
+  cmd->add_option("--width", o->camera.width, "Image width, pixels")->capture_default_str();
+  cmd->add_option("--height", o->camera.height, "Image height, pixels")->capture_default_str();
+  cmd->add_option("--fov", o->camera.fov, "Vertical field of view, degrees (default: the scene's, or 40)");
+  cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: auto-framed)");
+  cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
+  cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
+  cmd->add_option("--shaded", o->shaded, "Also write albedo x ambient x V with a soft key light, for viewing (sRGB)");
+  cmd->add_option("--gbuffer-out", o->gbuffer_out, "Also write the G-buffer as a multi-channel EXR (docs/gbuffer.md)");
+  cmd->add_option("--gbuffer-in", o->gbuffer_in, "Read the G-buffer from an EXR instead of rendering a scene (screen-space methods)");
+  cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
+  cmd->callback([o, &global, &action] { action = [o, &global] { return run_render(*o, global); }; });
+}
+
+}  // namespace ao::cli

@@ -1,0 +1,18 @@
+// Each subcommand registers its options and, when chosen, sets `action` to the work to run.
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace ao::cli {
+
+/// Options of `ao` itself, before the subcommand.
+struct GlobalOptions {
+  int threads = 0;     ///< Worker threads; 0 = all cores.
+  bool quiet = false;  ///< No progress bar.
+};
+
+void add_render_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);
+
+}  // namespace ao::cli

@@ -1,0 +1,75 @@
+#include "ao/core/sampling.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+namespace ao {
+namespace {
+
+TEST(Sampling, SobolPrefixIsStratifiedInEveryElementaryInterval) {
+  // A (0,2)-sequence: any 2^k consecutive-from-zero points put exactly one point in each cell of
+  // every 2^a x 2^b grid with a + b = k. Owen scrambling preserves this.
+  const int k = 8, n = 1 << k;
+  for (std::uint32_t seed : {0u, 1u, 12345u}) {
+    for (int a = 0; a <= k; ++a) {
+      const int cols = 1 << a, rows = 1 << (k - a);
+      std::set<int> cells;
+      for (int i = 0; i < n; ++i) {
+        const Vec2 u = sobol_owen_2d(static_cast<std::uint32_t>(i), seed);
+        ASSERT_GE(u.x, 0.0f);
+        ASSERT_LT(u.x, 1.0f);
+        cells.insert(static_cast<int>(u.x * cols) * rows + static_cast<int>(u.y * rows));
+      }
+      EXPECT_EQ(cells.size(), static_cast<std::size_t>(n)) << "seed " << seed << ", grid " << cols << "x" << rows;
+    }
+  }
+}
+
+TEST(Sampling, DifferentSeedsGiveDifferentPoints) {
+  EXPECT_NE(sobol_owen_2d(3, 1).x, sobol_owen_2d(3, 2).x);
+  EXPECT_EQ(sobol_owen_2d(3, 1).x, sobol_owen_2d(3, 1).x);
+}
+
+TEST(Sampling, CosineHemisphereHasCosineDensity) {
+  // E[cos theta] under pdf cos/pi is 2/3; E[cos^2] is 1/2. Every direction is a unit vector with z >= 0.
+  const int n = 1 << 14;
+  double m1 = 0, m2 = 0;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 d = cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(i), 7));
+    ASSERT_NEAR(length(d), 1.0f, 1e-5f);
+    ASSERT_GE(d.z, 0.0f);
+    m1 += d.z;
+    m2 += d.z * d.z;
+  }
+  EXPECT_NEAR(m1 / n, 2.0 / 3.0, 1e-3);
+  EXPECT_NEAR(m2 / n, 0.5, 1e-3);
+}
+
+TEST(Sampling, UniformSphereHasZeroMeanAndUnitLength) {
+  const int n = 1 << 14;
+  Vec3 sum{};
+  for (int i = 0; i < n; ++i) {
+    const Vec3 d = uniform_sphere(sobol_owen_2d(static_cast<std::uint32_t>(i), 3));
+    ASSERT_NEAR(length(d), 1.0f, 1e-5f);
+    sum += d;
+  }
+  EXPECT_NEAR(length(sum) / n, 0.0f, 2e-3f);
+}
+
+TEST(Sampling, FrameIsOrthonormalForAnyNormal) {
+  for (Vec3 n : {Vec3{0, 0, 1}, Vec3{0, 0, -1}, Vec3{1, 0, 0}, normalize(Vec3{1, -2, 3}), normalize(Vec3{1e-8f, 0, -1})}) {
+    const Frame f = Frame::from_normal(n);
+    EXPECT_NEAR(dot(f.t, f.b), 0.0f, 1e-6f);
+    EXPECT_NEAR(dot(f.t, f.n), 0.0f, 1e-6f);
+    EXPECT_NEAR(dot(f.b, f.n), 0.0f, 1e-6f);
+    EXPECT_NEAR(length(f.t), 1.0f, 1e-6f);
+    EXPECT_NEAR(length(f.b), 1.0f, 1e-6f);
+    // Right-handed: t x b = n.
+    EXPECT_NEAR(length(cross(f.t, f.b) - n), 0.0f, 1e-5f);
+  }
+}
+
+}  // namespace
+}  // namespace ao

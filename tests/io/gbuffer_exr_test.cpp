@@ -1,0 +1,277 @@
+// G-buffer EXR files: exact round trips with the camera, reconstruction of what compositors leave
+// out, and bad input.
+#include "ao/io/gbuffer_exr.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+
+#include "ao/core/error.h"
+#include "ao/io/image_io.h"
+
+namespace ao {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+ public:
+  TempDir() {
+    static int counter = 0;
+    path_ = fs::temp_directory_path() / ("ao-gbuffer-exr-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+Camera test_camera() {
+  Camera c;
+  c.eye = {1.0f, 2.0f, 5.0f};
+  c.target = {0.0f, 0.5f, 0.0f};
+  c.up = {0.0f, 1.0f, 0.0f};
+  c.vertical_fov_deg = 50.0f;
+  c.width = 48;
+  c.height = 32;
+  return c;
+}
+
+// A sphere in front of the camera on an empty background, built analytically in camera space:
+// covered and uncovered pixels, varied normals, depths, albedo and ids.
+GBuffer sphere_gbuffer(const Camera& camera) {
+  GBuffer g(camera);
+  const Vec3 centre{0.3f, -0.2f, -6.0f};
+  const float radius = 2.0f;
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const Vec3 d = camera.camera_direction(x + 0.5f, y + 0.5f);
+      // |t d - c|^2 = r^2, nearest root.
+      const float a = dot(d, d), b = -2.0f * dot(d, centre), k = dot(centre, centre) - radius * radius;
+      const float disc = b * b - 4 * a * k;
+      if (disc < 0) continue;
+      const float t = (-b - std::sqrt(disc)) / (2 * a);
+      const Vec3 p = d * t;
+      g.position(x, y) = p;
+      g.depth(x, y) = -p.z;
+      g.normal(x, y) = normalize(p - centre);
+      g.albedo(x, y) = {0.1f + 0.01f * x, 0.2f + 0.01f * y, 0.7f};
+      g.object_id(x, y) = 1u + static_cast<unsigned>(x % 3);
+      g.coverage(x, y) = 1;
+    }
+  }
+  return g;
+}
+
+int covered_count(const GBuffer& g) {
+  int n = 0;
+  for (const auto c : g.coverage.pixels()) n += c;
+  return n;
+}
+
+void expect_near(Vec3 a, Vec3 b, float tol) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+template <class Fn>
+void expect_one_line_input_error(Fn&& fn, const fs::path& path, const std::string& problem) {
+  try {
+    fn();
+    ADD_FAILURE() << "no exception for " << path;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_NE(what.find(path.filename().string()), std::string::npos) << what;
+    EXPECT_NE(what.find(problem), std::string::npos) << what;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "wrong exception type for " << path << ": " << e.what();
+  }
+}
+
+TEST(GBufferExr, RoundTripKeepsEveryChannelExactly) {
+  TempDir dir;
+  const GBuffer g = sphere_gbuffer(test_camera());
+  ASSERT_GT(covered_count(g), 100);
+  ASSERT_LT(covered_count(g), g.width() * g.height());
+  write_gbuffer_exr(dir / "g.exr", g);
+  const GBuffer back = read_gbuffer_exr(dir / "g.exr");
+  ASSERT_EQ(back.width(), g.width());
+  ASSERT_EQ(back.height(), g.height());
+  for (std::size_t i = 0; i < g.depth.size(); ++i) {
+    EXPECT_EQ(back.position[i], g.position[i]) << i;
+    EXPECT_EQ(back.depth[i], g.depth[i]) << i;  // +inf background included
+    EXPECT_EQ(back.albedo[i], g.albedo[i]) << i;
+    EXPECT_EQ(back.object_id[i], g.object_id[i]) << i;
+    EXPECT_EQ(back.coverage[i], g.coverage[i]) << i;
+    // Renormalising an already unit normal may move it by an ulp.
+    expect_near(back.normal[i], g.normal[i], 1e-6f);
+  }
+}
+
+TEST(GBufferExr, RoundTripRecoversTheCamera) {
+  TempDir dir;
+  const Camera camera = test_camera();
+  write_gbuffer_exr(dir / "g.exr", sphere_gbuffer(camera));
+  const Camera back = read_gbuffer_exr(dir / "g.exr").camera;
+  EXPECT_EQ(back.vertical_fov_deg, camera.vertical_fov_deg);
+  EXPECT_EQ(back.eye, camera.eye);
+  EXPECT_EQ(back.target, camera.target);
+  EXPECT_EQ(back.up, camera.up);
+  EXPECT_EQ(back.width, camera.width);
+  EXPECT_EQ(back.height, camera.height);
+}
+
+TEST(GBufferExr, DepthAndNormalsAloneReconstructPositionsAndDefaults) {
+  TempDir dir;
+  const GBuffer g = sphere_gbuffer(test_camera());
+  write_gbuffer_exr(dir / "zn.exr", g, {.positions = false, .albedo = false, .object_ids = false, .coverage = false});
+  const GBuffer back = read_gbuffer_exr(dir / "zn.exr");
+  for (int y = 0; y < g.height(); ++y) {
+    for (int x = 0; x < g.width(); ++x) {
+      ASSERT_EQ(back.covered(x, y), g.covered(x, y)) << x << ", " << y;
+      if (!g.covered(x, y)) {
+        EXPECT_EQ(back.depth(x, y), kInfinity);
+        EXPECT_EQ(back.object_id(x, y), 0u);
+        continue;
+      }
+      // Float rounding of the ray direction and the product: a few ulps, well inside 1e-4 relative.
+      const Vec3 p = g.position(x, y);
+      EXPECT_LE(length(back.position(x, y) - p), 1e-4f * length(p)) << x << ", " << y;
+      EXPECT_EQ(back.depth(x, y), g.depth(x, y));
+      EXPECT_EQ(back.albedo(x, y), (Vec3{0.8f, 0.8f, 0.8f}));
+      EXPECT_EQ(back.object_id(x, y), 1u);
+    }
+  }
+}
+
+TEST(GBufferExr, MissingFieldOfViewAsksForFovUnlessGiven) {
+  TempDir dir;
+  const GBuffer g = sphere_gbuffer(test_camera());
+  write_gbuffer_exr(dir / "nocam.exr", g, {.camera = false});
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "nocam.exr"); }, dir / "nocam.exr", "--fov");
+
+  const GBuffer back = read_gbuffer_exr(dir / "nocam.exr", {.vertical_fov_deg = 50.0f});
+  EXPECT_EQ(back.camera.vertical_fov_deg, 50.0f);
+  // Without a placement world space is camera space.
+  EXPECT_EQ(back.camera.eye, (Vec3{0, 0, 0}));
+  expect_near(back.camera.camera_to_world_point({1, 2, -3}), {1, 2, -3}, 1e-6f);
+}
+
+TEST(GBufferExr, FieldOfViewOverrideWinsOverTheFile) {
+  TempDir dir;
+  write_gbuffer_exr(dir / "g.exr", sphere_gbuffer(test_camera()));
+  EXPECT_EQ(read_gbuffer_exr(dir / "g.exr", {.vertical_fov_deg = 30.0f}).camera.vertical_fov_deg, 30.0f);
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "g.exr", {.vertical_fov_deg = 200.0f}); }, dir / "g.exr", "fov");
+}
+
+TEST(GBufferExr, WorldSpacePassesAreMovedIntoCameraSpace) {
+  TempDir dir;
+  const GBuffer g = sphere_gbuffer(test_camera());
+  GBuffer world = g;
+  for (std::size_t i = 0; i < g.depth.size(); ++i) {
+    if (!g.coverage[i]) continue;
+    world.position[i] = g.camera.camera_to_world_point(g.position[i]);
+    world.normal[i] = g.camera.camera_to_world_vector(g.normal[i]);
+  }
+  write_gbuffer_exr(dir / "world.exr", world);
+  const GBuffer back = read_gbuffer_exr(dir / "world.exr", {.world_space = true});
+  for (std::size_t i = 0; i < g.depth.size(); ++i) {
+    if (!g.coverage[i]) continue;
+    expect_near(back.position[i], g.position[i], 1e-4f * length(g.position[i]));
+    expect_near(back.normal[i], g.normal[i], 1e-5f);
+  }
+  write_gbuffer_exr(dir / "nocam.exr", world, {.camera = false});
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "nocam.exr", {.vertical_fov_deg = 50.0f, .world_space = true}); },
+                              dir / "nocam.exr", "camera placement");
+}
+
+TEST(GBufferExr, BlenderStyleHugeBackgroundDepthIsNotCovered) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  for (auto& d : g.depth.pixels())
+    if (!std::isfinite(d)) d = 1e10f;
+  write_gbuffer_exr(dir / "g.exr", g, {.coverage = false});
+  EXPECT_EQ(covered_count(read_gbuffer_exr(dir / "g.exr")), covered_count(g));
+}
+
+TEST(GBufferExr, NonFiniteNormalAtACoveredPixelIsAnErrorNamingThePixel) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  ASSERT_TRUE(g.covered(24, 16));
+  g.normal(24, 16).y = std::numeric_limits<float>::quiet_NaN();
+  write_gbuffer_exr(dir / "nan.exr", g);
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "nan.exr"); }, dir / "nan.exr", "pixel (24, 16)");
+}
+
+TEST(GBufferExr, NonFinitePositionOrDepthAtACoveredPixelIsAnError) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  g.position(24, 16).x = kInfinity;
+  write_gbuffer_exr(dir / "p.exr", g);
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "p.exr"); }, dir / "p.exr", "pixel (24, 16)");
+
+  g = sphere_gbuffer(test_camera());
+  g.depth(20, 15) = std::numeric_limits<float>::quiet_NaN();
+  write_gbuffer_exr(dir / "z.exr", g);  // A says covered, so the NaN depth is an error
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "z.exr"); }, dir / "z.exr", "pixel (20, 15)");
+}
+
+TEST(GBufferExr, NanDepthWithoutCoverageChannelIsBackground) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  ASSERT_TRUE(g.covered(20, 15));
+  g.depth(20, 15) = std::numeric_limits<float>::quiet_NaN();
+  write_gbuffer_exr(dir / "z.exr", g, {.coverage = false});
+  const GBuffer back = read_gbuffer_exr(dir / "z.exr");
+  EXPECT_FALSE(back.covered(20, 15));
+  EXPECT_EQ(covered_count(back), covered_count(g) - 1);
+}
+
+TEST(GBufferExr, MissingRequiredChannelsAreListed) {
+  TempDir dir;
+  write_image(dir / "depth-only.exr", Image<float>(8, 8, 3.0f), {.exr_channel = "Z"});
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "depth-only.exr", {.vertical_fov_deg = 40.0f}); },
+                              dir / "depth-only.exr", "N.X N.Y N.Z");
+}
+
+TEST(GBufferExr, BadFilesAreOneLineErrors) {
+  TempDir dir;
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "missing.exr"); }, dir / "missing.exr", "does not exist");
+
+  { std::ofstream(dir / "empty.exr"); }
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "empty.exr"); }, dir / "empty.exr", "empty");
+
+  write_image(dir / "image.png", Image<float>(4, 4, 0.5f));
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "image.png"); }, dir / "image.png", "not an OpenEXR file");
+
+  write_gbuffer_exr(dir / "g.exr", sphere_gbuffer(test_camera()));
+  std::ifstream in(dir / "g.exr", std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::ofstream(dir / "half.exr", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "half.exr"); }, dir / "half.exr", "OpenEXR");
+}
+
+TEST(GBufferExr, MismatchedImageSizesAreRejectedOnWrite) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  g.albedo = Image<Vec3>(3, 3);
+  expect_one_line_input_error([&] { write_gbuffer_exr(dir / "g.exr", g); }, dir / "g.exr", "match");
+  EXPECT_FALSE(fs::exists(dir / "g.exr"));
+}
+
+}  // namespace
+}  // namespace ao

@@ -116,6 +116,21 @@ double Stopwatch::lap_ms() {
   return ms;
 }
 
+void apply_param_overrides(nlohmann::json& params, const std::vector<std::string>& overrides, std::string_view method) {
+  for (const std::string& kv : overrides) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) throw InputError("--param: expected key=value, got '" + kv + "'");
+    const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+    if (!params.contains(key)) {
+      std::string known;
+      for (const auto& [k, v] : params.items()) known += (known.empty() ? "" : ", ") + k;
+      throw InputError("--param: method " + std::string(method) + " has no parameter '" + key + "' (it has: " + known + ")");
+    }
+    nlohmann::json parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
+    params[key] = parsed.is_discarded() ? nlohmann::json(value) : parsed;
+  }
+}
+
 nlohmann::json to_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 nlohmann::json to_json(const Camera& c) {

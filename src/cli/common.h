@@ -64,6 +64,11 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+/// Applies "key=value" overrides to a method's parameter object. The value is parsed as JSON when
+/// it is valid JSON (numbers, true/false, arrays) and taken as a string otherwise. Unknown keys are
+/// an InputError listing the method's parameters.
+void apply_param_overrides(nlohmann::json& params, const std::vector<std::string>& overrides, std::string_view method);
+
 nlohmann::json to_json(Vec3 v);
 nlohmann::json to_json(const Camera& c);
 

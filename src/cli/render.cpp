@@ -31,6 +31,7 @@ struct RenderOptions {
   int samples = 256;
   float target_error = 0.0f;
   std::uint32_t seed = 1;
+  std::vector<std::string> params;  ///< key=value overrides of the method's parameters.
   int png_bits = 8;
   bool json = false;
 };
@@ -66,6 +67,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   nlohmann::json params = method.default_params();
   if (params.contains("samples")) params["samples"] = o.samples;
   if (params.contains("target_error")) params["target_error"] = o.target_error;
+  apply_param_overrides(params, o.params, method.name);
 
   std::optional<Scene> scene;
   std::unique_ptr<RayScene> rays;
@@ -182,6 +184,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--shaded", o->shaded, "Also write albedo x ambient x V with a soft key light, for viewing (sRGB)");
   cmd->add_option("--gbuffer-out", o->gbuffer_out, "Also write the G-buffer as a multi-channel EXR (docs/gbuffer.md)");
   cmd->add_option("--gbuffer-in", o->gbuffer_in, "Read the G-buffer from an EXR instead of rendering a scene (screen-space methods)");
+  cmd->add_option("-p,--param", o->params, "Method parameter as key=value (JSON value), repeatable; --json lists them");
   cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
   cmd->callback([o, &global, &action] { action = [o, &global] { return run_render(*o, global); }; });

@@ -15,13 +15,16 @@ MethodOutput run_raytraced(const MethodInput& in, const nlohmann::json& j) {
   RaytracedParams p = j.get<RaytracedParams>();
   p.validate();
   RaytracedImage img = render_raytraced(*in.scene, in.gbuffer, in.falloff, p, in.seed, in.progress);
-  return {std::move(img.visibility),
-          {{"rays", img.rays}, {"mean_std_error", img.mean_std_error}, {"max_std_error", img.max_std_error}}};
+  MethodOutput out;
+  out.visibility = std::move(img.visibility);
+  out.stats = {{"rays", img.rays}, {"mean_std_error", img.mean_std_error}, {"max_std_error", img.max_std_error}};
+  return out;
 }
 
 const std::array kMethods{
     MethodInfo{"raytraced", "ground truth: Monte Carlo obscurance with Embree rays, any membership", true,
-               [] { return nlohmann::json(RaytracedParams{}); }, run_raytraced},
+               [] { return nlohmann::json(RaytracedParams{}); }, run_raytraced,
+               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
 };
 
 }  // namespace

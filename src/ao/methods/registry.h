@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <span>
 #include <string>
 #include <string_view>
@@ -30,6 +31,8 @@ struct MethodInput {
 
 struct MethodOutput {
   Image<float> visibility;  ///< V in [0,1] per pixel; 1 where the G-buffer is not covered.
+  Image<Vec3> color;        ///< Optional RGB result (e.g. ambient transfer's W per channel); empty if none.
+  std::map<std::string, Image<float>> extras;  ///< Optional further outputs by name (e.g. "obscurance").
   nlohmann::json stats;     ///< Method-specific numbers for --json (rays, standard errors, ...).
 };
 
@@ -41,6 +44,10 @@ struct MethodInfo {
   nlohmann::json (*default_params)();
   /// Validates `params` (unknown keys and bad values throw InputError) and runs the method.
   MethodOutput (*run)(const MethodInput& input, const nlohmann::json& params);
+  /// The ground-truth integral this method approximates, as the falloff `ao compare` gives the
+  /// ray-traced reference, from the falloff the user asked for and the method's parameters (e.g.
+  /// volumetric AO implies the cubic membership; cone tracing is classical AO with R = R_max).
+  Falloff (*reference_falloff)(const Falloff& requested, const nlohmann::json& params);
 };
 
 /// All methods, in the order --help lists them.

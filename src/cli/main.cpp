@@ -16,6 +16,7 @@
 int main(int argc, char** argv) {
   CLI::App app("ao: ambient occlusion on the CPU. Ray-traced ground truth and published AO methods.", "ao");
   app.require_subcommand(1);
+  app.fallthrough();  // --threads and --quiet may also follow the subcommand
   ao::cli::GlobalOptions global;
   app.add_option("--threads", global.threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
   app.add_flag("-q,--quiet", global.quiet, "No progress bar");

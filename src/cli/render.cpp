@@ -64,6 +64,14 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   const MethodInfo& method = find_method(o.method);
   if (!o.gbuffer_in.empty() && !o.scene.empty()) throw InputError("give either a scene or --gbuffer-in, not both");
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
+  // Check output names before the work, so a typo costs nothing.
+  for (const std::string& out : {o.output, o.shaded})
+    if (!out.empty() && !is_supported_image_path(out))
+      throw InputError(out + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+  if (!o.gbuffer_out.empty() && std::filesystem::path(o.gbuffer_out).extension() != ".exr")
+    throw InputError(o.gbuffer_out + ": --gbuffer-out writes OpenEXR, give it a .exr name");
+  if (!o.gbuffer_in.empty() && method.needs_scene)
+    throw InputError("method " + std::string(method.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
   nlohmann::json params = method.default_params();
   if (params.contains("samples")) params["samples"] = o.samples;
   if (params.contains("target_error")) params["target_error"] = o.target_error;

@@ -26,7 +26,9 @@ TEST(Membership, IsMonotoneAndReachesOneAtReach) {
       EXPECT_GE(f.mu(d), prev) << to_string(m) << " at " << d;
       prev = f.mu(d);
     }
-    if (m != Membership::Exp) EXPECT_EQ(f.mu(f.reach()), 1.0f) << to_string(m);
+    if (m != Membership::Exp) {
+      EXPECT_EQ(f.mu(f.reach()), 1.0f) << to_string(m);
+    }
   }
 }
 

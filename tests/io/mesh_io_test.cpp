@@ -282,6 +282,9 @@ TEST(MeshIo, SomeDegenerateTrianglesLoadWithWarning) {
   const Scene s = load_scene_file(dir.write("some.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n2 0 0\n3 0 1 2\n3 0 1 3\n"));
   EXPECT_EQ(s.triangle_count(), 1u);
   EXPECT_TRUE(has_warning(s, "degenerate")) << "warnings: " << s.warnings.size();
+  const Scene o = load_scene_file(dir.write("some.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n"));
+  EXPECT_EQ(o.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(o, "degenerate"));
 }
 
 // --- bad input --------------------------------------------------------------------------------
@@ -318,6 +321,11 @@ TEST(MeshIo, GarbageBytesAreAnInputErrorInEveryFormat) {
 TEST(MeshIo, UnknownFormatIsNamed) {
   TempDir dir;
   EXPECT_LOAD_ERROR(dir.write("notes.txt", "hello, this is not a mesh\n"), "format");
+}
+
+TEST(MeshIo, TruncatedGltfIsAnInputError) {
+  TempDir dir;
+  EXPECT_LOAD_ERROR(dir.write("cut.gltf", R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nod)"), "malformed or truncated");
 }
 
 TEST(MeshIo, TruncatedOffMidVertexListIsAnInputError) {
@@ -449,6 +457,36 @@ TEST(MeshIo, PlyAsciiMissingFacesIsTruncated) {
                               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                               "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
                     "truncated");
+}
+
+TEST(MeshIo, PlyAbsurdListCountsFailFast) {
+  TempDir dir;
+  const std::string header =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uint int vertex_indices\nend_header\n";
+  // assimp allocates a list of whatever count it reads: 16 GB here.
+  EXPECT_LOAD_ERROR(dir.write("ascii.ply", "ply\nformat ascii 1.0\n" + header + "0 0 0\n1 0 0\n0 1 0\n4294967295 0 1 2\n"),
+                    "expects 4294967295 more values");
+  std::string bin = "ply\nformat binary_little_endian 1.0\n" + header + std::string(36, '\0');
+  bin += std::string("\xff\xff\xff\x7f", 4) + std::string(12, '\0');
+  EXPECT_LOAD_ERROR(dir.write("binary.ply", bin), "truncated");
+}
+
+TEST(MeshIo, PlyBinaryRoundTrip) {
+  TempDir dir;
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const std::int32_t face[3] = {0, 1, 2};
+  bin.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  bin += '\3';
+  bin.append(reinterpret_cast<const char*>(face), sizeof face);
+  const Scene s = load_scene_file(dir.write("tri.ply", bin));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  expect_near(s.bounds().hi, {1, 1, 0});
+  // One byte short of the last index.
+  load_error(dir.write("short.ply", bin.substr(0, bin.size() - 1)));
 }
 
 TEST(MeshIo, PlyIndexOutOfRangeIsAnInputError) {

@@ -11,11 +11,33 @@ namespace {
 
 constexpr int kTile = 32;  // pixels per tile side: a tile is one TBB task
 
+// World-space direction through pixel centre (x + 0.5, y + 0.5) as origin + x * dx + y * dy: the
+// per-pixel work of Camera::camera_direction with the trigonometry done once per image.
+struct RayGenerator {
+  Vec3 origin, dx, dy;
+
+  RayGenerator(const Camera& cam, const Frame& basis) {
+    const Vec3 d00 = basis.to_world(cam.camera_direction(0.5f, 0.5f));
+    dx = basis.to_world(cam.camera_direction(1.5f, 0.5f)) - d00;
+    dy = basis.to_world(cam.camera_direction(0.5f, 1.5f)) - d00;
+    origin = d00;
+  }
+  Vec3 operator()(int x, int y) const { return origin + dx * static_cast<float>(x) + dy * static_cast<float>(y); }
+};
+
 // Writes the G-buffer entry of pixel (x, y) for a hit on triangle `prim` of mesh `geom` at
-// barycentric (u, v), or leaves the background values when geom is invalid.
+// barycentric (u, v), or the background values when geom is invalid.
 void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, GBuffer& g, int x, int y, unsigned geom, unsigned prim, float u,
                float v) {
-  if (geom == RTC_INVALID_GEOMETRY_ID) return;
+  if (geom == RTC_INVALID_GEOMETRY_ID) {
+    g.position(x, y) = {};
+    g.depth(x, y) = kInfinity;
+    g.normal(x, y) = {};
+    g.albedo(x, y) = {};
+    g.object_id(x, y) = 0;
+    g.coverage(x, y) = 0;
+    return;
+  }
   const Mesh& m = scene.meshes[geom];
   const std::uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1], i2 = m.indices[3 * prim + 2];
   const float w = 1.0f - u - v;
@@ -39,7 +61,7 @@ void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, GBuffe
 }
 
 template <int N>
-void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, GBuffer& g, const Tile& t) {
+void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const RayGenerator& gen, GBuffer& g, const Tile& t) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -47,7 +69,7 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, GBuf
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
-        const Vec3 d = basis.to_world(cam.camera_direction(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f));
+        const Vec3 d = gen(x, y);
         RTCRayHit rh{};
         rh.ray = {cam.eye.x, cam.eye.y, cam.eye.z, 0.0f, d.x, d.y, d.z, 0.0f, kInfinity, 0xffffffffu, 0, 0};
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -64,7 +86,7 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, GBuf
         for (int k = 0; k < N; ++k) {
           const int x = bx + k % bw, y = by + k / bw;
           valid[k] = (x < t.x1 && y < t.y1) ? -1 : 0;
-          const Vec3 d = basis.to_world(cam.camera_direction(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f));
+          const Vec3 d = gen(x, y);
           rh.ray.org_x[k] = cam.eye.x;
           rh.ray.org_y[k] = cam.eye.y;
           rh.ray.org_z[k] = cam.eye.z;
@@ -89,17 +111,24 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, GBuf
 }  // namespace
 
 GBuffer render_gbuffer(const RayScene& rs, const Camera& camera, const ProgressFn& progress) {
+  GBuffer g;
+  render_gbuffer(rs, camera, g, progress);
+  return g;
+}
+
+void render_gbuffer(const RayScene& rs, const Camera& camera, GBuffer& g, const ProgressFn& progress) {
   camera.validate();
-  GBuffer g(camera);
+  if (g.width() != camera.width || g.height() != camera.height || g.position.width() != camera.width) g = GBuffer(camera);
+  g.camera = camera;
   const Frame basis = camera.basis();
+  const RayGenerator gen(camera, basis);
   ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(camera.width, camera.height, kTile, [&](const Tile& t) {
-      render_tile<N>(rs, camera, basis, g, t);
+      render_tile<N>(rs, camera, basis, gen, g, t);
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
     });
   });
-  return g;
 }
 
 }  // namespace ao

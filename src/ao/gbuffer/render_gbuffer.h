@@ -12,4 +12,8 @@ namespace ao {
 /// the interpolated shading normal turned to face the camera, the mesh's albedo and id.
 GBuffer render_gbuffer(const RayScene& scene, const Camera& camera, const ProgressFn& progress = {});
 
+/// The same into an existing G-buffer, reusing its storage when the size matches (a renderer
+/// that draws frame after frame pays for the allocation once). Every pixel is written.
+void render_gbuffer(const RayScene& scene, const Camera& camera, GBuffer& out, const ProgressFn& progress = {});
+
 }  // namespace ao

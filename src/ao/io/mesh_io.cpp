@@ -6,10 +6,13 @@
 //    "aiMesh::mFaces[2258].mIndices is nullptr", and JoinIdenticalVertices makes cow.off's 2904
 //    vertices 2903, so counts stop matching the header. OFF is a trivial format, so we parse it.
 //  - PLY: a file cut inside its header makes assimp loop forever; a header claiming 3e9 vertices
-//    ends in bad_alloc; an ASCII file missing its last faces loads with invented ones. We check the
-//    header and the size it implies before assimp sees the file.
-// Every other check (non-finite data, index ranges, degenerate triangles) is shared: raw assimp data
-// is checked before post-processing can merge or hide it, then validate_and_prepare runs on all.
+//    ends in bad_alloc; a face list count of 4294967295 makes it allocate 16 GB; an ASCII file
+//    missing its last faces loads with invented ones; a damaged "property" line shifts the data
+//    until faces without indices abort the process in Triangulate's assertion. We check the header
+//    and walk the data (without allocating) before assimp sees the file.
+// Every other check (non-finite data, index ranges, empty faces, degenerate triangles) is shared: raw
+// assimp data is checked before post-processing can merge, hide or trip over it, then
+// validate_and_prepare runs on all. Found by tests and by fuzzing truncated and byte-flipped files.
 #include "ao/io/mesh_io.h"
 
 #include <assimp/Importer.hpp>
@@ -247,7 +250,8 @@ Scene read_off(const fs::path& path, std::string_view data) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// PLY header check (the data itself is left to assimp).
+// PLY structure check. assimp reads the data; this walks it first without allocating, so that
+// damaged files fail with a clear message instead of hanging, aborting or allocating gigabytes.
 
 bool looks_like_ply(std::string_view data) { return data.starts_with("ply\n") || data.starts_with("ply\r\n") || data.starts_with("PLY\n"); }
 
@@ -264,12 +268,32 @@ int ply_type_size(std::string_view type) {
   return 0;
 }
 
-void check_ply_header(const fs::path& path, std::string_view data) {
-  struct Element {
-    std::string name;
-    long long count = 0;
-    long long min_bytes = 0;  ///< Smallest possible size of one element in this file's encoding.
-  };
+struct PlyProperty {
+  bool is_list = false;
+  int count_size = 0;  ///< Bytes of a list's count, binary only.
+  bool count_signed = false;
+  int item_size = 0;   ///< Bytes of the scalar, or of each list item.
+};
+
+struct PlyElement {
+  std::string name;
+  long long count = 0;
+  long long min_bytes = 0;  ///< Smallest possible size of one element in this file's encoding.
+  std::vector<PlyProperty> properties;
+};
+
+/// Reads a binary list count of `size` bytes at `p`.
+long long read_ply_count(const char* p, int size, bool is_signed, bool big_endian) {
+  std::uint64_t u = 0;
+  for (int k = 0; k < size; ++k) {
+    const auto byte = static_cast<std::uint8_t>(p[big_endian ? k : size - 1 - k]);
+    u = (u << 8) | byte;
+  }
+  if (is_signed && size < 8 && (u >> (8 * size - 1)) != 0) return static_cast<long long>(u) - (1LL << (8 * size));
+  return static_cast<long long>(u);
+}
+
+void check_ply(const fs::path& path, std::string_view data) {
   // A PLY header is a few hundred bytes; looking at the first 64 KiB bounds the work on garbage.
   const std::size_t header_end = data.substr(0, 1 << 16).find("end_header");
   // assimp 5.2.5 loops forever on a PLY file cut inside its header, so this check is not optional.
@@ -277,7 +301,7 @@ void check_ply_header(const fs::path& path, std::string_view data) {
   LineReader reader(data.substr(0, header_end));
   std::string_view line;
   std::string format;
-  std::vector<Element> elements;
+  std::vector<PlyElement> elements;
   while (reader.next(line)) {
     const std::vector<std::string_view> t = split(line);
     const std::string at = "PLY header line " + std::to_string(reader.line_number());
@@ -286,19 +310,30 @@ void check_ply_header(const fs::path& path, std::string_view data) {
     } else if (t[0] == "format" && t.size() >= 2) {
       format = std::string(t[1]);
     } else if (t[0] == "element") {
-      Element e;
+      PlyElement e;
       if (t.size() < 3 || !parse_number(t[2], e.count) || e.count < 0) fail(path, at + ": malformed element line");
       if (e.count > std::numeric_limits<std::uint32_t>::max()) fail(path, at + ": absurd element count " + quote(t[2]));
       e.name = printable(t[1]);
       elements.push_back(e);
     } else if (t[0] == "property") {
       if (elements.empty()) fail(path, at + ": property before any element");
+      PlyProperty prop;
+      prop.is_list = t.size() >= 2 && t[1] == "list";
+      if (prop.is_list) {
+        if (t.size() < 5 || ply_type_size(t[2]) == 0 || ply_type_size(t[3]) == 0 || t[2] == "float" || t[2] == "float32" ||
+            t[2] == "double" || t[2] == "float64")
+          fail(path, at + ": malformed list property");
+        prop.count_size = ply_type_size(t[2]);
+        prop.count_signed = !t[2].starts_with("u");
+        prop.item_size = ply_type_size(t[3]);
+      } else {
+        if (t.size() < 3 || ply_type_size(t[1]) == 0) fail(path, at + ": malformed property line");
+        prop.item_size = ply_type_size(t[1]);
+      }
       // ASCII: each value takes at least a digit and a separator. Binary: a list takes at least its
       // count, a scalar its size.
-      const bool is_list = t.size() >= 2 && t[1] == "list";
-      const std::size_t type_at = is_list ? 2 : 1;
-      if (t.size() <= type_at + 1 || ply_type_size(t[type_at]) == 0) fail(path, at + ": malformed property line");
-      elements.back().min_bytes += format == "ascii" ? 2 : ply_type_size(t[type_at]);
+      elements.back().min_bytes += format == "ascii" ? 2 : (prop.is_list ? prop.count_size : prop.item_size);
+      elements.back().properties.push_back(prop);
     } else {
       // assimp skips a line it does not know, which for a damaged "property" line shifts every
       // value after it (and once ended in an assertion abort); a damaged header is an error.
@@ -309,25 +344,61 @@ void check_ply_header(const fs::path& path, std::string_view data) {
     fail(path, "PLY header has no valid format line");
 
   const std::size_t body_start = std::min(data.find('\n', header_end), data.size() - 1) + 1;
-  const long long body_bytes = static_cast<long long>(data.size() - body_start);
-  long long min_bytes = 0, element_total = 0;
+  const std::string_view body = data.substr(body_start);
+  long long min_bytes = 0;
   std::string summary;
-  for (const Element& e : elements) {
+  for (const PlyElement& e : elements) {
     min_bytes += e.count * e.min_bytes;  // < 2^32 * 2^16 properties at most: no overflow
-    element_total += e.count;
     summary += (summary.empty() ? "" : ", ") + std::to_string(e.count) + " x '" + e.name + "'";
   }
-  if (min_bytes > body_bytes)
-    fail(path, "header declares " + summary + " elements but the data has only " + std::to_string(body_bytes) + " bytes");
+  if (min_bytes > static_cast<long long>(body.size()))
+    fail(path, "header declares " + summary + " elements but the data has only " + std::to_string(body.size()) + " bytes");
+
+  // Walk the data. The size check above bounds this loop by the file size (an element without
+  // properties is skipped), and list counts are checked against what is left, because assimp
+  // allocates a list of whatever count it reads (4294967295 in a damaged file: 16 GB).
   if (format == "ascii") {
-    // ASCII PLY holds one element per line, so counting lines finds a truncated file exactly,
-    // which assimp does not notice.
-    LineReader body(data.substr(body_start));
-    long long lines = 0;
-    while (lines < element_total && body.next(line)) ++lines;
-    if (lines < element_total)
-      fail(path, "truncated: header declares " + summary + " elements (" + std::to_string(element_total) + " lines) but the file has " +
-                     std::to_string(lines) + " data lines");
+    // One element per line.
+    LineReader lines(body);
+    for (const PlyElement& e : elements) {
+      for (long long i = 0; i < e.count && !e.properties.empty(); ++i) {
+        if (!lines.next(line)) fail(path, "truncated: header declares " + summary + " elements, the data ends in '" + e.name + "' " + std::to_string(i));
+        const std::vector<std::string_view> t = split(line);
+        const std::string at = "data line " + std::to_string(lines.line_number()) + " ('" + e.name + "' " + std::to_string(i) + ")";
+        std::size_t next = 0;
+        for (const PlyProperty& prop : e.properties) {
+          long long n = 1;
+          if (prop.is_list) {
+            if (next >= t.size() || !parse_number(t[next], n) || n < 0) fail(path, at + ": missing or bad list count");
+            ++next;
+          }
+          if (static_cast<long long>(t.size() - next) < n)
+            fail(path, at + ": expects " + std::to_string(n) + " more values, the line has " + std::to_string(t.size() - next));
+          next += static_cast<std::size_t>(n);
+        }
+      }
+    }
+  } else {
+    const bool big_endian = format == "binary_big_endian";
+    std::size_t pos = 0;
+    for (const PlyElement& e : elements) {
+      for (long long i = 0; i < e.count && !e.properties.empty(); ++i) {
+        for (const PlyProperty& prop : e.properties) {
+          long long bytes = prop.item_size;
+          if (prop.is_list) {
+            if (body.size() - pos < static_cast<std::size_t>(prop.count_size)) bytes = prop.count_size;  // fails below
+            else {
+              const long long n = read_ply_count(body.data() + pos, prop.count_size, prop.count_signed, big_endian);
+              if (n < 0) fail(path, "'" + e.name + "' " + std::to_string(i) + " has a negative list count " + std::to_string(n));
+              bytes = prop.count_size + n * prop.item_size;
+            }
+          }
+          if (static_cast<long long>(body.size() - pos) < bytes)
+            fail(path, "truncated: header declares " + summary + " elements, the data ends in '" + e.name + "' " + std::to_string(i));
+          pos += static_cast<std::size_t>(bytes);
+        }
+      }
+    }
   }
 }
 
@@ -417,7 +488,13 @@ Scene read_with_assimp(const fs::path& path, std::string_view data) {
   } catch (const std::exception& e) {
     fail(path, explain_assimp_error(e.what()));
   }
-  if (raw == nullptr) fail(path, explain_assimp_error(importer.GetErrorString()));
+  if (raw == nullptr) {
+    const std::string error = importer.GetErrorString();
+    // "No suitable reader" for a file named like a format assimp reads means damaged content.
+    if (error.find("No suitable reader found") != std::string::npos && !ext.empty() && importer.IsExtensionSupported(ext))
+      fail(path, "malformed or truncated " + printable(ext.substr(1)) + " file: its content is not recognised");
+    fail(path, explain_assimp_error(error));
+  }
   check_raw_meshes(path, *raw);
 
   // No GenNormals / GenSmoothNormals (validate_and_prepare makes normals), and no FindInvalidData or
@@ -473,7 +550,7 @@ Scene load_scene_file(const fs::path& path) {
   if (ext == ".off" || looks_like_off(data)) return read_off(path, data);
   if (ext == ".ply" || looks_like_ply(data)) {
     if (!looks_like_ply(data)) fail(path, "not a PLY file: it does not start with 'ply'");
-    check_ply_header(path, data);
+    check_ply(path, data);
   }
   return read_with_assimp(path, data);
 }

@@ -1,5 +1,5 @@
 // Mesh files -> Scene. OFF is read by our own strict parser; everything else goes through assimp,
-// after a cheap header check for PLY (see mesh_io.cpp for why).
+// PLY after a structure check of our own (see mesh_io.cpp for why).
 #pragma once
 
 #include <filesystem>

@@ -101,8 +101,8 @@ Scene default_scene() {
   s.meshes.push_back(std::move(cubes));
 
   Camera view;
-  view.eye = {5.5f, 6.0f, 8.5f};
-  view.target = {0.0f, 0.0f, -0.6f};
+  view.eye = {4.4f, 4.6f, 7.0f};
+  view.target = {-0.2f, 0.1f, -0.9f};
   view.vertical_fov_deg = 45.0f;
   s.preferred_view = view;
   return s;

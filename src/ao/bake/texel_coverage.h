@@ -1,0 +1,66 @@
+// Which surface each texel of an AO map covers: the UV layout of a scene clipped exactly against
+// the texel grid. Both bakers use it: the histogram baker for the exact normalisation (each
+// texel's world-space area, the denominator of the paper's eq. 2), the ray-traced baker to spread
+// its sample points over the texel's patch of surface.
+//
+// Conventions: texel (x, y) of an N x N map covers u in [x/N, (x+1)/N] and v in
+// [1 - (y+1)/N, 1 - y/N]: v = 0 is the bottom row of the image (OpenGL / OBJ convention, which is
+// how the mesh loader stores UVs). "Texel units" below are u * N and (1 - v) * N.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ao/core/image.h"
+#include "ao/core/math.h"
+#include "ao/scene/mesh.h"
+
+namespace ao {
+
+/// One triangle's share of one texel.
+struct TexelFragment {
+  std::uint32_t mesh = 0;      ///< Index of the mesh in the scene.
+  std::uint32_t triangle = 0;  ///< Triangle index within that mesh.
+  float uv_area = 0;           ///< Area of triangle ∩ texel square, texel units (1 = the whole texel).
+  float world_area = 0;        ///< The same piece of surface in world units^2.
+};
+
+/// The UV layout of every mesh in a scene rasterised exactly onto an N x N grid.
+struct TexelCoverage {
+  int size = 0;                             ///< N.
+  std::vector<std::uint32_t> offsets;       ///< CSR: fragments of texel i are [offsets[i], offsets[i+1]).
+  std::vector<TexelFragment> fragments;     ///< Sorted by texel.
+  Image<float> world_area;                  ///< Per texel: world area of the surface it covers (eq. 2's denominator).
+  Image<float> uv_area;                     ///< Per texel: covered fraction of the texel, summed over triangles (> 1 where charts overlap).
+  Image<std::uint8_t> mask;                 ///< 1 where the texel covers some surface.
+  std::size_t covered_texels = 0;           ///< Texels with mask = 1.
+  std::size_t overlapping_texels = 0;       ///< Texels covered more than 1.01 times (overlapping charts).
+  std::size_t degenerate_uv_triangles = 0;  ///< Triangles with surface area but (near) zero UV area: they get no texel.
+  std::size_t outside_triangles = 0;        ///< Triangles partly outside [0,1]^2: the part outside is not baked.
+
+  std::size_t texel_count() const { return static_cast<std::size_t>(size) * size; }
+  /// One-line warnings for the user (overlaps, degenerate and out-of-range UVs); empty when clean.
+  std::vector<std::string> warnings() const;
+};
+
+/// Clips every triangle of every mesh with UVs against the texel grid (Sutherland-Hodgman against
+/// each texel square it overlaps). Meshes without UVs are skipped (they may still occlude).
+/// `size` in [1, 16384]. Throws InputError when no mesh has UVs or all UV triangles are degenerate.
+TexelCoverage compute_texel_coverage(const Scene& scene, int size);
+
+/// Texel-unit UV of vertex v of a mesh: (u * N, (1 - v) * N).
+inline Vec2 texel_uv(const Mesh& m, std::uint32_t v, int size) {
+  return {m.uvs[v].x * static_cast<float>(size), (1.0f - m.uvs[v].y) * static_cast<float>(size)};
+}
+
+/// A convex polygon in texel units (a triangle clipped to a square has at most 7 vertices).
+struct ClipPolygon {
+  Vec2 p[9];
+  int n = 0;
+  float area() const;  ///< Unsigned area.
+};
+/// Triangle a b c clipped to the square [x, x+1] x [y, y+1].
+ClipPolygon clip_to_texel(Vec2 a, Vec2 b, Vec2 c, int x, int y);
+
+}  // namespace ao

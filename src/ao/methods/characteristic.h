@@ -1,0 +1,173 @@
+// Characteristic functions I(p) of volumetric-ambient-occlusion (VAO), fig. 2, and ambient
+// transfer (AT) sec. 4: I(p) = 1 when camera-space point p is in the OUTER region (where the
+// camera is) and 0 in the inner region. Every function here also gives the distance from p to
+// the separating surface along the view axis, which volumetric AO needs (VAO, the paragraph after
+// fig. 2) and silhouette-shadow elimination uses (AT sec. 4.3):
+//
+//   distance(p) = z* - depth(p),  depth(p) = -p.z (camera looks down -z)
+//
+// > 0 when p is in front of the surface (outer), < 0 behind it (inner), +infinity when no
+// surface is crossed along the view axis. I(p) = [distance(p) >= -bias].
+//
+// Kinds (each a small value type with an inline `distance`, so kernels templated on the type
+// inline it into their vectorised loops; no virtual calls):
+//  - DepthBufferCharacteristic: the G-buffer's depth at p's projection (VAO fig. 2c). Points
+//    projecting outside the image or onto background are free (distance = +infinity).
+//  - ImplicitCharacteristic: f(p) >= 0 for f = min of analytic primitives (planes, sphere
+//    exteriors), with the Taylor distance z* - p_z ~ -f / (df/dz) (VAO, eq. after fig. 2).
+//  - HeightFieldCharacteristic: a displacement map in a surface's tangent space, p_n >= h(p_t, p_b)
+//    (VAO fig. 2b), distance by the same Taylor step.
+//  - ProductCharacteristic: the product of two (VAO fig. 12: depth buffer x height field); the
+//    nearer separating surface bounds the free part of a pipe, so distance = min.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "ao/core/camera.h"
+#include "ao/core/gbuffer.h"
+#include "ao/core/image.h"
+#include "ao/core/math.h"
+
+namespace ao {
+
+/// Camera-space point -> pixel index of the G-buffer, with the arithmetic of Camera::project
+/// folded into four constants.
+struct ScreenProjection {
+  float scale_x = 1, scale_y = 1;   ///< Pixels per unit of x/(-z) and y/(-z).
+  float centre_x = 0, centre_y = 0; ///< Pixel coordinate of the optical axis.
+  int width = 0, height = 0;
+
+  static ScreenProjection from_camera(const Camera& c) {
+    const float t = c.tan_half_fov();
+    return {0.5f * static_cast<float>(c.width) / (t * c.aspect()), 0.5f * static_cast<float>(c.height) / t,
+            0.5f * static_cast<float>(c.width), 0.5f * static_cast<float>(c.height), c.width, c.height};
+  }
+  /// Index y * width + x of the pixel containing p's projection, or -1 when p is behind the camera
+  /// or projects outside the image. Branch-free, so loops over it vectorise (with gathers).
+  int index(float x, float y, float z) const {
+    const float inv = -1.0f / z;
+    const float fx = x * inv * scale_x + centre_x;
+    const float fy = centre_y - y * inv * scale_y;
+    const bool valid = z < 0.0f && fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(width) && fy < static_cast<float>(height);
+    const int ix = static_cast<int>(valid ? fx : 0.0f), iy = static_cast<int>(valid ? fy : 0.0f);
+    return valid ? iy * width + ix : -1;
+  }
+};
+
+/// VAO fig. 2c: the z-buffer separates inner from outer. z* is the linear depth stored at p's pixel
+/// (nearest pixel); background pixels hold +infinity, so they are free.
+struct DepthBufferCharacteristic {
+  ScreenProjection projection;
+  const float* depth = nullptr;  ///< The G-buffer's depth, width * height values; must outlive this.
+
+  explicit DepthBufferCharacteristic(const GBuffer& g) : projection(ScreenProjection::from_camera(g.camera)), depth(g.depth.data()) {}
+
+  float distance(float x, float y, float z) const {
+    const int i = projection.index(x, y, z);
+    const float zs = depth[i < 0 ? 0 : i];
+    return i < 0 ? kInfinity : zs + z;  // z* - depth(p) with depth(p) = -z
+  }
+};
+
+/// One analytic primitive of an implicit surface, in camera space. f >= 0 outside.
+struct ImplicitPrimitive {
+  enum class Kind { HalfSpace, SphereExterior } kind = Kind::HalfSpace;
+  Vec3 normal{0, 0, 1};  ///< HalfSpace: unit normal pointing into the outer region.
+  float offset = 0;      ///< HalfSpace: f = dot(normal, p) - offset.
+  Vec3 centre{};         ///< SphereExterior: f = |p - centre| - radius.
+  float radius = 1;
+
+  static ImplicitPrimitive half_space(Vec3 n, Vec3 point_on_plane) {
+    const Vec3 u = normalize(n);
+    return {Kind::HalfSpace, u, dot(u, point_on_plane), {}, 1};
+  }
+  static ImplicitPrimitive sphere_exterior(Vec3 c, float r) { return {Kind::SphereExterior, {}, 0, c, r}; }
+
+  float value(Vec3 p) const { return kind == Kind::HalfSpace ? dot(normal, p) - offset : length(p - centre) - radius; }
+  Vec3 gradient(Vec3 p) const { return kind == Kind::HalfSpace ? normal : normalize(p - centre); }
+};
+
+/// Taylor step of VAO (eq. after fig. 2) for one implicit function with value f and gradient g:
+/// along the depth direction (0, 0, -1) the surface is at depth offset -f / (df/d depth) with
+/// df/d depth = -g.z. Where the surface does not get nearer going deeper (df/d depth >= 0) the
+/// line never enters the inner region ahead of p: +infinity from outside, -infinity from inside.
+inline float taylor_depth_distance(float f, float gz) {
+  constexpr float kFlat = 1e-6f;  // |df/d depth| below this: the line runs along the surface
+  if (gz <= kFlat) return f >= 0.0f ? kInfinity : -kInfinity;
+  return f / gz;
+}
+
+/// VAO fig. 2a: I(p) = [f(p) >= 0] with f = min over the primitives (the outer region is the
+/// intersection of theirs: a floor and a wall make a wedge, a plane and a sphere exterior make a
+/// sphere resting on a plane). The distance is the nearest surface crossing ahead, the minimum of
+/// the primitives' Taylor distances.
+struct ImplicitCharacteristic {
+  std::vector<ImplicitPrimitive> primitives;
+
+  float distance(float x, float y, float z) const {
+    const Vec3 p{x, y, z};
+    float d = kInfinity;
+    for (const ImplicitPrimitive& q : primitives) d = std::min(d, taylor_depth_distance(q.value(p), q.gradient(p).z));
+    return d;
+  }
+};
+
+/// VAO fig. 2b: a displacement map over a macrostructure plane, seen in the plane's tangent frame
+/// (camera space). With local coordinates (u, v, w) = ((p - origin) . tangent, . bitangent, . normal),
+/// I(p) = [w >= h(u, v)], h = amplitude * bilinear lookup of `map` tiled every `period` world units.
+struct HeightFieldCharacteristic {
+  Vec3 origin{};            ///< A point of the macrostructure plane, camera space.
+  Frame frame{};            ///< Tangent, bitangent, normal (towards the outer side), camera space.
+  Image<float> map;         ///< Heights in [0, 1] (any values work), tiled; must be non-empty.
+  float period = 1.0f;      ///< World units covered by the map along u and v, > 0.
+  float amplitude = 0.1f;   ///< World units of height for map value 1.
+
+  /// h(u, v), world units.
+  float height(float u, float v) const {
+    const float fx = u / period * static_cast<float>(map.width()) - 0.5f;
+    const float fy = v / period * static_cast<float>(map.height()) - 0.5f;
+    const float x0 = std::floor(fx), y0 = std::floor(fy);
+    const float ax = fx - x0, ay = fy - y0;
+    auto at = [&](float xi, float yi) {
+      const int w = map.width(), h = map.height();
+      const int ix = ((static_cast<int>(xi) % w) + w) % w, iy = ((static_cast<int>(yi) % h) + h) % h;
+      return map(ix, iy);
+    };
+    const float top = at(x0, y0) * (1 - ax) + at(x0 + 1, y0) * ax;
+    const float bottom = at(x0, y0 + 1) * (1 - ax) + at(x0 + 1, y0 + 1) * ax;
+    return amplitude * (top * (1 - ay) + bottom * ay);
+  }
+  /// f(p) = w - h(u, v) (>= 0 outside) and its camera-space gradient, by central differences of h
+  /// over a tenth of a texel (the bilinear h is piecewise smooth).
+  float value(Vec3 p, Vec3* gradient) const {
+    const Vec3 l = frame.to_local(p - origin);
+    const float f = l.z - height(l.x, l.y);
+    if (gradient) {
+      const float e = 0.1f * period / static_cast<float>(std::max(map.width(), map.height()));
+      const float hu = (height(l.x + e, l.y) - height(l.x - e, l.y)) / (2 * e);
+      const float hv = (height(l.x, l.y + e) - height(l.x, l.y - e)) / (2 * e);
+      *gradient = frame.to_world({-hu, -hv, 1.0f});
+    }
+    return f;
+  }
+  float distance(float x, float y, float z) const {
+    Vec3 g;
+    const float f = value({x, y, z}, &g);
+    return taylor_depth_distance(f, g.z);
+  }
+};
+
+/// VAO fig. 12: I = I_a * I_b. A point is free when both say so; along a pipe the nearer of the
+/// two separating surfaces ends the free part.
+template <class A, class B>
+struct ProductCharacteristic {
+  A a;
+  B b;
+  float distance(float x, float y, float z) const { return std::min(a.distance(x, y, z), b.distance(x, y, z)); }
+};
+
+using DepthTimesHeightField = ProductCharacteristic<DepthBufferCharacteristic, HeightFieldCharacteristic>;
+
+}  // namespace ao

@@ -1,0 +1,53 @@
+// Interleaved sampling (Keller and Heidrich 2001) as volumetric-ambient-occlusion (VAO) and
+// ambient transfer (AT) use it, both in their sec. 4.2: the pixels of a 4x4 pattern use 16
+// rotations of one sample set about the surface normal (VAO: about the view axis for the pipes'
+// disk), repeated over the image; a 4x4 box filter then averages the 16 uncorrelated estimates,
+// skipping neighbours whose depth differs from the centre's by more than a limit.
+//
+// Also the per-pixel setup the kernels share: a row of pixels as structure-of-arrays (position,
+// rotated tangent frame, depth bias), so the loops over samples run across pixels in SIMD lanes.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "ao/core/gbuffer.h"
+#include "ao/core/image.h"
+#include "ao/methods/samples.h"
+
+namespace ao {
+
+/// Options common to the screen-space methods' sampling and filtering.
+struct InterleaveOptions {
+  bool interleave = true;          ///< 16 rotations in a 4x4 pattern (sec. 4.2); false: one rotation everywhere.
+  bool filter = true;              ///< 4x4 depth-aware box filter after an interleaved pass (ignored without interleave).
+  float filter_depth_limit = 0.0f; ///< Neighbours whose depth differs by more than this are skipped, world units; 0 = R/4.
+};
+
+/// A run of pixels [x0, x0 + count) of one row, structure-of-arrays. Uncovered pixels get a
+/// harmless dummy point far in front of the camera and covered = 0.
+struct PixelRow {
+  int y = 0, x0 = 0, count = 0;
+  std::vector<float> px, py, pz;  ///< Camera-space position of the shaded point x.
+  std::vector<float> nx, ny, nz;  ///< Unit normal N.
+  std::vector<float> tx, ty, tz;  ///< Tangent T, rotated by the pixel's interleaving angle about N.
+  std::vector<float> bx, by, bz;  ///< Binormal B = N x T, rotated likewise.
+  std::vector<float> rc, rs;      ///< The pixel's rotation (cos, sin), for samples in the view plane.
+  std::vector<float> bias;        ///< Depth-test bias, world units (see load()).
+  std::vector<unsigned char> covered;
+
+  /// Fills the row from the G-buffer. The depth bias of a pixel is `bias_world` when > 0, else
+  /// auto: one pixel footprint at its depth times (1 + tan theta_v) with theta_v the angle between
+  /// the normal and the view ray (clamped to tan 83 deg = 8): the most a nearest-pixel depth lookup
+  /// on the same surface can be off by, so planes do not shadow themselves.
+  void load(const GBuffer& g, int y, int x0, int x1, const std::array<Rotation, 16>& rotations, float bias_world);
+};
+
+/// 4x4 box filter of `image` over covered pixels, window offsets -2..+1 in x and y (so it holds each
+/// of the 16 pattern positions once), skipping uncovered neighbours and those whose depth differs
+/// from the centre pixel's by more than `depth_limit` (world units). Uncovered pixels keep their
+/// value. Works for float and Vec3 images.
+Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit);
+Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit);
+
+}  // namespace ao

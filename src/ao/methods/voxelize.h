@@ -1,0 +1,137 @@
+// Solid binary voxelization by parity, after Eisemann & Decoret ("Single-pass GPU solid
+// voxelization for real-time applications", GI 2008), as used by Dalla Favera & Celes, "Ambient
+// occlusion using cone tracing with scene voxelization" (SIBGRAPI 2012), sec. III-B.
+//
+// The grid is a 2-D array of columns; each column is a bit mask of `depth_bits` voxels stored in
+// ceil(depth_bits / 64) 64-bit words (bit k of the column is bit k % 64 of word k / 64). Every
+// triangle, front and back faces alike, is rasterised at the column centres; each fragment XORs
+// all bits of its column from its depth to the far end, so voxels inside closed objects end up 1
+// (a voxel is inside when its centre is). We store the fragment as a single toggled bit and turn
+// toggles into "XOR to the end" with one prefix-XOR scan per column at the end: the two are equal
+// because XOR is associative and commutative.
+//
+// Two grids:
+//  - World: columns along world y over the scene bounds, independent of the view.
+//  - Eye: the paper's grid. Columns are the pixels of a lower-resolution copy of the camera's view
+//    frustum; along a column, eq. 2 maps linear eye depth z to the voxel index
+//    (z - z_nearest) / (z_far - z_nearest) * depth_bits, with z_nearest per column taken from the
+//    G-buffer's nearest depth (the "local slice" of sec. III-B) and z_far the far side of the scene.
+//
+// Parity needs closed surfaces. Meshes with boundary edges (an open ground plane) are, by default,
+// thickened into closed slabs: every triangle of an open mesh becomes a thin closed prism extruded
+// behind its front face. Columns whose parity still ends odd are counted and reported.
+#pragma once
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "ao/core/gbuffer.h"
+#include "ao/scene/mesh.h"
+
+namespace ao {
+
+/// The space the grid's columns live in.
+enum class GridSpace {
+  World,  ///< Columns along world +y over the scene bounds; bit 0 is the bottom.
+  Eye,    ///< The paper's eye-space grid: columns are pixels of the view frustum, bit 0 is z_nearest.
+};
+
+/// What to do with meshes that are not closed (have boundary edges).
+enum class OpenMeshes {
+  Slab,    ///< Thicken every triangle into a closed prism behind its front face (default).
+  Parity,  ///< Voxelize as they are: columns crossing them end odd (reported), as in the paper.
+};
+
+/// Topology of one mesh, computed once per scene (positions may move, connectivity does not).
+struct MeshClosure {
+  std::size_t boundary_edges = 0;  ///< Edges used by an odd number of triangles (positions compared exactly).
+  bool closed() const { return boundary_edges == 0; }
+};
+
+/// Boundary edges of every mesh of `scene`, in mesh order. Vertices are matched by exact position,
+/// so meshes whose faces carry their own copies of shared corners (make_box) count as closed.
+std::vector<MeshClosure> analyze_closure(const Scene& scene);
+
+/// Options of voxelize_world / voxelize_eye.
+struct VoxelizeOptions {
+  int columns = 512;              ///< World: columns along x and along z (columns x columns).
+                                  ///< Eye: columns along the longer image side. [8, 4096].
+  int depth_bits = 128;           ///< Voxels per column; a multiple of 32 in [32, 1024]. Paper: 128.
+  OpenMeshes open_meshes = OpenMeshes::Slab;
+  float slab_voxels = 1.5f;       ///< Slab thickness in voxels (the largest voxel side), > 0. 1.5 makes
+                                  ///< sure an edge-on wall still covers a column centre.
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+
+/// Numbers for --json.
+struct VoxelStats {
+  std::size_t triangles = 0;       ///< Triangles rasterised (slab prisms count 8 each).
+  std::size_t fragments = 0;       ///< Column-centre hits.
+  std::size_t odd_columns = 0;     ///< Columns whose parity ends at 1: open or leaky geometry.
+  std::size_t open_meshes = 0;     ///< Meshes with boundary edges.
+  std::size_t boundary_edges = 0;  ///< Over all meshes.
+  std::size_t set_voxels = 0;      ///< Solid voxels in the finished grid.
+};
+
+/// A binary voxel grid of columns of bits, and the map from space to voxel coordinates.
+/// Voxel coordinates are continuous: column (i, j) covers [i, i+1) x [j, j+1), voxel k covers
+/// [k, k+1) along the column; the voxel's centre is at +0.5.
+struct VoxelGrid {
+  GridSpace space = GridSpace::World;
+  int nx = 0, ny = 0;       ///< Columns.
+  int depth_bits = 0;       ///< Voxels per column.
+  int words = 0;            ///< 64-bit words per column = ceil(depth_bits / 64).
+  std::vector<std::uint64_t> bits;  ///< Column (i, j) is words [(j * nx + i) * words, ... + words).
+
+  // World grid: x -> i, z -> j, y -> k.
+  Vec3 origin;              ///< World point of voxel coordinate (0, 0, 0).
+  Vec3 voxel_size;          ///< World size of a voxel along (i, j, k) = (world x, world z, world y).
+
+  // Eye grid.
+  Camera camera;            ///< The G-buffer's camera; a column is a block of its pixels.
+  float pixels_per_column_x = 1, pixels_per_column_y = 1;
+  float z_far = 0;          ///< Linear depth of the far end of every column.
+  std::vector<float> z_near;        ///< Per column: z_nearest of eq. 2 (linear depth, world units).
+  std::vector<float> voxels_per_unit;  ///< Per column: depth_bits / (z_far - z_nearest).
+
+  /// Words of column (i, j), which must be inside the grid.
+  const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
+  /// Bit k of column (i, j).
+  bool voxel(int i, int j, int k) const { return (column(i, j)[k >> 6] >> (k & 63)) & 1u; }
+  /// Set voxels in the whole grid.
+  std::size_t count_set() const;
+};
+
+/// Set bits among bits [k0, k1) of a column of words (k0 and k1 are clamped to [0, 64 * words]).
+/// Whole words are counted with hardware popcount, partial ones through a mask.
+inline int count_bits(const std::uint64_t* column, int words, int k0, int k1) {
+  k0 = k0 < 0 ? 0 : k0;
+  k1 = k1 > 64 * words ? 64 * words : k1;
+  if (k1 <= k0) return 0;
+  const int w0 = k0 >> 6, w1 = (k1 - 1) >> 6;
+  const std::uint64_t lo_mask = ~std::uint64_t{0} << (k0 & 63);
+  const std::uint64_t hi_mask = ~std::uint64_t{0} >> (63 - ((k1 - 1) & 63));
+  if (w0 == w1) return std::popcount(column[w0] & lo_mask & hi_mask);
+  int n = std::popcount(column[w0] & lo_mask) + std::popcount(column[w1] & hi_mask);
+  for (int w = w0 + 1; w < w1; ++w) n += std::popcount(column[w]);
+  return n;
+}
+
+/// World-space grid of options.columns x options.columns columns over `scene`'s bounds (padded so
+/// that slabs fit), columns along world y. `closure` comes from analyze_closure(scene).
+VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& options, VoxelStats* stats = nullptr);
+
+/// The paper's eye-space grid for the G-buffer's camera (which must carry its world placement):
+/// columns are blocks of pixels, z_nearest per column is the smallest G-buffer depth in its block
+/// (eq. 2, local slice), z_far the farthest corner of the scene's bounds. Geometry outside the view
+/// frustum is not voxelized; triangles are clipped at a near plane in front of the eye.
+VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, const VoxelizeOptions& options,
+                       VoxelStats* stats = nullptr);
+
+}  // namespace ao

@@ -1,0 +1,163 @@
+// `ao render` as users and scripts meet it: outputs, JSON, exit codes, and bad input that gets a
+// one-line error, a non-zero exit and no output (SPEC, "Behaviour on bad input").
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run.h"
+
+namespace ao::test {
+namespace {
+
+const std::string kSmall = " --width 40 --height 30 --spp 16 ";
+
+// One line on stderr, starting "ao: error:", that mentions `needle`.
+void expect_one_line_error(const RunResult& r, const std::string& needle) {
+  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
+}
+
+TEST(RenderCli, DefaultSceneWritesImageAndJsonSummary) {
+  TempDir dir;
+  const RunResult r = run_ao("render" + kSmall + "-o v.exr --shaded s.png --gbuffer-out g.exr --json", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"v.exr", "s.png", "g.exr"}) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["scene"], "default");
+  EXPECT_EQ(j["method"], "raytraced");
+  EXPECT_EQ(j["width"], 40);
+  EXPECT_EQ(j["parameters"]["samples"], 16);
+  EXPECT_EQ(j["membership"], "step");
+  EXPECT_GT(j["radius"].get<double>(), 0.0);
+  EXPECT_GT(j["mean_visibility"].get<double>(), 0.0);
+  EXPECT_LE(j["mean_visibility"].get<double>(), 1.0);
+  EXPECT_GT(j["stats"]["rays"].get<double>(), 0.0);
+  EXPECT_GE(j["stats"]["max_std_error"].get<double>(), j["stats"]["mean_std_error"].get<double>());
+  for (const char* t : {"load_ms", "bvh_ms", "gbuffer_ms", "ao_ms", "write_ms"}) EXPECT_TRUE(j["timings"].contains(t)) << t;
+}
+
+TEST(RenderCli, WithoutOutputNamesTheFileAfterSceneAndMethod) {
+  TempDir dir;
+  const RunResult r = run_ao("render plane" + kSmall, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "plane-raytraced.png"));
+  EXPECT_NE(r.err.find("wrote plane-raytraced.png"), std::string::npos) << r.err;
+}
+
+TEST(RenderCli, RadiusCanBeGivenInWorldUnitsOrAsAFraction) {
+  TempDir dir;
+  auto radius = [&](const std::string& opt) {
+    const RunResult r = run_ao("render sphere-on-plane" + kSmall + "-o v.png --json " + opt, dir.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out)["radius"].get<double>();
+  };
+  EXPECT_NEAR(radius("--radius 0.75"), 0.75, 1e-6);
+  EXPECT_NEAR(radius("--radius-fraction 0.2"), 2.0 * radius("--radius-fraction 0.1"), 1e-5);
+}
+
+TEST(RenderCli, CameraOptionsOverrideTheFraming) {
+  TempDir dir;
+  const RunResult r = run_ao("render plane" + kSmall + "-o v.png --json --eye 0,5,5 --target 0,0,0 --fov 30", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto cam = nlohmann::json::parse(r.out)["camera"];
+  EXPECT_EQ(cam["eye"], nlohmann::json::array({0.0, 5.0, 5.0}));
+  EXPECT_EQ(cam["fov"], 30.0);
+}
+
+TEST(RenderCli, GBufferFileFeedsScreenSpaceMethodsButNotTheRayTracer) {
+  TempDir dir;
+  ASSERT_EQ(run_ao("render" + kSmall + "-o v.png --gbuffer-out g.exr", dir.path()).exit_code, 0);
+  const RunResult r = run_ao("render --gbuffer-in g.exr -o w.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "--gbuffer-in");
+  EXPECT_FALSE(std::filesystem::exists(dir / "w.png"));
+}
+
+TEST(RenderCli, MissingMeshIsAnInputError) {
+  TempDir dir;
+  const RunResult r = run_ao("render nowhere.obj -o v.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "nowhere.obj");
+  EXPECT_FALSE(std::filesystem::exists(dir / "v.png"));
+}
+
+TEST(RenderCli, UnknownSceneListsTheBuiltins) {
+  const RunResult r = run_ao("render teapot");
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "sphere-on-plane");
+}
+
+TEST(RenderCli, MalformedMeshesFailWithoutOutputAndKeepExistingFiles) {
+  TempDir dir;
+  write_text(dir / "keep.png", "previous contents");
+  const std::pair<const char*, const char*> cases[] = {
+      {"truncated.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n"},
+      {"nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"},
+      {"index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"},
+      {"huge.off", "OFF\n2000000000 2000000000 0\n0 0 0\n"},
+      {"degenerate.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n"},
+      {"garbage.obj", "\x7f\x01\x02 this is not a mesh\n"},
+      {"empty.stl", ""},
+  };
+  for (const auto& [name, text] : cases) {
+    write_text(dir / name, text);
+    const RunResult r = run_ao(std::string("render ") + name + " -o keep.png", dir.path());
+    EXPECT_EQ(r.exit_code, 1) << name << ": " << r.err;
+    expect_one_line_error(r, name);
+    EXPECT_EQ(read_text(dir / "keep.png"), "previous contents") << name;
+  }
+  // Nothing but the inputs and the untouched file: no temporary files left behind.
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path())) ++files;
+  EXPECT_EQ(files, std::size(cases) + 1);
+}
+
+TEST(RenderCli, AbsurdOptionsAreInputErrors) {
+  TempDir dir;
+  const std::pair<const char*, const char*> cases[] = {
+      {"--width 100000", "resolution"},
+      {"--height 0", "resolution"},
+      {"--spp 0", "samples"},
+      {"--spp 100000000", "samples"},
+      {"--target-error -1", "target error"},
+      {"--radius -2", "radius"},
+      {"--fov 200", "fov"},
+      {"--membership cosine", "cosine"},
+      {"--method magic", "magic"},
+      {"--eye 1,2", "--eye"},
+      {"--eye 0,0,0 --target 0,0,0", "same point"},
+      {"-p bogus=1", "bogus"},
+      {"--png-bits 12", "png-bits"},
+  };
+  for (const auto& [opt, needle] : cases) {
+    const RunResult r = run_ao(std::string("render plane -o v.png ") + opt, dir.path());
+    EXPECT_EQ(r.exit_code, 1) << opt << ": " << r.err;
+    expect_one_line_error(r, needle);
+    EXPECT_FALSE(std::filesystem::exists(dir / "v.png")) << opt;
+  }
+}
+
+TEST(RenderCli, UnwritableOutputIsAnErrorNamingIt) {
+  TempDir dir;
+  const RunResult r = run_ao("render plane" + kSmall + "-o missing-dir/v.png", dir.path());
+  EXPECT_NE(r.exit_code, 0);
+  expect_one_line_error(r, "missing-dir");
+}
+
+TEST(RenderCli, UnknownExtensionIsRejected) {
+  TempDir dir;
+  const RunResult r = run_ao("render plane" + kSmall + "-o v.bmp", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, ".png");
+}
+
+TEST(RenderCli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(run_ao("render --width abc").exit_code, 2);
+  EXPECT_EQ(run_ao("render --no-such-option").exit_code, 2);
+  EXPECT_EQ(run_ao("").exit_code, 2);
+  EXPECT_EQ(run_ao("render --help").exit_code, 0);
+}
+
+}  // namespace
+}  // namespace ao::test

@@ -1,0 +1,36 @@
+// Runs the `ao` binary the way a user or a script does and captures what it says.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace ao::test {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;  ///< stdout
+  std::string err;  ///< stderr
+};
+
+/// Runs `AO_CLI_PATH args` through the shell in `cwd` (the current directory when empty).
+RunResult run_ao(const std::string& args, const std::filesystem::path& cwd = {});
+
+/// A fresh empty directory under the system temp directory, removed by the destructor.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Writes `text` to `path`.
+void write_text(const std::filesystem::path& path, const std::string& text);
+std::string read_text(const std::filesystem::path& path);
+
+}  // namespace ao::test

@@ -9,7 +9,10 @@
 #pragma once
 
 #include <array>
+#include <initializer_list>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
@@ -23,6 +26,17 @@ struct InterleaveOptions {
   bool filter = true;              ///< 4x4 depth-aware box filter after an interleaved pass (ignored without interleave).
   float filter_depth_limit = 0.0f; ///< Neighbours whose depth differs by more than this are skipped, world units; 0 = R/4.
 };
+
+/// Writes the options' fields into `j` (a method's parameter object).
+void add_interleave_options(nlohmann::json& j, const InterleaveOptions& o);
+/// Reads the options' fields present in `j`; InputError (naming `method`) for wrong types.
+void read_interleave_options(const nlohmann::json& j, InterleaveOptions& o, const char* method);
+/// InputError naming `method` and the key when `j` is not an object or has a key not in `keys`.
+void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys, const char* method);
+/// Validates the options (the depth limit must be finite and >= 0).
+void validate_interleave_options(const InterleaveOptions& o, const char* method);
+/// The depth limit the filter uses: `filter_depth_limit`, or R/4 when it is 0.
+float effective_depth_limit(const InterleaveOptions& o, float radius);
 
 /// A run of pixels [x0, x0 + count) of one row, structure-of-arrays. Uncovered pixels get a
 /// harmless dummy point far in front of the camera and covered = 0.

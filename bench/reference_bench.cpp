@@ -96,6 +96,41 @@ void minimal_loop(benchmark::State& state, Fixture* f) {
   state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
 }
 
+// The same rays one at a time (rtcOccluded1): what the packets are measured against.
+void minimal_loop_single_rays(benchmark::State& state, Fixture* f) {
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const GBuffer& g = f->gbuffer;
+  const Frame basis = g.camera.basis();
+  const float offset = f->rays.self_intersection_offset(), R = f->falloff.radius;
+  std::uint64_t rays = 0;
+  for (auto _ : state) {
+    std::atomic<std::uint64_t> hits{0};
+    parallel_for_tiles(g.width(), g.height(), 16, [&](const Tile& t) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::uint64_t local = 0;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x) {
+          if (!g.covered(x, y)) continue;
+          const Vec3 n = basis.to_world(g.normal(x, y));
+          const Vec3 o = basis.to_world(g.position(x, y)) + g.camera.eye + n * offset;
+          const Frame frame = Frame::from_normal(n);
+          const std::uint32_t seed = pixel_seed(1, x, y);
+          for (int i = 0; i < kSamples; ++i) {
+            const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(i), seed)));
+            RTCRay ray{o.x, o.y, o.z, 0.0f, d.x, d.y, d.z, 0.0f, R, ~0u, 0, 0};
+            rtcOccluded1(f->rays.handle(), &ctx, &ray);
+            local += ray.tfar < 0;
+          }
+        }
+      hits += local;
+    });
+    benchmark::DoNotOptimize(hits.load());
+  }
+  for (std::size_t i = 0; i < g.coverage.size(); ++i) rays += g.coverage[i] ? kSamples : 0;
+  state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+}
+
 void raytraced(benchmark::State& state, Fixture* f) {
   if (!f) return state.SkipWithError("../shared/data/meshes not found");
   std::uint64_t rays = 0;
@@ -109,6 +144,7 @@ void raytraced(benchmark::State& state, Fixture* f) {
 BENCHMARK_CAPTURE(gbuffer, default_scene, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer, elephant_on_ground, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(minimal_loop, elephant_on_ground_64spp, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(minimal_loop_single_rays, elephant_on_ground_64spp, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK_CAPTURE(raytraced, elephant_on_ground_64spp, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK_CAPTURE(minimal_loop, default_scene_64spp, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK_CAPTURE(raytraced, default_scene_64spp, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);

@@ -62,6 +62,7 @@ void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, GBuffe
 
 template <int N>
 void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const RayGenerator& gen, GBuffer& g, const Tile& t) {
+  detail::flush_denormals_to_zero();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;

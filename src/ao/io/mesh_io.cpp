@@ -181,9 +181,9 @@ Scene read_off(const fs::path& path, std::string_view data) {
   // Check the counts against the size before allocating: the shortest vertex line is "0 0 0\n"
   // (6 bytes) and the shortest face line "3 0 0 0\n" (8 bytes), so a hostile header cannot make us
   // reserve more than a small multiple of the file size.
-  const long long min_bytes = 6 * vertex_count + 8 * face_count;  // counts are < 2^63 / 8 after the next check
-  if (vertex_count > std::numeric_limits<std::uint32_t>::max() || face_count > std::numeric_limits<std::uint32_t>::max() ||
-      min_bytes > static_cast<long long>(data.size()))
+  // Counts above 2^32 fail first, so the products below cannot overflow.
+  const long long max_count = std::numeric_limits<std::uint32_t>::max();
+  if (vertex_count > max_count || face_count > max_count || 6 * vertex_count + 8 * face_count > static_cast<long long>(data.size()))
     fail(path, "header says " + std::to_string(vertex_count) + " vertices and " + std::to_string(face_count) +
              " faces but the file has only " + std::to_string(data.size()) + " bytes");
 

@@ -3,8 +3,18 @@
 #pragma once
 
 #include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
 
 namespace ao::detail {
+
+/// Embree asks for flush-to-zero and denormals-are-zero on every thread that traces (denormal
+/// arithmetic in traversal is slow). Kernels call this at the start of each parallel task: two
+/// register writes, cheaper than tracking which pool threads have it already.
+inline void flush_denormals_to_zero() {
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
 
 template <int N>
 struct Packet;

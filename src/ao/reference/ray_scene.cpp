@@ -1,12 +1,7 @@
 #include "ao/reference/ray_scene.h"
 
-#include <pmmintrin.h>
-#include <xmmintrin.h>
-
 #include <cstring>
 #include <string>
-
-#include <tbb/task_scheduler_observer.h>
 
 #include "ao/core/error.h"
 
@@ -26,25 +21,9 @@ void check(RTCDevice device, const char* what) {
   if (e != RTC_ERROR_NONE) throw SystemError(std::string("embree: ") + what + " failed (error " + std::to_string(static_cast<int>(e)) + ")");
 }
 
-// Embree asks for flush-to-zero and denormals-are-zero on every thread that traces: denormal
-// arithmetic in traversal is slow. TBB's worker threads get it when they join the scheduler.
-void set_flush_to_zero() {
-  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-}
-
-class FlushToZeroObserver : public tbb::task_scheduler_observer {
- public:
-  FlushToZeroObserver() { observe(true); }
-  ~FlushToZeroObserver() override { observe(false); }
-  void on_scheduler_entry(bool /*worker*/) override { set_flush_to_zero(); }
-};
-
 }  // namespace
 
 RayScene::RayScene(const Scene& scene) : source_(scene), bounds_(scene.bounds()) {
-  static FlushToZeroObserver observer;
-  set_flush_to_zero();
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw SystemError("embree: cannot create a device (does this CPU support SSE2?)");
   rtcSetDeviceErrorFunction(device_, on_embree_error, nullptr);

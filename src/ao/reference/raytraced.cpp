@@ -163,6 +163,7 @@ RaytracedImage render_raytraced(const RayScene& rs, const GBuffer& g, const Fall
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+      detail::flush_denormals_to_zero();
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
       for (int y = t.y0; y < t.y1; ++y)

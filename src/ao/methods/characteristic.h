@@ -9,8 +9,8 @@
 // > 0 when p is in front of the surface (outer), < 0 behind it (inner), +infinity when no
 // surface is crossed along the view axis. I(p) = [distance(p) >= -bias].
 //
-// Kinds (each a small value type with an inline `distance`, so kernels templated on the type
-// inline it into their vectorised loops; no virtual calls):
+// Kinds (each a small, cheap-to-copy value type with an inline `distance`, so kernels templated
+// on the type copy it into locals and inline it into their vectorised loops; no virtual calls):
 //  - DepthBufferCharacteristic: the G-buffer's depth at p's projection (VAO fig. 2c). Points
 //    projecting outside the image or onto background are free (distance = +infinity).
 //  - ImplicitCharacteristic: f(p) >= 0 for f = min of analytic primitives (planes, sphere
@@ -22,8 +22,9 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <vector>
+#include <limits>
 
 #include "ao/core/camera.h"
 #include "ao/core/gbuffer.h"
@@ -44,15 +45,17 @@ struct ScreenProjection {
     return {0.5f * static_cast<float>(c.width) / (t * c.aspect()), 0.5f * static_cast<float>(c.height) / t,
             0.5f * static_cast<float>(c.width), 0.5f * static_cast<float>(c.height), c.width, c.height};
   }
-  /// Index y * width + x of the pixel containing p's projection, or -1 when p is behind the camera
-  /// or projects outside the image. Branch-free, so loops over it vectorise (with gathers).
-  int index(float x, float y, float z) const {
+  /// Sets `index` to y * width + x of the pixel containing p's projection and returns true, or
+  /// sets it to 0 and returns false when p is behind the camera or projects outside the image.
+  /// Branch-free, so loops over it vectorise (with gathers).
+  bool locate(float x, float y, float z, int& index) const {
     const float inv = -1.0f / z;
     const float fx = x * inv * scale_x + centre_x;
     const float fy = centre_y - y * inv * scale_y;
-    const bool valid = z < 0.0f && fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(width) && fy < static_cast<float>(height);
+    const bool valid = (z < 0.0f) & (fx >= 0.0f) & (fy >= 0.0f) & (fx < static_cast<float>(width)) & (fy < static_cast<float>(height));
     const int ix = static_cast<int>(valid ? fx : 0.0f), iy = static_cast<int>(valid ? fy : 0.0f);
-    return valid ? iy * width + ix : -1;
+    index = iy * width + ix;
+    return valid;
   }
 };
 
@@ -65,9 +68,10 @@ struct DepthBufferCharacteristic {
   explicit DepthBufferCharacteristic(const GBuffer& g) : projection(ScreenProjection::from_camera(g.camera)), depth(g.depth.data()) {}
 
   float distance(float x, float y, float z) const {
-    const int i = projection.index(x, y, z);
-    const float zs = depth[i < 0 ? 0 : i];
-    return i < 0 ? kInfinity : zs + z;  // z* - depth(p) with depth(p) = -z
+    int i;
+    const bool valid = projection.locate(x, y, z, i);
+    const float zs = depth[i];  // index 0 when off screen: always readable, so the gather is unconditional
+    return valid ? zs + z : kInfinity;  // z* - depth(p) with depth(p) = -z
   }
 };
 
@@ -92,10 +96,11 @@ struct ImplicitPrimitive {
 /// Taylor step of VAO (eq. after fig. 2) for one implicit function with value f and gradient g:
 /// along the depth direction (0, 0, -1) the surface is at depth offset -f / (df/d depth) with
 /// df/d depth = -g.z. Where the surface does not get nearer going deeper (df/d depth >= 0) the
-/// line never enters the inner region ahead of p: +infinity from outside, -infinity from inside.
+/// line never enters the inner region ahead of p: +infinity from outside, -FLT_MAX from inside
+/// (inner along the whole line, finite so that "d > -infinity" comparisons hold).
 inline float taylor_depth_distance(float f, float gz) {
   constexpr float kFlat = 1e-6f;  // |df/d depth| below this: the line runs along the surface
-  if (gz <= kFlat) return f >= 0.0f ? kInfinity : -kInfinity;
+  if (gz <= kFlat) return f >= 0.0f ? kInfinity : -std::numeric_limits<float>::max();
   return f / gz;
 }
 
@@ -104,12 +109,23 @@ inline float taylor_depth_distance(float f, float gz) {
 /// sphere resting on a plane). The distance is the nearest surface crossing ahead, the minimum of
 /// the primitives' Taylor distances.
 struct ImplicitCharacteristic {
-  std::vector<ImplicitPrimitive> primitives;
+  static constexpr int kMaxPrimitives = 4;
+  std::array<ImplicitPrimitive, kMaxPrimitives> primitives{};  ///< The first `count` are used.
+  int count = 0;
 
+  /// Adds a primitive; at most kMaxPrimitives (the type stays a cheap-to-copy value).
+  ImplicitCharacteristic& add(const ImplicitPrimitive& q) {
+    AO_ASSERT(count < kMaxPrimitives);
+    primitives[static_cast<std::size_t>(count++)] = q;
+    return *this;
+  }
   float distance(float x, float y, float z) const {
     const Vec3 p{x, y, z};
     float d = kInfinity;
-    for (const ImplicitPrimitive& q : primitives) d = std::min(d, taylor_depth_distance(q.value(p), q.gradient(p).z));
+    for (int k = 0; k < count; ++k) {
+      const ImplicitPrimitive& q = primitives[static_cast<std::size_t>(k)];
+      d = std::min(d, taylor_depth_distance(q.value(p), q.gradient(p).z));
+    }
     return d;
   }
 };
@@ -120,18 +136,18 @@ struct ImplicitCharacteristic {
 struct HeightFieldCharacteristic {
   Vec3 origin{};            ///< A point of the macrostructure plane, camera space.
   Frame frame{};            ///< Tangent, bitangent, normal (towards the outer side), camera space.
-  Image<float> map;         ///< Heights in [0, 1] (any values work), tiled; must be non-empty.
+  ImageView<const float> map;  ///< Heights in [0, 1] (any values work), tiled; non-empty; must outlive this.
   float period = 1.0f;      ///< World units covered by the map along u and v, > 0.
   float amplitude = 0.1f;   ///< World units of height for map value 1.
 
   /// h(u, v), world units.
   float height(float u, float v) const {
-    const float fx = u / period * static_cast<float>(map.width()) - 0.5f;
-    const float fy = v / period * static_cast<float>(map.height()) - 0.5f;
+    const float fx = u / period * static_cast<float>(map.width) - 0.5f;
+    const float fy = v / period * static_cast<float>(map.height) - 0.5f;
     const float x0 = std::floor(fx), y0 = std::floor(fy);
     const float ax = fx - x0, ay = fy - y0;
     auto at = [&](float xi, float yi) {
-      const int w = map.width(), h = map.height();
+      const int w = map.width, h = map.height;
       const int ix = ((static_cast<int>(xi) % w) + w) % w, iy = ((static_cast<int>(yi) % h) + h) % h;
       return map(ix, iy);
     };
@@ -145,7 +161,7 @@ struct HeightFieldCharacteristic {
     const Vec3 l = frame.to_local(p - origin);
     const float f = l.z - height(l.x, l.y);
     if (gradient) {
-      const float e = 0.1f * period / static_cast<float>(std::max(map.width(), map.height()));
+      const float e = 0.1f * period / static_cast<float>(std::max(map.width, map.height));
       const float hu = (height(l.x + e, l.y) - height(l.x - e, l.y)) / (2 * e);
       const float hv = (height(l.x, l.y + e) - height(l.x, l.y - e)) / (2 * e);
       *gradient = frame.to_world({-hu, -hv, 1.0f});
@@ -167,6 +183,10 @@ struct ProductCharacteristic {
   B b;
   float distance(float x, float y, float z) const { return std::min(a.distance(x, y, z), b.distance(x, y, z)); }
 };
+
+/// A periodic displacement map for HeightFieldCharacteristic: `bumps` x `bumps` smooth domes
+/// (cos^2 profile, height 1 at their centres, 0 between them) on a size x size map.
+Image<float> make_bump_map(int size, int bumps);
 
 using DepthTimesHeightField = ProductCharacteristic<DepthBufferCharacteristic, HeightFieldCharacteristic>;
 

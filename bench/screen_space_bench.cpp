@@ -1,0 +1,81 @@
+// Screen-space AO passes (containment, volumetric, transfer) and the 4x4 depth-aware box filter,
+// AO pass only: the G-buffer of the built-in default scene at 1280x720 is rendered once outside
+// the timed loops. 12 samples per pixel (VAO fig. 12's count), R = 0.1 x scene diagonal (the
+// CLI's default). Thread count: whatever TBB is given (run with taskset -c 0,1 for 2 threads).
+#include <benchmark/benchmark.h>
+
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/methods/containment.h"
+#include "ao/methods/interleave.h"
+#include "ao/methods/transfer.h"
+#include "ao/methods/volumetric.h"
+#include "bench_scenes.h"
+
+namespace ao::bench {
+namespace {
+
+constexpr int kWidth = 1280, kHeight = 720, kSamples = 12;
+
+struct Fixture {
+  Scene scene = make_builtin_scene("default");
+  RayScene rays{scene};
+  GBuffer g = render_gbuffer(rays, framed(scene, kWidth, kHeight));
+  float radius = 0.1f * scene.bounds().diagonal();
+};
+
+Fixture& demo() {
+  static Fixture f;
+  return f;
+}
+
+void rate(benchmark::State& state) {
+  state.counters["Mpix/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+}
+
+void containment(benchmark::State& state) {
+  Fixture& f = demo();
+  ContainmentParams p{.samples = kSamples};
+  p.interleave.filter = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(containment_ao(f.g, {Membership::Step, f.radius}, p, 1));
+  rate(state);
+}
+
+void volumetric(benchmark::State& state) {
+  Fixture& f = demo();
+  VolumetricParams p{.samples = kSamples};
+  p.interleave.filter = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(volumetric_ao(f.g, f.radius, p, 1));
+  rate(state);
+}
+
+void transfer(benchmark::State& state) {
+  Fixture& f = demo();
+  TransferParams p{.samples = kSamples, .ray_steps = static_cast<int>(state.range(1))};
+  p.interleave.filter = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(transfer_ao(f.g, {Membership::Step, f.radius}, p, 1));
+  rate(state);
+}
+
+void box_filter(benchmark::State& state) {
+  Fixture& f = demo();
+  const Image<float> v(kWidth, kHeight, 0.5f);
+  for (auto _ : state) benchmark::DoNotOptimize(depth_aware_box_filter(v, f.g, 0.25f * f.radius));
+  rate(state);
+}
+
+void box_filter_rgb(benchmark::State& state) {
+  Fixture& f = demo();
+  const Image<Vec3> v(kWidth, kHeight, Vec3{0.5f, 0.5f, 0.5f});
+  for (auto _ : state) benchmark::DoNotOptimize(depth_aware_box_filter(v, f.g, 0.25f * f.radius));
+  rate(state);
+}
+
+// Arg: filter on (1) / off (0); transfer's second arg is m (tests per ray).
+BENCHMARK(containment)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(volumetric)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(transfer)->Args({0, 1})->Args({1, 1})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(box_filter)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(box_filter_rgb)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+}  // namespace
+}  // namespace ao::bench

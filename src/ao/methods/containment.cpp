@@ -1,0 +1,102 @@
+#include "ao/methods/containment.h"
+
+#include <string>
+
+#include "ao/core/error.h"
+#include "ao/core/parallel.h"
+#include "ao/methods/characteristic.h"
+#include "ao/methods/samples.h"
+
+namespace ao {
+
+namespace {
+constexpr int kTile = 64;  // pixels per row segment: four 16-lane vectors; rows of a tile share cache lines of the depth buffer
+}
+
+void ContainmentParams::validate() const {
+  if (samples < 1 || samples > kMaxScreenSpaceSamples)
+    throw InputError("containment: samples must be in [1, " + std::to_string(kMaxScreenSpaceSamples) + "], got " + std::to_string(samples));
+  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("containment: bias must be a finite number >= 0 of world units (0 = auto)");
+  validate_interleave_options(interleave, "containment");
+}
+
+void to_json(nlohmann::json& j, const ContainmentParams& p) {
+  j = {{"samples", p.samples}, {"silhouette_elimination", p.silhouette_elimination}, {"bias", p.bias}};
+  add_interleave_options(j, p.interleave);
+}
+
+void from_json(const nlohmann::json& j, ContainmentParams& p) {
+  require_known_keys(j, {"samples", "silhouette_elimination", "bias", "interleave", "filter", "filter_depth_limit"}, "containment");
+  try {
+    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
+    if (j.contains("silhouette_elimination")) p.silhouette_elimination = j.at("silhouette_elimination").get<bool>();
+    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("containment: bad parameter type: ") + e.what());
+  }
+  read_interleave_options(j, p.interleave, "containment");
+}
+
+template <class Characteristic>
+Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Falloff& falloff, const ContainmentParams& params,
+                            std::uint32_t seed) {
+  falloff.validate();
+  params.validate();
+  const int w = g.width(), h = g.height();
+  const ContainmentSamples s = make_containment_samples(params.samples, falloff);
+  const std::array<Rotation, 16> rotations = interleave_rotations(seed, params.interleave.interleave);
+  // AT 4.3: a test point is occluded only if R > z - z* > 0, i.e. distance in (-R, -bias).
+  const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;
+  const float inv_n = 1.0f / static_cast<float>(params.samples);
+  Image<float> v(w, h, 1.0f);
+  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+    // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
+    const Characteristic local_ch = ch;
+    PixelRow row;
+    std::vector<float> open(static_cast<std::size_t>(t.x1 - t.x0));
+    for (int y = t.y0; y < t.y1; ++y) {
+      row.load(g, y, t.x0, t.x1, rotations, params.bias);
+      const int count = row.count;
+      std::fill(open.begin(), open.end(), 0.0f);
+      float* __restrict o = open.data();
+      const float *px = row.px.data(), *py = row.py.data(), *pz = row.pz.data();
+      const float *tx = row.tx.data(), *ty = row.ty.data(), *tz = row.tz.data();
+      const float *bx = row.bx.data(), *by = row.by.data(), *bz = row.bz.data();
+      const float *nx = row.nx.data(), *ny = row.ny.data(), *nz = row.nz.data();
+      const float* bias = row.bias.data();
+      for (int i = 0; i < s.size(); ++i) {
+        const float X = s.x[static_cast<std::size_t>(i)], Y = s.y[static_cast<std::size_t>(i)], Z = s.z[static_cast<std::size_t>(i)];
+        // Across the pixels of the row: SIMD lanes, one gather of the depth buffer per vector.
+// Lane k writes only its own accumulator; the gathers read the (read-only) G-buffer.
+#pragma GCC ivdep
+        for (int k = 0; k < count; ++k) {
+          // VAO eq. 5: p_i = x + X_i T + Y_i B + Z_i N.
+          const float qx = px[k] + X * tx[k] + Y * bx[k] + Z * nx[k];
+          const float qy = py[k] + X * ty[k] + Y * by[k] + Z * ny[k];
+          const float qz = pz[k] + X * tz[k] + Y * bz[k] + Z * nz[k];
+          const float d = local_ch.distance(qx, qy, qz);
+          // AT 4.3. (This exact form vectorises; with elimination on, an implicit surface's -inf,
+          // "inner along the whole line", counts as distant: analytic uses turn elimination off.)
+          const bool occluded = (d < -bias[k]) & (d > far_limit);
+          o[k] += occluded ? 0.0f : 1.0f;
+        }
+      }
+      for (int k = 0; k < count; ++k)
+        if (row.covered[static_cast<std::size_t>(k)]) v(t.x0 + k, y) = o[k] * inv_n;
+    }
+  });
+  if (params.interleave.interleave && params.interleave.filter)
+    v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, falloff.radius));
+  return v;
+}
+
+Image<float> containment_ao(const GBuffer& g, const Falloff& falloff, const ContainmentParams& params, std::uint32_t seed) {
+  return containment_ao(g, DepthBufferCharacteristic(g), falloff, params, seed);
+}
+
+template Image<float> containment_ao(const GBuffer&, const DepthBufferCharacteristic&, const Falloff&, const ContainmentParams&, std::uint32_t);
+template Image<float> containment_ao(const GBuffer&, const ImplicitCharacteristic&, const Falloff&, const ContainmentParams&, std::uint32_t);
+template Image<float> containment_ao(const GBuffer&, const HeightFieldCharacteristic&, const Falloff&, const ContainmentParams&, std::uint32_t);
+template Image<float> containment_ao(const GBuffer&, const DepthTimesHeightField&, const Falloff&, const ContainmentParams&, std::uint32_t);
+
+}  // namespace ao

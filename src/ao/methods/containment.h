@@ -1,0 +1,49 @@
+// Containment-test ambient occlusion. Based on Szirmay-Kalos, Umenhoffer, Toth, Szecsi, Sbert,
+// "Volumetric Ambient Occlusion for Real-Time Rendering and Games" (VAO), eq. 4-5, with the
+// samples of Umenhoffer, Toth, Szirmay-Kalos, "Efficient Methods for Ambient Lighting" (AT),
+// sec. 4-4.3:
+//
+//   O(x) ~ (1/n) sum_i I(x + X_i T + Y_i B + Z_i N)                              (VAO eq. 5)
+//
+// with (X_i, Y_i, Z_i) = w_i r_i, w_i cosine distributed and r_i = mu^-1(xi_i) (AT eq. 8), so the
+// estimate approximates the obscurance of eq. 2 with the user's membership mu, exactly when a
+// ray meets the surface at most once within R. The paper's O is already openness: V = O.
+// Additions from the papers: Poisson-disk samples by Lloyd relaxation (AT 4.1), 4x4 interleaved
+// sampling + depth-aware box filter (VAO and AT 4.2), silhouette-shadow elimination (AT 4.3).
+#pragma once
+
+#include <cstdint>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/core/gbuffer.h"
+#include "ao/core/membership.h"
+#include "ao/methods/interleave.h"
+
+namespace ao {
+
+struct ContainmentParams {
+  int samples = 12;                   ///< n in eq. 5: test points per pixel, [1, 256].
+  bool silhouette_elimination = true; ///< AT 4.3: a point is occluded only if the surface in front of it is less than R in front.
+  float bias = 0.0f;                  ///< Depth-test bias, world units, >= 0; 0 = auto (one pixel footprint x (1 + tan theta_v)).
+  InterleaveOptions interleave;       ///< sec. 4.2 options.
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+void to_json(nlohmann::json& j, const ContainmentParams& p);
+/// Rejects unknown keys and wrong types with InputError.
+void from_json(const nlohmann::json& j, ContainmentParams& p);
+
+/// V per pixel (1 where not covered) with characteristic function `ch` (characteristic.h;
+/// instantiated for DepthBufferCharacteristic, ImplicitCharacteristic, HeightFieldCharacteristic
+/// and DepthTimesHeightField), interleaved and filtered as `params` say. Deterministic for a seed,
+/// independent of the thread count.
+template <class Characteristic>
+Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Falloff& falloff, const ContainmentParams& params,
+                            std::uint32_t seed);
+
+/// The screen-space method: containment_ao with the G-buffer's depth buffer.
+Image<float> containment_ao(const GBuffer& g, const Falloff& falloff, const ContainmentParams& params, std::uint32_t seed);
+
+}  // namespace ao

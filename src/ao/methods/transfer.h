@@ -1,0 +1,60 @@
+// Ambient transfer. Based on Umenhoffer, Toth, Szirmay-Kalos, "Efficient Methods for Ambient
+// Lighting" (AT), eq. 6, 7 and 9:
+//
+//   W(x) ~ sum_i I(p_i) / (n - sum_i (1 - I(p_i)) a~(p_i))        per RGB channel   (eq. 9)
+//
+// with the containment-test samples p_i = x + X_i T + Y_i B + Z_i N of eq. 8 (cosine directions,
+// r_i = mu^-1(xi)), I(p_i) the product of m tests at r_i j/m, j = 1..m, along the ray (sec. 4),
+// and a~ the albedo read at the projection of the first test point found occluded (sec. 4). W is
+// obscurance plus the light of further bounces off nearby surfaces of albedo a, under the
+// assumption W(y) ~ W(x) (eq. 6); W >= O, and W -> O as a -> 0. The obscurance O = (1/n) sum I
+// (eq. 5) comes out of the same tests. Shading is L = a W La (eq. 2).
+//
+// Output: `color` = W per channel, `visibility` = Rec. 709 luminance of W, extra "obscurance" = O.
+// The reference is the ray-traced obscurance of the user's membership (which W approaches as the
+// albedo goes to 0); a ray-traced ambient transfer reference is not implemented.
+#pragma once
+
+#include <cstdint>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/core/gbuffer.h"
+#include "ao/core/membership.h"
+#include "ao/methods/interleave.h"
+
+namespace ao {
+
+struct TransferParams {
+  int samples = 12;                   ///< n in eq. 9: rays per pixel, [1, 256].
+  int ray_steps = 2;                  ///< m: containment tests per ray (sec. 4: "in practice 1 or 2"), [1, 8].
+  bool silhouette_elimination = true; ///< AT 4.3: occluded only if the surface in front is less than R in front.
+  float bias = 0.0f;                  ///< Depth-test bias, world units, >= 0; 0 = auto (as containment).
+  float albedo_scale = 1.0f;          ///< Multiplies a~ (studies of W -> O as albedo -> 0), [0, 1].
+  InterleaveOptions interleave;       ///< sec. 4.2 options; the filter runs on W and O alike.
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+void to_json(nlohmann::json& j, const TransferParams& p);
+/// Rejects unknown keys and wrong types with InputError.
+void from_json(const nlohmann::json& j, TransferParams& p);
+
+struct TransferImage {
+  Image<Vec3> transfer;      ///< W per RGB channel, in [0, 1]; 1 where not covered.
+  Image<float> obscurance;   ///< O (eq. 5), in [0, 1]; 1 where not covered.
+  Image<float> luminance;    ///< Rec. 709 luminance of W: the method's scalar visibility.
+};
+
+/// Ambient transfer with characteristic function `ch` (instantiated as containment_ao's) and the
+/// multi-bounce reflectance `indirect` read at occluded test points: the G-buffer's albedo
+/// (eq. 9), or a radiance image of the same size (the option at the end of AT 4.1, which brings
+/// direct lights into the indirect term). Deterministic for a seed, independent of threads.
+template <class Characteristic>
+TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Image<Vec3>& indirect, const Falloff& falloff,
+                          const TransferParams& params, std::uint32_t seed);
+
+/// The screen-space method: depth buffer, G-buffer albedo.
+TransferImage transfer_ao(const GBuffer& g, const Falloff& falloff, const TransferParams& params, std::uint32_t seed);
+
+}  // namespace ao

@@ -1,0 +1,125 @@
+#include "ao/methods/volumetric.h"
+
+#include <cmath>
+#include <string>
+
+#include "ao/core/error.h"
+#include "ao/core/parallel.h"
+#include "ao/methods/characteristic.h"
+#include "ao/methods/samples.h"
+
+namespace ao {
+
+namespace {
+constexpr int kTile = 64;
+}
+
+void VolumetricParams::validate() const {
+  if (samples < 1 || samples > kMaxScreenSpaceSamples)
+    throw InputError("volumetric: samples must be in [1, " + std::to_string(kMaxScreenSpaceSamples) + "], got " + std::to_string(samples));
+  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("volumetric: bias must be a finite number >= 0 of world units (0 = auto)");
+  validate_interleave_options(interleave, "volumetric");
+}
+
+void to_json(nlohmann::json& j, const VolumetricParams& p) {
+  j = {{"samples", p.samples},
+       {"normalizer", p.normalizer == VolumeNormalizer::Analytic ? "analytic" : "wis"},
+       {"silhouette_elimination", p.silhouette_elimination},
+       {"bias", p.bias}};
+  add_interleave_options(j, p.interleave);
+}
+
+void from_json(const nlohmann::json& j, VolumetricParams& p) {
+  require_known_keys(j, {"samples", "normalizer", "silhouette_elimination", "bias", "interleave", "filter", "filter_depth_limit"}, "volumetric");
+  try {
+    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
+    if (j.contains("normalizer")) {
+      const std::string n = j.at("normalizer").get<std::string>();
+      if (n == "wis") p.normalizer = VolumeNormalizer::WeightedImportance;
+      else if (n == "analytic") p.normalizer = VolumeNormalizer::Analytic;
+      else throw InputError("volumetric: normalizer must be \"wis\" or \"analytic\", got \"" + n + "\"");
+    }
+    if (j.contains("silhouette_elimination")) p.silhouette_elimination = j.at("silhouette_elimination").get<bool>();
+    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("volumetric: bad parameter type: ") + e.what());
+  }
+  read_interleave_options(j, p.interleave, "volumetric");
+}
+
+template <class Characteristic>
+Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float radius, const VolumetricParams& params, std::uint32_t seed) {
+  Falloff{Membership::Cubic, radius}.validate();
+  params.validate();
+  const int w = g.width(), h = g.height();
+  const DiskSamples s = make_disk_samples(params.samples);
+  const std::array<Rotation, 16> rotations = interleave_rotations(seed, params.interleave.interleave);
+  const float R = radius, half_r = 0.5f * radius;
+  // Eq. 7: F = R sum h_i (weighted importance: the samples' own estimate of |S|, whose error is
+  // correlated with that of the free volume) or the exact 2Rn/3.
+  float sum_h = 0;
+  for (float hi : s.h) sum_h += hi;
+  const float F = params.normalizer == VolumeNormalizer::WeightedImportance ? R * sum_h : 2.0f * R * static_cast<float>(params.samples) / 3.0f;
+  const float inv_f = 1.0f / F;
+  // AT 4.3 for pipes: a surface more than R in front of the pipe's entry is a distant foreground
+  // object and does not occlude (z_entry - z* > R).
+  const float far_limit = params.silhouette_elimination ? -R : -kInfinity;
+  Image<float> v(w, h, 1.0f);
+  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+    // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
+    const Characteristic local_ch = ch;
+    PixelRow row;
+    std::vector<float> cx, cy, cz, free_len;
+    for (int y = t.y0; y < t.y1; ++y) {
+      row.load(g, y, t.x0, t.x1, rotations, params.bias);
+      const int count = row.count;
+      cx.resize(static_cast<std::size_t>(count));
+      cy.resize(static_cast<std::size_t>(count));
+      cz.resize(static_cast<std::size_t>(count));
+      free_len.assign(static_cast<std::size_t>(count), 0.0f);
+      // Fig. 4: the tangent sphere's centre x + N R/2.
+      for (int k = 0; k < count; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        cx[i] = row.px[i] + half_r * row.nx[i];
+        cy[i] = row.py[i] + half_r * row.ny[i];
+        cz[i] = row.pz[i] + half_r * row.nz[i];
+      }
+      float* __restrict acc = free_len.data();
+      const float *pcx = cx.data(), *pcy = cy.data(), *pcz = cz.data(), *rc = row.rc.data(), *rs = row.rs.data(), *bias = row.bias.data();
+      for (int i = 0; i < s.size(); ++i) {
+        const float xi = s.x[static_cast<std::size_t>(i)], yi = s.y[static_cast<std::size_t>(i)];
+        const float half_chord = half_r * s.h[static_cast<std::size_t>(i)];  // (R/2) h_i = z_c - z_entry
+// Lane k writes only its own accumulator; the gathers read the (read-only) G-buffer.
+#pragma GCC ivdep
+        for (int k = 0; k < count; ++k) {
+          // Disk sample rotated by the pixel's interleaving angle about the view axis, at depth z_c.
+          const float ox = half_r * (rc[k] * xi - rs[k] * yi), oy = half_r * (rs[k] * xi + rc[k] * yi);
+          // distance = z* - z_c, so z* - z_entry = distance + (R/2) h_i.
+          const float to_surface = local_ch.distance(pcx[k] + ox, pcy[k] + oy, pcz[k]) + half_chord + bias[k];
+          // Fig. 7: (a) surface inside: z* - z_entry; (b) behind: the chord 2 (R/2) h_i; (c) in front: 0.
+          const float chord = 2.0f * half_chord;
+          const float clipped = to_surface > 0.0f ? to_surface : 0.0f;
+          const float dz = clipped < chord ? clipped : chord;
+          const bool distant = (to_surface < far_limit) & (to_surface > -1e30f);  // -inf: inner all along, not distant
+          acc[k] += distant ? chord : dz;
+        }
+      }
+      for (int k = 0; k < count; ++k)
+        if (row.covered[static_cast<std::size_t>(k)]) v(t.x0 + k, y) = std::min(acc[k] * inv_f, 1.0f);  // eq. 7; analytic F can overshoot 1
+    }
+  });
+  if (params.interleave.interleave && params.interleave.filter)
+    v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius));
+  return v;
+}
+
+Image<float> volumetric_ao(const GBuffer& g, float radius, const VolumetricParams& params, std::uint32_t seed) {
+  return volumetric_ao(g, DepthBufferCharacteristic(g), radius, params, seed);
+}
+
+template Image<float> volumetric_ao(const GBuffer&, const DepthBufferCharacteristic&, float, const VolumetricParams&, std::uint32_t);
+template Image<float> volumetric_ao(const GBuffer&, const ImplicitCharacteristic&, float, const VolumetricParams&, std::uint32_t);
+template Image<float> volumetric_ao(const GBuffer&, const HeightFieldCharacteristic&, float, const VolumetricParams&, std::uint32_t);
+template Image<float> volumetric_ao(const GBuffer&, const DepthTimesHeightField&, float, const VolumetricParams&, std::uint32_t);
+
+}  // namespace ao

@@ -1,0 +1,146 @@
+// Ambient transfer (AT eq. 6, 9): its relation to obscurance and known answers.
+#include "ao/methods/transfer.h"
+
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include "ao/core/error.h"
+#include "ao/methods/characteristic.h"
+#include "ao/methods/containment.h"
+#include "screen_space_fixtures.h"
+
+namespace ao {
+namespace {
+
+TEST(Transfer, OpenPlaneIsFullyVisible) {
+  const auto s = test::builtin_gbuffer("plane");
+  const TransferImage t = transfer_ao(s.g, {Membership::Linear, 2.0f}, {}, 1);
+  for (std::size_t i = 0; i < t.luminance.size(); ++i) {
+    ASSERT_EQ(t.obscurance[i], 1.0f);
+    ASSERT_NEAR(t.luminance[i], 1.0f, 1e-6f);
+  }
+}
+
+// W = sum I / (n - sum (1 - I) a) >= sum I / n = O for a in [0, 1], per channel, and the same
+// linear filter is applied to both.
+TEST(Transfer, TransferIsAtLeastObscuranceEverywhere) {
+  const auto s = test::builtin_gbuffer("default");
+  const TransferImage t = transfer_ao(s.g, {Membership::Step, 1.5f}, {}, 2);
+  double gain = 0;
+  for (std::size_t i = 0; i < t.obscurance.size(); ++i) {
+    const Vec3 w = t.transfer[i];
+    ASSERT_GE(std::min({w.x, w.y, w.z}) + 1e-6f, t.obscurance[i]) << "pixel " << i;
+    ASSERT_LE(std::max({w.x, w.y, w.z}), 1.0f);
+    gain += t.luminance[i] - t.obscurance[i];
+  }
+  EXPECT_GT(gain, 0.0) << "some bounce light somewhere";
+}
+
+TEST(Transfer, TendsToObscuranceAsAlbedoGoesToZero) {
+  const auto s = test::builtin_gbuffer("default");
+  const Falloff f{Membership::Step, 1.5f};
+  TransferParams p;
+  p.albedo_scale = 0;
+  const TransferImage t = transfer_ao(s.g, f, p, 2);
+  for (std::size_t i = 0; i < t.obscurance.size(); ++i) ASSERT_FLOAT_EQ(t.luminance[i], t.obscurance[i]);
+  // And O equals containment AO with m = 1 (same tests on the ray's end point).
+  TransferParams p1;
+  p1.ray_steps = 1;
+  ContainmentParams c;
+  const Image<float> o = transfer_ao(s.g, f, p1, 2).obscurance, v = containment_ao(s.g, f, c, 2);
+  for (std::size_t i = 0; i < o.size(); ++i) ASSERT_FLOAT_EQ(o[i], v[i]);
+}
+
+// AT sec. 3: "the corners of white rooms will not be darker than the wall itself". With albedo 1
+// every blocked ray returns all its light: W = sum I / sum I = 1 wherever any ray is open.
+TEST(Transfer, WhiteRoomCornersAreNoDarkerThanWalls) {
+  auto s = test::builtin_gbuffer("box-room");
+  for (Vec3& a : s.g.albedo.pixels()) a = {1, 1, 1};
+  const TransferImage t = transfer_ao(s.g, {Membership::Step, 1.0f}, {}, 3);
+  double min_o = 1;
+  for (std::size_t i = 0; i < t.luminance.size(); ++i) {
+    if (!s.g.coverage[i] || t.obscurance[i] == 0) continue;
+    min_o = std::min(min_o, static_cast<double>(t.obscurance[i]));
+    ASSERT_NEAR(t.luminance[i], 1.0f, 1e-5f) << "pixel " << i;
+  }
+  EXPECT_LT(min_o, 0.7) << "the corners are occluded, yet W is 1";
+}
+
+// Sec. 4: I = prod_j I0(x + w r j/m). The last of the m points is the one test of m = 1, so with
+// the same samples a ray open for m = 2 is open for m = 1: O can only fall (thin occluders that the
+// end point jumps over are caught).
+TEST(Transfer, MoreTestsPerRayNeverOpenMoreRays) {
+  const auto s = test::builtin_gbuffer("default");
+  TransferParams one, two;
+  one.ray_steps = 1;
+  two.ray_steps = 2;
+  const Falloff f{Membership::Step, 1.5f};
+  const Image<float> o1 = transfer_ao(s.g, f, one, 1).obscurance, o2 = transfer_ao(s.g, f, two, 1).obscurance;
+  double diff = 0;
+  for (std::size_t i = 0; i < o1.size(); ++i) {
+    ASSERT_LE(o2[i], o1[i] + 1e-6f) << "pixel " << i;
+    diff += o1[i] - o2[i];
+  }
+  EXPECT_GT(diff, 0.0);
+}
+
+TEST(Transfer, IdenticalAtOneAndTwoThreads) {
+  const auto s = test::builtin_gbuffer("default");
+  auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    return transfer_ao(s.g, {Membership::Sqrt, 1.0f}, {}, 42);
+  };
+  const auto a = run(1), b = run(2);
+  for (std::size_t i = 0; i < a.luminance.size(); ++i) {
+    ASSERT_EQ(a.luminance[i], b.luminance[i]) << "pixel " << i;
+    ASSERT_EQ(a.obscurance[i], b.obscurance[i]) << "pixel " << i;
+  }
+}
+
+// VAO fig. 12 / AT sec. 6: a displacement-mapped floor whose G-buffer is flat. The depth buffer
+// sees an open plane; the height field of bumps (test-local procedural displaced scene) darkens
+// the valleys between the bumps, and the product keeps both kinds of occlusion.
+TEST(Transfer, HeightFieldTimesDepthBufferShowsDisplacementDetail) {
+  const auto s = test::builtin_gbuffer("plane");
+  const Image<float> bumps = make_bump_map(64, 4);
+  HeightFieldCharacteristic hf;
+  hf.origin = s.g.camera.world_to_camera_point({0, 0, 0});
+  hf.frame = Frame::from_normal(s.g.camera.world_to_camera_vector({0, 1, 0}));
+  hf.map = bumps.view();
+  hf.period = 2.0f;  // 4 bumps per 2 world units
+  hf.amplitude = 0.2f;
+  // The displacement renderer's G-buffer: positions and normals on the displaced surface, depth
+  // left flat (VAO: "even if the depth value isn't modified").
+  GBuffer g = s.g;
+  for (std::size_t i = 0; i < g.position.size(); ++i) {
+    if (!g.coverage[i]) continue;
+    const Vec3 l = hf.frame.to_local(g.position[i] - hf.origin);
+    Vec3 gradient;
+    hf.value(g.position[i], &gradient);
+    g.position[i] += hf.frame.n * hf.height(l.x, l.y);
+    g.normal[i] = normalize(gradient);
+  }
+  const DepthTimesHeightField both{DepthBufferCharacteristic(g), hf};
+  const Falloff f{Membership::Step, 0.4f};
+  TransferParams p;
+  p.silhouette_elimination = false;
+  const Image<float> o_depth = transfer_ao(g, f, p, 1).obscurance;
+  const Image<float> o_both = transfer_ao(g, both, g.albedo, f, p, 1).obscurance;
+  double mean_depth = 0, mean_both = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < o_depth.size(); ++i)
+    if (s.g.coverage[i]) mean_depth += o_depth[i], mean_both += o_both[i], ++n;
+  EXPECT_GT(mean_depth / n, 0.99) << "the flat depth buffer alone sees (almost) no occlusion";
+  EXPECT_LT(mean_both / n, mean_depth / n - 0.01) << "the height field adds the bumps' self-occlusion";
+}
+
+TEST(Transfer, RejectsBadParameters) {
+  EXPECT_THROW((TransferParams{.ray_steps = 0}.validate()), InputError);
+  EXPECT_THROW((TransferParams{.albedo_scale = 2}.validate()), InputError);
+  TransferParams p;
+  EXPECT_THROW(from_json(nlohmann::json{{"m", 2}}, p), InputError);
+}
+
+}  // namespace
+}  // namespace ao

@@ -17,6 +17,9 @@ enum class Membership {
   Sqrt,    ///< Localised square root: mu = sqrt(min(d/R, 1)).
   Cubic,   ///< mu = min(d/R, 1)^3, the falloff implied by volumetric AO (its Figure 3e).
   Exp,     ///< mu = 1 - exp(-tau d), not localised: needs the distance of far occluders too.
+  Alchemy, ///< mu = 1 - min(1, u/d) for d < R, else 1: the falloff g(t) = u/t of Alchemy AO's eq. 7-10
+           ///< (eq. 10 folds u into sigma), clipped to g <= 1 as its eq. 4 requires; u >= R makes it Step.
+           ///< Derivation: docs/methods/alchemy.md.
 };
 
 /// A membership function with its parameters. Distances are in world units.
@@ -24,11 +27,15 @@ struct Falloff {
   Membership membership = Membership::Step;
   float radius = 1.0f;  ///< R, world units, > 0. Unused by Exp except for its default tau.
   float tau = 0.0f;     ///< Absorption coefficient of Exp, 1/world units; 0 selects 3/R (mu(R) = 0.95).
+  float alchemy_u = 0.0f;  ///< u of Alchemy's falloff (= its sigma in world units), world units, >= 0;
+                           ///< 0 selects 2R (the paper's sigma = 1 m at r = 0.5 m), where Alchemy equals Step.
 
   /// Throws InputError naming the bad field.
   void validate() const;
   /// The tau Exp actually uses.
   float effective_tau() const { return tau > 0 ? tau : 3.0f / radius; }
+  /// The u Alchemy actually uses.
+  float effective_alchemy_u() const { return alchemy_u > 0 ? alchemy_u : 2.0f * radius; }
   /// Distance beyond which mu = 1, so rays need not look further: R, or infinity for Exp.
   float reach() const;
   /// mu(d) for d >= 0; d = +infinity (nothing hit) gives 1.
@@ -39,7 +46,7 @@ struct Falloff {
 };
 
 std::string_view to_string(Membership m);
-/// Parses "step", "linear", "sqrt", "cubic", "exp"; nullopt for anything else.
+/// Parses "step", "linear", "sqrt", "cubic", "exp", "alchemy"; nullopt for anything else.
 std::optional<Membership> parse_membership(std::string_view name);
 /// Comma-separated list of valid names, for error messages and --help.
 std::string membership_names();

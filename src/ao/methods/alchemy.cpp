@@ -1,0 +1,270 @@
+#include "ao/methods/alchemy.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "ao/core/error.h"
+#include "ao/core/parallel.h"
+#include "ao/core/sampling.h"
+
+namespace ao {
+
+namespace {
+
+constexpr int kMaxSamples = 1024;
+// Tiles of 128 x 8 pixels: rows long enough to vectorise over pixels, and a tile's sample footprint
+// (the tile grown by the disk's pixel radius) small enough to stay in L2 for typical radii.
+constexpr int kTileWidth = 128, kTileHeight = 8;
+// The disk's screen radius is capped (a pixel whose disk covers the whole image gains nothing from a
+// larger one) so that pixel coordinates stay below kCoordOffset and truncation acts as floor.
+constexpr float kMaxPixelRadius = 16384.0f;
+constexpr float kCoordOffset = 65536.0f;
+// Per-pixel rotations of the sample pattern come from a table of this many angles (no trig per
+// pixel); 1024 steps of 0.35 degrees are far finer than any sample spacing.
+constexpr int kRotations = 1024;
+// Golden angle: successive samples of the pattern are spread evenly in angle.
+constexpr float kGoldenAngle = 2.39996322972865332f;
+
+struct RotationTable {
+  std::array<float, kRotations> c, s;
+  RotationTable() {
+    for (int i = 0; i < kRotations; ++i) {
+      const double a = 2.0 * M_PI * (i + 0.5) / kRotations;
+      c[i] = static_cast<float>(std::cos(a));
+      s[i] = static_cast<float>(std::sin(a));
+    }
+  }
+};
+const RotationTable& rotations() {
+  static const RotationTable t;
+  return t;
+}
+
+// Per-pixel data of one row segment, structure of arrays so the sample loop vectorises over pixels.
+struct Row {
+  alignas(64) std::array<float, kTileWidth> cx, cy, cz, nx, ny, nz, bias, radius_px, jitter, rot_c, rot_s, sum;
+};
+
+void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys) {
+  if (!j.is_object()) throw InputError("alchemy: parameters must be a JSON object");
+  for (const auto& [key, value] : j.items()) {
+    bool known = false;
+    for (const char* k : keys) known = known || key == k;
+    if (!known) throw InputError("alchemy: unknown parameter '" + key + "'");
+  }
+}
+
+// sqrt(x) for x in [0, 1]: std::sqrt keeps a branch to set errno on negative input, which stops the
+// sample loop from vectorising (we may not pass -fno-math-errno), so: the classic reciprocal square
+// root bit trick and two Newton steps, relative error < 5e-6 (far below a pixel at any disk radius).
+inline float sqrt_unit(float x) {
+  float r = std::bit_cast<float>(0x5f3759dfu - (std::bit_cast<std::uint32_t>(x) >> 1));
+  r = r * (1.5f - 0.5f * x * r * r);
+  r = r * (1.5f - 0.5f * x * r * r);
+  return x * r;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void AlchemyParams::validate() const {
+  if (!(radius >= 0.0f) || !std::isfinite(radius)) throw InputError("alchemy: radius r must be >= 0 world units (0 = the falloff radius)");
+  if (samples < 1 || samples > kMaxSamples)
+    throw InputError("alchemy: samples s must be in [1, " + std::to_string(kMaxSamples) + "], got " + std::to_string(samples));
+  if (!(intensity >= 0.0f) || !std::isfinite(intensity)) throw InputError("alchemy: intensity sigma must be a finite number >= 0");
+  if (!(contrast > 0.0f) || !std::isfinite(contrast)) throw InputError("alchemy: contrast k must be a finite number > 0");
+  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("alchemy: bias beta must be a finite number >= 0");
+  if (!(epsilon > 0.0f) || !std::isfinite(epsilon)) throw InputError("alchemy: epsilon must be a finite number > 0");
+  if (!(meter >= 0.0f) || !std::isfinite(meter)) throw InputError("alchemy: meter must be >= 0 world units (0 = r / 0.5)");
+  bilateral.validate();
+}
+
+void to_json(nlohmann::json& j, const AlchemyParams& p) {
+  j = {{"radius", p.radius},
+       {"samples", p.samples},
+       {"intensity", p.intensity},
+       {"contrast", p.contrast},
+       {"bias", p.bias},
+       {"epsilon", p.epsilon},
+       {"meter", p.meter},
+       {"filter", p.filter},
+       {"filter_taps", p.bilateral.taps},
+       {"filter_spatial_sigma", p.bilateral.spatial_sigma},
+       {"filter_plane_sigma", p.bilateral.plane_sigma}};
+}
+
+void from_json(const nlohmann::json& j, AlchemyParams& p) {
+  require_known_keys(j, {"radius", "samples", "intensity", "contrast", "bias", "epsilon", "meter", "filter", "filter_taps", "filter_spatial_sigma",
+                         "filter_plane_sigma"});
+  try {
+    if (j.contains("radius")) p.radius = j.at("radius").get<float>();
+    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
+    if (j.contains("intensity")) p.intensity = j.at("intensity").get<float>();
+    if (j.contains("contrast")) p.contrast = j.at("contrast").get<float>();
+    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
+    if (j.contains("epsilon")) p.epsilon = j.at("epsilon").get<float>();
+    if (j.contains("meter")) p.meter = j.at("meter").get<float>();
+    if (j.contains("filter")) p.filter = j.at("filter").get<bool>();
+    if (j.contains("filter_taps")) p.bilateral.taps = j.at("filter_taps").get<int>();
+    if (j.contains("filter_spatial_sigma")) p.bilateral.spatial_sigma = j.at("filter_spatial_sigma").get<float>();
+    if (j.contains("filter_plane_sigma")) p.bilateral.plane_sigma = j.at("filter_plane_sigma").get<float>();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("alchemy: bad parameter type: ") + e.what());
+  }
+}
+
+AlchemyConstants alchemy_constants(const AlchemyParams& p, float default_radius) {
+  p.validate();
+  const float r = p.radius > 0 ? p.radius : default_radius;
+  if (!(r > 0.0f) || !std::isfinite(r)) throw InputError("alchemy: radius r must be a positive number of world units");
+  // The paper's constants are metric and its images use r = 0.5 m: by default one paper metre is 2r.
+  const float m = p.meter > 0 ? p.meter : r / 0.5f;
+  // sigma is a length and epsilon an area in eq. 10 (v.n / v.v is 1/length); beta multiplies z_C and
+  // is compared with v.n, both lengths, so it is a pure number and is not scaled.
+  return {r, m, p.intensity * m, p.epsilon * m * m, p.bias};
+}
+
+Falloff alchemy_reference_falloff(const AlchemyParams& p, float default_radius) {
+  const AlchemyConstants k = alchemy_constants(p, default_radius);
+  Falloff f{Membership::Alchemy, k.radius};
+  // u = sigma in world units; an intensity of 0 means no obscurance at all, which u -> 0 reproduces
+  // (the smallest positive float keeps 0 from selecting the membership's default of 2R).
+  f.alchemy_u = std::max(k.sigma, std::numeric_limits<float>::min());
+  return f;
+}
+
+AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float default_radius, std::uint32_t seed, const ProgressFn& progress) {
+  const AlchemyConstants k = alchemy_constants(params, default_radius);
+  const int w = g.width(), h = g.height(), s = params.samples;
+  AlchemyImage out{Image<float>(w, h, 1.0f)};
+  const auto t0 = std::chrono::steady_clock::now();
+
+  // Screen radius of the world disk: both image axes have 0.5 * height / tan(fov/2) pixels per unit
+  // of x/(-z) (camera.h's projection), so the disk of radius r at depth z_C projects to a disk of
+  // radius r * that / z_C, and uniform area on it is uniform area on the world disk (sec. 2.3).
+  const float px_per_unit = 0.5f * static_cast<float>(h) / g.camera.tan_half_fov();
+  const float r2 = k.radius * k.radius;
+  // 2 sigma / s: eq. 9's 2 pi u / s (uniform directions, pdf 1/(2 pi)) times the paper's nominal
+  // 1/pi (sec. 2.3), with u folded into sigma.
+  const float scale = 2.0f * k.sigma / static_cast<float>(s);
+  const float inv_s = 1.0f / static_cast<float>(s);
+  const float eps = k.epsilon, beta = k.beta, contrast = params.contrast;
+  // Sample points are read from the depth buffer, P = z(Q') * (camera ray through the pixel centre),
+  // as sec. 2.3 allows ("read a depth or position buffer"): one 4-byte gather per sample instead of
+  // three from the 12-byte positions, which keeps a tile's sample footprint in L2 (the gathers' cache
+  // misses were most of the time; docs/methods/alchemy.md). C is reconstructed the same way, so C and
+  // its samples agree exactly on a plane.
+  const float* depth_buffer = g.depth.data();
+  const float t = g.camera.tan_half_fov();
+  // camera_direction(px, py) = (ax * px + bx, ay * py + by, -1) for continuous pixel coordinates.
+  const float ax = 2.0f * t * g.camera.aspect() / static_cast<float>(w), bx = -t * g.camera.aspect();
+  const float ay = -2.0f * t / static_cast<float>(h), by = t;
+  std::array<float, kMaxSamples> ux{}, uy{};
+  for (int i = 0; i < s; ++i) ux[i] = std::cos(kGoldenAngle * i), uy[i] = std::sin(kGoldenAngle * i);
+  const RotationTable& rot = rotations();
+  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
+
+  // 32-bit gather indices (twice the lanes of 64-bit ones) whenever the position buffer allows.
+  const bool small = static_cast<std::size_t>(w) * h < static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+  const auto run = [&]<class Index>() {
+    tbb::parallel_for(
+        tbb::blocked_range2d<int>(0, h, kTileHeight, 0, w, kTileWidth),
+        [&](const tbb::blocked_range2d<int>& range) {
+          const int x0 = range.cols().begin(), n = range.cols().end() - x0;
+          Row row;
+          for (int y = range.rows().begin(); y < range.rows().end(); ++y) {
+            const std::size_t base = static_cast<std::size_t>(y) * w + x0;
+            const float* nn = &g.normal[base].x;
+            const float* depth = &g.depth[base];
+            const std::uint8_t* cov = &g.coverage[base];
+            // Per-pixel set-up in plain loops the compiler vectorises (component loads of the AoS
+            // Vec3s, integer hashing, a table gather).
+            for (int j = 0; j < n; ++j) {
+              const float d = cov[j] ? depth[j] : 0.0f;  // background: C = 0, its result is overwritten
+              row.cx[j] = d * (ax * (static_cast<float>(x0 + j) + 0.5f) + bx);
+              row.cy[j] = d * (ay * (static_cast<float>(y) + 0.5f) + by);
+              row.cz[j] = -d;
+              row.nx[j] = nn[3 * j], row.ny[j] = nn[3 * j + 1], row.nz[j] = nn[3 * j + 2];
+            }
+            for (int j = 0; j < n; ++j) {
+              // Eq. 10's z_C beta: z_C < 0, so this lowers v.n and drops samples nearly in the tangent
+              // plane (self-occlusion from imprecise normals and positions), more so far away.
+              row.bias[j] = row.cz[j] * beta;
+              // Background has depth +inf, so radius 0; it is overwritten with V = 1 below.
+              row.radius_px[j] = std::min(kMaxPixelRadius, k.radius * px_per_unit / depth[j]);
+              row.sum[j] = 0.0f;
+            }
+            for (int j = 0; j < n; ++j) {
+              const std::uint32_t hs = pixel_seed(seed, x0 + j, y);
+              row.jitter[j] = to_unit_float(hs);
+              const std::uint32_t ri = hash32(hs) & (kRotations - 1);
+              row.rot_c[j] = rot.c[ri], row.rot_s[j] = rot.s[ri];
+            }
+            const float fy0 = static_cast<float>(y) + 0.5f + kCoordOffset;
+            const float fx0 = static_cast<float>(x0) + 0.5f + kCoordOffset;
+            for (int i = 0; i < s; ++i) {
+              const float pux = ux[i], puy = uy[i], stratum = static_cast<float>(i);
+              // Vectorised over the row's pixels: one sample each, a gather of P_i, eq. 10's term.
+              // Branch-free (bitwise & on the conditions, selects) so it if-converts.
+              for (int j = 0; j < n; ++j) {
+                // Sample i lies in the i-th of s equal-area annuli (radius sqrt((i + jitter) / s)) at
+                // angle i * golden angle + the pixel's rotation: stratified, and uniform on the disk.
+                const float rho = row.radius_px[j] * sqrt_unit((stratum + row.jitter[j]) * inv_s);
+                const float dx = rho * (row.rot_c[j] * pux - row.rot_s[j] * puy);
+                const float dy = rho * (row.rot_s[j] * pux + row.rot_c[j] * puy);
+                // +kCoordOffset keeps the coordinate positive, so truncation is floor.
+                const int ix = static_cast<int>(fx0 + static_cast<float>(j) + dx) - static_cast<int>(kCoordOffset);
+                const int iy = static_cast<int>(fy0 + dy) - static_cast<int>(kCoordOffset);
+                const bool inside = (static_cast<unsigned>(ix) < static_cast<unsigned>(w)) & (static_cast<unsigned>(iy) < static_cast<unsigned>(h));
+                // Masked rather than selected, so the compiler sees a plain gather base[index].
+                const Index idx = (static_cast<Index>(iy) * w + ix) & -static_cast<Index>(inside);
+                const float dp = depth_buffer[idx];
+                const float px = dp * (ax * (static_cast<float>(ix) + 0.5f) + bx);
+                const float py = dp * (ay * (static_cast<float>(iy) + 0.5f) + by);
+                const float pz = -dp;
+                const float vx = px - row.cx[j], vy = py - row.cy[j], vz = pz - row.cz[j];
+                const float vv = vx * vx + vy * vy + vz * vz;
+                const float vn = vx * row.nx[j] + vy * row.ny[j] + vz * row.nz[j] + row.bias[j];
+                // Off-screen and background samples (depth +inf, so vv is inf or NaN and fails vv < r^2)
+                // contribute nothing: the paper's assumption that unseen space is empty. vv < r^2 is
+                // eq. 9's H.
+                const bool use = inside & (vv < r2) & (vn > 0.0f);
+                const float term = vn / (vv + eps);
+                row.sum[j] += use ? term : 0.0f;
+              }
+            }
+            float* v = &out.visibility[base];
+            for (int j = 0; j < n; ++j) {
+              const float a = std::max(0.0f, 1.0f - scale * row.sum[j]);  // eq. 10 before ^k
+              v[j] = cov[j] ? a : 1.0f;
+            }
+            if (contrast != 1.0f)
+              for (int j = 0; j < n; ++j) v[j] = std::pow(v[j], contrast);  // eq. 10's ^k; 1 stays 1
+          }
+          counter.add(static_cast<std::size_t>(n) * (range.rows().end() - range.rows().begin()));
+        },
+        tbb::simple_partitioner());
+  };
+  if (small)
+    run.template operator()<std::int32_t>();
+  else
+    run.template operator()<std::int64_t>();
+  out.estimator_ms = ms_since(t0);
+  if (params.filter) {
+    const auto t1 = std::chrono::steady_clock::now();
+    out.unfiltered = out.visibility;
+    bilateral_filter(g, out.visibility, params.bilateral);
+    out.filter_ms = ms_since(t1);
+  }
+  return out;
+}
+
+}  // namespace ao

@@ -18,8 +18,11 @@
 //    G-buffer's nearest depth (the "local slice" of sec. III-B) and z_far the far side of the scene.
 //
 // Parity needs closed surfaces. Meshes with boundary edges (an open ground plane) are, by default,
-// thickened into closed slabs: every triangle of an open mesh becomes a thin closed prism extruded
-// behind its front face. Columns whose parity still ends odd are counted and reported.
+// kept out of the parity pass and turned into one-sided slabs: after the parity scan, each of their
+// fragments ORs the voxels within `slab_thickness` behind its front face (below a ground plane);
+// open faces steep to the columns (walls) become closed prisms of that thickness behind them,
+// voxelized by parity in a scratch grid and ORed in.
+// Columns whose parity still ends odd are counted and reported.
 #pragma once
 
 #include <bit>
@@ -42,7 +45,7 @@ enum class GridSpace {
 
 /// What to do with meshes that are not closed (have boundary edges).
 enum class OpenMeshes {
-  Slab,    ///< Thicken every triangle into a closed prism behind its front face (default).
+  Slab,    ///< Fill `slab_thickness` behind every front face, as a union (default).
   Parity,  ///< Voxelize as they are: columns crossing them end odd (reported), as in the paper.
 };
 
@@ -62,8 +65,9 @@ struct VoxelizeOptions {
                                   ///< Eye: columns along the longer image side. [8, 4096].
   int depth_bits = 128;           ///< Voxels per column; a multiple of 32 in [32, 1024]. Paper: 128.
   OpenMeshes open_meshes = OpenMeshes::Slab;
-  float slab_voxels = 1.5f;       ///< Slab thickness in voxels (the largest voxel side), > 0. 1.5 makes
-                                  ///< sure an edge-on wall still covers a column centre.
+  float slab_thickness = 0.0f;    ///< World units behind open faces; 0 = two voxels. >= 0. The cone
+                                  ///< method uses R_max: under an open ground a cone then meets
+                                  ///< solid as deep as it can look, as under a closed floor.
 
   /// Throws InputError naming the bad field.
   void validate() const;
@@ -71,7 +75,7 @@ struct VoxelizeOptions {
 
 /// Numbers for --json.
 struct VoxelStats {
-  std::size_t triangles = 0;       ///< Triangles rasterised (slab prisms count 8 each).
+  std::size_t triangles = 0;       ///< Triangles rasterised (after clipping and culling).
   std::size_t fragments = 0;       ///< Column-centre hits.
   std::size_t odd_columns = 0;     ///< Columns whose parity ends at 1: open or leaky geometry.
   std::size_t open_meshes = 0;     ///< Meshes with boundary edges.
@@ -100,6 +104,13 @@ struct VoxelGrid {
   std::vector<float> z_near;        ///< Per column: z_nearest of eq. 2 (linear depth, world units).
   std::vector<float> voxels_per_unit;  ///< Per column: depth_bits / (z_far - z_nearest).
 
+  // Coarse occupancy for empty-space skipping: block (bi, bj) holds the OR of the columns
+  // [bi * kBlock, +kBlock) x [bj * kBlock, +kBlock), `words` words like a column.
+  static constexpr int kBlock = 8;
+  int bnx = 0, bny = 0;
+  std::vector<std::uint64_t> block_bits;
+  const std::uint64_t* block(int bi, int bj) const { return block_bits.data() + (static_cast<std::size_t>(bj) * bnx + bi) * words; }
+
   /// Words of column (i, j), which must be inside the grid.
   const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
   /// Bit k of column (i, j).
@@ -123,8 +134,24 @@ inline int count_bits(const std::uint64_t* column, int words, int k0, int k1) {
   return n;
 }
 
-/// World-space grid of options.columns x options.columns columns over `scene`'s bounds (padded so
-/// that slabs fit), columns along world y. `closure` comes from analyze_closure(scene).
+/// True when any of bits [k0, k1) of a column is set (k0, k1 clamped as in count_bits).
+inline bool any_bits(const std::uint64_t* column, int words, int k0, int k1) {
+  k0 = k0 < 0 ? 0 : k0;
+  k1 = k1 > 64 * words ? 64 * words : k1;
+  if (k1 <= k0) return false;
+  const int w0 = k0 >> 6, w1 = (k1 - 1) >> 6;
+  const std::uint64_t lo_mask = ~std::uint64_t{0} << (k0 & 63);
+  const std::uint64_t hi_mask = ~std::uint64_t{0} >> (63 - ((k1 - 1) & 63));
+  if (w0 == w1) return (column[w0] & lo_mask & hi_mask) != 0;
+  if ((column[w0] & lo_mask) | (column[w1] & hi_mask)) return true;
+  for (int w = w0 + 1; w < w1; ++w)
+    if (column[w]) return true;
+  return false;
+}
+
+/// World-space grid of options.columns x options.columns columns over `scene`'s bounds, columns
+/// along world y. The bounds are padded by a voxel, and below and at the sides by the slab
+/// thickness when there are open meshes. `closure` comes from analyze_closure(scene).
 VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& options, VoxelStats* stats = nullptr);
 
 /// The paper's eye-space grid for the G-buffer's camera (which must carry its world placement):

@@ -1,0 +1,139 @@
+// Voxel cone traced AO (docs/methods/cone.md): voxelization and the cone pass separately, the
+// shape of the paper's Table III (time against resolution) and Table IV (time against triangle
+// count), and quality against the ray-traced reference as counters (RMSE), so one run gives the
+// numbers in BENCHMARKS.md. Run with --benchmark_filter=cone.
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+
+#include "ao/eval/metrics.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/methods/cone.h"
+#include "ao/reference/raytraced.h"
+#include "bench_scenes.h"
+
+namespace ao::bench {
+namespace {
+
+// A scene with its BVH (for the G-buffer), topology and G-buffers by size, built once.
+struct ConeFixture {
+  Scene scene;
+  RayScene rays;
+  std::vector<MeshClosure> closure;
+  float r_max;
+  std::map<std::pair<int, int>, GBuffer> gbuffers;
+
+  explicit ConeFixture(Scene s) : scene(std::move(s)), rays(scene), closure(analyze_closure(scene)), r_max(0.1f * scene.bounds().diagonal()) {}
+  const GBuffer& gbuffer(int w, int h) {
+    auto it = gbuffers.find({w, h});
+    if (it == gbuffers.end()) it = gbuffers.emplace(std::pair{w, h}, render_gbuffer(rays, framed(scene, w, h))).first;
+    return it->second;
+  }
+};
+
+ConeFixture* fixture(const std::string& file) {
+  static std::map<std::string, std::unique_ptr<ConeFixture>> cache;
+  auto it = cache.find(file);
+  if (it != cache.end()) return it->second.get();
+  std::unique_ptr<ConeFixture> f;
+  if (file == "default") f = std::make_unique<ConeFixture>(make_builtin_scene("default"));
+  else if (auto s = mesh_on_ground(file)) f = std::make_unique<ConeFixture>(std::move(*s));
+  return cache.emplace(file, std::move(f)).first->second.get();
+}
+
+// Voxelization of a mesh into a world grid of columns x columns x depth_bits.
+void cone_voxelize(benchmark::State& state, const std::string& file) {
+  ConeFixture* f = fixture(file);
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  VoxelizeOptions o;
+  o.columns = static_cast<int>(state.range(0));
+  o.depth_bits = static_cast<int>(state.range(1));
+  o.slab_thickness = f->r_max;
+  VoxelStats stats;
+  for (auto _ : state) benchmark::DoNotOptimize(voxelize_world(f->scene, f->closure, o, &stats));
+  state.counters["Mtri/s"] = benchmark::Counter(static_cast<double>(f->scene.triangle_count()) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+  state.counters["triangles"] = static_cast<double>(f->scene.triangle_count());
+  state.counters["odd_columns"] = static_cast<double>(stats.odd_columns);
+}
+
+// The cone pass alone (grid built once) at width x height, preset from range(2).
+void cone_trace(benchmark::State& state, const std::string& file) {
+  ConeFixture* f = fixture(file);
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const GBuffer& g = f->gbuffer(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const ConeParams p = cone_preset(static_cast<ConeQuality>(state.range(2))).resolved();
+  const VoxelGrid grid = voxelize_world(f->scene, f->closure, p.voxelize_options(f->r_max));
+  Image<float> v(g.width(), g.height());
+  for (auto _ : state) compute_cone(g, grid, f->r_max, p, 1, v.view());
+  std::size_t covered = 0;
+  for (std::uint8_t c : g.coverage.pixels()) covered += c;
+  state.counters["Mpix/s"] = benchmark::Counter(static_cast<double>(covered) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+  state.counters["covered"] = static_cast<double>(covered);
+}
+
+// The whole frame after the G-buffer: voxelization + cone pass (Tables III and IV).
+void cone_frame(benchmark::State& state, const std::string& file) {
+  ConeFixture* f = fixture(file);
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const GBuffer& g = f->gbuffer(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const ConeParams p = cone_preset(ConeQuality::Medium);
+  for (auto _ : state) benchmark::DoNotOptimize(render_cone(f->scene, f->closure, g, f->r_max, p, 1));
+  state.counters["triangles"] = static_cast<double>(f->scene.triangle_count());
+}
+
+// Quality: RMSE against the ray-traced reference (step, R = R_max, 1024 rays, standard error
+// ~0.01) at 320 x 240, as counters; args: preset, depth bits.
+void cone_rmse(benchmark::State& state, const std::string& file) {
+  ConeFixture* f = fixture(file);
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const GBuffer& g = f->gbuffer(320, 240);
+  static std::map<std::string, Image<float>> references;
+  if (!references.count(file))
+    references[file] = render_raytraced(f->rays, g, {Membership::Step, f->r_max}, {.samples = 1024}, 7).visibility;
+  ConeParams p = cone_preset(static_cast<ConeQuality>(state.range(0)));
+  p.depth_bits = static_cast<int>(state.range(1));
+  ErrorMetrics m;
+  for (auto _ : state) {
+    const ConeResult r = render_cone(f->scene, f->closure, g, f->r_max, p, 1);
+    m = compare_images(r.visibility, references[file], g.coverage);
+  }
+  state.counters["rmse"] = m.rmse;
+  state.counters["mean_signed"] = m.mean_signed;
+}
+
+constexpr int kLow = 0, kMedium = 1, kHigh = 2;
+
+BENCHMARK_CAPTURE(cone_voxelize, refined_elephant, std::string("refined_elephant.off"))
+    ->Args({512, 256})->Args({512, 128})->Args({512, 512})->Args({512, 1024})->Args({256, 256})
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK_CAPTURE(cone_trace, refined_elephant, std::string("refined_elephant.off"))
+    ->Args({1024, 768, kMedium})->Args({1024, 768, kLow})->Args({1024, 768, kHigh})
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK_CAPTURE(cone_trace, default_scene, std::string("default"))->Args({1024, 768, kMedium})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+// Table III shape: one mesh, growing resolution.
+BENCHMARK_CAPTURE(cone_frame, table3_refined_elephant, std::string("refined_elephant.off"))
+    ->Args({640, 480})->Args({800, 600})->Args({1024, 768})->Args({1280, 960})->Args({1600, 1200})
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+// Table IV shape: fixed resolution, growing triangle count.
+#define AO_CONE_TABLE4(name, file) \
+  BENCHMARK_CAPTURE(cone_frame, table4_##name, std::string(file))->Args({1024, 768})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5)
+AO_CONE_TABLE4(pinion, "pinion.off");
+AO_CONE_TABLE4(elephant, "elephant.off");
+AO_CONE_TABLE4(cow, "cow.off");
+AO_CONE_TABLE4(knot1, "knot1.off");
+AO_CONE_TABLE4(turbine, "turbine.off");
+AO_CONE_TABLE4(dragon, "ChineseDragon-10kv.off");
+AO_CONE_TABLE4(fandisk_large, "fandisk_large.off");
+AO_CONE_TABLE4(refined_elephant, "refined_elephant.off");
+#undef AO_CONE_TABLE4
+// Quality against the reference: presets at the paper's 128 bits, then depth bits at medium.
+BENCHMARK_CAPTURE(cone_rmse, elephant, std::string("elephant.off"))
+    ->Args({kLow, 128})->Args({kMedium, 128})->Args({kHigh, 128})->Args({kMedium, 256})->Args({kMedium, 512})
+    ->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(cone_rmse, default_scene, std::string("default"))
+    ->Args({kLow, 128})->Args({kMedium, 128})->Args({kHigh, 128})->Args({kMedium, 256})->Args({kMedium, 512})
+    ->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace ao::bench

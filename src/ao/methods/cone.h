@@ -1,0 +1,106 @@
+// Voxel cone traced ambient occlusion, based on E. C. Dalla Favera and W. Celes, "Ambient
+// occlusion using cone tracing with scene voxelization", SIBGRAPI 2012.
+//
+// Per pixel, the hemisphere about the normal is sampled by cones (sec. III-C, Fig. 5a); each cone
+// is sampled by a chain of spheres, tangent to each other and inscribed in the cone out to the
+// distance of influence R_max (Fig. 5b); each sphere's obstructed volume is estimated from prisms
+// along the grid's z through Poisson-disk samples of its great disk, counting solid voxels with
+// masks and popcount (sec. III-C1, Figs. 6-7); spheres combine front to back,
+// T *= (1 - occluded_k) (sec. III-C2, Fig. 8); cones are averaged.
+//
+// Convention: the paper computes the blocked fraction (occlusion); we return visibility
+// V = mean over cones of T, 1 = fully open, which is 1 - the paper's occlusion.
+// The reference this approximates is classical AO (membership `step`, R = R_max), cosine-weighted
+// by default (the cones are placed in cells of equal cosine-weighted measure).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/core/gbuffer.h"
+#include "ao/core/progress.h"
+#include "ao/methods/voxelize.h"
+
+namespace ao {
+
+/// The paper's quality settings (Table I).
+enum class ConeQuality { Low, Medium, High };
+
+/// How cone directions are laid out over the hemisphere (always regularly in spherical coordinates).
+enum class ConeWeighting {
+  Cosine,   ///< Cells of equal cosine-weighted measure: the plain mean estimates classical AO (default).
+  Uniform,  ///< Cells of equal solid angle: the plain mean is the unweighted hemisphere average.
+};
+
+struct ConeParams {
+  ConeQuality preset = ConeQuality::Medium;  ///< Table I; fills cones/spheres/prisms left unset.
+  std::optional<int> cones;    ///< Cones per pixel; unset (JSON null) = from the preset (6). [1, 64].
+  std::optional<int> spheres;  ///< Spheres per cone; unset = from the preset (3/5/7). [1, 16].
+  std::optional<int> prisms;   ///< Prisms per sphere; unset = from the preset (3/6/12). [1, 64].
+  float aperture_deg = 30;   ///< Full apex angle of each cone, degrees (sec. III-C: 30). (0, 90).
+  int depth_bits = 128;      ///< Voxels per grid column, multiple of 32 in [32, 1024]. Paper: 128.
+  int columns = 512;         ///< Grid columns per side (world) or along the longer image side (eye). [8, 4096].
+  GridSpace grid = GridSpace::World;               ///< "world" (default) or the paper's "eye".
+  ConeWeighting weighting = ConeWeighting::Cosine; ///< "cosine" (default) or "uniform".
+  OpenMeshes open_meshes = OpenMeshes::Slab;       ///< "slab" (default) or "parity" (the paper).
+  float slab_fraction = 1.0f;  ///< Thickness of the slab behind open meshes, as a fraction of R_max. (0, 16].
+  bool jitter = true;        ///< Rotate the cone and prism patterns per pixel (noise instead of banding).
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+  /// Copy with cones/spheres/prisms taken from the preset where they are unset.
+  ConeParams resolved() const;
+  VoxelizeOptions voxelize_options(float r_max) const;
+};
+/// Keys: preset ("low"|"medium"|"high"), cones, spheres, prisms, aperture_deg, depth_bits, columns,
+/// grid ("world"|"eye"), weighting ("cosine"|"uniform"), open_meshes ("slab"|"parity"), slab_fraction, jitter.
+void to_json(nlohmann::json& j, const ConeParams& p);
+/// Rejects unknown keys, wrong types and unknown enum names with InputError.
+void from_json(const nlohmann::json& j, ConeParams& p);
+
+/// Table I: low (6 cones, 3 spheres, 3 prisms), medium (6, 5, 6), high (6, 7, 12); other fields default.
+ConeParams cone_preset(ConeQuality q);
+
+/// Derived constants of one parameter set: one pure function of the (resolved) parameters.
+struct ConeSetup {
+  struct Cone {
+    float sin_theta, cos_theta, cos_phi, sin_phi;  ///< Axis in the normal's frame (theta from the normal).
+  };
+  struct Disk {
+    float u, v, half_chord;  ///< Great-disk sample (unit radius) and sqrt(1 - u^2 - v^2).
+  };
+  std::vector<Cone> cones;
+  std::vector<float> sphere_distance;  ///< d_k / R_max, k = 0 nearest the apex.
+  std::vector<float> sphere_radius;    ///< r_k / R_max = d_k sin(alpha).
+  std::vector<Disk> disk;              ///< Prism positions on the unit great disk.
+};
+ConeSetup derive_cone_setup(const ConeParams& resolved);
+
+/// The kernel: V for every covered pixel of `gbuffer` from `grid` (built from the same scene and,
+/// for an eye grid, the same camera), with R_max = `r_max` world units. `params` must be resolved.
+/// Pixel (x, y)'s rotations come from pixel_seed(seed, x, y): the result does not depend on the
+/// thread count. Uncovered pixels get 1.
+void compute_cone(const GBuffer& gbuffer, const VoxelGrid& grid, float r_max, const ConeParams& params, std::uint32_t seed,
+                  ImageView<float> visibility, const ProgressFn& progress = {});
+
+struct ConeResult {
+  Image<float> visibility;
+  VoxelStats voxel_stats;
+  double voxelize_ms = 0, trace_ms = 0;
+  int grid_nx = 0, grid_ny = 0;
+};
+
+/// Voxelizes `scene` (rebuilt on every call: a dynamic-scene method) and runs the kernel.
+/// `closure` comes from analyze_closure(scene) (topology, reusable across frames).
+ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, float r_max, const ConeParams& params,
+                       std::uint32_t seed, const ProgressFn& progress = {});
+
+/// Numbers for --json: grid size, voxelization statistics, timings, and "warnings" (odd columns,
+/// open meshes thickened into slabs), one line each.
+nlohmann::json cone_stats(const ConeResult& result);
+
+}  // namespace ao

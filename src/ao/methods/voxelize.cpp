@@ -1,0 +1,513 @@
+// Solid parity voxelization (Eisemann & Decoret 2008; Dalla Favera & Celes 2012, sec. III-B).
+// See voxelize.h for the grid layout. The CPU pipeline:
+//  1. every triangle is mapped to the
+//     grid: column coordinates (x, y) and a depth attribute that is affine in (x, y) (voxel units
+//     for the orthographic world grid, 1/depth for the perspective eye grid);
+//  2. the rows of columns are split into bands; each band rasterises every triangle that overlaps
+//     it at the column centres and toggles one bit per fragment (no atomics: bands are disjoint);
+//  3. one prefix-XOR scan per column turns toggles into "XOR from the fragment to the far end".
+#include "ao/methods/voxelize.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "ao/core/error.h"
+
+namespace ao {
+
+namespace {
+
+constexpr std::size_t kChunk = 4096;  // triangles per projection task
+constexpr int kBands = 48;            // row bands of the raster stage: enough to balance 2-16 threads
+
+// A triangle in grid space: column coordinates and the affine depth attribute.
+struct GridTri {
+  float x[3], y[3], a[3];
+  int j0, j1;  // rows whose centres the bounding box covers
+  int fill;    // 0: parity fragment; +1 / -1: open-mesh slab filled towards larger / smaller k;
+               // 2: parity fragment of an open wall's prism (scratch grid)
+};
+
+struct Tri3 {
+  Vec3 v[3];
+  int kind;     // 0: parity; 1: open-mesh face, filled behind; 2: side of an open face's prism
+  Vec3 normal;  // geometric normal of the front face (counter-clockwise, mesh.h); set when kind 1
+};
+
+Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
+  const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], c = m.positions[m.indices[3 * t + 2]];
+  return {{a, b, c}, open ? 1 : 0, open ? normalize(cross(b - a, c - a)) : Vec3{}};
+}
+
+// An open face steep to the columns (a wall, for the world grid) has few or no fragments: a span
+// along the column cannot stand for it. It becomes the closed prism between it and its copy
+// moved `thickness` behind its front face, voxelized by parity in a scratch grid (kind 2) that is
+// ORed into the grid. Calls emit for the prism's 8 triangles.
+template <class Emit>
+void emit_prism(const Tri3& t, float thickness, Emit&& emit) {
+  const Vec3 o = t.normal * -thickness;
+  const Vec3 top[3] = {t.v[0], t.v[1], t.v[2]}, bottom[3] = {t.v[0] + o, t.v[1] + o, t.v[2] + o};
+  emit(Tri3{{top[0], top[1], top[2]}, 2, {}});
+  emit(Tri3{{bottom[0], bottom[2], bottom[1]}, 2, {}});
+  for (int e = 0; e < 3; ++e) {
+    const int f = (e + 1) % 3;
+    emit(Tri3{{top[e], bottom[e], bottom[f]}, 2, {}});
+    emit(Tri3{{top[e], bottom[f], top[f]}, 2, {}});
+  }
+}
+
+// |cos| of the angle between an open face and the column direction below which it is a wall.
+constexpr float kSteep = 0.5f;
+
+// Grid-space mapping of the two grids. map() returns false for a vertex that needs clipping.
+struct WorldMap {
+  Vec3 origin, inv_size;
+  float slab;
+  static constexpr bool kPerspective = false;
+  void operator()(Vec3 p, float& x, float& y, float& a) const {
+    x = (p.x - origin.x) * inv_size.x;
+    y = (p.z - origin.z) * inv_size.y;
+    a = (p.y - origin.y) * inv_size.z;
+  }
+};
+
+struct EyeMap {
+  Frame basis;
+  Vec3 eye;
+  float sx, sy, ox, oy;  // column = (x / depth) * sx + ox, (y / depth) * sy + oy
+  float z_clip;
+  float slab;
+  static constexpr bool kPerspective = true;
+};
+
+void push_if_visible(std::vector<GridTri>& out, const GridTri& g, int nx, int ny) {
+  const float xmin = std::min({g.x[0], g.x[1], g.x[2]}), xmax = std::max({g.x[0], g.x[1], g.x[2]});
+  const float ymin = std::min({g.y[0], g.y[1], g.y[2]}), ymax = std::max({g.y[0], g.y[1], g.y[2]});
+  // Column i's centre is i + 0.5: the box covers i in [ceil(min - 0.5), floor(max - 0.5)].
+  if (!(xmax >= 0.5f && xmin <= static_cast<float>(nx) - 0.5f)) return;  // also rejects NaN
+  const float j0 = std::ceil(ymin - 0.5f), j1 = std::floor(ymax - 0.5f);
+  if (j1 < 0 || j0 > static_cast<float>(ny - 1) || j0 > j1) return;
+  GridTri t = g;
+  t.j0 = static_cast<int>(std::max(j0, 0.0f));
+  t.j1 = static_cast<int>(std::min(j1, static_cast<float>(ny - 1)));
+  out.push_back(t);
+}
+
+void emit_world(std::vector<GridTri>& out, const Tri3& t, const WorldMap& m, int nx, int ny) {
+  if (t.kind == 1 && std::abs(t.normal.y) < kSteep)
+    return emit_prism(t, m.slab, [&](const Tri3& side) { emit_world(out, side, m, nx, ny); });
+  GridTri g;
+  for (int k = 0; k < 3; ++k) m(t.v[k], g.x[k], g.y[k], g.a[k]);
+  // Behind the front face: below a face looking up (+y is +k), above a face looking down.
+  g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : 0;
+  push_if_visible(out, g, nx, ny);
+}
+
+// Perspective: clip against depth >= z_clip (Sutherland-Hodgman on one plane), project, and
+// keep 1/depth as the attribute, which is affine in screen space.
+void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx, int ny) {
+  std::array<Vec3, 4> poly;
+  int n = 0;
+  Vec3 c[3];
+  for (int k = 0; k < 3; ++k) c[k] = m.basis.to_local(t.v[k] - m.eye);
+  const float facing = t.kind == 1 ? dot(m.basis.to_local(t.normal), normalize(c[0] + c[1] + c[2])) : 0.0f;
+  if (t.kind == 1 && std::abs(facing) < kSteep)
+    return emit_prism(t, m.slab, [&](const Tri3& side) { emit_eye(out, side, m, nx, ny); });
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 p = c[k], q = c[(k + 1) % 3];
+    const float dp = -p.z - m.z_clip, dq = -q.z - m.z_clip;
+    if (dp >= 0) poly[n++] = p;
+    if ((dp >= 0) != (dq >= 0)) poly[n++] = p + (q - p) * (dp / (dp - dq));
+  }
+  if (n < 3) return;
+  // Behind the front face: deeper for a face turned to the eye, nearer for one turned away.
+  const int fill = t.kind == 1 ? (facing < 0 ? 1 : -1) : t.kind == 2 ? 2 : 0;
+  float x[4], y[4], a[4];
+  for (int k = 0; k < n; ++k) {
+    const float inv = 1.0f / -poly[k].z;
+    x[k] = poly[k].x * inv * m.sx + m.ox;
+    y[k] = poly[k].y * inv * m.sy + m.oy;
+    a[k] = inv;
+  }
+  for (int k = 1; k + 1 < n; ++k) {
+    GridTri g{{x[0], x[k], x[k + 1]}, {y[0], y[k], y[k + 1]}, {a[0], a[k], a[k + 1]}, 0, 0, fill};
+    push_if_visible(out, g, nx, ny);
+  }
+}
+
+// Edge function E(x, y) = A x + B y + C of the directed edge p -> q. Swapping p and q negates A,
+// B and C exactly (C is an antisymmetric difference of two products), so two triangles sharing
+// an edge evaluate exactly opposite values at every column centre, and the tie rule below gives
+// a centre on the shared edge to exactly one of them: the voxelization stays watertight.
+struct Edge {
+  double A, B, C;
+  Edge(double px, double py, double qx, double qy) : A(py - qy), B(qx - px), C(px * qy - py * qx) {}
+  void negate() { A = -A, B = -B, C = -C; }
+  bool inside(double x, double y) const {
+    const double e = A * x + B * y + C;
+    return e > 0 || (e == 0 && (A > 0 || (A == 0 && B > 0)));
+  }
+};
+
+// Sets bits [b0, b1) of a column (clamped to the column).
+inline void set_bits(std::uint64_t* col, int nbits, int b0, int b1) {
+  b0 = std::max(b0, 0);
+  b1 = std::min(b1, nbits);
+  for (int b = b0; b < b1;) {
+    const int w = b >> 6, lo = b & 63, n = std::min(64 - lo, b1 - b);
+    col[w] |= (n == 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << n) - 1)) << lo;
+    b += n;
+  }
+}
+
+// Rasterises one triangle's rows [r0, r1]. A parity fragment toggles one bit (XOR to the end after
+// the scan); a slab fragment of an open mesh ORs the voxels within `slab` (world units) behind it.
+// Returns fragments.
+template <bool kPerspective>
+std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab) {
+  const double x0 = t.x[0], y0 = t.y[0];
+  const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
+  if (area2 == 0) return 0;  // edge-on: no column centre lies inside
+  Edge e[3] = {{t.x[0], t.y[0], t.x[1], t.y[1]}, {t.x[1], t.y[1], t.x[2], t.y[2]}, {t.x[2], t.y[2], t.x[0], t.y[0]}};
+  if (area2 < 0)
+    for (Edge& ed : e) ed.negate();  // back faces count as much as front faces (sec. III-B)
+  // Plane of the attribute over the column coordinates.
+  const double da1 = double(t.a[1]) - t.a[0], da2 = double(t.a[2]) - t.a[0];
+  const double dadx = (da1 * (double(t.y[2]) - y0) - da2 * (double(t.y[1]) - y0)) / area2;
+  const double dady = (da2 * (double(t.x[1]) - x0) - da1 * (double(t.x[2]) - x0)) / area2;
+  const float xmin = std::min({t.x[0], t.x[1], t.x[2]}), xmax = std::max({t.x[0], t.x[1], t.x[2]});
+  const int i0 = std::max(0, static_cast<int>(std::ceil(xmin - 0.5f)));
+  const int i1 = std::min(g.nx - 1, static_cast<int>(std::floor(xmax - 0.5f)));
+  const int nbits = g.depth_bits, words = g.words;
+  std::size_t fragments = 0;
+  for (int j = r0; j <= r1; ++j) {
+    const double yc = j + 0.5;
+    std::uint64_t* row = g.bits.data() + static_cast<std::size_t>(j) * g.nx * words;
+    for (int i = i0; i <= i1; ++i) {
+      const double xc = i + 0.5;
+      if (!(e[0].inside(xc, yc) && e[1].inside(xc, yc) && e[2].inside(xc, yc))) continue;
+      const double a = t.a[0] + dadx * (xc - x0) + dady * (yc - y0);
+      double k;  // continuous voxel coordinate of the fragment along the column
+      if constexpr (kPerspective) {
+        // eq. 2: z_GridIndex = (z - z_nearest) / (z_far - z_nearest), scaled to depth_bits.
+        const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
+        k = (1.0 / a - g.z_near[c]) * g.voxels_per_unit[c];
+      } else {
+        k = a;
+      }
+      if (t.fill == 1 || t.fill == -1) {
+        double thickness;  // slab thickness in voxels along the column
+        if constexpr (kPerspective) thickness = slab * g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i];
+        else thickness = slab / g.voxel_size.z;
+        const double lo = t.fill > 0 ? k : k - thickness, hi = t.fill > 0 ? k + thickness : k;
+        const double b0 = std::clamp(std::ceil(lo - 0.5), 0.0, double(nbits)), b1 = std::clamp(std::ceil(hi - 0.5), 0.0, double(nbits));
+        set_bits(row + static_cast<std::size_t>(i) * words, nbits, static_cast<int>(b0), static_cast<int>(b1));
+        ++fragments;
+        continue;
+      }
+      // The fragment flips every voxel whose centre (b + 0.5) lies beyond it.
+      const double first = std::ceil(k - 0.5);
+      if (first >= nbits) continue;
+      const int b = first <= 0 ? 0 : static_cast<int>(first);
+      row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
+      ++fragments;
+    }
+  }
+  return fragments;
+}
+
+// Prefix XOR along every column: bit k becomes the XOR of toggles 0..k. Returns odd columns.
+std::size_t scan_columns(VoxelGrid& g) {
+  const int words = g.words, nbits = g.depth_bits;
+  const int last_bits = nbits - 64 * (words - 1);
+  const std::uint64_t last_mask = last_bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << last_bits) - 1;
+  std::vector<std::size_t> odd_per_row(g.ny, 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, g.ny, 8), [&](const tbb::blocked_range<int>& r) {
+    for (int j = r.begin(); j < r.end(); ++j) {
+      std::size_t odd = 0;
+      for (int i = 0; i < g.nx; ++i) {
+        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(j) * g.nx + i) * words;
+        std::uint64_t carry = 0;
+        for (int w = 0; w < words; ++w) {
+          std::uint64_t x = col[w];
+          x ^= x << 1;
+          x ^= x << 2;
+          x ^= x << 4;
+          x ^= x << 8;
+          x ^= x << 16;
+          x ^= x << 32;
+          x ^= carry;  // carry is all ones when the previous words left the column inside
+          carry = (x >> 63) ? ~std::uint64_t{0} : 0;
+          col[w] = x;
+        }
+        std::uint64_t& last = col[words - 1];
+        odd += (last >> (last_bits - 1)) & 1u;
+        last &= last_mask;  // keep the unused high bits of the last word zero for popcount
+      }
+      odd_per_row[j] = odd;
+    }
+  });
+  std::size_t odd = 0;
+  for (std::size_t o : odd_per_row) odd += o;
+  return odd;
+}
+
+// OR of each block of kBlock x kBlock columns, for empty-space skipping.
+void build_blocks(VoxelGrid& g) {
+  constexpr int B = VoxelGrid::kBlock;
+  g.bnx = (g.nx + B - 1) / B;
+  g.bny = (g.ny + B - 1) / B;
+  g.block_bits.assign(static_cast<std::size_t>(g.bnx) * g.bny * g.words, 0);
+  tbb::parallel_for(0, g.bny, [&](int bj) {
+    for (int j = bj * B; j < std::min(g.ny, (bj + 1) * B); ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::uint64_t* col = g.column(i, j);
+        std::uint64_t* blk = g.block_bits.data() + (static_cast<std::size_t>(bj) * g.bnx + i / B) * g.words;
+        for (int w = 0; w < g.words; ++w) blk[w] |= col[w];
+      }
+  });
+}
+
+// Stages 1-3 for any grid whose geometry fields are set; `emit` maps one Tri3 into a vector.
+template <bool kPerspective, class Emit>
+void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, float slab_thickness,
+                   Emit&& emit, VoxelStats* stats) {
+  if (closure.size() != scene.meshes.size()) throw InputError("voxelize: closure has " + std::to_string(closure.size()) +
+                                                              " meshes, the scene " + std::to_string(scene.meshes.size()));
+  g.depth_bits = o.depth_bits;
+  g.words = (o.depth_bits + 63) / 64;
+  g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
+
+  // 1. Map triangles to the grid, chunk by chunk (chunk boundaries are fixed: deterministic).
+  std::vector<std::size_t> first{0};
+  for (const Mesh& m : scene.meshes) first.push_back(first.back() + m.triangle_count());
+  const std::size_t total = first.back();
+  const std::size_t chunks = (total + kChunk - 1) / kChunk;
+  std::vector<std::vector<GridTri>> tris(chunks);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    const std::size_t t0 = c * kChunk, t1 = std::min(total, t0 + kChunk);
+    std::size_t mi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
+    auto& out = tris[c];
+    out.reserve(t1 - t0);
+    for (std::size_t t = t0; t < t1; ++t) {
+      while (t >= first[mi + 1]) ++mi;
+      const bool open = o.open_meshes == OpenMeshes::Slab && !closure[mi].closed();
+      emit(out, source_triangle(scene.meshes[mi], t - first[mi], open));
+    }
+  });
+
+  // 2. Raster bands of rows; parity fragments first, then (after the scan) open-mesh slabs,
+  // which are ORed: a union, so overlapping slabs of neighbouring open triangles do not cancel.
+  const int bands = std::min(g.ny, kBands);
+  std::vector<std::size_t> fragments(bands, 0);
+  const auto raster_pass = [&](VoxelGrid& target, int fill_kind) {  // 0 parity, 1 spans, 2 prisms
+    tbb::parallel_for(0, bands, [&](int b) {
+      const int r0 = static_cast<int>(static_cast<long long>(g.ny) * b / bands);
+      const int r1 = static_cast<int>(static_cast<long long>(g.ny) * (b + 1) / bands) - 1;
+      std::size_t f = 0;
+      for (const auto& chunk : tris)
+        for (const GridTri& t : chunk)
+          if ((t.fill == 0 ? 0 : t.fill == 2 ? 2 : 1) == fill_kind && t.j1 >= r0 && t.j0 <= r1)
+            f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), target, slab_thickness);
+      fragments[b] += f;
+    });
+  };
+  raster_pass(g, 0);
+
+  // 3. Toggles -> solid.
+  const std::size_t odd = scan_columns(g);
+  bool any_open = false;
+  for (const MeshClosure& c : closure) any_open = any_open || !c.closed();
+  if (any_open && o.open_meshes == OpenMeshes::Slab) {
+    raster_pass(g, 1);
+    bool any_prism = false;
+    for (const auto& chunk : tris)
+      for (const GridTri& t : chunk) any_prism = any_prism || t.fill == 2;
+    if (any_prism) {
+      VoxelGrid scratch = g;  // same geometry; bits cleared below
+      std::fill(scratch.bits.begin(), scratch.bits.end(), 0);
+      raster_pass(scratch, 2);
+      scan_columns(scratch);
+      for (std::size_t w = 0; w < g.bits.size(); ++w) g.bits[w] |= scratch.bits[w];
+    }
+  }
+  build_blocks(g);
+  if (stats) {
+    *stats = {};
+    for (const auto& chunk : tris) stats->triangles += chunk.size();
+    for (std::size_t f : fragments) stats->fragments += f;
+    stats->odd_columns = odd;
+    for (const MeshClosure& c : closure) {
+      stats->open_meshes += c.closed() ? 0 : 1;
+      stats->boundary_edges += c.boundary_edges;
+    }
+    stats->set_voxels = g.count_set();
+  }
+}
+
+}  // namespace
+
+void VoxelizeOptions::validate() const {
+  if (columns < 8 || columns > 4096) throw InputError("cone: columns must be in [8, 4096], got " + std::to_string(columns));
+  if (depth_bits < 32 || depth_bits > 1024 || depth_bits % 32 != 0)
+    throw InputError("cone: depth_bits must be a multiple of 32 in [32, 1024], got " + std::to_string(depth_bits));
+  if (!(slab_thickness >= 0.0f) || !std::isfinite(slab_thickness))
+    throw InputError("cone: slab thickness must be a finite number >= 0, got " + std::to_string(slab_thickness));
+}
+
+std::size_t VoxelGrid::count_set() const {
+  std::size_t n = 0;
+  for (std::uint64_t w : bits) n += static_cast<std::size_t>(std::popcount(w));
+  return n;
+}
+
+std::vector<MeshClosure> analyze_closure(const Scene& scene) {
+  std::vector<MeshClosure> out;
+  out.reserve(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) {
+    // Weld vertices by exact position, then count each undirected edge; an edge used an odd
+    // number of times is a boundary (a closed 2-manifold uses each edge twice).
+    const std::size_t nv = m.positions.size();
+    std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> keyed(nv);
+    for (std::size_t v = 0; v < nv; ++v) {
+      std::array<std::uint32_t, 3> k;
+      const float c[3] = {m.positions[v].x + 0.0f, m.positions[v].y + 0.0f, m.positions[v].z + 0.0f};  // + 0 turns -0 into +0
+      std::memcpy(k.data(), c, sizeof c);
+      keyed[v] = {k, static_cast<std::uint32_t>(v)};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    std::vector<std::uint32_t> id(nv);
+    std::uint32_t next = 0;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (v > 0 && keyed[v].first != keyed[v - 1].first) ++next;
+      id[keyed[v].second] = next;
+    }
+    std::vector<std::uint64_t> edges;
+    edges.reserve(m.indices.size());
+    for (std::size_t t = 0; t < m.triangle_count(); ++t)
+      for (int e = 0; e < 3; ++e) {
+        std::uint64_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
+        if (a > b) std::swap(a, b);
+        edges.push_back(a << 32 | b);
+      }
+    std::sort(edges.begin(), edges.end());
+    MeshClosure c;
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      c.boundary_edges += (j - i) % 2;
+      i = j;
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats) {
+  o.validate();
+  VoxelGrid g;
+  g.space = GridSpace::World;
+  g.nx = g.ny = o.columns;
+  const Bounds3 b = scene.bounds();
+  if (b.empty()) throw InputError(scene.name + ": cannot voxelize an empty scene");
+  // A flat scene has no height: give every axis at least 1e-4 of the diagonal so voxels have size.
+  const float floor_extent = std::max(1e-4f * b.diagonal(), 1e-6f);
+  const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
+  const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
+  bool any_open = false;
+  for (const MeshClosure& c : closure) any_open = any_open || !c.closed();
+  const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
+  // One voxel of margin on every side, and room for the slabs of open meshes below and beside
+  // (a ground plane's slab hangs below it, a wall's prism stands behind it).
+  const float side = (any_open && o.open_meshes == OpenMeshes::Slab ? slab : 0.0f) + v0;
+  const Vec3 lo = b.lo - Vec3{side, side, side};
+  const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
+  g.origin = lo;
+  g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
+  const WorldMap map{lo, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}, slab};
+  voxelize_into<false>(g, scene, closure, o, slab,
+                       [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); }, stats);
+  return g;
+}
+
+VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const VoxelizeOptions& o, VoxelStats* stats) {
+  o.validate();
+  VoxelGrid g;
+  g.space = GridSpace::Eye;
+  const Camera& cam = gb.camera;
+  const int W = cam.width, H = cam.height;
+  if (W >= H) {
+    g.nx = o.columns;
+    g.ny = std::max(1, static_cast<int>(std::lround(static_cast<double>(o.columns) * H / W)));
+  } else {
+    g.ny = o.columns;
+    g.nx = std::max(1, static_cast<int>(std::lround(static_cast<double>(o.columns) * W / H)));
+  }
+  g.camera = cam;
+  g.pixels_per_column_x = static_cast<float>(W) / g.nx;
+  g.pixels_per_column_y = static_cast<float>(H) / g.ny;
+
+  const Bounds3 b = scene.bounds();
+  if (b.empty()) throw InputError(scene.name + ": cannot voxelize an empty scene");
+  const Frame basis = cam.basis();
+  float zmin = kInfinity, zmax = 0;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+    const float d = -basis.to_local(p - cam.eye).z;
+    zmin = std::min(zmin, d);
+    zmax = std::max(zmax, d);
+  }
+  const float diag = b.diagonal();
+  // Near clipping plane: 1e-4 of the scene diagonal in front of the eye, far enough from 0 for
+  // 1/depth to stay finite, close enough that only geometry touching the eye is lost.
+  const float z_clip = std::max(1e-4f * diag, 1e-6f);
+  zmin = std::max(zmin, z_clip);
+  // The slab extends behind the far corner too, and by one voxel so the last fragment fits.
+  const float column_at_far = 2.0f * cam.tan_half_fov() * std::max(zmax, z_clip) / g.ny;
+  const float v0 = std::max(column_at_far, (zmax - zmin) / o.depth_bits);
+  const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
+  g.z_far = std::max(zmax + slab + v0, zmin * 2.0f);
+
+  // z_nearest per column: the smallest G-buffer depth among the pixels whose centres it holds
+  // (eq. 2's local slice); columns that see no surface use the scene's nearest corner.
+  const std::size_t ncol = static_cast<std::size_t>(g.nx) * g.ny;
+  g.z_near.assign(ncol, kInfinity);
+  for (int y = 0; y < H; ++y) {
+    const int j = std::min(g.ny - 1, static_cast<int>((y + 0.5f) / g.pixels_per_column_y));
+    for (int x = 0; x < W; ++x) {
+      if (!gb.covered(x, y)) continue;
+      const int i = std::min(g.nx - 1, static_cast<int>((x + 0.5f) / g.pixels_per_column_x));
+      float& zn = g.z_near[static_cast<std::size_t>(j) * g.nx + i];
+      zn = std::min(zn, gb.depth(x, y));
+    }
+  }
+  g.voxels_per_unit.resize(ncol);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    float& zn = g.z_near[c];
+    if (!std::isfinite(zn)) zn = zmin;
+    zn = std::clamp(zn, z_clip, g.z_far * 0.999f);
+    g.voxels_per_unit[c] = static_cast<float>(o.depth_bits) / (g.z_far - zn);
+  }
+
+  // Camera-space (x, y, depth) -> column: camera.project divided by the pixels per column.
+  const float t = cam.tan_half_fov();
+  EyeMap map;
+  map.basis = basis;
+  map.eye = cam.eye;
+  map.sx = 0.5f * W / (t * cam.aspect()) / g.pixels_per_column_x;
+  map.ox = 0.5f * W / g.pixels_per_column_x;
+  map.sy = -0.5f * H / t / g.pixels_per_column_y;
+  map.oy = 0.5f * H / g.pixels_per_column_y;
+  map.z_clip = z_clip;
+  map.slab = slab;
+  voxelize_into<true>(g, scene, closure, o, slab, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); },
+                      stats);
+  return g;
+}
+
+}  // namespace ao

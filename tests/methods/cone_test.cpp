@@ -1,0 +1,197 @@
+// Voxel cone traced AO: configurations with known answers, the depth-resolution limitation the
+// paper names (sec. IV-A) and its fix, the ray-traced reference, properties, bad parameters.
+#include "ao/methods/cone.h"
+
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "ao/eval/metrics.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/reference/raytraced.h"
+#include "ao/scene/procedural.h"
+
+namespace ao {
+namespace {
+
+Scene scene_of(std::vector<Mesh> meshes) {
+  Scene s;
+  s.name = "test";
+  s.meshes = std::move(meshes);
+  validate_and_prepare(s);
+  return s;
+}
+
+// A one-pixel G-buffer seeing world point p with world normal n from a camera 3 units along n.
+GBuffer one_pixel(Vec3 p, Vec3 n) {
+  Camera cam;
+  cam.eye = p + normalize(n + Vec3{0.1f, 0.2f, 0.3f}) * 3.0f;
+  cam.target = p;
+  cam.width = cam.height = 1;
+  GBuffer g(cam);
+  g.position(0, 0) = cam.world_to_camera_point(p);
+  g.depth(0, 0) = -g.position(0, 0).z;
+  g.normal(0, 0) = normalize(cam.world_to_camera_vector(n));
+  g.albedo(0, 0) = {0.8f, 0.8f, 0.8f};
+  g.object_id(0, 0) = 1;
+  g.coverage(0, 0) = 1;
+  return g;
+}
+
+float cone_at(const Scene& s, Vec3 p, Vec3 n, float R, ConeParams params) {
+  const GBuffer g = one_pixel(p, n);
+  return render_cone(s, analyze_closure(s), g, R, params, 1).visibility(0, 0);
+}
+
+GBuffer small_gbuffer(const Scene& s, int w, int h) {
+  const RayScene rs(s);
+  Camera cam = *s.preferred_view;
+  cam.width = w;
+  cam.height = h;
+  return render_gbuffer(rs, cam);
+}
+
+TEST(Cone, OpenPlaneIsFullyVisible) {
+  const Scene s = make_builtin_scene("plane");
+  const GBuffer g = small_gbuffer(s, 48, 32);
+  for (ConeQuality q : {ConeQuality::Low, ConeQuality::Medium, ConeQuality::High}) {
+    ConeParams p = cone_preset(q);
+    p.columns = 128;
+    const ConeResult r = render_cone(s, analyze_closure(s), g, 2.0f, p, 1);
+    for (std::size_t i = 0; i < r.visibility.size(); ++i) ASSERT_EQ(r.visibility[i], 1.0f) << "pixel " << i;
+  }
+}
+
+// Floor y = 0 and wall z = 0 (the built-in wedge). At distance a from the wall on the floor,
+// classical AO with R = 1 is 1 - (acos a - a sqrt(1 - a^2)) / pi (tests/reference).
+TEST(Cone, WedgeFloorNearWallFollowsDiskSegmentFormula) {
+  // The built-in wedge is 200 units wide; a 6-unit copy keeps voxels small against R = 1.
+  Mesh m = make_quad({-3, 0, 3}, {3, 0, 3}, {3, 0, 0}, {-3, 0, 0});
+  append_mesh(m, make_quad({-3, 0, 0}, {3, 0, 0}, {3, 3, 0}, {-3, 3, 0}));
+  const Scene s = scene_of({m});
+  ConeParams p = cone_preset(ConeQuality::High);
+  p.cones = 24;  // more cones: the formula is about the integral, not about 6 cones' quantisation
+  p.columns = 256;
+  p.jitter = false;
+  for (float a : {0.15f, 0.4f, 0.8f}) {
+    const float expected = 1.0f - (std::acos(a) - a * std::sqrt(1.0f - a * a)) / kPi;
+    // 0.08: each of 24 cones is 1/24 = 0.042 of the measure and straddles the wall's horizon
+    // partially; sphere volumes, not rays, decide a straddling cone, which errs by up to about
+    // two cones' worth at this resolution (measured 0.01-0.05).
+    EXPECT_NEAR(cone_at(s, {0.3f, 0, a}, {0, 1, 0}, 1.0f, p), expected, 0.08f) << "a = " << a;
+  }
+  // Far from the wall the floor is open.
+  EXPECT_EQ(cone_at(s, {0.3f, 0, 2.5f}, {0, 1, 0}, 1.0f, p), 1.0f);
+}
+
+// The paper's limitation (sec. IV-A: small cavities come out too bright at 128 bits): a point on a
+// floor under a thin roof 0.11 above it. A tall pillar elsewhere stretches the grid to 8 units, so
+// at 128 bits a voxel is 0.063 deep and no voxel centre falls inside the 0.03-thick roof: the roof
+// vanishes and the cavity looks open. At 512 bits (0.016 deep) two centres do.
+TEST(Cone, ThinRoofMissedAt128BitsIsResolvedAt512) {
+  const Scene s = scene_of({make_box({-2, -0.5f, -2}, {2, 0, 2}), make_box({-2, 0.11f, -2}, {2, 0.14f, 2}),
+                            make_box({3, -0.5f, 3}, {3.2f, 7.5f, 3.2f})});
+  const float R = 0.5f;
+  // Reference: rays with theta > acos(0.11 / 0.5) travel R under the roof: V = (0.11 / R)^2... of
+  // the cosine measure, V = 1 - sin^2(acos 0.22) = 0.0484.
+  const RayScene rs(s);
+  const float rt = estimate_visibility(rs, {0, 0, 0}, {0, 1, 0}, {Membership::Step, R}, {.samples = 4096}, 3).visibility;
+  ASSERT_NEAR(rt, 0.0484f, 0.02f) << "the configuration's reference";
+  ConeParams p = cone_preset(ConeQuality::Medium);
+  p.depth_bits = 128;
+  const float v128 = cone_at(s, {0, 0, 0}, {0, 1, 0}, R, p);
+  p.depth_bits = 512;
+  const float v512 = cone_at(s, {0, 0, 0}, {0, 1, 0}, R, p);
+  EXPECT_GT(v128, 0.95f) << "at 128 bits the roof is lost and the point looks open";
+  // At 512 bits the roof is there, but a 0.03-thick roof fills only part of the spheres that cut
+  // it, and the spheres beyond it are empty: volume sampling, the paper's and ours, sees a thin
+  // occluder as a partial one (measured 0.58). The bound asks for the error to drop by over 40%.
+  EXPECT_LT(std::abs(v512 - rt), 0.6f * std::abs(v128 - rt)) << "v128 " << v128 << ", v512 " << v512;
+}
+
+// Against the ray-traced reference (step, R = R_max) on built-in scenes at a small resolution.
+// Bounds: the measured RMSE (sphere-on-plane 0.05, default 0.09 at this commit, see
+// docs/methods/cone.md) plus a margin of 0.03 for the reference's own noise (256 rays, standard
+// error ~0.03 per pixel) and platform differences.
+TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
+  for (const auto& [name, bound] : {std::pair{"sphere-on-plane", 0.08}, std::pair{"default", 0.12}}) {
+    const Scene s = make_builtin_scene(name);
+    const RayScene rs(s);
+    Camera cam = *s.preferred_view;
+    cam.width = 96;
+    cam.height = 64;
+    const GBuffer g = render_gbuffer(rs, cam);
+    const float R = 0.1f * s.bounds().diagonal();
+    const auto ref = render_raytraced(rs, g, {Membership::Step, R}, {.samples = 256}, 9);
+    const ConeResult r = render_cone(s, analyze_closure(s), g, R, cone_preset(ConeQuality::Medium), 1);
+    const ErrorMetrics m = compare_images(r.visibility, ref.visibility, g.coverage);
+    EXPECT_LT(m.rmse, bound) << name << ": mean signed error " << m.mean_signed;
+  }
+}
+
+TEST(Cone, VisibilityInUnitIntervalAndSameAtOneAndTwoThreads) {
+  const Scene s = make_builtin_scene("default");
+  const GBuffer g = small_gbuffer(s, 64, 40);
+  const auto closure = analyze_closure(s);
+  for (GridSpace grid : {GridSpace::World, GridSpace::Eye}) {
+    ConeParams p;
+    p.grid = grid;
+    p.columns = 128;
+    Image<float> a, b;
+    {
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      a = render_cone(s, closure, g, 1.5f, p, 4).visibility;
+    }
+    {
+      tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+      b = render_cone(s, closure, g, 1.5f, p, 4).visibility;
+    }
+    double sum = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(a[i], b[i]) << "pixel " << i;
+      ASSERT_GE(a[i], 0.0f);
+      ASSERT_LE(a[i], 1.0f);
+      sum += a[i];
+    }
+    EXPECT_LT(sum / static_cast<double>(a.size()), 0.99) << "the demo scene has occlusion";
+  }
+}
+
+TEST(Cone, PresetsFollowTableOneAndExplicitCountsOverride) {
+  const ConeParams low = cone_preset(ConeQuality::Low).resolved(), high = cone_preset(ConeQuality::High).resolved();
+  EXPECT_EQ(*low.cones, 6);
+  EXPECT_EQ(*low.spheres, 3);
+  EXPECT_EQ(*low.prisms, 3);
+  EXPECT_EQ(*high.spheres, 7);
+  EXPECT_EQ(*high.prisms, 12);
+  const ConeParams p = nlohmann::json{{"preset", "high"}, {"prisms", 4}}.get<ConeParams>().resolved();
+  EXPECT_EQ(*p.spheres, 7);
+  EXPECT_EQ(*p.prisms, 4);
+  // The sphere chain: tangent neighbours, inscribed in the cone, the last one ending at R_max.
+  const ConeSetup setup = derive_cone_setup(p);
+  const float sa = std::sin(15.0f * kPi / 180.0f);
+  for (std::size_t k = 0; k + 1 < setup.sphere_distance.size(); ++k)
+    EXPECT_NEAR(setup.sphere_distance[k + 1] - setup.sphere_radius[k + 1], setup.sphere_distance[k] + setup.sphere_radius[k], 1e-5f);
+  EXPECT_NEAR(setup.sphere_distance.back() + setup.sphere_radius.back(), 1.0f, 1e-6f);
+  EXPECT_NEAR(setup.sphere_radius[0], setup.sphere_distance[0] * sa, 1e-6f);
+}
+
+TEST(Cone, JsonRoundTripAndRejectsBadParameters) {
+  ConeParams p = cone_preset(ConeQuality::Low);
+  p.grid = GridSpace::Eye;
+  p.depth_bits = 512;
+  const ConeParams q = nlohmann::json(p).get<ConeParams>();
+  EXPECT_EQ(nlohmann::json(q), nlohmann::json(p));
+  for (const nlohmann::json& bad : {nlohmann::json{{"depth_bits", 33}}, nlohmann::json{{"depth_bits", 2000}}, nlohmann::json{{"cones", 0}},
+                                    nlohmann::json{{"aperture_deg", -30}}, nlohmann::json{{"spheres", 17}}, nlohmann::json{{"columns", 2}}}) {
+    EXPECT_THROW(bad.get<ConeParams>().resolved().validate(), InputError) << bad.dump();
+  }
+  EXPECT_THROW((nlohmann::json{{"preset", "ultra"}}.get<ConeParams>()), InputError);
+  EXPECT_THROW((nlohmann::json{{"cone_count", 6}}.get<ConeParams>()), InputError);
+  EXPECT_THROW((nlohmann::json{{"cones", "six"}}.get<ConeParams>()), InputError);
+}
+
+}  // namespace
+}  // namespace ao

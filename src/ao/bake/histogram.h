@@ -29,7 +29,7 @@ struct HistogramParams {
   float pixels_per_texel = 1.0f;   ///< View resolution: pixels along a texel's edge, for an average texel seen face-on. (0, 8].
   float point_size = 1.0f;         ///< Sec. 3.2 splat size in texels: 1 = one texel (no smoothing); > 1 blurs. [1, 16].
   BakeNormalization normalization = BakeNormalization::Area;  ///< See BakeNormalization.
-  bool seam_fix = false;           ///< Sec. 3.3 erosion + dilation of chart borders. Off by default with Area (borders are exact).
+  bool seam_fix = true;            ///< Sec. 3.3: refill chart-border texels less than half covered from the nearest well-covered texel.
   bool bent_normals = false;       ///< Also accumulate the average unoccluded direction (sec. 3, last paragraph).
   std::uint32_t seed = 1;          ///< Keys the directions and the per-direction pixel-grid offsets.
 

@@ -1,0 +1,274 @@
+// Based on McGraw & Sowers, "Hardware Accelerated Per-Texel Ambient Occlusion Mapping" (2008).
+//
+// The paper's pipeline, stage by stage, and where it lives here:
+//  - Directions w_d uniform on the sphere (sec. 3, after eq. 6): sphere_directions.cpp.
+//  - Stage 1, "render from light direction w": an orthographic z-buffered rasterisation with back-face
+//    culling (ortho_raster.cpp). For each visible pixel the fragment program outputs (u, v) and
+//    (w . n)|J|, with n the interpolated normal and |J| = |det d(u,v)/d(x_w,y_w)| (eq. 9). We
+//    recompute (u, v) and (w . n) from the pixel's barycentrics in the scatter loop below; |J| of an
+//    affine map is the ratio of the triangle's UV area to its image area, exactly what the paper's
+//    dFdx/dFdy estimate (they are exact for linear interpolation).
+//  - Stage 2, "sum over pixels": the histogram scatter of eq. 7-8, each pixel adding (w . n)|J| to
+//    the texel holding its (u, v).
+//  - Stage 3, normalisation and seams (sec. 3.3): below, and padding.cpp.
+//
+// Normalisation. Eq. 8 leaves the constant C open and the paper fixes it by scaling the largest
+// value to 1 (BakeNormalization::Max). The default computes it. With D directions uniform on the
+// sphere, (1/pi) * integral over the hemisphere ~= (1/pi)(4 pi / D) sum_d = (4/D) sum_d, and each
+// pixel of world area p^2 covers p^2 / (w . n_g) of surface, so
+//     V(T) = (4/D) * sum_d sum_pixels in T  (w . n) * p^2 / (w . n_g)  /  A(T)                 (eq. 2)
+// with A(T) the world area of the texel's patch (texel_coverage.cpp). The per-pixel weight is the
+// paper's (w . n)|J| times the triangle's stretch s = world area / UV area: |J| s = 1 / (w . n_g),
+// i.e. |J| converts image area to UV area (sec. 3.1) and s converts UV area to surface area, so
+// no constant-stretch-per-texel assumption (eq. 4) is needed. On flat geometry (n = n_g) the weight
+// is 1: the estimate is the count of visible pixels, i.e. the texel's visible projected area.
+//
+// Deviations: the splat (sec. 3.2) is applied as a box convolution of the accumulated histogram,
+// which is what additive blending of points of that size computes, once instead of per fragment.
+// Accumulation is in 64-bit fixed point (weights quantised to 2^-20), so per-thread buffers sum
+// to the same bits in any order: the map is identical at any thread count.
+#include "ao/bake/histogram.h"
+
+#include <cmath>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "ao/bake/ortho_raster.h"
+#include "ao/bake/padding.h"
+#include "ao/core/error.h"
+#include "ao/core/sampling.h"
+
+namespace ao {
+
+namespace {
+
+constexpr double kFixedScale = 1048576.0;  // 2^20
+// Upper bound of a pixel's weight (w . n)/(w . n_g) in units of 1: reached only on nearly edge-on
+// triangles whose interpolated normal leans far from the face normal; those pixels are rare and
+// their expected contribution is bounded, so the clamp only removes spikes of noise.
+constexpr float kMaxWeight = 64.0f;
+
+struct ThreadAccum {
+  std::vector<std::uint64_t> sum;
+  std::vector<std::int64_t> bent;  // 3 per texel
+  std::vector<float> cos_v;        // per vertex, w . n
+  std::uint64_t fragments = 0;
+  RasterTarget target;
+};
+
+// 1-D weights of a box of width `size` texels centred on a texel: the overlap of [k-0.5, k+0.5]
+// with [-size/2, size/2], i.e. an antialiased point of that size (sec. 3.2).
+std::vector<double> box_weights(float size) {
+  const int r = static_cast<int>(std::ceil(size / 2 - 0.5f));
+  std::vector<double> w(static_cast<std::size_t>(2 * r + 1));
+  for (int k = -r; k <= r; ++k)
+    w[static_cast<std::size_t>(k + r)] = std::max(0.0, std::min<double>(k + 0.5, size / 2.0) - std::max<double>(k - 0.5, -size / 2.0));
+  return w;
+}
+
+void box_filter(std::vector<double>& img, int n, const std::vector<double>& kw) {
+  const int r = static_cast<int>(kw.size() / 2);
+  std::vector<double> tmp(img.size(), 0.0);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      double s = 0;
+      for (int k = -r; k <= r; ++k)
+        if (x + k >= 0 && x + k < n) s += kw[static_cast<std::size_t>(k + r)] * img[static_cast<std::size_t>(y) * n + x + k];
+      tmp[static_cast<std::size_t>(y) * n + x] = s;
+    }
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      double s = 0;
+      for (int k = -r; k <= r; ++k)
+        if (y + k >= 0 && y + k < n) s += kw[static_cast<std::size_t>(k + r)] * tmp[static_cast<std::size_t>(y + k) * n + x];
+      img[static_cast<std::size_t>(y) * n + x] = s;
+    }
+}
+
+}  // namespace
+
+std::string_view to_string(BakeNormalization n) { return n == BakeNormalization::Area ? "area" : "max"; }
+
+std::optional<BakeNormalization> parse_normalization(std::string_view name) {
+  if (name == "area") return BakeNormalization::Area;
+  if (name == "max") return BakeNormalization::Max;
+  return std::nullopt;
+}
+
+void HistogramParams::validate() const {
+  if (directions < 1 || directions > 65536) throw InputError("histogram: directions must be in [1, 65536], got " + std::to_string(directions));
+  if (!(pixels_per_texel > 0.0f && pixels_per_texel <= 8.0f)) throw InputError("histogram: pixels per texel must be in (0, 8]");
+  if (!(point_size >= 1.0f && point_size <= 16.0f)) throw InputError("histogram: point size must be in [1, 16] texels");
+}
+
+void to_json(nlohmann::json& j, const HistogramParams& p) {
+  j = {{"directions", p.directions},         {"direction_set", to_string(p.direction_set)}, {"pixels_per_texel", p.pixels_per_texel},
+       {"point_size", p.point_size},         {"normalization", to_string(p.normalization)}, {"seam_fix", p.seam_fix},
+       {"bent_normals", p.bent_normals},     {"seed", p.seed}};
+}
+
+float histogram_pixel_size(const TexelCoverage& coverage, float pixels_per_texel) {
+  double area = 0;
+  for (float a : coverage.world_area.pixels()) area += a;
+  const double per_texel = area / static_cast<double>(std::max<std::size_t>(coverage.covered_texels, 1));
+  return static_cast<float>(std::sqrt(per_texel) / pixels_per_texel);
+}
+
+BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const HistogramParams& params, const ProgressFn& progress) {
+  params.validate();
+  const int n = cov.size;
+  const std::size_t texels = cov.texel_count();
+  const RasterMesh mesh = make_raster_mesh(scene, n);
+  const std::vector<Vec3> dirs = sphere_directions(params.direction_set, params.directions, params.seed);
+
+  // The view resolution matches the texel density: an average texel seen face-on spans
+  // pixels_per_texel pixels. Views larger than 8192^2 are coarsened (a tiny UV region on a huge mesh).
+  float pixel_size = histogram_pixel_size(cov, params.pixels_per_texel);
+  pixel_size = std::max(pixel_size, 2.0f * mesh.radius / 8192.0f);
+  const bool bent = params.bent_normals;
+  const bool area_norm = params.normalization == BakeNormalization::Area;
+
+  tbb::enumerable_thread_specific<ThreadAccum> accum;
+  ProgressCounter counter(progress, dirs.size());
+  tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(dirs.size()), 1), [&](const tbb::blocked_range<int>& range) {
+    ThreadAccum& acc = accum.local();
+    if (acc.sum.empty()) {
+      acc.sum.assign(texels, 0);
+      if (bent) acc.bent.assign(3 * texels, 0);
+      acc.cos_v.resize(mesh.positions.size());
+    }
+    for (int d = range.begin(); d < range.end(); ++d) {
+      const Vec3 w = dirs[static_cast<std::size_t>(d)];
+      const std::uint32_t key = hash_combine(hash32(params.seed), static_cast<std::uint32_t>(d));
+      const Vec2 jitter{to_unit_float(hash_combine(key, 1)), to_unit_float(hash_combine(key, 2))};
+      const OrthoView view = make_ortho_view(mesh, w, pixel_size, jitter);
+      rasterize(mesh, view, acc.target);  // stage 1
+      for (std::size_t i = 0; i < mesh.normals.size(); ++i) acc.cos_v[i] = dot(w, mesh.normals[i]);
+      const std::int64_t bx = std::llround(w.x * 1024.0), by = std::llround(w.y * 1024.0), bz = std::llround(w.z * 1024.0);
+
+      // Stage 2: the histogram scatter, eq. 8.
+      const std::uint32_t* ids = acc.target.id.data();
+      const float* px = acc.target.px.data();
+      const float* py = acc.target.py.data();
+      for (int y = 0; y < view.height; ++y) {
+        const float fy = static_cast<float>(y) + 0.5f;
+        for (int x = 0; x < view.width; ++x) {
+          const std::uint32_t id = ids[static_cast<std::size_t>(y) * view.width + x];
+          if (id == 0) continue;  // background: V = 0 (sec. 3)
+          const std::size_t t = id - 1;
+          if (!mesh.has_uv[t]) continue;
+          const std::uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
+          const float fx = static_cast<float>(x) + 0.5f;
+          const float ax = px[i0], ay = py[i0];
+          const float area2 = (px[i1] - ax) * (py[i2] - ay) - (px[i2] - ax) * (py[i1] - ay);
+          const float l1 = ((ax - px[i2]) * (fy - py[i2]) - (ay - py[i2]) * (fx - px[i2])) / area2;
+          const float l2 = ((px[i1] - ax) * (fy - ay) - (py[i1] - ay) * (fx - ax)) / area2;
+          const Vec2 ua = mesh.uvs[i0], ub = mesh.uvs[i1], uc = mesh.uvs[i2];
+          const float u = ua.x + l1 * (ub.x - ua.x) + l2 * (uc.x - ua.x);
+          const float v = ua.y + l1 * (ub.y - ua.y) + l2 * (uc.y - ua.y);
+          const int tx = static_cast<int>(std::floor(u)), ty = static_cast<int>(std::floor(v));
+          if (tx < 0 || ty < 0 || tx >= n || ty >= n) continue;
+          // (w . n) with the interpolated normal, as the paper's fragment program computes it;
+          // directions below the shading normal's horizon contribute nothing.
+          const float cos_s = std::max(0.0f, acc.cos_v[i0] + l1 * (acc.cos_v[i1] - acc.cos_v[i0]) + l2 * (acc.cos_v[i2] - acc.cos_v[i0]));
+          // |J| (eq. 9) in texels^2 per pixel: UV area over image area, both of this triangle.
+          const float uv_area2 = std::abs((ub.x - ua.x) * (uc.y - ua.y) - (uc.x - ua.x) * (ub.y - ua.y));
+          const float jac = uv_area2 / area2;
+          // Area: times s / p^2 (surface per texel^2, in pixels), see the header comment: weight
+          // = (w . n)/(w . n_g), 1 on flat geometry. Max: the paper's (w . n)|J|.
+          float weight = cos_s * jac * (area_norm ? mesh.stretch[t] / (pixel_size * pixel_size) : 1.0f);
+          weight = std::min(weight, kMaxWeight);
+          const auto q = static_cast<std::uint64_t>(static_cast<double>(weight) * kFixedScale + 0.5);
+          const std::size_t texel = static_cast<std::size_t>(ty) * n + tx;
+          acc.sum[texel] += q;
+          ++acc.fragments;
+          if (bent) {
+            const auto sq = static_cast<std::int64_t>(q >> 10);
+            acc.bent[3 * texel] += sq * bx;
+            acc.bent[3 * texel + 1] += sq * by;
+            acc.bent[3 * texel + 2] += sq * bz;
+          }
+        }
+      }
+      counter.add(1);
+    }
+  });
+
+  // Merge: integer sums, so the order of threads does not matter.
+  std::vector<double> num(texels, 0.0);
+  std::vector<std::int64_t> bent_sum(bent ? 3 * texels : 0, 0);
+  BakeResult out;
+  {
+    std::vector<std::uint64_t> total(texels, 0);
+    for (ThreadAccum& acc : accum) {
+      if (acc.sum.empty()) continue;
+      for (std::size_t i = 0; i < texels; ++i) total[i] += acc.sum[i];
+      for (std::size_t i = 0; i < bent_sum.size(); ++i) bent_sum[i] += acc.bent[i];
+      out.fragments += acc.fragments;
+    }
+    for (std::size_t i = 0; i < texels; ++i) num[i] = static_cast<double>(total[i]) / kFixedScale;
+  }
+
+  // Denominator of the area normalisation: A(T) in pixel units (the weights' unit).
+  std::vector<double> den(texels, 0.0);
+  const double pix2 = static_cast<double>(pixel_size) * pixel_size;
+  for (std::size_t i = 0; i < texels; ++i) den[i] = cov.world_area[i] / pix2;
+  if (params.point_size > 1.0f) {
+    // Sec. 3.2: splats of point_size texels = a box convolution of the histogram. The area
+    // normalisation convolves its denominator too, so the result stays a weighted mean of V.
+    const std::vector<double> kw = box_weights(params.point_size);
+    box_filter(num, n, kw);
+    box_filter(den, n, kw);
+  }
+
+  out.visibility = Image<float>(n, n, 0.0f);
+  out.mask = cov.mask;
+  out.covered_texels = cov.covered_texels;
+  out.directions = params.directions;
+  out.warnings = cov.warnings();
+  double max_num = 0;
+  for (std::size_t i = 0; i < texels; ++i)
+    if (cov.mask[i]) max_num = std::max(max_num, num[i]);
+  std::size_t clamped = 0;
+  for (std::size_t i = 0; i < texels; ++i) {
+    if (!cov.mask[i]) continue;
+    double v = 0;
+    if (area_norm) v = den[i] > 0 ? 4.0 / params.directions * num[i] / den[i] : 0.0;  // eq. 2 with (4/D) sum_d
+    else v = max_num > 0 ? num[i] / max_num : 0.0;                              // the paper: max(1 - AO) = 1
+    // Monte Carlo noise can exceed 1 on open texels; V is a fraction, so clamp (and count it).
+    if (v > 1.0) ++clamped;
+    out.visibility[i] = static_cast<float>(std::clamp(v, 0.0, 1.0));
+  }
+  if (bent) {
+    out.bent_normal = Image<Vec3>(n, n, Vec3{0, 0, 0});
+    for (std::size_t i = 0; i < texels; ++i)
+      if (cov.mask[i])
+        out.bent_normal[i] = normalize(Vec3{static_cast<float>(bent_sum[3 * i]), static_cast<float>(bent_sum[3 * i + 1]), static_cast<float>(bent_sum[3 * i + 2])});
+  }
+  if (params.seam_fix) {
+    // Sec. 3.3: discard chart-boundary texels (erosion) and refill them from the nearest kept texel
+    // (dilation). Deviation: we discard only boundary texels less than half covered by the
+    // charts. Their estimate rests on few pixels, so it is noisy; fully covered border texels
+    // are as exact as interior ones under the area normalisation. Texels with no kept texel
+    // within two rings (thin charts) keep their own values.
+    Image<std::uint8_t> keep = erode(cov.mask);
+    for (std::size_t i = 0; i < texels; ++i)
+      if (cov.mask[i] && cov.uv_area[i] >= 0.5f) keep[i] = 1;
+    const Image<std::int32_t> nearest = nearest_valid_texel(keep, 2);
+    for (std::size_t i = 0; i < texels; ++i)
+      if (cov.mask[i] && nearest[i] >= 0) {
+        out.visibility[i] = out.visibility[static_cast<std::size_t>(nearest[i])];
+        if (bent) out.bent_normal[i] = out.bent_normal[static_cast<std::size_t>(nearest[i])];
+      }
+  }
+  out.stats = {{"view_size", make_ortho_view(mesh, {0, 0, 1}, pixel_size, {0, 0}).width},
+               {"pixel_size", pixel_size},
+               {"fragments", out.fragments},
+               {"clamped_texels", clamped}};
+  return out;
+}
+
+}  // namespace ao

@@ -1,0 +1,48 @@
+// Inside-out AO map baking with Embree: per texel, rays from points spread over the texel's patch
+// of surface. The reference for the histogram baker, and the baker to use when occluders should
+// only count within a distance R (the histogram baker's distance is unlimited).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/bake/bake_result.h"
+#include "ao/bake/texel_coverage.h"
+#include "ao/core/membership.h"
+#include "ao/core/progress.h"
+#include "ao/reference/ray_scene.h"
+
+namespace ao {
+
+struct RaytracedBakeParams {
+  int samples = 256;                     ///< Rays per texel (or vertex), each from its own point of the patch. [1, 1048576].
+  std::optional<float> max_distance;     ///< R, world units, > 0; nullopt = unlimited distance (the paper's eq. 1).
+  Membership membership = Membership::Step;  ///< mu(d) when max_distance is set; unlimited distance is a step at infinity.
+  float offset = 0.0f;                   ///< Ray origin offset along the face normal, world units, >= 0; 0 = RayScene's default (1e-5 x diagonal).
+  bool ignore_back_faces = false;        ///< Rays pass through back faces (what xNormal's and Substance's "ignore backface" do).
+  bool bent_normals = false;             ///< Also average the unoccluded directions per texel.
+  std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+  /// The falloff actually used; for unlimited distance, a Step whose reach is +infinity.
+  Falloff falloff() const;
+};
+void to_json(nlohmann::json& j, const RaytracedBakeParams& p);
+
+/// V per covered texel, the area-weighted mean of the obscurance integral over the texel's patch
+/// (eq. 2 of the per-texel AO paper, with mu(D) in place of V when R is set). Sample i of texel
+/// (x, y) takes its point and its cosine-weighted direction from two independently scrambled
+/// Sobol sequences keyed by pixel_seed(seed, x, y): deterministic at any thread count.
+/// Rays whose direction lies below the face (possible with smooth normals) count as occluded.
+BakeResult bake_raytraced(const RayScene& rays, const TexelCoverage& coverage, const RaytracedBakeParams& params,
+                          const ProgressFn& progress = {});
+
+/// V at each vertex of each mesh (concatenated in mesh order), from the vertex along its normal.
+std::vector<float> bake_vertices_raytraced(const RayScene& rays, const RaytracedBakeParams& params, std::uint64_t* rays_traced = nullptr,
+                                           const ProgressFn& progress = {});
+
+}  // namespace ao

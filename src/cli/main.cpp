@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", global.quiet, "No progress bar");
   std::function<int()> action;
   ao::cli::add_render_command(app, global, action);
+  ao::cli::add_bake_command(app, global, action);
+  ao::cli::add_compare_command(app, global, action);
 
   try {
     app.parse(argc, argv);

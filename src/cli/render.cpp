@@ -28,8 +28,8 @@ struct RenderOptions {
   std::string gbuffer_in;
   CameraOptions camera;
   FalloffOptions falloff;
-  int samples = 256;
-  float target_error = 0.0f;
+  std::optional<int> samples;         ///< Overrides the method's own default sample count.
+  std::optional<float> target_error;
   std::uint32_t seed = 1;
   std::vector<std::string> params;  ///< key=value overrides of the method's parameters.
   int png_bits = 8;
@@ -73,8 +73,16 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (!o.gbuffer_in.empty() && method.needs_scene)
     throw InputError("method " + std::string(method.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
   nlohmann::json params = method.default_params();
-  if (params.contains("samples")) params["samples"] = o.samples;
-  if (params.contains("target_error")) params["target_error"] = o.target_error;
+  // --spp and --target-error set the method's parameters of those names when given; otherwise
+  // each method keeps its own default (256 rays for raytraced, the paper's count for the others).
+  if (o.samples) {
+    if (!params.contains("samples")) throw InputError("--spp: method " + std::string(method.name) + " has no sample count");
+    params["samples"] = *o.samples;
+  }
+  if (o.target_error) {
+    if (!params.contains("target_error")) throw InputError("--target-error: only the ray-traced method stops adaptively");
+    params["target_error"] = *o.target_error;
+  }
   apply_param_overrides(params, o.params, method.name);
 
   std::optional<Scene> scene;
@@ -111,6 +119,9 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   }
   const double ao_ms = clock.lap_ms();
   timings["ao_ms"] = ao_ms;
+  // Methods report problems they worked around (e.g. cone: open meshes, odd voxel columns).
+  if (result.stats.contains("warnings"))
+    for (const auto& w : result.stats["warnings"]) std::cerr << "warning: " << w.get<std::string>() << "\n";
 
   const std::string output = o.output.empty() ? default_output(scene ? scene->name : o.gbuffer_in, o.method) : o.output;
   const ImageWriteOptions write_opt{.png_bits = o.png_bits};
@@ -180,8 +191,9 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal, when --radius is not given")
       ->capture_default_str();
   cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
-  cmd->add_option("--spp,--samples", o->samples, "Rays per pixel (raytraced); the maximum with --target-error")->capture_default_str();
-  cmd->add_option("--target-error", o->target_error, "Stop a pixel once its standard error is below this (raytraced; 0 = off)")->capture_default_str();
+  cmd->add_option("--spp,--samples", o->samples,
+                  "Samples per pixel (default: the method's own; 256 rays for raytraced, the maximum with --target-error)");
+  cmd->add_option("--target-error", o->target_error, "Stop a pixel once its standard error is below this (raytraced; default off)");
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
   cmd->add_option("--width", o->camera.width, "Image width, pixels")->capture_default_str();
   cmd->add_option("--height", o->camera.height, "Image height, pixels")->capture_default_str();

@@ -86,6 +86,30 @@ fs::path batch_path(const fs::path& in, const std::string& given, const std::str
   return dir / (in.stem().string() + "-" + fs::path(given).filename().string());
 }
 
+std::string lower_extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+// Output names are checked before any work, so a typo costs nothing and leaves nothing behind:
+// known extensions, and (for a single mesh, whose outputs are the given paths) existing folders.
+void check_output_names(const BakeOptions& o, bool batch) {
+  for (const std::string& img : {o.output, o.bent})
+    if (!img.empty() && !is_supported_image_path(img))
+      throw InputError(img + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+  if (!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".ply")
+    throw InputError(o.per_vertex + ": --per-vertex writes PLY, give it a .ply name");
+  if (!o.gltf.empty() && lower_extension(o.gltf) != ".glb") throw InputError(o.gltf + ": --gltf writes binary glTF, give it a .glb name");
+  if (!o.out_dir.empty() && !fs::is_directory(o.out_dir)) throw InputError("--out-dir: " + o.out_dir + " is not a directory");
+  if (batch) return;  // outputs go to --out-dir or beside each mesh
+  for (const std::string& out : {o.output, o.bent, o.per_vertex, o.gltf}) {
+    if (out.empty()) continue;
+    const fs::path parent = fs::path(out).parent_path();
+    if (!parent.empty() && !fs::is_directory(parent)) throw InputError(out + ": folder " + parent.string() + " does not exist");
+  }
+}
+
 nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
@@ -120,12 +144,15 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   if (want_map && !has_uv)
     throw InputError(input.string() + ": the mesh has no UV coordinates, so it cannot be baked to a texture; use --per-vertex out.ply for per-vertex AO");
 
+  // Everything is computed first and written at the end, so a mesh that fails half-way (or a
+  // per-vertex bake that fails after the map) leaves no partial set of outputs behind.
+  BakeResult r;
+  double bake_ms = 0;
+  fs::path map_out;
   if (want_map) {
     const TexelCoverage cov = compute_texel_coverage(scene, o.size);
     timings["uv_coverage_ms"] = clock.lap_ms();
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": " << w << "\n";
-    BakeResult r;
-    double bake_ms = 0;
     {
       ProgressBar bar("bake " + input.filename().string(), progress);
       if (o.method == "histogram") r = bake_histogram(scene, cov, hist, bar.callback());
@@ -133,37 +160,11 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
       bake_ms = clock.lap_ms();
     }
     timings["bake_ms"] = bake_ms;
-    if (o.padding > 0) {
-      const Image<std::int32_t> nearest = nearest_valid_texel(r.mask, o.padding);
-      pad(r.visibility, nearest);
-      if (!r.bent_normal.empty()) pad(r.bent_normal, nearest);
-    }
-    timings["padding_ms"] = clock.lap_ms();
-    const fs::path out = batch_path(input, o.output, o.out_dir, batch, "-ao.png");
-    write_image(out, r.visibility, {.png_bits = o.png_bits});
-    if (!o.bent.empty() && !r.bent_normal.empty()) {
-      Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
-      for (std::size_t i = 0; i < enc.size(); ++i)
-        if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
-      write_rgb_image(batch_path(input, o.bent, o.out_dir, batch, "-bent.png"), enc, {.png_bits = o.png_bits});
-    }
-    if (!o.gltf.empty()) {
-      std::string png;
-      if (out.extension() == ".png" || out.extension() == ".PNG") {
-        png = read_bytes(out);
-      } else {
-        const fs::path tmp = fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png");
-        write_image(tmp, r.visibility, {.png_bits = 8});
-        png = read_bytes(tmp);
-        fs::remove(tmp);
-      }
-      write_ao_glb(batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb"), scene, png);
-    }
-    timings["write_ms"] = clock.lap_ms();
+    map_out = batch_path(input, o.output, o.out_dir, batch, "-ao.png");
     double sum = 0;
     for (std::size_t i = 0; i < r.mask.size(); ++i)
       if (r.mask[i]) sum += r.visibility[i];
-    summary["output"] = out.string();
+    summary["output"] = map_out.string();
     summary["size"] = o.size;
     summary["texels_covered"] = r.covered_texels;
     summary["mean_visibility"] = r.covered_texels ? sum / static_cast<double>(r.covered_texels) : 1.0;
@@ -173,7 +174,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     summary["degenerate_uv_triangles"] = cov.degenerate_uv_triangles;
     summary["stats"] = r.stats;
     if (!o.reference.empty()) {
-      // Before padding would be better, but padding leaves covered texels unchanged.
+      // Before padding: only covered texels are compared.
       const Image<float> ref = read_image(o.reference);
       summary["against_reference"] = compare_images(r.visibility, ref, r.mask);
     }
@@ -185,31 +186,66 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
       summary["rays_per_second"] = bake_ms > 0 ? static_cast<double>(r.rays) / (bake_ms / 1000.0) : 0.0;
       summary["parameters"] = rt;
     }
-    if (!o.json)
-      std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", out.string().c_str(),
-                   input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
-                   summary["texels_per_second"].get<double>() / 1e6);
+    if (o.padding > 0) {
+      const Image<std::int32_t> nearest = nearest_valid_texel(r.mask, o.padding);
+      pad(r.visibility, nearest);
+      if (!r.bent_normal.empty()) pad(r.bent_normal, nearest);
+    }
+    timings["padding_ms"] = clock.lap_ms();
   }
+  std::vector<float> vertex_ao;
+  double vertex_ms = 0;
   if (!o.per_vertex.empty()) {
-    std::vector<float> v;
     std::uint64_t nrays = 0;
     {
       ProgressBar bar("per-vertex " + input.filename().string(), progress);
       if (o.method == "histogram") {
-        v = bake_vertices_histogram(scene, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed},
-                                    bar.callback());
+        vertex_ao = bake_vertices_histogram(
+            scene, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed}, bar.callback());
       } else {
-        v = bake_vertices_raytraced(ray_scene(), rt, &nrays, bar.callback());
+        vertex_ao = bake_vertices_raytraced(ray_scene(), rt, &nrays, bar.callback());
       }
     }
-    const double ms = clock.lap_ms();
-    timings["per_vertex_ms"] = ms;
-    const fs::path out = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
-    write_vertex_ao_ply(out, scene, v);
-    summary["per_vertex_output"] = out.string();
+    vertex_ms = clock.lap_ms();
+    timings["per_vertex_ms"] = vertex_ms;
     if (nrays) summary["per_vertex_rays"] = nrays;
-    if (!o.json) std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", out.string().c_str(), v.size(), ms);
   }
+
+  // Writes (each atomic).
+  if (want_map) {
+    write_image(map_out, r.visibility, {.png_bits = o.png_bits});
+    if (!o.bent.empty() && !r.bent_normal.empty()) {
+      Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
+      for (std::size_t i = 0; i < enc.size(); ++i)
+        if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
+      write_rgb_image(batch_path(input, o.bent, o.out_dir, batch, "-bent.png"), enc, {.png_bits = o.png_bits});
+    }
+    if (!o.gltf.empty()) {
+      std::string png;
+      if (map_out.extension() == ".png" || map_out.extension() == ".PNG") {
+        png = read_bytes(map_out);
+      } else {
+        const fs::path tmp = fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png");
+        write_image(tmp, r.visibility, {.png_bits = 8});
+        png = read_bytes(tmp);
+        fs::remove(tmp);
+      }
+      const fs::path glb = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
+      write_ao_glb(glb, scene, png);
+      summary["gltf_output"] = glb.string();
+    }
+    if (!o.json)
+      std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
+                   input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
+                   summary["texels_per_second"].get<double>() / 1e6);
+  }
+  if (!o.per_vertex.empty()) {
+    const fs::path out = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
+    write_vertex_ao_ply(out, scene, vertex_ao);
+    summary["per_vertex_output"] = out.string();
+    if (!o.json) std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", out.string().c_str(), vertex_ao.size(), vertex_ms);
+  }
+  timings["write_ms"] = clock.lap_ms();
   summary["timings"] = timings;
   return summary;
 }
@@ -231,12 +267,12 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   const std::vector<fs::path> inputs = expand_inputs(o.inputs);
   if (inputs.empty()) throw InputError("no mesh files to bake (folders are searched for .obj .ply .off .stl .gltf .glb)");
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
+  check_output_names(o, batch);
   if (!batch) {
     const nlohmann::json s = bake_one(inputs.front(), o, false, global);
     if (o.json) std::cout << s.dump(2) << "\n";
     return 0;
   }
-  if (!o.out_dir.empty() && !fs::is_directory(o.out_dir)) throw InputError("--out-dir: " + o.out_dir + " is not a directory");
   nlohmann::json all = nlohmann::json::array();
   int failed = 0;
   for (const fs::path& in : inputs) {
@@ -273,6 +309,9 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--pixels-per-texel", o->hist.pixels_per_texel, "histogram: view resolution, pixels per texel edge (0, 8]")->capture_default_str();
   cmd->add_option("--point-size", o->hist.point_size, "histogram: splat size in texels, >1 smooths (paper sec. 3.2) [1, 16]")->capture_default_str();
   cmd->add_option("--normalization", o->normalization, "histogram: area (exact, absolute V) or max (the paper's: max V = 1)")->capture_default_str();
+  cmd->add_option("--min-samples", o->hist.min_samples,
+                  "histogram: texels expected to get fewer pixel samples than this (chart slivers) copy the nearest texel that gets enough; 0 = off")
+      ->capture_default_str();
   cmd->add_flag("--seam-fix,!--no-seam-fix", o->hist.seam_fix, "histogram: refill poorly covered chart-border texels from their neighbours (paper sec. 3.3; default on)");
   cmd->add_option("--samples,--spp", o->rt.samples, "raytraced: rays per texel (per vertex with --per-vertex)")->capture_default_str();
   cmd->add_option("--max-distance", o->max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");

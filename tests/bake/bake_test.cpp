@@ -95,6 +95,32 @@ TEST(Bake, SingleQuadIsFullyVisibleBothMethods) {
   EXPECT_GT(hmin, 0.85);
 }
 
+// A chart that grazes a column of texels with a sliver (1% of a texel wide): no pixel sample lands
+// in those texels, and 0 samples over the area must not read as V = 0 (the dragon's dark dots).
+// They copy the nearest texel that has enough samples; on an open quad that is V ~ 1.
+TEST(Bake, SliverTexelsOnChartBordersAreNotBlack) {
+  Scene s;
+  const float eps = 0.01f / 16;
+  s.meshes.push_back(uv_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, {0.25f - eps, 0.25f}, {0.75f, 0.75f}));
+  s = prepared(std::move(s));
+  const TexelCoverage cov = compute_texel_coverage(s, 16);
+  for (bool seam_fix : {true, false}) {
+    const BakeResult h = bake_histogram(s, cov, {.directions = 128, .pixels_per_texel = 2.0f, .seam_fix = seam_fix});
+    int slivers = 0;
+    for (int y = 0; y < 16; ++y)
+      if (cov.mask(3, y)) {
+        ++slivers;
+        EXPECT_GT(h.visibility(3, y), 0.8f) << "sliver texel row " << y << (seam_fix ? "" : " (no seam fix)");
+      }
+    EXPECT_EQ(slivers, 8);
+    EXPECT_EQ(h.stats["unreliable_texels"], 8);
+    EXPECT_EQ(h.stats["unreliable_texels_unfilled"], 0);
+  }
+  // With the check off, they are the raw estimate: no sample, V = 0.
+  const BakeResult raw = bake_histogram(s, cov, {.directions = 128, .pixels_per_texel = 2.0f, .seam_fix = false, .min_samples = 0.0f});
+  EXPECT_EQ(raw.visibility(3, 5), 0.0f);
+}
+
 TEST(Bake, FloorNextToWallMatchesViewFactorBothMethods) {
   const Scene s = floor_and_wall(1.0f);
   const int n = 16;

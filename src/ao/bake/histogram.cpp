@@ -50,6 +50,8 @@ constexpr double kFixedScale = 1048576.0;  // 2^20
 // triangles whose interpolated normal leans far from the face normal; those pixels are rare and
 // their expected contribution is bounded, so the clamp only removes spikes of noise.
 constexpr float kMaxWeight = 64.0f;
+// How far (texel rings) a texel with too few expected samples looks for a reliable one.
+constexpr int kUnreliableRings = 8;
 
 struct ThreadAccum {
   std::vector<std::uint64_t> sum;
@@ -102,12 +104,13 @@ void HistogramParams::validate() const {
   if (directions < 1 || directions > 65536) throw InputError("histogram: directions must be in [1, 65536], got " + std::to_string(directions));
   if (!(pixels_per_texel > 0.0f && pixels_per_texel <= 8.0f)) throw InputError("histogram: pixels per texel must be in (0, 8]");
   if (!(point_size >= 1.0f && point_size <= 16.0f)) throw InputError("histogram: point size must be in [1, 16] texels");
+  if (!(min_samples >= 0.0f && min_samples <= 1e6f)) throw InputError("histogram: min samples must be in [0, 1e6]");
 }
 
 void to_json(nlohmann::json& j, const HistogramParams& p) {
   j = {{"directions", p.directions},         {"direction_set", to_string(p.direction_set)}, {"pixels_per_texel", p.pixels_per_texel},
        {"point_size", p.point_size},         {"normalization", to_string(p.normalization)}, {"seam_fix", p.seam_fix},
-       {"bent_normals", p.bent_normals},     {"seed", p.seed}};
+       {"bent_normals", p.bent_normals},     {"min_samples", p.min_samples}, {"seed", p.seed}};
 }
 
 float histogram_pixel_size(const TexelCoverage& coverage, float pixels_per_texel) {
@@ -248,26 +251,63 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
       if (cov.mask[i])
         out.bent_normal[i] = normalize(Vec3{static_cast<float>(bent_sum[3 * i]), static_cast<float>(bent_sum[3 * i + 1]), static_cast<float>(bent_sum[3 * i + 2])});
   }
+  // Texels that too few pixel samples can reach. A texel's expected number of samples over all
+  // directions is (D/4) A(T)/p^2 (a quarter of its area faces a random direction, in pixels). A
+  // chart that grazes a texel with a sliver of surface (the dragon at 512^2 has thousands with
+  // A(T) < 1e-3 of an average texel's) expects far less than one: no pixel lands in it and the
+  // ratio says V = 0, a black texel on the chart border that is not occlusion at all (and with
+  // a handful of samples the estimate is mostly noise). Such texels are not estimated: they take
+  // the value of the nearest texel that is (below).
+  const double samples_per_pixel_area = static_cast<double>(params.directions) / 4.0;
+  Image<std::uint8_t> reliable(n, n, 0);
+  std::size_t unreliable = 0, unfilled = 0;
+  for (std::size_t i = 0; i < texels; ++i) {
+    if (!cov.mask[i]) continue;
+    const double expected = samples_per_pixel_area * den[i];  // den: A(T)/p^2, box-filtered with the splats
+    reliable[i] = expected >= params.min_samples ? 1 : 0;
+    unreliable += reliable[i] ? 0 : 1;
+  }
+  std::vector<std::uint8_t> refilled(texels, 0);
+  auto refill = [&](const Image<std::uint8_t>& keep, int rings, bool only_unreliable) {
+    const Image<std::int32_t> nearest = nearest_valid_texel(keep, rings);
+    for (std::size_t i = 0; i < texels; ++i) {
+      if (!cov.mask[i] || keep[i] || refilled[i] || nearest[i] < 0 || (only_unreliable && reliable[i])) continue;
+      out.visibility[i] = out.visibility[static_cast<std::size_t>(nearest[i])];
+      if (bent) out.bent_normal[i] = out.bent_normal[static_cast<std::size_t>(nearest[i])];
+      refilled[i] = 1;
+    }
+  };
   if (params.seam_fix) {
     // Sec. 3.3: discard chart-boundary texels (erosion) and refill them from the nearest kept texel
     // (dilation). Deviation: we discard only boundary texels less than half covered by the
-    // charts. Their estimate rests on few pixels, so it is noisy; fully covered border texels
-    // are as exact as interior ones under the area normalisation. Texels with no kept texel
-    // within two rings (thin charts) keep their own values.
+    // charts, and texels with too few samples. Their estimate rests on few pixels, so it is noisy;
+    // fully covered border texels are as exact as interior ones under the area normalisation.
+    // Texels with no kept texel within two rings (thin charts) keep their own values, if reliable.
     Image<std::uint8_t> keep = erode(cov.mask);
-    for (std::size_t i = 0; i < texels; ++i)
+    for (std::size_t i = 0; i < texels; ++i) {
       if (cov.mask[i] && cov.uv_area[i] >= 0.5f) keep[i] = 1;
-    const Image<std::int32_t> nearest = nearest_valid_texel(keep, 2);
-    for (std::size_t i = 0; i < texels; ++i)
-      if (cov.mask[i] && nearest[i] >= 0) {
-        out.visibility[i] = out.visibility[static_cast<std::size_t>(nearest[i])];
-        if (bent) out.bent_normal[i] = out.bent_normal[static_cast<std::size_t>(nearest[i])];
-      }
+      if (!reliable[i]) keep[i] = 0;
+    }
+    refill(keep, 2, false);
   }
+  // Unreliable texels not refilled yet (seam fix off, or no kept texel within two rings) take the
+  // nearest reliable texel within kUnreliableRings; beyond that (a chart too small to hold one
+  // reliable texel) they keep their own estimate.
+  refill(reliable, kUnreliableRings, true);
+  // Last resort for texels that no pixel reached at all (V = 0/den says nothing): the nearest
+  // texel that some pixel reached, if any within kUnreliableRings.
+  Image<std::uint8_t> sampled(n, n, 0);
+  for (std::size_t i = 0; i < texels; ++i) sampled[i] = cov.mask[i] && (num[i] > 0 || refilled[i]) ? 1 : 0;
+  for (std::size_t i = 0; i < texels; ++i)
+    if (cov.mask[i] && !sampled[i] && reliable[i]) sampled[i] = 1;  // reached by no pixel but expected to be: truly occluded
+  refill(sampled, kUnreliableRings, true);
+  for (std::size_t i = 0; i < texels; ++i) unfilled += cov.mask[i] && !reliable[i] && !refilled[i] ? 1 : 0;
   out.stats = {{"view_size", make_ortho_view(mesh, {0, 0, 1}, pixel_size, {0, 0}).width},
                {"pixel_size", pixel_size},
                {"fragments", out.fragments},
-               {"clamped_texels", clamped}};
+               {"clamped_texels", clamped},
+               {"unreliable_texels", unreliable},
+               {"unreliable_texels_unfilled", unfilled}};
   return out;
 }
 

@@ -30,6 +30,7 @@ struct HistogramParams {
   float point_size = 1.0f;         ///< Sec. 3.2 splat size in texels: 1 = one texel (no smoothing); > 1 blurs. [1, 16].
   BakeNormalization normalization = BakeNormalization::Area;  ///< See BakeNormalization.
   bool seam_fix = true;            ///< Sec. 3.3: refill chart-border texels less than half covered from the nearest well-covered texel.
+  float min_samples = 16.0f;       ///< Texels expected to get fewer pixel samples than this (over all directions; slivers of charts) copy the nearest texel that gets enough. [0, 1e6]; 0 = off.
   bool bent_normals = false;       ///< Also accumulate the average unoccluded direction (sec. 3, last paragraph).
   std::uint32_t seed = 1;          ///< Keys the directions and the per-direction pixel-grid offsets.
 

@@ -1,0 +1,227 @@
+// `ao bake` as users and scripts meet it: outputs, --json, batches, and bad input that gets a
+// one-line error naming the file, exit status 1 and no (partial) output (SPEC, "Behaviour on bad
+// input"). Meshes are tiny OBJ files written here; maps are 16-32 texels, so each run is quick.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/io/image_io.h"
+#include "ao/io/mesh_io.h"
+#include "support/run.h"
+
+namespace ao::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kQuick = " --size 16 --directions 32 --pixels-per-texel 4 --padding 2 ";
+
+// Unit cube [0,1]^3 as an OBJ with flat normals; with `uvs`, each face gets its own cell of a
+// 3 x 2 grid of the UV square (inset, so charts do not touch). Convex: V = 1 everywhere.
+std::string cube_obj(bool uvs) {
+  const char* v = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+  const char* vn = "vn 0 0 -1\nvn 0 0 1\nvn 0 -1 0\nvn 0 1 0\nvn -1 0 0\nvn 1 0 0\n";
+  const int faces[6][4] = {{1, 4, 3, 2}, {5, 6, 7, 8}, {1, 2, 6, 5}, {4, 8, 7, 3}, {1, 5, 8, 4}, {2, 3, 7, 6}};
+  std::ostringstream s;
+  s << "# cube written by bake_cli_test\n" << v << vn;
+  if (uvs)
+    for (int f = 0; f < 6; ++f) {
+      const double u0 = (f % 3) / 3.0 + 0.02, u1 = (f % 3 + 1) / 3.0 - 0.02, v0 = (f / 3) / 2.0 + 0.02, v1 = (f / 3 + 1) / 2.0 - 0.02;
+      s << "vt " << u0 << " " << v0 << "\nvt " << u1 << " " << v0 << "\nvt " << u1 << " " << v1 << "\nvt " << u0 << " " << v1 << "\n";
+    }
+  for (int f = 0; f < 6; ++f) {
+    s << "f";
+    for (int k = 0; k < 4; ++k) {
+      s << " " << faces[f][k];
+      if (uvs) s << "/" << 4 * f + k + 1 << "/" << f + 1;
+      else s << "//" << f + 1;
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+// Index out of range: the loader rejects it.
+const std::string kBrokenObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 9/3\n";
+
+// One line on stderr, starting "ao: error:", that mentions `needle`.
+void expect_one_line_error(const RunResult& r, const std::string& needle) {
+  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
+}
+
+TEST(BakeCli, HistogramBakeWritesMapAndJsonSummary) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  const RunResult r = run_ao("bake cube.obj -o ao.png --json" + kQuick, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image<float> map = read_image(dir / "ao.png");
+  EXPECT_EQ(map.width(), 16);
+  EXPECT_EQ(map.height(), 16);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["input"], "cube.obj");
+  EXPECT_EQ(j["output"], "ao.png");
+  EXPECT_EQ(j["method"], "histogram");
+  EXPECT_EQ(j["size"], 16);
+  EXPECT_EQ(j["triangles"], 12);
+  EXPECT_EQ(j["directions"], 32);
+  EXPECT_EQ(j["parameters"]["directions"], 32);
+  EXPECT_EQ(j["parameters"]["normalization"], "area");
+  EXPECT_GT(j["texels_covered"].get<int>(), 100);
+  EXPECT_LE(j["texels_covered"].get<int>(), 256);
+  // A convex cube is open everywhere: V ~ 1 up to the histogram's noise and clamping (measured
+  // 0.984 at 32 directions and 4 pixels per texel; 0.91 at 1 pixel per texel, where most of these
+  // partly covered texels get a handful of pixels per direction).
+  EXPECT_GT(j["mean_visibility"].get<double>(), 0.95);
+  EXPECT_LE(j["mean_visibility"].get<double>(), 1.0);
+  EXPECT_EQ(j["overlapping_texels"], 0);
+  EXPECT_EQ(j["degenerate_uv_triangles"], 0);
+  for (const char* t : {"load_ms", "uv_coverage_ms", "bake_ms", "padding_ms", "write_ms"}) EXPECT_TRUE(j["timings"].contains(t)) << t;
+  // Texels far from every chart (the padding is 2) stay black; the charts are bright.
+  EXPECT_GT(map(8, 4), 0.9f);
+}
+
+TEST(BakeCli, RaytracedBakeWritesExrWithExactValuesOnAConvexMesh) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  const RunResult r = run_ao("bake cube.obj -o ao.exr --method raytraced --samples 8 --json" + kQuick, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["method"], "raytraced");
+  EXPECT_EQ(j["mean_visibility"].get<double>(), 1.0);
+  EXPECT_EQ(j["rays"].get<std::uint64_t>(), j["texels_covered"].get<std::uint64_t>() * 8);
+  EXPECT_EQ(j["parameters"]["samples"], 8);
+  EXPECT_EQ(j["parameters"]["max_distance"], "unlimited");
+  EXPECT_EQ(read_image(dir / "ao.exr").width(), 16);
+}
+
+TEST(BakeCli, WithoutOutputNamesTheMapAfterTheMesh) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  const RunResult r = run_ao("bake cube.obj" + kQuick, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "cube-ao.png"));
+  EXPECT_NE(r.err.find("wrote cube-ao.png"), std::string::npos) << r.err;
+}
+
+TEST(BakeCli, MeshWithoutUvsIsAnErrorThatSuggestsPerVertex) {
+  TempDir dir;
+  write_text(dir / "nouv.obj", cube_obj(false));
+  const RunResult r = run_ao("bake nouv.obj -o ao.png" + kQuick, dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "nouv.obj");
+  EXPECT_NE(r.err.find("--per-vertex"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "ao.png"));
+  // And what it suggests works.
+  const RunResult pv = run_ao("bake nouv.obj --per-vertex v.ply --directions 32 --vertex-resolution 64", dir.path());
+  EXPECT_EQ(pv.exit_code, 0) << pv.err;
+  EXPECT_TRUE(fs::exists(dir / "v.ply"));
+  EXPECT_FALSE(fs::exists(dir / "nouv-ao.png"));
+}
+
+TEST(BakeCli, BatchBakesTheGoodMeshesAndNamesTheBrokenOne) {
+  TempDir dir;
+  fs::create_directories(dir / "meshes");
+  fs::create_directories(dir / "out");
+  write_text(dir / "meshes/a.obj", cube_obj(true));
+  write_text(dir / "meshes/b_broken.obj", kBrokenObj);
+  write_text(dir / "meshes/c.obj", cube_obj(true));
+  write_text(dir / "meshes/notes.txt", "not a mesh\n");
+  const RunResult r = run_ao("bake meshes --out-dir out --json" + kQuick, dir.path());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "out/a-ao.png"));
+  EXPECT_TRUE(fs::exists(dir / "out/c-ao.png"));
+  EXPECT_FALSE(fs::exists(dir / "out/b_broken-ao.png"));
+  EXPECT_NE(r.err.find("ao: error: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("b_broken.obj"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("a.obj"), std::string::npos) << "only the broken mesh is an error: " << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.size(), 3u);  // notes.txt is not a mesh file: skipped
+  EXPECT_FALSE(j[0].contains("error"));
+  EXPECT_TRUE(j[1].contains("error"));
+  EXPECT_FALSE(j[2].contains("error"));
+  // A list of files works the same, outputs named <stem>-<given name> beside each mesh.
+  const RunResult list = run_ao("bake meshes/a.obj meshes/b_broken.obj meshes/c.obj -o map.png" + kQuick, dir.path());
+  EXPECT_EQ(list.exit_code, 1);
+  EXPECT_TRUE(fs::exists(dir / "meshes/a-map.png"));
+  EXPECT_TRUE(fs::exists(dir / "meshes/c-map.png"));
+  EXPECT_FALSE(fs::exists(dir / "meshes/b_broken-map.png"));
+}
+
+TEST(BakeCli, UnknownExtensionsAreRejectedBeforeBaking) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  // The mesh reader goes by content (an OBJ named .xyz is read as OBJ), so an unknown input is one
+  // whose content no reader recognises.
+  write_text(dir / "notes.xyz", "these are not the vertices you are looking for\n");
+  const RunResult in = run_ao("bake notes.xyz -o ao.png" + kQuick, dir.path());
+  EXPECT_EQ(in.exit_code, 1);
+  expect_one_line_error(in, "notes.xyz");
+  EXPECT_FALSE(fs::exists(dir / "ao.png"));
+  const RunResult out = run_ao("bake cube.obj -o ao.bmp" + kQuick, dir.path());
+  EXPECT_EQ(out.exit_code, 1);
+  expect_one_line_error(out, "ao.bmp");
+  EXPECT_FALSE(fs::exists(dir / "ao.bmp"));
+  const RunResult glb = run_ao("bake cube.obj -o ao.png --gltf m.gltf" + kQuick, dir.path());
+  EXPECT_EQ(glb.exit_code, 1);
+  expect_one_line_error(glb, "m.gltf");
+  EXPECT_FALSE(fs::exists(dir / "ao.png"));
+  const RunResult ply = run_ao("bake cube.obj -o ao.png --per-vertex v.obj" + kQuick, dir.path());
+  EXPECT_EQ(ply.exit_code, 1);
+  expect_one_line_error(ply, "v.obj");
+  EXPECT_FALSE(fs::exists(dir / "ao.png"));
+}
+
+TEST(BakeCli, ExistingOutputIsUntouchedAfterAFailure) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  write_text(dir / "nouv.obj", cube_obj(false));
+  write_text(dir / "ao.png", "previous map");
+  write_text(dir / "m.glb", "previous glb");
+  // The mesh cannot be baked.
+  RunResult r = run_ao("bake nouv.obj -o ao.png --gltf m.glb" + kQuick, dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(read_text(dir / "ao.png"), "previous map");
+  EXPECT_EQ(read_text(dir / "m.glb"), "previous glb");
+  // One of the outputs cannot be written (its folder does not exist): nothing is written.
+  r = run_ao("bake cube.obj -o ao.png --gltf m.glb --per-vertex nowhere/v.ply" + kQuick, dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "nowhere");
+  EXPECT_EQ(read_text(dir / "ao.png"), "previous map");
+  EXPECT_EQ(read_text(dir / "m.glb"), "previous glb");
+  // A bad option value.
+  r = run_ao("bake cube.obj -o ao.png --directions 0", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "directions");
+  EXPECT_EQ(read_text(dir / "ao.png"), "previous map");
+  // No leftover temporary files.
+  for (const auto& e : fs::directory_iterator(dir.path())) EXPECT_NE(e.path().filename().string().rfind('.', 0), 0u) << e.path();
+}
+
+TEST(BakeCli, PerVertexAndGltfOutputsAreWrittenAndReadable) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  for (const char* method : {"histogram", "raytraced"}) {
+    const std::string m(method);
+    const RunResult r = run_ao("bake cube.obj -o ao-" + m + ".exr --per-vertex v-" + m + ".ply --gltf m-" + m + ".glb --method " + m +
+                                   " --samples 8 --vertex-resolution 64 --json" + kQuick,
+                               dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["per_vertex_output"], "v-" + m + ".ply");
+    EXPECT_TRUE(j["timings"].contains("per_vertex_ms"));
+    const Scene ply = load_scene_file(dir / ("v-" + m + ".ply"));
+    EXPECT_EQ(ply.triangle_count(), 12u);
+    EXPECT_EQ(read_text(dir / ("v-" + m + ".ply")).rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+    const Scene glb = load_scene_file(dir / ("m-" + m + ".glb"));
+    EXPECT_EQ(glb.triangle_count(), 12u);
+    EXPECT_EQ(read_text(dir / ("m-" + m + ".glb")).substr(0, 4), "glTF");
+  }
+}
+
+}  // namespace
+}  // namespace ao::test

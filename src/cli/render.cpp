@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
+#include "ao/core/texture.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
@@ -26,6 +27,7 @@ struct RenderOptions {
   std::string shaded;
   std::string gbuffer_out;
   std::string gbuffer_in;
+  std::string ao_map;
   CameraOptions camera;
   FalloffOptions falloff;
   std::optional<int> samples;         ///< Overrides the method's own default sample count.
@@ -34,20 +36,39 @@ struct RenderOptions {
   std::vector<std::string> params;  ///< key=value overrides of the method's parameters.
   int png_bits = 8;
   bool json = false;
+  bool extras = false;  ///< Also write the method's extra outputs (MethodOutput::extras) beside the output.
 };
 
 // Albedo x V x (ambient + soft key light): a picture for people, not data. The key light comes
 // from above-left of the camera; wrapping (n.l + w) / (1 + w) keeps faces turned away from it
-// from going black, so the AO stays readable everywhere.
-Image<Vec3> shade(const GBuffer& g, const Image<float>& v) {
+// from going black, so the AO stays readable everywhere. With an RGB result (ambient transfer's W
+// per channel) the ambient term is per channel too: L = a W La (AT eq. 2), La = the same lighting.
+Image<Vec3> shade(const GBuffer& g, const Image<float>& v, const Image<Vec3>& color) {
   const Vec3 light = normalize(Vec3{-0.4f, 0.8f, 0.45f});  // camera space
   constexpr float kAmbient = 0.45f, kKey = 0.75f, kWrap = 0.5f;
   Image<Vec3> out(g.width(), g.height(), Vec3{1, 1, 1});
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (!g.coverage[i]) continue;
     const float wrap = std::max(0.0f, (dot(g.normal[i], light) + kWrap) / (1.0f + kWrap));
-    out[i] = g.albedo[i] * (v[i] * (kAmbient + kKey * wrap));
+    const float light_in = kAmbient + kKey * wrap;
+    out[i] = color.empty() ? g.albedo[i] * (v[i] * light_in) : g.albedo[i] * color[i] * light_in;
   }
+  return out;
+}
+
+// V from a baked AO map: the map's value at each covered pixel's UV (bilinear), for looking at a
+// map on its mesh. Every visible mesh needs UVs.
+MethodOutput visibility_from_map(const GBuffer& g, const Scene& scene, const Image<float>& map, const std::string& map_name) {
+  MethodOutput out;
+  out.visibility = Image<float>(g.width(), g.height(), 1.0f);
+  for (std::size_t i = 0; i < g.coverage.size(); ++i) {
+    if (!g.coverage[i]) continue;
+    const Mesh& mesh = scene.meshes[g.object_id[i] - 1];
+    if (mesh.uvs.empty())
+      throw InputError(scene.name + ": mesh '" + mesh.name + "' is visible but has no UVs, so --ao-map " + map_name + " cannot be shown on it");
+    out.visibility[i] = std::clamp(sample_bilinear(map, g.uv[i]), 0.0f, 1.0f);
+  }
+  out.stats = {{"ao_map", map_name}, {"map_width", map.width()}, {"map_height", map.height()}};
   return out;
 }
 
@@ -62,7 +83,11 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   nlohmann::json timings;
   const bool progress = !global.quiet && stderr_is_terminal();
   const MethodInfo& method = find_method(o.method);
+  const std::string method_name = o.ao_map.empty() ? std::string(method.name) : "ao-map";
   if (!o.gbuffer_in.empty() && !o.scene.empty()) throw InputError("give either a scene or --gbuffer-in, not both");
+  if (!o.ao_map.empty() && !o.gbuffer_in.empty()) throw InputError("--ao-map needs the scene's UVs: give a scene, not --gbuffer-in");
+  if (!o.ao_map.empty() && o.method != "raytraced") throw InputError("--ao-map shows a baked map instead of a method: drop --method");
+  const Image<float> ao_map = o.ao_map.empty() ? Image<float>() : read_image(o.ao_map);
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
   // Check output names before the work, so a typo costs nothing.
   for (const std::string& out : {o.output, o.shaded})
@@ -72,7 +97,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     throw InputError(o.gbuffer_out + ": --gbuffer-out writes OpenEXR, give it a .exr name");
   if (!o.gbuffer_in.empty() && method.needs_scene)
     throw InputError("method " + std::string(method.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
-  nlohmann::json params = method.default_params();
+  nlohmann::json params = o.ao_map.empty() ? method.default_params() : nlohmann::json::object();
   // --spp and --target-error set the method's parameters of those names when given; otherwise
   // each method keeps its own default (256 rays for raytraced, the paper's count for the others).
   if (o.samples) {
@@ -113,8 +138,10 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   const Falloff falloff = choose_falloff(o.falloff, diagonal);
 
   MethodOutput result;
-  {
-    ProgressBar bar(std::string(method.name), progress);
+  if (!ao_map.empty()) {
+    result = visibility_from_map(g, *scene, ao_map, o.ao_map);
+  } else {
+    ProgressBar bar(method_name, progress);
     result = method.run(MethodInput{g, rays.get(), falloff, o.seed, bar.callback()}, params);
   }
   const double ao_ms = clock.lap_ms();
@@ -123,10 +150,18 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (result.stats.contains("warnings"))
     for (const auto& w : result.stats["warnings"]) std::cerr << "warning: " << w.get<std::string>() << "\n";
 
-  const std::string output = o.output.empty() ? default_output(scene ? scene->name : o.gbuffer_in, o.method) : o.output;
+  const std::string output = o.output.empty() ? default_output(scene ? scene->name : o.gbuffer_in, method_name) : o.output;
   const ImageWriteOptions write_opt{.png_bits = o.png_bits};
   write_image(output, result.visibility, write_opt);
-  if (!o.shaded.empty()) write_rgb_image(o.shaded, shade(g, result.visibility), {.png_bits = o.png_bits, .srgb = true});
+  if (!o.shaded.empty()) write_rgb_image(o.shaded, shade(g, result.visibility, result.color), {.png_bits = o.png_bits, .srgb = true});
+  nlohmann::json extras_written = nlohmann::json::object();
+  if (o.extras)
+    for (const auto& [name, image] : result.extras) {  // <output-stem>-<name><ext>, beside the output
+      const std::filesystem::path out_path(output);
+      const std::filesystem::path path = out_path.parent_path() / (out_path.stem().string() + "-" + name + out_path.extension().string());
+      write_image(path, image, write_opt);
+      extras_written[name] = path.string();
+    }
   if (!o.gbuffer_out.empty()) write_gbuffer_exr(o.gbuffer_out, g);
   timings["write_ms"] = clock.lap_ms();
 
@@ -141,7 +176,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
 
   nlohmann::json summary = {
       {"scene", scene ? scene->name : o.gbuffer_in},
-      {"method", method.name},
+      {"method", method_name},
       {"parameters", params},
       {"membership", to_string(falloff.membership)},
       {"radius", falloff.radius},
@@ -153,6 +188,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
       {"mean_visibility", mean_v},
       {"timings", timings},
       {"output", output},
+      {"extras", extras_written},
       {"stats", result.stats},
   };
   if (falloff.membership == Membership::Exp) summary["tau"] = falloff.effective_tau();
@@ -166,7 +202,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     std::cout << summary.dump(2) << "\n";
   } else {
     std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, R = %.4g (%s), mean V = %.4f, %.0f ms\n", output.c_str(), summary["scene"].get<std::string>().c_str(),
-                 std::string(method.name).c_str(), g.width(), g.height(), falloff.radius, std::string(to_string(falloff.membership)).c_str(), mean_v,
+                 method_name.c_str(), g.width(), g.height(), falloff.radius, std::string(to_string(falloff.membership)).c_str(), mean_v,
                  ao_ms);
     if (result.stats.contains("mean_std_error"))
       std::fprintf(stderr, "  standard error: mean %.4f, max %.4f; %.1f M rays/s\n", result.stats["mean_std_error"].get<double>(),
@@ -203,9 +239,13 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
   cmd->add_option("--shaded", o->shaded, "Also write albedo x ambient x V with a soft key light, for viewing (sRGB)");
   cmd->add_option("--gbuffer-out", o->gbuffer_out, "Also write the G-buffer as a multi-channel EXR (docs/gbuffer.md)");
+  cmd->add_option("--ao-map", o->ao_map,
+                  "Show a baked AO map (from ao bake) on the scene instead of computing AO: V = the map at each pixel's UV");
   cmd->add_option("--gbuffer-in", o->gbuffer_in, "Read the G-buffer from an EXR instead of rendering a scene (screen-space methods)");
   cmd->add_option("-p,--param", o->params, "Method parameter as key=value (JSON value), repeatable; --json lists them");
   cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
+  cmd->add_flag("--extras", o->extras,
+                "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");
   cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
   cmd->callback([o, &global, &action] { action = [o, &global] { return run_render(*o, global); }; });
 }

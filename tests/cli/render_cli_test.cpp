@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/io/image_io.h"
 #include "support/run.h"
 
 namespace ao::test {
@@ -72,6 +73,35 @@ TEST(RenderCli, GBufferFileFeedsScreenSpaceMethodsButNotTheRayTracer) {
   EXPECT_EQ(r.exit_code, 1);
   expect_one_line_error(r, "--gbuffer-in");
   EXPECT_FALSE(std::filesystem::exists(dir / "w.png"));
+}
+
+TEST(RenderCli, AoMapIsShownThroughTheMeshUvs) {
+  TempDir dir;
+  // A unit quad facing +y with UVs over the whole map; left half of the map 0.2, right half 0.8.
+  write_text(dir / "quad.obj",
+             "v 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  Image<float> map(64, 64, 0.2f);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 32; x < 64; ++x) map(x, y) = 0.8f;
+  write_image(dir / "map.exr", map);
+  const RunResult r = run_ao("render quad.obj --ao-map map.exr --eye 0.5,2,-0.5 --target 0.5,0,-0.5 --up 0,0,-1 --fov 20 --width 64 --height 64 -o v.exr --json",
+                             dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["method"], "ao-map");
+  // The quad fills the view's middle; u grows with world x, which is image x here.
+  const Image<float> v = read_image(dir / "v.exr");
+  EXPECT_NEAR(v(24, 32), 0.2f, 1e-5f);
+  EXPECT_NEAR(v(40, 32), 0.8f, 1e-5f);
+}
+
+TEST(RenderCli, AoMapNeedsUvs) {
+  TempDir dir;
+  write_image(dir / "map.png", Image<float>(4, 4, 0.5f));
+  const RunResult r = run_ao("render plane --ao-map map.png -o v.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "no UVs");
+  EXPECT_FALSE(std::filesystem::exists(dir / "v.png"));
 }
 
 TEST(RenderCli, MissingMeshIsAnInputError) {

@@ -56,15 +56,21 @@ Camera frame_bounds(const Bounds3& bounds, Vec3 direction, float vertical_fov_de
   c.width = width;
   c.height = height;
   const Vec3 dir = normalize(direction);
-  const float radius = std::max(bounds.diagonal() * 0.5f, 1e-6f);
-  const float half_v = vertical_fov_deg * kPi / 360.0f;
-  const float half_h = std::atan(std::tan(half_v) * c.aspect());
-  const float half = std::min(half_v, half_h);
-  // Distance at which the bounding sphere just fits the narrower half-angle, plus a small margin.
-  const float distance = 1.05f * radius / std::sin(half);
   c.target = bounds.center();
-  c.eye = c.target + dir * distance;
   c.up = std::abs(dir.y) > 0.999f ? Vec3{0, 0, -1} : Vec3{0, 1, 0};
+  c.eye = c.target + dir;  // provisional, for the basis
+  const Frame basis = c.basis();
+  const float tan_v = c.tan_half_fov(), tan_h = tan_v * c.aspect();
+  // The distance from the centre at which every corner of the box projects inside the image:
+  // a corner at (x, y, z) in the camera basis (z towards the camera) is at depth distance - z, and
+  // fits when |x| <= tan_h (distance - z) and |y| <= tan_v (distance - z).
+  float distance = 1e-6f;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner{i & 1 ? bounds.hi.x : bounds.lo.x, i & 2 ? bounds.hi.y : bounds.lo.y, i & 4 ? bounds.hi.z : bounds.lo.z};
+    const Vec3 p = basis.to_local(corner - c.target);
+    distance = std::max({distance, p.z + std::abs(p.x) / tan_h, p.z + std::abs(p.y) / tan_v});
+  }
+  c.eye = c.target + dir * (1.08f * distance);  // a small margin around the tightest fit
   return c;
 }
 

@@ -18,6 +18,7 @@ struct GBuffer {
   Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered.
   Image<std::uint32_t> object_id;  ///< 1 + index of the mesh in its scene; 0 where not covered.
   Image<std::uint8_t> coverage;    ///< 1 where a surface is visible, 0 for background.
+  Image<Vec2> uv;                  ///< First UV set of the visible surface; (0,0) where not covered or the mesh has none.
 
   GBuffer() = default;
   explicit GBuffer(const Camera& cam)
@@ -27,7 +28,8 @@ struct GBuffer {
         normal(cam.width, cam.height),
         albedo(cam.width, cam.height),
         object_id(cam.width, cam.height, 0u),
-        coverage(cam.width, cam.height, std::uint8_t{0}) {}
+        coverage(cam.width, cam.height, std::uint8_t{0}),
+        uv(cam.width, cam.height) {}
 
   int width() const { return camera.width; }
   int height() const { return camera.height; }

@@ -36,6 +36,7 @@ void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, GBuffe
     g.albedo(x, y) = {};
     g.object_id(x, y) = 0;
     g.coverage(x, y) = 0;
+    g.uv(x, y) = {};
     return;
   }
   const Mesh& m = scene.meshes[geom];
@@ -58,6 +59,12 @@ void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, GBuffe
   g.albedo(x, y) = m.albedo;
   g.object_id(x, y) = geom + 1;
   g.coverage(x, y) = 1;
+  if (!m.uvs.empty()) {
+    const Vec2 t0 = m.uvs[i0], t1 = m.uvs[i1], t2 = m.uvs[i2];
+    g.uv(x, y) = {t0.x * w + t1.x * u + t2.x * v, t0.y * w + t1.y * u + t2.y * v};
+  } else {
+    g.uv(x, y) = {};
+  }
 }
 
 template <int N>

@@ -78,12 +78,8 @@ void minimal_loop(benchmark::State& state, Fixture* f) {
           const Frame frame = Frame::from_normal(n);
           const std::uint32_t seed = pixel_seed(1, x, y);
           for (int first = 0; first < kSamples; first += 16) {
-            for (int k = 0; k < 16; ++k) {
-              const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), seed)));
-              ray.org_x[k] = o.x, ray.org_y[k] = o.y, ray.org_z[k] = o.z;
-              ray.dir_x[k] = d.x, ray.dir_y[k] = d.y, ray.dir_z[k] = d.z;
-              ray.tnear[k] = 0, ray.tfar[k] = R, ray.time[k] = 0, ray.mask[k] = ~0u, ray.id[k] = 0, ray.flags[k] = 0;
-            }
+            for (int k = 0; k < 16; ++k)
+              detail::set_ray(ray, k, o, frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), seed))), R);
             rtcOccluded16(valid.data(), f->rays.handle(), &ctx, &ray);
             for (int k = 0; k < 16; ++k) local += ray.tfar[k] < 0;
           }

@@ -85,19 +85,7 @@ struct Tracer {
       for (int k = 0; k < N; ++k) {
         const int s = k < count ? k : 0;
         valid[k] = k < count ? -1 : 0;
-        rh.ray.org_x[k] = org[s].x;
-        rh.ray.org_y[k] = org[s].y;
-        rh.ray.org_z[k] = org[s].z;
-        rh.ray.dir_x[k] = dir[s].x;
-        rh.ray.dir_y[k] = dir[s].y;
-        rh.ray.dir_z[k] = dir[s].z;
-        rh.ray.tnear[k] = 0.0f;
-        rh.ray.tfar[k] = reach;
-        rh.ray.time[k] = 0.0f;
-        rh.ray.mask[k] = 0xffffffffu;
-        rh.ray.id[k] = static_cast<unsigned>(k);
-        rh.ray.flags[k] = 0;
-        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        detail::set_ray_hit(rh, k, org[s], dir[s], reach);
       }
       if (occlusion_only) {
         detail::Packet<N>::occluded(valid.data(), rs.handle(), &ctx, &rh.ray);

@@ -95,19 +95,7 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
           const int x = bx + k % bw, y = by + k / bw;
           valid[k] = (x < t.x1 && y < t.y1) ? -1 : 0;
           const Vec3 d = gen(x, y);
-          rh.ray.org_x[k] = cam.eye.x;
-          rh.ray.org_y[k] = cam.eye.y;
-          rh.ray.org_z[k] = cam.eye.z;
-          rh.ray.dir_x[k] = d.x;
-          rh.ray.dir_y[k] = d.y;
-          rh.ray.dir_z[k] = d.z;
-          rh.ray.tnear[k] = 0.0f;
-          rh.ray.tfar[k] = kInfinity;
-          rh.ray.time[k] = 0.0f;
-          rh.ray.mask[k] = 0xffffffffu;
-          rh.ray.id[k] = static_cast<unsigned>(k);
-          rh.ray.flags[k] = 0;
-          rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          detail::set_ray_hit(rh, k, cam.eye, d, kInfinity);
         }
         detail::Packet<N>::intersect(valid.data(), rs.handle(), &ctx, &rh);
         for (int k = 0; k < N; ++k)

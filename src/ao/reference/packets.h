@@ -6,7 +6,33 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
+#include "ao/core/math.h"
+
 namespace ao::detail {
+
+/// Fills lane k of a ray packet (RTCRay4/8/16): origin, direction, [0, tfar], all masks, no flags.
+template <class RayN>
+inline void set_ray(RayN& ray, int k, Vec3 origin, Vec3 direction, float tfar) {
+  ray.org_x[k] = origin.x;
+  ray.org_y[k] = origin.y;
+  ray.org_z[k] = origin.z;
+  ray.dir_x[k] = direction.x;
+  ray.dir_y[k] = direction.y;
+  ray.dir_z[k] = direction.z;
+  ray.tnear[k] = 0.0f;
+  ray.tfar[k] = tfar;
+  ray.time[k] = 0.0f;
+  ray.mask[k] = 0xffffffffu;
+  ray.id[k] = static_cast<unsigned>(k);
+  ray.flags[k] = 0;
+}
+
+/// The same for a ray-hit packet, with the hit cleared to "no geometry".
+template <class RayHitN>
+inline void set_ray_hit(RayHitN& rh, int k, Vec3 origin, Vec3 direction, float tfar) {
+  set_ray(rh.ray, k, origin, direction, tfar);
+  rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+}
 
 /// Embree asks for flush-to-zero and denormals-are-zero on every thread that traces (denormal
 /// arithmetic in traversal is slow). Kernels call this at the start of each parallel task: two

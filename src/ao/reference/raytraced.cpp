@@ -61,19 +61,7 @@ void trace_batch(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, cons
     for (int k = 0; k < N; ++k) {
       valid[k] = k < count ? -1 : 0;
       const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), seed)));
-      rh.ray.org_x[k] = origin.x;
-      rh.ray.org_y[k] = origin.y;
-      rh.ray.org_z[k] = origin.z;
-      rh.ray.dir_x[k] = d.x;
-      rh.ray.dir_y[k] = d.y;
-      rh.ray.dir_z[k] = d.z;
-      rh.ray.tnear[k] = 0.0f;
-      rh.ray.tfar[k] = reach;
-      rh.ray.time[k] = 0.0f;
-      rh.ray.mask[k] = 0xffffffffu;
-      rh.ray.id[k] = static_cast<unsigned>(k);
-      rh.ray.flags[k] = 0;
-      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      detail::set_ray_hit(rh, k, origin, d, reach);
     }
     if (step) {
       // Classical AO needs only "is anything closer than R", the cheaper occlusion query.

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "ao/core/error.h"
+#include "support/run.h"
 #include "ao/io/image_io.h"
 
 namespace ao {
@@ -20,23 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() / ("ao-gbuffer-exr-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
+using test::TempDir;
 
 Camera test_camera() {
   Camera c;

@@ -15,7 +15,8 @@ struct RunResult {
 /// Runs `AO_CLI_PATH args` through the shell in `cwd` (the current directory when empty).
 RunResult run_ao(const std::string& args, const std::filesystem::path& cwd = {});
 
-/// A fresh empty directory under the system temp directory, removed by the destructor.
+/// A fresh empty directory under the system temp directory, removed by the destructor: one per
+/// test, so tests never see each other's files.
 class TempDir {
  public:
   TempDir();
@@ -24,6 +25,8 @@ class TempDir {
   TempDir& operator=(const TempDir&) = delete;
   const std::filesystem::path& path() const { return path_; }
   std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+  /// Entries directly in the directory (to check that nothing, not even a temporary file, was left).
+  int file_count() const;
 
  private:
   std::filesystem::path path_;

@@ -114,8 +114,14 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   Stopwatch clock;
   nlohmann::json timings;
   const bool progress = !global.quiet && stderr_is_terminal();
-  Scene scene = load_scene_file(input);
+  Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
+  // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.
+  std::optional<GltfSource> source;
+  if (!o.gltf.empty() && is_gltf_file(input)) {
+    source = load_gltf_materials(input, scene, o.uv_set);
+    for (const std::string& w : source->warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
+  }
   timings["load_ms"] = clock.lap_ms();
   nlohmann::json summary = {{"input", input.string()}, {"method", o.method}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   RaytracedBakeParams rt = o.rt;
@@ -231,7 +237,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
         fs::remove(tmp);
       }
       const fs::path glb = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
-      write_ao_glb(glb, scene, png);
+      write_ao_glb(glb, scene, png, source ? &*source : nullptr);
       summary["gltf_output"] = glb.string();
     }
     if (!o.json)
@@ -252,7 +258,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
 
 int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.method != "histogram" && o.method != "raytraced") throw InputError("--method: expected histogram or raytraced, got '" + o.method + "'");
-  if (o.uv_set != 0) throw InputError("--uv-set: only the first UV set (0) is loaded by the mesh reader for now");
+  if (o.uv_set < 0 || o.uv_set > 7) throw InputError("--uv-set must be in [0, 7] (UV sets count from 0)");
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
   if (o.padding < 0 || o.padding > 1024) throw InputError("--padding must be in [0, 1024] texels");
   const auto ds = parse_direction_set(o.direction_set);
@@ -303,7 +309,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   cmd->add_option("-m,--method", o->method, "histogram (outside-in, McGraw & Sowers; unlimited distance) or raytraced (Embree)")->capture_default_str();
   cmd->add_option("-s,--size", o->size, "Map width = height, texels [1, 16384]")->capture_default_str();
-  cmd->add_option("--uv-set", o->uv_set, "UV set to bake into (only 0 is supported by the mesh reader)")->capture_default_str();
+  cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
   cmd->add_option("--direction-set", o->direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();
   cmd->add_option("--pixels-per-texel", o->hist.pixels_per_texel, "histogram: view resolution, pixels per texel edge (0, 8]")->capture_default_str();

@@ -223,5 +223,53 @@ TEST(BakeCli, PerVertexAndGltfOutputsAreWrittenAndReadable) {
   }
 }
 
+// A unit quad with two UV sets (TEXCOORD_0 over [0.1, 0.4]^2, TEXCOORD_1 over [0.5, 0.9]^2, glTF's
+// v down) and a named material, as glTF with an embedded base64 buffer.
+const std::string kTwoUvSetsGltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],
+  "nodes":[{"mesh":0}],
+  "meshes":[{"name":"quad","primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1,"TEXCOORD_1":2},"indices":3,"material":0}]}],
+  "materials":[{"name":"Keep me","pbrMetallicRoughness":{"baseColorFactor":[0.2,0.4,0.6,1],"roughnessFactor":0.5},"doubleSided":true}],
+  "buffers":[{"byteLength":124,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAzczMPc3MzD3NzMw+zczMPc3MzD7NzMw+zczMPc3MzD4AAAA/AAAAP2ZmZj8AAAA/ZmZmP2ZmZj8AAAA/ZmZmPwAAAQACAAAAAgADAA=="}],
+  "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":32},
+                 {"buffer":0,"byteOffset":80,"byteLength":32},{"buffer":0,"byteOffset":112,"byteLength":12}],
+  "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+               {"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"},
+               {"bufferView":2,"componentType":5126,"count":4,"type":"VEC2"},
+               {"bufferView":3,"componentType":5123,"count":6,"type":"SCALAR"}]})";
+
+TEST(BakeCli, UvSetPicksTheSecondSetAndTheGlbKeepsTheMaterial) {
+  TempDir dir;
+  write_text(dir / "quad.gltf", kTwoUvSetsGltf);
+  // Set 1 covers [0.5, 0.9] x [0.1, 0.5] (v up) = 6.4 x 6.4 texels of a 16^2 map; set 0 the same area elsewhere.
+  const RunResult r = run_ao("bake quad.gltf --uv-set 1 -o ao.png --gltf out.glb --json" + kQuick, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["texels_covered"].get<int>(), 30);
+  EXPECT_LT(j["texels_covered"].get<int>(), 70);
+  // The .glb's TEXCOORD_0 is the baked set (read back by the loader in its v-up convention).
+  const Scene glb = load_scene_file(dir / "out.glb");
+  ASSERT_EQ(glb.meshes.size(), 1u);
+  ASSERT_EQ(glb.meshes[0].uvs.size(), 4u);
+  for (const Vec2& t : glb.meshes[0].uvs) {
+    EXPECT_NEAR(std::min(std::abs(t.x - 0.5f), std::abs(t.x - 0.9f)), 0.0f, 1e-6f) << t.x;
+    EXPECT_NEAR(std::min(std::abs(t.y - 0.1f), std::abs(t.y - 0.5f)), 0.0f, 1e-6f) << t.y;
+  }
+  // The input's material is kept (name, doubleSided) with the occlusion texture added.
+  const std::string bytes = read_text(dir / "out.glb");
+  EXPECT_NE(bytes.find("\"name\":\"Keep me\""), std::string::npos);
+  EXPECT_NE(bytes.find("\"doubleSided\":true"), std::string::npos);
+  EXPECT_NE(bytes.find("\"occlusionTexture\""), std::string::npos);
+}
+
+TEST(BakeCli, AbsentUvSetIsAOneLineErrorAndWritesNothing) {
+  TempDir dir;
+  write_text(dir / "quad.gltf", kTwoUvSetsGltf);
+  const RunResult r = run_ao("bake quad.gltf --uv-set 2 -o ao.png --gltf out.glb" + kQuick, dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "quad.gltf: has 2 UV sets, --uv-set 2 asked for");
+  EXPECT_FALSE(fs::exists(dir / "ao.png"));
+  EXPECT_FALSE(fs::exists(dir / "out.glb"));
+}
+
 }  // namespace
 }  // namespace ao::test

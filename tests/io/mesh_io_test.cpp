@@ -13,7 +13,9 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <unistd.h>
+#include <utility>
 #include <vector>
 
 #include "ao/core/error.h"
@@ -275,6 +277,80 @@ TEST(MeshIo, GltfEmbeddedBufferAppliesNodeTransformAndBaseColor) {
   expect_near(s.bounds().lo, {10, 0, 0});
   expect_near(s.bounds().hi, {11, 1, 0});
   expect_near(s.meshes[0].albedo, {0.2f, 0.4f, 0.6f});
+}
+
+// A unit quad (z = 0, facing +z) with two UV sets, as glTF with an embedded base64 buffer:
+// TEXCOORD_0 spans [0.1, 0.4]^2 and TEXCOORD_1 [0.5, 0.9]^2 (glTF's v-down convention).
+const std::string kTwoUvSetsGltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],
+  "nodes":[{"mesh":0}],
+  "meshes":[{"name":"quad","primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1,"TEXCOORD_1":2},"indices":3}]}],
+  "buffers":[{"byteLength":124,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAzczMPc3MzD3NzMw+zczMPc3MzD7NzMw+zczMPc3MzD4AAAA/AAAAP2ZmZj8AAAA/ZmZmP2ZmZj8AAAA/ZmZmPwAAAQACAAAAAgADAA=="}],
+  "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":32},
+                 {"buffer":0,"byteOffset":80,"byteLength":32},{"buffer":0,"byteOffset":112,"byteLength":12}],
+  "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+               {"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"},
+               {"bufferView":2,"componentType":5126,"count":4,"type":"VEC2"},
+               {"bufferView":3,"componentType":5123,"count":6,"type":"SCALAR"}]})";
+
+/// UV range of a loaded mesh.
+std::pair<Vec2, Vec2> uv_range(const Mesh& m) {
+  Vec2 lo{1e9f, 1e9f}, hi{-1e9f, -1e9f};
+  for (const Vec2& t : m.uvs) {
+    lo = {std::min(lo.x, t.x), std::min(lo.y, t.y)};
+    hi = {std::max(hi.x, t.x), std::max(hi.y, t.y)};
+  }
+  return {lo, hi};
+}
+
+TEST(MeshIo, GltfUvSetOptionPicksTheSecondSet) {
+  TempDir dir;
+  const fs::path file = dir.write("two-sets.gltf", kTwoUvSetsGltf);
+  // Default: the first set. The loader turns glTF's v-down into v-up (v' = 1 - v).
+  const Scene first = load_scene_file(file);
+  ASSERT_EQ(first.meshes.size(), 1u);
+  ASSERT_EQ(first.meshes[0].uvs.size(), first.meshes[0].positions.size());
+  auto [lo0, hi0] = uv_range(first.meshes[0]);
+  EXPECT_NEAR(lo0.x, 0.1f, 1e-6f);
+  EXPECT_NEAR(hi0.x, 0.4f, 1e-6f);
+  EXPECT_NEAR(lo0.y, 0.6f, 1e-6f);
+  EXPECT_NEAR(hi0.y, 0.9f, 1e-6f);
+  const Scene second = load_scene_file(file, {.uv_set = 1});
+  ASSERT_EQ(second.meshes.size(), 1u);
+  ASSERT_EQ(second.meshes[0].uvs.size(), second.meshes[0].positions.size());
+  auto [lo1, hi1] = uv_range(second.meshes[0]);
+  EXPECT_NEAR(lo1.x, 0.5f, 1e-6f);
+  EXPECT_NEAR(hi1.x, 0.9f, 1e-6f);
+  EXPECT_NEAR(lo1.y, 0.1f, 1e-6f);
+  EXPECT_NEAR(hi1.y, 0.5f, 1e-6f);
+  // Same vertices, each with its own UV of the other set: vertex (1,0,0) has TEXCOORD_1 (0.9, 0.5).
+  for (std::size_t v = 0; v < second.meshes[0].positions.size(); ++v) {
+    const Vec3 p = second.meshes[0].positions[v];
+    EXPECT_NEAR(second.meshes[0].uvs[v].x, 0.5f + 0.4f * p.x, 1e-6f) << v;
+    EXPECT_NEAR(second.meshes[0].uvs[v].y, 1.0f - (0.5f + 0.4f * p.y), 1e-6f) << v;
+  }
+}
+
+TEST(MeshIo, AbsentUvSetIsAnInputErrorCountingTheSets) {
+  TempDir dir;
+  try {
+    load_scene_file(dir.write("two-sets.gltf", kTwoUvSetsGltf), {.uv_set = 2});
+    ADD_FAILURE() << "loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("two-sets.gltf: has 2 UV sets, --uv-set 2 asked for"), std::string::npos) << e.what();
+  }
+  for (const auto& [name, content, sets] : {std::tuple{"quad.obj", std::string(kQuadObj), "has 1 UV set,"},
+                                             std::tuple{"tri.off", std::string("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "has 0 UV sets,"}}) {
+    try {
+      load_scene_file(dir.write(name, content), {.uv_set = 1});
+      ADD_FAILURE() << name << " loaded";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(std::string(name) + ": " + sets + " --uv-set 1 asked for"), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+  // Set 0 of a file without UVs still loads (without UVs), as before.
+  EXPECT_TRUE(load_scene_file(dir.write("tri2.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).meshes[0].uvs.empty());
 }
 
 TEST(MeshIo, SomeDegenerateTrianglesLoadWithWarning) {

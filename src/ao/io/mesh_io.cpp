@@ -419,6 +419,10 @@ Vec3 material_albedo(const aiMaterial& material, bool format_has_materials) {
   return fallback;
 }
 
+std::string uv_set_error(unsigned sets, int asked) {
+  return "has " + std::to_string(sets) + " UV set" + (sets == 1 ? "" : "s") + ", --uv-set " + std::to_string(asked) + " asked for";
+}
+
 /// Explains assimp's error in the user's terms where we recognise it; keeps assimp's words otherwise.
 std::string explain_assimp_error(std::string_view error) {
   const std::string e = one_line(error);
@@ -434,9 +438,9 @@ std::string mesh_label(const aiMesh& m, unsigned index) {
   return m.mName.length > 0 ? "mesh '" + std::string(m.mName.C_Str()) + "'" : "mesh " + std::to_string(index);
 }
 
-/// Faces without indices, and non-finite values, checked before JoinIdenticalVertices can merge or hide them (it joins NaN
+/// Faces without indices, and non-finite values (of the UV set that is loaded), checked before JoinIdenticalVertices can merge or hide them (it joins NaN
 /// vertices with their neighbours, which turns the error into a "degenerate triangle").
-void check_raw_meshes(const fs::path& path, const aiScene& scene) {
+void check_raw_meshes(const fs::path& path, const aiScene& scene, unsigned uv_set) {
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh& mesh = *scene.mMeshes[m];
     const std::string where = scene.mNumMeshes > 1 ? " of " + mesh_label(mesh, m) : "";
@@ -459,15 +463,16 @@ void check_raw_meshes(const fs::path& path, const aiScene& scene) {
         if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
           fail(path, "normal " + std::to_string(v) + where + " is not finite");
       }
-      if (mesh.HasTextureCoords(0)) {
-        const aiVector3D t = mesh.mTextureCoords[0][v];
-        if (!std::isfinite(t.x) || !std::isfinite(t.y)) fail(path, "UV " + std::to_string(v) + where + " is not finite");
+      if (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && mesh.HasTextureCoords(uv_set)) {
+        const aiVector3D t = mesh.mTextureCoords[uv_set][v];
+        if (!std::isfinite(t.x) || !std::isfinite(t.y))
+          fail(path, "UV " + std::to_string(v) + (uv_set ? " of UV set " + std::to_string(uv_set) : std::string()) + where + " is not finite");
       }
     }
   }
 }
 
-Scene read_with_assimp(const fs::path& path, std::string_view data) {
+Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOptions& options) {
   const std::string ext = lower(path.extension().string());
   const bool is_stl = ext == ".stl" || data.starts_with("solid");
   // STL, PLY and OFF carry no materials; assimp's stand-in colour for them is white.
@@ -495,7 +500,7 @@ Scene read_with_assimp(const fs::path& path, std::string_view data) {
       fail(path, "malformed or truncated " + printable(ext.substr(1)) + " file: its content is not recognised");
     fail(path, explain_assimp_error(error));
   }
-  check_raw_meshes(path, *raw);
+  check_raw_meshes(path, *raw, static_cast<unsigned>(options.uv_set));
 
   // No GenNormals / GenSmoothNormals (validate_and_prepare makes normals), and no FindInvalidData or
   // FixInfacingNormals, which would change the data without telling anyone.
@@ -508,6 +513,19 @@ Scene read_with_assimp(const fs::path& path, std::string_view data) {
     fail(path, explain_assimp_error(e.what()));
   }
   if (ai == nullptr) fail(path, explain_assimp_error(importer.GetErrorString()));
+
+  // The UV set asked for: a set above 0 that no mesh has is a mistake worth stopping on (set 0
+  // missing is the "no UVs" case the callers report in their own terms).
+  const unsigned uv_set = static_cast<unsigned>(options.uv_set);
+  if (uv_set > 0) {
+    unsigned sets = 0;
+    bool found = false;
+    for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+      sets = std::max(sets, ai->mMeshes[m]->GetNumUVChannels());
+      found = found || (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && ai->mMeshes[m]->HasTextureCoords(uv_set));
+    }
+    if (!found) fail(path, uv_set_error(sets, options.uv_set));
+  }
 
   Scene scene;
   scene.name = path.filename().string();
@@ -522,9 +540,9 @@ Scene read_with_assimp(const fs::path& path, std::string_view data) {
       mesh.normals.reserve(in.mNumVertices);
       for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.normals.push_back({in.mNormals[v].x, in.mNormals[v].y, in.mNormals[v].z});
     }
-    if (in.HasTextureCoords(0)) {
+    if (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && in.HasTextureCoords(uv_set)) {
       mesh.uvs.reserve(in.mNumVertices);
-      for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.uvs.push_back({in.mTextureCoords[0][v].x, in.mTextureCoords[0][v].y});
+      for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.uvs.push_back({in.mTextureCoords[uv_set][v].x, in.mTextureCoords[uv_set][v].y});
     }
     mesh.indices.reserve(static_cast<std::size_t>(in.mNumFaces) * 3);
     for (unsigned f = 0; f < in.mNumFaces; ++f) {
@@ -542,17 +560,21 @@ Scene read_with_assimp(const fs::path& path, std::string_view data) {
 
 }  // namespace
 
-Scene load_scene_file(const fs::path& path) {
+Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
+  if (options.uv_set < 0) fail(path, "--uv-set " + std::to_string(options.uv_set) + " asked for, UV sets count from 0");
   // The whole file is read once up front: both our parsers need it, the size check for counts
   // needs its length, and it is at most a copy of what assimp reads anyway.
   const std::string data = read_whole_file(path);
   const std::string ext = lower(path.extension().string());
-  if (ext == ".off" || looks_like_off(data)) return read_off(path, data);
+  if (ext == ".off" || looks_like_off(data)) {
+    if (options.uv_set > 0) fail(path, uv_set_error(0, options.uv_set));  // OFF has no UVs
+    return read_off(path, data);
+  }
   if (ext == ".ply" || looks_like_ply(data)) {
     if (!looks_like_ply(data)) fail(path, "not a PLY file: it does not start with 'ply'");
     check_ply(path, data);
   }
-  return read_with_assimp(path, data);
+  return read_with_assimp(path, data, options);
 }
 
 }  // namespace ao

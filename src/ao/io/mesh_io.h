@@ -8,9 +8,16 @@
 
 namespace ao {
 
+struct LoadOptions {
+  /// Which UV set (assimp channel = glTF TEXCOORD_n, in the file's order) becomes Mesh::uvs. 0, the
+  /// default, is the first set; a mesh lacking the set loads without UVs. Asking for a set above 0
+  /// that no mesh of the file has is an InputError "<file>: has K UV sets, --uv-set N asked for".
+  int uv_set = 0;
+};
+
 /// Loads OBJ, PLY, OFF, STL, glTF/GLB (by content/extension, via assimp) into a Scene: one Mesh per
-/// assimp mesh (so per material), triangulated, with normals when the file has them, the first UV set,
-/// and the material's diffuse colour (or glTF baseColorFactor) as albedo. Node transforms are applied
+/// assimp mesh (so per material), triangulated, with normals when the file has them, the UV set
+/// `options.uv_set` (default the first), and the material's diffuse colour (or glTF baseColorFactor) as albedo. Node transforms are applied
 /// (pre-transform vertices). Calls validate_and_prepare. Throws InputError with one line naming the
 /// file and problem: missing/unreadable file, unknown format, truncated/malformed content, bad counts,
 /// NaN/inf, indices out of range, empty scene.
@@ -21,6 +28,6 @@ namespace ao {
 /// discarded so the triangle soup can be welded into a connected mesh with smooth normals.
 /// Scene::name is the file name without its folder; Mesh::name is the file's mesh name (the file stem
 /// for OFF). The file's cameras are not read.
-Scene load_scene_file(const std::filesystem::path& path);
+Scene load_scene_file(const std::filesystem::path& path, const LoadOptions& options = {});
 
 }  // namespace ao

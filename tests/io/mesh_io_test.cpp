@@ -19,17 +19,14 @@
 #include <vector>
 
 #include "ao/core/error.h"
+#include "support/run.h"
 
 namespace ao {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// A fresh folder under the system temp dir, removed with everything in it at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
+using test::TempDir;
     path_ = fs::temp_directory_path() / ("ao_mesh_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     fs::create_directories(path_);
   }

@@ -44,6 +44,11 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+std::filesystem::path TempDir::write(const std::string& name, const std::string& content) const {
+  write_text(path_ / name, content);
+  return path_ / name;
+}
+
 int TempDir::file_count() const {
   return static_cast<int>(std::distance(std::filesystem::directory_iterator(path_), std::filesystem::directory_iterator()));
 }

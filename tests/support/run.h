@@ -25,6 +25,8 @@ class TempDir {
   TempDir& operator=(const TempDir&) = delete;
   const std::filesystem::path& path() const { return path_; }
   std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+  /// Writes `content` to the file `name` in the directory and returns its path.
+  std::filesystem::path write(const std::string& name, const std::string& content) const;
   /// Entries directly in the directory (to check that nothing, not even a temporary file, was left).
   int file_count() const;
 

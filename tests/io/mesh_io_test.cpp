@@ -27,23 +27,6 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::TempDir;
-    path_ = fs::temp_directory_path() / ("ao_mesh_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path write(const std::string& name, const std::string& content) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary) << content;
-    return p;
-  }
-
- private:
-  fs::path path_;
-};
 
 /// Loads a file that must be rejected; returns the message after checking that it is one line and
 /// names the file.

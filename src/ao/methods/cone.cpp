@@ -3,8 +3,15 @@
 #include "ao/methods/cone.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <mutex>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -42,50 +49,175 @@ inline float solid_length(const std::uint64_t* col, int words, int nbits, float 
 struct WorldSampler {
   const VoxelGrid& g;
   Vec3 inv;  // 1 / voxel size along (i, j, k)
+  int np;    // prisms per sphere
+  int lanes; // np rounded up to a multiple of 8
+  // Per sphere of the chain (they differ only in radius): radii in voxels along (i, j, k), the sum
+  // of the prisms' chords, how far its prisms reach along the column (voxels) and across the
+  // columns (coarse cells, -1: beyond the coarse masks' cap).
+  struct Sphere {
+    float rx, ry, rz, chord, zreach;
+    int reach;
+  };
+  std::vector<Sphere> spheres;
+  // Structure of arrays, padded to `lanes` with zeros: disk points, and per sphere each prism's
+  // half chord in voxels ([k * lanes + s]).
+  std::vector<float> du, dv, half;
 
-  // centre in world space, radius in world units; disk points are (u, v) in the world x-z plane.
-  float operator()(Vec3 c, float r, const ConeSetup::Disk* disk, int n, float rot_c, float rot_s) const {
-    const float gx = (c.x - g.origin.x) * inv.x, gy = (c.z - g.origin.z) * inv.y, gz = (c.y - g.origin.y) * inv.z;
-    const float rx = r * inv.x, ry = r * inv.y, rz = r * inv.z;
-    // Empty-space skipping (not in the paper): if no block the sphere's bounding box touches has
-    // a solid voxel in its z range, the sphere is unobstructed and its prisms need no lookups.
-    {
-      constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
-      const int bx0 = std::max(0, static_cast<int>(std::floor((gx - rx) * kInvB)));
-      const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + rx) * kInvB)));
-      const int by0 = std::max(0, static_cast<int>(std::floor((gy - ry) * kInvB)));
-      const int by1 = std::min(g.bny - 1, static_cast<int>(std::floor((gy + ry) * kInvB)));
-      const int k0 = static_cast<int>(std::floor(std::max(gz - rz, -1.0f))), k1 = static_cast<int>(std::min(gz + rz, 1e6f)) + 1;
-      bool any = false;
-      for (int by = by0; by <= by1 && !any; ++by)
-        for (int bx = bx0; bx <= bx1 && !any; ++bx) any = any_bits(g.block(bx, by), g.words, k0, k1);
-      if (!any) return 0.0f;
+  WorldSampler(const VoxelGrid& grid, const ConeSetup& setup, float r_max)
+      : g(grid), inv{1.0f / grid.voxel_size.x, 1.0f / grid.voxel_size.y, 1.0f / grid.voxel_size.z}, np(static_cast<int>(setup.disk.size())),
+        lanes((np + 7) / 8 * 8), du(lanes, 0.0f), dv(lanes, 0.0f) {
+    // The prisms stay within rho_max of the disk's centre and half_max of the equator.
+    float rho_max = 0, half_max = 0;
+    for (int s = 0; s < np; ++s) {
+      const ConeSetup::Disk& d = setup.disk[s];
+      du[s] = d.u, dv[s] = d.v;
+      rho_max = std::max(rho_max, std::sqrt(d.u * d.u + d.v * d.v));
+      half_max = std::max(half_max, d.half_chord);
     }
-    float solid = 0, chord = 0;
-    for (int s = 0; s < n; ++s) {
-      const float u = disk[s].u * rot_c - disk[s].v * rot_s, v = disk[s].u * rot_s + disk[s].v * rot_c;
-      const float half = disk[s].half_chord * rz;
-      chord += 2.0f * half;
-      const float fx = gx + u * rx, fy = gy + v * ry;
-      if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) continue;
-      solid += solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - half, gz + half);
+    half.assign(setup.sphere_radius.size() * lanes, 0.0f);
+    for (std::size_t k = 0; k < setup.sphere_radius.size(); ++k) {
+      const float r = setup.sphere_radius[k] * r_max;
+      Sphere sp{r * inv.x, r * inv.y, r * inv.z, 0.0f, 0.0f, -1};
+      for (int s = 0; s < np; ++s) {
+        const float h = setup.disk[s].half_chord * sp.rz;
+        half[k * lanes + s] = h;
+        sp.chord += 2.0f * h;
+      }
+      // A prism reads columns within rho_max * r of the centre and voxels within half_max * r
+      // along the column; floor(a) - floor(a - b) <= ceil(b); margins cover rounding.
+      sp.zreach = half_max * sp.rz * 1.001f + 1e-3f;
+      const float e = std::ceil(std::max(rho_max * sp.rx, rho_max * sp.ry) / VoxelGrid::kCellXY * 1.001f + 1e-3f);
+      if (!g.dilated.empty() && e <= static_cast<float>(VoxelGrid::kReachCap)) sp.reach = static_cast<int>(e);
+      spheres.push_back(sp);
     }
-    return chord > 0 ? std::min(1.0f, solid / chord) : 0.0f;
   }
+
+  static int clamp_index(float x, int n) {  // clamp(floor(x), 0, n - 1), branch-free; NaN -> 0
+    return static_cast<int>(std::min(std::max(0.0f, x), static_cast<float>(n - 1)));
+  }
+
+  // Conservative: false only when no prism of sphere k centred at (gx, gy, gz) can meet a solid voxel.
+  bool maybe_solid(const Sphere& sp, float gx, float gy, float gz) const {
+    if (sp.reach >= 0) {
+      // One 64-bit mask: the cells within `reach` of the centre's cell across the columns (the
+      // centre clamped into the grid, which only shrinks the set the prisms can read), tested
+      // over the cells of the prisms' z range.
+      constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
+      const std::uint64_t m = g.near_mask(sp.reach, clamp_index(gx * kInvC, g.dnx), clamp_index(gy * kInvC, g.dny));
+      const int cl = clamp_index(gz - sp.zreach, g.depth_bits) >> g.cell_shift, ch = clamp_index(gz + sp.zreach, g.depth_bits) >> g.cell_shift;
+      const std::uint64_t bits = m >> cl;
+      const int len = ch - cl + 1;
+      return (len >= 64 ? bits : bits & ((std::uint64_t{1} << len) - 1)) != 0;
+    }
+    // Too large for the masks: the OR of every block the sphere's bounding box touches.
+    constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
+    const int bx0 = std::max(0, static_cast<int>(std::floor((gx - sp.rx) * kInvB)));
+    const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + sp.rx) * kInvB)));
+    const int by0 = std::max(0, static_cast<int>(std::floor((gy - sp.ry) * kInvB)));
+    const int by1 = std::min(g.bny - 1, static_cast<int>(std::floor((gy + sp.ry) * kInvB)));
+    const int k0 = static_cast<int>(std::floor(std::max(gz - sp.rz, -1.0f))), k1 = static_cast<int>(std::min(gz + sp.rz, 1e6f)) + 1;
+    for (int by = by0; by <= by1; ++by)
+      for (int bx = bx0; bx <= bx1; ++bx)
+        if (any_bits(g.block(bx, by), g.words, k0, k1)) return true;
+    return false;
+  }
+
+  // centre in world space, sphere k of the chain; disk points are (u, v) in the world x-z plane.
+  float operator()(Vec3 c, int k, float rot_c, float rot_s) const {
+    const float gx = (c.x - g.origin.x) * inv.x, gy = (c.z - g.origin.z) * inv.y, gz = (c.y - g.origin.y) * inv.z;
+    const Sphere& sp = spheres[k];
+    // Empty-space skipping (not in the paper): an empty neighbourhood needs no prism lookups.
+    if (!maybe_solid(sp, gx, gy, gz)) return 0.0f;
+    const float* h = half.data() + static_cast<std::size_t>(k) * lanes;
+    float len[64];  // solid length per prism, summed in prism order below (same sum at any width)
+    prisms(gx, gy, gz, sp.rx, sp.ry, h, rot_c, rot_s, len);
+    float solid = 0;
+    for (int s = 0; s < np; ++s) solid += len[s];
+    return sp.chord > 0 ? std::min(1.0f, solid / sp.chord) : 0.0f;
+  }
+
+  float scalar_prism(int s, float gx, float gy, float gz, float rx, float ry, float h, float rot_c, float rot_s) const {
+    const float u = du[s] * rot_c - dv[s] * rot_s, v = du[s] * rot_s + dv[s] * rot_c;
+    const float fx = gx + u * rx, fy = gy + v * ry;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return 0.0f;
+    return solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - h, gz + h);
+  }
+
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__)
+  // 8 prisms at once: column indices, z ranges, two gathered words per prism (the words of the end
+  // voxels), masks and VPOPCNTQ. Prisms whose range spans more than two words go the scalar way.
+  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float rot_c, float rot_s, float* len) const {
+    const __m256 vrc = _mm256_set1_ps(rot_c), vrs = _mm256_set1_ps(rot_s);
+    const __m256 zero = _mm256_setzero_ps(), fnx = _mm256_set1_ps(static_cast<float>(g.nx)), fny = _mm256_set1_ps(static_cast<float>(g.ny));
+    const __m256 fbits = _mm256_set1_ps(static_cast<float>(g.depth_bits));
+    const __m256i last_bit = _mm256_set1_epi32(g.depth_bits - 1), nx = _mm256_set1_epi32(g.nx), words = _mm256_set1_epi32(g.words);
+    const __m512i one = _mm512_set1_epi64(1), ones = _mm512_set1_epi64(-1), c63 = _mm512_set1_epi64(63);
+    const long long* base = reinterpret_cast<const long long*>(g.bits.data());
+    for (int s0 = 0; s0 < np; s0 += 8) {
+      const __mmask8 lane = static_cast<__mmask8>(np - s0 >= 8 ? 0xff : (1u << (np - s0)) - 1);
+      const __m256 u0 = _mm256_loadu_ps(du.data() + s0), v0 = _mm256_loadu_ps(dv.data() + s0), hh = _mm256_loadu_ps(h + s0);
+      const __m256 u = _mm256_fmsub_ps(u0, vrc, _mm256_mul_ps(v0, vrs)), v = _mm256_fmadd_ps(u0, vrs, _mm256_mul_ps(v0, vrc));
+      const __m256 fx = _mm256_fmadd_ps(u, _mm256_set1_ps(rx), _mm256_set1_ps(gx)), fy = _mm256_fmadd_ps(v, _mm256_set1_ps(ry), _mm256_set1_ps(gy));
+      __m256 zlo = _mm256_sub_ps(_mm256_set1_ps(gz), hh), zhi = _mm256_add_ps(_mm256_set1_ps(gz), hh);
+      zlo = _mm256_max_ps(zlo, zero);
+      zhi = _mm256_min_ps(zhi, fbits);
+      __mmask8 ok = lane & _mm256_cmp_ps_mask(fx, zero, _CMP_GE_OQ) & _mm256_cmp_ps_mask(fy, zero, _CMP_GE_OQ) &
+                    _mm256_cmp_ps_mask(fx, fnx, _CMP_LT_OQ) & _mm256_cmp_ps_mask(fy, fny, _CMP_LT_OQ) & _mm256_cmp_ps_mask(zhi, zlo, _CMP_GT_OQ);
+      const __m256i ix = _mm256_cvttps_epi32(fx), iy = _mm256_cvttps_epi32(fy);
+      const __m256i k0 = _mm256_cvttps_epi32(zlo), k1 = _mm256_min_epi32(_mm256_cvttps_epi32(zhi), last_bit);
+      const __m256i w0 = _mm256_srli_epi32(k0, 6), w1 = _mm256_srli_epi32(k1, 6);
+      // Lanes spanning more than two words: scalar.
+      const __mmask8 wide = ok & _mm256_cmp_epi32_mask(_mm256_sub_epi32(w1, w0), _mm256_set1_epi32(1), _MM_CMPINT_GT);
+      ok &= static_cast<__mmask8>(~wide);
+      const __m256i col = _mm256_mullo_epi32(_mm256_add_epi32(_mm256_mullo_epi32(iy, nx), ix), words);
+      const __m512i a = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), ok, _mm256_add_epi32(col, w0), base, 8);
+      const __m512i b = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), ok, _mm256_add_epi32(col, w1), base, 8);
+      const __m512i s0b = _mm512_and_si512(_mm512_cvtepi32_epi64(k0), c63), s1b = _mm512_and_si512(_mm512_cvtepi32_epi64(k1), c63);
+      const __m512i bit0 = _mm512_and_si512(_mm512_srlv_epi64(a, s0b), one), bit1 = _mm512_and_si512(_mm512_srlv_epi64(b, s1b), one);
+      // Bits strictly between the end voxels: [k0 + 1, k1) = [k0, k1) minus bit k0.
+      const __m512i lo = _mm512_sllv_epi64(ones, s0b), hi = _mm512_sub_epi64(_mm512_sllv_epi64(one, s1b), one);
+      const __mmask8 same = _mm256_cmp_epi32_mask(w0, w1, _MM_CMPINT_EQ);
+      const __m512i pa = _mm512_and_si512(a, _mm512_and_si512(lo, _mm512_mask_blend_epi64(same, ones, hi)));
+      const __m512i pb = _mm512_maskz_and_epi64(static_cast<__mmask8>(~same), b, hi);
+      const __m512i mid = _mm512_sub_epi64(_mm512_add_epi64(_mm512_popcnt_epi64(pa), _mm512_popcnt_epi64(pb)), bit0);
+      const __m256 fb0 = _mm512_cvtepi64_ps(bit0), fb1 = _mm512_cvtepi64_ps(bit1), fmid = _mm512_cvtepi64_ps(mid);
+      const __m256 fk0 = _mm256_cvtepi32_ps(k0), fk1 = _mm256_cvtepi32_ps(k1);
+      // k0 == k1: bit(k0) * (zhi - zlo); else bit(k0) (k0 + 1 - zlo) + between + bit(k1) (zhi - k1).
+      const __m256 multi = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(fb0, _mm256_sub_ps(_mm256_add_ps(fk0, _mm256_set1_ps(1.0f)), zlo)), fmid),
+                                         _mm256_mul_ps(fb1, _mm256_sub_ps(zhi, fk1)));
+      const __m256 single = _mm256_mul_ps(fb0, _mm256_sub_ps(zhi, zlo));
+      const __mmask8 one_voxel = _mm256_cmp_epi32_mask(k0, k1, _MM_CMPINT_GE);
+      const __m256 r = _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single));
+      _mm256_storeu_ps(len + s0, r);
+      for (unsigned m = wide; m; m &= m - 1) {
+        const int s = s0 + std::countr_zero(m);
+        len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s], rot_c, rot_s);
+      }
+    }
+  }
+#else
+  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float rot_c, float rot_s, float* len) const {
+    for (int s = 0; s < np; ++s) len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s], rot_c, rot_s);
+  }
+#endif
 };
 
 struct EyeSampler {
   const VoxelGrid& g;
   float sx, sy, ox, oy;  // camera-space (x/depth, y/depth) -> column coordinates
+  const ConeSetup::Disk* disk;
+  int np;
+  std::vector<float> radius;  // world units, per sphere of the chain
 
   // centre in camera space; the prisms run along the camera's z (the grid's columns are view rays:
   // over one sphere they are close to parallel, the approximation the paper's texture fetch makes).
-  float operator()(Vec3 c, float r, const ConeSetup::Disk* disk, int n, float rot_c, float rot_s) const {
+  float operator()(Vec3 c, int k, float rot_c, float rot_s) const {
+    const float r = radius[k];
     float solid = 0, chord = 0;
     const float depth = -c.z;
     if (!(depth > 0)) return 0.0f;
     const float inv = 1.0f / depth;
-    for (int s = 0; s < n; ++s) {
+    for (int s = 0; s < np; ++s) {
       const float u = disk[s].u * rot_c - disk[s].v * rot_s, v = disk[s].u * rot_s + disk[s].v * rot_c;
       const float half = disk[s].half_chord * r;
       chord += 2.0f * half;
@@ -107,7 +239,8 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
   const Frame basis = gb.camera.basis();
   const Vec3 eye = gb.camera.eye;
   const int nc = static_cast<int>(setup.cones.size()), ns = static_cast<int>(setup.sphere_distance.size());
-  const int np = static_cast<int>(setup.disk.size());
+  std::vector<float> distance(ns);
+  for (int k = 0; k < ns; ++k) distance[k] = setup.sphere_distance[k] * r_max;
   const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
@@ -141,8 +274,7 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
           // obstructed fraction of the rays that reach it.
           float transmittance = 1.0f;
           for (int k = 0; k < ns && transmittance > kOpaque; ++k) {
-            const float d = setup.sphere_distance[k] * r_max, r = setup.sphere_radius[k] * r_max;
-            transmittance *= 1.0f - sample(pos + axis * d, r, setup.disk.data(), np, rot_c, rot_s);
+            transmittance *= 1.0f - sample(pos + axis * distance[k], k, rot_c, rot_s);
           }
           v += weight * transmittance;
         }
@@ -342,7 +474,17 @@ ConeSetup derive_cone_setup(const ConeParams& p) {
     s.sphere_radius[k] = d * sa;
     d /= q;
   }
-  s.disk = poisson_disk(p.prisms.value_or(6));
+  {
+    // The point sets depend on n alone; the Lloyd relaxation costs about a millisecond, per frame
+    // otherwise.
+    static std::mutex mutex;
+    static std::map<int, std::vector<ConeSetup::Disk>> cache;
+    const int n_prisms = p.prisms.value_or(6);
+    const std::lock_guard<std::mutex> lock(mutex);
+    auto it = cache.find(n_prisms);
+    if (it == cache.end()) it = cache.emplace(n_prisms, poisson_disk(n_prisms)).first;
+    s.disk = it->second;
+  }
   return s;
 }
 
@@ -354,13 +496,15 @@ void compute_cone(const GBuffer& gb, const VoxelGrid& g, float r_max, const Cone
   if (out.width != gb.width() || out.height != gb.height()) throw InputError("cone: output and G-buffer sizes differ");
   const ConeSetup setup = derive_cone_setup(params);
   if (g.space == GridSpace::World) {
-    const WorldSampler s{g, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}};
+    const WorldSampler s(g, setup, r_max);
     trace(gb, s, true, r_max, params, setup, seed, out, progress);
   } else {
     const Camera& cam = g.camera;
     const float t = cam.tan_half_fov();
-    const EyeSampler s{g, 0.5f * cam.width / (t * cam.aspect()) / g.pixels_per_column_x, -0.5f * cam.height / t / g.pixels_per_column_y,
-                       0.5f * cam.width / g.pixels_per_column_x, 0.5f * cam.height / g.pixels_per_column_y};
+    EyeSampler s{g, 0.5f * cam.width / (t * cam.aspect()) / g.pixels_per_column_x, -0.5f * cam.height / t / g.pixels_per_column_y,
+                       0.5f * cam.width / g.pixels_per_column_x, 0.5f * cam.height / g.pixels_per_column_y, setup.disk.data(),
+                       static_cast<int>(setup.disk.size()), {}};
+    for (float rk : setup.sphere_radius) s.radius.push_back(rk * r_max);
     trace(gb, s, false, r_max, params, setup, seed, out, progress);
   }
 }

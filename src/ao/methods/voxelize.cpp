@@ -3,13 +3,16 @@
 //  1. every triangle is mapped to the
 //     grid: column coordinates (x, y) and a depth attribute that is affine in (x, y) (voxel units
 //     for the orthographic world grid, 1/depth for the perspective eye grid);
-//  2. the rows of columns are split into bands; each band rasterises every triangle that overlaps
-//     it at the column centres and toggles one bit per fragment (no atomics: bands are disjoint);
-//  3. one prefix-XOR scan per column turns toggles into "XOR from the fragment to the far end".
+//  2. the rows of columns are split into bands; triangles are bucketed by band (counting sort per
+//     chunk); each band rasterises the triangles that overlap it at the column centres and toggles
+//     one bit per fragment (no atomics: bands are disjoint);
+//  3. one prefix-XOR scan per column turns toggles into "XOR from the fragment to the far end";
+//  4. coarse occupancy (blocks and dilated cell masks, voxelize.h) for empty-space skipping.
 #include "ao/methods/voxelize.h"
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 
@@ -85,27 +88,33 @@ struct EyeMap {
   static constexpr bool kPerspective = true;
 };
 
-void push_if_visible(std::vector<GridTri>& out, const GridTri& g, int nx, int ny) {
-  const float xmin = std::min({g.x[0], g.x[1], g.x[2]}), xmax = std::max({g.x[0], g.x[1], g.x[2]});
-  const float ymin = std::min({g.y[0], g.y[1], g.y[2]}), ymax = std::max({g.y[0], g.y[1], g.y[2]});
+// Sets the rows of a mapped triangle; false when no column centre of the grid can be inside.
+bool finish_visible(GridTri& t, int nx, int ny) {
+  const float xmin = std::min({t.x[0], t.x[1], t.x[2]}), xmax = std::max({t.x[0], t.x[1], t.x[2]});
+  const float ymin = std::min({t.y[0], t.y[1], t.y[2]}), ymax = std::max({t.y[0], t.y[1], t.y[2]});
   // Column i's centre is i + 0.5: the box covers i in [ceil(min - 0.5), floor(max - 0.5)].
-  if (!(xmax >= 0.5f && xmin <= static_cast<float>(nx) - 0.5f)) return;  // also rejects NaN
+  if (!(xmax >= 0.5f && xmin <= static_cast<float>(nx) - 0.5f)) return false;  // also rejects NaN
   const float j0 = std::ceil(ymin - 0.5f), j1 = std::floor(ymax - 0.5f);
-  if (j1 < 0 || j0 > static_cast<float>(ny - 1) || j0 > j1) return;
-  GridTri t = g;
+  if (j1 < 0 || j0 > static_cast<float>(ny - 1) || j0 > j1) return false;
   t.j0 = static_cast<int>(std::max(j0, 0.0f));
   t.j1 = static_cast<int>(std::min(j1, static_cast<float>(ny - 1)));
-  out.push_back(t);
+  return true;
+}
+
+void push_if_visible(std::vector<GridTri>& out, const GridTri& g, int nx, int ny) {
+  GridTri t = g;
+  if (finish_visible(t, nx, ny)) out.push_back(t);
 }
 
 void emit_world(std::vector<GridTri>& out, const Tri3& t, const WorldMap& m, int nx, int ny) {
   if (t.kind == 1 && std::abs(t.normal.y) < kSteep)
     return emit_prism(t, m.slab, [&](const Tri3& side) { emit_world(out, side, m, nx, ny); });
-  GridTri g;
+  // Built in place: a copy of a struct just written field by field stalls on store forwarding.
+  GridTri& g = out.emplace_back();
   for (int k = 0; k < 3; ++k) m(t.v[k], g.x[k], g.y[k], g.a[k]);
   // Behind the front face: below a face looking up (+y is +k), above a face looking down.
   g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : 0;
-  push_if_visible(out, g, nx, ny);
+  if (!finish_visible(g, nx, ny)) out.pop_back();
 }
 
 // Perspective: clip against depth >= z_clip (Sutherland-Hodgman on one plane), project, and
@@ -222,27 +231,35 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
 }
 
 // Prefix XOR along every column: bit k becomes the XOR of toggles 0..k. Returns odd columns.
+// Two passes per row of columns (the row stays in L1): the prefix XOR inside every word, a flat
+// loop over the row's words that the compiler vectorises (8 words per AVX-512 op), then the carry
+// between the words of each column (the top bit of a word is the parity of the column so far).
 std::size_t scan_columns(VoxelGrid& g) {
   const int words = g.words, nbits = g.depth_bits;
   const int last_bits = nbits - 64 * (words - 1);
   const std::uint64_t last_mask = last_bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << last_bits) - 1;
   std::vector<std::size_t> odd_per_row(g.ny, 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, g.ny, 8), [&](const tbb::blocked_range<int>& r) {
+    const std::size_t row_words = static_cast<std::size_t>(g.nx) * words;
     for (int j = r.begin(); j < r.end(); ++j) {
+      std::uint64_t* __restrict row = g.bits.data() + static_cast<std::size_t>(j) * row_words;
+      for (std::size_t w = 0; w < row_words; ++w) {
+        std::uint64_t x = row[w];
+        x ^= x << 1;
+        x ^= x << 2;
+        x ^= x << 4;
+        x ^= x << 8;
+        x ^= x << 16;
+        x ^= x << 32;
+        row[w] = x;
+      }
       std::size_t odd = 0;
       for (int i = 0; i < g.nx; ++i) {
-        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(j) * g.nx + i) * words;
-        std::uint64_t carry = 0;
+        std::uint64_t* col = row + static_cast<std::size_t>(i) * words;
+        std::uint64_t carry = 0;  // all ones when the previous words left the column inside
         for (int w = 0; w < words; ++w) {
-          std::uint64_t x = col[w];
-          x ^= x << 1;
-          x ^= x << 2;
-          x ^= x << 4;
-          x ^= x << 8;
-          x ^= x << 16;
-          x ^= x << 32;
-          x ^= carry;  // carry is all ones when the previous words left the column inside
-          carry = (x >> 63) ? ~std::uint64_t{0} : 0;
+          const std::uint64_t x = col[w] ^ carry;
+          carry = static_cast<std::uint64_t>(static_cast<std::int64_t>(x) >> 63);
           col[w] = x;
         }
         std::uint64_t& last = col[words - 1];
@@ -257,20 +274,89 @@ std::size_t scan_columns(VoxelGrid& g) {
   return odd;
 }
 
-// OR of each block of kBlock x kBlock columns, for empty-space skipping.
-void build_blocks(VoxelGrid& g) {
-  constexpr int B = VoxelGrid::kBlock;
+// Coarse occupancy for empty-space skipping, in one pass over the grid: the OR of each cell of
+// kCellXY x kCellXY columns (all words), from which the blocks (2 x 2 cells, all words) and the
+// cells' 64-bit masks along the column (one bit per cell_bits voxels), dilated by 0..kReachCap
+// cells across the columns (separable 3 x 3 OR, repeated). Returns the number of solid voxels.
+std::size_t build_coarse(VoxelGrid& g) {
+  constexpr int C = VoxelGrid::kCellXY, B = VoxelGrid::kBlock;
+  static_assert(B == 2 * C);
+  const int words = g.words;
+  int cb = 1;
+  while (cb * 64 < g.depth_bits) cb *= 2;
+  g.cell_bits = cb;
+  g.cell_shift = std::countr_zero(static_cast<unsigned>(cb));
+  g.dnx = (g.nx + C - 1) / C;
+  g.dny = (g.ny + C - 1) / C;
   g.bnx = (g.nx + B - 1) / B;
   g.bny = (g.ny + B - 1) / B;
-  g.block_bits.assign(static_cast<std::size_t>(g.bnx) * g.bny * g.words, 0);
-  tbb::parallel_for(0, g.bny, [&](int bj) {
-    for (int j = bj * B; j < std::min(g.ny, (bj + 1) * B); ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const std::uint64_t* col = g.column(i, j);
-        std::uint64_t* blk = g.block_bits.data() + (static_cast<std::size_t>(bj) * g.bnx + i / B) * g.words;
-        for (int w = 0; w < g.words; ++w) blk[w] |= col[w];
+  const int dnx = g.dnx, dny = g.dny;
+  const std::size_t cells = static_cast<std::size_t>(dnx) * dny;
+  std::vector<std::uint64_t> cell_words(cells * words, 0);
+  constexpr int L = VoxelGrid::kReachCap + 1;
+  std::vector<std::uint64_t> level(cells * L);  // level t at [t * cells, (t + 1) * cells), then interleaved
+  std::uint64_t* m0 = level.data();
+  std::vector<std::size_t> set_per_row(dny, 0);
+  tbb::parallel_for(0, dny, [&](int cj) {
+    const std::size_t row_words = static_cast<std::size_t>(g.nx) * words;
+    std::vector<std::uint64_t> acc(row_words, 0);
+    std::size_t set = 0;
+    for (int j = cj * C; j < std::min(g.ny, (cj + 1) * C); ++j) {
+      const std::uint64_t* __restrict row = g.column(0, j);
+      for (std::size_t w = 0; w < row_words; ++w) {
+        acc[w] |= row[w];
+        set += static_cast<std::size_t>(std::popcount(row[w]));
       }
+    }
+    set_per_row[cj] = set;
+    for (int ci = 0; ci < dnx; ++ci) {
+      std::uint64_t* out = cell_words.data() + (static_cast<std::size_t>(cj) * dnx + ci) * words;
+      for (int i = ci * C; i < std::min(g.nx, (ci + 1) * C); ++i)
+        for (int w = 0; w < words; ++w) out[w] |= acc[static_cast<std::size_t>(i) * words + w];
+      std::uint64_t m = 0;
+      if (cb == 1) {
+        m = out[0];
+      } else {
+        const int per_word = 64 / cb;
+        for (int w = 0; w < words; ++w) {
+          std::uint64_t x = out[w];
+          for (int f = 1; f < cb; f <<= 1) x |= x >> f;  // bit q * cb: OR of its cell's voxels
+          for (int q = 0; q < per_word; ++q) m |= ((x >> (q * cb)) & 1u) << (w * per_word + q);
+        }
+      }
+      m0[static_cast<std::size_t>(cj) * dnx + ci] = m;
+    }
   });
+  g.block_bits.assign(static_cast<std::size_t>(g.bnx) * g.bny * words, 0);
+  for (int cj = 0; cj < dny; ++cj)
+    for (int ci = 0; ci < dnx; ++ci) {
+      std::uint64_t* blk = g.block_bits.data() + (static_cast<std::size_t>(cj / 2) * g.bnx + ci / 2) * words;
+      const std::uint64_t* cw = cell_words.data() + (static_cast<std::size_t>(cj) * dnx + ci) * words;
+      for (int w = 0; w < words; ++w) blk[w] |= cw[w];
+    }
+  std::vector<std::uint64_t> tmp(cells);
+  for (int t = 1; t <= VoxelGrid::kReachCap; ++t) {
+    const std::uint64_t* prev = level.data() + (t - 1) * cells;
+    std::uint64_t* next = level.data() + t * cells;
+    for (int cj = 0; cj < dny; ++cj) {
+      const std::uint64_t* __restrict p = prev + static_cast<std::size_t>(cj) * dnx;
+      std::uint64_t* __restrict q = tmp.data() + static_cast<std::size_t>(cj) * dnx;
+      for (int ci = 0; ci < dnx; ++ci) q[ci] = p[ci] | (ci > 0 ? p[ci - 1] : 0) | (ci + 1 < dnx ? p[ci + 1] : 0);
+    }
+    for (int cj = 0; cj < dny; ++cj) {
+      const std::uint64_t* p = tmp.data() + static_cast<std::size_t>(cj) * dnx;
+      const std::uint64_t* up = cj > 0 ? p - dnx : p;
+      const std::uint64_t* down = cj + 1 < dny ? p + dnx : p;
+      std::uint64_t* __restrict q = next + static_cast<std::size_t>(cj) * dnx;
+      for (int ci = 0; ci < dnx; ++ci) q[ci] = p[ci] | up[ci] | down[ci];
+    }
+  }
+  g.dilated.resize(cells * L);
+  for (std::size_t c = 0; c < cells; ++c)
+    for (int t = 0; t < L; ++t) g.dilated[c * L + t] = level[t * cells + c];
+  std::size_t set = 0;
+  for (std::size_t n : set_per_row) set += n;
+  return set;
 }
 
 // Stages 1-3 for any grid whose geometry fields are set; `emit` maps one Tri3 into a vector.
@@ -283,12 +369,24 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   g.words = (o.depth_bits + 63) / 64;
   g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
 
-  // 1. Map triangles to the grid, chunk by chunk (chunk boundaries are fixed: deterministic).
+  // 1. Map triangles to the grid, chunk by chunk (chunk boundaries are fixed: deterministic),
+  // and bucket each chunk's triangles by (fill kind, row band) so that a band visits only the
+  // triangles overlapping it (a counting sort; a triangle spanning bands is listed in each).
+  const int bands = std::min(g.ny, kBands);
+  const auto band_first_row = [&](int b) { return static_cast<int>(static_cast<long long>(g.ny) * b / bands); };
+  std::vector<int> band_of(g.ny);
+  for (int b = 0; b < bands; ++b)
+    for (int j = band_first_row(b); j < band_first_row(b + 1); ++j) band_of[j] = b;
+  const auto kind_of = [](const GridTri& t) { return t.fill == 0 ? 0 : t.fill == 2 ? 2 : 1; };
+  struct Buckets {
+    std::vector<std::uint32_t> start, index;  // bucket (kind * bands + band): index[start[k], start[k + 1])
+  };
   std::vector<std::size_t> first{0};
   for (const Mesh& m : scene.meshes) first.push_back(first.back() + m.triangle_count());
   const std::size_t total = first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
   std::vector<std::vector<GridTri>> tris(chunks);
+  std::vector<Buckets> buckets(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
     const std::size_t t0 = c * kChunk, t1 = std::min(total, t0 + kChunk);
     std::size_t mi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
@@ -299,21 +397,30 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       const bool open = o.open_meshes == OpenMeshes::Slab && !closure[mi].closed();
       emit(out, source_triangle(scene.meshes[mi], t - first[mi], open));
     }
+    Buckets& bk = buckets[c];
+    bk.start.assign(3 * static_cast<std::size_t>(bands) + 1, 0);
+    for (const GridTri& t : out)
+      for (int b = band_of[t.j0]; b <= band_of[t.j1]; ++b) ++bk.start[kind_of(t) * bands + b + 1];
+    for (std::size_t k = 1; k < bk.start.size(); ++k) bk.start[k] += bk.start[k - 1];
+    bk.index.resize(bk.start.back());
+    std::vector<std::uint32_t> pos(bk.start.begin(), bk.start.end() - 1);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int b = band_of[out[i].j0]; b <= band_of[out[i].j1]; ++b) bk.index[pos[kind_of(out[i]) * bands + b]++] = static_cast<std::uint32_t>(i);
   });
 
   // 2. Raster bands of rows; parity fragments first, then (after the scan) open-mesh slabs,
   // which are ORed: a union, so overlapping slabs of neighbouring open triangles do not cancel.
-  const int bands = std::min(g.ny, kBands);
   std::vector<std::size_t> fragments(bands, 0);
   const auto raster_pass = [&](VoxelGrid& target, int fill_kind) {  // 0 parity, 1 spans, 2 prisms
     tbb::parallel_for(0, bands, [&](int b) {
-      const int r0 = static_cast<int>(static_cast<long long>(g.ny) * b / bands);
-      const int r1 = static_cast<int>(static_cast<long long>(g.ny) * (b + 1) / bands) - 1;
+      const int r0 = band_first_row(b), r1 = band_first_row(b + 1) - 1;
+      const std::size_t k = static_cast<std::size_t>(fill_kind) * bands + b;
       std::size_t f = 0;
-      for (const auto& chunk : tris)
-        for (const GridTri& t : chunk)
-          if ((t.fill == 0 ? 0 : t.fill == 2 ? 2 : 1) == fill_kind && t.j1 >= r0 && t.j0 <= r1)
-            f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), target, slab_thickness);
+      for (std::size_t c = 0; c < chunks; ++c)
+        for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
+          const GridTri& t = tris[c][buckets[c].index[q]];
+          f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), target, slab_thickness);
+        }
       fragments[b] += f;
     });
   };
@@ -336,7 +443,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       for (std::size_t w = 0; w < g.bits.size(); ++w) g.bits[w] |= scratch.bits[w];
     }
   }
-  build_blocks(g);
+  const std::size_t set_voxels = build_coarse(g);  // also counts the solid voxels
   if (stats) {
     *stats = {};
     for (const auto& chunk : tris) stats->triangles += chunk.size();
@@ -346,7 +453,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       stats->open_meshes += c.closed() ? 0 : 1;
       stats->boundary_edges += c.boundary_edges;
     }
-    stats->set_voxels = g.count_set();
+    stats->set_voxels = set_voxels;
   }
 }
 

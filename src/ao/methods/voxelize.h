@@ -111,6 +111,18 @@ struct VoxelGrid {
   std::vector<std::uint64_t> block_bits;
   const std::uint64_t* block(int bi, int bj) const { return block_bits.data() + (static_cast<std::size_t>(bj) * bnx + bi) * words; }
 
+  // Dilated coarse occupancy for O(1) empty-space skipping. Cells are kCellXY x kCellXY columns x
+  // cell_bits voxels (cell_bits: the smallest power of two that gives at most 64 cells per column).
+  // dilated[(cj * dnx + ci) * (kReachCap + 1) + t], t in [0, kReachCap] (one cache line per cell),
+  // is a 64-bit mask over the cells along the column: bit ck is set when a cell (ci', cj', ck) with
+  // max(|ci' - ci|, |cj' - cj|) <= t holds a solid voxel. Blocks (above) are 2 x 2 cells.
+  static constexpr int kCellXY = 4;
+  static constexpr int kReachCap = 7;
+  int dnx = 0, dny = 0;
+  int cell_bits = 0, cell_shift = 0;  ///< cell_bits = 1 << cell_shift.
+  std::vector<std::uint64_t> dilated;
+  std::uint64_t near_mask(int t, int ci, int cj) const { return dilated[(static_cast<std::size_t>(cj) * dnx + ci) * (kReachCap + 1) + t]; }
+
   /// Words of column (i, j), which must be inside the grid.
   const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
   /// Bit k of column (i, j).

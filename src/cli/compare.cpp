@@ -1,4 +1,4 @@
-// ao compare: renders each screen-space method and the ray-traced ground truth it approximates (same
+// ao compare: renders each approximate method and the ray-traced ground truth it approximates (same
 // camera, R and membership, from the registry's reference_falloff) and writes a table (Markdown and
 // JSON), a contact sheet, and optionally error against a swept parameter. docs/compare.md.
 #include <unistd.h>
@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 
 struct CompareOptions {
   std::vector<std::string> scene;
-  std::string methods;               ///< Comma-separated; empty = every screen-space method in the registry.
+  std::string methods;               ///< Comma-separated; empty = every approximate method in the registry.
   int spp_reference = 256;
   std::string sweep;                 ///< "key=v1,v2,...".
   std::string out_dir;
@@ -150,9 +150,11 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   // Everything that can be checked without rendering is checked before anything is written.
   std::vector<const MethodInfo*> methods;
   if (o.methods.empty()) {
+    // Every approximate method: the screen-space ones and cone tracing, which is compared with
+    // the same ground truth (the reference itself is not compared with itself).
     for (const MethodInfo& m : all_methods())
-      if (!m.needs_scene) methods.push_back(&m);
-    if (methods.empty()) throw InputError("--methods: the registry has no screen-space methods");
+      if (m.name != "raytraced") methods.push_back(&m);
+    if (methods.empty()) throw InputError("--methods: the registry has no approximate methods");
   } else {
     for (const std::string& name : split(o.methods, ',')) methods.push_back(&find_method(name));
     if (methods.empty()) throw InputError("--methods: no method named");
@@ -312,12 +314,12 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
 
 void add_compare_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action) {
   auto o = std::make_shared<CompareOptions>();
-  CLI::App* cmd = app.add_subcommand("compare", "Compare screen-space methods with the ray-traced ground truth each approximates.");
+  CLI::App* cmd = app.add_subcommand("compare", "Compare AO methods with the ray-traced ground truth each approximates.");
   cmd->add_option("scene", o->scene, "Mesh file(s) (OBJ, PLY, OFF, STL, glTF/GLB) or a built-in scene: default, plane, wedge, sphere-on-plane, box-room")
       ->type_name("SCENE");
   std::string names;
   for (const MethodInfo& m : all_methods()) names += (names.empty() ? "" : ", ") + std::string(m.name);
-  cmd->add_option("--methods", o->methods, "Comma-separated methods (" + names + "); default: every screen-space method");
+  cmd->add_option("--methods", o->methods, "Comma-separated methods (" + names + "); default: every method but raytraced");
   cmd->add_option("--spp-reference", o->spp_reference, "Rays per pixel of the ray-traced references")->capture_default_str();
   cmd->add_option("--sweep", o->sweep, "Also measure error against one parameter: key=v1,v2,... (e.g. samples=4,8,16,32)");
   cmd->add_option("--out-dir", o->out_dir, "Output directory (default: compare-<scene>)");

@@ -26,14 +26,18 @@ struct Rays {
   float y(float py) const { return ay * py + by; }
 };
 
-// The centre pixels of one row segment: the normal, n . (ray through the pixel), the depth, and
-// the reciprocal of the plane-distance scale. Positions are depth * ray (as in alchemy.cpp): the
-// taps then read one float of depth each instead of a 12-byte position.
+// The centre pixels of one row segment, folded into three coefficients per pass so that a tap
+// costs two FMAs before the kernel. With C = d0 (rx, ry, -1) (positions are depth * ray, as in
+// alchemy.cpp: taps read one float of depth, not a 12-byte position) and a tap at depth d on the
+// ray (tx, ty, -1), the tangent-plane distance over the scale, halved (K(x) = max(0, 1 - (x/2)^2)^2), is
+//   x/2 = |d (n . (tx, ty, -1)) - n . C| * s/2 = |d (a t + b) - c|,  s = 1 / (plane_sigma d0),
+// where t is the coordinate that varies along the pass (tx horizontally, ty vertically):
+//   horizontal: a = nx s/2, b = (ny ry - nz) s/2;  vertical: a = ny s/2, b = (nx rx - nz) s/2;  c = (n . C) s/2.
 struct Centres {
-  alignas(64) std::array<float, kTileWidth> nx, ny, nz, d0, inv_scale, cov;
+  alignas(64) std::array<float, kTileWidth> a, b, c, cov;
 };
 
-void load_centres(const GBuffer& g, const Rays& rays, int y, int x0, int x1, float plane_sigma, Centres& c) {
+void load_centres(const GBuffer& g, const Rays& rays, int y, int x0, int x1, float plane_sigma, bool vertical, Centres& ce) {
   const std::size_t base = static_cast<std::size_t>(y) * g.width() + x0;
   const float* n = &g.normal[base].x;
   const float* depth = &g.depth[base];
@@ -41,35 +45,32 @@ void load_centres(const GBuffer& g, const Rays& rays, int y, int x0, int x1, flo
   const float ry = rays.y(static_cast<float>(y) + 0.5f);
   const int count = x1 - x0;
   for (int k = 0; k < count; ++k) {
-    c.nx[k] = n[3 * k], c.ny[k] = n[3 * k + 1], c.nz[k] = n[3 * k + 2];
-  }
-  for (int k = 0; k < count; ++k) {
+    const float nx = n[3 * k], ny = n[3 * k + 1], nz = n[3 * k + 2];
     const bool covered = cov[k] != 0;
     const float d = covered ? depth[k] : 0.0f;
     const float rx = rays.x(static_cast<float>(x0 + k) + 0.5f);
-    // n . C with C = d * (rx, ry, -1): the centre's tangent plane is n . P = d0.
-    c.d0[k] = d * (c.nx[k] * rx + c.ny[k] * ry - c.nz[k]);
-    // Background: scale 0 (and cov 0), so its taps are never used.
-    c.inv_scale[k] = covered ? 1.0f / (plane_sigma * d) : 0.0f;
-    c.cov[k] = covered ? 1.0f : 0.0f;
+    // Background: scale 0 (and cov 0), so its result is never used.
+    const float half_s = covered ? 0.5f / (plane_sigma * d) : 0.0f;
+    ce.a[k] = (vertical ? ny : nx) * half_s;
+    ce.b[k] = (vertical ? nx * rx - nz : ny * ry - nz) * half_s;
+    ce.c[k] = d * (nx * rx + ny * ry - nz) * half_s;
+    ce.cov[k] = covered ? 1.0f : 0.0f;
   }
 }
 
-// K(x) = max(0, 1 - x^2/4)^2 with x = plane distance / scale.
-inline float range_weight(float dist_scaled) {
-  const float t = std::max(0.0f, 1.0f - 0.25f * dist_scaled * dist_scaled);
-  return t * t;
-}
-
 // One tap, accumulated for a row segment. tdepth/tval point at the tap pixels (aligned with the
-// segment's first pixel); the tap's ray is (trx[k], try_, -1).
-inline void accumulate_tap(const Centres& c, int count, float spatial, const float* __restrict trx, float try_, const float* __restrict tdepth,
+// segment's first pixel); the tap's varying ray coordinate is t[k] (horizontal: per pixel) or
+// t[0] (vertical: one value for the whole row).
+template <bool kPerPixel>
+inline void accumulate_tap(const Centres& ce, int count, float spatial, const float* __restrict t, const float* __restrict tdepth,
                            const float* __restrict tval, float* __restrict sum_w, float* __restrict sum_v) {
   for (int k = 0; k < count; ++k) {
     const float d = tdepth[k];
-    const float dist = std::abs(d * (c.nx[k] * trx[k] + c.ny[k] * try_ - c.nz[k]) - c.d0[k]) * c.inv_scale[k];
-    // Background taps have depth +inf: dist is inf or NaN, and the select gives them weight 0.
-    const float w = d < kInfinity ? spatial * range_weight(dist) : 0.0f;
+    const float half_x = d * (ce.a[k] * t[kPerPixel ? k : 0] + ce.b[k]) - ce.c[k];
+    // K = max(0, 1 - (x/2)^2)^2. Background taps have depth +inf: x is inf or NaN, and the select
+    // gives them weight 0.
+    const float u = std::max(0.0f, 1.0f - half_x * half_x);
+    const float w = d < kInfinity ? spatial * (u * u) : 0.0f;
     sum_w[k] += w;
     sum_v[k] += w * tval[k];
   }
@@ -134,19 +135,18 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
         alignas(64) std::array<float, kTileWidth> sum_w, sum_v;
         for (int k = 0; k < n + 2 * half; ++k) rx[k] = rays.x(static_cast<float>(x0 - half + k) + 0.5f);
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-          load_centres(g, rays, y, x0, x1, params.plane_sigma, c);
+          load_centres(g, rays, y, x0, x1, params.plane_sigma, false, c);
           const std::size_t row = static_cast<std::size_t>(y) * w;
-          for (int k = 0; k < n + 2 * half; ++k) {
-            const int x = x0 - half + k;
-            const bool in = x >= 0 && x < w;
-            rd[k] = in ? depth[row + x] : kInfinity;
-            rv[k] = in ? values[row + x] : 0.0f;
-          }
+          // Inside the image a plain copy (the per-element bounds test kept this loop scalar), margins apart.
+          const int lo = std::max(0, half - x0), hi = std::min(n + 2 * half, w - x0 + half);
+          std::fill(rd.begin(), rd.begin() + lo, kInfinity), std::fill(rv.begin(), rv.begin() + lo, 0.0f);
+          std::copy_n(&depth[row + x0 - half + lo], hi - lo, rd.begin() + lo);
+          std::copy_n(&values[row + x0 - half + lo], hi - lo, rv.begin() + lo);
+          std::fill(rd.begin() + hi, rd.begin() + n + 2 * half, kInfinity), std::fill(rv.begin() + hi, rv.begin() + n + 2 * half, 0.0f);
           std::fill_n(sum_w.begin(), n, 0.0f);
           std::fill_n(sum_v.begin(), n, 0.0f);
-          const float ry = rays.y(static_cast<float>(y) + 0.5f);
           for (int j = 0; j < params.taps; ++j)
-            accumulate_tap(c, n, spatial[j], &rx[j], ry, &rd[j], &rv[j], sum_w.data(), sum_v.data());
+            accumulate_tap<true>(c, n, spatial[j], &rx[j], &rd[j], &rv[j], sum_w.data(), sum_v.data());
           finish(c, n, sum_w.data(), sum_v.data(), &values[row + x0], &tmp[row + x0]);
         }
       },
@@ -157,18 +157,17 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
       [&](const tbb::blocked_range2d<int>& r) {
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
         Centres c;
-        alignas(64) std::array<float, kTileWidth> rx, sum_w, sum_v;
-        for (int k = 0; k < n; ++k) rx[k] = rays.x(static_cast<float>(x0 + k) + 0.5f);
+        alignas(64) std::array<float, kTileWidth> sum_w, sum_v;
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-          load_centres(g, rays, y, x0, x1, params.plane_sigma, c);
+          load_centres(g, rays, y, x0, x1, params.plane_sigma, true, c);
           std::fill_n(sum_w.begin(), n, 0.0f);
           std::fill_n(sum_v.begin(), n, 0.0f);
           for (int j = -half; j <= half; ++j) {
             const int yj = y + j;
             if (yj < 0 || yj >= h) continue;
             const std::size_t i = static_cast<std::size_t>(yj) * w + x0;
-            accumulate_tap(c, n, spatial[j + half], rx.data(), rays.y(static_cast<float>(yj) + 0.5f), &depth[i], &tmp[i], sum_w.data(),
-                           sum_v.data());
+            const float ry = rays.y(static_cast<float>(yj) + 0.5f);
+            accumulate_tap<false>(c, n, spatial[j + half], &ry, &depth[i], &tmp[i], sum_w.data(), sum_v.data());
           }
           const std::size_t row = static_cast<std::size_t>(y) * w + x0;
           finish(c, n, sum_w.data(), sum_v.data(), &tmp[row], &values[row]);

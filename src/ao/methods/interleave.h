@@ -10,6 +10,7 @@
 
 #include <array>
 #include <initializer_list>
+#include <span>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -63,5 +64,9 @@ struct PixelRow {
 /// value. Works for float and Vec3 images.
 Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit);
 Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit);
+/// The same filter over planar float channels of one image (e.g. W's R, G, B and O), in place: each
+/// tap's depth test is shared by up to 4 channels. Each plane gives what depth_aware_box_filter
+/// would give for it alone. Planes must have the G-buffer's size (InputError otherwise).
+void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit);
 
 }  // namespace ao

@@ -1,7 +1,9 @@
 #include "ao/methods/volumetric.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -67,9 +69,13 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
+    // Locals, not the closure's references: loads through the closure may alias the accumulators,
+    // which kept them in the loop and stopped if-conversion (GCC 12: "control flow in loop").
     const Characteristic local_ch = ch;
+    const float hr = half_r, lim = far_limit;
     PixelRow row;
     std::vector<float> cx, cy, cz, free_len;
+    alignas(64) float fx0[kTile], fy0[kTile], cax[kTile], cbx[kTile], cay[kTile], cby[kTile];  // depth-buffer path
     for (int y = t.y0; y < t.y1; ++y) {
       row.load(g, y, t.x0, t.x1, rotations, params.bias);
       const int count = row.count;
@@ -86,22 +92,56 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
       }
       float* __restrict acc = free_len.data();
       const float *pcx = cx.data(), *pcy = cy.data(), *pcz = cz.data(), *rc = row.rc.data(), *rs = row.rs.data(), *bias = row.bias.data();
-      for (int i = 0; i < s.size(); ++i) {
-        const float xi = s.x[static_cast<std::size_t>(i)], yi = s.y[static_cast<std::size_t>(i)];
-        const float half_chord = half_r * s.h[static_cast<std::size_t>(i)];  // (R/2) h_i = z_c - z_entry
+      if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {
+        // The depth-buffer lookup with the projection hoisted out of the sample loop: a pipe's point
+        // (c_x + o_x, c_y + o_y, c_z) has the same depth c_z for every sample, so the divide by -c_z
+        // and the rotation fold into per-pixel affine coefficients of the pixel position:
+        //   f_x = f_x0 + x_i a_x - y_i b_x,  f_y = f_y0 - x_i a_y - y_i b_y.
+        const ScreenProjection pr = local_ch.projection;
+        const float* __restrict depth = local_ch.depth;
+        const float width = static_cast<float>(pr.width), height = static_cast<float>(pr.height);
+        for (int k = 0; k < count; ++k) {
+          const float inv = -1.0f / pcz[k], kx = inv * pr.scale_x, ky = inv * pr.scale_y;
+          fx0[k] = pcx[k] * kx + pr.centre_x, fy0[k] = pr.centre_y - pcy[k] * ky;
+          cax[k] = rc[k] * kx, cbx[k] = rs[k] * kx, cay[k] = rs[k] * ky, cby[k] = rc[k] * ky;
+        }
+        for (int i = 0; i < s.size(); ++i) {
+          const float xi = hr * s.x[static_cast<std::size_t>(i)], yi = hr * s.y[static_cast<std::size_t>(i)];
+          const float half_chord = hr * s.h[static_cast<std::size_t>(i)];  // (R/2) h_i = z_c - z_entry
+          const float chord = 2.0f * half_chord;                              // z_exit - z_entry
+#pragma GCC ivdep
+          for (int k = 0; k < count; ++k) {
+            const float fx = fx0[k] + xi * cax[k] - yi * cbx[k], fy = fy0[k] - xi * cay[k] - yi * cby[k];
+            const float z = pcz[k];
+            const bool valid = (z < 0.0f) & (fx >= 0.0f) & (fy >= 0.0f) & (fx < width) & (fy < height);
+            const int ix = static_cast<int>(valid ? fx : 0.0f), iy = static_cast<int>(valid ? fy : 0.0f);
+            const float zs = depth[iy * pr.width + ix];
+            // As DepthBufferCharacteristic::distance (+inf off screen), then z* - z_entry = (z* - z_c) + (R/2) h_i.
+            const float to_surface = (valid ? zs + z : kInfinity) + half_chord + bias[k];
+            const float dz = std::min(std::max(to_surface, 0.0f), chord);  // fig. 7 a-c
+            const bool distant = (to_surface < lim) & (to_surface > -1e30f);
+            acc[k] += distant ? chord : dz;
+          }
+        }
+      } else {
+        for (int i = 0; i < s.size(); ++i) {
+          // Disk sample i scaled to the sphere, rotated per pixel below by (rc, rs) about the view axis.
+          const float xi = hr * s.x[static_cast<std::size_t>(i)], yi = hr * s.y[static_cast<std::size_t>(i)];
+          const float half_chord = hr * s.h[static_cast<std::size_t>(i)];  // (R/2) h_i = z_c - z_entry
+          const float chord = 2.0f * half_chord;                              // z_exit - z_entry
 // Lane k writes only its own accumulator; the gathers read the (read-only) G-buffer.
 #pragma GCC ivdep
-        for (int k = 0; k < count; ++k) {
-          // Disk sample rotated by the pixel's interleaving angle about the view axis, at depth z_c.
-          const float ox = half_r * (rc[k] * xi - rs[k] * yi), oy = half_r * (rs[k] * xi + rc[k] * yi);
-          // distance = z* - z_c, so z* - z_entry = distance + (R/2) h_i.
-          const float to_surface = local_ch.distance(pcx[k] + ox, pcy[k] + oy, pcz[k]) + half_chord + bias[k];
-          // Fig. 7: (a) surface inside: z* - z_entry; (b) behind: the chord 2 (R/2) h_i; (c) in front: 0.
-          const float chord = 2.0f * half_chord;
-          const float clipped = to_surface > 0.0f ? to_surface : 0.0f;
-          const float dz = clipped < chord ? clipped : chord;
-          const bool distant = (to_surface < far_limit) & (to_surface > -1e30f);  // -inf: inner all along, not distant
-          acc[k] += distant ? chord : dz;
+          for (int k = 0; k < count; ++k) {
+            // Disk sample rotated by the pixel's interleaving angle about the view axis, at depth z_c.
+            const float ox = rc[k] * xi - rs[k] * yi, oy = rs[k] * xi + rc[k] * yi;
+            // distance = z* - z_c, so z* - z_entry = distance + (R/2) h_i.
+            const float to_surface = local_ch.distance(pcx[k] + ox, pcy[k] + oy, pcz[k]) + half_chord + bias[k];
+            // Fig. 7: dz = clamp(z* - z_entry, 0, chord): (a) surface inside: z* - z_entry; (b) behind:
+            // the chord; (c) in front: 0. Branch-free (max/min, & not &&) so the loop if-converts.
+            const float dz = std::min(std::max(to_surface, 0.0f), chord);
+            const bool distant = (to_surface < lim) & (to_surface > -1e30f);  // -inf: inner all along, not distant
+            acc[k] += distant ? chord : dz;
+          }
         }
       }
       for (int k = 0; k < count; ++k)

@@ -538,8 +538,8 @@ nlohmann::json cone_stats(const ConeResult& r) {
     warnings.push_back("cone: " + std::to_string(v.odd_columns) +
                        " voxel columns end with odd parity: the scene is not watertight there, voxels behind the leak are wrong");
   if (v.open_meshes > 0)
-    warnings.push_back("cone: " + std::to_string(v.open_meshes) + " open mesh(es) with " + std::to_string(v.boundary_edges) +
-                       " boundary edges: filled as one-sided slabs behind their front faces (open_meshes=slab)");
+    warnings.push_back("cone: " + std::to_string(v.open_meshes) + " open surface(s) (" + std::to_string(v.boundary_edges) +
+                       " boundary edges in all meshes): filled as one-sided slabs behind their front faces (open_meshes=slab)");
   return {{"grid_columns", {r.grid_nx, r.grid_ny}},
           {"triangles_rasterised", v.triangles},
           {"fragments", v.fragments},

@@ -394,7 +394,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     out.reserve(t1 - t0);
     for (std::size_t t = t0; t < t1; ++t) {
       while (t >= first[mi + 1]) ++mi;
-      const bool open = o.open_meshes == OpenMeshes::Slab && !closure[mi].closed();
+      const bool open = o.open_meshes == OpenMeshes::Slab && closure[mi].open_surface();
       emit(out, source_triangle(scene.meshes[mi], t - first[mi], open));
     }
     Buckets& bk = buckets[c];
@@ -429,7 +429,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // 3. Toggles -> solid.
   const std::size_t odd = scan_columns(g);
   bool any_open = false;
-  for (const MeshClosure& c : closure) any_open = any_open || !c.closed();
+  for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
   if (any_open && o.open_meshes == OpenMeshes::Slab) {
     raster_pass(g, 1);
     bool any_prism = false;
@@ -450,7 +450,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     for (std::size_t f : fragments) stats->fragments += f;
     stats->odd_columns = odd;
     for (const MeshClosure& c : closure) {
-      stats->open_meshes += c.closed() ? 0 : 1;
+      stats->open_meshes += c.open_surface() ? 1 : 0;
       stats->boundary_edges += c.boundary_edges;
     }
     stats->set_voxels = set_voxels;
@@ -508,6 +508,7 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
       std::size_t j = i;
       while (j < edges.size() && edges[j] == edges[i]) ++j;
       c.boundary_edges += (j - i) % 2;
+      ++c.edges;
       i = j;
     }
     out.push_back(c);
@@ -527,7 +528,7 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
   const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
   bool any_open = false;
-  for (const MeshClosure& c : closure) any_open = any_open || !c.closed();
+  for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
   // (a ground plane's slab hangs below it, a wall's prism stands behind it).

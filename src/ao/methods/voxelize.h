@@ -17,8 +17,9 @@
 //    (z - z_nearest) / (z_far - z_nearest) * depth_bits, with z_nearest per column taken from the
 //    G-buffer's nearest depth (the "local slice" of sec. III-B) and z_far the far side of the scene.
 //
-// Parity needs closed surfaces. Meshes with boundary edges (an open ground plane) are, by default,
-// kept out of the parity pass and turned into one-sided slabs: after the parity scan, each of their
+// Parity needs closed surfaces. Open surfaces (a ground plane: more than 1% of the edges are
+// boundary, see MeshClosure::open_surface) are, by default, kept out of the parity pass and
+// turned into one-sided slabs: after the parity scan, each of their
 // fragments ORs the voxels within `slab_thickness` behind its front face (below a ground plane);
 // open faces steep to the columns (walls) become closed prisms of that thickness behind them,
 // voxelized by parity in a scratch grid and ORed in.
@@ -52,7 +53,14 @@ enum class OpenMeshes {
 /// Topology of one mesh, computed once per scene (positions may move, connectivity does not).
 struct MeshClosure {
   std::size_t boundary_edges = 0;  ///< Edges used by an odd number of triangles (positions compared exactly).
+  std::size_t edges = 0;           ///< Distinct edges.
   bool closed() const { return boundary_edges == 0; }
+  /// An open surface (a ground plane, a wall, a terrain) rather than a closed mesh with a few holes:
+  /// more than 1% of its edges are boundary. Only these become slabs. A scanned statue with a
+  /// handful of holes stays with parity, which is wrong only in the columns through the holes,
+  /// where slabs R_max thick behind every face would fill its thin parts and the space in front
+  /// of them.
+  bool open_surface() const { return boundary_edges * 100 > edges; }
 };
 
 /// Boundary edges of every mesh of `scene`, in mesh order. Vertices are matched by exact position,
@@ -78,7 +86,7 @@ struct VoxelStats {
   std::size_t triangles = 0;       ///< Triangles rasterised (after clipping and culling).
   std::size_t fragments = 0;       ///< Column-centre hits.
   std::size_t odd_columns = 0;     ///< Columns whose parity ends at 1: open or leaky geometry.
-  std::size_t open_meshes = 0;     ///< Meshes with boundary edges.
+  std::size_t open_meshes = 0;     ///< Meshes treated as open surfaces (slabs).
   std::size_t boundary_edges = 0;  ///< Over all meshes.
   std::size_t set_voxels = 0;      ///< Solid voxels in the finished grid.
 };

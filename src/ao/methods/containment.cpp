@@ -1,5 +1,7 @@
 #include "ao/methods/containment.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "ao/core/error.h"
@@ -37,6 +39,73 @@ void from_json(const nlohmann::json& j, ContainmentParams& p) {
   read_interleave_options(j, p.interleave, "containment");
 }
 
+void load_pixel_row_simd(PixelRow& row, std::vector<int>& index, const GBuffer& g, int y, int first, int last,
+                         const std::array<Rotation, 16>& rotations, float bias_world, bool frame) {
+  row.y = y;
+  row.x0 = first;
+  const auto n = static_cast<std::size_t>(last - first);
+  for (std::vector<float>* v : {&row.px, &row.py, &row.pz, &row.nx, &row.ny, &row.nz, &row.rc, &row.rs, &row.bias}) v->resize(n);
+  if (frame)
+    for (std::vector<float>* v : {&row.tx, &row.ty, &row.tz, &row.bx, &row.by, &row.bz}) v->resize(n);
+  row.covered.assign(n, 1);
+  index.resize(n);
+  // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
+  const float footprint = 2.0f * g.camera.tan_half_fov() / static_cast<float>(g.height());
+  float *px = row.px.data(), *py = row.py.data(), *pz = row.pz.data();
+  float *nx = row.nx.data(), *ny = row.ny.data(), *nz = row.nz.data();
+  float *rc = row.rc.data(), *rs = row.rs.data(), *bias = row.bias.data();
+  int* idx = index.data();
+  const Vec3* pos = &g.position(first, y);
+  const Vec3* nrm = &g.normal(first, y);
+  const std::uint8_t* cov = &g.coverage(first, y);
+  // Compaction: the covered pixels' offsets (scalar, branch-free), then their data gathered
+  // across entries (vectorised). The row's rotations repeat every 4 pixels.
+  int m = 0;
+  for (int j = 0; j < last - first; ++j) {
+    idx[m] = j;
+    m += cov[j] != 0 ? 1 : 0;
+  }
+  const Rotation* rot = rotations.data();
+#pragma GCC ivdep
+  for (int k = 0; k < m; ++k) {
+    const int j = idx[k];
+    const Vec3 p = pos[j], nn = nrm[j];
+    const Rotation r = rot[(y & 3) * 4 + ((first + j) & 3)];
+    px[k] = p.x, py[k] = p.y, pz[k] = p.z;
+    nx[k] = nn.x, ny[k] = nn.y, nz[k] = nn.z;
+    rc[k] = r.c, rs[k] = r.s;
+  }
+  row.count = m;
+  // The auto bias, as PixelRow::load: tan theta_v from the normal and the unit view direction
+  // (clamped to 8). Lane k reads and writes only entry k (GCC 12 ignores __restrict on locals and
+  // would need too many run-time alias checks, hence ivdep).
+  if (bias_world > 0) {
+    std::fill(bias, bias + m, bias_world);
+  } else {
+#pragma GCC ivdep
+    for (int k = 0; k < m; ++k) {
+      const Vec3 p{px[k], py[k], pz[k]}, nn{nx[k], ny[k], nz[k]};
+      const float len = std::sqrt(dot(p, p));
+      const Vec3 u = len > 0 ? p / len : p;
+      const float cos_v = std::max(std::abs(dot(nn, u)), 0.124f);
+      const float tan_v = std::sqrt(1.0f - cos_v * cos_v) / cos_v;
+      bias[k] = footprint * (-p.z) * (1.0f + tan_v);
+    }
+  }
+  if (!frame) return;
+  float *tx = row.tx.data(), *ty = row.ty.data(), *tz = row.tz.data();
+  float *bx = row.bx.data(), *by = row.by.data(), *bz = row.bz.data();
+#pragma GCC ivdep
+  for (int k = 0; k < m; ++k) {
+    const Frame f = Frame::from_normal({nx[k], ny[k], nz[k]});
+    // Rotation by alpha about N (sec. 4.2): T' = cos a T + sin a B, B' = -sin a T + cos a B.
+    const float rck = rc[k], rsk = rs[k];
+    const Vec3 t = f.t * rck + f.b * rsk, b = f.b * rck - f.t * rsk;
+    tx[k] = t.x, ty[k] = t.y, tz[k] = t.z;
+    bx[k] = b.x, by[k] = b.y, bz[k] = b.z;
+  }
+}
+
 template <class Characteristic>
 Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Falloff& falloff, const ContainmentParams& params,
                             std::uint32_t seed) {
@@ -53,9 +122,10 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
     // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
     const Characteristic local_ch = ch;
     PixelRow row;
+    std::vector<int> index;
     std::vector<float> open(static_cast<std::size_t>(t.x1 - t.x0));
     for (int y = t.y0; y < t.y1; ++y) {
-      row.load(g, y, t.x0, t.x1, rotations, params.bias);
+      load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
       const int count = row.count;
       std::fill(open.begin(), open.end(), 0.0f);
       float* __restrict o = open.data();
@@ -81,8 +151,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
           o[k] += occluded ? 0.0f : 1.0f;
         }
       }
-      for (int k = 0; k < count; ++k)
-        if (row.covered[static_cast<std::size_t>(k)]) v(t.x0 + k, y) = o[k] * inv_n;
+      for (int k = 0; k < count; ++k) v(t.x0 + index[static_cast<std::size_t>(k)], y) = o[k] * inv_n;
     }
   });
   if (params.interleave.interleave && params.interleave.filter)

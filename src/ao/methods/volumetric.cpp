@@ -8,6 +8,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/methods/characteristic.h"
+#include "ao/methods/containment.h"
 #include "ao/methods/samples.h"
 
 namespace ao {
@@ -74,10 +75,11 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
     const Characteristic local_ch = ch;
     const float hr = half_r, lim = far_limit;
     PixelRow row;
+    std::vector<int> index;  // entry k of the row is pixel t.x0 + index[k] (covered pixels only)
     std::vector<float> cx, cy, cz, free_len;
     alignas(64) float fx0[kTile], fy0[kTile], cax[kTile], cbx[kTile], cay[kTile], cby[kTile];  // depth-buffer path
     for (int y = t.y0; y < t.y1; ++y) {
-      row.load(g, y, t.x0, t.x1, rotations, params.bias);
+      load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, false);  // no tangent frame: pipes run along the view axis
       const int count = row.count;
       cx.resize(static_cast<std::size_t>(count));
       cy.resize(static_cast<std::size_t>(count));
@@ -144,8 +146,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
           }
         }
       }
-      for (int k = 0; k < count; ++k)
-        if (row.covered[static_cast<std::size_t>(k)]) v(t.x0 + k, y) = std::min(acc[k] * inv_f, 1.0f);  // eq. 7; analytic F can overshoot 1
+      for (int k = 0; k < count; ++k) v(t.x0 + index[static_cast<std::size_t>(k)], y) = std::min(acc[k] * inv_f, 1.0f);  // eq. 7; analytic F can overshoot 1
     }
   });
   if (params.interleave.interleave && params.interleave.filter)

@@ -3,8 +3,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <type_traits>
+#include <vector>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -60,13 +66,14 @@ namespace {
 // tests run from the far end inwards and each occluded one overwrites `at`, so the nearest wins
 // without a loop-carried "already hit" test. at = -1: the ray is free; otherwise the pixel whose
 // albedo is a~ (the pixel's own when the occluded point projects off screen: locally homogeneous
-// material). The albedo is then read once per blocked ray, from the caller's image (no copy).
+// material). The albedo is then read once per blocked ray only (AVX-512: masked gathers, through
+// the exact 32-entry palette when the image has one, else in place from the caller's image).
 // Each step is its own short loop over the lanes (projection; depth gather; test; accumulation):
 // fused, GCC 12 sinks the gathers into branches and the loop no longer if-converts.
 template <class Characteristic>
 void transfer_row(const Characteristic ch, const ScreenProjection projection, const PixelRow& row, const ContainmentSamples& s, int m,
-                  float far_limit, const float* __restrict albedo, int row_base, float* __restrict open, float* __restrict lost_r,
-                  float* __restrict lost_g, float* __restrict lost_b) {
+                  float far_limit, const float* __restrict albedo, const std::uint8_t* __restrict palette_index, const float* __restrict palette,
+                  int row_base, float* __restrict open, float* __restrict lost_r, float* __restrict lost_g, float* __restrict lost_b) {
   constexpr bool kDepthBuffer = std::is_same_v<Characteristic, DepthBufferCharacteristic>;
   const float inv_m = 1.0f / static_cast<float>(m);
   const int count = row.count;
@@ -109,11 +116,44 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
         at[k] = occluded ? (pixel[k] >= 0 ? pixel[k] : row_base + k) : at[k];
       }
     }
+    int k0 = 0;
+#if defined(__AVX512F__)
+    // Masked gathers, 16 lanes: free rays (at < 0) read no albedo at all and keep their sums
+    // (the scalar form adds 0 * a, which is the same value for finite a).
+    const __m512 one = _mm512_set1_ps(1.0f);
+    for (; k0 < count; k0 += 16) {
+      const __mmask16 live = static_cast<__mmask16>(count - k0 >= 16 ? 0xFFFF : (1u << (count - k0)) - 1u);
+      const __m512i atv = _mm512_maskz_loadu_epi32(live, at + k0);
+      const __mmask16 blocked = _mm512_mask_cmpge_epi32_mask(live, atv, _mm512_setzero_si512());
+      const __mmask16 free_rays = live & static_cast<__mmask16>(~blocked);
+      const __m512 zero = _mm512_setzero_ps();
+      __m512 ar, ag, ab;
+      if (palette_index) {
+        // One byte per pixel (4 bytes read at the pixel's offset; the index array is padded), then
+        // the palette's exact float R, G, B planes of 32 entries, looked up in registers.
+        const __m512i idx = _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, atv, palette_index, 1),
+                                             _mm512_set1_epi32(0xFF));
+        ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), idx, _mm512_loadu_ps(palette + 16));
+        ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), idx, _mm512_loadu_ps(palette + 48));
+        ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), idx, _mm512_loadu_ps(palette + 80));
+      } else {
+        const __m512i a = _mm512_mullo_epi32(atv, _mm512_set1_epi32(3));
+        ar = _mm512_mask_i32gather_ps(zero, blocked, a, albedo, 4);
+        ag = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 1, 4);
+        ab = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 2, 4);
+      }
+      _mm512_mask_storeu_ps(open + k0, free_rays, _mm512_add_ps(_mm512_maskz_loadu_ps(free_rays, open + k0), one));
+      _mm512_mask_storeu_ps(lost_r + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_r + k0), ar));
+      _mm512_mask_storeu_ps(lost_g + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_g + k0), ag));
+      _mm512_mask_storeu_ps(lost_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_b + k0), ab));
+    }
+#endif
+    (void)palette_index, (void)palette;
 // Lane k writes only its own accumulators; the gathers read the (read-only) albedo.
 #pragma GCC ivdep
-    for (int k = 0; k < count; ++k) {
+    for (int k = k0; k < count; ++k) {
       const float blocked = at[k] >= 0 ? 1.0f : 0.0f;
-      const int a = 3 * std::max(at[k], row_base + k);  // always a valid pixel (free: own); int: 32-bit gather indices
+      const int a = 3 * (at[k] >= 0 ? at[k] : row_base + k);  // always a valid pixel (free: own); int: 32-bit gather indices
       open[k] += 1.0f - blocked;
       // (1 - I) a~ of eq. 9's denominator.
       lost_r[k] += blocked * albedo[a];
@@ -122,6 +162,47 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
     }
   }
 }
+
+#if defined(__AVX512F__)
+// An exact palette of the reflectance image: one byte per pixel indexing at most 32 distinct RGB
+// triples (bitwise equal). G-buffer albedo is per-material constant, so this usually exists; a
+// blocked ray's albedo is then one byte gather plus three in-register table lookups instead of
+// three float gathers (gather throughput and misses are most of the pass's time). Empty `index`
+// when there are more than 32 distinct values: the caller reads the image in place.
+struct ReflectancePalette {
+  std::vector<std::uint8_t> index;   ///< width * height + 3 (padding for 4-byte gathers).
+  alignas(64) std::array<float, 96> planes{};  ///< R[32], G[32], B[32].
+};
+constexpr int kPaletteSize = 32;
+
+ReflectancePalette make_palette(const Image<Vec3>& img) {
+  ReflectancePalette p;
+  const std::size_t n = img.size();
+  const Vec3* px = img.data();
+  p.index.assign(n + 3, 0);
+  std::array<Vec3, kPaletteSize> entries;
+  int used = 0, last = -1;
+  Vec3 last_value{};
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 v = px[i];
+    if (last < 0 || std::memcmp(&v, &last_value, sizeof(Vec3)) != 0) {
+      int e = 0;
+      while (e < used && std::memcmp(&v, &entries[static_cast<std::size_t>(e)], sizeof(Vec3)) != 0) ++e;
+      if (e == used) {
+        if (used == kPaletteSize) return {};
+        entries[static_cast<std::size_t>(used++)] = v;
+      }
+      last = e, last_value = v;
+    }
+    p.index[i] = static_cast<std::uint8_t>(last);
+  }
+  for (int e = 0; e < used; ++e) {
+    const Vec3 v = entries[static_cast<std::size_t>(e)];
+    p.planes[static_cast<std::size_t>(e)] = v.x, p.planes[static_cast<std::size_t>(32 + e)] = v.y, p.planes[static_cast<std::size_t>(64 + e)] = v.z;
+  }
+  return p;
+}
+#endif
 
 }  // namespace
 
@@ -142,6 +223,14 @@ TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Imag
   // A view of the reflectance: RGB triples, read in place (Vec3 is three packed floats).
   static_assert(sizeof(Vec3) == 3 * sizeof(float));
   const float* albedo = &indirect.data()->x;
+#if defined(__AVX512F__)
+  const ReflectancePalette palette = make_palette(indirect);
+  const std::uint8_t* palette_index = palette.index.empty() ? nullptr : palette.index.data();
+  const float* palette_rgb = palette.planes.data();
+#else
+  const std::uint8_t* palette_index = nullptr;
+  const float* palette_rgb = nullptr;
+#endif
   // Planar results (W per channel, O): the filter then shares its depth tests across all four.
   Image<float> wr(w, h, 1.0f), wg(w, h, 1.0f), wb(w, h, 1.0f), obscurance(w, h, 1.0f);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
@@ -155,8 +244,8 @@ TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Imag
       const int count = row.count;
       open.fill(0.0f), lost_r.fill(0.0f), lost_g.fill(0.0f), lost_b.fill(0.0f);
       const std::size_t base = static_cast<std::size_t>(y) * w + t.x0;
-      transfer_row(local_ch, local_projection, row, s, m, far_limit, albedo, static_cast<int>(base), open.data(), lost_r.data(), lost_g.data(),
-                   lost_b.data());
+      transfer_row(local_ch, local_projection, row, s, m, far_limit, albedo, palette_index, palette_rgb, static_cast<int>(base), open.data(),
+                   lost_r.data(), lost_g.data(), lost_b.data());
       for (int k = 0; k < count; ++k) {
         if (!row.covered[static_cast<std::size_t>(k)]) continue;
         const float o = open[static_cast<std::size_t>(k)];
@@ -175,11 +264,18 @@ TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Imag
     Image<float>* planes[] = {&wr, &wg, &wb, &obscurance};
     depth_aware_box_filter_planes(planes, g, effective_depth_limit(params.interleave, falloff.radius));
   }
-  TransferImage out{Image<Vec3>(w, h), std::move(obscurance), Image<float>(w, h)};
-  for (std::size_t i = 0; i < out.luminance.size(); ++i) {
-    out.transfer[i] = Vec3{wr[i], wg[i], wb[i]};
-    out.luminance[i] = 0.2126f * wr[i] + 0.7152f * wg[i] + 0.0722f * wb[i];
-  }
+  // Interleave in parallel (it was a serial pass on the calling thread); the luminance overwrites
+  // the R plane in place (each pixel reads its R before writing), saving an allocation.
+  TransferImage out{Image<Vec3>(w, h), std::move(obscurance), std::move(wr)};
+  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        const float r = out.luminance[i];
+        out.transfer[i] = Vec3{r, wg[i], wb[i]};
+        out.luminance[i] = 0.2126f * r + 0.7152f * wg[i] + 0.0722f * wb[i];
+      }
+  });
   return out;
 }
 

@@ -67,6 +67,34 @@ TEST(Transfer, WhiteRoomCornersAreNoDarkerThanWalls) {
   EXPECT_LT(min_o, 0.7) << "the corners are occluded, yet W is 1";
 }
 
+// Eq. 9 reads a~ where the ray is first occluded, not at the shaded pixel: a grey floor in front of
+// a red wall gets red light back from it. The wall is farther from the camera than the floor, so it
+// lies above the floor in the image (earlier rows): this once read the floor's own albedo there.
+TEST(Transfer, BouncedLightTakesTheOccludersAlbedo) {
+  Scene scene;
+  scene.name = "red-wall";
+  scene.meshes.push_back(make_quad({-5, 0, 5}, {5, 0, 5}, {5, 0, -1}, {-5, 0, -1}, {0.5f, 0.5f, 0.5f}));  // floor
+  scene.meshes.push_back(make_box({-5, 0, -1.5f}, {5, 3, -1}, {1.0f, 0.0f, 0.0f}));                     // red wall
+  validate_and_prepare(scene);
+  Camera view;
+  view.eye = {0, 2.5f, 5};
+  view.target = {0, 0.3f, -0.5f};
+  auto s = test::scene_gbuffer(std::move(scene), view);
+  const TransferImage t = transfer_ao(s.g, {Membership::Step, 1.0f}, {}, 5);
+  double red = 0, green = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < t.obscurance.size(); ++i) {
+    if (s.g.object_id[i] != 1 || t.obscurance[i] > 0.9f) continue;  // floor pixels the wall occludes
+    red += t.transfer[i].x;
+    green += t.transfer[i].y;
+    ++n;
+  }
+  ASSERT_GT(n, 50) << "the view must show floor near the wall";
+  // A red occluder returns light in red only (a~ = (1, 0, 0)): W_r > O = W_g. The margin is far
+  // below the red gain of the pixels measured (about 0.1 at O ~ 0.8 with 12 samples).
+  EXPECT_GT(red / n, green / n + 0.02) << "mean W over " << n << " floor pixels near the wall";
+}
+
 // Sec. 4: I = prod_j I0(x + w r j/m). The last of the m points is the one test of m = 1, so with
 // the same samples a ray open for m = 2 is open for m = 1: O can only fall (thin occluders that the
 // end point jumps over are caught).

@@ -315,7 +315,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
 void add_compare_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action) {
   auto o = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand("compare", "Compare AO methods with the ray-traced ground truth each approximates.");
-  cmd->add_option("scene", o->scene, "Mesh file(s) (OBJ, PLY, OFF, STL, glTF/GLB) or a built-in scene: default, plane, wedge, sphere-on-plane, box-room")
+  cmd->add_option("scene", o->scene, kSceneHelp)
       ->type_name("SCENE");
   std::string names;
   for (const MethodInfo& m : all_methods()) names += (names.empty() ? "" : ", ") + std::string(m.name);

@@ -216,7 +216,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
 void add_render_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand("render", "Render an AO image of a scene (or of a G-buffer EXR).");
-  cmd->add_option("scene", o->scene, "Mesh file(s) (OBJ, PLY, OFF, STL, glTF/GLB) or a built-in scene: default, plane, wedge, sphere-on-plane, box-room")
+  cmd->add_option("scene", o->scene, kSceneHelp)
       ->type_name("SCENE");
   cmd->add_option("-o,--output", o->output, "Visibility image: .png (linear, 8 or 16 bit) or .exr (float). Default: <scene>-<method>.png");
   std::string methods;

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "ao/core/error.h"
+#include "support/errors.h"
 #include "support/run.h"
 #include "ao/io/image_io.h"
 
@@ -70,21 +71,6 @@ void expect_near(Vec3 a, Vec3 b, float tol) {
   EXPECT_NEAR(a.x, b.x, tol);
   EXPECT_NEAR(a.y, b.y, tol);
   EXPECT_NEAR(a.z, b.z, tol);
-}
-
-template <class Fn>
-void expect_one_line_input_error(Fn&& fn, const fs::path& path, const std::string& problem) {
-  try {
-    fn();
-    ADD_FAILURE() << "no exception for " << path;
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    EXPECT_NE(what.find(path.filename().string()), std::string::npos) << what;
-    EXPECT_NE(what.find(problem), std::string::npos) << what;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "wrong exception type for " << path << ": " << e.what();
-  }
 }
 
 TEST(GBufferExr, RoundTripKeepsEveryChannelExactly) {
@@ -147,7 +133,7 @@ TEST(GBufferExr, MissingFieldOfViewAsksForFovUnlessGiven) {
   TempDir dir;
   const GBuffer g = sphere_gbuffer(test_camera());
   write_gbuffer_exr(dir / "nocam.exr", g, {.camera = false});
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "nocam.exr"); }, dir / "nocam.exr", "--fov");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "nocam.exr"); }, dir / "nocam.exr", "--fov");
 
   const GBuffer back = read_gbuffer_exr(dir / "nocam.exr", {.vertical_fov_deg = 50.0f});
   EXPECT_EQ(back.camera.vertical_fov_deg, 50.0f);
@@ -160,7 +146,7 @@ TEST(GBufferExr, FieldOfViewOverrideWinsOverTheFile) {
   TempDir dir;
   write_gbuffer_exr(dir / "g.exr", sphere_gbuffer(test_camera()));
   EXPECT_EQ(read_gbuffer_exr(dir / "g.exr", {.vertical_fov_deg = 30.0f}).camera.vertical_fov_deg, 30.0f);
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "g.exr", {.vertical_fov_deg = 200.0f}); }, dir / "g.exr", "fov");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "g.exr", {.vertical_fov_deg = 200.0f}); }, dir / "g.exr", "fov");
 }
 
 TEST(GBufferExr, WorldSpacePassesAreMovedIntoCameraSpace) {
@@ -180,7 +166,7 @@ TEST(GBufferExr, WorldSpacePassesAreMovedIntoCameraSpace) {
     expect_near(back.normal[i], g.normal[i], 1e-5f);
   }
   write_gbuffer_exr(dir / "nocam.exr", world, {.camera = false});
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "nocam.exr", {.vertical_fov_deg = 50.0f, .world_space = true}); },
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "nocam.exr", {.vertical_fov_deg = 50.0f, .world_space = true}); },
                               dir / "nocam.exr", "camera placement");
 }
 
@@ -199,7 +185,7 @@ TEST(GBufferExr, NonFiniteNormalAtACoveredPixelIsAnErrorNamingThePixel) {
   ASSERT_TRUE(g.covered(24, 16));
   g.normal(24, 16).y = std::numeric_limits<float>::quiet_NaN();
   write_gbuffer_exr(dir / "nan.exr", g);
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "nan.exr"); }, dir / "nan.exr", "pixel (24, 16)");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "nan.exr"); }, dir / "nan.exr", "pixel (24, 16)");
 }
 
 TEST(GBufferExr, NonFinitePositionOrDepthAtACoveredPixelIsAnError) {
@@ -207,12 +193,12 @@ TEST(GBufferExr, NonFinitePositionOrDepthAtACoveredPixelIsAnError) {
   GBuffer g = sphere_gbuffer(test_camera());
   g.position(24, 16).x = kInfinity;
   write_gbuffer_exr(dir / "p.exr", g);
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "p.exr"); }, dir / "p.exr", "pixel (24, 16)");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "p.exr"); }, dir / "p.exr", "pixel (24, 16)");
 
   g = sphere_gbuffer(test_camera());
   g.depth(20, 15) = std::numeric_limits<float>::quiet_NaN();
   write_gbuffer_exr(dir / "z.exr", g);  // A says covered, so the NaN depth is an error
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "z.exr"); }, dir / "z.exr", "pixel (20, 15)");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "z.exr"); }, dir / "z.exr", "pixel (20, 15)");
 }
 
 TEST(GBufferExr, NanDepthWithoutCoverageChannelIsBackground) {
@@ -229,32 +215,32 @@ TEST(GBufferExr, NanDepthWithoutCoverageChannelIsBackground) {
 TEST(GBufferExr, MissingRequiredChannelsAreListed) {
   TempDir dir;
   write_image(dir / "depth-only.exr", Image<float>(8, 8, 3.0f), {.exr_channel = "Z"});
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "depth-only.exr", {.vertical_fov_deg = 40.0f}); },
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "depth-only.exr", {.vertical_fov_deg = 40.0f}); },
                               dir / "depth-only.exr", "N.X N.Y N.Z");
 }
 
 TEST(GBufferExr, BadFilesAreOneLineErrors) {
   TempDir dir;
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "missing.exr"); }, dir / "missing.exr", "does not exist");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "missing.exr"); }, dir / "missing.exr", "does not exist");
 
   { std::ofstream(dir / "empty.exr"); }
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "empty.exr"); }, dir / "empty.exr", "empty");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "empty.exr"); }, dir / "empty.exr", "empty");
 
   write_image(dir / "image.png", Image<float>(4, 4, 0.5f));
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "image.png"); }, dir / "image.png", "not an OpenEXR file");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "image.png"); }, dir / "image.png", "not an OpenEXR file");
 
   write_gbuffer_exr(dir / "g.exr", sphere_gbuffer(test_camera()));
   std::ifstream in(dir / "g.exr", std::ios::binary);
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   std::ofstream(dir / "half.exr", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
-  expect_one_line_input_error([&] { read_gbuffer_exr(dir / "half.exr"); }, dir / "half.exr", "OpenEXR");
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "half.exr"); }, dir / "half.exr", "OpenEXR");
 }
 
 TEST(GBufferExr, MismatchedImageSizesAreRejectedOnWrite) {
   TempDir dir;
   GBuffer g = sphere_gbuffer(test_camera());
   g.albedo = Image<Vec3>(3, 3);
-  expect_one_line_input_error([&] { write_gbuffer_exr(dir / "g.exr", g); }, dir / "g.exr", "match");
+  test::expect_one_line_error<InputError>([&] { write_gbuffer_exr(dir / "g.exr", g); }, dir / "g.exr", "match");
   EXPECT_FALSE(fs::exists(dir / "g.exr"));
 }
 

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "ao/core/error.h"
+#include "support/errors.h"
 #include "support/run.h"
 #include "ao/io/atomic_file.h"
 
@@ -25,6 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::TempDir;
+using test::expect_one_line_error;
 
 std::string read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -50,22 +52,6 @@ Image<Vec3> colour_ramp(int width, int height) {
     for (int x = 0; x < width; ++x)
       image(x, y) = {static_cast<float>(x) / (width - 1), static_cast<float>(y) / (height - 1), 0.25f + 0.5f * ((x + y) % 2)};
   return image;
-}
-
-// Runs fn, which must throw E with a one-line message containing the file name and `problem`.
-template <class E, class Fn>
-void expect_one_line_error(Fn&& fn, const fs::path& path, const std::string& problem) {
-  try {
-    fn();
-    ADD_FAILURE() << "no exception for " << path;
-  } catch (const E& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    EXPECT_NE(what.find(path.filename().string()), std::string::npos) << what;
-    EXPECT_NE(what.find(problem), std::string::npos) << what;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "wrong exception type for " << path << ": " << e.what();
-  }
 }
 
 // --- atomic writes --------------------------------------------------------------------------

@@ -13,16 +13,12 @@
 #include "ao/reference/raytraced.h"
 #include "ao/scene/procedural.h"
 
+#include "support/scenes.h"
+
 namespace ao {
 namespace {
 
-Scene scene_of(std::vector<Mesh> meshes) {
-  Scene s;
-  s.name = "test";
-  s.meshes = std::move(meshes);
-  validate_and_prepare(s);
-  return s;
-}
+using test::scene_of;
 
 // A one-pixel G-buffer seeing world point p with world normal n from a camera 3 units along n.
 GBuffer one_pixel(Vec3 p, Vec3 n) {

@@ -13,16 +13,12 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/scene/procedural.h"
 
+#include "support/scenes.h"
+
 namespace ao {
 namespace {
 
-Scene scene_of(std::vector<Mesh> meshes) {
-  Scene s;
-  s.name = "test";
-  s.meshes = std::move(meshes);
-  validate_and_prepare(s);
-  return s;
-}
+using test::scene_of;
 
 // Voxel centres origin + (k + 0.5) * size strictly inside (lo, hi).
 int centres_inside(float origin, float size, int n, float lo, float hi) {

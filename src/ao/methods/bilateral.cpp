@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -58,27 +60,76 @@ void load_centres(const GBuffer& g, const Rays& rays, int y, int x0, int x1, flo
   }
 }
 
-// One tap, accumulated for a row segment. tdepth/tval point at the tap pixels (aligned with the
-// segment's first pixel); the tap's varying ray coordinate is t[k] (horizontal: per pixel) or
-// t[0] (vertical: one value for the whole row).
+// All taps of a row segment, in blocks of kBlock pixels whose two sums stay in registers across the
+// taps (one pass over the segment instead of one per tap). Tap j reads depths td[j][k] and values
+// tv[j][k] (aligned with the segment's first pixel) with spatial weight sp[j]; its varying ray
+// coordinate is tt[j][k] (horizontal: per pixel) or tt[j][0] (vertical: one value for the whole
+// row). Per pixel the taps are summed in order, so the result does not depend on the blocking.
+// 16-wide vectors (one AVX-512 register; two AVX ones elsewhere), two per block for independent sums.
+constexpr int kLanes = 16, kBlock = 2 * kLanes;
+using VecF = float __attribute__((vector_size(4 * kLanes)));
+using VecI = std::int32_t __attribute__((vector_size(4 * kLanes)));
+
+inline VecF loadv(const float* p) {
+  VecF v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline VecF splatv(float f) { return VecF{} + f; }
+inline VecF selectv(VecI m, VecF a, VecF b) { return (VecF)((m & (VecI)a) | (~m & (VecI)b)); }
+
+// Blocks of kBlock pixels: two vectors per sum, the same arithmetic as the 1-pixel path below.
 template <bool kPerPixel>
-inline void accumulate_tap(const Centres& ce, int count, float spatial, const float* __restrict t, const float* __restrict tdepth,
-                           const float* __restrict tval, float* __restrict sum_w, float* __restrict sum_v) {
-  for (int k = 0; k < count; ++k) {
-    const float d = tdepth[k];
-    const float half_x = d * (ce.a[k] * t[kPerPixel ? k : 0] + ce.b[k]) - ce.c[k];
-    // K = max(0, 1 - (x/2)^2)^2. Background taps have depth +inf: x is inf or NaN, and the select
-    // gives them weight 0.
-    const float u = std::max(0.0f, 1.0f - half_x * half_x);
-    const float w = d < kInfinity ? spatial * (u * u) : 0.0f;
-    sum_w[k] += w;
-    sum_v[k] += w * tval[k];
+inline void filter_block(const Centres& ce, int k0, int taps, const float* sp, const float* const* tt, const float* const* td,
+                           const float* const* tv, const float* __restrict in, float* __restrict out) {
+  VecF a[2], b[2], c[2], sum_w[2] = {}, sum_v[2] = {};
+  for (int h = 0; h < 2; ++h) a[h] = loadv(&ce.a[k0 + kLanes * h]), b[h] = loadv(&ce.b[k0 + kLanes * h]), c[h] = loadv(&ce.c[k0 + kLanes * h]);
+  const VecF zero{}, one = splatv(1.0f);
+  for (int j = 0; j < taps; ++j) {
+    const VecF spatial = splatv(sp[j]);
+    for (int h = 0; h < 2; ++h) {
+      const VecF t = kPerPixel ? loadv(tt[j] + k0 + kLanes * h) : splatv(tt[j][0]);
+      const VecF d = loadv(td[j] + k0 + kLanes * h);
+      const VecF half_x = d * (a[h] * t + b[h]) - c[h];
+      VecF u = one - half_x * half_x;
+      u = selectv(u > zero, u, zero);  // max(0, u), NaN -> 0 as std::max(0.0f, NaN)
+      // Background taps (d = +inf): half_x is +-inf or NaN, so u = 0 and w = 0 as in filter_pixel.
+      const VecF w = spatial * (u * u);
+      sum_w[h] += w;
+      sum_v[h] += w * loadv(tv[j] + k0 + kLanes * h);
+    }
+  }
+  for (int h = 0; h < 2; ++h) {
+    const VecI covered = loadv(&ce.cov[k0 + kLanes * h]) > zero;
+    const VecF r = selectv(covered, sum_v[h] / sum_w[h], loadv(in + k0 + kLanes * h));
+    std::memcpy(out + k0 + kLanes * h, &r, sizeof r);
   }
 }
 
-inline void finish(const Centres& c, int count, const float* sum_w, const float* sum_v, const float* in, float* out) {
+template <bool kPerPixel>
+inline void filter_pixel(const Centres& ce, int k, int taps, const float* sp, const float* const* tt, const float* const* td,
+                         const float* const* tv, const float* __restrict in, float* __restrict out) {
+  float sum_w = 0.0f, sum_v = 0.0f;
+  for (int j = 0; j < taps; ++j) {
+    const float d = td[j][k];
+    const float half_x = d * (ce.a[k] * tt[j][kPerPixel ? k : 0] + ce.b[k]) - ce.c[k];
+    // K = max(0, 1 - (x/2)^2)^2. Background taps have depth +inf: x is inf or NaN, and the select
+    // gives them weight 0.
+    const float u = std::max(0.0f, 1.0f - half_x * half_x);
+    const float w = d < kInfinity ? sp[j] * (u * u) : 0.0f;
+    sum_w += w;
+    sum_v += w * tv[j][k];
+  }
   // The centre tap has weight spatial(0) * 1 > 0 on covered pixels, so sum_w > 0 there.
-  for (int k = 0; k < count; ++k) out[k] = c.cov[k] > 0 ? sum_v[k] / sum_w[k] : in[k];
+  out[k] = ce.cov[k] > 0 ? sum_v / sum_w : in[k];
+}
+
+template <bool kPerPixel>
+void filter_segment(const Centres& ce, int count, int taps, const float* sp, const float* const* tt, const float* const* td, const float* const* tv,
+                    const float* in, float* out) {
+  int k0 = 0;
+  for (; k0 + kBlock <= count; k0 += kBlock) filter_block<kPerPixel>(ce, k0, taps, sp, tt, td, tv, in, out);
+  for (; k0 < count; ++k0) filter_pixel<kPerPixel>(ce, k0, taps, sp, tt, td, tv, in, out);
 }
 
 }  // namespace
@@ -132,7 +183,6 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
         Centres c;
         alignas(64) std::array<float, kTileWidth + 2 * kMaxTaps> rx, rd, rv;
-        alignas(64) std::array<float, kTileWidth> sum_w, sum_v;
         for (int k = 0; k < n + 2 * half; ++k) rx[k] = rays.x(static_cast<float>(x0 - half + k) + 0.5f);
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
           load_centres(g, rays, y, x0, x1, params.plane_sigma, false, c);
@@ -143,11 +193,9 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
           std::copy_n(&depth[row + x0 - half + lo], hi - lo, rd.begin() + lo);
           std::copy_n(&values[row + x0 - half + lo], hi - lo, rv.begin() + lo);
           std::fill(rd.begin() + hi, rd.begin() + n + 2 * half, kInfinity), std::fill(rv.begin() + hi, rv.begin() + n + 2 * half, 0.0f);
-          std::fill_n(sum_w.begin(), n, 0.0f);
-          std::fill_n(sum_v.begin(), n, 0.0f);
-          for (int j = 0; j < params.taps; ++j)
-            accumulate_tap<true>(c, n, spatial[j], &rx[j], &rd[j], &rv[j], sum_w.data(), sum_v.data());
-          finish(c, n, sum_w.data(), sum_v.data(), &values[row + x0], &tmp[row + x0]);
+          std::array<const float*, kMaxTaps> tt, td, tv;
+          for (int j = 0; j < params.taps; ++j) tt[j] = &rx[j], td[j] = &rd[j], tv[j] = &rv[j];
+          filter_segment<true>(c, n, params.taps, spatial.data(), tt.data(), td.data(), tv.data(), &values[row + x0], &tmp[row + x0]);
         }
       },
       tbb::simple_partitioner());
@@ -157,20 +205,22 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
       [&](const tbb::blocked_range2d<int>& r) {
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
         Centres c;
-        alignas(64) std::array<float, kTileWidth> sum_w, sum_v;
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
           load_centres(g, rays, y, x0, x1, params.plane_sigma, true, c);
-          std::fill_n(sum_w.begin(), n, 0.0f);
-          std::fill_n(sum_v.begin(), n, 0.0f);
+          std::array<const float*, kMaxTaps> tt, td, tv;
+          std::array<float, kMaxTaps> ry, sp;
+          int taps = 0;
           for (int j = -half; j <= half; ++j) {
             const int yj = y + j;
             if (yj < 0 || yj >= h) continue;
             const std::size_t i = static_cast<std::size_t>(yj) * w + x0;
-            const float ry = rays.y(static_cast<float>(yj) + 0.5f);
-            accumulate_tap<false>(c, n, spatial[j + half], &ry, &depth[i], &tmp[i], sum_w.data(), sum_v.data());
+            ry[taps] = rays.y(static_cast<float>(yj) + 0.5f);
+            sp[taps] = spatial[j + half];
+            tt[taps] = &ry[taps], td[taps] = &depth[i], tv[taps] = &tmp[i];
+            ++taps;
           }
           const std::size_t row = static_cast<std::size_t>(y) * w + x0;
-          finish(c, n, sum_w.data(), sum_v.data(), &tmp[row], &values[row]);
+          filter_segment<false>(c, n, taps, sp.data(), tt.data(), td.data(), tv.data(), &tmp[row], &values[row]);
         }
       },
       tbb::simple_partitioner());

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -87,54 +89,125 @@ void PixelRow::load(const GBuffer& g, int row, int first, int last, const std::a
 namespace {
 
 // The 4x4 window is not separable (neighbours are skipped by their depth difference to the CENTRE
-// pixel), so it runs as one pass of 16 taps over whole rows, SIMD across x. Each tap's depth test
-// is made once per pixel and shared by the N planar channels filtered together (RGB + obscurance
-// for transfer). Taps are summed in the same order (dy, then dx) for every channel count, so
-// results match between the float, RGB and planar entry points, and never depend on threads.
-template <int N>
-void box_filter_planes(const std::array<const float*, N>& src, const std::array<float*, N>& dst, const GBuffer& g, float limit) {
-  const int w = g.width(), h = g.height();
+// pixel), so it runs as one pass of 16 taps, SIMD across x. Sources are rows of S interleaved
+// floats per pixel (S = 1: float planes; S = 3: a Vec3 RGB image, filtered in place of planes).
+// Blocks of 16 pixels make each tap's depth test once per pixel (spread to the pixel's S lanes by a
+// permute for RGB) and share it by the N sources filtered together (RGB + obscurance for transfer);
+// the count and sums of all 16 taps stay in registers (no per-tap row traffic). Taps are summed in
+// the same order (dy, then dx) for every channel count and layout, and a skipped tap adds +0 exactly
+// as a missing one, so results match between the float, RGB and planar entry points (and the scalar
+// border pixels), and never depend on threads.
+using V8 = float __attribute__((vector_size(32)));
+using V8i = std::int32_t __attribute__((vector_size(32)));
+
+inline V8 load8(const float* p) {
+  V8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store8(float* p, V8 v) { std::memcpy(p, &v, sizeof v); }
+inline V8 splat8(float f) { return V8{f, f, f, f, f, f, f, f}; }
+inline V8i splat8i(std::int32_t i) { return V8i{i, i, i, i, i, i, i, i}; }
+
+// A pixel mask (or value) of 8 pixels spread to their S lanes each: S vectors of 8 lanes.
+template <int S, typename T>
+inline std::array<T, S> spread(T m) {
+  if constexpr (S == 1) {
+    return {m};
+  } else {
+    static_assert(S == 3);
+#if defined(__clang__)
+    return {__builtin_shufflevector(m, m, 0, 0, 0, 1, 1, 1, 2, 2), __builtin_shufflevector(m, m, 2, 3, 3, 3, 4, 4, 4, 5),
+            __builtin_shufflevector(m, m, 5, 5, 6, 6, 6, 7, 7, 7)};
+#else
+    return {__builtin_shuffle(m, V8i{0, 0, 0, 1, 1, 1, 2, 2}), __builtin_shuffle(m, V8i{2, 3, 3, 3, 4, 4, 4, 5}),
+            __builtin_shuffle(m, V8i{5, 5, 6, 6, 6, 7, 7, 7})};
+#endif
+  }
+}
+
+template <int N, int S>
+void box_filter_lanes(const std::array<const float*, N>& src, const std::array<float*, N>& dst, const GBuffer& g, float limit) {
+  const int w = g.width(), h = g.height(), lanes = S * w;
   const float* depth = g.depth.data();
   const std::uint8_t* cov = g.coverage.data();
   tbb::parallel_for(
-      tbb::blocked_range<int>(0, h, 4),
+      tbb::blocked_range<int>(0, h, 8),
       [&](const tbb::blocked_range<int>& r) {
-        std::vector<float> buffer(static_cast<std::size_t>(w) * (N + 1));
-        float* __restrict count = buffer.data();
-        std::array<float*, N> sum;
-        for (int c = 0; c < N; ++c) sum[static_cast<std::size_t>(c)] = buffer.data() + static_cast<std::size_t>(c + 1) * w;
+        auto depth_row = [&](int yy) { return depth + static_cast<std::size_t>(yy) * w; };
+        // Centre depths, NaN on uncovered pixels: no tap passes, count stays 0 and the value is kept.
+        std::vector<float> centre(static_cast<std::size_t>(w));
+        const V8 lim = splat8(limit), one = splat8(1.0f);
+        const V8i abs_mask = splat8i(0x7fffffff);
         for (int y = r.begin(); y < r.end(); ++y) {
-          std::fill(buffer.begin(), buffer.end(), 0.0f);
-          const std::size_t row = static_cast<std::size_t>(y) * w;
-          const float* __restrict dc = depth + row;
-          for (int dy = -2; dy <= 1; ++dy) {
-            const int yy = y + dy;
-            if (yy < 0 || yy >= h) continue;
-            const std::size_t nrow = static_cast<std::size_t>(yy) * w;
-            for (int dx = -2; dx <= 1; ++dx) {
-              const int lo = std::max(0, -dx), hi = std::min(w, w - dx);
-              const float* __restrict dn = depth + nrow + dx;
-              std::array<const float*, N> vn;
-              for (int c = 0; c < N; ++c) vn[static_cast<std::size_t>(c)] = src[static_cast<std::size_t>(c)] + nrow + dx;
-// Accumulators are private to the task; sources are read-only.
-#pragma GCC ivdep
-              for (int x = lo; x < hi; ++x) {
-                // Background neighbours hold depth +infinity, so |difference| > limit drops them too.
-                const bool use = std::abs(dn[x] - dc[x]) <= limit;
-                count[x] += use ? 1.0f : 0.0f;
-                for (int c = 0; c < N; ++c) sum[static_cast<std::size_t>(c)][x] += use ? vn[static_cast<std::size_t>(c)][x] : 0.0f;
+          const std::size_t row = static_cast<std::size_t>(y) * lanes;
+          const float* dcy = depth_row(y);
+          for (int x = 0; x < w; ++x) centre[static_cast<std::size_t>(x)] = cov[static_cast<std::size_t>(y) * w + x] ? dcy[x] : std::numeric_limits<float>::quiet_NaN();
+          const int dy_lo = std::max(-2, -y), dy_hi = std::min(1, h - 1 - y);
+          // Pixels whose taps dx = -2..+1 all lie inside the row run in blocks of 16 (16 x S lanes): the
+          // depth test is made once per pixel; for RGB its mask is spread to the pixel's 3 lanes.
+          int p = 2;
+          for (; p + 16 <= w - 1; p += 16) {
+            const V8 dc0 = load8(&centre[static_cast<std::size_t>(p)]), dc1 = load8(&centre[static_cast<std::size_t>(p) + 8]);
+            V8 n0{}, n1{};
+            std::array<V8, N * S> s0{}, s1{};
+            for (int dy = dy_lo; dy <= dy_hi; ++dy) {
+              const float* dn = depth_row(y + dy) + p;
+              const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes + static_cast<std::size_t>(S) * p;
+              for (int dx = -2; dx <= 1; ++dx) {
+                const V8i m0 = (V8)((V8i)(load8(dn + dx) - dc0) & abs_mask) <= lim;
+                const V8i m1 = (V8)((V8i)(load8(dn + dx + 8) - dc1) & abs_mask) <= lim;
+                n0 += (V8)(m0 & (V8i)one);
+                n1 += (V8)(m1 & (V8i)one);
+                const std::array<V8i, S> e0 = spread<S>(m0), e1 = spread<S>(m1);
+                for (int c = 0; c < N; ++c) {
+                  const float* v = src[static_cast<std::size_t>(c)] + nrow + S * dx;
+                  for (int k = 0; k < S; ++k) {
+                    s0[static_cast<std::size_t>(c * S + k)] += (V8)(e0[static_cast<std::size_t>(k)] & (V8i)load8(v + 8 * k));
+                    s1[static_cast<std::size_t>(c * S + k)] += (V8)(e1[static_cast<std::size_t>(k)] & (V8i)load8(v + 8 * S + 8 * k));
+                  }
+                }
+              }
+            }
+            const std::array<V8, S> c0 = spread<S>(n0), c1 = spread<S>(n1);
+            for (int k = 0; k < S; ++k) {
+              const V8 q0 = c0[static_cast<std::size_t>(k)], q1 = c1[static_cast<std::size_t>(k)];
+              const V8i k0 = q0 > V8{}, k1 = q1 > V8{};  // else keep the value (uncovered, or no tap)
+              for (int c = 0; c < N; ++c) {
+                const std::size_t at = row + static_cast<std::size_t>(S) * p + 8 * k;
+                const float* in = src[static_cast<std::size_t>(c)] + at;
+                float* out = dst[static_cast<std::size_t>(c)] + at;
+                store8(out, (V8)((k0 & (V8i)(s0[static_cast<std::size_t>(c * S + k)] / q0)) | (~k0 & (V8i)load8(in))));
+                store8(out + 8 * S, (V8)((k1 & (V8i)(s1[static_cast<std::size_t>(c * S + k)] / q1)) | (~k1 & (V8i)load8(in + 8 * S))));
               }
             }
           }
-#pragma GCC ivdep
-          for (int x = 0; x < w; ++x) {
-            const bool keep = (cov[row + x] == 0) | !(count[x] > 0);  // uncovered pixels keep their value (&: no branch)
-            const float n = keep ? 1.0f : count[x];
-            for (int c = 0; c < N; ++c) {
-              const float in = src[static_cast<std::size_t>(c)][row + x];
-              dst[static_cast<std::size_t>(c)][row + x] = keep ? in : sum[static_cast<std::size_t>(c)][x] / n;  // divide: as before, exact means
+          const int l = S * p, vlo = 2 * S;
+          // The rest one lane at a time, same tap order.
+          auto scalar = [&](int l0, int l1) {
+            for (int q = l0; q < l1; ++q) {
+              const int x = q / S;
+              const float dc = centre[static_cast<std::size_t>(x)];
+              float n = 0;
+              std::array<float, N> s{};
+              for (int dy = dy_lo; dy <= dy_hi; ++dy) {
+                const float* dn = depth_row(y + dy);
+                const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes;
+                for (int dx = std::max(-2, -x); dx <= std::min(1, w - 1 - x); ++dx) {
+                  const int t = q + S * dx;
+                  const bool use = std::abs(dn[x + dx] - dc) <= limit;
+                  n += use ? 1.0f : 0.0f;
+                  for (int c = 0; c < N; ++c) s[static_cast<std::size_t>(c)] += use ? src[static_cast<std::size_t>(c)][nrow + t] : 0.0f;
+                }
+              }
+              for (int c = 0; c < N; ++c) {
+                const float in = src[static_cast<std::size_t>(c)][row + q];
+                dst[static_cast<std::size_t>(c)][row + q] = n > 0 ? s[static_cast<std::size_t>(c)] / n : in;
+              }
             }
-          }
+          };
+          scalar(0, std::min(vlo, lanes));
+          scalar(std::max(l, std::min(vlo, lanes)), lanes);
         }
       },
       tbb::simple_partitioner());
@@ -149,20 +222,16 @@ void check_size(const GBuffer& g, int w, int h) {
 Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit) {
   check_size(g, image.width(), image.height());
   Image<float> out(image.width(), image.height());
-  box_filter_planes<1>({image.data()}, {out.data()}, g, depth_limit);
+  box_filter_lanes<1, 1>({image.data()}, {out.data()}, g, depth_limit);
   return out;
 }
 
 Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit) {
   check_size(g, image.width(), image.height());
-  // Planar channels: the AoS Vec3 layout would need strided loads in the tap loop.
-  const std::size_t n = image.size();
-  std::vector<float> planes(6 * n);
-  float *r = planes.data(), *gr = r + n, *b = gr + n;
-  for (std::size_t i = 0; i < n; ++i) r[i] = image[i].x, gr[i] = image[i].y, b[i] = image[i].z;
-  box_filter_planes<3>({r, gr, b}, {b + n, b + 2 * n, b + 3 * n}, g, depth_limit);
+  // Interleaved RGB lanes directly (3 lanes per pixel, one depth test per lane), no planar copies.
+  static_assert(sizeof(Vec3) == 3 * sizeof(float));
   Image<Vec3> out(image.width(), image.height());
-  for (std::size_t i = 0; i < n; ++i) out[i] = Vec3{b[n + i], b[2 * n + i], b[3 * n + i]};
+  box_filter_lanes<1, 3>({&image.data()->x}, {&out.data()->x}, g, depth_limit);
   return out;
 }
 
@@ -175,10 +244,10 @@ void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const 
     std::vector<Image<float>> out;
     for (std::size_t c = 0; c < k; ++c) out.emplace_back(g.width(), g.height());
     auto in = [&](std::size_t c) { return static_cast<const float*>(planes[done + c]->data()); };
-    if (k == 1) box_filter_planes<1>({in(0)}, {out[0].data()}, g, depth_limit);
-    if (k == 2) box_filter_planes<2>({in(0), in(1)}, {out[0].data(), out[1].data()}, g, depth_limit);
-    if (k == 3) box_filter_planes<3>({in(0), in(1), in(2)}, {out[0].data(), out[1].data(), out[2].data()}, g, depth_limit);
-    if (k == 4) box_filter_planes<4>({in(0), in(1), in(2), in(3)}, {out[0].data(), out[1].data(), out[2].data(), out[3].data()}, g, depth_limit);
+    if (k == 1) box_filter_lanes<1, 1>({in(0)}, {out[0].data()}, g, depth_limit);
+    if (k == 2) box_filter_lanes<2, 1>({in(0), in(1)}, {out[0].data(), out[1].data()}, g, depth_limit);
+    if (k == 3) box_filter_lanes<3, 1>({in(0), in(1), in(2)}, {out[0].data(), out[1].data(), out[2].data()}, g, depth_limit);
+    if (k == 4) box_filter_lanes<4, 1>({in(0), in(1), in(2), in(3)}, {out[0].data(), out[1].data(), out[2].data(), out[3].data()}, g, depth_limit);
     for (std::size_t c = 0; c < k; ++c) *planes[done + c] = std::move(out[c]);
     done += k;
   }

@@ -52,6 +52,19 @@ void gbuffer(benchmark::State& state, Fixture* f) {
   state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(cam.width) * cam.height * state.iterations() / 1e6, benchmark::Counter::kIsRate);
 }
 
+// What both minimal loops trace from pixel (x, y): the reference's origin (offset along the normal),
+// tangent frame and sample-set seed (seed 1, as the `raytraced` benchmark), so all three trace the
+// same rays.
+struct PixelRays {
+  Vec3 origin;
+  Frame frame;
+  std::uint32_t seed;
+};
+PixelRays pixel_rays(const GBuffer& g, const Frame& basis, float offset, int x, int y) {
+  const Vec3 n = basis.to_world(g.normal(x, y));
+  return {basis.to_world(g.position(x, y)) + g.camera.eye + n * offset, Frame::from_normal(n), pixel_seed(1, x, y)};
+}
+
 // The limit: for every covered pixel, the same 64 cosine-weighted directions the reference uses
 // (same seed, same sequence), 16-wide occlusion packets, a counter of hits. No accumulation of
 // statistics, no early exit, nothing written.
@@ -73,10 +86,7 @@ void minimal_loop(benchmark::State& state, Fixture* f) {
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x) {
           if (!g.covered(x, y)) continue;
-          const Vec3 n = basis.to_world(g.normal(x, y));
-          const Vec3 o = basis.to_world(g.position(x, y)) + g.camera.eye + n * offset;
-          const Frame frame = Frame::from_normal(n);
-          const std::uint32_t seed = pixel_seed(1, x, y);
+          const auto [o, frame, seed] = pixel_rays(g, basis, offset, x, y);
           for (int first = 0; first < kSamples; first += 16) {
             for (int k = 0; k < 16; ++k)
               detail::set_ray(ray, k, o, frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), seed))), R);
@@ -108,10 +118,7 @@ void minimal_loop_single_rays(benchmark::State& state, Fixture* f) {
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x) {
           if (!g.covered(x, y)) continue;
-          const Vec3 n = basis.to_world(g.normal(x, y));
-          const Vec3 o = basis.to_world(g.position(x, y)) + g.camera.eye + n * offset;
-          const Frame frame = Frame::from_normal(n);
-          const std::uint32_t seed = pixel_seed(1, x, y);
+          const auto [o, frame, seed] = pixel_rays(g, basis, offset, x, y);
           for (int i = 0; i < kSamples; ++i) {
             const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(i), seed)));
             RTCRay ray{o.x, o.y, o.z, 0.0f, d.x, d.y, d.z, 0.0f, R, ~0u, 0, 0};

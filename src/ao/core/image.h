@@ -33,6 +33,14 @@ class Image {
     AO_ASSERT(width >= 0 && height >= 0);
   }
 
+  /// Gives the image a new size, keeping its storage when that is large enough: a caller that
+  /// renders every frame then touches no fresh pages. Pixel values are unspecified afterwards.
+  void resize(int width, int height) {
+    AO_ASSERT(width >= 0 && height >= 0);
+    width_ = width, height_ = height;
+    pixels_.resize(static_cast<std::size_t>(width) * height);
+  }
+
   int width() const { return width_; }
   int height() const { return height_; }
   std::size_t size() const { return pixels_.size(); }

@@ -1,5 +1,6 @@
 #include "ao/methods/interleave.h"
 
+#include <array>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -235,19 +236,31 @@ Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, f
   return out;
 }
 
+void depth_aware_box_filter_planes(std::span<const float* const> src, std::span<float* const> dst, const GBuffer& g, float depth_limit) {
+  if (src.size() != dst.size() || src.size() > 4) throw InputError("depth_aware_box_filter_planes: 1 to 4 source planes, one destination each");
+  auto in = [&](std::size_t c) { return src[c]; };
+  auto out = [&](std::size_t c) { return dst[c]; };
+  switch (src.size()) {  // up to 4 channels share one pass of depth tests
+    case 1: box_filter_lanes<1, 1>({in(0)}, {out(0)}, g, depth_limit); break;
+    case 2: box_filter_lanes<2, 1>({in(0), in(1)}, {out(0), out(1)}, g, depth_limit); break;
+    case 3: box_filter_lanes<3, 1>({in(0), in(1), in(2)}, {out(0), out(1), out(2)}, g, depth_limit); break;
+    case 4: box_filter_lanes<4, 1>({in(0), in(1), in(2), in(3)}, {out(0), out(1), out(2), out(3)}, g, depth_limit); break;
+    default: break;
+  }
+}
+
 void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit) {
-  if (planes.empty()) return;
   for (const Image<float>* p : planes) check_size(g, p->width(), p->height());
-  std::size_t done = 0;
-  while (done < planes.size()) {  // up to 4 channels share one pass of depth tests
+  for (std::size_t done = 0; done < planes.size();) {
     const std::size_t k = std::min<std::size_t>(4, planes.size() - done);
-    std::vector<Image<float>> out;
-    for (std::size_t c = 0; c < k; ++c) out.emplace_back(g.width(), g.height());
-    auto in = [&](std::size_t c) { return static_cast<const float*>(planes[done + c]->data()); };
-    if (k == 1) box_filter_lanes<1, 1>({in(0)}, {out[0].data()}, g, depth_limit);
-    if (k == 2) box_filter_lanes<2, 1>({in(0), in(1)}, {out[0].data(), out[1].data()}, g, depth_limit);
-    if (k == 3) box_filter_lanes<3, 1>({in(0), in(1), in(2)}, {out[0].data(), out[1].data(), out[2].data()}, g, depth_limit);
-    if (k == 4) box_filter_lanes<4, 1>({in(0), in(1), in(2), in(3)}, {out[0].data(), out[1].data(), out[2].data(), out[3].data()}, g, depth_limit);
+    std::array<Image<float>, 4> out;
+    std::array<const float*, 4> src{};
+    std::array<float*, 4> dst{};
+    for (std::size_t c = 0; c < k; ++c) {
+      out[c] = Image<float>(g.width(), g.height());
+      src[c] = planes[done + c]->data(), dst[c] = out[c].data();
+    }
+    depth_aware_box_filter_planes(std::span(src.data(), k), std::span(dst.data(), k), g, depth_limit);
     for (std::size_t c = 0; c < k; ++c) *planes[done + c] = std::move(out[c]);
     done += k;
   }

@@ -68,5 +68,8 @@ Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, f
 /// tap's depth test is shared by up to 4 channels. Each plane gives what depth_aware_box_filter
 /// would give for it alone. Planes must have the G-buffer's size (InputError otherwise).
 void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit);
+/// The same over up to 4 planes from `src` into `dst` (each width * height floats of the
+/// G-buffer's size, dst[c] != src[c]): what a caller that keeps its own storage uses.
+void depth_aware_box_filter_planes(std::span<const float* const> src, std::span<float* const> dst, const GBuffer& g, float depth_limit);
 
 }  // namespace ao

@@ -15,6 +15,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/methods/characteristic.h"
+#include "ao/methods/containment.h"
 #include "ao/methods/samples.h"
 
 namespace ao {
@@ -164,6 +165,103 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
 }
 
 #if defined(__AVX512F__)
+// The depth-buffer kernel, AVX-512: 16 compacted covered pixels of a row in the lanes of one
+// vector, and all n x m tests of them with every per-pixel value and accumulator in registers.
+// (The generic transfer_row streams each step through small arrays; here a test is a dozen
+// arithmetic instructions and one depth gather, and the tests of successive samples are
+// independent, so the core keeps several gathers in flight.) The test point of step j is the
+// sample scaled by j/m, p = x + (j/m)(X T + Y B + Z N) (sec. 4), evaluated in the order of
+// containment_ao's kernel and with its projection, so with m = 1 both give the same I bit for bit.
+// GCC 12 reports the deliberately undefined pass-through operand of _mm512_cvttps_epi32 as
+// "maybe uninitialized" (its intrinsics header initialises it from itself).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+void transfer_row_depth_avx512(const ScreenProjection& projection, const float* __restrict depth, const PixelRow& row,
+                               const ContainmentSamples& s, int m, float far_limit, const float* __restrict albedo,
+                               const std::uint8_t* __restrict palette_index, const float* __restrict palette, const int* index, float n,
+                               float albedo_scale, float* __restrict out_r, float* __restrict out_g, float* __restrict out_b,
+                               float* __restrict out_o) {
+  const __m512 scale_x = _mm512_set1_ps(projection.scale_x), scale_y = _mm512_set1_ps(projection.scale_y);
+  const __m512 centre_x = _mm512_set1_ps(projection.centre_x), centre_y = _mm512_set1_ps(projection.centre_y);
+  const __m512 width = _mm512_set1_ps(static_cast<float>(projection.width)), height = _mm512_set1_ps(static_cast<float>(projection.height));
+  const __m512i row_stride = _mm512_set1_epi32(projection.width);
+  const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), minus_one = _mm512_set1_ps(-1.0f);
+  const __m512 far = _mm512_set1_ps(far_limit);
+  const float inv_m = 1.0f / static_cast<float>(m);
+  for (int k0 = 0; k0 < row.count; k0 += 16) {
+    const __mmask16 live = static_cast<__mmask16>(row.count - k0 >= 16 ? 0xFFFF : (1u << (row.count - k0)) - 1u);
+    auto load = [&](const std::vector<float>& v) { return _mm512_maskz_loadu_ps(live, v.data() + k0); };
+    const __m512 px = load(row.px), py = load(row.py), pz = load(row.pz);
+    const __m512 tx = load(row.tx), ty = load(row.ty), tz = load(row.tz);
+    const __m512 bx = load(row.bx), by = load(row.by), bz = load(row.bz);
+    const __m512 nx = load(row.nx), ny = load(row.ny), nz = load(row.nz);
+    const __m512 minus_bias = _mm512_sub_ps(zero, load(row.bias));
+    __m512 open_v = zero, lr = zero, lg = zero, lb = zero;
+    for (int i = 0; i < s.size(); ++i) {
+      const auto si = static_cast<std::size_t>(i);
+      // Sec. 4: nearest occluded test wins; steps run from the far end inwards, each occluded one
+      // overwriting `at` (the pixel whose albedo is a~, -1 while the ray is free).
+      __m512i at = _mm512_set1_epi32(-1);
+      for (int j = m; j >= 1; --j) {
+        const float f = static_cast<float>(j) * inv_m;
+        const __m512 X = _mm512_set1_ps(f * s.x[si]), Y = _mm512_set1_ps(f * s.y[si]), Z = _mm512_set1_ps(f * s.z[si]);
+        const __m512 qx = _mm512_fmadd_ps(Z, nx, _mm512_fmadd_ps(Y, bx, _mm512_fmadd_ps(X, tx, px)));
+        const __m512 qy = _mm512_fmadd_ps(Z, ny, _mm512_fmadd_ps(Y, by, _mm512_fmadd_ps(X, ty, py)));
+        const __m512 qz = _mm512_fmadd_ps(Z, nz, _mm512_fmadd_ps(Y, bz, _mm512_fmadd_ps(X, tz, pz)));
+        // ScreenProjection::locate, lane-wise.
+        const __m512 inv = _mm512_div_ps(minus_one, qz);
+        const __m512 fx = _mm512_fmadd_ps(_mm512_mul_ps(qx, inv), scale_x, centre_x);
+        const __m512 fy = _mm512_fnmadd_ps(_mm512_mul_ps(qy, inv), scale_y, centre_y);
+        __mmask16 valid = _mm512_mask_cmp_ps_mask(live, qz, zero, _CMP_LT_OQ);
+        valid = _mm512_mask_cmp_ps_mask(valid, fx, zero, _CMP_GE_OQ);
+        valid = _mm512_mask_cmp_ps_mask(valid, fy, zero, _CMP_GE_OQ);
+        valid = _mm512_mask_cmp_ps_mask(valid, fx, width, _CMP_LT_OQ);
+        valid = _mm512_mask_cmp_ps_mask(valid, fy, height, _CMP_LT_OQ);
+        const __m512i pixel = _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(fy), row_stride), _mm512_cvttps_epi32(fx));
+        const __m512 d = _mm512_add_ps(_mm512_mask_i32gather_ps(zero, valid, pixel, depth, 4), qz);  // z* - depth(p)
+        // AT 4.3: occluded only when the surface in front is less than R in front.
+        __mmask16 occluded = _mm512_mask_cmp_ps_mask(valid, d, minus_bias, _CMP_LT_OQ);
+        occluded = _mm512_mask_cmp_ps_mask(occluded, d, far, _CMP_GT_OQ);
+        at = _mm512_mask_mov_epi32(at, occluded, pixel);
+      }
+      const __mmask16 blocked = _mm512_mask_cmpge_epi32_mask(live, at, _mm512_setzero_si512());
+      open_v = _mm512_mask_add_ps(open_v, live & static_cast<__mmask16>(~blocked), open_v, one);
+      __m512 ar, ag, ab;
+      if (palette_index) {
+        const __m512i idx = _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, at, palette_index, 1),
+                                             _mm512_set1_epi32(0xFF));
+        ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), idx, _mm512_loadu_ps(palette + 16));
+        ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), idx, _mm512_loadu_ps(palette + 48));
+        ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), idx, _mm512_loadu_ps(palette + 80));
+      } else {
+        const __m512i a = _mm512_mullo_epi32(at, _mm512_set1_epi32(3));
+        ar = _mm512_mask_i32gather_ps(zero, blocked, a, albedo, 4);
+        ag = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 1, 4);
+        ab = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 2, 4);
+      }
+      // (1 - I) a~ of eq. 9's denominator.
+      lr = _mm512_mask_add_ps(lr, blocked, lr, ar);
+      lg = _mm512_mask_add_ps(lg, blocked, lg, ag);
+      lb = _mm512_mask_add_ps(lb, blocked, lb, ab);
+    }
+    // Eq. 9 as in the generic path below, and O = sum I / n (eq. 5), scattered to the entries' pixels.
+    const __m512 nv = _mm512_set1_ps(n), scale = _mm512_set1_ps(albedo_scale);
+    const __mmask16 lit = _mm512_mask_cmp_ps_mask(live, open_v, zero, _CMP_GT_OQ);
+    auto ratio = [&](__m512 lost) { return _mm512_maskz_min_ps(lit, _mm512_div_ps(open_v, _mm512_fnmadd_ps(scale, lost, nv)), one); };
+    // Stored, then copied out lane by lane: cheaper than a scatter (microcoded on current cores).
+    alignas(64) float wr[16], wg[16], wb[16], o[16];
+    _mm512_store_ps(wr, ratio(lr)), _mm512_store_ps(wg, ratio(lg)), _mm512_store_ps(wb, ratio(lb));
+    _mm512_store_ps(o, _mm512_div_ps(open_v, nv));
+    for (int k = 0; k < std::min(16, row.count - k0); ++k) {
+      const int at_pixel = index[k0 + k];
+      out_r[at_pixel] = wr[k], out_g[at_pixel] = wg[k], out_b[at_pixel] = wb[k], out_o[at_pixel] = o[k];
+    }
+  }
+}
+#pragma GCC diagnostic pop
+#endif
+
+#if defined(__AVX512F__)
 // An exact palette of the reflectance image: one byte per pixel indexing at most 32 distinct RGB
 // triples (bitwise equal). G-buffer albedo is per-material constant, so this usually exists; a
 // blocked ray's albedo is then one byte gather plus three in-register table lookups instead of
@@ -207,8 +305,8 @@ ReflectancePalette make_palette(const Image<Vec3>& img) {
 }  // namespace
 
 template <class Characteristic>
-TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Image<Vec3>& indirect, const Falloff& falloff,
-                          const TransferParams& params, std::uint32_t seed) {
+const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, const Characteristic& ch, const Image<Vec3>& indirect,
+                                 const Falloff& falloff, const TransferParams& params, std::uint32_t seed) {
   falloff.validate();
   params.validate();
   const int w = g.width(), h = g.height();
@@ -219,6 +317,7 @@ TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Imag
   const float n = static_cast<float>(params.samples);
   const float scale = params.albedo_scale;
   const int m = params.ray_steps;
+  const bool filter = params.interleave.interleave && params.interleave.filter;
   const ScreenProjection projection = ScreenProjection::from_camera(g.camera);
   // A view of the reflectance: RGB triples, read in place (Vec3 is three packed floats).
   static_assert(sizeof(Vec3) == 3 * sizeof(float));
@@ -231,65 +330,101 @@ TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Imag
   const std::uint8_t* palette_index = nullptr;
   const float* palette_rgb = nullptr;
 #endif
-  // Planar results (W per channel, O): the filter then shares its depth tests across all four.
-  Image<float> wr(w, h, 1.0f), wg(w, h, 1.0f), wb(w, h, 1.0f), obscurance(w, h, 1.0f);
+  TransferImage& out = buffers.result;
+  out.transfer.resize(w, h), out.obscurance.resize(w, h), out.luminance.resize(w, h);
+  for (Image<float>& p : buffers.scratch) p.resize(w, h);
+  // Planar W (R, G, B) and O, the filter's input: its depth tests are then shared by all four.
+  // Unfiltered, R goes where the luminance will be and O to its final place.
+  float* raw_r = filter ? buffers.scratch[0].data() : out.luminance.data();
+  float* raw_g = buffers.scratch[1].data();
+  float* raw_b = buffers.scratch[2].data();
+  float* raw_o = filter ? buffers.scratch[3].data() : out.obscurance.data();
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     // Local copies: their members are then known not to alias the accumulators, so the loop vectorises.
     const Characteristic local_ch = ch;
     const ScreenProjection local_projection = projection;
     PixelRow row;
+    std::vector<int> index;  // compacted entry -> offset from t.x0 (AVX-512 depth-buffer path)
     alignas(64) std::array<float, kTile> open, lost_r, lost_g, lost_b;
     for (int y = t.y0; y < t.y1; ++y) {
-      row.load(g, y, t.x0, t.x1, rotations, params.bias);
-      const int count = row.count;
-      open.fill(0.0f), lost_r.fill(0.0f), lost_g.fill(0.0f), lost_b.fill(0.0f);
       const std::size_t base = static_cast<std::size_t>(y) * w + t.x0;
+      for (float* plane : {raw_r, raw_g, raw_b, raw_o}) std::fill(plane + base, plane + base + (t.x1 - t.x0), 1.0f);  // uncovered: 1
+#if defined(__AVX512F__)
+      if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {
+        load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
+        transfer_row_depth_avx512(local_projection, local_ch.depth, row, s, m, far_limit, albedo, palette_index, palette_rgb, index.data(), n,
+                                  scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
+        continue;
+      }
+#endif
+      row.load(g, y, t.x0, t.x1, rotations, params.bias);
+      open.fill(0.0f), lost_r.fill(0.0f), lost_g.fill(0.0f), lost_b.fill(0.0f);
       transfer_row(local_ch, local_projection, row, s, m, far_limit, albedo, palette_index, palette_rgb, static_cast<int>(base), open.data(),
                    lost_r.data(), lost_g.data(), lost_b.data());
-      for (int k = 0; k < count; ++k) {
-        if (!row.covered[static_cast<std::size_t>(k)]) continue;
-        const float o = open[static_cast<std::size_t>(k)];
+      for (int k = 0; k < row.count; ++k) {
+        const auto ks = static_cast<std::size_t>(k);
+        if (!row.covered[ks]) continue;
+        const float o = open[ks];
         // Eq. 9. The denominator is >= sum I since a~ <= 1; with no open ray at all W = 0 (0/0 when
         // every ray is blocked by white surfaces: no sky light ever enters).
         auto ratio = [&](float lost) { return o > 0 ? std::min(o / (n - scale * lost), 1.0f) : 0.0f; };
-        const std::size_t i = base + static_cast<std::size_t>(k);
-        wr[i] = ratio(lost_r[static_cast<std::size_t>(k)]);
-        wg[i] = ratio(lost_g[static_cast<std::size_t>(k)]);
-        wb[i] = ratio(lost_b[static_cast<std::size_t>(k)]);
-        obscurance[i] = o / n;  // eq. 5 from the same tests
+        const std::size_t i = base + ks;
+        raw_r[i] = ratio(lost_r[ks]);
+        raw_g[i] = ratio(lost_g[ks]);
+        raw_b[i] = ratio(lost_b[ks]);
+        raw_o[i] = o / n;  // eq. 5 from the same tests
       }
     }
   });
-  if (params.interleave.interleave && params.interleave.filter) {
-    Image<float>* planes[] = {&wr, &wg, &wb, &obscurance};
-    depth_aware_box_filter_planes(planes, g, effective_depth_limit(params.interleave, falloff.radius));
+  // Sec. 4.2's filter on W and O alike; filtered R goes where the luminance will be.
+  float* fr = raw_r;
+  float* fg = raw_g;
+  float* fb = raw_b;
+  if (filter) {
+    fr = out.luminance.data(), fg = buffers.scratch[4].data(), fb = buffers.scratch[5].data();
+    const std::array<const float*, 4> src{raw_r, raw_g, raw_b, raw_o};
+    const std::array<float*, 4> dst{fr, fg, fb, out.obscurance.data()};
+    depth_aware_box_filter_planes(src, dst, g, effective_depth_limit(params.interleave, falloff.radius));
   }
-  // Interleave in parallel (it was a serial pass on the calling thread); the luminance overwrites
-  // the R plane in place (each pixel reads its R before writing), saving an allocation.
-  TransferImage out{Image<Vec3>(w, h), std::move(obscurance), std::move(wr)};
+  // Interleave W, and its luminance over the R plane in place (each pixel reads R before writing).
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        const float r = out.luminance[i];
-        out.transfer[i] = Vec3{r, wg[i], wb[i]};
-        out.luminance[i] = 0.2126f * r + 0.7152f * wg[i] + 0.0722f * wb[i];
+        const Vec3 c{fr[i], fg[i], fb[i]};
+        out.transfer[i] = c;
+        out.luminance[i] = 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
       }
   });
   return out;
+}
+
+template <class Characteristic>
+TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Image<Vec3>& indirect, const Falloff& falloff,
+                          const TransferParams& params, std::uint32_t seed) {
+  TransferBuffers buffers;
+  transfer_ao(buffers, g, ch, indirect, falloff, params, seed);
+  return std::move(buffers.result);
 }
 
 TransferImage transfer_ao(const GBuffer& g, const Falloff& falloff, const TransferParams& params, std::uint32_t seed) {
   return transfer_ao(g, DepthBufferCharacteristic(g), g.albedo, falloff, params, seed);
 }
 
-template TransferImage transfer_ao(const GBuffer&, const DepthBufferCharacteristic&, const Image<Vec3>&, const Falloff&, const TransferParams&,
-                                   std::uint32_t);
-template TransferImage transfer_ao(const GBuffer&, const ImplicitCharacteristic&, const Image<Vec3>&, const Falloff&, const TransferParams&,
-                                   std::uint32_t);
-template TransferImage transfer_ao(const GBuffer&, const HeightFieldCharacteristic&, const Image<Vec3>&, const Falloff&, const TransferParams&,
-                                   std::uint32_t);
-template TransferImage transfer_ao(const GBuffer&, const DepthTimesHeightField&, const Image<Vec3>&, const Falloff&, const TransferParams&,
-                                   std::uint32_t);
+const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, const Falloff& falloff, const TransferParams& params,
+                                 std::uint32_t seed) {
+  return transfer_ao(buffers, g, DepthBufferCharacteristic(g), g.albedo, falloff, params, seed);
+}
+
+#define AO_INSTANTIATE_TRANSFER(Characteristic)                                                                                       \
+  template TransferImage transfer_ao(const GBuffer&, const Characteristic&, const Image<Vec3>&, const Falloff&, const TransferParams&, \
+                                     std::uint32_t);                                                                                  \
+  template const TransferImage& transfer_ao(TransferBuffers&, const GBuffer&, const Characteristic&, const Image<Vec3>&,             \
+                                            const Falloff&, const TransferParams&, std::uint32_t);
+AO_INSTANTIATE_TRANSFER(DepthBufferCharacteristic)
+AO_INSTANTIATE_TRANSFER(ImplicitCharacteristic)
+AO_INSTANTIATE_TRANSFER(HeightFieldCharacteristic)
+AO_INSTANTIATE_TRANSFER(DepthTimesHeightField)
+#undef AO_INSTANTIATE_TRANSFER
 
 }  // namespace ao

@@ -126,6 +126,46 @@ TEST(Transfer, IdenticalAtOneAndTwoThreads) {
   }
 }
 
+// The AVX-512 kernel reads the depth and the occluder's albedo index from one packed word per
+// pixel (depth with its low mantissa bits replaced) and re-reads the true depth only where a
+// comparison is too close to call. That must be invisible: the same W and O, bit for bit, as the
+// plain path, which it takes when the depth buffer is not the G-buffer's own (here a copy), and
+// as reading the albedo in place (more than 32 distinct albedos: no palette). Every membership
+// and both silhouette settings, m = 1 and 2; exact equality on a real scene's million tests.
+TEST(Transfer, PackedDepthAndPaletteChangeNothing) {
+  const auto s = test::builtin_gbuffer("default");
+  const Image<float> depth_copy = s.g.depth;
+  DepthBufferCharacteristic plain(s.g);
+  plain.depth = depth_copy.data();
+  int cases = 0;
+  for (Membership mu : {Membership::Step, Membership::Sqrt})
+    for (bool silhouettes : {true, false})
+      for (int m : {1, 2})
+        for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+          TransferParams p;
+          p.ray_steps = m;
+          p.silhouette_elimination = silhouettes;
+          const Falloff f{mu, 1.5f};
+          const TransferImage packed = transfer_ao(s.g, f, p, seed);
+          const TransferImage exact = transfer_ao(s.g, plain, s.g.albedo, f, p, seed);
+          ++cases;
+          for (std::size_t i = 0; i < packed.obscurance.size(); ++i) {
+            ASSERT_EQ(packed.obscurance[i], exact.obscurance[i]) << "pixel " << i << ", case " << cases;
+            ASSERT_EQ(packed.transfer[i].x, exact.transfer[i].x) << "pixel " << i << ", case " << cases;
+            ASSERT_EQ(packed.transfer[i].y, exact.transfer[i].y) << "pixel " << i << ", case " << cases;
+            ASSERT_EQ(packed.transfer[i].z, exact.transfer[i].z) << "pixel " << i << ", case " << cases;
+          }
+        }
+  // No palette: 33+ distinct albedos (a gradient), read in place by both paths.
+  GBuffer g = s.g;
+  for (std::size_t i = 0; i < g.albedo.size(); ++i) g.albedo[i] = Vec3{0.5f, static_cast<float>(i % 64) / 64.0f, 0.25f};
+  DepthBufferCharacteristic plain_g(g);
+  plain_g.depth = depth_copy.data();
+  const TransferImage a = transfer_ao(g, {Membership::Step, 1.5f}, {}, 3);
+  const TransferImage b = transfer_ao(g, plain_g, g.albedo, {Membership::Step, 1.5f}, {}, 3);
+  for (std::size_t i = 0; i < a.luminance.size(); ++i) ASSERT_EQ(a.luminance[i], b.luminance[i]) << "pixel " << i;
+}
+
 // VAO fig. 12 / AT sec. 6: a displacement-mapped floor whose G-buffer is flat. The depth buffer
 // sees an open plane; the height field of bumps (test-local procedural displaced scene) darkens
 // the valleys between the bumps, and the product keeps both kinds of occlusion.

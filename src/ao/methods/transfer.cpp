@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -11,6 +12,9 @@
 #if defined(__AVX512F__)
 #include <immintrin.h>
 #endif
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -24,6 +28,8 @@ namespace {
 constexpr float kInfinityLike = 1e30f;
 constexpr int kTile = 64;
 constexpr int kMaxRaySteps = 8;
+constexpr int kPaletteSize = 32;                  // distinct reflectances a packed palette holds
+constexpr std::uint32_t kPaletteMask = 0x1F;      // its index's bits in a packed depth word
 }
 
 void TransferParams::validate() const {
@@ -73,7 +79,7 @@ namespace {
 // fused, GCC 12 sinks the gathers into branches and the loop no longer if-converts.
 template <class Characteristic>
 void transfer_row(const Characteristic ch, const ScreenProjection projection, const PixelRow& row, const ContainmentSamples& s, int m,
-                  float far_limit, const float* __restrict albedo, const std::uint8_t* __restrict palette_index, const float* __restrict palette,
+                  float far_limit, const float* __restrict albedo, const std::uint32_t* __restrict packed, const float* __restrict palette,
                   int row_base, float* __restrict open, float* __restrict lost_r, float* __restrict lost_g, float* __restrict lost_b) {
   constexpr bool kDepthBuffer = std::is_same_v<Characteristic, DepthBufferCharacteristic>;
   const float inv_m = 1.0f / static_cast<float>(m);
@@ -129,11 +135,11 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       const __mmask16 free_rays = live & static_cast<__mmask16>(~blocked);
       const __m512 zero = _mm512_setzero_ps();
       __m512 ar, ag, ab;
-      if (palette_index) {
-        // One byte per pixel (4 bytes read at the pixel's offset; the index array is padded), then
+      if (packed) {
+        // The palette index in the low bits of the pixel's packed depth word (make_palette), then
         // the palette's exact float R, G, B planes of 32 entries, looked up in registers.
-        const __m512i idx = _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, atv, palette_index, 1),
-                                             _mm512_set1_epi32(0xFF));
+        const __m512i idx = _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, atv, packed, 4),
+                                             _mm512_set1_epi32(kPaletteMask));
         ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), idx, _mm512_loadu_ps(palette + 16));
         ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), idx, _mm512_loadu_ps(palette + 48));
         ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), idx, _mm512_loadu_ps(palette + 80));
@@ -149,7 +155,7 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       _mm512_mask_storeu_ps(lost_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_b + k0), ab));
     }
 #endif
-    (void)palette_index, (void)palette;
+    (void)packed, (void)palette;
 // Lane k writes only its own accumulators; the gathers read the (read-only) albedo.
 #pragma GCC ivdep
     for (int k = k0; k < count; ++k) {
@@ -178,7 +184,7 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 void transfer_row_depth_avx512(const ScreenProjection& projection, const float* __restrict depth, const PixelRow& row,
                                const ContainmentSamples& s, int m, float far_limit, const float* __restrict albedo,
-                               const std::uint8_t* __restrict palette_index, const float* __restrict palette, const int* index, float n,
+                               const std::uint32_t* __restrict packed, const float* __restrict palette, const int* index, float n,
                                float albedo_scale, float* __restrict out_r, float* __restrict out_g, float* __restrict out_b,
                                float* __restrict out_o) {
   const __m512 scale_x = _mm512_set1_ps(projection.scale_x), scale_y = _mm512_set1_ps(projection.scale_y);
@@ -187,6 +193,8 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
   const __m512i row_stride = _mm512_set1_epi32(projection.width);
   const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), minus_one = _mm512_set1_ps(-1.0f);
   const __m512 far = _mm512_set1_ps(far_limit);
+  const __m512i palette_mask = _mm512_set1_epi32(kPaletteMask);
+  const __m512 exactness = _mm512_set1_ps(0x1p-16f);
   const float inv_m = 1.0f / static_cast<float>(m);
   for (int k0 = 0; k0 < row.count; k0 += 16) {
     const __mmask16 live = static_cast<__mmask16>(row.count - k0 >= 16 ? 0xFFFF : (1u << (row.count - k0)) - 1u);
@@ -200,8 +208,9 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
     for (int i = 0; i < s.size(); ++i) {
       const auto si = static_cast<std::size_t>(i);
       // Sec. 4: nearest occluded test wins; steps run from the far end inwards, each occluded one
-      // overwriting `at` (the pixel whose albedo is a~, -1 while the ray is free).
-      __m512i at = _mm512_set1_epi32(-1);
+      // overwriting `at`: what identifies a~, the palette index with `packed`, else the pixel.
+      __m512i at = _mm512_setzero_si512();
+      __mmask16 blocked = 0;
       for (int j = m; j >= 1; --j) {
         const float f = static_cast<float>(j) * inv_m;
         const __m512 X = _mm512_set1_ps(f * s.x[si]), Y = _mm512_set1_ps(f * s.y[si]), Z = _mm512_set1_ps(f * s.z[si]);
@@ -218,21 +227,36 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
         valid = _mm512_mask_cmp_ps_mask(valid, fx, width, _CMP_LT_OQ);
         valid = _mm512_mask_cmp_ps_mask(valid, fy, height, _CMP_LT_OQ);
         const __m512i pixel = _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(fy), row_stride), _mm512_cvttps_epi32(fx));
-        const __m512 d = _mm512_add_ps(_mm512_mask_i32gather_ps(zero, valid, pixel, depth, 4), qz);  // z* - depth(p)
+        __m512 d;  // z* - depth(p)
+        __m512i id = pixel;
+        if (packed) {
+          // One gather brings z* and the pixel's palette index (make_palette). z* with its low
+          // mantissa bits cleared is within 2^-18 of the true depth (relative); only when a
+          // comparison below is closer than 2^-16 of the magnitudes involved can it differ, and
+          // then the true depth is gathered for those lanes: the tests stay exact.
+          const __m512i bits = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, pixel, packed, 4);
+          const __m512 z_near = _mm512_castsi512_ps(_mm512_andnot_si512(palette_mask, bits));
+          d = _mm512_add_ps(z_near, qz);
+          const __m512 margin = _mm512_mul_ps(_mm512_add_ps(z_near, _mm512_abs_ps(qz)), exactness);
+          const __mmask16 close = _mm512_mask_cmp_ps_mask(valid, _mm512_abs_ps(_mm512_sub_ps(d, minus_bias)), margin, _CMP_LT_OQ) |
+                                  _mm512_mask_cmp_ps_mask(valid, _mm512_abs_ps(_mm512_sub_ps(d, far)), margin, _CMP_LT_OQ);
+          if (close) d = _mm512_mask_add_ps(d, close, _mm512_mask_i32gather_ps(zero, close, pixel, depth, 4), qz);
+          id = _mm512_and_si512(bits, palette_mask);
+        } else {
+          d = _mm512_add_ps(_mm512_mask_i32gather_ps(zero, valid, pixel, depth, 4), qz);
+        }
         // AT 4.3: occluded only when the surface in front is less than R in front.
         __mmask16 occluded = _mm512_mask_cmp_ps_mask(valid, d, minus_bias, _CMP_LT_OQ);
         occluded = _mm512_mask_cmp_ps_mask(occluded, d, far, _CMP_GT_OQ);
-        at = _mm512_mask_mov_epi32(at, occluded, pixel);
+        at = _mm512_mask_mov_epi32(at, occluded, id);
+        blocked |= occluded;
       }
-      const __mmask16 blocked = _mm512_mask_cmpge_epi32_mask(live, at, _mm512_setzero_si512());
       open_v = _mm512_mask_add_ps(open_v, live & static_cast<__mmask16>(~blocked), open_v, one);
       __m512 ar, ag, ab;
-      if (palette_index) {
-        const __m512i idx = _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, at, palette_index, 1),
-                                             _mm512_set1_epi32(0xFF));
-        ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), idx, _mm512_loadu_ps(palette + 16));
-        ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), idx, _mm512_loadu_ps(palette + 48));
-        ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), idx, _mm512_loadu_ps(palette + 80));
+      if (packed) {
+        ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), at, _mm512_loadu_ps(palette + 16));
+        ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), at, _mm512_loadu_ps(palette + 48));
+        ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), at, _mm512_loadu_ps(palette + 80));
       } else {
         const __m512i a = _mm512_mullo_epi32(at, _mm512_set1_epi32(3));
         ar = _mm512_mask_i32gather_ps(zero, blocked, a, albedo, 4);
@@ -262,43 +286,54 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
 #endif
 
 #if defined(__AVX512F__)
-// An exact palette of the reflectance image: one byte per pixel indexing at most 32 distinct RGB
-// triples (bitwise equal). G-buffer albedo is per-material constant, so this usually exists; a
-// blocked ray's albedo is then one byte gather plus three in-register table lookups instead of
-// three float gathers (gather throughput and misses are most of the pass's time). Empty `index`
-// when there are more than 32 distinct values: the caller reads the image in place.
-struct ReflectancePalette {
-  std::vector<std::uint8_t> index;   ///< width * height + 3 (padding for 4-byte gathers).
-  alignas(64) std::array<float, 96> planes{};  ///< R[32], G[32], B[32].
-};
-constexpr int kPaletteSize = 32;
-
-ReflectancePalette make_palette(const Image<Vec3>& img) {
-  ReflectancePalette p;
+// An exact palette of the reflectance image: at most 32 distinct RGB triples (bitwise equal),
+// whose index per pixel is packed into the low 5 mantissa bits of the pixel's depth. G-buffer
+// albedo is per-material constant, so this usually exists. A test's depth gather then also
+// brings the index of the albedo a blocked ray reads, and a~ is three in-register table lookups:
+// no second gather, no second array in the cache (the gathers' misses are most of the pass's
+// time). The depth kernel keeps its tests exact (see transfer_row_depth_avx512). Returns false,
+// and the caller reads the image in place, when there are more than 32 values or a depth is
+// neither +infinity nor a positive normal float (the packing's bound needs one of those).
+bool make_palette(const Image<Vec3>& img, const Image<float>& depth, Image<std::uint32_t>& packed, std::array<float, 96>& planes) {
   const std::size_t n = img.size();
   const Vec3* px = img.data();
-  p.index.assign(n + 3, 0);
   std::array<Vec3, kPaletteSize> entries;
-  int used = 0, last = -1;
+  int used = 0;
   Vec3 last_value{};
-  for (std::size_t i = 0; i < n; ++i) {
+  auto find = [&](const Vec3& v) {
+    int e = 0;
+    while (e < used && std::memcmp(&v, &entries[static_cast<std::size_t>(e)], sizeof(Vec3)) != 0) ++e;
+    return e;
+  };
+  for (std::size_t i = 0; i < n; ++i) {  // the distinct values, in first-seen order
     const Vec3 v = px[i];
-    if (last < 0 || std::memcmp(&v, &last_value, sizeof(Vec3)) != 0) {
-      int e = 0;
-      while (e < used && std::memcmp(&v, &entries[static_cast<std::size_t>(e)], sizeof(Vec3)) != 0) ++e;
-      if (e == used) {
-        if (used == kPaletteSize) return {};
-        entries[static_cast<std::size_t>(used++)] = v;
-      }
-      last = e, last_value = v;
-    }
-    p.index[i] = static_cast<std::uint8_t>(last);
+    if (i > 0 && std::memcmp(&v, &last_value, sizeof(Vec3)) == 0) continue;
+    last_value = v;
+    if (find(v) < used) continue;
+    if (used == kPaletteSize) return false;
+    entries[static_cast<std::size_t>(used++)] = v;
   }
+  for (const float z : depth.pixels())
+    if (!(z == kInfinity || (z >= std::numeric_limits<float>::min() && z <= std::numeric_limits<float>::max()))) return false;
+  packed.resize(img.width(), img.height());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    int last = -1;
+    Vec3 last_v{};
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      const Vec3 v = px[i];
+      if (last < 0 || std::memcmp(&v, &last_v, sizeof(Vec3)) != 0) last = find(v), last_v = v;
+      const float z = depth[i];
+      std::uint32_t bits;
+      std::memcpy(&bits, &z, sizeof bits);
+      // +infinity (background) stays exact: it is never an occluder, so it needs no index.
+      packed[i] = z == kInfinity ? bits : (bits & ~kPaletteMask) | static_cast<std::uint32_t>(last);
+    }
+  });
   for (int e = 0; e < used; ++e) {
     const Vec3 v = entries[static_cast<std::size_t>(e)];
-    p.planes[static_cast<std::size_t>(e)] = v.x, p.planes[static_cast<std::size_t>(32 + e)] = v.y, p.planes[static_cast<std::size_t>(64 + e)] = v.z;
+    planes[static_cast<std::size_t>(e)] = v.x, planes[static_cast<std::size_t>(32 + e)] = v.y, planes[static_cast<std::size_t>(64 + e)] = v.z;
   }
-  return p;
+  return true;
 }
 #endif
 
@@ -323,12 +358,13 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
   static_assert(sizeof(Vec3) == 3 * sizeof(float));
   const float* albedo = &indirect.data()->x;
 #if defined(__AVX512F__)
-  const ReflectancePalette palette = make_palette(indirect);
-  const std::uint8_t* palette_index = palette.index.empty() ? nullptr : palette.index.data();
-  const float* palette_rgb = palette.planes.data();
+  alignas(64) std::array<float, 96> palette_rgb{};
+  const std::uint32_t* packed =
+      make_palette(indirect, g.depth, buffers.depth_and_palette, palette_rgb) ? buffers.depth_and_palette.data() : nullptr;
+  const float* palette_rgb_ptr = palette_rgb.data();
 #else
-  const std::uint8_t* palette_index = nullptr;
-  const float* palette_rgb = nullptr;
+  const std::uint32_t* packed = nullptr;
+  const float* palette_rgb_ptr = nullptr;
 #endif
   TransferImage& out = buffers.result;
   out.transfer.resize(w, h), out.obscurance.resize(w, h), out.luminance.resize(w, h);
@@ -352,14 +388,16 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
 #if defined(__AVX512F__)
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {
         load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
-        transfer_row_depth_avx512(local_projection, local_ch.depth, row, s, m, far_limit, albedo, palette_index, palette_rgb, index.data(), n,
+        // The packed words hold the G-buffer's depth: used when that is the depth this reads.
+        const std::uint32_t* depth_packed = local_ch.depth == g.depth.data() ? packed : nullptr;
+        transfer_row_depth_avx512(local_projection, local_ch.depth, row, s, m, far_limit, albedo, depth_packed, palette_rgb.data(), index.data(), n,
                                   scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
         continue;
       }
 #endif
       row.load(g, y, t.x0, t.x1, rotations, params.bias);
       open.fill(0.0f), lost_r.fill(0.0f), lost_g.fill(0.0f), lost_b.fill(0.0f);
-      transfer_row(local_ch, local_projection, row, s, m, far_limit, albedo, palette_index, palette_rgb, static_cast<int>(base), open.data(),
+      transfer_row(local_ch, local_projection, row, s, m, far_limit, albedo, packed, palette_rgb_ptr, static_cast<int>(base), open.data(),
                    lost_r.data(), lost_g.data(), lost_b.data());
       for (int k = 0; k < row.count; ++k) {
         const auto ks = static_cast<std::size_t>(k);

@@ -53,6 +53,7 @@ struct TransferImage {
 struct TransferBuffers {
   TransferImage result;
   std::array<Image<float>, 6> scratch;  ///< Unfiltered W (R, G, B) and O, filtered G and B.
+  Image<std::uint32_t> depth_and_palette;  ///< The depth with an albedo index in its low bits (transfer.cpp).
 };
 
 /// Ambient transfer with characteristic function `ch` (instantiated as containment_ao's) and the

@@ -7,6 +7,7 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cstdlib>
 
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/containment.h"
@@ -20,11 +21,18 @@ namespace {
 
 constexpr int kWidth = 1280, kHeight = 720, kSamples = 12;
 
+// AO_BENCH_RADIUS_SCALE=s scales R (default 1): how much of a pass's time is cache misses that
+// grow with the screen-space footprint of the samples (see BENCHMARKS.md).
+float radius_scale() {
+  const char* s = std::getenv("AO_BENCH_RADIUS_SCALE");
+  return s ? std::strtof(s, nullptr) : 1.0f;
+}
+
 struct Fixture {
   Scene scene = make_builtin_scene("default");
   RayScene rays{scene};
   GBuffer g = render_gbuffer(rays, framed(scene, kWidth, kHeight));
-  float radius = 0.1f * scene.bounds().diagonal();
+  float radius = radius_scale() * 0.1f * scene.bounds().diagonal();
 };
 
 Fixture& demo() {

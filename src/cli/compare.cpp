@@ -5,10 +5,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -19,10 +21,12 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/image_io.h"
+#include "ao/io/text.h"
 #include "ao/methods/registry.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 #include "common.h"
+#include "contact_sheet.h"
 #include "subcommands.h"
 
 namespace ao::cli {
@@ -57,6 +61,9 @@ std::vector<std::string> split(const std::string& s, char sep) {
 using FalloffKey = std::tuple<int, float, float, float>;
 FalloffKey key_of(const Falloff& f) { return {static_cast<int>(f.membership), f.radius, f.tau, f.alchemy_u}; }
 
+// |signed error| at which the heat map saturates, V units.
+constexpr float kHeatRange = 0.25f;
+
 struct Reference {
   Image<float> visibility;
   double ms = 0;
@@ -76,30 +83,23 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
-// Contact sheet: one row per method, [method | reference | signed error], separated by 4-pixel
-// dark gutters. Greys are linear V.
-Image<Vec3> contact_sheet(const std::vector<std::array<const Image<float>*, 2>>& rows, const std::vector<Image<Vec3>>& heat, int w, int h) {
-  constexpr int kGap = 4;
-  const int cols = 3, n = static_cast<int>(rows.size());
-  Image<Vec3> sheet(cols * w + (cols + 1) * kGap, n * h + (n + 1) * kGap, Vec3{0.1f, 0.1f, 0.1f});
-  for (int r = 0; r < n; ++r) {
-    const int oy = kGap + r * (h + kGap);
-    for (int c = 0; c < cols; ++c) {
-      const int ox = kGap + c * (w + kGap);
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          Vec3 v;
-          if (c < 2) {
-            const float g = (*rows[r][c])(x, y);
-            v = {g, g, g};
-          } else {
-            v = heat[r](x, y);
-          }
-          sheet(ox + x, oy + y) = v;
-        }
-    }
+// The parameters a reader needs to tell rows apart on the contact sheet: the sample count and
+// quality preset where a method has them, and whatever -p changed from the defaults. Left out when
+// longer than kMaxKeyParamsChars, as table.md lists every parameter anyway.
+constexpr std::size_t kMaxKeyParamsChars = 40;
+std::string key_params(const nlohmann::json& p, const nlohmann::json& defaults) {
+  std::string s;
+  for (const auto& [k, v] : p.items()) {
+    if (k != "samples" && k != "preset" && defaults.value(k, nlohmann::json()) == v) continue;
+    s += (s.empty() ? "" : ", ") + k + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
   }
-  return sheet;
+  return s.size() <= kMaxKeyParamsChars ? s : "";
+}
+
+// The font of the sheet's labels: $AO_FONT when set, else DejaVu Sans where Debian installs it.
+fs::path sheet_font_path() {
+  const char* env = std::getenv("AO_FONT");
+  return env != nullptr && *env != 0 ? fs::path(env) : fs::path(kDejaVuSansPath);
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -229,7 +229,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
     double ms = 0;
     MethodOutput out = run_method(*m, p, ms);
     const ErrorMetrics e = compare_images(out.visibility, ref.visibility, g.coverage);
-    heat.push_back(signed_error_heat_map(out.visibility, ref.visibility, g.coverage));
+    heat.push_back(signed_error_heat_map(out.visibility, ref.visibility, g.coverage, kHeatRange));
     nlohmann::json reference = {{"membership", to_string(rf.membership)}, {"radius", rf.radius}, {"spp", o.spp_reference},
                                 {"mean_std_error", ref.mean_std_error}, {"ms", ref.ms}};
     if (rf.membership == Membership::Exp) reference["tau"] = rf.effective_tau();
@@ -281,15 +281,28 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
        << (r["psnr_db"].is_number() ? fixed(r["psnr_db"].get<double>(), 2) : "inf") << " | " << fixed(r["ssim"].get<double>(), 4) << " | "
        << fixed(r["mean_signed_error"].get<double>(), 4) << " |\n";
   }
-  md << "\n`sheet.png`: one row per method in the order above; columns: the method's V, the reference's V, the signed error "
-     << "(blue: darker than the reference, red: brighter, white: equal, saturated at |error| = 0.25; grey: background).\n";
+  md << "\n`sheet.png`: one row per method in the order above, labelled with its name and RMSE; columns: the method's V, the "
+     << "reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at |error| = "
+     << kHeatRange << "; grey: background).\n";
 
   StagedDir dir(out_dir);
   write_text(dir.file("table.json"), table.dump(2) + "\n");
   write_text(dir.file("table.md"), md.str());
-  std::vector<std::array<const Image<float>*, 2>> sheet_rows;
-  for (std::size_t i = 0; i < images.size(); ++i) sheet_rows.push_back({&images[i], &references.at(key_of(ref_falloffs[i])).visibility});
-  write_rgb_image(dir.file("sheet.png"), contact_sheet(sheet_rows, heat, g.width(), g.height()));
+  std::vector<SheetRow> sheet_rows;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const nlohmann::json& r = rows[i];
+    std::vector<std::string> label = {r["method"].get<std::string>()};
+    const std::string kp = key_params(r["parameters"], methods[i]->default_params());
+    if (!kp.empty()) label.push_back(kp);
+    label.push_back("reference: " + r["reference"]["membership"].get<std::string>());
+    label.push_back("RMSE " + fixed(r["rmse"].get<double>(), 4));  // as in table.md
+    sheet_rows.push_back({&images[i], &references.at(key_of(ref_falloffs[i])).visibility, &heat[i], std::move(label)});
+  }
+  // A missing font costs the labels, never the comparison.
+  std::string font_error;
+  const std::optional<Font> font = Font::open(sheet_font_path(), &font_error);
+  if (!font) std::cerr << "warning: " << font_error << "; sheet.png has no labels (install fonts-dejavu-core or set AO_FONT)\n";
+  write_rgb_image(dir.file("sheet.png"), contact_sheet(sheet_rows, kHeatRange, font ? &*font : nullptr));
   if (!sweep_key.empty()) {
     write_text(dir.file("sweep.json"), nlohmann::json{{"key", sweep_key}, {"rows", sweep_rows}}.dump(2) + "\n");
     std::ostringstream s;
@@ -337,6 +350,8 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
   cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
   cmd->add_flag("--json", o->json, "Print table.json on stdout");
+  cmd->footer(std::string("Environment: AO_FONT, the font file of sheet.png's labels (default ") + kDejaVuSansPath +
+              "; without a readable font the sheet has no labels).");
   cmd->callback([o, &global, &action] { action = [o, &global] { return run_compare(*o, global); }; });
 }
 

@@ -14,6 +14,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/io/image_io.h"
+#include "ao/io/text.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -30,9 +33,10 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
-CliRun run_ao(const std::string& args) {
+// `env` is prepended to the command line, e.g. "AO_FONT=/x".
+CliRun run_ao(const std::string& args, const std::string& env = "") {
   const fs::path err = scratch("stderr.txt");
-  const std::string cmd = std::string(AO_CLI_PATH) + " -q " + args + " > /dev/null 2> " + err.string();
+  const std::string cmd = env + " " + std::string(AO_CLI_PATH) + " -q " + args + " > /dev/null 2> " + err.string();
   const int status = std::system(cmd.c_str());
   std::ifstream in(err);
   std::stringstream s;
@@ -62,8 +66,60 @@ TEST(CompareCli, WritesTableSheetAndSweep) {
   const nlohmann::json s = read_json(out / "sweep.json");
   ASSERT_EQ(s["rows"].size(), 2u);
   EXPECT_EQ(s["rows"][1]["samples"], 8);
+  // One 48x32 image per column, 4-pixel gutters, and with the font a header and a label above.
+  const ao::Image<ao::Vec3> sheet = ao::read_rgb_image(out / "sheet.png");
+  EXPECT_GE(sheet.width(), 3 * 48 + 4 * 4);
+  if (fs::exists(ao::kDejaVuSansPath)) {
+    EXPECT_GT(sheet.height(), 32 + 2 * 4 + 2 * 12) << "room for a header and a label of 12-pixel text";
+  }
   // No staging directory is left beside the output.
   for (const auto& e : fs::directory_iterator(out.parent_path())) EXPECT_EQ(e.path().filename().string().find(".out.tmp"), std::string::npos);
+}
+
+bool same_pixels(const ao::Image<ao::Vec3>& a, int ax, int ay, const ao::Image<ao::Vec3>& b, int bx, int by, int w, int h) {
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (!(a(ax + x, ay + y) == b(bx + x, by + y))) return false;
+  return true;
+}
+
+// The same comparison with and without the font: the labelled sheet is the unlabelled one's images,
+// untouched, below a header and a label with text (bright pixels) and the heat map's colour scale
+// (pure red and pure blue); without the font the sheet is still written, with a one-line warning.
+TEST(CompareCli, SheetHasHeaderAndLabelsAboveUntouchedImagesAndWorksWithoutFont) {
+  if (!fs::exists(ao::kDejaVuSansPath)) GTEST_SKIP() << ao::kDejaVuSansPath << " missing (scripts/setup installs fonts-dejavu-core)";
+  constexpr int kW = 160, kH = 120, kGap = 4;
+  const std::string args = "compare sphere-on-plane --methods alchemy --width 160 --height 120 --spp-reference 4 --out-dir ";
+  const fs::path labelled = scratch("labelled"), plain = scratch("plain");
+  CliRun r = run_ao(args + labelled.string(), "AO_FONT=");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  r = run_ao(args + plain.string(), "AO_FONT=/nonexistent/font.ttf");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto warning = r.err.find("warning: /nonexistent/font.ttf: no such font file");
+  ASSERT_NE(warning, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no labels", warning), std::string::npos) << r.err;
+  EXPECT_LT(r.err.find("no labels", warning), r.err.find('\n', warning)) << "one line: " << r.err;
+
+  const ao::Image<ao::Vec3> with = ao::read_rgb_image(labelled / "sheet.png"), without = ao::read_rgb_image(plain / "sheet.png");
+  ASSERT_EQ(without.width(), 3 * kW + 4 * kGap);
+  ASSERT_EQ(without.height(), kH + 2 * kGap);
+  ASSERT_GE(with.width(), without.width());
+  ASSERT_GT(with.height(), without.height() + 12) << "a header and a label";
+  const int col_w = (with.width() - 4 * kGap) / 3, top = with.height() - kGap - kH;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_TRUE(same_pixels(with, kGap + c * (col_w + kGap), top, without, kGap + c * (kW + kGap), kGap, kW, kH)) << "column " << c;
+  int text = 0, red = 0, blue = 0;
+  for (int y = 0; y < top; ++y)
+    for (int x = 0; x < with.width(); ++x) {
+      const ao::Vec3 p = with(x, y);
+      text += p.x > 0.6f && p.y > 0.6f && p.z > 0.6f;
+      red += p.x > 0.9f && p.y < 0.1f && p.z < 0.1f;
+      blue += p.z > 0.9f && p.x < 0.1f && p.y < 0.1f;
+    }
+  EXPECT_GT(text, 100);
+  EXPECT_GT(red, 0);
+  EXPECT_GT(blue, 0);
 }
 
 TEST(CompareCli, UnknownMethodFailsWithOneLineAndNoOutput) {

@@ -90,14 +90,18 @@ ErrorMetrics compare_images(const Image<float>& image, const Image<float>& refer
   return m;
 }
 
+Vec3 signed_error_colour(float error, float range) {
+  const float t = std::clamp(error / range, -1.0f, 1.0f);
+  // White at zero, towards red (too bright) or blue (too dark).
+  return t >= 0 ? Vec3{1.0f, 1.0f - t, 1.0f - t} : Vec3{1.0f + t, 1.0f + t, 1.0f};
+}
+
 Image<Vec3> signed_error_heat_map(const Image<float>& image, const Image<float>& reference, const Image<std::uint8_t>& mask, float range) {
   check_sizes(image, reference, mask);
   Image<Vec3> out(image.width(), image.height(), Vec3{0.5f, 0.5f, 0.5f});
   for (std::size_t i = 0; i < image.size(); ++i) {
     if (!selected(mask, i)) continue;
-    const float t = std::clamp((image[i] - reference[i]) / range, -1.0f, 1.0f);
-    // White at zero, towards red (too bright) or blue (too dark).
-    out[i] = t >= 0 ? Vec3{1.0f, 1.0f - t, 1.0f - t} : Vec3{1.0f + t, 1.0f + t, 1.0f};
+    out[i] = signed_error_colour(image[i] - reference[i], range);
   }
   return out;
 }

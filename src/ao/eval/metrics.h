@@ -26,9 +26,14 @@ void to_json(nlohmann::json& j, const ErrorMetrics& m);
 /// every masked pixel over masked neighbours only, so the background does not inflate it.
 ErrorMetrics compare_images(const Image<float>& image, const Image<float>& reference, const Image<std::uint8_t>& mask = {});
 
+/// Colour of one signed error (image - reference) in signed_error_heat_map: white at 0, towards
+/// pure red at +range (the image is too bright) and pure blue at -range (too dark), saturated beyond.
+/// `range` > 0.
+Vec3 signed_error_colour(float error, float range);
+
 /// Signed error heat map for people: blue where the image is darker than the reference, red where
-/// brighter, white where equal; `range` is the |error| shown at full saturation. Unmasked pixels
-/// are mid grey.
+/// brighter, white where equal (signed_error_colour); `range` is the |error| shown at full saturation.
+/// Unmasked pixels are mid grey.
 Image<Vec3> signed_error_heat_map(const Image<float>& image, const Image<float>& reference, const Image<std::uint8_t>& mask = {},
                                   float range = 0.25f);
 

@@ -30,6 +30,7 @@
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
 #include "ao/core/math.h"
+#include "ao/scene/analytic.h"
 
 namespace ao {
 
@@ -183,10 +184,6 @@ struct ProductCharacteristic {
   B b;
   float distance(float x, float y, float z) const { return std::min(a.distance(x, y, z), b.distance(x, y, z)); }
 };
-
-/// A periodic displacement map for HeightFieldCharacteristic: `bumps` x `bumps` smooth domes
-/// (cos^2 profile, height 1 at their centres, 0 between them) on a size x size map.
-Image<float> make_bump_map(int size, int bumps);
 
 using DepthTimesHeightField = ProductCharacteristic<DepthBufferCharacteristic, HeightFieldCharacteristic>;
 

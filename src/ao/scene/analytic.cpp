@@ -1,4 +1,4 @@
-#include "ao/methods/characteristic.h"
+#include "ao/scene/analytic.h"
 
 namespace ao {
 

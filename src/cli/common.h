@@ -19,7 +19,7 @@ namespace ao::cli {
 
 /// Help text of the positional scene argument, shared by the subcommands that take a scene.
 inline constexpr const char* kSceneHelp =
-    "Mesh file(s) (OBJ, PLY, OFF, STL, glTF/GLB) or a built-in scene: default, plane, wedge, sphere-on-plane, box-room";
+    "Mesh file(s) (OBJ, PLY, OFF, STL, glTF/GLB) or a built-in scene: default, plane, wedge, sphere-on-plane, box-room, displaced";
 
 /// Scene from positional arguments: none -> the built-in "default"; one built-in name (when no file
 /// of that name exists) -> that scene; otherwise mesh files, merged into one scene.

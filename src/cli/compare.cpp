@@ -213,7 +213,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   auto run_method = [&](const MethodInfo& m, const nlohmann::json& p, double& ms) {
     ProgressBar bar(std::string(m.name), progress);
     Stopwatch sw;
-    MethodOutput out = m.run(MethodInput{g, &rays, requested, o.seed, bar.callback()}, p);
+    MethodOutput out = m.run(MethodInput{g, &rays, requested, o.seed, bar.callback(), &scene.analytic}, p);
     ms = sw.lap_ms();
     return out;
   };

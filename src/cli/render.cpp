@@ -142,7 +142,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     result = visibility_from_map(g, *scene, ao_map, o.ao_map);
   } else {
     ProgressBar bar(method_name, progress);
-    result = method.run(MethodInput{g, rays.get(), falloff, o.seed, bar.callback()}, params);
+    result = method.run(MethodInput{g, rays.get(), falloff, o.seed, bar.callback(), scene ? &scene->analytic : nullptr}, params);
   }
   const double ao_ms = clock.lap_ms();
   timings["ao_ms"] = ao_ms;
@@ -242,7 +242,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--ao-map", o->ao_map,
                   "Show a baked AO map (from ao bake) on the scene instead of computing AO: V = the map at each pixel's UV");
   cmd->add_option("--gbuffer-in", o->gbuffer_in, "Read the G-buffer from an EXR instead of rendering a scene (screen-space methods)");
-  cmd->add_option("-p,--param", o->params, "Method parameter as key=value (JSON value), repeatable; --json lists them");
+  cmd->add_option("-p,--param", o->params, "Method parameter as key=value (JSON value), repeatable; --json lists them. containment, volumetric, transfer: "
+                  "characteristic=depth|implicit|height-field|'depth*height-field' (docs/methods/containment.md)");
   cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
   cmd->add_flag("--extras", o->extras,
                 "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");

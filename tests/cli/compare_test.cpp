@@ -122,6 +122,21 @@ TEST(CompareCli, SheetHasHeaderAndLabelsAboveUntouchedImagesAndWorksWithoutFont)
   EXPECT_GT(blue, 0);
 }
 
+// The characteristic function is a parameter like any other: set per method, and swept.
+TEST(CompareCli, SweepsTheCharacteristicFunction) {
+  const fs::path out = scratch("characteristic");
+  const CliRun r = run_ao("compare sphere-on-plane --methods containment,volumetric --width 48 --height 32 --spp-reference 8 -R 0.5 "
+                          "-p volumetric.characteristic=implicit --sweep characteristic=depth,implicit --out-dir " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json t = read_json(out / "table.json");
+  ASSERT_EQ(t["rows"].size(), 2u);
+  EXPECT_EQ(t["rows"][0]["parameters"]["characteristic"], "depth");
+  EXPECT_EQ(t["rows"][1]["parameters"]["characteristic"], "implicit");
+  const nlohmann::json s = read_json(out / "sweep.json");
+  ASSERT_EQ(s["rows"].size(), 4u);
+  EXPECT_EQ(s["rows"][1]["characteristic"], "implicit");
+}
+
 TEST(CompareCli, UnknownMethodFailsWithOneLineAndNoOutput) {
   const fs::path out = scratch("bad-method");
   const CliRun r = run_ao("compare plane --methods alchemy,nonsense --width 16 --height 16 --out-dir " + out.string());

@@ -119,6 +119,44 @@ TEST(RenderCli, GBufferRoundTripGivesTheSameScreenSpaceImage) {
   for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "pixel " << i;
 }
 
+// VAO fig. 12 from the command line: the displaced floor's height field times the depth buffer.
+// The '*' is quoted as a shell user would; the JSON echoes the choice and what ran.
+TEST(RenderCli, CharacteristicParameterChoosesThePapersOtherFunctions) {
+  TempDir dir;
+  const auto mean_v = [&](const std::string& args) {
+    const RunResult r = run_ao("render displaced --width 64 --height 36 --method volumetric --json " + args, dir.path());
+    EXPECT_EQ(r.exit_code, 0) << args << ": " << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const auto depth = mean_v("-o depth.png");
+  const auto both = mean_v("-p 'characteristic=depth*height-field' -o x.png");
+  EXPECT_TRUE(std::filesystem::exists(dir / "x.png"));
+  EXPECT_EQ(depth["parameters"]["characteristic"], "depth");
+  EXPECT_EQ(both["parameters"]["characteristic"], "depth*height-field");
+  EXPECT_EQ(both["stats"]["characteristic"], "depth*height-field");
+  EXPECT_LT(both["mean_visibility"].get<double>(), depth["mean_visibility"].get<double>());
+  const RunResult r = run_ao("render wedge --width 32 --height 24 -m containment -p characteristic=implicit -R 0.5 -o w.png", dir.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST(RenderCli, CharacteristicTheSceneCannotProvideIsAnInputError) {
+  TempDir dir;
+  ASSERT_EQ(run_ao("render wedge --width 32 --height 24 -m containment -o v.png --gbuffer-out g.exr", dir.path()).exit_code, 0);
+  const std::pair<std::string, const char*> cases[] = {
+      {"wedge -m containment -p characteristic=height-field", "displaced"},
+      {"displaced -m transfer -p characteristic=implicit", "sphere-on-plane"},
+      {"--gbuffer-in g.exr -m volumetric -p characteristic=implicit", "--gbuffer-in"},
+      {"--gbuffer-in g.exr -m containment -p 'characteristic=depth*height-field'", "--gbuffer-in"},
+      {"plane -m volumetric -p characteristic=zbuffer", "zbuffer"},
+  };
+  for (const auto& [args, needle] : cases) {
+    const RunResult r = run_ao("render " + args + " --width 32 --height 24 -o out.png", dir.path());
+    EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
+    expect_one_line_error(r, needle);
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.png")) << args;
+  }
+}
+
 TEST(RenderCli, MissingMeshIsAnInputError) {
   TempDir dir;
   const RunResult r = run_ao("render nowhere.obj -o v.png", dir.path());

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
+#include <string>
+#include <vector>
 #include <utility>
 
 #include "ao/core/error.h"
@@ -74,6 +77,55 @@ TEST(Procedural, EveryBuiltinSceneBuildsAndValidates) {
     EXPECT_TRUE(s.warnings.empty()) << name << ": " << (s.warnings.empty() ? "" : s.warnings[0]);
   }
   EXPECT_THROW(make_builtin_scene("teapot"), InputError);
+}
+
+TEST(Procedural, AnalyticDescriptionsAreWhereTheListsSay) {
+  const std::vector<std::string> implicit = builtin_scenes_with_implicit_surface(), height_field = builtin_scenes_with_height_field();
+  EXPECT_EQ(implicit, (std::vector<std::string>{"plane", "wedge", "sphere-on-plane"}));
+  EXPECT_EQ(height_field, (std::vector<std::string>{"displaced"}));
+  for (const std::string& name : builtin_scene_names()) {
+    const Scene s = make_builtin_scene(name);
+    EXPECT_EQ(s.analytic.implicit.has_value(), std::count(implicit.begin(), implicit.end(), name) == 1) << name;
+    EXPECT_EQ(s.analytic.height_field.has_value(), std::count(height_field.begin(), height_field.end(), name) == 1) << name;
+  }
+}
+
+// Each implicit description bounds what its meshes show: every vertex is on the boundary of the
+// outer region (min f = 0) and no triangle's centroid is outside it (min f <= 0; the sphere's flat
+// triangles are inside the round sphere by up to their sagitta).
+TEST(Procedural, ImplicitDescriptionsPassThroughTheirMeshes) {
+  for (const std::string& name : builtin_scenes_with_implicit_surface()) {
+    const Scene s = make_builtin_scene(name);
+    const ImplicitSurface& surface = *s.analytic.implicit;
+    for (const Mesh& m : s.meshes) {
+      for (const Vec3& p : m.positions) ASSERT_NEAR(surface.value(p), 0.0f, 1e-5f) << name << ", " << m.name;
+      for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+        const Vec3 c = (m.positions[m.indices[t]] + m.positions[m.indices[t + 1]] + m.positions[m.indices[t + 2]]) / 3.0f;
+        ASSERT_LE(surface.value(c), 1e-5f) << name << ", " << m.name << ", triangle " << t / 3;
+        ASSERT_GT(surface.value(c), -1e-3f) << name << ", " << m.name << ", triangle " << t / 3;
+      }
+    }
+  }
+}
+
+TEST(Procedural, DisplacedSceneIsAFloorOfDomesWithObjectsOnIt) {
+  const Scene s = make_builtin_scene("displaced");
+  ASSERT_EQ(s.meshes.size(), 3u);
+  EXPECT_EQ(s.meshes[0].name, "floor");
+  const HeightFieldSurface& hf = *s.analytic.height_field;
+  ASSERT_TRUE(hf.map);
+  float lo = kInfinity, hi = -kInfinity;
+  for (const Vec3& p : s.meshes[0].positions) lo = std::min(lo, p.y), hi = std::max(hi, p.y);
+  EXPECT_NEAR(lo, 0.0f, 1e-6f);
+  // The domes' tops fall between texel centres, half a texel diagonal off: cos^2(pi/2 x 0.088) = 0.98.
+  EXPECT_NEAR(hi, 0.98f * hf.amplitude, 0.005f * hf.amplitude);
+  // Normals face up, and the winding agrees with them.
+  const Mesh& floor = s.meshes[0];
+  for (std::size_t t = 0; t < floor.indices.size(); t += 3) {
+    const Vec3 a = floor.positions[floor.indices[t]], b = floor.positions[floor.indices[t + 1]], c = floor.positions[floor.indices[t + 2]];
+    ASSERT_GT(dot(cross(b - a, c - a), floor.normals[floor.indices[t]]), 0.0f) << "triangle " << t / 3;
+    ASSERT_GT(floor.normals[floor.indices[t]].y, 0.3f) << "triangle " << t / 3;
+  }
 }
 
 TEST(Procedural, DefaultSceneShowsEveryFeature) {

@@ -1,21 +1,46 @@
 #include "ao/methods/characteristic.h"
 
+#include <string>
+
+#include "ao/core/error.h"
+
 namespace ao {
 
-Image<float> make_bump_map(int size, int bumps) {
-  // A grid of bumps x bumps smooth domes, h = cos^2 of the distance to the cell centre scaled so the
-  // dome ends at the cell's inscribed circle: heights in [0, 1], C1 continuous, periodic.
-  Image<float> map(size, size, 0.0f);
-  const float cell = static_cast<float>(size) / static_cast<float>(bumps);
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      const float u = std::fmod((static_cast<float>(x) + 0.5f), cell) / cell - 0.5f;
-      const float v = std::fmod((static_cast<float>(y) + 0.5f), cell) / cell - 0.5f;
-      const float r = std::sqrt(u * u + v * v) * 2.0f;  // 1 at the inscribed circle
-      const float c = r < 1.0f ? std::cos(0.5f * kPi * r) : 0.0f;
-      map(x, y) = c * c;
-    }
-  return map;
+ImplicitCharacteristic implicit_characteristic(const ImplicitSurface& surface, const Camera& camera) {
+  const auto n = surface.primitives.size();
+  if (n == 0 || n > static_cast<std::size_t>(ImplicitCharacteristic::kMaxPrimitives))
+    throw InputError("implicit surface: " + std::to_string(n) + " primitives, the characteristic function takes 1 to " +
+                     std::to_string(ImplicitCharacteristic::kMaxPrimitives));
+  // The camera transform is rigid, so signed distances (f of a half-space, of a sphere exterior)
+  // keep their values: f_camera(world_to_camera(p)) = f_world(p).
+  ImplicitCharacteristic ch;
+  for (const ImplicitSurfacePrimitive& q : surface.primitives) {
+    if (q.kind == ImplicitSurfacePrimitive::Kind::HalfSpace)
+      ch.add(ImplicitPrimitive::half_space(camera.world_to_camera_vector(q.normal), camera.world_to_camera_point(q.point)));
+    else
+      ch.add(ImplicitPrimitive::sphere_exterior(camera.world_to_camera_point(q.point), q.radius));
+  }
+  return ch;
+}
+
+HeightFieldCharacteristic height_field_characteristic(const HeightFieldSurface& surface, const Camera& camera) {
+  if (!surface.map || surface.map->empty()) throw InputError("height field: the displacement map is empty");
+  if (!(surface.period > 0.0f) || !std::isfinite(surface.period) || !std::isfinite(surface.amplitude))
+    throw InputError("height field: period must be a finite number > 0 and amplitude finite");
+  const Frame& f = surface.frame;
+  constexpr float kTolerance = 1e-4f;  // float rounding of unit vectors built by hand
+  for (Vec3 a : {f.t, f.b, f.n})
+    if (std::abs(dot(a, a) - 1.0f) > kTolerance) throw InputError("height field: the frame's axes must be unit vectors");
+  if (std::abs(dot(f.t, f.b)) > kTolerance || std::abs(dot(f.t, f.n)) > kTolerance || std::abs(dot(f.b, f.n)) > kTolerance)
+    throw InputError("height field: the frame's axes must be orthogonal");
+  // Rigid transform: the local coordinates (u, v, w) of a point are the same in both spaces.
+  HeightFieldCharacteristic ch;
+  ch.origin = camera.world_to_camera_point(surface.origin);
+  ch.frame = {camera.world_to_camera_vector(f.t), camera.world_to_camera_vector(f.b), camera.world_to_camera_vector(f.n)};
+  ch.map = surface.map->view();
+  ch.period = surface.period;
+  ch.amplitude = surface.amplitude;
+  return ch;
 }
 
 }  // namespace ao

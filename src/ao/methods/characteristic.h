@@ -19,6 +19,9 @@
 //    (VAO fig. 2b), distance by the same Taylor step.
 //  - ProductCharacteristic: the product of two (VAO fig. 12: depth buffer x height field); the
 //    nearer separating surface bounds the free part of a pipe, so distance = min.
+//  - SilhouetteEliminated: AT sec. 4.3 applied to one factor of a product (the depth buffer's).
+// The analytic kinds are made from a scene's world-space description (scene/analytic.h) by
+// implicit_characteristic and height_field_characteristic.
 #pragma once
 
 #include <algorithm>
@@ -30,6 +33,7 @@
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
 #include "ao/core/math.h"
+#include "ao/scene/analytic.h"
 
 namespace ao {
 
@@ -184,10 +188,34 @@ struct ProductCharacteristic {
   float distance(float x, float y, float z) const { return std::min(a.distance(x, y, z), b.distance(x, y, z)); }
 };
 
-/// A periodic displacement map for HeightFieldCharacteristic: `bumps` x `bumps` smooth domes
-/// (cos^2 profile, height 1 at their centres, 0 between them) on a size x size map.
-Image<float> make_bump_map(int size, int bumps);
+/// AT sec. 4.3 as a characteristic function: a surface more than `limit` in front of p (distance <
+/// -limit) is taken for a distant foreground object with free space behind it, so p counts as outer
+/// (distance +infinity). The kernels apply the same test to the whole characteristic
+/// (`silhouette_elimination`); this wrapper applies it to one factor of a product, so that an
+/// analytic factor, whose inner region really is solid, keeps its points inner however far in
+/// front its surface is. limit = +infinity: no elimination.
+template <class C>
+struct SilhouetteEliminated {
+  C inner;
+  float limit = kInfinity;  ///< World units along the view axis, > 0.
+  float distance(float x, float y, float z) const {
+    const float d = inner.distance(x, y, z);
+    return d < -limit ? kInfinity : d;
+  }
+};
 
 using DepthTimesHeightField = ProductCharacteristic<DepthBufferCharacteristic, HeightFieldCharacteristic>;
+/// VAO fig. 12 with the depth buffer's silhouette shadows eliminated and the height field's kept
+/// (what `characteristic=depth*height-field` of the registry runs).
+using EliminatedDepthTimesHeightField = ProductCharacteristic<SilhouetteEliminated<DepthBufferCharacteristic>, HeightFieldCharacteristic>;
+
+/// The scene's implicit surface (world space) as a characteristic function in the camera space of
+/// `camera`. InputError when it has no primitive or more than ImplicitCharacteristic::kMaxPrimitives.
+ImplicitCharacteristic implicit_characteristic(const ImplicitSurface& surface, const Camera& camera);
+
+/// The scene's height field (world space) in the camera space of `camera`. The map is shared, not
+/// copied: `surface.map` must outlive the result. InputError for an empty map, a non-positive or
+/// non-finite period, or a frame that is not orthonormal.
+HeightFieldCharacteristic height_field_characteristic(const HeightFieldSurface& surface, const Camera& camera);
 
 }  // namespace ao

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -12,6 +13,7 @@
 namespace ao {
 
 namespace {
+constexpr float kInfinityLike = 1e30f;  // below this a distance stands for -infinity (characteristic.h)
 constexpr int kTile = 64;  // pixels per row segment: four 16-lane vectors; rows of a tile share cache lines of the depth buffer
 }
 
@@ -145,9 +147,13 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
           const float qy = py[k] + X * ty[k] + Y * by[k] + Z * ny[k];
           const float qz = pz[k] + X * tz[k] + Y * bz[k] + Z * nz[k];
           const float d = local_ch.distance(qx, qy, qz);
-          // AT 4.3. (This exact form vectorises; with elimination on, an implicit surface's -inf,
-          // "inner along the whole line", counts as distant: analytic uses turn elimination off.)
-          const bool occluded = (d < -bias[k]) & (d > far_limit);
+          // AT 4.3; an analytic surface's -FLT_MAX ("inner along the whole line") is never a distant
+          // foreground object, as in volumetric.cpp and transfer.cpp. The depth buffer never gives
+          // it, and its loop keeps the plain form: with the extra test GCC 12 no longer vectorises
+          // it (3.5x slower, bench containment/0).
+          bool near = d > far_limit;
+          if constexpr (!std::is_same_v<Characteristic, DepthBufferCharacteristic>) near = near | (d < -kInfinityLike);
+          const bool occluded = (d < -bias[k]) & near;
           o[k] += occluded ? 0.0f : 1.0f;
         }
       }
@@ -167,5 +173,7 @@ template Image<float> containment_ao(const GBuffer&, const DepthBufferCharacteri
 template Image<float> containment_ao(const GBuffer&, const ImplicitCharacteristic&, const Falloff&, const ContainmentParams&, std::uint32_t);
 template Image<float> containment_ao(const GBuffer&, const HeightFieldCharacteristic&, const Falloff&, const ContainmentParams&, std::uint32_t);
 template Image<float> containment_ao(const GBuffer&, const DepthTimesHeightField&, const Falloff&, const ContainmentParams&, std::uint32_t);
+template Image<float> containment_ao(const GBuffer&, const EliminatedDepthTimesHeightField&, const Falloff&, const ContainmentParams&,
+                                     std::uint32_t);
 
 }  // namespace ao

@@ -38,9 +38,10 @@ void to_json(nlohmann::json& j, const ContainmentParams& p);
 void from_json(const nlohmann::json& j, ContainmentParams& p);
 
 /// V per pixel (1 where not covered) with characteristic function `ch` (characteristic.h;
-/// instantiated for DepthBufferCharacteristic, ImplicitCharacteristic, HeightFieldCharacteristic
-/// and DepthTimesHeightField), interleaved and filtered as `params` say. Deterministic for a seed,
-/// independent of the thread count.
+/// instantiated for DepthBufferCharacteristic, ImplicitCharacteristic, HeightFieldCharacteristic,
+/// DepthTimesHeightField and EliminatedDepthTimesHeightField), interleaved and filtered as `params`
+/// say. Deterministic for a seed, independent of the thread count. With an analytic `ch`, turn
+/// silhouette_elimination off: their inner regions are solid (the registry does, registry.h).
 template <class Characteristic>
 Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Falloff& falloff, const ContainmentParams& params,
                             std::uint32_t seed);

@@ -1,14 +1,18 @@
 #include "ao/methods/registry.h"
 
 #include <array>
+#include <string>
+#include <vector>
 
 #include "ao/core/error.h"
 #include "ao/methods/alchemy.h"
+#include "ao/methods/characteristic.h"
 #include "ao/methods/cone.h"
 #include "ao/methods/containment.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
 #include "ao/reference/raytraced.h"
+#include "ao/scene/procedural.h"
 
 namespace ao {
 
@@ -26,27 +30,124 @@ MethodOutput run_raytraced(const MethodInput& in, const nlohmann::json& j) {
   return out;
 }
 
+// The characteristic functions a screen-space method can run with (registry.h,
+// kCharacteristicParam), in the order of characteristic_names().
+enum class CharacteristicKind { Depth, Implicit, HeightField, DepthTimesHeightField };
+constexpr std::array<std::string_view, 4> kCharacteristicNames{"depth", "implicit", "height-field", "depth*height-field"};
+
+std::string joined_names(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+// A screen-space method's default parameters: its Params plus the registry's characteristic choice.
+template <class Params>
+nlohmann::json screen_space_defaults() {
+  nlohmann::json j = Params{};
+  j[kCharacteristicParam] = kCharacteristicNames[0];
+  return j;
+}
+
+// Splits the characteristic choice off `j` (what remains goes to the method's from_json, which
+// rejects unknown keys) and returns it; absent means the depth buffer.
+CharacteristicKind take_characteristic(nlohmann::json& j, std::string_view method) {
+  if (!j.is_object() || !j.contains(kCharacteristicParam)) return CharacteristicKind::Depth;
+  const nlohmann::json value = j.at(kCharacteristicParam);
+  j.erase(kCharacteristicParam);
+  std::string names;
+  for (std::string_view n : kCharacteristicNames) names += (names.empty() ? "" : ", ") + std::string(n);
+  if (value.is_string())
+    for (std::size_t k = 0; k < kCharacteristicNames.size(); ++k)
+      if (value.get<std::string>() == kCharacteristicNames[k]) return static_cast<CharacteristicKind>(k);
+  throw InputError(std::string(method) + ": characteristic must be one of " + names + ", got " + value.dump());
+}
+
+// Builds the characteristic function of `kind` in the G-buffer's camera space and calls
+// fn(ch, kernel_elimination): whether the kernel's own silhouette elimination (AT 4.3) is to run.
+// `elimination` is the user's silhouette_elimination; `limit` the distance in front of a sample
+// point beyond which the depth-buffer factor of the product counts as a distant foreground object.
+template <class Fn>
+void with_characteristic(const MethodInput& in, CharacteristicKind kind, std::string_view method, bool elimination, float limit, Fn&& fn) {
+  const GBuffer& g = in.gbuffer;
+  if (kind == CharacteristicKind::Depth) return fn(DepthBufferCharacteristic(g), elimination);
+  const bool implicit = kind == CharacteristicKind::Implicit;
+  const std::string name(kCharacteristicNames[static_cast<std::size_t>(kind)]);
+  const std::string builtins = joined_names(implicit ? builtin_scenes_with_implicit_surface() : builtin_scenes_with_height_field());
+  const std::string what = implicit ? "implicit surface" : "height field";
+  if (!in.surfaces)
+    throw InputError(std::string(method) + ": characteristic " + name + " reads the scene's " + what +
+                     ", and a G-buffer file has none: give a built-in scene that has one (" + builtins + ") instead of --gbuffer-in");
+  if (implicit ? !in.surfaces->implicit : !in.surfaces->height_field)
+    throw InputError(std::string(method) + ": characteristic " + name + " needs a scene with an analytic " + what + ", and " +
+                     (in.scene ? "'" + in.scene->scene().name + "'" : std::string("this scene")) + " has none (built-in scenes with one: " +
+                     builtins + ")");
+  // Analytic factors: their inner regions are solid, so the kernels' elimination stays off for them.
+  switch (kind) {
+    case CharacteristicKind::Implicit: return fn(implicit_characteristic(*in.surfaces->implicit, g.camera), false);
+    case CharacteristicKind::HeightField: return fn(height_field_characteristic(*in.surfaces->height_field, g.camera), false);
+    default: {
+      const EliminatedDepthTimesHeightField product{{DepthBufferCharacteristic(g), elimination ? limit : kInfinity},
+                                                    height_field_characteristic(*in.surfaces->height_field, g.camera)};
+      return fn(product, false);
+    }
+  }
+}
+
+// What --json reports about the characteristic function a method ran with (nothing for the default).
+void add_characteristic_stats(MethodOutput& out, CharacteristicKind kind, bool elimination) {
+  if (kind == CharacteristicKind::Depth) return;
+  out.stats[kCharacteristicParam] = kCharacteristicNames[static_cast<std::size_t>(kind)];
+  out.stats["silhouette_elimination"] = kind == CharacteristicKind::DepthTimesHeightField && elimination ? "depth-buffer factor only" : "off";
+}
+
 MethodOutput run_containment(const MethodInput& in, const nlohmann::json& j) {
-  const ContainmentParams p = j.get<ContainmentParams>();
+  nlohmann::json rest = j;
+  const CharacteristicKind kind = take_characteristic(rest, "containment");
+  const ContainmentParams p = rest.get<ContainmentParams>();
   MethodOutput out;
-  out.visibility = containment_ao(in.gbuffer, in.falloff, p, in.seed);
+  // AT 4.3 tests the sample point itself: a surface more than R in front of it is distant.
+  with_characteristic(in, kind, "containment", p.silhouette_elimination, in.falloff.radius, [&](const auto& ch, bool kernel_elimination) {
+    ContainmentParams q = p;
+    q.silhouette_elimination = kernel_elimination;
+    out.visibility = containment_ao(in.gbuffer, ch, in.falloff, q, in.seed);
+  });
+  add_characteristic_stats(out, kind, p.silhouette_elimination);
   return out;
 }
 
 MethodOutput run_volumetric(const MethodInput& in, const nlohmann::json& j) {
-  const VolumetricParams p = j.get<VolumetricParams>();
+  nlohmann::json rest = j;
+  const CharacteristicKind kind = take_characteristic(rest, "volumetric");
+  const VolumetricParams p = rest.get<VolumetricParams>();
   MethodOutput out;
-  out.visibility = volumetric_ao(in.gbuffer, in.falloff.radius, p, in.seed);
+  // The kernel eliminates a surface more than R in front of a pipe's entry, which lies up to R/2 in
+  // front of the sphere's centre, where the characteristic is read: a depth-buffer surface more than
+  // 1.5 R in front of the centre is distant for every pipe, so the wrapped factor never drops a
+  // surface the kernel's per-pipe test would keep.
+  with_characteristic(in, kind, "volumetric", p.silhouette_elimination, 1.5f * in.falloff.radius, [&](const auto& ch, bool kernel_elimination) {
+    VolumetricParams q = p;
+    q.silhouette_elimination = kernel_elimination;
+    out.visibility = volumetric_ao(in.gbuffer, ch, in.falloff.radius, q, in.seed);
+  });
+  add_characteristic_stats(out, kind, p.silhouette_elimination);
   return out;
 }
 
 MethodOutput run_transfer(const MethodInput& in, const nlohmann::json& j) {
-  const TransferParams p = j.get<TransferParams>();
-  TransferImage img = transfer_ao(in.gbuffer, in.falloff, p, in.seed);
+  nlohmann::json rest = j;
+  const CharacteristicKind kind = take_characteristic(rest, "transfer");
+  const TransferParams p = rest.get<TransferParams>();
   MethodOutput out;
-  out.visibility = std::move(img.luminance);
-  out.color = std::move(img.transfer);
-  out.extras["obscurance"] = std::move(img.obscurance);
+  with_characteristic(in, kind, "transfer", p.silhouette_elimination, in.falloff.radius, [&](const auto& ch, bool kernel_elimination) {
+    TransferParams q = p;
+    q.silhouette_elimination = kernel_elimination;
+    TransferImage img = transfer_ao(in.gbuffer, ch, in.gbuffer.albedo, in.falloff, q, in.seed);
+    out.visibility = std::move(img.luminance);
+    out.color = std::move(img.transfer);
+    out.extras["obscurance"] = std::move(img.obscurance);
+  });
+  add_characteristic_stats(out, kind, p.silhouette_elimination);
   return out;
 }
 
@@ -76,15 +177,15 @@ const std::array kMethods{
                [] { return nlohmann::json(RaytracedParams{}); }, run_raytraced,
                [](const Falloff& requested, const nlohmann::json&) { return requested; }},
     MethodInfo{"containment", "containment tests against the depth buffer, r = mu^-1(xi) (volumetric AO eq. 5), any membership", false,
-               [] { return nlohmann::json(ContainmentParams{}); }, run_containment,
+               screen_space_defaults<ContainmentParams>, run_containment,
                [](const Falloff& requested, const nlohmann::json&) { return requested; }},
     // Volumetric AO implies mu = (r/R)^3 with the same R (tangent sphere of radius R/2: distances up to R).
     MethodInfo{"volumetric", "free volume of the tangent sphere by pipes along z (volumetric AO eq. 6-7); implies cubic membership", false,
-               [] { return nlohmann::json(VolumetricParams{}); }, run_volumetric,
+               screen_space_defaults<VolumetricParams>, run_volumetric,
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; }},
     // W approaches the obscurance of the same membership as the albedo goes to 0.
     MethodInfo{"transfer", "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance", false,
-               [] { return nlohmann::json(TransferParams{}); }, run_transfer,
+               screen_space_defaults<TransferParams>, run_transfer,
                [](const Falloff& requested, const nlohmann::json&) { return requested; }},
     // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.
     MethodInfo{"cone", "voxel cone tracing: parity voxelization in bit columns, cones of spheres, prisms by popcount (Dalla Favera & Celes)", true,
@@ -101,6 +202,8 @@ const std::array kMethods{
 }  // namespace
 
 std::span<const MethodInfo> all_methods() { return kMethods; }
+
+std::span<const std::string_view> characteristic_names() { return kCharacteristicNames; }
 
 const MethodInfo& find_method(std::string_view name) {
   std::string names;

@@ -13,21 +13,42 @@
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
+#include "ao/scene/analytic.h"
 
 namespace ao {
 
 class RayScene;
 
-/// Everything a method may read. Screen-space methods read only the G-buffer; object-space
-/// methods (the ray-traced reference) also need the scene, which is absent when the G-buffer came
-/// from a file.
+/// Everything a method may read. Screen-space methods read only the G-buffer (and, when asked for
+/// an analytic characteristic function, the scene's analytic description); object-space methods
+/// (the ray-traced reference) also need the scene, which is absent when the G-buffer came from a file.
 struct MethodInput {
   const GBuffer& gbuffer;
   const RayScene* scene = nullptr;  ///< Null when running from --gbuffer-in.
   Falloff falloff;                  ///< R and membership; methods that imply their own say so.
   std::uint32_t seed = 0;           ///< Keys every per-pixel sample set.
   ProgressFn progress;
+  /// The scene's analytic surfaces (Scene::analytic, world space; the G-buffer's camera takes them
+  /// to camera space). Null when running from --gbuffer-in; may be set and empty.
+  const AnalyticSurfaces* surfaces = nullptr;
 };
+
+/// The registry-level parameter of containment, volumetric and transfer that chooses their
+/// characteristic function I(p) (VAO fig. 2 and 12; methods/characteristic.h). It is not a field of
+/// their Params structs: the library calls take the function itself (containment_ao(g, ch, ...)),
+/// and only the registry has the scene's description at hand to build one. Values:
+///  - "depth" (default): the G-buffer's depth buffer (VAO fig. 2c), with AT 4.3's silhouette
+///    elimination as `silhouette_elimination` says;
+///  - "implicit": the scene's half-spaces and sphere exteriors (fig. 2a; built-ins plane, wedge,
+///    sphere-on-plane). Silhouette elimination is not applied: the inner region of an analytic
+///    surface is solid, so a point in it is occluded however far in front the surface is;
+///  - "height-field": the scene's displacement map over its macro plane (fig. 2b; built-in
+///    displaced), alone: other objects do not occlude. No silhouette elimination, as implicit;
+///  - "depth*height-field": their product (fig. 12): occluded when either says so. Silhouette
+///    elimination, when on, applies to the depth-buffer factor only (SilhouetteEliminated).
+inline constexpr const char* kCharacteristicParam = "characteristic";
+/// The accepted values of kCharacteristicParam, in the order above.
+std::span<const std::string_view> characteristic_names();
 
 struct MethodOutput {
   Image<float> visibility;  ///< V in [0,1] per pixel; 1 where the G-buffer is not covered.

@@ -463,6 +463,7 @@ AO_INSTANTIATE_TRANSFER(DepthBufferCharacteristic)
 AO_INSTANTIATE_TRANSFER(ImplicitCharacteristic)
 AO_INSTANTIATE_TRANSFER(HeightFieldCharacteristic)
 AO_INSTANTIATE_TRANSFER(DepthTimesHeightField)
+AO_INSTANTIATE_TRANSFER(EliminatedDepthTimesHeightField)
 #undef AO_INSTANTIATE_TRANSFER
 
 }  // namespace ao

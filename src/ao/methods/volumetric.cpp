@@ -162,5 +162,6 @@ template Image<float> volumetric_ao(const GBuffer&, const DepthBufferCharacteris
 template Image<float> volumetric_ao(const GBuffer&, const ImplicitCharacteristic&, float, const VolumetricParams&, std::uint32_t);
 template Image<float> volumetric_ao(const GBuffer&, const HeightFieldCharacteristic&, float, const VolumetricParams&, std::uint32_t);
 template Image<float> volumetric_ao(const GBuffer&, const DepthTimesHeightField&, float, const VolumetricParams&, std::uint32_t);
+template Image<float> volumetric_ao(const GBuffer&, const EliminatedDepthTimesHeightField&, float, const VolumetricParams&, std::uint32_t);
 
 }  // namespace ao

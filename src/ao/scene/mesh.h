@@ -9,6 +9,7 @@
 
 #include "ao/core/camera.h"
 #include "ao/core/math.h"
+#include "ao/scene/analytic.h"
 
 namespace ao {
 
@@ -25,11 +26,13 @@ struct Mesh {
   Bounds3 bounds() const;
 };
 
-/// A scene: meshes, plus an optional camera the scene was designed to be seen from.
+/// A scene: meshes, plus an optional camera the scene was designed to be seen from, and (for
+/// built-in scenes that are exactly such surfaces) analytic descriptions of what the meshes show.
 struct Scene {
   std::string name;                     ///< File name or built-in scene name, used in messages.
   std::vector<Mesh> meshes;
   std::optional<Camera> preferred_view; ///< Eye/target/up/fov only; size comes from the caller.
+  AnalyticSurfaces analytic;            ///< World space; empty for scenes from files. The meshes are authoritative, these describe them.
   std::vector<std::string> warnings;    ///< Things fixed while loading (dropped triangles, ...).
 
   Bounds3 bounds() const;

@@ -1,6 +1,7 @@
 #include "ao/scene/procedural.h"
 
 #include <cmath>
+#include <memory>
 
 #include "ao/core/error.h"
 
@@ -115,6 +116,7 @@ Scene plane_scene() {
   m.name = "plane";
   add_ground_rect(m, -20, -20, 20, 20);
   s.meshes.push_back(std::move(m));
+  s.analytic.implicit = ImplicitSurface{{ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 1, 0})}};
   Camera view;
   view.eye = {0, 6, 10};
   view.target = {0, 0, 0};
@@ -131,6 +133,9 @@ Scene wedge_scene() {
   add_flat_quad(m, {-L, 0, L}, {L, 0, L}, {L, 0, 0}, {-L, 0, 0});  // floor, facing +y
   add_flat_quad(m, {-L, 0, 0}, {L, 0, 0}, {L, L, 0}, {-L, L, 0});  // wall, facing +z
   s.meshes.push_back(std::move(m));
+  // Outer region y >= 0 and z >= 0 (the quads end at 100 units; R is far smaller).
+  s.analytic.implicit = ImplicitSurface{{ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 1, 0}),
+                                         ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 0, 1})}};
   Camera view;
   view.eye = {3, 3, 6};
   view.target = {0, 0.5f, 0.5f};
@@ -146,6 +151,10 @@ Scene sphere_on_plane_scene() {
   add_ground_rect(ground, -20, -20, 20, 20);
   s.meshes.push_back(std::move(ground));
   s.meshes.push_back(named(make_sphere({0, 1, 0}, 1.0f, 96, 48), "sphere"));
+  // The tessellated sphere lies inside the analytic one by at most its sagitta, 1 - cos(pi/96) ~ 5e-4
+  // units, far below the depth-test bias at any distance the view shows.
+  s.analytic.implicit = ImplicitSurface{{ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 1, 0}),
+                                         ImplicitSurfacePrimitive::sphere_exterior({0, 1, 0}, 1.0f)}};
   Camera view;
   view.eye = {0, 3, 6};
   view.target = {0, 0.6f, 0};
@@ -167,9 +176,107 @@ Scene box_room_scene() {
   return s;
 }
 
+// The height field as a mesh: one vertex per texel centre, where HeightFieldSurface's bilinear
+// lookup is exactly the texel's value, so the mesh interpolates the analytic surface (within a
+// triangle the two differ by the bilinear patch's twist, at most a quarter of the texel's second
+// difference). `count_u` x `count_v` vertices from texel (0, 0); smooth normals from central
+// differences of the map, the slope of the surface through the neighbouring vertices.
+Mesh make_height_field_mesh(const HeightFieldSurface& hf, int count_u, int count_v) {
+  Mesh m;
+  const Image<float>& map = *hf.map;
+  const int w = map.width(), h = map.height();
+  const float du = hf.period / static_cast<float>(w), dv = hf.period / static_cast<float>(h);
+  auto at = [&](int i, int j) { return hf.amplitude * map(((i % w) + w) % w, ((j % h) + h) % h); };
+  for (int j = 0; j < count_v; ++j)
+    for (int i = 0; i < count_u; ++i) {
+      const float u = (static_cast<float>(i) + 0.5f) * du, v = (static_cast<float>(j) + 0.5f) * dv;
+      const float hu = (at(i + 1, j) - at(i - 1, j)) / (2 * du), hv = (at(i, j + 1) - at(i, j - 1)) / (2 * dv);
+      add_vertex(m, hf.origin + hf.frame.to_world({u, v, at(i, j)}), normalize(hf.frame.to_world({-hu, -hv, 1.0f})));
+    }
+  // Counter-clockwise seen from the normal's side when (t, b, n) is right-handed; flipped otherwise.
+  const bool right_handed = dot(cross(hf.frame.t, hf.frame.b), hf.frame.n) > 0;
+  const auto idx = [&](int i, int j) { return static_cast<std::uint32_t>(j * count_u + i); };
+  for (int j = 0; j + 1 < count_v; ++j)
+    for (int i = 0; i + 1 < count_u; ++i) {
+      const std::uint32_t a = idx(i, j), b = idx(i + 1, j), c = idx(i + 1, j + 1), d = idx(i, j + 1);
+      if (right_handed) {
+        add_triangle(m, a, b, c);
+        add_triangle(m, a, c, d);
+      } else {
+        add_triangle(m, a, c, b);
+        add_triangle(m, a, d, c);
+      }
+    }
+  return m;
+}
+
+Scene displaced_scene() {
+  Scene s;
+  s.name = "displaced";
+  // An 8 x 8 floor displaced by a 64 x 64 map of 4 x 4 domes repeating every 2 units (domes 0.5
+  // apart, 0.2 high), so the default R (0.1 x diagonal, ~1.1) spans a few of them.
+  constexpr int kMapSize = 64, kBumps = 4, kTiles = 4;
+  constexpr float kPeriod = 2.0f, kAmplitude = 0.2f, kHalf = 0.5f * kPeriod * kTiles;
+  HeightFieldSurface hf;
+  const float texel = kPeriod / kMapSize;
+  // u along +x, v along -z, normal +y (right-handed); the first vertex (a texel centre) at (-4, ., 4).
+  hf.frame = {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+  hf.origin = {-kHalf - 0.5f * texel, 0.0f, kHalf + 0.5f * texel};
+  hf.map = std::make_shared<const Image<float>>(make_bump_map(kMapSize, kBumps));
+  hf.period = kPeriod;
+  hf.amplitude = kAmplitude;
+  const int count = kMapSize * kTiles + 1;  // vertices per side: the floor spans [-4, 4] exactly
+  Mesh floor = make_height_field_mesh(hf, count, count);
+  floor.name = "floor";
+  floor.albedo = {0.76f, 0.70f, 0.60f};
+  s.meshes.push_back(std::move(floor));
+  s.analytic.height_field = std::move(hf);
+  // Objects standing on the bumps, which pierce their undersides: occlusion the height field alone
+  // does not know about (VAO fig. 12: "the z-buffer-based classification handles other objects' occlusions").
+  s.meshes.push_back(named(make_sphere({-1.3f, 0.8f, 0.3f}, 0.8f, 64, 32, {0.35f, 0.55f, 0.80f}), "sphere"));
+  s.meshes.push_back(named(make_box({0.5f, 0.0f, -1.7f}, {1.9f, 1.1f, -0.5f}, {0.80f, 0.45f, 0.30f}, 25.0f), "box"));
+  Camera view;
+  view.eye = {3.0f, 3.0f, 5.2f};  // low enough that the domes hide parts of each other
+  view.target = {0.0f, 0.2f, -0.6f};
+  view.vertical_fov_deg = 45.0f;
+  s.preferred_view = view;
+  return s;
+}
+
+// The built-in scenes, in the order the help lists them, with the analytic descriptions they carry.
+struct BuiltinScene {
+  const char* name;
+  Scene (*make)();
+  bool implicit;      ///< Scene::analytic.implicit is set.
+  bool height_field;  ///< Scene::analytic.height_field is set.
+};
+const BuiltinScene kBuiltinScenes[] = {
+    {"default", default_scene, false, false},       {"plane", plane_scene, true, false},
+    {"wedge", wedge_scene, true, false},            {"sphere-on-plane", sphere_on_plane_scene, true, false},
+    {"box-room", box_room_scene, false, false},     {"displaced", displaced_scene, false, true},
+};
+
 }  // namespace
 
-std::vector<std::string> builtin_scene_names() { return {"default", "plane", "wedge", "sphere-on-plane", "box-room"}; }
+std::vector<std::string> builtin_scene_names() {
+  std::vector<std::string> names;
+  for (const BuiltinScene& b : kBuiltinScenes) names.emplace_back(b.name);
+  return names;
+}
+
+std::vector<std::string> builtin_scenes_with_implicit_surface() {
+  std::vector<std::string> names;
+  for (const BuiltinScene& b : kBuiltinScenes)
+    if (b.implicit) names.emplace_back(b.name);
+  return names;
+}
+
+std::vector<std::string> builtin_scenes_with_height_field() {
+  std::vector<std::string> names;
+  for (const BuiltinScene& b : kBuiltinScenes)
+    if (b.height_field) names.emplace_back(b.name);
+  return names;
+}
 
 bool is_builtin_scene(std::string_view name) {
   for (const auto& n : builtin_scene_names())
@@ -178,19 +285,15 @@ bool is_builtin_scene(std::string_view name) {
 }
 
 Scene make_builtin_scene(std::string_view name) {
-  Scene s;
-  if (name == "default") s = default_scene();
-  else if (name == "plane") s = plane_scene();
-  else if (name == "wedge") s = wedge_scene();
-  else if (name == "sphere-on-plane") s = sphere_on_plane_scene();
-  else if (name == "box-room") s = box_room_scene();
-  else {
-    std::string names;
-    for (const auto& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
-    throw InputError(std::string(name) + ": not a file and not a built-in scene (" + names + ")");
-  }
-  validate_and_prepare(s);
-  return s;
+  for (const BuiltinScene& b : kBuiltinScenes)
+    if (name == b.name) {
+      Scene s = b.make();
+      validate_and_prepare(s);
+      return s;
+    }
+  std::string names;
+  for (const auto& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
+  throw InputError(std::string(name) + ": not a file and not a built-in scene (" + names + ")");
 }
 
 Mesh make_quad(Vec3 p0, Vec3 p1, Vec3 p2, Vec3 p3, Vec3 albedo) {

@@ -83,7 +83,10 @@ const std::array kMethods{
                [] { return nlohmann::json(VolumetricParams{}); }, run_volumetric,
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; }},
     // W approaches the obscurance of the same membership as the albedo goes to 0.
-    MethodInfo{"transfer", "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance", false,
+    MethodInfo{"transfer",
+               "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance; "
+               "-p reflectance=radiance adds the light of sunlit occluders (needs --sun)",
+               false,
                [] { return nlohmann::json(TransferParams{}); }, run_transfer,
                [](const Falloff& requested, const nlohmann::json&) { return requested; }},
     // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.

@@ -170,7 +170,7 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       _mm512_mask_storeu_ps(lost_g + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_g + k0), ag));
       _mm512_mask_storeu_ps(lost_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_b + k0), ab));
       if constexpr (kDirect) {
-        // (1 - I) Ld~ of eq. 9's numerator: the direct radiance at the occluder's pixel.
+        // (1 - I) Ld~ in the numerator of eq. 9' (docs/methods/transfer.md): Ld at the occluder's pixel.
         const __m512i a = _mm512_mullo_epi32(atv, _mm512_set1_epi32(3));
         const __m512 dr = _mm512_mask_i32gather_ps(zero, blocked, a, direct, 4);
         const __m512 dg = _mm512_mask_i32gather_ps(zero, blocked, a, direct + 1, 4);
@@ -192,7 +192,7 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       lost_r[k] += blocked * albedo[a];
       lost_g[k] += blocked * albedo[a + 1];
       lost_b[k] += blocked * albedo[a + 2];
-      if constexpr (kDirect) {  // (1 - I) Ld~ of the radiance mode's numerator
+      if constexpr (kDirect) {  // (1 - I) Ld~ in the numerator of eq. 9'
         gain_r[k] += blocked * direct[a];
         gain_g[k] += blocked * direct[a + 1];
         gain_b[k] += blocked * direct[a + 2];
@@ -210,7 +210,7 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
 // sample scaled by j/m, p = x + (j/m)(X T + Y B + Z N) (sec. 4), evaluated in the order of
 // containment_ao's kernel and with its projection, so with m = 1 both give the same I bit for bit.
 // kDirect: the radiance mode (transfer.h), with `packed` null (the occluder's pixel is needed to
-// read Ld~ there), two more masked gathers of the direct pass per blocked ray and its own finish;
+// read Ld~ there), three more masked gathers (Ld~ R, G, B) per blocked ray and its own finish;
 // the albedo mode (kDirect = false) is compiled exactly as before the mode existed.
 // GCC 12 reports the deliberately undefined pass-through operand of _mm512_cvttps_epi32 as
 // "maybe uninitialized" (its intrinsics header initialises it from itself).
@@ -305,7 +305,7 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
       lg = _mm512_mask_add_ps(lg, blocked, lg, ag);
       lb = _mm512_mask_add_ps(lb, blocked, lb, ab);
       if constexpr (kDirect) {
-        // (1 - I) Ld~ of the radiance mode's numerator, at the same occluder pixel as a~.
+        // (1 - I) Ld~ in the numerator of eq. 9', at the same occluder pixel as a~.
         const __m512i a = _mm512_mullo_epi32(at, _mm512_set1_epi32(3));
         gr = _mm512_mask_add_ps(gr, blocked, gr, _mm512_mask_i32gather_ps(zero, blocked, a, direct, 4));
         gg = _mm512_mask_add_ps(gg, blocked, gg, _mm512_mask_i32gather_ps(zero, blocked, a, direct + 1, 4));

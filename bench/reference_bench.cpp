@@ -7,6 +7,7 @@
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/gbuffer/render_gbuffer.h"
+#include "ao/reference/direct_light.h"
 #include "ao/reference/packets.h"
 #include "ao/reference/raytraced.h"
 #include "bench_scenes.h"
@@ -144,6 +145,19 @@ void raytraced(benchmark::State& state, Fixture* f) {
   state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays) / 1e6, benchmark::Counter::kIsRate);
 }
 
+// The sun's direct-light pass (`ao render --sun`): one shadow ray per covered pixel facing the
+// sun, the sun of docs/methods/transfer.md's picture. Mrays/s counts the rays traced.
+void direct_light(benchmark::State& state, Fixture* f) {
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const Sun sun{normalize(Vec3{-1.0f, 0.6f, 0.5f}), kPi};
+  const Vec3 l = f->gbuffer.camera.basis().to_local(sun.direction);  // camera space, as the G-buffer's normals
+  double rays = 0;
+  for (std::size_t i = 0; i < f->gbuffer.coverage.size(); ++i) rays += f->gbuffer.coverage[i] && dot(f->gbuffer.normal[i], l) > 0;
+  for (auto _ : state) benchmark::DoNotOptimize(render_direct_light(f->rays, f->gbuffer, sun).data());
+  state.counters["Mrays/s"] = benchmark::Counter(rays * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+}
+
+BENCHMARK_CAPTURE(direct_light, default_scene, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer, default_scene, demo())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer, elephant_on_ground, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(minimal_loop, elephant_on_ground_64spp, elephant())->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);

@@ -14,6 +14,7 @@
 #include "ao/methods/interleave.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
+#include "ao/reference/direct_light.h"
 #include "bench_scenes.h"
 
 namespace ao::bench {
@@ -70,6 +71,18 @@ void transfer(benchmark::State& state) {
   rate(state);
 }
 
+// The radiance mode (reflectance=radiance, docs/methods/transfer.md) with a sun's direct-light
+// pass made once outside the loop; filtered, m = 2 (the default): compare with transfer/1/2.
+void transfer_radiance(benchmark::State& state) {
+  Fixture& f = demo();
+  GBuffer g = f.g;
+  g.direct = render_direct_light(f.rays, g, Sun{normalize(Vec3{-1.0f, 0.6f, 0.5f}), kPi});
+  TransferParams p{.samples = kSamples, .reflectance = TransferReflectance::Radiance};
+  TransferBuffers buffers;
+  for (auto _ : state) benchmark::DoNotOptimize(transfer_ao(buffers, g, {Membership::Step, f.radius}, p, 1).luminance.data());
+  rate(state);
+}
+
 void box_filter(benchmark::State& state) {
   Fixture& f = demo();
   const Image<float> v(kWidth, kHeight, 0.5f);
@@ -101,6 +114,7 @@ void box_filter_planes4(benchmark::State& state) {
 BENCHMARK(containment)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(volumetric)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(transfer)->Args({0, 1})->Args({0, 2})->Args({1, 1})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(transfer_radiance)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter_rgb)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter_planes4)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

@@ -1,6 +1,7 @@
 // ao render: scene (or G-buffer EXR) -> AO image, with optional G-buffer, shaded image and JSON.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -12,6 +13,7 @@
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
 #include "ao/methods/registry.h"
+#include "ao/reference/direct_light.h"
 #include "ao/reference/ray_scene.h"
 #include "common.h"
 #include "subcommands.h"
@@ -34,6 +36,7 @@ struct RenderOptions {
   std::optional<float> target_error;
   std::uint32_t seed = 1;
   std::vector<std::string> params;  ///< key=value overrides of the method's parameters.
+  std::optional<std::string> sun;   ///< "DX,DY,DZ[,E]": a direct-light pass (parse_sun).
   int png_bits = 8;
   bool json = false;
   bool extras = false;  ///< Also write the method's extra outputs (MethodOutput::extras) beside the output.
@@ -43,17 +46,68 @@ struct RenderOptions {
 // from above-left of the camera; wrapping (n.l + w) / (1 + w) keeps faces turned away from it
 // from going black, so the AO stays readable everywhere. With an RGB result (ambient transfer's W
 // per channel) the ambient term is per channel too: L = a W La (AT eq. 2), La = the same lighting.
+// With a direct-light pass (--sun, or direct.* in --gbuffer-in) that pass replaces the key light:
+// L = (a V + Ld) La, or (a W + Ld) La (docs/methods/transfer.md), Ld being in units of La. La =
+// 0.5 display units, so that a white surface in the open (V = 1) facing a sun of E = pi (Ld = 1)
+// shows at 1.
 Image<Vec3> shade(const GBuffer& g, const Image<float>& v, const Image<Vec3>& color) {
   const Vec3 light = normalize(Vec3{-0.4f, 0.8f, 0.45f});  // camera space
   constexpr float kAmbient = 0.45f, kKey = 0.75f, kWrap = 0.5f;
+  constexpr float kSkyWithSun = 0.5f;
   Image<Vec3> out(g.width(), g.height(), Vec3{1, 1, 1});
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (!g.coverage[i]) continue;
+    if (!g.direct.empty()) {
+      const Vec3 ambient = color.empty() ? g.albedo[i] * v[i] : g.albedo[i] * color[i];  // a V or a W
+      out[i] = (ambient + g.direct[i]) * kSkyWithSun;
+      continue;
+    }
     const float wrap = std::max(0.0f, (dot(g.normal[i], light) + kWrap) / (1.0f + kWrap));
     const float light_in = kAmbient + kKey * wrap;
     out[i] = color.empty() ? g.albedo[i] * (v[i] * light_in) : g.albedo[i] * color[i] * light_in;
   }
   return out;
+}
+
+// --sun DX,DY,DZ[,E]: the direction towards the sun in world space (any non-zero length,
+// normalised here) and optionally its irradiance E in units of La (default pi, see
+// direct_light.h). One-line InputErrors for a wrong count, non-numbers, non-finite values, a
+// zero direction and a negative E.
+Sun parse_sun(const std::string& text) {
+  std::vector<std::string> items;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = text.find(',', start);
+    items.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (items.size() != 3 && items.size() != 4)
+    throw InputError("--sun: expected DX,DY,DZ (towards the sun) or DX,DY,DZ,E, 3 or 4 numbers, got '" + text + "'");
+  std::vector<double> v;
+  for (const std::string& item : items) {
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size())
+      throw InputError("--sun: '" + item + "' is not a number (expected DX,DY,DZ or DX,DY,DZ,E)");
+    if (!std::isfinite(x) || std::abs(x) > 3.0e38) throw InputError("--sun: '" + item + "' is not a finite float");
+    v.push_back(x);
+  }
+  const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(len > 0)) throw InputError("--sun: the direction " + text + " has no length: give the direction towards the sun, e.g. 1,2,1");
+  Sun sun;
+  sun.direction = {static_cast<float>(v[0] / len), static_cast<float>(v[1] / len), static_cast<float>(v[2] / len)};
+  if (v.size() == 4) {
+    if (!(v[3] >= 0))
+      throw InputError("--sun: the irradiance E must be >= 0 (units of the ambient radiance; pi: as bright as the sky), got " + items[3]);
+    sun.irradiance = static_cast<float>(v[3]);
+  }
+  sun.validate();
+  return sun;
+}
+
+// The parameters ask for transfer's radiance mode (transfer.h), which reads the direct-light pass.
+bool wants_direct_pass(const nlohmann::json& params) {
+  return params.is_object() && params.contains("reflectance") && params["reflectance"] == "radiance";
 }
 
 // V from a baked AO map: the map's value at each covered pixel's UV (bilinear), for looking at a
@@ -109,6 +163,14 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     params["target_error"] = *o.target_error;
   }
   apply_param_overrides(params, o.params, method.name);
+  const std::optional<Sun> sun = o.sun ? std::optional<Sun>(parse_sun(*o.sun)) : std::nullopt;
+  if (sun && !o.gbuffer_in.empty())
+    throw InputError("--sun traces shadow rays in the scene, and --gbuffer-in gives only a G-buffer: give a scene, or a G-buffer EXR with "
+                     "direct.R direct.G direct.B channels");
+  const bool radiance_mode = o.ao_map.empty() && wants_direct_pass(params);
+  if (radiance_mode && !sun && o.gbuffer_in.empty())
+    throw InputError("-p reflectance=radiance reads the occluders' direct light: give a sun with --sun DX,DY,DZ[,E] (or --gbuffer-in "
+                     "with direct.R direct.G direct.B channels)");
 
   std::optional<Scene> scene;
   std::unique_ptr<RayScene> rays;
@@ -134,7 +196,15 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     }
     timings["gbuffer_ms"] = clock.lap_ms();
     diagonal = scene->bounds().diagonal();
+    if (sun) {
+      ProgressBar bar("sun", progress);
+      g.direct = render_direct_light(*rays, g, *sun, bar.callback());
+      timings["direct_ms"] = clock.lap_ms();
+    }
   }
+  if (radiance_mode && g.direct.empty())
+    throw InputError(o.gbuffer_in + ": -p reflectance=radiance reads the occluders' direct light, and the file has no direct.R direct.G "
+                     "direct.B channels (docs/gbuffer.md)");
   const Falloff falloff = choose_falloff(o.falloff, diagonal);
 
   MethodOutput result;
@@ -192,6 +262,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
       {"stats", result.stats},
   };
   if (falloff.membership == Membership::Exp) summary["tau"] = falloff.effective_tau();
+  if (sun) summary["sun"] = {{"direction", to_json(sun->direction)}, {"irradiance", sun->irradiance}};
   if (scene) {
     summary["triangles"] = scene->triangle_count();
     summary["warnings"] = scene->warnings;
@@ -237,7 +308,14 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: auto-framed)");
   cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
   cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
-  cmd->add_option("--shaded", o->shaded, "Also write albedo x ambient x V with a soft key light, for viewing (sRGB)");
+  cmd->add_option("--shaded", o->shaded,
+                  "Also write albedo x ambient x V with a soft key light, for viewing (sRGB); transfer: a W La. With --sun (or direct.* "
+                  "in --gbuffer-in) the sun replaces the key light: (a V + Ld) La, transfer (a W + Ld) La");
+  cmd->add_option("--sun", o->sun,
+                  "Direct-light pass: a sun towards world direction DX,DY,DZ (normalised), with shadow rays; E = its irradiance in "
+                  "units of the ambient radiance, >= 0 (default pi: as bright as the sky). Used by --shaded, by transfer's "
+                  "-p reflectance=radiance, and stored by --gbuffer-out")
+      ->type_name("DX,DY,DZ[,E]");
   cmd->add_option("--gbuffer-out", o->gbuffer_out, "Also write the G-buffer as a multi-channel EXR (docs/gbuffer.md)");
   cmd->add_option("--ao-map", o->ao_map,
                   "Show a baked AO map (from ao bake) on the scene instead of computing AO: V = the map at each pixel's UV");

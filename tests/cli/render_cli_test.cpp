@@ -2,6 +2,10 @@
 // one-line error, a non-zero exit and no output (SPEC, "Behaviour on bad input").
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <utility>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "ao/io/image_io.h"
@@ -154,6 +158,87 @@ TEST(RenderCli, CharacteristicTheSceneCannotProvideIsAnInputError) {
     EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
     expect_one_line_error(r, needle);
     EXPECT_FALSE(std::filesystem::exists(dir / "out.png")) << args;
+  }
+}
+
+// --sun computes the direct-light pass; transfer's radiance mode reads it and --shaded adds it.
+TEST(RenderCli, SunFeedsTransfersRadianceModeAndTheShadedImage) {
+  TempDir dir;
+  const RunResult r =
+      run_ao("render --width 64 --height 48 -m transfer --sun 1,2,1 -p reflectance=radiance --shaded s.png -o v.exr --json", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "s.png"));
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["parameters"]["reflectance"], "radiance");
+  const float k = 1.0f / std::sqrt(6.0f);  // (1, 2, 1), normalised
+  EXPECT_NEAR(j["sun"]["direction"][0].get<double>(), k, 1e-6);
+  EXPECT_NEAR(j["sun"]["direction"][1].get<double>(), 2 * k, 1e-6);
+  EXPECT_NEAR(j["sun"]["irradiance"].get<double>(), 3.14159265, 1e-6);  // default: pi, as bright as the sky
+  EXPECT_TRUE(j["timings"].contains("direct_ms"));
+}
+
+// E = 0: no direct light, so the radiance mode is eq. 9 and gives the albedo mode's image exactly.
+TEST(RenderCli, SunOfZeroIrradianceLeavesTransferUnchanged) {
+  TempDir dir;
+  const std::string common = "render --width 64 --height 48 -m transfer -R 0.5 ";
+  ASSERT_EQ(run_ao(common + "-o albedo.exr", dir.path()).exit_code, 0);
+  const RunResult r = run_ao(common + "--sun 0,1,0,0 -p reflectance=radiance -o radiance.exr", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image<float> a = read_image(dir / "albedo.exr"), b = read_image(dir / "radiance.exr");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "pixel " << i;
+}
+
+// A compositor's path with a direct pass: the G-buffer EXR carries direct.*, and the radiance mode
+// on the file gives the image of the run that computed it.
+TEST(RenderCli, DirectPassRoundTripsThroughTheGBufferFile) {
+  TempDir dir;
+  const std::string method = " -m transfer -p reflectance=radiance -R 0.5 ";
+  ASSERT_EQ(run_ao("render --width 64 --height 48 --sun 1,2,1,2" + method + "-o direct.exr --gbuffer-out g.exr", dir.path()).exit_code, 0);
+  const RunResult r = run_ao("render --gbuffer-in g.exr" + method + "-o fromfile.exr", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image<float> a = read_image(dir / "direct.exr"), b = read_image(dir / "fromfile.exr");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "pixel " << i;
+}
+
+TEST(RenderCli, RadianceModeWithoutADirectPassSaysHowToGetOne) {
+  TempDir dir;
+  RunResult r = run_ao("render" + kSmall + "-m transfer -p reflectance=radiance -o v.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "--sun");
+  EXPECT_FALSE(std::filesystem::exists(dir / "v.png"));
+  ASSERT_EQ(run_ao("render" + kSmall + "-m transfer -o v.png --gbuffer-out g.exr", dir.path()).exit_code, 0);
+  std::filesystem::remove(dir / "v.png");
+  r = run_ao("render --gbuffer-in g.exr -m transfer -p reflectance=radiance -o v.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "direct.R direct.G direct.B");
+  EXPECT_FALSE(std::filesystem::exists(dir / "v.png"));
+  r = run_ao("render --gbuffer-in g.exr -m transfer --sun 0,1,0 -o v.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "--sun traces shadow rays in the scene");
+  r = run_ao("render" + kSmall + "-m transfer -p reflectance=sunny -o v.png", dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  expect_one_line_error(r, "reflectance");
+}
+
+TEST(RenderCli, BadSunsAreOneLineErrors) {
+  TempDir dir;
+  for (const auto& [sun, needle] : std::vector<std::pair<std::string, std::string>>{{"0,0,0", "no length"},
+                                                                                   {"1,nan,0", "not a finite"},
+                                                                                   {"1,inf,0", "not a finite"},
+                                                                                   {"1e39,0,0", "not a finite"},
+                                                                                   {"0,1,0,-1", ">= 0"},
+                                                                                   {"0,1,0,inf", "not a finite"},
+                                                                                   {"1,2", "3 or 4 numbers"},
+                                                                                   {"1,2,3,4,5", "3 or 4 numbers"},
+                                                                                   {"1,2,3,", "not a number"},
+                                                                                   {"x,1,0", "not a number"},
+                                                                                   {"1,,0", "not a number"}}) {
+    const RunResult r = run_ao("render plane" + kSmall + "-m transfer --sun=" + sun + " -o v.png", dir.path());
+    EXPECT_EQ(r.exit_code, 1) << sun << ": " << r.err;
+    expect_one_line_error(r, needle);
+    EXPECT_FALSE(std::filesystem::exists(dir / "v.png")) << sun;
   }
 }
 

@@ -93,6 +93,62 @@ TEST(GBufferExr, RoundTripKeepsEveryChannelExactly) {
   }
 }
 
+// The direct-light pass (direct.R direct.G direct.B) is optional: kept exactly when there, absent
+// (empty) when not written, and written only when the G-buffer has one.
+TEST(GBufferExr, DirectLightPassRoundTripsExactlyAndIsOptional) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  write_gbuffer_exr(dir / "none.exr", g);
+  EXPECT_TRUE(read_gbuffer_exr(dir / "none.exr").direct.empty());
+
+  g.direct = Image<Vec3>(g.width(), g.height());
+  for (std::size_t i = 0; i < g.direct.size(); ++i)
+    if (g.coverage[i]) g.direct[i] = {0.01f * static_cast<float>(i % 97), 2.5f, 1e-8f * static_cast<float>(i)};  // > 1 is allowed
+  write_gbuffer_exr(dir / "g.exr", g);
+  const GBuffer back = read_gbuffer_exr(dir / "g.exr");
+  ASSERT_EQ(back.direct.width(), g.width());
+  ASSERT_EQ(back.direct.height(), g.height());
+  for (std::size_t i = 0; i < g.direct.size(); ++i) ASSERT_EQ(back.direct[i], g.direct[i]) << "pixel " << i;
+
+  write_gbuffer_exr(dir / "left-out.exr", g, {.direct = false});
+  EXPECT_TRUE(read_gbuffer_exr(dir / "left-out.exr").direct.empty());
+}
+
+TEST(GBufferExr, BadDirectLightPassIsAnError) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  g.direct = Image<Vec3>(g.width(), g.height());
+  ASSERT_TRUE(g.covered(24, 16));
+  g.direct(24, 16).y = -0.5f;  // light is never negative
+  write_gbuffer_exr(dir / "neg.exr", g);
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "neg.exr"); }, dir / "neg.exr", "pixel (24, 16)");
+  g.direct(24, 16).y = std::numeric_limits<float>::quiet_NaN();
+  write_gbuffer_exr(dir / "nan.exr", g);
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "nan.exr"); }, dir / "nan.exr", "direct radiance");
+  // Background pixels are background whatever the file holds.
+  ASSERT_FALSE(g.covered(0, 0));
+  g.direct(24, 16).y = 0.0f;
+  g.direct(0, 0) = {-1.0f, -1.0f, -1.0f};
+  write_gbuffer_exr(dir / "bg.exr", g);
+  EXPECT_EQ(read_gbuffer_exr(dir / "bg.exr").direct(0, 0), (Vec3{0, 0, 0}));
+
+  // Two of the three channels: rename direct.G in the header to direct.H (same length, same
+  // channel order, so the file stays readable).
+  g.direct(0, 0) = {};
+  write_gbuffer_exr(dir / "g.exr", g);
+  std::string bytes;
+  {
+    std::ifstream in(dir / "g.exr", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::size_t at = bytes.find(std::string("direct.G\0", 9));
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 7] = 'H';
+  std::ofstream(dir / "partial.exr", std::ios::binary) << bytes;
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "partial.exr"); }, dir / "partial.exr",
+                                          "needs all of direct.R direct.G direct.B");
+}
+
 TEST(GBufferExr, RoundTripRecoversTheCamera) {
   TempDir dir;
   const Camera camera = test_camera();

@@ -19,6 +19,11 @@ struct GBuffer {
   Image<std::uint32_t> object_id;  ///< 1 + index of the mesh in its scene; 0 where not covered.
   Image<std::uint8_t> coverage;    ///< 1 where a surface is visible, 0 for background.
   Image<Vec2> uv;                  ///< First UV set of the visible surface; (0,0) where not covered or the mesh has none.
+  /// Optional direct-light pass: the radiance Ld the visible surface reflects of direct lights
+  /// (sun, point lights; not the ambient light), per channel, in units of the ambient radiance La
+  /// (Ld = 1: as bright as the sky), >= 0; 0 where not covered. Empty (the default) = no such
+  /// pass. Read by ambient transfer's radiance mode (transfer.h) and by shading.
+  Image<Vec3> direct;
 
   GBuffer() = default;
   explicit GBuffer(const Camera& cam)

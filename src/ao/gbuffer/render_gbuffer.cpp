@@ -116,6 +116,7 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, GBuffer& g, const 
   camera.validate();
   if (g.width() != camera.width || g.height() != camera.height || g.position.width() != camera.width) g = GBuffer(camera);
   g.camera = camera;
+  g.direct = Image<Vec3>();  // belongs to the lighting of the previous view: render_direct_light makes a new one
   const Frame basis = camera.basis();
   const RayGenerator gen(camera, basis);
   ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);

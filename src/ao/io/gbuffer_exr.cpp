@@ -166,7 +166,11 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
   const bool has_albedo = has("albedo.R") && has("albedo.G") && has("albedo.B");
   const bool has_id = has("id");
   const bool has_a = has("A");
-  std::vector<float> z(n, kInfinity), nx(n, 0.0f), ny(n, 0.0f), nz(n, 0.0f), px, py, pz, ar, ag, ab, a;
+  const int direct_channels = int{has("direct.R")} + int{has("direct.G")} + int{has("direct.B")};
+  if (direct_channels != 0 && direct_channels != 3)
+    throw InputError(path.string() + ": the direct-light pass needs all of direct.R direct.G direct.B (the file has: " + channel_list(channels) + ")");
+  const bool has_direct = direct_channels == 3;
+  std::vector<float> z(n, kInfinity), nx(n, 0.0f), ny(n, 0.0f), nz(n, 0.0f), px, py, pz, ar, ag, ab, a, dr, dg, db;
   std::vector<std::uint32_t> id;
   std::vector<ExrChannelTarget> targets = {{"Z", Imf::FLOAT, z.data()},
                                            {"N.X", Imf::FLOAT, nx.data()},
@@ -186,6 +190,11 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
     add("albedo.G", ag);
     add("albedo.B", ab);
   }
+  if (has_direct) {
+    add("direct.R", dr);
+    add("direct.G", dg);
+    add("direct.B", db);
+  }
   if (has_a) add("A", a);
   if (has_id) {
     id.assign(n, 0u);
@@ -194,6 +203,7 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
   read_exr_channels(file, w, targets);
 
   GBuffer g(camera);
+  if (has_direct) g.direct = Image<Vec3>(w.width, w.height);  // 0 where not covered
   const Frame basis = camera.basis();
   for (int y = 0; y < w.height; ++y) {
     for (int x = 0; x < w.width; ++x) {
@@ -214,6 +224,12 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
       if (!is_finite(position)) bad_pixel(path, x, y, "position P = " + format_vec(position) + " is not finite");
       const Vec3 albedo = has_albedo ? Vec3{ar[i], ag[i], ab[i]} : Vec3{kDefaultAlbedo, kDefaultAlbedo, kDefaultAlbedo};
       if (!is_finite(albedo)) bad_pixel(path, x, y, "albedo = " + format_vec(albedo) + " is not finite");
+      if (has_direct) {
+        const Vec3 d{dr[i], dg[i], db[i]};
+        if (!is_finite(d) || d.x < 0 || d.y < 0 || d.z < 0)
+          bad_pixel(path, x, y, "direct radiance = " + format_vec(d) + " is not finite and >= 0");
+        g.direct(x, y) = d;
+      }
 
       g.position(x, y) = position;
       g.depth(x, y) = depth;
@@ -232,7 +248,7 @@ void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWrit
   const int width = g.width(), height = g.height();
   const auto same_size = [&](const auto& image) { return image.width() == width && image.height() == height; };
   if (width < 1 || height < 1 || !same_size(g.position) || !same_size(g.depth) || !same_size(g.normal) || !same_size(g.albedo) ||
-      !same_size(g.object_id) || !same_size(g.coverage))
+      !same_size(g.object_id) || !same_size(g.coverage) || (!g.direct.empty() && !same_size(g.direct)))
     throw InputError(path.string() + ": G-buffer images do not all match the camera's " + std::to_string(width) + "x" +
                      std::to_string(height) + " pixels");
 
@@ -269,6 +285,7 @@ void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWrit
   if (opt.albedo) insert_vec3("albedo.R", "albedo.G", "albedo.B", g.albedo);
   if (opt.object_ids) insert("id", Imf::UINT, g.object_id.data(), sizeof(std::uint32_t));
   if (opt.coverage) insert("A", Imf::FLOAT, alpha.data(), sizeof(float));
+  if (opt.direct && !g.direct.empty()) insert_vec3("direct.R", "direct.G", "direct.B", g.direct);
   write_exr_atomically(path, header, frame);
 }
 

@@ -184,8 +184,10 @@ const std::array kMethods{
                screen_space_defaults<VolumetricParams>, run_volumetric,
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; }},
     // W approaches the obscurance of the same membership as the albedo goes to 0.
-    MethodInfo{"transfer", "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance", false,
-               screen_space_defaults<TransferParams>, run_transfer,
+    MethodInfo{"transfer",
+               "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance; "
+               "-p reflectance=radiance adds the light of sunlit occluders (needs --sun)",
+               false, screen_space_defaults<TransferParams>, run_transfer,
                [](const Falloff& requested, const nlohmann::json&) { return requested; }},
     // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.
     MethodInfo{"cone", "voxel cone tracing: parity voxelization in bit columns, cones of spheres, prisms by popcount (Dalla Favera & Celes)", true,

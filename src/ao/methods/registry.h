@@ -51,7 +51,9 @@ inline constexpr const char* kCharacteristicParam = "characteristic";
 std::span<const std::string_view> characteristic_names();
 
 struct MethodOutput {
-  Image<float> visibility;  ///< V in [0,1] per pixel; 1 where the G-buffer is not covered.
+  /// V in [0,1] per pixel; 1 where the G-buffer is not covered. (Transfer's radiance mode: the
+  /// luminance of W, which exceeds 1 where sunlit occluders send more light than the sky.)
+  Image<float> visibility;
   Image<Vec3> color;        ///< Optional RGB result (e.g. ambient transfer's W per channel); empty if none.
   std::map<std::string, Image<float>> extras;  ///< Optional further outputs by name (e.g. "obscurance").
   nlohmann::json stats;     ///< Method-specific numbers for --json (rays, standard errors, ...).

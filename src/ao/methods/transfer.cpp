@@ -42,24 +42,36 @@ void TransferParams::validate() const {
   validate_interleave_options(interleave, "transfer");
 }
 
+namespace {
+const char* reflectance_name(TransferReflectance r) { return r == TransferReflectance::Radiance ? "radiance" : "albedo"; }
+}  // namespace
+
 void to_json(nlohmann::json& j, const TransferParams& p) {
   j = {{"samples", p.samples},
        {"ray_steps", p.ray_steps},
        {"silhouette_elimination", p.silhouette_elimination},
        {"bias", p.bias},
-       {"albedo_scale", p.albedo_scale}};
+       {"albedo_scale", p.albedo_scale},
+       {"reflectance", reflectance_name(p.reflectance)}};
   add_interleave_options(j, p.interleave);
 }
 
 void from_json(const nlohmann::json& j, TransferParams& p) {
-  require_known_keys(j, {"samples", "ray_steps", "silhouette_elimination", "bias", "albedo_scale", "interleave", "filter", "filter_depth_limit"},
-                     "transfer");
+  require_known_keys(
+      j, {"samples", "ray_steps", "silhouette_elimination", "bias", "albedo_scale", "reflectance", "interleave", "filter", "filter_depth_limit"},
+      "transfer");
   try {
     if (j.contains("samples")) p.samples = j.at("samples").get<int>();
     if (j.contains("ray_steps")) p.ray_steps = j.at("ray_steps").get<int>();
     if (j.contains("silhouette_elimination")) p.silhouette_elimination = j.at("silhouette_elimination").get<bool>();
     if (j.contains("bias")) p.bias = j.at("bias").get<float>();
     if (j.contains("albedo_scale")) p.albedo_scale = j.at("albedo_scale").get<float>();
+    if (j.contains("reflectance")) {
+      const std::string r = j.at("reflectance").get<std::string>();
+      if (r != "albedo" && r != "radiance")
+        throw InputError("transfer: reflectance must be \"albedo\" (eq. 9) or \"radiance\" (adds the occluders' direct light), got \"" + r + "\"");
+      p.reflectance = r == "radiance" ? TransferReflectance::Radiance : TransferReflectance::Albedo;
+    }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("transfer: bad parameter type: ") + e.what());
   }
@@ -77,10 +89,14 @@ namespace {
 // the exact 32-entry palette when the image has one, else in place from the caller's image).
 // Each step is its own short loop over the lanes (projection; depth gather; test; accumulation):
 // fused, GCC 12 sinks the gathers into branches and the loop no longer if-converts.
-template <class Characteristic>
+// kDirect (radiance mode): the blocked ray also reads the direct radiance Ld~ at the same pixel
+// into gain_* (the numerator term of docs/methods/transfer.md's eq. 9'); never with a palette,
+// which knows the occluder's albedo but not its pixel.
+template <class Characteristic, bool kDirect>
 void transfer_row(const Characteristic ch, const ScreenProjection projection, const PixelRow& row, const ContainmentSamples& s, int m,
                   float far_limit, const float* __restrict albedo, const std::uint32_t* __restrict packed, const float* __restrict palette,
-                  int row_base, float* __restrict open, float* __restrict lost_r, float* __restrict lost_g, float* __restrict lost_b) {
+                  const float* __restrict direct, int row_base, float* __restrict open, float* __restrict lost_r, float* __restrict lost_g,
+                  float* __restrict lost_b, float* __restrict gain_r, float* __restrict gain_g, float* __restrict gain_b) {
   constexpr bool kDepthBuffer = std::is_same_v<Characteristic, DepthBufferCharacteristic>;
   const float inv_m = 1.0f / static_cast<float>(m);
   const int count = row.count;
@@ -153,9 +169,19 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       _mm512_mask_storeu_ps(lost_r + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_r + k0), ar));
       _mm512_mask_storeu_ps(lost_g + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_g + k0), ag));
       _mm512_mask_storeu_ps(lost_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_b + k0), ab));
+      if constexpr (kDirect) {
+        // (1 - I) Ld~ in the numerator of eq. 9' (docs/methods/transfer.md): Ld at the occluder's pixel.
+        const __m512i a = _mm512_mullo_epi32(atv, _mm512_set1_epi32(3));
+        const __m512 dr = _mm512_mask_i32gather_ps(zero, blocked, a, direct, 4);
+        const __m512 dg = _mm512_mask_i32gather_ps(zero, blocked, a, direct + 1, 4);
+        const __m512 db = _mm512_mask_i32gather_ps(zero, blocked, a, direct + 2, 4);
+        _mm512_mask_storeu_ps(gain_r + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, gain_r + k0), dr));
+        _mm512_mask_storeu_ps(gain_g + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, gain_g + k0), dg));
+        _mm512_mask_storeu_ps(gain_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, gain_b + k0), db));
+      }
     }
 #endif
-    (void)packed, (void)palette;
+    (void)packed, (void)palette, (void)direct, (void)gain_r, (void)gain_g, (void)gain_b;
 // Lane k writes only its own accumulators; the gathers read the (read-only) albedo.
 #pragma GCC ivdep
     for (int k = k0; k < count; ++k) {
@@ -166,6 +192,11 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       lost_r[k] += blocked * albedo[a];
       lost_g[k] += blocked * albedo[a + 1];
       lost_b[k] += blocked * albedo[a + 2];
+      if constexpr (kDirect) {  // (1 - I) Ld~ in the numerator of eq. 9'
+        gain_r[k] += blocked * direct[a];
+        gain_g[k] += blocked * direct[a + 1];
+        gain_b[k] += blocked * direct[a + 2];
+      }
     }
   }
 }
@@ -178,15 +209,19 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
 // independent, so the core keeps several gathers in flight.) The test point of step j is the
 // sample scaled by j/m, p = x + (j/m)(X T + Y B + Z N) (sec. 4), evaluated in the order of
 // containment_ao's kernel and with its projection, so with m = 1 both give the same I bit for bit.
+// kDirect: the radiance mode (transfer.h), with `packed` null (the occluder's pixel is needed to
+// read Ld~ there), three more masked gathers (Ld~ R, G, B) per blocked ray and its own finish;
+// the albedo mode (kDirect = false) is compiled exactly as before the mode existed.
 // GCC 12 reports the deliberately undefined pass-through operand of _mm512_cvttps_epi32 as
 // "maybe uninitialized" (its intrinsics header initialises it from itself).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+template <bool kDirect>
 void transfer_row_depth_avx512(const ScreenProjection& projection, const float* __restrict depth, const PixelRow& row,
                                const ContainmentSamples& s, int m, float far_limit, const float* __restrict albedo,
-                               const std::uint32_t* __restrict packed, const float* __restrict palette, const int* index, float n,
-                               float albedo_scale, float* __restrict out_r, float* __restrict out_g, float* __restrict out_b,
-                               float* __restrict out_o) {
+                               const std::uint32_t* __restrict packed, const float* __restrict palette, const float* __restrict direct,
+                               const int* index, float n, float albedo_scale, float* __restrict out_r, float* __restrict out_g,
+                               float* __restrict out_b, float* __restrict out_o) {
   const __m512 scale_x = _mm512_set1_ps(projection.scale_x), scale_y = _mm512_set1_ps(projection.scale_y);
   const __m512 centre_x = _mm512_set1_ps(projection.centre_x), centre_y = _mm512_set1_ps(projection.centre_y);
   const __m512 width = _mm512_set1_ps(static_cast<float>(projection.width)), height = _mm512_set1_ps(static_cast<float>(projection.height));
@@ -205,6 +240,8 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
     const __m512 nx = load(row.nx), ny = load(row.ny), nz = load(row.nz);
     const __m512 minus_bias = _mm512_sub_ps(zero, load(row.bias));
     __m512 open_v = zero, lr = zero, lg = zero, lb = zero;
+    __m512 gr = zero, gg = zero, gb = zero;  // sum (1 - I) Ld~ (kDirect)
+    (void)gr, (void)gg, (void)gb, (void)direct;
     for (int i = 0; i < s.size(); ++i) {
       const auto si = static_cast<std::size_t>(i);
       // Sec. 4: nearest occluded test wins; steps run from the far end inwards, each occluded one
@@ -267,14 +304,32 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
       lr = _mm512_mask_add_ps(lr, blocked, lr, ar);
       lg = _mm512_mask_add_ps(lg, blocked, lg, ag);
       lb = _mm512_mask_add_ps(lb, blocked, lb, ab);
+      if constexpr (kDirect) {
+        // (1 - I) Ld~ in the numerator of eq. 9', at the same occluder pixel as a~.
+        const __m512i a = _mm512_mullo_epi32(at, _mm512_set1_epi32(3));
+        gr = _mm512_mask_add_ps(gr, blocked, gr, _mm512_mask_i32gather_ps(zero, blocked, a, direct, 4));
+        gg = _mm512_mask_add_ps(gg, blocked, gg, _mm512_mask_i32gather_ps(zero, blocked, a, direct + 1, 4));
+        gb = _mm512_mask_add_ps(gb, blocked, gb, _mm512_mask_i32gather_ps(zero, blocked, a, direct + 2, 4));
+      }
     }
     // Eq. 9 as in the generic path below, and O = sum I / n (eq. 5), scattered to the entries' pixels.
     const __m512 nv = _mm512_set1_ps(n), scale = _mm512_set1_ps(albedo_scale);
-    const __mmask16 lit = _mm512_mask_cmp_ps_mask(live, open_v, zero, _CMP_GT_OQ);
-    auto ratio = [&](__m512 lost) { return _mm512_maskz_min_ps(lit, _mm512_div_ps(open_v, _mm512_fnmadd_ps(scale, lost, nv)), one); };
     // Stored, then copied out lane by lane: cheaper than a scatter (microcoded on current cores).
     alignas(64) float wr[16], wg[16], wb[16], o[16];
-    _mm512_store_ps(wr, ratio(lr)), _mm512_store_ps(wg, ratio(lg)), _mm512_store_ps(wb, ratio(lb));
+    if constexpr (kDirect) {
+      // (sum I + scale sum (1 - I) Ld~) / (n - scale sum (1 - I) a~), 0 unless both are > 0 (as
+      // radiance_ratio below), not clamped: lit occluders can send more than the sky would.
+      auto ratio = [&](__m512 lost, __m512 gain) {
+        const __m512 num = _mm512_fmadd_ps(scale, gain, open_v), den = _mm512_fnmadd_ps(scale, lost, nv);
+        const __mmask16 ok = _mm512_mask_cmp_ps_mask(_mm512_mask_cmp_ps_mask(live, num, zero, _CMP_GT_OQ), den, zero, _CMP_GT_OQ);
+        return _mm512_maskz_div_ps(ok, num, den);
+      };
+      _mm512_store_ps(wr, ratio(lr, gr)), _mm512_store_ps(wg, ratio(lg, gg)), _mm512_store_ps(wb, ratio(lb, gb));
+    } else {
+      const __mmask16 lit = _mm512_mask_cmp_ps_mask(live, open_v, zero, _CMP_GT_OQ);
+      auto ratio = [&](__m512 lost) { return _mm512_maskz_min_ps(lit, _mm512_div_ps(open_v, _mm512_fnmadd_ps(scale, lost, nv)), one); };
+      _mm512_store_ps(wr, ratio(lr)), _mm512_store_ps(wg, ratio(lg)), _mm512_store_ps(wb, ratio(lb));
+    }
     _mm512_store_ps(o, _mm512_div_ps(open_v, nv));
     for (int k = 0; k < std::min(16, row.count - k0); ++k) {
       const int at_pixel = index[k0 + k];
@@ -346,6 +401,11 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
   params.validate();
   const int w = g.width(), h = g.height();
   if (indirect.width() != w || indirect.height() != h) throw InputError("transfer: the indirect reflectance image must have the G-buffer's size");
+  const bool radiance = params.reflectance == TransferReflectance::Radiance;
+  if (radiance && g.direct.empty())
+    throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
+  if (radiance && (g.direct.width() != w || g.direct.height() != h))
+    throw InputError("transfer: the G-buffer's direct-light pass must have its size");
   const ContainmentSamples s = make_containment_samples(params.samples, falloff);
   const std::array<Rotation, 16> rotations = interleave_rotations(seed, params.interleave.interleave);
   const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;  // AT 4.3
@@ -357,10 +417,12 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
   // A view of the reflectance: RGB triples, read in place (Vec3 is three packed floats).
   static_assert(sizeof(Vec3) == 3 * sizeof(float));
   const float* albedo = &indirect.data()->x;
+  const float* direct = radiance ? &g.direct.data()->x : nullptr;  // Ld~, radiance mode only
 #if defined(__AVX512F__)
   alignas(64) std::array<float, 96> palette_rgb{};
+  // The radiance mode reads Ld~ at the occluder's pixel, which a palette index does not give.
   const std::uint32_t* packed =
-      make_palette(indirect, g.depth, buffers.depth_and_palette, palette_rgb) ? buffers.depth_and_palette.data() : nullptr;
+      !radiance && make_palette(indirect, g.depth, buffers.depth_and_palette, palette_rgb) ? buffers.depth_and_palette.data() : nullptr;
   const float* palette_rgb_ptr = palette_rgb.data();
 #else
   const std::uint32_t* packed = nullptr;
@@ -381,7 +443,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     const ScreenProjection local_projection = projection;
     PixelRow row;
     std::vector<int> index;  // compacted entry -> offset from t.x0 (AVX-512 depth-buffer path)
-    alignas(64) std::array<float, kTile> open, lost_r, lost_g, lost_b;
+    alignas(64) std::array<float, kTile> open, lost_r, lost_g, lost_b, gain_r, gain_g, gain_b;
     for (int y = t.y0; y < t.y1; ++y) {
       const std::size_t base = static_cast<std::size_t>(y) * w + t.x0;
       for (float* plane : {raw_r, raw_g, raw_b, raw_o}) std::fill(plane + base, plane + base + (t.x1 - t.x0), 1.0f);  // uncovered: 1
@@ -390,15 +452,27 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
         load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
         // The packed words hold the G-buffer's depth: used when that is the depth this reads.
         const std::uint32_t* depth_packed = local_ch.depth == g.depth.data() ? packed : nullptr;
-        transfer_row_depth_avx512(local_projection, local_ch.depth, row, s, m, far_limit, albedo, depth_packed, palette_rgb.data(), index.data(), n,
-                                  scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
+        if (radiance)
+          transfer_row_depth_avx512<true>(local_projection, local_ch.depth, row, s, m, far_limit, albedo, nullptr, palette_rgb.data(), direct,
+                                          index.data(), n, scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
+        else
+          transfer_row_depth_avx512<false>(local_projection, local_ch.depth, row, s, m, far_limit, albedo, depth_packed, palette_rgb.data(),
+                                           nullptr, index.data(), n, scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
         continue;
       }
 #endif
       row.load(g, y, t.x0, t.x1, rotations, params.bias);
       open.fill(0.0f), lost_r.fill(0.0f), lost_g.fill(0.0f), lost_b.fill(0.0f);
-      transfer_row(local_ch, local_projection, row, s, m, far_limit, albedo, packed, palette_rgb_ptr, static_cast<int>(base), open.data(),
-                   lost_r.data(), lost_g.data(), lost_b.data());
+      if (radiance) {
+        gain_r.fill(0.0f), gain_g.fill(0.0f), gain_b.fill(0.0f);
+        transfer_row<Characteristic, true>(local_ch, local_projection, row, s, m, far_limit, albedo, nullptr, palette_rgb_ptr, direct,
+                                           static_cast<int>(base), open.data(), lost_r.data(), lost_g.data(), lost_b.data(), gain_r.data(),
+                                           gain_g.data(), gain_b.data());
+      } else {
+        transfer_row<Characteristic, false>(local_ch, local_projection, row, s, m, far_limit, albedo, packed, palette_rgb_ptr, nullptr,
+                                            static_cast<int>(base), open.data(), lost_r.data(), lost_g.data(), lost_b.data(), nullptr, nullptr,
+                                            nullptr);
+      }
       for (int k = 0; k < row.count; ++k) {
         const auto ks = static_cast<std::size_t>(k);
         if (!row.covered[ks]) continue;
@@ -406,10 +480,25 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
         // Eq. 9. The denominator is >= sum I since a~ <= 1; with no open ray at all W = 0 (0/0 when
         // every ray is blocked by white surfaces: no sky light ever enters).
         auto ratio = [&](float lost) { return o > 0 ? std::min(o / (n - scale * lost), 1.0f) : 0.0f; };
+        // The radiance mode (transfer.h): the occluders' direct light joins the numerator. Not
+        // clamped (lit occluders can send more light than the sky they hide); 0 when nothing
+        // arrives, or when the denominator is 0 (every ray blocked by white surfaces: with light
+        // arriving, the bounces of eq. 6 then sum to infinity). With Ld~ = 0 the same value as
+        // ratio(): num = o, and o > 0 implies den >= o > 0 for a~ <= 1, where the clamp does nothing.
+        auto radiance_ratio = [&](float lost, float gain) {
+          const float num = o + scale * gain, den = n - scale * lost;
+          return num > 0 && den > 0 ? num / den : 0.0f;
+        };
         const std::size_t i = base + ks;
-        raw_r[i] = ratio(lost_r[ks]);
-        raw_g[i] = ratio(lost_g[ks]);
-        raw_b[i] = ratio(lost_b[ks]);
+        if (radiance) {
+          raw_r[i] = radiance_ratio(lost_r[ks], gain_r[ks]);
+          raw_g[i] = radiance_ratio(lost_g[ks], gain_g[ks]);
+          raw_b[i] = radiance_ratio(lost_b[ks], gain_b[ks]);
+        } else {
+          raw_r[i] = ratio(lost_r[ks]);
+          raw_g[i] = ratio(lost_g[ks]);
+          raw_b[i] = ratio(lost_b[ks]);
+        }
         raw_o[i] = o / n;  // eq. 5 from the same tests
       }
     }

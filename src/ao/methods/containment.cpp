@@ -14,7 +14,9 @@ namespace ao {
 
 namespace {
 constexpr float kInfinityLike = 1e30f;  // below this a distance stands for -infinity (characteristic.h)
-constexpr int kTile = 64;  // pixels per row segment: four 16-lane vectors; rows of a tile share cache lines of the depth buffer
+// Tiles of 128 x 16 pixels: a row segment of eight 16-lane vectors per sample loop, and few rows
+// per tile. Measured against 64 x 64 (bench containment/0, alternated): 5.7-5.9 vs 7.5-7.9 ms.
+constexpr int kTileWidth = 128, kTileHeight = 16;
 }
 
 void ContainmentParams::validate() const {
@@ -120,7 +122,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
   const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;
   const float inv_n = 1.0f / static_cast<float>(params.samples);
   Image<float> v(w, h, 1.0f);
-  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+  parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
     const Characteristic local_ch = ch;
     PixelRow row;

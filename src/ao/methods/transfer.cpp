@@ -226,8 +226,7 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
                                float* __restrict out_b, float* __restrict out_o) {
   const __m512 scale_x = _mm512_set1_ps(projection.scale_x), scale_y = _mm512_set1_ps(projection.scale_y);
   const __m512 centre_x = _mm512_set1_ps(projection.centre_x), centre_y = _mm512_set1_ps(projection.centre_y);
-  const __m512 width = _mm512_set1_ps(static_cast<float>(projection.width)), height = _mm512_set1_ps(static_cast<float>(projection.height));
-  const __m512i row_stride = _mm512_set1_epi32(projection.width);
+  const __m512i row_stride = _mm512_set1_epi32(projection.width), rows = _mm512_set1_epi32(projection.height);
   const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), minus_one = _mm512_set1_ps(-1.0f);
   const __m512 far = _mm512_set1_ps(far_limit);
   const __m512i palette_mask = _mm512_set1_epi32(kPaletteMask);
@@ -260,12 +259,14 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
         const __m512 inv = _mm512_div_ps(minus_one, qz);
         const __m512 fx = _mm512_fmadd_ps(_mm512_mul_ps(qx, inv), scale_x, centre_x);
         const __m512 fy = _mm512_fnmadd_ps(_mm512_mul_ps(qy, inv), scale_y, centre_y);
+        // In the image iff 0 <= floor(f) < size: floor maps [-1, 0) to -1, and NaN or out-of-range
+        // values to INT_MIN, which the unsigned compares reject (the same lanes as locate's tests).
+        const __m512i ix = _mm512_cvt_roundps_epi32(fx, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+        const __m512i iy = _mm512_cvt_roundps_epi32(fy, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
         __mmask16 valid = _mm512_mask_cmp_ps_mask(live, qz, zero, _CMP_LT_OQ);
-        valid = _mm512_mask_cmp_ps_mask(valid, fx, zero, _CMP_GE_OQ);
-        valid = _mm512_mask_cmp_ps_mask(valid, fy, zero, _CMP_GE_OQ);
-        valid = _mm512_mask_cmp_ps_mask(valid, fx, width, _CMP_LT_OQ);
-        valid = _mm512_mask_cmp_ps_mask(valid, fy, height, _CMP_LT_OQ);
-        const __m512i pixel = _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(fy), row_stride), _mm512_cvttps_epi32(fx));
+        valid = _mm512_mask_cmplt_epu32_mask(valid, ix, row_stride);
+        valid = _mm512_mask_cmplt_epu32_mask(valid, iy, rows);
+        const __m512i pixel = _mm512_add_epi32(_mm512_mullo_epi32(iy, row_stride), ix);
         __m512 d;  // z* - depth(p)
         __m512i id = pixel;
         if (packed) {

@@ -68,10 +68,8 @@ TEST(Transfer, WhiteRoomCornersAreNoDarkerThanWalls) {
   EXPECT_LT(min_o, 0.7) << "the corners are occluded, yet W is 1";
 }
 
-// Eq. 9 reads a~ where the ray is first occluded, not at the shaded pixel: a grey floor in front of
-// a red wall gets red light back from it. The wall is farther from the camera than the floor, so it
-// lies above the floor in the image (earlier rows): this once read the floor's own albedo there.
-TEST(Transfer, BouncedLightTakesTheOccludersAlbedo) {
+// A grey floor in front of a red wall, seen from above the floor.
+test::SceneGBuffer red_wall() {
   Scene scene;
   scene.name = "red-wall";
   scene.meshes.push_back(make_quad({-5, 0, 5}, {5, 0, 5}, {5, 0, -1}, {-5, 0, -1}, {0.5f, 0.5f, 0.5f}));  // floor
@@ -80,20 +78,34 @@ TEST(Transfer, BouncedLightTakesTheOccludersAlbedo) {
   Camera view;
   view.eye = {0, 2.5f, 5};
   view.target = {0, 0.3f, -0.5f};
-  auto s = test::scene_gbuffer(std::move(scene), view);
-  const TransferImage t = transfer_ao(s.g, {Membership::Step, 1.0f}, {}, 5);
+  return test::scene_gbuffer(std::move(scene), view);
+}
+
+// Mean W (red, green) over the floor pixels the wall occludes (O <= 0.9).
+struct FloorMeans {
   double red = 0, green = 0;
-  int n = 0;
+  int pixels = 0;
+};
+FloorMeans floor_near_wall(const test::SceneGBuffer& s, const TransferImage& t) {
+  FloorMeans m;
   for (std::size_t i = 0; i < t.obscurance.size(); ++i) {
-    if (s.g.object_id[i] != 1 || t.obscurance[i] > 0.9f) continue;  // floor pixels the wall occludes
-    red += t.transfer[i].x;
-    green += t.transfer[i].y;
-    ++n;
+    if (s.g.object_id[i] != 1 || t.obscurance[i] > 0.9f) continue;
+    m.red += t.transfer[i].x, m.green += t.transfer[i].y, ++m.pixels;
   }
-  ASSERT_GT(n, 50) << "the view must show floor near the wall";
+  if (m.pixels > 0) m.red /= m.pixels, m.green /= m.pixels;
+  return m;
+}
+
+// Eq. 9 reads a~ where the ray is first occluded, not at the shaded pixel: a grey floor in front of
+// a red wall gets red light back from it. The wall is farther from the camera than the floor, so it
+// lies above the floor in the image (earlier rows): this once read the floor's own albedo there.
+TEST(Transfer, BouncedLightTakesTheOccludersAlbedo) {
+  const auto s = red_wall();
+  const FloorMeans m = floor_near_wall(s, transfer_ao(s.g, {Membership::Step, 1.0f}, {}, 5));
+  ASSERT_GT(m.pixels, 50) << "the view must show floor near the wall";
   // A red occluder returns light in red only (a~ = (1, 0, 0)): W_r > O = W_g. The margin is far
   // below the red gain of the pixels measured (about 0.1 at O ~ 0.8 with 12 samples).
-  EXPECT_GT(red / n, green / n + 0.02) << "mean W over " << n << " floor pixels near the wall";
+  EXPECT_GT(m.red, m.green + 0.02) << "mean W over " << m.pixels << " floor pixels near the wall";
 }
 
 // Sec. 4: I = prod_j I0(x + w r j/m). The last of the m points is the one test of m = 1, so with
@@ -298,31 +310,15 @@ TEST(Transfer, RadianceModeGrowsWithTheSunWhereOccludersAreLit) {
 // the margin is a third of the estimate. Green moves only through the floor's own (grey) light
 // where the floor is the occluder, and the 4x4 filter's mixing (measured 0.025).
 TEST(Transfer, LitRedWallMakesTheFloorRedder) {
-  Scene scene;
-  scene.name = "red-wall";
-  scene.meshes.push_back(make_quad({-5, 0, 5}, {5, 0, 5}, {5, 0, -1}, {-5, 0, -1}, {0.5f, 0.5f, 0.5f}));  // floor
-  scene.meshes.push_back(make_box({-5, 0, -1.5f}, {5, 3, -1}, {1.0f, 0.0f, 0.0f}));                     // red wall
-  validate_and_prepare(scene);
-  Camera view;
-  view.eye = {0, 2.5f, 5};
-  view.target = {0, 0.3f, -0.5f};
-  auto s = test::scene_gbuffer(std::move(scene), view);
+  auto s = red_wall();
   TransferParams p;
   p.reflectance = TransferReflectance::Radiance;
   const Falloff f{Membership::Step, 1.0f};
   auto floor_means = [&](float e) {
     s.g.direct = render_direct_light(*s.rays, s.g, Sun{normalize(Vec3{0, 1, 1}), e});
-    const TransferImage t = transfer_ao(s.g, f, p, 5);
-    double red = 0, green = 0;
-    int n = 0;
-    for (std::size_t i = 0; i < t.obscurance.size(); ++i) {
-      if (s.g.object_id[i] != 1 || t.obscurance[i] > 0.9f) continue;  // floor pixels the wall occludes
-      red += t.transfer[i].x;
-      green += t.transfer[i].y;
-      ++n;
-    }
-    EXPECT_GT(n, 50) << "the view must show floor near the wall";
-    return std::pair{red / n, green / n};
+    const FloorMeans m = floor_near_wall(s, transfer_ao(s.g, f, p, 5));
+    EXPECT_GT(m.pixels, 50) << "the view must show floor near the wall";
+    return std::pair{m.red, m.green};
   };
   const auto [red_unlit, green_unlit] = floor_means(0.0f);
   const auto [red_lit, green_lit] = floor_means(kPi);

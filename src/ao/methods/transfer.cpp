@@ -82,6 +82,25 @@ void from_json(const nlohmann::json& j, TransferParams& p) {
 
 namespace {
 
+#if defined(__AVX512F__)
+// An RGB value per blocked lane (a~, or Ld~ in the radiance mode): with a palette, `id` holds
+// palette indices and the exact float R, G, B planes of its 32 entries are looked up in registers;
+// else `id` holds pixels and the RGB image is read in place, masked (free rays read nothing).
+inline void blocked_rgb(bool by_palette, __m512i id, __mmask16 blocked, const float* palette, const float* image, __m512& r, __m512& g,
+                        __m512& b) {
+  if (by_palette) {
+    r = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), id, _mm512_loadu_ps(palette + 16));
+    g = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), id, _mm512_loadu_ps(palette + 48));
+    b = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), id, _mm512_loadu_ps(palette + 80));
+  } else {
+    const __m512i a = _mm512_mullo_epi32(id, _mm512_set1_epi32(3));
+    r = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), blocked, a, image, 4);
+    g = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), blocked, a, image + 1, 4);
+    b = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), blocked, a, image + 2, 4);
+  }
+}
+#endif
+
 // The per-row kernel: rays of sample i across the pixels of a row segment in SIMD lanes.
 // Sec. 4: I = prod_j I0(x + w r j/m), and a~ comes from the FIRST test point found occluded. The
 // tests run from the far end inwards and each occluded one overwrites `at`, so the nearest wins
@@ -151,32 +170,20 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       const __m512i atv = _mm512_maskz_loadu_epi32(live, at + k0);
       const __mmask16 blocked = _mm512_mask_cmpge_epi32_mask(live, atv, _mm512_setzero_si512());
       const __mmask16 free_rays = live & static_cast<__mmask16>(~blocked);
-      const __m512 zero = _mm512_setzero_ps();
       __m512 ar, ag, ab;
-      if (packed) {
-        // The palette index in the low bits of the pixel's packed depth word (make_palette), then
-        // the palette's exact float R, G, B planes of 32 entries, looked up in registers.
-        const __m512i idx = _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, atv, packed, 4),
-                                             _mm512_set1_epi32(kPaletteMask));
-        ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), idx, _mm512_loadu_ps(palette + 16));
-        ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), idx, _mm512_loadu_ps(palette + 48));
-        ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), idx, _mm512_loadu_ps(palette + 80));
-      } else {
-        const __m512i a = _mm512_mullo_epi32(atv, _mm512_set1_epi32(3));
-        ar = _mm512_mask_i32gather_ps(zero, blocked, a, albedo, 4);
-        ag = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 1, 4);
-        ab = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 2, 4);
-      }
+      // With a palette: the index in the low bits of the pixel's packed depth word (make_palette).
+      const __m512i id = packed ? _mm512_and_si512(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), blocked, atv, packed, 4),
+                                                   _mm512_set1_epi32(kPaletteMask))
+                                : atv;
+      blocked_rgb(packed != nullptr, id, blocked, palette, albedo, ar, ag, ab);
       _mm512_mask_storeu_ps(open + k0, free_rays, _mm512_add_ps(_mm512_maskz_loadu_ps(free_rays, open + k0), one));
       _mm512_mask_storeu_ps(lost_r + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_r + k0), ar));
       _mm512_mask_storeu_ps(lost_g + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_g + k0), ag));
       _mm512_mask_storeu_ps(lost_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, lost_b + k0), ab));
       if constexpr (kDirect) {
         // (1 - I) Ld~ in the numerator of eq. 9' (docs/methods/transfer.md): Ld at the occluder's pixel.
-        const __m512i a = _mm512_mullo_epi32(atv, _mm512_set1_epi32(3));
-        const __m512 dr = _mm512_mask_i32gather_ps(zero, blocked, a, direct, 4);
-        const __m512 dg = _mm512_mask_i32gather_ps(zero, blocked, a, direct + 1, 4);
-        const __m512 db = _mm512_mask_i32gather_ps(zero, blocked, a, direct + 2, 4);
+        __m512 dr, dg, db;
+        blocked_rgb(false, atv, blocked, nullptr, direct, dr, dg, db);
         _mm512_mask_storeu_ps(gain_r + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, gain_r + k0), dr));
         _mm512_mask_storeu_ps(gain_g + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, gain_g + k0), dg));
         _mm512_mask_storeu_ps(gain_b + k0, blocked, _mm512_add_ps(_mm512_maskz_loadu_ps(blocked, gain_b + k0), db));
@@ -293,26 +300,18 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
       }
       open_v = _mm512_mask_add_ps(open_v, live & static_cast<__mmask16>(~blocked), open_v, one);
       __m512 ar, ag, ab;
-      if (packed) {
-        ar = _mm512_permutex2var_ps(_mm512_loadu_ps(palette), at, _mm512_loadu_ps(palette + 16));
-        ag = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 32), at, _mm512_loadu_ps(palette + 48));
-        ab = _mm512_permutex2var_ps(_mm512_loadu_ps(palette + 64), at, _mm512_loadu_ps(palette + 80));
-      } else {
-        const __m512i a = _mm512_mullo_epi32(at, _mm512_set1_epi32(3));
-        ar = _mm512_mask_i32gather_ps(zero, blocked, a, albedo, 4);
-        ag = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 1, 4);
-        ab = _mm512_mask_i32gather_ps(zero, blocked, a, albedo + 2, 4);
-      }
+      blocked_rgb(packed != nullptr, at, blocked, palette, albedo, ar, ag, ab);
       // (1 - I) a~ of eq. 9's denominator.
       lr = _mm512_mask_add_ps(lr, blocked, lr, ar);
       lg = _mm512_mask_add_ps(lg, blocked, lg, ag);
       lb = _mm512_mask_add_ps(lb, blocked, lb, ab);
       if constexpr (kDirect) {
         // (1 - I) Ld~ in the numerator of eq. 9', at the same occluder pixel as a~.
-        const __m512i a = _mm512_mullo_epi32(at, _mm512_set1_epi32(3));
-        gr = _mm512_mask_add_ps(gr, blocked, gr, _mm512_mask_i32gather_ps(zero, blocked, a, direct, 4));
-        gg = _mm512_mask_add_ps(gg, blocked, gg, _mm512_mask_i32gather_ps(zero, blocked, a, direct + 1, 4));
-        gb = _mm512_mask_add_ps(gb, blocked, gb, _mm512_mask_i32gather_ps(zero, blocked, a, direct + 2, 4));
+        __m512 dr, dg, db;
+        blocked_rgb(false, at, blocked, nullptr, direct, dr, dg, db);
+        gr = _mm512_mask_add_ps(gr, blocked, gr, dr);
+        gg = _mm512_mask_add_ps(gg, blocked, gg, dg);
+        gb = _mm512_mask_add_ps(gb, blocked, gb, db);
       }
     }
     // Eq. 9 as in the generic path below, and O = sum I / n (eq. 5), scattered to the entries' pixels.

@@ -239,6 +239,15 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
   const __m512i palette_mask = _mm512_set1_epi32(kPaletteMask);
   const __m512 exactness = _mm512_set1_ps(0x1p-16f);
   const float inv_m = 1.0f / static_cast<float>(m);
+  // The sample offsets scaled to each step, (j/m)(X, Y, Z), once per row.
+  std::array<float, 3 * kMaxScreenSpaceSamples * kMaxRaySteps> offsets;
+  for (int i = 0; i < s.size(); ++i)
+    for (int j = 1; j <= m; ++j) {
+      const float f = static_cast<float>(j) * inv_m;
+      float* o = &offsets[3 * (static_cast<std::size_t>(i) * kMaxRaySteps + static_cast<std::size_t>(j - 1))];
+      const auto si = static_cast<std::size_t>(i);
+      o[0] = f * s.x[si], o[1] = f * s.y[si], o[2] = f * s.z[si];
+    }
   for (int k0 = 0; k0 < row.count; k0 += 16) {
     const __mmask16 live = static_cast<__mmask16>(row.count - k0 >= 16 ? 0xFFFF : (1u << (row.count - k0)) - 1u);
     auto load = [&](const std::vector<float>& v) { return _mm512_maskz_loadu_ps(live, v.data() + k0); };
@@ -251,14 +260,13 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
     __m512 gr = zero, gg = zero, gb = zero;  // sum (1 - I) Ld~ (kDirect)
     (void)gr, (void)gg, (void)gb, (void)direct;
     for (int i = 0; i < s.size(); ++i) {
-      const auto si = static_cast<std::size_t>(i);
       // Sec. 4: nearest occluded test wins; steps run from the far end inwards, each occluded one
       // overwriting `at`: what identifies a~, the palette index with `packed`, else the pixel.
       __m512i at = _mm512_setzero_si512();
       __mmask16 blocked = 0;
       for (int j = m; j >= 1; --j) {
-        const float f = static_cast<float>(j) * inv_m;
-        const __m512 X = _mm512_set1_ps(f * s.x[si]), Y = _mm512_set1_ps(f * s.y[si]), Z = _mm512_set1_ps(f * s.z[si]);
+        const float* o = &offsets[3 * (static_cast<std::size_t>(i) * kMaxRaySteps + static_cast<std::size_t>(j - 1))];
+        const __m512 X = _mm512_set1_ps(o[0]), Y = _mm512_set1_ps(o[1]), Z = _mm512_set1_ps(o[2]);
         const __m512 qx = _mm512_fmadd_ps(Z, nx, _mm512_fmadd_ps(Y, bx, _mm512_fmadd_ps(X, tx, px)));
         const __m512 qy = _mm512_fmadd_ps(Z, ny, _mm512_fmadd_ps(Y, by, _mm512_fmadd_ps(X, ty, py)));
         const __m512 qz = _mm512_fmadd_ps(Z, nz, _mm512_fmadd_ps(Y, bz, _mm512_fmadd_ps(X, tz, pz)));

@@ -32,6 +32,9 @@ constexpr int kTileWidth = 128, kTileHeight = 16;
 constexpr int kMaxRaySteps = 8;
 constexpr int kPaletteSize = 32;                  // distinct reflectances a packed palette holds
 constexpr std::uint32_t kPaletteMask = 0x1F;      // its index's bits in a packed depth word
+
+// Rec. 709 luminance of W: the method's scalar visibility.
+inline float luminance(Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 }
 
 void TransferParams::validate() const {
@@ -230,7 +233,7 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
                                const ContainmentSamples& s, int m, float far_limit, const float* __restrict albedo,
                                const std::uint32_t* __restrict packed, const float* __restrict palette, const float* __restrict direct,
                                const int* index, float n, float albedo_scale, float* __restrict out_r, float* __restrict out_g,
-                               float* __restrict out_b, float* __restrict out_o) {
+                               float* __restrict out_b, float* __restrict out_o, Vec3* __restrict out_rgb) {
   const __m512 scale_x = _mm512_set1_ps(projection.scale_x), scale_y = _mm512_set1_ps(projection.scale_y);
   const __m512 centre_x = _mm512_set1_ps(projection.centre_x), centre_y = _mm512_set1_ps(projection.centre_y);
   const __m512i row_stride = _mm512_set1_epi32(projection.width), rows = _mm512_set1_epi32(projection.height);
@@ -343,7 +346,12 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
     _mm512_store_ps(o, _mm512_div_ps(open_v, nv));
     for (int k = 0; k < std::min(16, row.count - k0); ++k) {
       const int at_pixel = index[k0 + k];
-      out_r[at_pixel] = wr[k], out_g[at_pixel] = wg[k], out_b[at_pixel] = wb[k], out_o[at_pixel] = o[k];
+      if (out_rgb) {  // the final images directly: W interleaved, its luminance in out_r
+        const Vec3 c{wr[k], wg[k], wb[k]};
+        out_rgb[at_pixel] = c, out_r[at_pixel] = luminance(c), out_o[at_pixel] = o[k];
+      } else {
+        out_r[at_pixel] = wr[k], out_g[at_pixel] = wg[k], out_b[at_pixel] = wb[k], out_o[at_pixel] = o[k];
+      }
     }
   }
 }
@@ -364,22 +372,45 @@ bool make_palette(const Image<Vec3>& img, const Image<float>& depth, Image<std::
   const Vec3* px = img.data();
   std::array<Vec3, kPaletteSize> entries;
   int used = 0;
-  Vec3 last_value{};
   auto find = [&](const Vec3& v) {
     int e = 0;
     while (e < used && std::memcmp(&v, &entries[static_cast<std::size_t>(e)], sizeof(Vec3)) != 0) ++e;
     return e;
   };
-  for (std::size_t i = 0; i < n; ++i) {  // the distinct values, in first-seen order
-    const Vec3 v = px[i];
-    if (i > 0 && std::memcmp(&v, &last_value, sizeof(Vec3)) == 0) continue;
-    last_value = v;
-    if (find(v) < used) continue;
-    if (used == kPaletteSize) return false;
-    entries[static_cast<std::size_t>(used++)] = v;
+  // The distinct values and the depth check, per band in parallel (a band stops at 33 values),
+  // then merged in band order, so the palette is the same for any thread count.
+  struct Band {
+    std::array<Vec3, kPaletteSize + 1> values;
+    int count = 0;
+    bool depth_ok = true;
+  };
+  constexpr std::size_t kBand = 1 << 15;
+  std::vector<Band> bands((n + kBand - 1) / kBand);
+  tbb::parallel_for(std::size_t{0}, bands.size(), [&](std::size_t b) {
+    Band& band = bands[b];
+    Vec3 last{};
+    for (std::size_t i = b * kBand; i < std::min(n, (b + 1) * kBand); ++i) {
+      const float z = depth[i];
+      band.depth_ok &= z == kInfinity || (z >= std::numeric_limits<float>::min() && z <= std::numeric_limits<float>::max());
+      const Vec3 v = px[i];
+      if (band.count > 0 && std::memcmp(&v, &last, sizeof(Vec3)) == 0) continue;
+      last = v;
+      int e = 0;
+      while (e < band.count && std::memcmp(&v, &band.values[static_cast<std::size_t>(e)], sizeof(Vec3)) != 0) ++e;
+      if (e < band.count) continue;
+      if (band.count == kPaletteSize + 1) return;  // too many: the merge fails anyway
+      band.values[static_cast<std::size_t>(band.count++)] = v;
+    }
+  });
+  for (const Band& band : bands) {
+    if (!band.depth_ok) return false;
+    for (int k = 0; k < band.count; ++k) {
+      const Vec3 v = band.values[static_cast<std::size_t>(k)];
+      if (find(v) < used) continue;
+      if (used == kPaletteSize) return false;
+      entries[static_cast<std::size_t>(used++)] = v;
+    }
   }
-  for (const float z : depth.pixels())
-    if (!(z == kInfinity || (z >= std::numeric_limits<float>::min() && z <= std::numeric_limits<float>::max()))) return false;
   packed.resize(img.width(), img.height());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
     int last = -1;
@@ -447,6 +478,14 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
   float* raw_g = buffers.scratch[1].data();
   float* raw_b = buffers.scratch[2].data();
   float* raw_o = filter ? buffers.scratch[3].data() : out.obscurance.data();
+  // Unfiltered, the AVX-512 depth-buffer kernel writes the final images itself (W interleaved, its
+  // luminance where R would go, O), and the interleave pass below is skipped.
+#if defined(__AVX512F__)
+  const bool kernel_writes_final = !filter && std::is_same_v<Characteristic, DepthBufferCharacteristic>;
+#else
+  const bool kernel_writes_final = false;
+#endif
+  Vec3* final_rgb = kernel_writes_final ? out.transfer.data() : nullptr;
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     // Local copies: their members are then known not to alias the accumulators, so the loop vectorises.
     const Characteristic local_ch = ch;
@@ -457,17 +496,23 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     for (int y = t.y0; y < t.y1; ++y) {
       const std::size_t base = static_cast<std::size_t>(y) * w + t.x0;
       for (float* plane : {raw_r, raw_g, raw_b, raw_o}) std::fill(plane + base, plane + base + (t.x1 - t.x0), 1.0f);  // uncovered: 1
+      if (final_rgb) {
+        std::fill(final_rgb + base, final_rgb + base + (t.x1 - t.x0), Vec3{1, 1, 1});
+        std::fill(raw_r + base, raw_r + base + (t.x1 - t.x0), luminance(Vec3{1, 1, 1}));
+      }
 #if defined(__AVX512F__)
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {
         load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
         // The packed words hold the G-buffer's depth: used when that is the depth this reads.
         const std::uint32_t* depth_packed = local_ch.depth == g.depth.data() ? packed : nullptr;
+        Vec3* row_rgb = final_rgb ? final_rgb + base : nullptr;
         if (radiance)
           transfer_row_depth_avx512<true>(local_projection, local_ch.depth, row, s, m, far_limit, albedo, nullptr, palette_rgb.data(), direct,
-                                          index.data(), n, scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
+                                          index.data(), n, scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base, row_rgb);
         else
           transfer_row_depth_avx512<false>(local_projection, local_ch.depth, row, s, m, far_limit, albedo, depth_packed, palette_rgb.data(),
-                                           nullptr, index.data(), n, scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base);
+                                           nullptr, index.data(), n, scale, raw_r + base, raw_g + base, raw_b + base, raw_o + base,
+                                           row_rgb);
         continue;
       }
 #endif
@@ -523,6 +568,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     const std::array<float*, 4> dst{fr, fg, fb, out.obscurance.data()};
     depth_aware_box_filter_planes(src, dst, g, effective_depth_limit(params.interleave, falloff.radius));
   }
+  if (kernel_writes_final) return out;  // the kernel wrote the final images
   // Interleave W, and its luminance over the R plane in place (each pixel reads R before writing).
   parallel_for_tiles(w, h, kTileWidth, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y)
@@ -530,7 +576,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
         const std::size_t i = static_cast<std::size_t>(y) * w + x;
         const Vec3 c{fr[i], fg[i], fb[i]};
         out.transfer[i] = c;
-        out.luminance[i] = 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+        out.luminance[i] = luminance(c);
       }
   });
   return out;

@@ -224,6 +224,10 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
 // kDirect: the radiance mode (transfer.h), with `packed` null (the occluder's pixel is needed to
 // read Ld~ there), three more masked gathers (Ld~ R, G, B) per blocked ray and its own finish;
 // the albedo mode (kDirect = false) is compiled exactly as before the mode existed.
+// GCC 12 reports the deliberately undefined pass-through operand of _mm512_cvttps_epi32 as
+// "maybe uninitialized" (its intrinsics header initialises it from itself).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 template <bool kDirect>
 void transfer_row_depth_avx512(const ScreenProjection& projection, const float* __restrict depth, const PixelRow& row,
                                const ContainmentSamples& s, int m, float far_limit, const float* __restrict albedo,
@@ -351,6 +355,7 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
     }
   }
 }
+#pragma GCC diagnostic pop
 #endif
 
 #if defined(__AVX512F__)

@@ -224,8 +224,9 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
 // kDirect: the radiance mode (transfer.h), with `packed` null (the occluder's pixel is needed to
 // read Ld~ there), three more masked gathers (Ld~ R, G, B) per blocked ray and its own finish;
 // the albedo mode (kDirect = false) is compiled exactly as before the mode existed.
-// GCC 12 reports the deliberately undefined pass-through operand of _mm512_cvttps_epi32 as
-// "maybe uninitialized" (its intrinsics header initialises it from itself).
+// GCC 12 reports the deliberately undefined pass-through operand of unmasked AVX-512 conversions
+// (_mm512_cvt_roundps_epi32 and others) as "maybe uninitialized": its intrinsics header
+// initialises it from itself.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 template <bool kDirect>

@@ -496,10 +496,14 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     alignas(64) std::array<float, kTileWidth> open, lost_r, lost_g, lost_b, gain_r, gain_g, gain_b;
     for (int y = t.y0; y < t.y1; ++y) {
       const std::size_t base = static_cast<std::size_t>(y) * w + t.x0;
-      for (float* plane : {raw_r, raw_g, raw_b, raw_o}) std::fill(plane + base, plane + base + (t.x1 - t.x0), 1.0f);  // uncovered: 1
+      // Uncovered pixels: W = O = 1. Writing the final images, only those (raw_g, raw_b unused).
+      const std::size_t end = base + static_cast<std::size_t>(t.x1 - t.x0);
       if (final_rgb) {
-        std::fill(final_rgb + base, final_rgb + base + (t.x1 - t.x0), Vec3{1, 1, 1});
-        std::fill(raw_r + base, raw_r + base + (t.x1 - t.x0), luminance(Vec3{1, 1, 1}));
+        std::fill(final_rgb + base, final_rgb + end, Vec3{1, 1, 1});
+        std::fill(raw_r + base, raw_r + end, luminance(Vec3{1, 1, 1}));
+        std::fill(raw_o + base, raw_o + end, 1.0f);
+      } else {
+        for (float* plane : {raw_r, raw_g, raw_b, raw_o}) std::fill(plane + base, plane + end, 1.0f);
       }
 #if defined(__AVX512F__)
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {

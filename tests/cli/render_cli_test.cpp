@@ -288,7 +288,7 @@ TEST(RenderCli, AbsurdOptionsAreInputErrors) {
       {"--height 0", "resolution"},
       {"--spp 0", "samples"},
       {"--spp 100000000", "samples"},
-      {"--target-error -1", "target error"},
+      {"--target-error -1", "target_error"},
       {"--radius -2", "radius"},
       {"--fov 200", "fov"},
       {"--membership cosine", "cosine"},

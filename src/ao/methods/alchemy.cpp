@@ -50,15 +50,6 @@ struct Row {
   alignas(64) std::array<float, kTileWidth> cx, cy, cz, nx, ny, nz, bias, radius_px, jitter, rot_c, rot_s, sum;
 };
 
-void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys) {
-  if (!j.is_object()) throw InputError("alchemy: parameters must be a JSON object");
-  for (const auto& [key, value] : j.items()) {
-    bool known = false;
-    for (const char* k : keys) known = known || key == k;
-    if (!known) throw InputError("alchemy: unknown parameter '" + key + "'");
-  }
-}
-
 // sqrt(x) for x in [0, 1]: std::sqrt keeps a branch to set errno on negative input, which stops the
 // sample loop from vectorising (we may not pass -fno-math-errno), so: the classic reciprocal square
 // root bit trick and two Newton steps, relative error < 5e-6 (far below a pixel at any disk radius).
@@ -75,51 +66,28 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
+const ParamTable<AlchemyParams>& alchemy_param_table() {
+  using P = Param<AlchemyParams>;
+  static const ParamTable<AlchemyParams> table{
+      "alchemy",
+      {{P::real("radius", &AlchemyParams::radius, Range::at_least(0), "world units", "r of eq. 9-10; 0 = the falloff radius R"),
+        P::integer("samples", &AlchemyParams::samples, Range::closed(1, kMaxSamples), "", "s of eq. 10: samples per pixel"),
+        P::real("intensity", &AlchemyParams::intensity, Range::at_least(0), "paper metres", "sigma of eq. 10"),
+        P::real("contrast", &AlchemyParams::contrast, Range::above(0), "", "k of eq. 10"),
+        P::real("bias", &AlchemyParams::bias, Range::at_least(0), "", "beta of eq. 10, multiplies z_C"),
+        P::real("epsilon", &AlchemyParams::epsilon, Range::above(0), "paper square metres", "epsilon of eq. 10"),
+        P::real("meter", &AlchemyParams::meter, Range::at_least(0), "world units", "world units per paper metre; 0 = r / 0.5"),
+        P::boolean("filter", &AlchemyParams::filter, "apply the cross-bilateral filter (sec. 2, pass 5)")},
+       bilateral_params<AlchemyParams>("filter_", [](AlchemyParams& p) -> BilateralParams& { return p.bilateral; })}};
+  return table;
+}
+
 void AlchemyParams::validate() const {
-  if (!(radius >= 0.0f) || !std::isfinite(radius)) throw InputError("alchemy: radius r must be >= 0 world units (0 = the falloff radius)");
-  if (samples < 1 || samples > kMaxSamples)
-    throw InputError("alchemy: samples s must be in [1, " + std::to_string(kMaxSamples) + "], got " + std::to_string(samples));
-  if (!(intensity >= 0.0f) || !std::isfinite(intensity)) throw InputError("alchemy: intensity sigma must be a finite number >= 0");
-  if (!(contrast > 0.0f) || !std::isfinite(contrast)) throw InputError("alchemy: contrast k must be a finite number > 0");
-  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("alchemy: bias beta must be a finite number >= 0");
-  if (!(epsilon > 0.0f) || !std::isfinite(epsilon)) throw InputError("alchemy: epsilon must be a finite number > 0");
-  if (!(meter >= 0.0f) || !std::isfinite(meter)) throw InputError("alchemy: meter must be >= 0 world units (0 = r / 0.5)");
+  alchemy_param_table().validate(*this);
   bilateral.validate();
 }
-
-void to_json(nlohmann::json& j, const AlchemyParams& p) {
-  j = {{"radius", p.radius},
-       {"samples", p.samples},
-       {"intensity", p.intensity},
-       {"contrast", p.contrast},
-       {"bias", p.bias},
-       {"epsilon", p.epsilon},
-       {"meter", p.meter},
-       {"filter", p.filter},
-       {"filter_taps", p.bilateral.taps},
-       {"filter_spatial_sigma", p.bilateral.spatial_sigma},
-       {"filter_plane_sigma", p.bilateral.plane_sigma}};
-}
-
-void from_json(const nlohmann::json& j, AlchemyParams& p) {
-  require_known_keys(j, {"radius", "samples", "intensity", "contrast", "bias", "epsilon", "meter", "filter", "filter_taps", "filter_spatial_sigma",
-                         "filter_plane_sigma"});
-  try {
-    if (j.contains("radius")) p.radius = j.at("radius").get<float>();
-    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
-    if (j.contains("intensity")) p.intensity = j.at("intensity").get<float>();
-    if (j.contains("contrast")) p.contrast = j.at("contrast").get<float>();
-    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
-    if (j.contains("epsilon")) p.epsilon = j.at("epsilon").get<float>();
-    if (j.contains("meter")) p.meter = j.at("meter").get<float>();
-    if (j.contains("filter")) p.filter = j.at("filter").get<bool>();
-    if (j.contains("filter_taps")) p.bilateral.taps = j.at("filter_taps").get<int>();
-    if (j.contains("filter_spatial_sigma")) p.bilateral.spatial_sigma = j.at("filter_spatial_sigma").get<float>();
-    if (j.contains("filter_plane_sigma")) p.bilateral.plane_sigma = j.at("filter_plane_sigma").get<float>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("alchemy: bad parameter type: ") + e.what());
-  }
-}
+void to_json(nlohmann::json& j, const AlchemyParams& p) { j = alchemy_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, AlchemyParams& p) { alchemy_param_table().from_json(j, p); }
 
 AlchemyConstants alchemy_constants(const AlchemyParams& p, float default_radius) {
   p.validate();

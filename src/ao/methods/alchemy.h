@@ -42,8 +42,10 @@ struct AlchemyParams {
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<AlchemyParams>& alchemy_param_table();
 void to_json(nlohmann::json& j, const AlchemyParams& p);
-/// Rejects unknown keys and wrong types with InputError.
+/// Rejects unknown keys, wrong types and values out of range with InputError.
 void from_json(const nlohmann::json& j, AlchemyParams& p);
 
 /// The constants of eq. 10 in world units, derived from the user's parameters by one pure function.

@@ -16,7 +16,7 @@ namespace ao {
 
 namespace {
 
-constexpr int kMaxTaps = 63;
+constexpr int kMaxTaps = kMaxBilateralTaps;
 // Tiles as wide as a typical image row so the inner loops are long and vectorise; 8 rows keep a
 // tile's working set (the depths of 8 + 12 rows for the vertical pass) in L1/L2.
 constexpr int kTileWidth = 512, kTileHeight = 8;
@@ -134,29 +134,17 @@ void filter_segment(const Centres& ce, int count, int taps, const float* sp, con
 
 }  // namespace
 
+const ParamTable<BilateralParams>& bilateral_param_table() {
+  static const ParamTable<BilateralParams> table{"bilateral", bilateral_params<BilateralParams>("", [](BilateralParams& p) -> BilateralParams& { return p; })};
+  return table;
+}
+
 void BilateralParams::validate() const {
-  if (taps < 1 || taps > kMaxTaps || taps % 2 == 0)
-    throw InputError("bilateral: taps must be odd and in [1, " + std::to_string(kMaxTaps) + "], got " + std::to_string(taps));
-  if (!(spatial_sigma >= 0.0f) || !std::isfinite(spatial_sigma)) throw InputError("bilateral: spatial_sigma must be >= 0 pixels (0 = taps / 4)");
-  if (!(plane_sigma > 0.0f) || !std::isfinite(plane_sigma)) throw InputError("bilateral: plane_sigma must be > 0 (a fraction of depth)");
+  bilateral_param_table().validate(*this);
+  if (taps % 2 == 0) throw InputError("bilateral: taps must be odd, got " + std::to_string(taps));
 }
-
-void to_json(nlohmann::json& j, const BilateralParams& p) {
-  j = {{"taps", p.taps}, {"spatial_sigma", p.spatial_sigma}, {"plane_sigma", p.plane_sigma}};
-}
-
-void from_json(const nlohmann::json& j, BilateralParams& p) {
-  if (!j.is_object()) throw InputError("bilateral: parameters must be a JSON object");
-  for (const auto& [key, value] : j.items())
-    if (key != "taps" && key != "spatial_sigma" && key != "plane_sigma") throw InputError("bilateral: unknown parameter '" + key + "'");
-  try {
-    if (j.contains("taps")) p.taps = j.at("taps").get<int>();
-    if (j.contains("spatial_sigma")) p.spatial_sigma = j.at("spatial_sigma").get<float>();
-    if (j.contains("plane_sigma")) p.plane_sigma = j.at("plane_sigma").get<float>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("bilateral: bad parameter type: ") + e.what());
-  }
-}
+void to_json(nlohmann::json& j, const BilateralParams& p) { j = bilateral_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, BilateralParams& p) { bilateral_param_table().from_json(j, p); }
 
 void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralParams& params) {
   params.validate();

@@ -21,8 +21,12 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
+#include "ao/core/params.h"
 
 namespace ao {
+
+/// The most taps per 1-D pass.
+inline constexpr int kMaxBilateralTaps = 63;
 
 struct BilateralParams {
   int taps = 13;               ///< Taps per 1-D pass, odd, in [1, 63]. Paper: 13 (Figure 6, Table 1). 1 = no filtering.
@@ -34,9 +38,23 @@ struct BilateralParams {
   void validate() const;
   float effective_spatial_sigma() const { return spatial_sigma > 0 ? spatial_sigma : static_cast<float>(taps) / 4.0f; }
 };
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<BilateralParams>& bilateral_param_table();
 void to_json(nlohmann::json& j, const BilateralParams& p);
-/// Rejects unknown keys and wrong types with InputError.
+/// Rejects unknown keys, wrong types and values out of range with InputError.
 void from_json(const nlohmann::json& j, BilateralParams& p);
+
+/// The filter's rows of a parameter table for a struct P that holds a BilateralParams, reached by
+/// `ref` (a function P& -> BilateralParams&), with keys prefixed by `prefix` (alchemy: "filter_").
+template <class P, class Ref>
+std::vector<Param<P>> bilateral_params(const std::string& prefix, Ref ref) {
+  return {Param<P>::integer(prefix + "taps", [ref](P& p) -> int& { return ref(p).taps; }, Range::closed(1, kMaxBilateralTaps), "",
+                            "taps per 1-D pass, odd; 1 = no filtering (paper: 13)"),
+          Param<P>::real(prefix + "spatial_sigma", [ref](P& p) -> float& { return ref(p).spatial_sigma; }, Range::at_least(0), "pixels",
+                         "Gaussian standard deviation across taps; 0 = taps / 4"),
+          Param<P>::real(prefix + "plane_sigma", [ref](P& p) -> float& { return ref(p).plane_sigma; }, Range::above(0), "",
+                         "tangent-plane distance scale, as a fraction of the centre's depth")};
+}
 
 /// Filters `values` (one per G-buffer pixel; same size as `gbuffer`, InputError otherwise) in place
 /// with a horizontal then a vertical pass. Tiles run in parallel; the result does not depend on the

@@ -329,28 +329,6 @@ std::vector<ConeSetup::Disk> poisson_disk(int n) {
   return out;
 }
 
-void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys) {
-  if (!j.is_object()) throw InputError("cone: parameters must be a JSON object");
-  for (const auto& [key, value] : j.items()) {
-    bool known = false;
-    for (const char* k : keys) known = known || key == k;
-    if (!known) throw InputError("cone: unknown parameter '" + key + "'");
-  }
-}
-
-template <class E>
-E parse_enum(const nlohmann::json& j, const char* key, std::initializer_list<std::pair<const char*, E>> names) {
-  const std::string s = j.at(key).get<std::string>();
-  std::string valid;
-  for (const auto& [name, value] : names) {
-    if (s == name) return value;
-    valid += (valid.empty() ? "" : "|") + std::string(name);
-  }
-  throw InputError(std::string("cone: ") + key + " must be " + valid + ", got '" + s + "'");
-}
-
-const char* name(ConeQuality q) { return q == ConeQuality::Low ? "low" : q == ConeQuality::High ? "high" : "medium"; }
-
 }  // namespace
 
 ConeParams cone_preset(ConeQuality q) {
@@ -373,58 +351,35 @@ ConeParams ConeParams::resolved() const {
 
 VoxelizeOptions ConeParams::voxelize_options(float r_max) const { return {columns, depth_bits, open_meshes, slab_fraction * r_max}; }
 
+const ParamTable<ConeParams>& cone_param_table() {
+  using P = Param<ConeParams>;
+  static const ParamTable<ConeParams> table{
+      "cone",
+      {P::enumeration<ConeQuality>("preset", &ConeParams::preset, {{"low", ConeQuality::Low}, {"medium", ConeQuality::Medium}, {"high", ConeQuality::High}},
+                                   "Table I; fills cones, spheres, prisms left null"),
+       P::optional_integer("cones", &ConeParams::cones, Range::closed(1, 64), "", "cones per pixel; null = from the preset (6)"),
+       P::optional_integer("spheres", &ConeParams::spheres, Range::closed(1, 16), "", "spheres per cone; null = from the preset (3/5/7)"),
+       P::optional_integer("prisms", &ConeParams::prisms, Range::closed(1, 64), "", "prisms per sphere; null = from the preset (3/6/12)"),
+       P::real("aperture_deg", &ConeParams::aperture_deg, Range::open(0, 90), "degrees", "full apex angle of each cone (sec. III-C: 30)"),
+       P::integer("depth_bits", &ConeParams::depth_bits, Range::closed(32, 1024), "", "voxels per grid column, a multiple of 32 (paper: 128)"),
+       P::integer("columns", &ConeParams::columns, Range::closed(8, 4096), "", "grid columns per side (world) or along the longer image side (eye)"),
+       P::enumeration<GridSpace>("grid", &ConeParams::grid, {{"world", GridSpace::World}, {"eye", GridSpace::Eye}}, "world grid, or the paper's eye-space grid"),
+       P::enumeration<ConeWeighting>("weighting", &ConeParams::weighting, {{"cosine", ConeWeighting::Cosine}, {"uniform", ConeWeighting::Uniform}},
+                                     "cone cells of equal cosine-weighted measure or of equal solid angle"),
+       P::enumeration<OpenMeshes>("open_meshes", &ConeParams::open_meshes, {{"slab", OpenMeshes::Slab}, {"parity", OpenMeshes::Parity}},
+                                  "thicken open meshes into slabs, or voxelize them by parity as the paper"),
+       P::real("slab_fraction", &ConeParams::slab_fraction, Range::open_closed(0, 16), "R_max", "thickness of the slab behind open meshes"),
+       P::boolean("jitter", &ConeParams::jitter, "rotate the cone and prism patterns per pixel (noise instead of banding)")}};
+  return table;
+}
+
 void ConeParams::validate() const {
-  if (cones && (*cones < 1 || *cones > 64)) throw InputError("cone: cones must be in [1, 64] (null = preset), got " + std::to_string(*cones));
-  if (spheres && (*spheres < 1 || *spheres > 16))
-    throw InputError("cone: spheres must be in [1, 16] (null = preset), got " + std::to_string(*spheres));
-  if (prisms && (*prisms < 1 || *prisms > 64)) throw InputError("cone: prisms must be in [1, 64] (null = preset), got " + std::to_string(*prisms));
-  if (!(aperture_deg > 0.0f && aperture_deg < 90.0f))
-    throw InputError("cone: aperture_deg must be in (0, 90) degrees, got " + std::to_string(aperture_deg));
-  if (!(slab_fraction > 0.0f && slab_fraction <= 16.0f)) throw InputError("cone: slab_fraction must be in (0, 16], got " + std::to_string(slab_fraction));
+  cone_param_table().validate(*this);
   voxelize_options(1.0f).validate();
 }
 
-void to_json(nlohmann::json& j, const ConeParams& p) {
-  const auto opt = [](const std::optional<int>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
-  j = {{"preset", name(p.preset)},
-       {"cones", opt(p.cones)},
-       {"spheres", opt(p.spheres)},
-       {"prisms", opt(p.prisms)},
-       {"aperture_deg", p.aperture_deg},
-       {"depth_bits", p.depth_bits},
-       {"columns", p.columns},
-       {"grid", p.grid == GridSpace::World ? "world" : "eye"},
-       {"weighting", p.weighting == ConeWeighting::Cosine ? "cosine" : "uniform"},
-       {"open_meshes", p.open_meshes == OpenMeshes::Slab ? "slab" : "parity"},
-       {"slab_fraction", p.slab_fraction},
-       {"jitter", p.jitter}};
-}
-
-void from_json(const nlohmann::json& j, ConeParams& p) {
-  require_known_keys(j, {"preset", "cones", "spheres", "prisms", "aperture_deg", "depth_bits", "columns", "grid", "weighting", "open_meshes",
-                         "slab_fraction", "jitter"});
-  try {
-    if (j.contains("preset"))
-      p.preset = parse_enum<ConeQuality>(j, "preset", {{"low", ConeQuality::Low}, {"medium", ConeQuality::Medium}, {"high", ConeQuality::High}});
-    const auto opt = [&](const char* key, std::optional<int>& v) {
-      if (j.contains(key)) v = j.at(key).is_null() ? std::nullopt : std::optional<int>(j.at(key).get<int>());
-    };
-    opt("cones", p.cones);
-    opt("spheres", p.spheres);
-    opt("prisms", p.prisms);
-    if (j.contains("aperture_deg")) p.aperture_deg = j.at("aperture_deg").get<float>();
-    if (j.contains("depth_bits")) p.depth_bits = j.at("depth_bits").get<int>();
-    if (j.contains("columns")) p.columns = j.at("columns").get<int>();
-    if (j.contains("grid")) p.grid = parse_enum<GridSpace>(j, "grid", {{"world", GridSpace::World}, {"eye", GridSpace::Eye}});
-    if (j.contains("weighting"))
-      p.weighting = parse_enum<ConeWeighting>(j, "weighting", {{"cosine", ConeWeighting::Cosine}, {"uniform", ConeWeighting::Uniform}});
-    if (j.contains("open_meshes")) p.open_meshes = parse_enum<OpenMeshes>(j, "open_meshes", {{"slab", OpenMeshes::Slab}, {"parity", OpenMeshes::Parity}});
-    if (j.contains("slab_fraction")) p.slab_fraction = j.at("slab_fraction").get<float>();
-    if (j.contains("jitter")) p.jitter = j.at("jitter").get<bool>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("cone: bad parameter type: ") + e.what());
-  }
-}
+void to_json(nlohmann::json& j, const ConeParams& p) { j = cone_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, ConeParams& p) { cone_param_table().from_json(j, p); }
 
 ConeSetup derive_cone_setup(const ConeParams& p) {
   ConeSetup s;

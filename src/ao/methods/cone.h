@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ao/core/gbuffer.h"
+#include "ao/core/params.h"
 #include "ao/core/progress.h"
 #include "ao/methods/voxelize.h"
 
@@ -59,8 +60,10 @@ struct ConeParams {
 /// Keys: preset ("low"|"medium"|"high"), cones, spheres, prisms, aperture_deg, depth_bits, columns,
 /// grid ("world"|"eye"), weighting ("cosine"|"uniform"), open_meshes ("slab"|"parity"), slab_fraction, jitter.
 void to_json(nlohmann::json& j, const ConeParams& p);
-/// Rejects unknown keys, wrong types and unknown enum names with InputError.
+/// Rejects unknown keys, wrong types, unknown enum names and values out of range with InputError.
 void from_json(const nlohmann::json& j, ConeParams& p);
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<ConeParams>& cone_param_table();
 
 /// Table I: low (6 cones, 3 spheres, 3 prisms), medium (6, 5, 6), high (6, 7, 12); other fields default.
 ConeParams cone_preset(ConeQuality q);

@@ -20,29 +20,22 @@ constexpr float kInfinityLike = 1e30f;  // below this a distance stands for -inf
 constexpr int kTileWidth = 128, kTileHeight = 16;
 }
 
-void ContainmentParams::validate() const {
-  if (samples < 1 || samples > kMaxScreenSpaceSamples)
-    throw InputError("containment: samples must be in [1, " + std::to_string(kMaxScreenSpaceSamples) + "], got " + std::to_string(samples));
-  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("containment: bias must be a finite number >= 0 of world units (0 = auto)");
-  validate_interleave_options(interleave, "containment");
+const ParamTable<ContainmentParams>& containment_param_table() {
+  using P = Param<ContainmentParams>;
+  static const ParamTable<ContainmentParams> table{
+      "containment",
+      {{P::integer("samples", &ContainmentParams::samples, Range::closed(1, kMaxScreenSpaceSamples), "", "n in eq. 5: test points per pixel"),
+        P::boolean("silhouette_elimination", &ContainmentParams::silhouette_elimination,
+                   "AT 4.3: a point is occluded only if the surface in front of it is less than R in front"),
+        P::real("bias", &ContainmentParams::bias, Range::at_least(0), "world units",
+                "depth-test bias; 0 = auto (one pixel footprint x (1 + tan theta_v))")},
+       interleave_params(&ContainmentParams::interleave)}};
+  return table;
 }
 
-void to_json(nlohmann::json& j, const ContainmentParams& p) {
-  j = {{"samples", p.samples}, {"silhouette_elimination", p.silhouette_elimination}, {"bias", p.bias}};
-  add_interleave_options(j, p.interleave);
-}
-
-void from_json(const nlohmann::json& j, ContainmentParams& p) {
-  require_known_keys(j, {"samples", "silhouette_elimination", "bias", "interleave", "filter", "filter_depth_limit"}, "containment");
-  try {
-    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
-    if (j.contains("silhouette_elimination")) p.silhouette_elimination = j.at("silhouette_elimination").get<bool>();
-    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("containment: bad parameter type: ") + e.what());
-  }
-  read_interleave_options(j, p.interleave, "containment");
-}
+void ContainmentParams::validate() const { containment_param_table().validate(*this); }
+void to_json(nlohmann::json& j, const ContainmentParams& p) { j = containment_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, ContainmentParams& p) { containment_param_table().from_json(j, p); }
 
 void load_pixel_row_simd(PixelRow& row, std::vector<int>& index, const GBuffer& g, int y, int first, int last,
                          const std::array<Rotation, 16>& rotations, float bias_world, bool frame) {

@@ -33,8 +33,10 @@ struct ContainmentParams {
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<ContainmentParams>& containment_param_table();
 void to_json(nlohmann::json& j, const ContainmentParams& p);
-/// Rejects unknown keys and wrong types with InputError.
+/// Rejects unknown keys, wrong types and values out of range with InputError.
 void from_json(const nlohmann::json& j, ContainmentParams& p);
 
 /// V per pixel (1 where not covered) with characteristic function `ch` (characteristic.h;

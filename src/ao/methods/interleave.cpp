@@ -13,36 +13,6 @@
 
 namespace ao {
 
-void add_interleave_options(nlohmann::json& j, const InterleaveOptions& o) {
-  j["interleave"] = o.interleave;
-  j["filter"] = o.filter;
-  j["filter_depth_limit"] = o.filter_depth_limit;
-}
-
-void read_interleave_options(const nlohmann::json& j, InterleaveOptions& o, const char* method) {
-  try {
-    if (j.contains("interleave")) o.interleave = j.at("interleave").get<bool>();
-    if (j.contains("filter")) o.filter = j.at("filter").get<bool>();
-    if (j.contains("filter_depth_limit")) o.filter_depth_limit = j.at("filter_depth_limit").get<float>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string(method) + ": bad parameter type: " + e.what());
-  }
-}
-
-void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys, const char* method) {
-  if (!j.is_object()) throw InputError(std::string(method) + ": parameters must be a JSON object");
-  for (const auto& [key, value] : j.items()) {
-    bool known = false;
-    for (const char* k : keys) known = known || key == k;
-    if (!known) throw InputError(std::string(method) + ": unknown parameter '" + key + "'");
-  }
-}
-
-void validate_interleave_options(const InterleaveOptions& o, const char* method) {
-  if (!(o.filter_depth_limit >= 0.0f) || !std::isfinite(o.filter_depth_limit))
-    throw InputError(std::string(method) + ": filter_depth_limit must be a finite number >= 0 of world units (0 = R/4)");
-}
-
 float effective_depth_limit(const InterleaveOptions& o, float radius) { return o.filter_depth_limit > 0 ? o.filter_depth_limit : 0.25f * radius; }
 
 void PixelRow::load(const GBuffer& g, int row, int first, int last, const std::array<Rotation, 16>& rotations, float bias_world) {

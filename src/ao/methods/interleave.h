@@ -13,6 +13,7 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
+#include "ao/core/params.h"
 #include "ao/methods/samples.h"
 
 namespace ao {
@@ -24,12 +25,17 @@ struct InterleaveOptions {
   float filter_depth_limit = 0.0f; ///< Neighbours whose depth differs by more than this are skipped, world units; 0 = R/4.
 };
 
-/// Writes the options' fields into `j` (a method's parameter object).
-void add_interleave_options(nlohmann::json& j, const InterleaveOptions& o);
-/// Reads the options' fields present in `j`; InputError (naming `method`) for wrong types.
-void read_interleave_options(const nlohmann::json& j, InterleaveOptions& o, const char* method);
-/// Validates the options (the depth limit must be finite and >= 0).
-void validate_interleave_options(const InterleaveOptions& o, const char* method);
+/// The options' rows of a method's parameter table (core/params.h), for a Params struct P that
+/// holds them in `member`: interleave, filter, filter_depth_limit.
+template <class P>
+std::vector<Param<P>> interleave_params(InterleaveOptions P::*member) {
+  return {Param<P>::boolean("interleave", [member](P& p) -> bool& { return (p.*member).interleave; },
+                            "sec. 4.2: 16 rotations in a 4x4 pattern; false: one rotation everywhere"),
+          Param<P>::boolean("filter", [member](P& p) -> bool& { return (p.*member).filter; },
+                            "4x4 depth-aware box filter after an interleaved pass (ignored without interleave)"),
+          Param<P>::real("filter_depth_limit", [member](P& p) -> float& { return (p.*member).filter_depth_limit; }, Range::at_least(0),
+                         "world units", "the filter skips neighbours whose depth differs by more than this; 0 = R/4")};
+}
 /// The depth limit the filter uses: `filter_depth_limit`, or R/4 when it is 0.
 float effective_depth_limit(const InterleaveOptions& o, float radius);
 

@@ -1,6 +1,7 @@
 #include "ao/methods/registry.h"
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,24 @@ nlohmann::json screen_space_defaults() {
   return j;
 }
 
+// A screen-space method's parameters: its table's, then the registry's characteristic choice.
+template <auto Table>
+std::vector<ParamSpec> screen_space_specs() {
+  std::vector<ParamSpec> s = Table().specs();
+  ParamSpec c;
+  c.name = kCharacteristicParam;
+  c.type = ParamType::Enum;
+  for (std::string_view n : kCharacteristicNames) c.enum_names.emplace_back(n);
+  c.help = "the characteristic function I(p): depth buffer, the scene's implicit surface or height field, or depth x height field";
+  c.default_value = kCharacteristicNames[0];
+  s.push_back(c);
+  return s;
+}
+template <auto Table>
+std::vector<ParamSpec> table_specs() {
+  return Table().specs();
+}
+
 // Splits the characteristic choice off `j` (what remains goes to the method's from_json, which
 // rejects unknown keys) and returns it; absent means the depth buffer.
 CharacteristicKind take_characteristic(nlohmann::json& j, std::string_view method) {
@@ -61,6 +80,24 @@ CharacteristicKind take_characteristic(nlohmann::json& j, std::string_view metho
     for (std::size_t k = 0; k < kCharacteristicNames.size(); ++k)
       if (value.get<std::string>() == kCharacteristicNames[k]) return static_cast<CharacteristicKind>(k);
   throw InputError(std::string(method) + ": characteristic must be one of " + names + ", got " + value.dump());
+}
+
+// `j` read into Params, validated and written back; a screen-space method's characteristic choice
+// is checked and kept.
+template <auto Table, bool kScreenSpace>
+nlohmann::json canonical(const nlohmann::json& j) {
+  using Params = typename std::decay_t<decltype(Table())>::Struct;
+  nlohmann::json rest = j;
+  std::optional<nlohmann::json> characteristic;
+  if (kScreenSpace && rest.is_object() && rest.contains(kCharacteristicParam)) {
+    characteristic = rest.at(kCharacteristicParam);
+    take_characteristic(rest, Table().owner());
+  }
+  Params p = rest.get<Params>();
+  p.validate();
+  nlohmann::json out = p;
+  if (kScreenSpace) out[kCharacteristicParam] = characteristic ? *characteristic : nlohmann::json(kCharacteristicNames[0]);
+  return out;
 }
 
 // Builds the characteristic function of `kind` in the G-buffer's camera space and calls
@@ -175,30 +212,33 @@ MethodOutput run_alchemy(const MethodInput& in, const nlohmann::json& j) {
 const std::array kMethods{
     MethodInfo{"raytraced", "ground truth: Monte Carlo obscurance with Embree rays, any membership", true,
                [] { return nlohmann::json(RaytracedParams{}); }, run_raytraced,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
+               [](const Falloff& requested, const nlohmann::json&) { return requested; }, table_specs<raytraced_param_table>, canonical<raytraced_param_table, false>},
     MethodInfo{"containment", "containment tests against the depth buffer, r = mu^-1(xi) (volumetric AO eq. 5), any membership", false,
                screen_space_defaults<ContainmentParams>, run_containment,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
+               [](const Falloff& requested, const nlohmann::json&) { return requested; }, screen_space_specs<containment_param_table>, canonical<containment_param_table, true>},
     // Volumetric AO implies mu = (r/R)^3 with the same R (tangent sphere of radius R/2: distances up to R).
     MethodInfo{"volumetric", "free volume of the tangent sphere by pipes along z (volumetric AO eq. 6-7); implies cubic membership", false,
                screen_space_defaults<VolumetricParams>, run_volumetric,
-               [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; }},
+               [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; },
+               screen_space_specs<volumetric_param_table>, canonical<volumetric_param_table, true>},
     // W approaches the obscurance of the same membership as the albedo goes to 0.
     MethodInfo{"transfer",
                "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance; "
                "-p reflectance=radiance adds the light of sunlit occluders (needs --sun)",
                false, screen_space_defaults<TransferParams>, run_transfer,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
+               [](const Falloff& requested, const nlohmann::json&) { return requested; }, screen_space_specs<transfer_param_table>, canonical<transfer_param_table, true>},
     // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.
     MethodInfo{"cone", "voxel cone tracing: parity voxelization in bit columns, cones of spheres, prisms by popcount (Dalla Favera & Celes)", true,
                [] { return nlohmann::json(ConeParams{}); }, run_cone,
-               [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; }},
+               [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; },
+               table_specs<cone_param_table>, canonical<cone_param_table, false>},
     // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r.
     MethodInfo{"alchemy", "Alchemy AO: screen-space disk samples, eq. 10 (sigma, k, beta, epsilon, r, s) + 13-tap cross-bilateral filter", false,
                [] { return nlohmann::json(AlchemyParams{}); }, run_alchemy,
                [](const Falloff& requested, const nlohmann::json& params) {
                  return alchemy_reference_falloff(params.get<AlchemyParams>(), requested.radius);
-               }},
+               },
+               table_specs<alchemy_param_table>, canonical<alchemy_param_table, false>},
 };
 
 }  // namespace

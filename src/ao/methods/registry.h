@@ -7,11 +7,13 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/core/params.h"
 #include "ao/core/progress.h"
 #include "ao/scene/analytic.h"
 
@@ -71,6 +73,13 @@ struct MethodInfo {
   /// ray-traced reference, from the falloff the user asked for and the method's parameters (e.g.
   /// volumetric AO implies the cubic membership; cone tracing is classical AO with R = R_max).
   Falloff (*reference_falloff)(const Falloff& requested, const nlohmann::json& params);
+  /// The parameters as described by the method's parameter table (core/params.h), in table order,
+  /// plus the registry's own (kCharacteristicParam); null for a method without a table.
+  std::vector<ParamSpec> (*param_specs)() = nullptr;
+  /// Reads `params` through the method's table (InputError, one line, for an unknown key, a wrong
+  /// type or a value out of range) and writes every parameter back: what --json echoes. Null for
+  /// a method without a table.
+  nlohmann::json (*canonical_params)(const nlohmann::json& params) = nullptr;
 };
 
 /// All methods, in the order --help lists them.

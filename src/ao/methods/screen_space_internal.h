@@ -1,22 +1,15 @@
 // Internals of the screen-space methods (containment, volumetric, transfer), not installed: the
 // per-pixel setup their kernels share, a row of pixels as structure-of-arrays (position, rotated
-// tangent frame, depth bias) so that the loops over samples run across pixels in SIMD lanes, and
-// the parameter objects' key check.
+// tangent frame, depth bias) so that the loops over samples run across pixels in SIMD lanes.
 #pragma once
 
 #include <array>
-#include <initializer_list>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/methods/samples.h"
 
 namespace ao {
-
-/// InputError naming `method` and the key when `j` is not an object or has a key not in `keys`.
-void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys, const char* method);
 
 /// A run of pixels [x0, x0 + count) of one row, structure-of-arrays. Uncovered pixels get a
 /// harmless dummy point far in front of the camera and covered = 0.

@@ -39,51 +39,26 @@ constexpr std::uint32_t kPaletteMask = 0x1F;      // its index's bits in a packe
 inline float luminance(Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 }
 
-void TransferParams::validate() const {
-  if (samples < 1 || samples > kMaxScreenSpaceSamples)
-    throw InputError("transfer: samples must be in [1, " + std::to_string(kMaxScreenSpaceSamples) + "], got " + std::to_string(samples));
-  if (ray_steps < 1 || ray_steps > kMaxRaySteps)
-    throw InputError("transfer: ray_steps (m) must be in [1, " + std::to_string(kMaxRaySteps) + "], got " + std::to_string(ray_steps));
-  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("transfer: bias must be a finite number >= 0 of world units (0 = auto)");
-  if (!(albedo_scale >= 0.0f && albedo_scale <= 1.0f)) throw InputError("transfer: albedo_scale must be in [0, 1]");
-  validate_interleave_options(interleave, "transfer");
+const ParamTable<TransferParams>& transfer_param_table() {
+  using P = Param<TransferParams>;
+  static const ParamTable<TransferParams> table{
+      "transfer",
+      {{P::integer("samples", &TransferParams::samples, Range::closed(1, kMaxScreenSpaceSamples), "", "n in eq. 9: rays per pixel"),
+        P::integer("ray_steps", &TransferParams::ray_steps, Range::closed(1, kMaxRaySteps), "", "m: containment tests per ray (sec. 4)"),
+        P::boolean("silhouette_elimination", &TransferParams::silhouette_elimination,
+                   "AT 4.3: occluded only if the surface in front is less than R in front"),
+        P::real("bias", &TransferParams::bias, Range::at_least(0), "world units", "depth-test bias; 0 = auto (as containment)"),
+        P::real("albedo_scale", &TransferParams::albedo_scale, Range::closed(0, 1), "", "multiplies a~ and Ld~ (W -> O as it goes to 0)"),
+        P::enumeration<TransferReflectance>("reflectance", &TransferParams::reflectance,
+                                            {{"albedo", TransferReflectance::Albedo}, {"radiance", TransferReflectance::Radiance}},
+                                            "what occluders send back: albedo (eq. 9) or also their direct light (sec. 4.1, needs --sun)")},
+       interleave_params(&TransferParams::interleave)}};
+  return table;
 }
 
-namespace {
-const char* reflectance_name(TransferReflectance r) { return r == TransferReflectance::Radiance ? "radiance" : "albedo"; }
-}  // namespace
-
-void to_json(nlohmann::json& j, const TransferParams& p) {
-  j = {{"samples", p.samples},
-       {"ray_steps", p.ray_steps},
-       {"silhouette_elimination", p.silhouette_elimination},
-       {"bias", p.bias},
-       {"albedo_scale", p.albedo_scale},
-       {"reflectance", reflectance_name(p.reflectance)}};
-  add_interleave_options(j, p.interleave);
-}
-
-void from_json(const nlohmann::json& j, TransferParams& p) {
-  require_known_keys(
-      j, {"samples", "ray_steps", "silhouette_elimination", "bias", "albedo_scale", "reflectance", "interleave", "filter", "filter_depth_limit"},
-      "transfer");
-  try {
-    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
-    if (j.contains("ray_steps")) p.ray_steps = j.at("ray_steps").get<int>();
-    if (j.contains("silhouette_elimination")) p.silhouette_elimination = j.at("silhouette_elimination").get<bool>();
-    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
-    if (j.contains("albedo_scale")) p.albedo_scale = j.at("albedo_scale").get<float>();
-    if (j.contains("reflectance")) {
-      const std::string r = j.at("reflectance").get<std::string>();
-      if (r != "albedo" && r != "radiance")
-        throw InputError("transfer: reflectance must be \"albedo\" (eq. 9) or \"radiance\" (adds the occluders' direct light), got \"" + r + "\"");
-      p.reflectance = r == "radiance" ? TransferReflectance::Radiance : TransferReflectance::Albedo;
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("transfer: bad parameter type: ") + e.what());
-  }
-  read_interleave_options(j, p.interleave, "transfer");
-}
+void TransferParams::validate() const { transfer_param_table().validate(*this); }
+void to_json(nlohmann::json& j, const TransferParams& p) { j = transfer_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, TransferParams& p) { transfer_param_table().from_json(j, p); }
 
 namespace {
 

@@ -58,8 +58,10 @@ struct TransferParams {
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<TransferParams>& transfer_param_table();
 void to_json(nlohmann::json& j, const TransferParams& p);
-/// Rejects unknown keys and wrong types with InputError.
+/// Rejects unknown keys, wrong types and values out of range with InputError.
 void from_json(const nlohmann::json& j, TransferParams& p);
 
 struct TransferImage {

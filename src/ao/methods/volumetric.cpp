@@ -18,38 +18,24 @@ namespace {
 constexpr int kTile = 64;
 }
 
-void VolumetricParams::validate() const {
-  if (samples < 1 || samples > kMaxScreenSpaceSamples)
-    throw InputError("volumetric: samples must be in [1, " + std::to_string(kMaxScreenSpaceSamples) + "], got " + std::to_string(samples));
-  if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("volumetric: bias must be a finite number >= 0 of world units (0 = auto)");
-  validate_interleave_options(interleave, "volumetric");
+const ParamTable<VolumetricParams>& volumetric_param_table() {
+  using P = Param<VolumetricParams>;
+  static const ParamTable<VolumetricParams> table{
+      "volumetric",
+      {{P::integer("samples", &VolumetricParams::samples, Range::closed(1, kMaxScreenSpaceSamples), "", "n in eq. 6-7: pipes per pixel"),
+        P::enumeration<VolumeNormalizer>("normalizer", &VolumetricParams::normalizer,
+                                         {{"wis", VolumeNormalizer::WeightedImportance}, {"analytic", VolumeNormalizer::Analytic}},
+                                         "F in eq. 7: the samples' own estimate of the sphere's volume (wis) or the exact one"),
+        P::boolean("silhouette_elimination", &VolumetricParams::silhouette_elimination,
+                   "AT 4.3 for pipes: a surface more than R in front of a pipe's entry does not occlude it"),
+        P::real("bias", &VolumetricParams::bias, Range::at_least(0), "world units", "added to z* - z_entry; 0 = auto (as containment)")},
+       interleave_params(&VolumetricParams::interleave)}};
+  return table;
 }
 
-void to_json(nlohmann::json& j, const VolumetricParams& p) {
-  j = {{"samples", p.samples},
-       {"normalizer", p.normalizer == VolumeNormalizer::Analytic ? "analytic" : "wis"},
-       {"silhouette_elimination", p.silhouette_elimination},
-       {"bias", p.bias}};
-  add_interleave_options(j, p.interleave);
-}
-
-void from_json(const nlohmann::json& j, VolumetricParams& p) {
-  require_known_keys(j, {"samples", "normalizer", "silhouette_elimination", "bias", "interleave", "filter", "filter_depth_limit"}, "volumetric");
-  try {
-    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
-    if (j.contains("normalizer")) {
-      const std::string n = j.at("normalizer").get<std::string>();
-      if (n == "wis") p.normalizer = VolumeNormalizer::WeightedImportance;
-      else if (n == "analytic") p.normalizer = VolumeNormalizer::Analytic;
-      else throw InputError("volumetric: normalizer must be \"wis\" or \"analytic\", got \"" + n + "\"");
-    }
-    if (j.contains("silhouette_elimination")) p.silhouette_elimination = j.at("silhouette_elimination").get<bool>();
-    if (j.contains("bias")) p.bias = j.at("bias").get<float>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("volumetric: bad parameter type: ") + e.what());
-  }
-  read_interleave_options(j, p.interleave, "volumetric");
-}
+void VolumetricParams::validate() const { volumetric_param_table().validate(*this); }
+void to_json(nlohmann::json& j, const VolumetricParams& p) { j = volumetric_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, VolumetricParams& p) { volumetric_param_table().from_json(j, p); }
 
 template <class Characteristic>
 Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float radius, const VolumetricParams& params, std::uint32_t seed) {

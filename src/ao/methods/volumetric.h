@@ -43,8 +43,10 @@ struct VolumetricParams {
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<VolumetricParams>& volumetric_param_table();
 void to_json(nlohmann::json& j, const VolumetricParams& p);
-/// Rejects unknown keys and wrong types with InputError.
+/// Rejects unknown keys, wrong types and values out of range with InputError.
 void from_json(const nlohmann::json& j, VolumetricParams& p);
 
 /// V per pixel (1 where not covered) for radius R = falloff.radius (the membership is implied:

@@ -89,42 +89,28 @@ VisibilityEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 p
   return {static_cast<float>(acc.mean()), static_cast<float>(acc.std_error()), acc.n};
 }
 
-void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys, const char* what) {
-  if (!j.is_object()) throw InputError(std::string(what) + ": parameters must be a JSON object");
-  for (const auto& [key, value] : j.items()) {
-    bool known = false;
-    for (const char* k : keys) known = known || key == k;
-    if (!known) throw InputError(std::string(what) + ": unknown parameter '" + key + "'");
-  }
-}
-
 }  // namespace
 
+const ParamTable<RaytracedParams>& raytraced_param_table() {
+  using P = Param<RaytracedParams>;
+  static const ParamTable<RaytracedParams> table{
+      "raytraced",
+      {P::integer("samples", &RaytracedParams::samples, Range::closed(1, kMaxSamples), "", "rays per pixel; with target_error, the most a pixel may take"),
+       P::real("target_error", &RaytracedParams::target_error, Range::closed(0, 0.5), "",
+               "stop a pixel once the standard error of its mean is at most this; 0 = off"),
+       P::integer("min_samples", &RaytracedParams::min_samples, Range::closed(16, kMaxSamples), "",
+                  "with target_error: rays a pixel takes before it may stop (at most samples)"),
+       P::real("offset", &RaytracedParams::offset, Range::at_least(0), "world units", "ray origin offset along the normal; 0 = RayScene's default")}};
+  return table;
+}
+
 void RaytracedParams::validate() const {
-  if (samples < 1 || samples > kMaxSamples)
-    throw InputError("raytraced: samples must be in [1, " + std::to_string(kMaxSamples) + "], got " + std::to_string(samples));
-  if (!(target_error >= 0.0f && target_error <= 0.5f))
-    throw InputError("raytraced: target error must be in [0, 0.5] (0 = off), got " + std::to_string(target_error));
-  if (target_error > 0 && (min_samples < 16 || min_samples > samples))
-    throw InputError("raytraced: min samples must be in [16, samples], got " + std::to_string(min_samples));
-  if (!(offset >= 0.0f) || !std::isfinite(offset)) throw InputError("raytraced: offset must be a finite number >= 0");
+  raytraced_param_table().validate(*this);
+  if (target_error > 0 && min_samples > samples)
+    throw InputError("raytraced: min_samples must be at most samples (" + std::to_string(samples) + "), got " + std::to_string(min_samples));
 }
-
-void to_json(nlohmann::json& j, const RaytracedParams& p) {
-  j = {{"samples", p.samples}, {"target_error", p.target_error}, {"min_samples", p.min_samples}, {"offset", p.offset}};
-}
-
-void from_json(const nlohmann::json& j, RaytracedParams& p) {
-  require_known_keys(j, {"samples", "target_error", "min_samples", "offset"}, "raytraced");
-  try {
-    if (j.contains("samples")) p.samples = j.at("samples").get<int>();
-    if (j.contains("target_error")) p.target_error = j.at("target_error").get<float>();
-    if (j.contains("min_samples")) p.min_samples = j.at("min_samples").get<int>();
-    if (j.contains("offset")) p.offset = j.at("offset").get<float>();
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("raytraced: bad parameter type: ") + e.what());
-  }
-}
+void to_json(nlohmann::json& j, const RaytracedParams& p) { j = raytraced_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, RaytracedParams& p) { raytraced_param_table().from_json(j, p); }
 
 VisibilityEstimate estimate_visibility(const RayScene& rs, Vec3 p, Vec3 n, const Falloff& falloff, const RaytracedParams& params,
                                        std::uint32_t seed) {

@@ -11,6 +11,7 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/core/params.h"
 #include "ao/core/progress.h"
 #include "ao/reference/ray_scene.h"
 
@@ -25,8 +26,10 @@ struct RaytracedParams {
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+/// The parameter table (core/params.h): JSON keys, ranges, defaults, help.
+const ParamTable<RaytracedParams>& raytraced_param_table();
 void to_json(nlohmann::json& j, const RaytracedParams& p);
-/// Rejects unknown keys and wrong types with InputError.
+/// Rejects unknown keys, wrong types and values out of range with InputError.
 void from_json(const nlohmann::json& j, RaytracedParams& p);
 
 /// The estimate at one point.

@@ -1,0 +1,137 @@
+#include "ao/core/params.h"
+
+#include <charconv>
+#include <cstdlib>
+
+#include "ao/core/error.h"
+
+namespace ao {
+
+namespace {
+
+// A bound of a range as the shortest decimal (ranges are written as float or int literals).
+std::string number_text(double v) {
+  if (v == std::floor(v) && std::abs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+  return float_text(static_cast<float>(v));
+}
+
+const char* type_name(ParamType t) {
+  switch (t) {
+    case ParamType::Int: return "an integer";
+    case ParamType::Float: return "a number";
+    case ParamType::Bool: return "true or false";
+    case ParamType::Enum: return "one of";
+    case ParamType::OptionalInt: return "null or an integer";
+  }
+  return "";
+}
+
+}  // namespace
+
+bool Range::contains(double v) const {
+  // NaN fails every comparison, so it is never in range; infinities only where the bound is closed.
+  const bool lo = min_open ? v > min : v >= min;
+  const bool hi = max_open ? v < max : v <= max;
+  return lo && hi && !std::isnan(v);
+}
+
+std::string Range::text() const {
+  const bool no_min = std::isinf(min), no_max = std::isinf(max);
+  if (no_min && no_max) return "";
+  if (no_max) return std::string(min_open ? "> " : ">= ") + number_text(min);
+  if (no_min) return std::string(max_open ? "< " : "<= ") + number_text(max);
+  return std::string(min_open ? "(" : "[") + number_text(min) + ", " + number_text(max) + (max_open ? ")" : "]");
+}
+
+std::string ParamSpec::valid_text() const {
+  std::string s = type_name(type);
+  if (type == ParamType::Enum) {
+    std::string names;
+    for (const std::string& n : enum_names) {
+      if (!names.empty()) names += ", ";
+      names += n;
+    }
+    return s + " " + names;
+  }
+  const std::string r = range.text();
+  if (!r.empty()) s += (r[0] == '[' || r[0] == '(' ? " in " : " ") + r;
+  if (!unit.empty()) s += " (" + unit + ")";
+  return s;
+}
+
+std::string float_text(float v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::to_string(v);
+}
+
+nlohmann::json float_json(float v) {
+  if (!std::isfinite(v)) return static_cast<double>(v);
+  // The shortest decimal that reads back to v, as the double nearest to it: JSON then prints it
+  // with the digits it was given.
+  return std::strtod(float_text(v).c_str(), nullptr);
+}
+
+std::string json_text(const nlohmann::json& j) { return j.is_string() ? j.get<std::string>() : j.dump(); }
+
+namespace params_detail {
+
+void throw_bad_value(std::string_view owner, const ParamSpec& spec, const nlohmann::json& got) {
+  std::string value = got.dump();
+  if (got.is_number_float()) value = float_text(got.get<float>());
+  throw InputError(std::string(owner) + ": " + spec.name + " must be " + spec.valid_text() + ", got " + value);
+}
+
+void throw_unknown_key(std::string_view owner, std::string_view key, const std::vector<const ParamSpec*>& specs) {
+  std::string known;
+  for (const ParamSpec* s : specs) {
+    if (!known.empty()) known += ", ";
+    known += s->name;
+  }
+  throw InputError(std::string(owner) + ": unknown parameter '" + std::string(key) + "' (known: " + known + ")");
+}
+
+void throw_not_object(std::string_view owner, const nlohmann::json& got) {
+  throw InputError(std::string(owner) + ": parameters must be a JSON object, got " + got.dump());
+}
+
+bool type_matches(const ParamSpec& spec, const nlohmann::json& j) {
+  switch (spec.type) {
+    case ParamType::Int: return j.is_number_integer();
+    case ParamType::OptionalInt: return j.is_null() || j.is_number_integer();
+    case ParamType::Float: return j.is_number();
+    case ParamType::Bool: return j.is_boolean();
+    case ParamType::Enum:
+      if (!j.is_string()) return false;
+      for (const std::string& n : spec.enum_names)
+        if (n == j.get<std::string>()) return true;
+      return false;
+  }
+  return false;
+}
+
+bool in_range(const ParamSpec& spec, const nlohmann::json& j) {
+  if (spec.type != ParamType::Int && spec.type != ParamType::Float && spec.type != ParamType::OptionalInt) return true;
+  if (j.is_null()) return spec.type == ParamType::OptionalInt;
+  if (!j.is_number()) return false;
+  // Integers beyond int's range are out of every int range; floats are checked as the float they become.
+  if (j.is_number_integer()) {
+    const double v = j.get<double>();
+    if (spec.type != ParamType::Float && (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())) return false;
+    return spec.range.contains(spec.type == ParamType::Float ? static_cast<double>(static_cast<float>(v)) : v);
+  }
+  return spec.range.contains(static_cast<double>(j.get<float>()));
+}
+
+}  // namespace params_detail
+
+std::string params_markdown(const std::vector<ParamSpec>& specs) {
+  std::string s = "| parameter | valid values | default | meaning |\n|---|---|---|---|\n";
+  for (const ParamSpec& p : specs) {
+    std::string def = p.default_value.is_null() ? "null" : json_text(p.default_value);
+    s += "| `" + p.name + "` | " + p.valid_text() + " | " + def + " | " + p.help + " |\n";
+  }
+  return s;
+}
+
+}  // namespace ao

@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <tbb/global_control.h>
 
 #include "ao/core/error.h"
 #include "ao/methods/characteristic.h"
@@ -82,16 +81,6 @@ TEST(Containment, SilhouetteEliminationRemovesFalseShadowOfDistantObject) {
     }
   EXPECT_LT(min_off, 0.8) << "the false halo exists without elimination";
   EXPECT_EQ(min_on, 1.0) << "and is gone with it";
-}
-
-TEST(Containment, IdenticalAtOneAndTwoThreads) {
-  const auto s = test::builtin_gbuffer("default");
-  auto run = [&](int threads) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-    return containment_ao(s.g, {Membership::Linear, 1.0f}, {}, 42);
-  };
-  const auto a = run(1), b = run(2);
-  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "pixel " << i;
 }
 
 TEST(Containment, VisibilityInUnitRangeAndMonotoneInRadius) {

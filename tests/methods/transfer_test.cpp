@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <tbb/global_control.h>
 
 #include "ao/core/error.h"
 #include "ao/methods/characteristic.h"
@@ -124,19 +123,6 @@ TEST(Transfer, MoreTestsPerRayNeverOpenMoreRays) {
     diff += o1[i] - o2[i];
   }
   EXPECT_GT(diff, 0.0);
-}
-
-TEST(Transfer, IdenticalAtOneAndTwoThreads) {
-  const auto s = test::builtin_gbuffer("default");
-  auto run = [&](int threads) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-    return transfer_ao(s.g, {Membership::Sqrt, 1.0f}, {}, 42);
-  };
-  const auto a = run(1), b = run(2);
-  for (std::size_t i = 0; i < a.luminance.size(); ++i) {
-    ASSERT_EQ(a.luminance[i], b.luminance[i]) << "pixel " << i;
-    ASSERT_EQ(a.obscurance[i], b.obscurance[i]) << "pixel " << i;
-  }
 }
 
 // The AVX-512 kernel reads the depth and the occluder's albedo index from one packed word per

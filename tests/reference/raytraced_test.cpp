@@ -11,7 +11,6 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/scene/procedural.h"
 
-#include <tbb/global_control.h>
 
 namespace ao {
 namespace {
@@ -149,21 +148,6 @@ TEST(Raytraced, TargetErrorStopsEachPixelBelowIt) {
   const auto img = render_raytraced(rs, g, {Membership::Step, 1.0f}, p, 2);
   EXPECT_LE(img.max_std_error, 0.01);
   EXPECT_LT(img.rays, static_cast<std::uint64_t>(16384) * 40 * 30 / 4) << "open pixels should stop early";
-}
-
-TEST(Raytraced, IdenticalAtOneAndTwoThreads) {
-  const Scene s = make_builtin_scene("default");
-  const RayScene rs(s);
-  Camera cam = *s.preferred_view;
-  cam.width = 64;
-  cam.height = 40;
-  const GBuffer g = render_gbuffer(rs, cam);
-  auto run = [&](int threads) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-    return render_raytraced(rs, g, {Membership::Linear, 1.0f}, {.samples = 32}, 42);
-  };
-  const auto a = run(1), b = run(2);
-  for (std::size_t i = 0; i < a.visibility.size(); ++i) ASSERT_EQ(a.visibility[i], b.visibility[i]) << "pixel " << i;
 }
 
 TEST(Raytraced, VisibilityIsMonotoneInRadius) {

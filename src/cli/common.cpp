@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/io/camera_json.h"
 #include "ao/io/mesh_io.h"
 #include "ao/scene/procedural.h"
 
@@ -39,20 +40,29 @@ Vec3 parse_vec3(const std::string& text, const char* option) {
 
 Camera choose_camera(const Scene& scene, const CameraOptions& opt) {
   Camera cam;
-  if (scene.preferred_view) {
+  if (opt.file) {
+    Camera defaults;
+    defaults.width = opt.width;
+    defaults.height = opt.height;
+    cam = read_camera_file(*opt.file, defaults);
+    if (opt.width_set) cam.width = opt.width;
+    if (opt.height_set) cam.height = opt.height;
+  } else if (scene.preferred_view) {
     cam = *scene.preferred_view;
   } else {
     // Auto-framing: from the front, a little to the right and above, the usual product shot.
     cam = frame_bounds(scene.bounds(), {0.55f, 0.5f, 1.0f}, opt.fov.value_or(40.0f), opt.width, opt.height);
   }
-  cam.width = opt.width;
-  cam.height = opt.height;
+  if (!opt.file) {
+    cam.width = opt.width;
+    cam.height = opt.height;
+  }
   if (opt.fov) cam.vertical_fov_deg = *opt.fov;
   if (opt.up) cam.up = parse_vec3(*opt.up, "--up");
   if (opt.target) cam.target = parse_vec3(*opt.target, "--target");
   if (opt.eye) {
     cam.eye = parse_vec3(*opt.eye, "--eye");
-  } else if (opt.target && !scene.preferred_view) {
+  } else if (opt.target && !scene.preferred_view && !opt.file) {
     // Keep the framing distance and direction, looking at the new target.
     const Camera framed = frame_bounds(scene.bounds(), {0.55f, 0.5f, 1.0f}, cam.vertical_fov_deg, cam.width, cam.height);
     cam.eye = cam.target + (framed.eye - framed.target);

@@ -30,8 +30,11 @@ struct CameraOptions {
   std::optional<std::string> eye, target, up;  ///< "x,y,z" in world units.
   std::optional<float> fov;                    ///< Vertical, degrees.
   int width = 1280, height = 720;
+  /// A camera JSON (io/camera_json.h): its view, and its size unless --width/--height were given.
+  std::optional<std::string> file;
+  bool width_set = false, height_set = false;  ///< Whether --width/--height were given explicitly.
 };
-/// The scene's preferred view if it has one, else auto-framing of its bounds from above and in
+/// The camera file if given, else the scene's preferred view if it has one, else auto-framing of its bounds from above and in
 /// front; any option given overrides the corresponding field. Validated.
 Camera choose_camera(const Scene& scene, const CameraOptions& opt);
 Vec3 parse_vec3(const std::string& text, const char* option);

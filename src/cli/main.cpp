@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   ao::cli::add_render_command(app, global, action);
   ao::cli::add_bake_command(app, global, action);
   ao::cli::add_compare_command(app, global, action);
+  ao::cli::add_view_command(app, global, action);
 
   try {
     app.parse(argc, argv);

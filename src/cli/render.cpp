@@ -308,6 +308,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: auto-framed)");
   cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
   cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
+  cmd->add_option("--camera", o->camera.file,
+                  "Camera JSON (eye, target, up, fov, width, height; written by ao view): its view, and its size unless --width/--height are given");
   cmd->add_option("--shaded", o->shaded,
                   "Also write albedo x ambient x V with a soft key light, for viewing (sRGB); transfer: a W La. With --sun (or direct.* "
                   "in --gbuffer-in) the sun replaces the key light: (a V + Ld) La, transfer (a W + Ld) La");
@@ -326,7 +328,11 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_flag("--extras", o->extras,
                 "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");
   cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
-  cmd->callback([o, &global, &action] { action = [o, &global] { return run_render(*o, global); }; });
+  cmd->callback([o, &global, &action, cmd] {
+    o->camera.width_set = cmd->get_option("--width")->count() > 0;
+    o->camera.height_set = cmd->get_option("--height")->count() > 0;
+    action = [o, &global] { return run_render(*o, global); };
+  });
 }
 
 }  // namespace ao::cli

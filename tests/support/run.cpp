@@ -18,10 +18,12 @@ std::string quote(const std::string& s) {
 }
 }  // namespace
 
-RunResult run_ao(const std::string& args, const std::filesystem::path& cwd) {
+RunResult run_ao(const std::string& args, const std::filesystem::path& cwd) { return run_ao_under("", args, cwd); }
+
+RunResult run_ao_under(const std::string& prefix, const std::string& args, const std::filesystem::path& cwd) {
   TempDir capture;
   const std::string cd = cwd.empty() ? "" : "cd " + quote(cwd.string()) + " && ";
-  const std::string cmd = cd + quote(AO_CLI_PATH) + " " + args + " </dev/null >" + quote((capture / "out").string()) + " 2>" +
+  const std::string cmd = cd + (prefix.empty() ? "" : prefix + " ") + quote(AO_CLI_PATH) + " " + args + " </dev/null >" + quote((capture / "out").string()) + " 2>" +
                           quote((capture / "err").string());
   const int status = std::system(cmd.c_str());
   RunResult r;

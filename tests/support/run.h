@@ -14,6 +14,8 @@ struct RunResult {
 
 /// Runs `AO_CLI_PATH args` through the shell in `cwd` (the current directory when empty).
 RunResult run_ao(const std::string& args, const std::filesystem::path& cwd = {});
+/// The same with `prefix` before the binary (e.g. "xvfb-run -a" for a command that opens a window).
+RunResult run_ao_under(const std::string& prefix, const std::string& args, const std::filesystem::path& cwd = {});
 
 /// A fresh empty directory under the system temp directory, removed by the destructor: one per
 /// test, so tests never see each other's files.

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include "ao/bake/histogram.h"
@@ -15,10 +16,13 @@
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/raytraced_bake.h"
 #include "ao/core/error.h"
+#include "ao/core/memory.h"
 #include "ao/eval/metrics.h"
 #include "ao/io/gltf_export.h"
+#include "ao/io/atomic_file.h"
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
+#include "ao/io/output_set.h"
 #include "ao/io/ply_export.h"
 #include "ao/reference/ray_scene.h"
 #include "common.h"
@@ -110,10 +114,50 @@ void check_output_names(const BakeOptions& o, bool batch) {
   }
 }
 
+// The outputs of one mesh, each with the option that names it (for messages).
+struct MeshOutputs {
+  std::vector<std::pair<fs::path, std::string>> files;
+  fs::path map, bent, gltf, per_vertex;  ///< Empty when not written.
+};
+
+bool wants_map(const BakeOptions& o) { return o.per_vertex.empty() || !o.output.empty() || !o.gltf.empty(); }
+
+MeshOutputs outputs_of(const fs::path& input, const BakeOptions& o, bool batch) {
+  MeshOutputs out;
+  if (wants_map(o)) {
+    out.map = batch_path(input, o.output, o.out_dir, batch, "-ao.png");
+    out.files.emplace_back(out.map, o.output.empty() ? "the default map output" : "-o");
+    if (!o.bent.empty()) {
+      out.bent = batch_path(input, o.bent, o.out_dir, batch, "-bent.png");
+      out.files.emplace_back(out.bent, "--bent-normals");
+    }
+    if (!o.gltf.empty()) {
+      out.gltf = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
+      out.files.emplace_back(out.gltf, "--gltf");
+    }
+  }
+  if (!o.per_vertex.empty()) {
+    out.per_vertex = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
+    out.files.emplace_back(out.per_vertex, "--per-vertex");
+  }
+  return out;
+}
+
+// The transaction of one mesh's outputs (output_set.h): its inputs, then its outputs, checked now.
+// `of_mesh`: name the mesh in the option labels (a batch, where several meshes have a "-o").
+void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const MeshOutputs& outs, bool of_mesh = false) {
+  set.add_input(input, "the mesh " + input.string());
+  set.add_input(o.reference, "--reference");
+  for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
+}
+
 nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
   const bool progress = !global.quiet && stderr_is_terminal();
+  const MeshOutputs outs = outputs_of(input, o, batch);
+  OutputSet outputs;
+  declare(outputs, input, o, outs);
   Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.
@@ -127,15 +171,9 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   RaytracedBakeParams rt = o.rt;
   rt.seed = o.seed;
   rt.max_distance = o.max_distance;
-  if (o.max_distance) {
-    const auto m = parse_membership(o.membership);
-    if (!m || *m == Membership::Exp) throw InputError("--membership: use step, linear, sqrt or cubic for baking, got '" + o.membership + "'");
-    rt.membership = *m;
-  }
+  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
   HistogramParams hist = o.hist;
   hist.seed = o.seed;
-  if (o.method == "histogram" && o.max_distance)
-    throw InputError("--max-distance needs --method raytraced: the histogram baker sees occluders at any distance (paper eq. 1)");
   std::unique_ptr<RayScene> rays;
   auto ray_scene = [&]() -> RayScene& {
     if (!rays) {
@@ -145,7 +183,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     return *rays;
   };
 
-  const bool want_map = o.per_vertex.empty() || !o.output.empty() || !o.gltf.empty();
+  const bool want_map = wants_map(o);
   const bool has_uv = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return !m.uvs.empty(); });
   if (want_map && !has_uv)
     throw InputError(input.string() + ": the mesh has no UV coordinates, so it cannot be baked to a texture; use --per-vertex out.ply for per-vertex AO");
@@ -166,7 +204,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
       bake_ms = clock.lap_ms();
     }
     timings["bake_ms"] = bake_ms;
-    map_out = batch_path(input, o.output, o.out_dir, batch, "-ao.png");
+    map_out = outs.map;
     double sum = 0;
     for (std::size_t i = 0; i < r.mask.size(); ++i)
       if (r.mask[i]) sum += r.visibility[i];
@@ -217,40 +255,39 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     if (nrays) summary["per_vertex_rays"] = nrays;
   }
 
-  // Writes (each atomic).
+  // Writes: staged beside their destinations and renamed together once all are written.
   if (want_map) {
-    write_image(map_out, r.visibility, {.png_bits = o.png_bits});
-    if (!o.bent.empty() && !r.bent_normal.empty()) {
+    outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
+    if (!outs.bent.empty() && !r.bent_normal.empty()) {
       Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
       for (std::size_t i = 0; i < enc.size(); ++i)
         if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
-      write_rgb_image(batch_path(input, o.bent, o.out_dir, batch, "-bent.png"), enc, {.png_bits = o.png_bits});
+      outputs.write(outs.bent, [&] { write_rgb_image(outs.bent, enc, {.png_bits = o.png_bits}); });
     }
-    if (!o.gltf.empty()) {
+    if (!outs.gltf.empty()) {
       std::string png;
       if (map_out.extension() == ".png" || map_out.extension() == ".PNG") {
-        png = read_bytes(map_out);
+        png = read_bytes(outputs.staged(map_out));
       } else {
-        const fs::path tmp = fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png");
-        write_image(tmp, r.visibility, {.png_bits = 8});
-        png = read_bytes(tmp);
-        fs::remove(tmp);
+        const ScratchFile tmp(fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png"));
+        write_image(tmp.path(), r.visibility, {.png_bits = 8});
+        png = read_bytes(tmp.path());
       }
-      const fs::path glb = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
-      write_ao_glb(glb, scene, png, source ? &*source : nullptr);
-      summary["gltf_output"] = glb.string();
+      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, source ? &*source : nullptr); });
+      summary["gltf_output"] = outs.gltf.string();
     }
-    if (!o.json)
-      std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
-                   input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
-                   summary["texels_per_second"].get<double>() / 1e6);
   }
-  if (!o.per_vertex.empty()) {
-    const fs::path out = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
-    write_vertex_ao_ply(out, scene, vertex_ao);
-    summary["per_vertex_output"] = out.string();
-    if (!o.json) std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", out.string().c_str(), vertex_ao.size(), vertex_ms);
+  if (!outs.per_vertex.empty()) {
+    outputs.write(outs.per_vertex, [&] { write_vertex_ao_ply(outs.per_vertex, scene, vertex_ao); });
+    summary["per_vertex_output"] = outs.per_vertex.string();
   }
+  outputs.commit();
+  if (want_map && !o.json)
+    std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
+                 input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
+                 summary["texels_per_second"].get<double>() / 1e6);
+  if (!outs.per_vertex.empty() && !o.json)
+    std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", outs.per_vertex.string().c_str(), vertex_ao.size(), vertex_ms);
   timings["write_ms"] = clock.lap_ms();
   summary["timings"] = timings;
   return summary;
@@ -258,6 +295,12 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
 
 int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.method != "histogram" && o.method != "raytraced") throw InputError("--method: expected histogram or raytraced, got '" + o.method + "'");
+  if (o.max_distance) {
+    const auto m = parse_membership(o.membership);
+    if (!m || *m == Membership::Exp) throw InputError("--membership: use step, linear, sqrt or cubic for baking, got '" + o.membership + "'");
+  }
+  if (o.method == "histogram" && o.max_distance)
+    throw InputError("--max-distance needs --method raytraced: the histogram baker sees occluders at any distance (paper eq. 1)");
   if (o.uv_set < 0 || o.uv_set > 7) throw InputError("--uv-set must be in [0, 7] (UV sets count from 0)");
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
   if (o.padding < 0 || o.padding > 1024) throw InputError("--padding must be in [0, 1024] texels");
@@ -274,6 +317,19 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (inputs.empty()) throw InputError("no mesh files to bake (folders are searched for .obj .ply .off .stl .gltf .glb)");
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
   check_output_names(o, batch);
+  // Every output of the run is checked against every input and every other output before any
+  // mesh is loaded (each mesh's outputs are then one transaction of their own).
+  {
+    OutputSet all;
+    for (const fs::path& in : inputs) all.add_input(in, "the mesh " + in.string());
+    for (const fs::path& in : inputs) declare(all, in, o, outputs_of(in, o, batch), batch);
+  }
+  if (wants_map(o)) {
+    const int threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    check_memory(estimate_bake_memory({.size = o.size, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
+                                       .pixels_per_texel = o.hist.pixels_per_texel, .threads = threads}),
+                 "ao bake: a " + std::to_string(o.size) + "x" + std::to_string(o.size) + " map");
+  }
   if (!batch) {
     const nlohmann::json s = bake_one(inputs.front(), o, false, global);
     if (o.json) std::cout << s.dump(2) << "\n";

@@ -1,8 +1,6 @@
 // ao compare: renders each approximate method and the ray-traced ground truth it approximates (same
 // camera, R and membership, from the registry's reference_falloff) and writes a table (Markdown and
 // JSON), a contact sheet, and optionally error against a swept parameter. docs/compare.md.
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +19,7 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/image_io.h"
+#include "ao/io/output_set.h"
 #include "ao/io/text.h"
 #include "ao/methods/registry.h"
 #include "ao/reference/ray_scene.h"
@@ -111,38 +110,6 @@ void write_text(const fs::path& path, const std::string& text) {
   });
 }
 
-// All outputs go to a hidden sibling directory first and are moved into place only when every one
-// of them is complete, so a failure never leaves a half-written output directory.
-class StagedDir {
- public:
-  explicit StagedDir(fs::path target) : target_(std::move(target)) {
-    if (fs::exists(target_) && !fs::is_directory(target_)) throw InputError(target_.string() + ": exists and is not a directory");
-    const fs::path parent = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
-    if (!fs::is_directory(parent)) throw InputError(target_.string() + ": the parent directory does not exist");
-    staging_ = parent / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()));
-    fs::remove_all(staging_);
-    fs::create_directory(staging_);
-  }
-  ~StagedDir() {
-    std::error_code ec;
-    if (!committed_) fs::remove_all(staging_, ec);
-  }
-  fs::path file(const std::string& name) const { return staging_ / name; }
-  void commit() {
-    if (!fs::exists(target_)) {
-      fs::rename(staging_, target_);
-    } else {
-      for (const auto& e : fs::directory_iterator(staging_)) fs::rename(e.path(), target_ / e.path().filename());
-      fs::remove(staging_);
-    }
-    committed_ = true;
-  }
-
- private:
-  fs::path target_, staging_;
-  bool committed_ = false;
-};
-
 int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   const bool progress = !global.quiet && stderr_is_terminal();
   if (o.spp_reference < 1 || o.spp_reference > (1 << 20)) throw InputError("--spp-reference must be in [1, 1048576]");
@@ -185,11 +152,25 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
     if (!any) throw InputError("--sweep: no chosen method has a parameter '" + sweep_key + "'");
   }
 
+  check_camera_options(o.camera);
+  check_falloff_options(o.falloff);
+  // The outputs are declared before the work (refused if one names an input) and renamed into
+  // place together once all are written (output_set.h); a missing folder is created then.
+  const fs::path out_dir =
+      o.out_dir.empty() ? fs::path("compare-" + fs::path(scene_arguments_name(o.scene)).stem().string()) : fs::path(o.out_dir);
+  OutputSet outputs;
+  add_scene_inputs(outputs, o.scene);
+  outputs.add_directory(out_dir, "--out-dir");
+  std::vector<std::string> files = {"table.json", "table.md", "sheet.png"};
+  if (!sweep_key.empty()) files.insert(files.end(), {"sweep.json", "sweep.md"});
+  for (const std::string& f : files) outputs.add_output(out_dir / f, "--out-dir");
+  auto write_output_text = [&](const std::string& name, const std::string& text) {
+    outputs.write(out_dir / name, [&] { write_text(out_dir / name, text); });
+  };
+
   Stopwatch clock;
   Scene scene = load_scene_arguments(o.scene);
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << w << "\n";
-  const fs::path out_dir = o.out_dir.empty() ? fs::path("compare-" + fs::path(scene.name).stem().string()) : fs::path(o.out_dir);
-  if (fs::exists(out_dir) && !fs::is_directory(out_dir)) throw InputError(out_dir.string() + ": exists and is not a directory");
   const RayScene rays(scene);
   const Camera cam = choose_camera(scene, o.camera);
   GBuffer g;
@@ -285,9 +266,8 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
      << "reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at |error| = "
      << kHeatRange << "; grey: background).\n";
 
-  StagedDir dir(out_dir);
-  write_text(dir.file("table.json"), table.dump(2) + "\n");
-  write_text(dir.file("table.md"), md.str());
+  write_output_text("table.json", table.dump(2) + "\n");
+  write_output_text("table.md", md.str());
   std::vector<SheetRow> sheet_rows;
   for (std::size_t i = 0; i < images.size(); ++i) {
     const nlohmann::json& r = rows[i];
@@ -302,17 +282,18 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   std::string font_error;
   const std::optional<Font> font = Font::open(sheet_font_path(), &font_error);
   if (!font) std::cerr << "warning: " << font_error << "; sheet.png has no labels (install fonts-dejavu-core or set AO_FONT)\n";
-  write_rgb_image(dir.file("sheet.png"), contact_sheet(sheet_rows, kHeatRange, font ? &*font : nullptr));
+  const Image<Vec3> sheet = contact_sheet(sheet_rows, kHeatRange, font ? &*font : nullptr);
+  outputs.write(out_dir / "sheet.png", [&] { write_rgb_image(out_dir / "sheet.png", sheet); });
   if (!sweep_key.empty()) {
-    write_text(dir.file("sweep.json"), nlohmann::json{{"key", sweep_key}, {"rows", sweep_rows}}.dump(2) + "\n");
+    write_output_text("sweep.json", nlohmann::json{{"key", sweep_key}, {"rows", sweep_rows}}.dump(2) + "\n");
     std::ostringstream s;
     s << "# ao compare sweep: " << sweep_key << "\n\n| method | " << sweep_key << " | RMSE | ms |\n|---|---:|---:|---:|\n";
     for (const nlohmann::json& r : sweep_rows)
       s << "| " << r["method"].get<std::string>() << " | " << r[sweep_key].dump() << " | " << fixed(r["rmse"].get<double>(), 4) << " | "
         << fixed(r["ms"].get<double>(), 1) << " |\n";
-    write_text(dir.file("sweep.md"), s.str());
+    write_output_text("sweep.md", s.str());
   }
-  dir.commit();
+  outputs.commit();
 
   if (o.json) {
     std::cout << table.dump(2) << "\n";

@@ -196,6 +196,8 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
     Stopwatch sw;
     MethodOutput out = m.run(MethodInput{g, &rays, requested, o.seed, bar.callback(), &scene.analytic}, p);
     ms = sw.lap_ms();
+    if (out.stats.contains("warnings"))
+      for (const auto& w : out.stats["warnings"]) std::cerr << "warning: " << w.get<std::string>() << "\n";
     return out;
   };
 

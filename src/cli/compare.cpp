@@ -3,31 +3,26 @@
 // the contact sheet and optionally the sweep. docs/compare.md.
 #include <unistd.h>
 
-#include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <memory>
-#include <algorithm>
 #include <optional>
 #include <sstream>
-#include <tuple>
 
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
 #include "ao/eval/compare.h"
-#include "ao/eval/metrics.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/image_io.h"
 #include "ao/io/text.h"
 #include "ao/methods/registry.h"
 #include "ao/reference/ray_scene.h"
-#include "ao/reference/raytraced.h"
 #include "common.h"
 #include "contact_sheet.h"
 #include "subcommands.h"

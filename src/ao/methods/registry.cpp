@@ -12,23 +12,53 @@
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
 #include "ao/reference/raytraced.h"
+#include "ao/reference/reference.h"
 #include "ao/scene/procedural.h"
 
 namespace ao {
 
 namespace {
 
+// The reference kind raytraced renders (kReferenceParam), taken off `j` so that the rest goes to
+// RaytracedParams' from_json, which rejects unknown keys; absent means obscurance.
+ReferenceKind take_reference_kind(nlohmann::json& j) {
+  if (!j.is_object() || !j.contains(kReferenceParam)) return ReferenceKind::Obscurance;
+  const nlohmann::json value = j.at(kReferenceParam);
+  j.erase(kReferenceParam);
+  if (value.is_string())
+    if (const auto kind = parse_reference_kind(value.get<std::string>())) return *kind;
+  throw InputError("raytraced: reference must be one of " + reference_kind_names() + ", got " + value.dump());
+}
+
 MethodOutput run_raytraced(const MethodInput& in, const nlohmann::json& j) {
   if (!in.scene)
     throw InputError("method raytraced traces rays in the scene, and a G-buffer file has none: give a scene instead of --gbuffer-in");
-  RaytracedParams p = j.get<RaytracedParams>();
+  nlohmann::json rest = j;
+  const ReferenceKind kind = take_reference_kind(rest);
+  RaytracedParams p = rest.get<RaytracedParams>();
   p.validate();
-  RaytracedImage img = render_raytraced(*in.scene, in.gbuffer, in.falloff, p, in.seed, in.progress);
+  ReferenceImage img = render_reference(*in.scene, in.gbuffer, {kind, in.falloff}, p, in.seed, in.progress);
   MethodOutput out;
-  out.visibility = std::move(img.visibility);
-  out.stats = {{"rays", img.rays}, {"mean_std_error", img.mean_std_error}, {"max_std_error", img.max_std_error}};
+  out.visibility = std::move(img.scalar.visibility);
+  if (!img.color.empty()) out.color = std::move(img.color);
+  if (!img.obscurance.empty()) out.extras["obscurance"] = std::move(img.obscurance);
+  out.stats = {{"rays", img.scalar.rays}, {"mean_std_error", img.scalar.mean_std_error}, {"max_std_error", img.scalar.max_std_error}};
   return out;
 }
+
+nlohmann::json raytraced_defaults() {
+  nlohmann::json j = RaytracedParams{};
+  j[kReferenceParam] = to_string(ReferenceKind::Obscurance);
+  return j;
+}
+
+// The occluders' albedo scale a method's parameters carry (transfer's albedo_scale), else 1.
+float albedo_scale_of(const nlohmann::json& params) {
+  return params.is_object() && params.contains("albedo_scale") && params.at("albedo_scale").is_number() ? params.at("albedo_scale").get<float>()
+                                                                                                       : 1.0f;
+}
+
+Falloff requested_falloff(const Falloff& requested, const nlohmann::json&) { return requested; }
 
 // The characteristic functions a screen-space method can run with (registry.h,
 // kCharacteristicParam), in the order of characteristic_names().
@@ -173,29 +203,50 @@ MethodOutput run_alchemy(const MethodInput& in, const nlohmann::json& j) {
 }
 
 const std::array kMethods{
-    MethodInfo{"raytraced", "ground truth: Monte Carlo obscurance with Embree rays, any membership", true,
-               [] { return nlohmann::json(RaytracedParams{}); }, run_raytraced,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
+    MethodInfo{"raytraced",
+               "ground truth with Embree rays: obscurance of any membership (-p reference=obscurance), the tangent sphere's visible "
+               "fraction (tangent-sphere) or ambient transfer W (transfer)",
+               true, raytraced_defaults, run_raytraced,
+               [](const Falloff& requested, const nlohmann::json& params) {
+                 nlohmann::json rest = params;
+                 return ReferenceSpec{take_reference_kind(rest), requested};
+               },
+               requested_falloff},
+    // Containment estimates the obscurance of the requested membership directly (eq. 5).
     MethodInfo{"containment", "containment tests against the depth buffer, r = mu^-1(xi) (volumetric AO eq. 5), any membership", false,
                screen_space_defaults<ContainmentParams>, run_containment,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
-    // Volumetric AO implies mu = (r/R)^3 with the same R (tangent sphere of radius R/2: distances up to R).
+               [](const Falloff& requested, const nlohmann::json&) { return obscurance_reference(requested); }, requested_falloff},
+    // Volumetric AO's V is the free fraction of the tangent sphere of radius R/2 (eq. 6-7), whose
+    // ray-traced form is tangent_sphere.h. As an obscurance it implies mu = (r/R)^3 with the same R.
     MethodInfo{"volumetric", "free volume of the tangent sphere by pipes along z (volumetric AO eq. 6-7); implies cubic membership", false,
                screen_space_defaults<VolumetricParams>, run_volumetric,
+               [](const Falloff& requested, const nlohmann::json&) {
+                 return ReferenceSpec{ReferenceKind::TangentSphere, {Membership::Cubic, requested.radius}};
+               },
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; }},
-    // W approaches the obscurance of the same membership as the albedo goes to 0.
+    // W of eq. 9 estimates eq. 6 (transfer_reference.h) with the same membership and albedo scale;
+    // it approaches the obscurance of that membership as the albedo goes to 0. (Radiance mode's
+    // direct term is not in the reference: it would need the sun, which MethodInput does not carry.)
     MethodInfo{"transfer",
                "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance; "
                "-p reflectance=radiance adds the light of sunlit occluders (needs --sun)",
                false, screen_space_defaults<TransferParams>, run_transfer,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }},
+               [](const Falloff& requested, const nlohmann::json& params) {
+                 return ReferenceSpec{ReferenceKind::Transfer, requested, albedo_scale_of(params)};
+               },
+               requested_falloff},
     // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.
     MethodInfo{"cone", "voxel cone tracing: parity voxelization in bit columns, cones of spheres, prisms by popcount (Dalla Favera & Celes)", true,
                [] { return nlohmann::json(ConeParams{}); }, run_cone,
+               [](const Falloff& requested, const nlohmann::json&) { return obscurance_reference({Membership::Step, requested.radius}); },
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; }},
-    // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r.
+    // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r;
+    // at its defaults u = 2r >= r, where that falloff is exactly step AO (obscurance_reference says so).
     MethodInfo{"alchemy", "Alchemy AO: screen-space disk samples, eq. 10 (sigma, k, beta, epsilon, r, s) + 13-tap cross-bilateral filter", false,
                [] { return nlohmann::json(AlchemyParams{}); }, run_alchemy,
+               [](const Falloff& requested, const nlohmann::json& params) {
+                 return obscurance_reference(alchemy_reference_falloff(params.get<AlchemyParams>(), requested.radius));
+               },
                [](const Falloff& requested, const nlohmann::json& params) {
                  return alchemy_reference_falloff(params.get<AlchemyParams>(), requested.radius);
                }},
@@ -206,6 +257,20 @@ const std::array kMethods{
 std::span<const MethodInfo> all_methods() { return kMethods; }
 
 std::span<const std::string_view> characteristic_names() { return kCharacteristicNames; }
+
+ReferenceSpec choose_reference(const MethodInfo& m, std::string_view name, const Falloff& requested, const nlohmann::json& params) {
+  if (name == kMatchedReference) return m.reference(requested, params);
+  const Falloff f = m.obscurance_falloff(requested, params);
+  const std::optional<ReferenceKind> kind = parse_reference_kind(name);
+  if (!kind)
+    throw InputError("unknown reference '" + std::string(name) + "' for " + std::string(m.name) + " (known: " + kMatchedReference + ", " +
+                     reference_kind_names() + ")");
+  switch (*kind) {
+    case ReferenceKind::TangentSphere: return {ReferenceKind::TangentSphere, {Membership::Cubic, f.radius}};
+    case ReferenceKind::Transfer: return {ReferenceKind::Transfer, f, albedo_scale_of(params)};
+    default: return obscurance_reference(f);
+  }
+}
 
 const MethodInfo& find_method(std::string_view name) {
   std::string names;

@@ -86,7 +86,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("-p,--param", o->params, "Method parameter as key=value, repeatable (as ao render)");
   cmd->add_option("--ao-map", o->ao_map, "A baked AO map to show on the mesh (view 'map')");
   cmd->add_option("--set", o->sets,
-                  "A viewer setting or method parameter as key=value before the first frame: method, view (ao, transfer, map, error), "
+                  "A viewer setting or method parameter as key=value before the first frame: method, view (ao, shaded, transfer, map, error), "
                   "wipe (0-1), scale (1, 2, 4), seed, threads, radius, radius_fraction, membership, up (y, z), panel, hud (on, off), "
                   "or any -p key");
   cmd->add_option("--event", o->events, "Scripted input FRAME:KIND:ARGS, repeatable: orbit:dx,dy  pan:dx,dy  zoom:steps  key:K  set:key=value");

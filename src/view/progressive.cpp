@@ -4,7 +4,6 @@
 #include <exception>
 
 #include "ao/core/sampling.h"
-#include "ao/methods/registry.h"
 
 namespace ao::view {
 
@@ -57,7 +56,6 @@ std::string ProgressiveReference::error() const {
 }
 
 void ProgressiveReference::run() {
-  const MethodInfo& raytraced = find_method("raytraced");
   for (;;) {
     ReferenceJob job;
     std::uint64_t generation = 0;
@@ -72,12 +70,12 @@ void ProgressiveReference::run() {
     }
     // Each batch draws an independent sample set (its own seed), so the batch means are
     // independent estimates of V and their spread gives the standard error of their mean.
-    nlohmann::json params = job.params;
-    params["samples"] = batch_samples_;
-    MethodOutput out;
+    RaytracedParams params;
+    params.samples = batch_samples_;
+    ReferenceImage out;
     try {
       const std::uint32_t seed = hash_combine(job.seed, static_cast<std::uint32_t>(batch));
-      out = raytraced.run(MethodInput{*job.gbuffer, job.scene, job.falloff, seed, {}, nullptr}, params);
+      out = render_reference(*job.scene, *job.gbuffer, job.spec, params, seed);
     } catch (const std::exception& e) {
       std::lock_guard lock(mutex_);
       if (generation == generation_) error_ = e.what();
@@ -93,7 +91,7 @@ void ProgressiveReference::run() {
     std::size_t covered = 0;
     for (std::size_t i = 0; i < g.coverage.size(); ++i) {
       if (!g.coverage[i]) continue;
-      const double v = out.visibility[i];
+      const double v = out.scalar.visibility[i];
       sum_[i] += v;
       sum_sq_[i] += v * v;
       s.visibility[i] = static_cast<float>(sum_[i] / n);

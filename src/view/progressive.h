@@ -10,22 +10,20 @@
 #include <mutex>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
 #include "ao/core/membership.h"
 #include "ao/reference/ray_scene.h"
+#include "ao/reference/reference.h"
 
 namespace ao::view {
 
-/// What the reference computes: the registry's `raytraced` method with these parameters (the
-/// method's matched reference) at this falloff, over this G-buffer.
+/// What the reference computes: the method's matched reference (MethodInfo::reference) over this
+/// G-buffer.
 struct ReferenceJob {
   std::shared_ptr<const GBuffer> gbuffer;
   const RayScene* scene = nullptr;
-  Falloff falloff;
-  nlohmann::json params = nlohmann::json::object();  ///< raytraced's parameters; `samples` is set per batch.
+  ReferenceSpec spec;
   std::uint32_t seed = 1;
 };
 

@@ -21,8 +21,8 @@
 #include <thread>
 
 #include "ao/core/error.h"
-#include "ao/core/texture.h"
 #include "ao/eval/metrics.h"
+#include "ao/eval/shading.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
@@ -39,8 +39,9 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-enum class ViewMode { AO, Transfer, Map, Error };
-constexpr const char* kViewNames[] = {"ao", "transfer", "map", "error"};
+enum class ViewMode { AO, Shaded, Transfer, Map, Error };
+constexpr const char* kViewNames[] = {"ao", "shaded", "transfer", "map", "error"};
+constexpr int kViewCount = 5;
 constexpr float kHeatRange = 0.25f;  // |signed error| at full colour, as ao compare's sheets
 constexpr int kPanelWidth = 340;
 // The reference adds this many rays per pixel per batch: a batch at 960x540 then takes tens of
@@ -107,6 +108,9 @@ std::uint8_t to_byte(float v) {
   const float c = v > 0.0f ? std::min(v, 1.0f) : 0.0f;
   return static_cast<std::uint8_t>(std::lround(c * 255.0f));
 }
+
+// IEC 61966-2-1, as the PNG writer encodes --shaded pictures.
+float srgb(float v) { return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f; }
 
 std::string next_free_name(const std::string& stem) {
   for (int i = 1;; ++i) {
@@ -252,7 +256,7 @@ class Viewer {
       if (io.MouseWheel != 0) any |= on_zoom(io.MouseWheel);
     }
     if (!io.WantCaptureKeyboard)
-      for (int key : {GLFW_KEY_F, GLFW_KEY_Z, GLFW_KEY_S, GLFW_KEY_1, GLFW_KEY_2, GLFW_KEY_3, GLFW_KEY_4, GLFW_KEY_P, GLFW_KEY_H})
+      for (int key : {GLFW_KEY_F, GLFW_KEY_Z, GLFW_KEY_S, GLFW_KEY_1, GLFW_KEY_2, GLFW_KEY_3, GLFW_KEY_4, GLFW_KEY_5, GLFW_KEY_P, GLFW_KEY_H})
         if (ImGui::IsKeyPressed(key, false)) any |= on_key(key);
     return any;
   }
@@ -281,7 +285,7 @@ class Viewer {
         screenshot_pending_ = true;
         break;
       }
-      case GLFW_KEY_1: case GLFW_KEY_2: case GLFW_KEY_3: case GLFW_KEY_4:
+      case GLFW_KEY_1: case GLFW_KEY_2: case GLFW_KEY_3: case GLFW_KEY_4: case GLFW_KEY_5:
         set_view(static_cast<ViewMode>(key - GLFW_KEY_1));
         break;
       case GLFW_KEY_P: show_panel_ = !show_panel_; break;
@@ -306,8 +310,8 @@ class Viewer {
 
   static int key_code(const std::string& name) {
     if (name.size() == 1 && std::isalpha(static_cast<unsigned char>(name[0]))) return GLFW_KEY_A + (std::toupper(name[0]) - 'A');
-    if (name.size() == 1 && name[0] >= '1' && name[0] <= '4') return GLFW_KEY_1 + (name[0] - '1');
-    throw InputError("--event: unknown key '" + name + "' (keys: F, Z, S, P, H, 1-4)");
+    if (name.size() == 1 && name[0] >= '1' && name[0] <= '5') return GLFW_KEY_1 + (name[0] - '1');
+    throw InputError("--event: unknown key '" + name + "' (keys: F, Z, S, P, H, 1-5)");
   }
 
   void camera_moved() {
@@ -337,9 +341,9 @@ class Viewer {
       find_method(value);
       select_method(value);
     } else if (key == "view") {
-      for (int i = 0; i < 4; ++i)
+      for (int i = 0; i < kViewCount; ++i)
         if (value == kViewNames[i]) return set_view(static_cast<ViewMode>(i));
-      throw InputError("--set view: one of ao, transfer, map, error, got '" + value + "'");
+      throw InputError("--set view: one of ao, shaded, transfer, map, error, got '" + value + "'");
     } else if (key == "wipe") {
       wipe_ = number(0, 1);
       dirty_display_ = true;
@@ -471,11 +475,7 @@ class Viewer {
     ReferenceJob job;
     job.gbuffer = gbuffer_;
     job.scene = &rays_;
-    job.falloff = method_ == "raytraced" ? falloff_ : m.reference_falloff(falloff_, params);
-    if (method_ == "raytraced") {
-      job.params = params;
-      job.params.erase("samples");
-    }
+    job.spec = m.reference(falloff_, params);
     job.seed = s_.seed;
     progressive_.restart(std::move(job));
   }
@@ -498,6 +498,20 @@ class Viewer {
   bool reference_ready() const { return s_.wait_reference_spp <= 0 || ref_.samples_per_pixel >= s_.wait_reference_spp || !progressive_.error().empty(); }
 
   // --- display -------------------------------------------------------------------------------
+  // The images the shaded and map views show, made when they are shown (library calls).
+  void prepare_view() {
+    const GBuffer& g = *gbuffer_;
+    try {
+      if (view_ == ViewMode::Shaded) {
+        const Image<float>& v = method_ == "raytraced" && !ref_.visibility.empty() ? ref_.visibility : result_.visibility;
+        shaded_ = v.size() == g.coverage.size() ? shade_for_display(g, v, result_.color) : Image<Vec3>();
+      }
+      if (view_ == ViewMode::Map && !s_.ao_map.empty()) map_v_ = visibility_from_ao_map(g, s_.scene, s_.ao_map, "--ao-map");
+    } catch (const InputError& e) {
+      error_ = e.what();
+    }
+  }
+
   // The method's V (or what the view asks for) as RGBA8, left of the wipe; the reference right of it.
   void build_display() {
     if (!gbuffer_) return;
@@ -524,8 +538,10 @@ class Viewer {
           c = {v, v, v};
         } else if (view_ == ViewMode::Transfer && !result_.color.empty()) {
           c = result_.color[i];
-        } else if (view_ == ViewMode::Map && !s_.ao_map.empty()) {
-          c = Vec3{1, 1, 1} * map_value(g, i);
+        } else if (view_ == ViewMode::Shaded && !shaded_.empty()) {
+          c = {srgb(shaded_[i].x), srgb(shaded_[i].y), srgb(shaded_[i].z)};
+        } else if (view_ == ViewMode::Map && !map_v_.empty()) {
+          c = Vec3{1, 1, 1} * map_v_[i];
         } else if (!method_v.empty()) {
           const float v = method_v[i];
           c = {v, v, v};
@@ -534,16 +550,9 @@ class Viewer {
       }
   }
 
-  // V of the baked map at the pixel's UV (bilinear), 1 where the mesh has no UVs or nothing is seen.
-  float map_value(const GBuffer& g, std::size_t i) const {
-    if (!g.coverage[i]) return 1.0f;
-    const Mesh& mesh = s_.scene.meshes[g.object_id[i] - 1];
-    if (mesh.uvs.empty()) return 1.0f;
-    return std::clamp(sample_bilinear(s_.ao_map, g.uv[i]), 0.0f, 1.0f);
-  }
-
   void upload_if_needed() {
     if (!dirty_display_ || !gbuffer_) return;
+    prepare_view();
     build_display();
     const int w = gbuffer_->width(), h = gbuffer_->height();
     glBindTexture(GL_TEXTURE_2D, texture_);
@@ -647,7 +656,7 @@ class Viewer {
     }
     if (ImGui::CollapsingHeader("view", ImGuiTreeNodeFlags_DefaultOpen)) {
       int view = static_cast<int>(view_);
-      for (int i = 0; i < 4; ++i) {
+      for (int i = 0; i < kViewCount; ++i) {
         if (i > 0) ImGui::SameLine();
         if (ImGui::RadioButton(kViewNames[i], &view, i)) set_view(static_cast<ViewMode>(view));
       }
@@ -776,6 +785,8 @@ class Viewer {
   Falloff falloff_;
   std::shared_ptr<GBuffer> gbuffer_;
   MethodOutput result_;
+  Image<Vec3> shaded_;
+  Image<float> map_v_;
   double rmse_ = -1;
   std::string error_;
   ViewMode view_ = ViewMode::AO;

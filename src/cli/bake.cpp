@@ -177,6 +177,8 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   std::unique_ptr<RayScene> rays;
   auto ray_scene = [&]() -> RayScene& {
     if (!rays) {
+      check_memory(estimate_ray_scene_memory(scene.triangle_count(), scene.vertex_count()),
+                   input.string() + ": the BVH of " + std::to_string(scene.triangle_count()) + " triangles");
       rays = std::make_unique<RayScene>(scene);
       timings["bvh_ms"] = clock.lap_ms();
     }

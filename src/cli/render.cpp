@@ -143,10 +143,19 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   outputs.add_output(output, o.output.empty() ? "the default output" : "-o");
   if (!o.shaded.empty()) outputs.add_output(o.shaded, "--shaded");
   if (!o.gbuffer_out.empty()) outputs.add_output(o.gbuffer_out, "--gbuffer-out");
+  // Cone tracing's voxel grid, from its parameters (their types and ranges are checked by the method).
+  std::uint64_t grid_bytes = 0;
+  if (method.name == "cone" && o.ao_map.empty() && params.value("columns", nlohmann::json()).is_number_integer() &&
+      params.value("depth_bits", nlohmann::json()).is_number_integer())
+    grid_bytes = estimate_cone_grid_memory(params["columns"].get<int>(), params["depth_bits"].get<int>());
   if (o.gbuffer_in.empty())
     check_memory(estimate_render_memory({.width = o.camera.width, .height = o.camera.height, .sun = sun.has_value(),
-                                         .shaded = !o.shaded.empty(), .gbuffer_out = !o.gbuffer_out.empty()}),
-                 "ao render: " + std::to_string(o.camera.width) + "x" + std::to_string(o.camera.height) + " pixels");
+                                         .shaded = !o.shaded.empty(), .gbuffer_out = !o.gbuffer_out.empty()}) +
+                     grid_bytes,
+                 "ao render: " + std::to_string(o.camera.width) + "x" + std::to_string(o.camera.height) + " pixels" +
+                     (grid_bytes ? " and a " + std::to_string(params["columns"].get<int>()) + "^2 x " +
+                                       std::to_string(params["depth_bits"].get<int>()) + " voxel grid"
+                                 : std::string()));
 
   const Image<float> ao_map = o.ao_map.empty() ? Image<float>() : read_image(o.ao_map);
   std::optional<Scene> scene;

@@ -244,6 +244,10 @@ TEST(OutputsCli, RunsTooBigForTheMemoryAreRefusedUpFrontWithTheEstimate) {
   r = limited("bake grid.obj -s 16384 -o m.png");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   expect_one_line_error(r, "16384x16384 map needs about");
+  // Cone tracing's largest voxel grid (4096^2 columns x 1024 bits: 2.1 GB of bits) counts too.
+  r = limited("render plane --width 64 --height 48 -m cone -p columns=4096 -p depth_bits=1024 -o v.png");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  expect_one_line_error(r, "4096^2 x 1024 voxel grid needs about");
   // Small runs fit under the same limit.
   r = limited("render plane --width 64 --height 48 --spp 4 -o v.png");
   EXPECT_EQ(r.exit_code, 0) << r.err;

@@ -24,6 +24,12 @@ struct RenderMemoryInput {
 /// of the registry's methods), and the encoded outputs, plus a fixed 64 MiB for the process.
 std::uint64_t estimate_render_memory(const RenderMemoryInput& in);
 
+/// Peak bytes of cone tracing's voxel grid of columns x columns x depth_bits voxels (ConeParams;
+/// the eye grid has at most that many): the bit grid, its coarser levels and the voxelizer's
+/// scratch, about twice the grid's bits, plus 16 bytes of masks per column. Arguments are clamped
+/// to ConeParams' ranges.
+std::uint64_t estimate_cone_grid_memory(int columns, int depth_bits);
+
 /// Peak bytes of the ray-traced scene (Embree BVH and its copy of the geometry) for a scene of
 /// `triangles` triangles and `vertices` vertices, beyond the Scene itself.
 std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t vertices);

@@ -97,14 +97,6 @@ struct WorldSampler {
   // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
   // voxel whose centre is inside) fills them.
   float near_limit(Vec3) const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
-  // How far the solid voxels of a plane with world normal n can reach in front of it: a voxel is
-  // solid when its centre is inside, so its box reaches at most half its extent along n,
-  // 0.5 (|n_x| v_x + |n_y| v_y + |n_z| v_z). The apex moves this far along n, so that the spheres of
-  // a cone at the horizon (tangent to the tangent plane) do not cut the surface's own voxels.
-  float surface_offset(Vec3, Vec3 n) const {
-    return 0.5f * (std::abs(n.x) * g.voxel_size.x + std::abs(n.z) * g.voxel_size.y + std::abs(n.y) * g.voxel_size.z);
-  }
-
   static int clamp_index(float x, int n) {  // clamp(floor(x), 0, n - 1), branch-free; NaN -> 0
     return static_cast<int>(std::min(std::max(0.0f, x), static_cast<float>(n - 1)));
   }
@@ -237,9 +229,6 @@ struct EyeSampler {
     return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
   }
 
-  // As WorldSampler::surface_offset, with the voxel of near_limit (a third of 1.5 voxels).
-  float surface_offset(Vec3 c, Vec3) const { return near_limit(c) / 3.0f; }
-
   // centre in camera space; the prisms run along the camera's z (the grid's columns are view rays:
   // over one sphere they are close to parallel, the approximation the paper's texture fetch makes).
   float operator()(Vec3 c, int k, float scale, float rot_c, float rot_s) const {
@@ -292,7 +281,6 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
         }
         const Frame frame = Frame::from_normal(n);
         const float near = sample.near_limit(gb.position(x, y));
-        pos = pos + n * sample.surface_offset(gb.position(x, y), n);
         // Per-pixel jitter (deviation 5 of docs/methods/cone.md), all from hash(seed, pixel), so
         // the image does not depend on the thread count: the prism pattern turns by beta, and each
         // cone takes one random direction in its own cell of the hemisphere (stratified sampling
@@ -316,8 +304,19 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
             st = setup.cosine ? std::sqrt(u) : std::sqrt(std::max(0.0f, u * (2.0f - u)));  // 1 - cos = u
             st = std::min(st, setup.sin_theta_max);
             ct = std::sqrt(1.0f - st * st);
-            const float phi = cone.phi0 + to_unit_float(hash_combine(hc, 1u)) * cone.dphi;
-            cp = std::cos(phi), sp = std::sin(phi);
+            // phi = the cell's centre + delta, delta uniform in +-dphi / 2.
+            const float delta = (to_unit_float(hash_combine(hc, 1u)) - 0.5f) * cone.dphi;
+            float cd, sd;
+            if (cone.dphi <= 2.0f) {
+              // |delta| <= 1: Taylor series to delta^6 / delta^7, cheaper than sin and cos; the
+              // truncation error is at most delta^8 / 8! = 2.5e-5.
+              const float d2 = delta * delta;
+              cd = 1.0f - d2 * (0.5f - d2 * (1.0f / 24.0f - d2 * (1.0f / 720.0f)));
+              sd = delta * (1.0f - d2 * (1.0f / 6.0f - d2 * (1.0f / 120.0f - d2 * (1.0f / 5040.0f))));
+            } else {
+              cd = std::cos(delta), sd = std::sin(delta);  // a ring of one or two cones
+            }
+            cp = cone.cos_phi * cd - cone.sin_phi * sd, sp = cone.sin_phi * cd + cone.cos_phi * sd;
             // Chain scale s = q^-xi in (1/q, 1]: one ratio step of random phase, the geometric
             // analogue of jittering a uniform step.
             scale = std::exp(-to_unit_float(hash_combine(hc, 2u)) * log_q);

@@ -10,6 +10,8 @@
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include "ao/bake/bake_groups.h"
+#include "ao/bake/high_to_low.h"
 #include "ao/bake/histogram.h"
 #include "ao/bake/padding.h"
 #include "ao/bake/per_vertex.h"
@@ -21,6 +23,7 @@
 #include "ao/io/mesh_io.h"
 #include "ao/io/ply_export.h"
 #include "ao/reference/ray_scene.h"
+#include "ao/scene/procedural.h"
 #include "common.h"
 #include "subcommands.h"
 
@@ -34,6 +37,16 @@ struct BakeOptions {
   std::vector<std::string> inputs;
   std::string output, out_dir, per_vertex, gltf, bent, reference;
   std::string method = "histogram";
+  bool method_given = false;  // -m was on the command line (high-to-low then picks raytraced itself)
+  // Options given on the command line that only one baker reads, by name ("--directions", ...).
+  std::vector<std::string> histogram_only, raytraced_only;
+  // High to low (high_to_low.h).
+  std::vector<std::string> high;
+  std::string cage, miss_mask;
+  HighToLowParams h2l;
+  // Occluders and bake groups (bake_groups.h).
+  std::vector<std::string> occluders, groups;
+  bool floor = false, match_by_name = false, self_occlusion = false;
   int size = 1024;
   int uv_set = 0;
   int padding = kDefaultPadding;
@@ -110,6 +123,125 @@ void check_output_names(const BakeOptions& o, bool batch) {
   }
 }
 
+// The high meshes of --high, one scene (their UVs are not used).
+Scene load_high_scene(const std::vector<std::string>& files) {
+  Scene high;
+  high.name = files.size() == 1 ? files.front() : "--high meshes";
+  for (const std::string& f : files) {
+    Scene s = load_scene_file(f);
+    for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
+    for (Mesh& m : s.meshes) high.meshes.push_back(std::move(m));
+  }
+  return high;
+}
+
+// --occluder meshes (UVs dropped: they occlude, they are not baked) and the --floor.
+std::vector<Mesh> load_occluders(const BakeOptions& o, const Scene& scene, const Scene* high) {
+  std::vector<Mesh> out;
+  for (const std::string& f : o.occluders) {
+    Scene s = load_scene_file(f);
+    for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
+    for (Mesh& m : s.meshes) {
+      m.uvs.clear();
+      out.push_back(std::move(m));
+    }
+  }
+  if (o.floor) {
+    // A slab under the model (y up), its top at the lowest point of the baked and high meshes and
+    // of the occluders; 20 model diagonals wide, so a point of the model sees it as the ground to
+    // within atan(1/20) ~ 3 degrees of the horizon (the reach of any occluder within R).
+    Bounds3 b = scene.bounds();
+    if (high) b.extend(high->bounds());
+    for (const Mesh& m : out) b.extend(m.bounds());
+    const float d = b.diagonal(), cx = 0.5f * (b.lo.x + b.hi.x), cz = 0.5f * (b.lo.z + b.hi.z);
+    Mesh floor = make_box({cx - 10 * d, b.lo.y - 0.05f * d, cz - 10 * d}, {cx + 10 * d, b.lo.y, cz + 10 * d});
+    floor.name = "floor";
+    out.push_back(std::move(floor));
+  }
+  return out;
+}
+
+// Bake groups: by name, explicit lists, one per mesh, or everything in one.
+std::vector<BakeGroup> make_groups(const BakeOptions& o, const Scene& scene, const Scene* high) {
+  std::vector<BakeGroup> groups;
+  if (o.match_by_name) {
+    std::vector<std::string> unused;
+    groups = groups_by_name(scene, *high, &unused);
+    for (const std::string& n : unused) std::cerr << "warning: --match-by-name: high mesh '" << n << "' matches no low mesh and is not used\n";
+    return groups;
+  }
+  if (!o.groups.empty()) {
+    std::vector<std::vector<std::string>> lists;
+    for (const std::string& g : o.groups) {
+      std::vector<std::string>& l = lists.emplace_back();
+      std::stringstream ss(g);
+      for (std::string name; std::getline(ss, name, ',');)
+        if (!name.empty()) l.push_back(name);
+    }
+    groups = groups_from_lists(scene, lists);
+  } else if (o.self_occlusion) {
+    groups = groups_per_mesh(scene);
+  } else {
+    BakeGroup all{"", {}, {}};
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) all.meshes.push_back(i);
+    groups.push_back(std::move(all));
+  }
+  if (high)
+    for (BakeGroup& g : groups)
+      for (std::size_t i = 0; i < high->meshes.size(); ++i) g.high.push_back(i);
+  return groups;
+}
+
+// The map baked group by group: high to low (AO at the group's high meshes, occluded by them and
+// the occluders), or the group's own meshes with the occluders.
+BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene* high, const std::vector<Mesh>& occluders, const BakeOptions& o,
+                          const RaytracedBakeParams& rt, const HistogramParams& hist, nlohmann::json& summary, const ProgressFn& progress) {
+  const std::vector<BakeGroup> groups = make_groups(o, scene, high);
+  std::optional<CagePositions> cage;  // of the whole low scene; each group takes its meshes' cages
+  HighToLowParams p = o.h2l;
+  p.ao = rt;
+  if (high) {
+    if (!o.cage.empty()) {
+      cage = cage_from_mesh(scene, load_scene_file(o.cage));
+    } else {
+      if (!p.cage_extrusion) p.cage_extrusion = kDefaultCageFraction * scene.bounds().diagonal();
+      cage = extrude_cage(scene, *p.cage_extrusion);
+    }
+  }
+  BakeResult r = bake_groups(scene, groups, high ? std::vector<Mesh>{} : occluders, o.size,
+                             [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
+                               if (!high) {
+                                 if (o.method == "histogram") return bake_histogram(gs, cov, hist, progress);
+                                 const RayScene rays(gs);
+                                 return bake_raytraced(rays, cov, rt, progress);
+                               }
+                               Scene targets;
+                               targets.name = high->name;
+                               for (std::size_t i : g.high) targets.meshes.push_back(high->meshes[i]);
+                               Scene blockers = targets;
+                               for (const Mesh& m : occluders) blockers.meshes.push_back(m);
+                               CagePositions gc;
+                               for (std::size_t i : g.meshes) gc.push_back((*cage)[i]);
+                               const RayScene target_rays(targets);
+                               if (occluders.empty()) return bake_high_to_low(gs, cov, gc, target_rays, target_rays, p, progress);
+                               const RayScene blocker_rays(blockers);
+                               return bake_high_to_low(gs, cov, gc, target_rays, blocker_rays, p, progress);
+                             });
+  if (groups.size() > 1) summary["groups"] = groups.size();
+  if (!occluders.empty()) summary["occluder_meshes"] = occluders.size();
+  if (high) {
+    summary["high"] = o.high;
+    summary["high_triangles"] = high->triangle_count();
+    summary["missed_texels"] = r.missed_texels;
+    summary["parameters"] = p;
+    if (r.missed_texels > 0)
+      std::cerr << "warning: " << input.string() << ": " << r.missed_texels << " of " << r.covered_texels
+                << " texels: every cage ray missed the high mesh; filled from their neighbours (raise --cage-extrusion or --max-back"
+                << (o.miss_mask.empty() ? "; --miss-mask shows where)" : ")") << "\n";
+  }
+  return r;
+}
+
 nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
@@ -145,6 +277,10 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     return *rays;
   };
 
+  std::optional<Scene> high;
+  if (!o.high.empty()) high = load_high_scene(o.high);
+  const std::vector<Mesh> occluders = load_occluders(o, scene, high ? &*high : nullptr);
+  const bool grouped = high || !occluders.empty() || !o.groups.empty() || o.self_occlusion;
   const bool want_map = o.per_vertex.empty() || !o.output.empty() || !o.gltf.empty();
   const bool has_uv = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return !m.uvs.empty(); });
   if (want_map && !has_uv)
@@ -161,7 +297,8 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": " << w << "\n";
     {
       ProgressBar bar("bake " + input.filename().string(), progress);
-      if (o.method == "histogram") r = bake_histogram(scene, cov, hist, bar.callback());
+      if (grouped) r = bake_in_groups(input, scene, high ? &*high : nullptr, occluders, o, rt, hist, summary, bar.callback());
+      else if (o.method == "histogram") r = bake_histogram(scene, cov, hist, bar.callback());
       else r = bake_raytraced(ray_scene(), cov, rt, bar.callback());
       bake_ms = clock.lap_ms();
     }
@@ -190,7 +327,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     } else {
       summary["rays"] = r.rays;
       summary["rays_per_second"] = bake_ms > 0 ? static_cast<double>(r.rays) / (bake_ms / 1000.0) : 0.0;
-      summary["parameters"] = rt;
+      if (!high) summary["parameters"] = rt;
     }
     if (o.padding > 0) {
       const Image<std::int32_t> nearest = nearest_valid_texel(r.mask, o.padding);
@@ -205,12 +342,23 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     std::uint64_t nrays = 0;
     {
       ProgressBar bar("per-vertex " + input.filename().string(), progress);
+      // With occluders, the scene's meshes come first, so their vertices lead the result.
+      Scene with_occluders;
+      if (!occluders.empty()) {
+        with_occluders = scene;
+        for (const Mesh& m : occluders) with_occluders.meshes.push_back(m);
+      }
+      const Scene& vs = occluders.empty() ? scene : with_occluders;
       if (o.method == "histogram") {
         vertex_ao = bake_vertices_histogram(
-            scene, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed}, bar.callback());
-      } else {
+            vs, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed}, bar.callback());
+      } else if (occluders.empty()) {
         vertex_ao = bake_vertices_raytraced(ray_scene(), rt, &nrays, bar.callback());
+      } else {
+        const RayScene occluded(vs);
+        vertex_ao = bake_vertices_raytraced(occluded, rt, &nrays, bar.callback());
       }
+      vertex_ao.resize(scene.vertex_count());
     }
     vertex_ms = clock.lap_ms();
     timings["per_vertex_ms"] = vertex_ms;
@@ -220,6 +368,11 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   // Writes (each atomic).
   if (want_map) {
     write_image(map_out, r.visibility, {.png_bits = o.png_bits});
+    if (!o.miss_mask.empty()) {
+      Image<float> miss(o.size, o.size, 0.0f);
+      for (std::size_t i = 0; i < r.missed.size(); ++i) miss[i] = r.missed[i];
+      write_image(batch_path(input, o.miss_mask, o.out_dir, batch, "-miss.png"), miss, {});
+    }
     if (!o.bent.empty() && !r.bent_normal.empty()) {
       Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
       for (std::size_t i = 0; i < enc.size(); ++i)
@@ -256,8 +409,42 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   return summary;
 }
 
+// High-to-low options: they need --high, the ray-traced baker, a texture map and one low mesh.
+void check_high_to_low_options(BakeOptions& o) {
+  const int grouping = (o.match_by_name ? 1 : 0) + (o.groups.empty() ? 0 : 1) + (o.self_occlusion ? 1 : 0);
+  if (grouping > 1) throw InputError("--match-by-name, --group and --self-occlusion: give one way of forming bake groups");
+  if (o.match_by_name && o.high.empty()) throw InputError("--match-by-name needs --high: it pairs low meshes NAME_low with high meshes NAME_high");
+  if (grouping > 0 && !o.per_vertex.empty()) throw InputError("--per-vertex with bake groups: per-vertex AO is baked with every mesh occluding; drop the grouping");
+  if (o.floor && o.method_given && o.method == "histogram")
+    throw InputError("--floor needs --method raytraced: the histogram baker renders views covering the whole scene, and a floor 20 model diagonals "
+                     "wide would make each view's pixels 400 times as many");
+  if (o.floor) o.method = "raytraced";
+  if (o.high.empty()) {
+    if (!o.cage.empty() || o.h2l.cage_extrusion || o.h2l.max_front || o.h2l.max_back || !o.miss_mask.empty())
+      throw InputError("--cage, --cage-extrusion, --max-front, --max-back and --miss-mask need --high (the high-poly mesh to bake from)");
+    return;
+  }
+  if (o.method_given && o.method == "histogram")
+    throw InputError(
+        "--high needs --method raytraced: the histogram baker scatters each view's pixels into the texels of the surface it sees, "
+        "and pixels of the high mesh have no texel in the low mesh's map without a cage ray per pixel, which is the ray-traced baker");
+  o.method = "raytraced";
+  if (!o.per_vertex.empty()) throw InputError("--per-vertex with --high: per-vertex AO is baked from the mesh itself; bake the high mesh's map, or drop --high");
+  if (!o.cage.empty() && o.h2l.cage_extrusion) throw InputError("--cage and --cage-extrusion: give one (an explicit cage, or the low mesh pushed out by a distance)");
+  if (!o.miss_mask.empty() && !is_supported_image_path(o.miss_mask))
+    throw InputError(o.miss_mask + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+  o.h2l.validate();
+}
+
 int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.method != "histogram" && o.method != "raytraced") throw InputError("--method: expected histogram or raytraced, got '" + o.method + "'");
+  check_high_to_low_options(o);
+  const std::vector<std::string>& foreign = o.method == "histogram" ? o.raytraced_only : o.histogram_only;
+  if (!foreign.empty())
+    throw InputError(foreign.front() + " does not apply to --method " + o.method + " (it is a " + (o.method == "histogram" ? "raytraced" : "histogram") +
+                     " option); drop it or choose --method " + (o.method == "histogram" ? "raytraced" : "histogram"));
+  if (!o.max_distance && std::find(o.raytraced_only.begin(), o.raytraced_only.end(), "--membership") != o.raytraced_only.end())
+    throw InputError("--membership needs --max-distance: with unlimited distance every occluder counts fully (there is no falloff)");
   if (o.uv_set < 0 || o.uv_set > 7) throw InputError("--uv-set must be in [0, 7] (UV sets count from 0)");
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
   if (o.padding < 0 || o.padding > 1024) throw InputError("--padding must be in [0, 1024] texels");
@@ -273,6 +460,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   const std::vector<fs::path> inputs = expand_inputs(o.inputs);
   if (inputs.empty()) throw InputError("no mesh files to bake (folders are searched for .obj .ply .off .stl .gltf .glb)");
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
+  if (batch && !o.high.empty()) throw InputError("--high bakes one low mesh: give one low-poly mesh file, not " + std::to_string(inputs.size()) + " or a folder");
   check_output_names(o, batch);
   if (!batch) {
     const nlohmann::json s = bake_one(inputs.front(), o, false, global);
@@ -307,7 +495,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("meshes", o->inputs, "Mesh files (OBJ, PLY, OFF, STL, glTF/GLB) or folders of them; several are baked in turn")->required()->type_name("MESH");
   cmd->add_option("-o,--output", o->output, "AO map: .png (linear, 8/16 bit) or .exr (float). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
-  cmd->add_option("-m,--method", o->method, "histogram (outside-in, McGraw & Sowers; unlimited distance) or raytraced (Embree)")->capture_default_str();
+  CLI::Option* method = cmd->add_option("-m,--method", o->method, "histogram (outside-in, McGraw & Sowers; unlimited distance) or raytraced (Embree)")->capture_default_str();
   cmd->add_option("-s,--size", o->size, "Map width = height, texels [1, 16384]")->capture_default_str();
   cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
@@ -333,7 +521,33 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--reference", o->reference, "Compare the map with this reference map (EXR/PNG, same size) over covered texels; RMSE etc. in --json");
   cmd->add_option("--seed", o->seed, "Seed of directions / sample sets")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary (texels covered, directions or rays, timings, texels/s, rays/s) on stdout");
-  cmd->callback([o, &global, &action] { action = [o, &global] { return run_bake(*o, global); }; });
+  cmd->add_option("--high", o->high, "High to low: bake the AO of this high-poly mesh into the low mesh's UVs (repeatable; ray-traced)")->type_name("MESH");
+  cmd->add_option("--cage", o->cage, "High to low: cage mesh (the low mesh's topology, pushed out); rays start on it and travel inwards");
+  cmd->add_option("--cage-extrusion", o->h2l.cage_extrusion,
+                  "High to low: without --cage, push the low mesh out along its smoothed normals by this distance, world units (default 0.01 x diagonal)");
+  cmd->add_option("--max-front", o->h2l.max_front, "High to low: rays start this far outside the low surface, world units (default: at the cage)");
+  cmd->add_option("--max-back", o->h2l.max_back, "High to low: rays look this far inside the low surface, world units (default: the cage distance)");
+  cmd->add_option("--occluder", o->occluders, "Mesh that occludes but is not baked (repeatable)")->type_name("MESH");
+  cmd->add_flag("--floor", o->floor, "Add a ground plane under the model (y up, at its lowest point) as an occluder");
+  cmd->add_option("--group", o->groups, "Bake group: comma-separated mesh names that occlude each other and nothing else (repeatable; meshes not named form one more group)")
+      ->type_name("NAMES");
+  cmd->add_flag("--self-occlusion", o->self_occlusion, "Each mesh is occluded only by itself (and --occluder, --floor)");
+  cmd->add_flag("--match-by-name", o->match_by_name, "With --high: low mesh NAME_low bakes only from high meshes NAME_high (or NAME), Substance's convention");
+  cmd->add_option("--miss-mask", o->miss_mask, "High to low: write 1 where every cage ray of a texel missed the high mesh (those texels are filled from neighbours)");
+  // Options that only one baker reads: giving them to the other is an error, not silently ignored.
+  std::vector<CLI::Option*> histogram_only, raytraced_only;
+  for (const char* name : {"--directions", "--direction-set", "--pixels-per-texel", "--point-size", "--normalization", "--min-samples", "--seam-fix",
+                           "--vertex-resolution"})
+    histogram_only.push_back(cmd->get_option(name));
+  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces"}) raytraced_only.push_back(cmd->get_option(name));
+  cmd->callback([o, method, histogram_only, raytraced_only, &global, &action] {
+    o->method_given = method->count() > 0;
+    for (const CLI::Option* opt : histogram_only)
+      if (opt->count() > 0) o->histogram_only.push_back(opt->get_name());
+    for (const CLI::Option* opt : raytraced_only)
+      if (opt->count() > 0) o->raytraced_only.push_back(opt->get_name());
+    action = [o, &global] { return run_bake(*o, global); };
+  });
 }
 
 }  // namespace ao::cli

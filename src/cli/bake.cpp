@@ -23,7 +23,6 @@
 #include "ao/io/mesh_io.h"
 #include "ao/io/ply_export.h"
 #include "ao/reference/ray_scene.h"
-#include "ao/scene/procedural.h"
 #include "common.h"
 #include "subcommands.h"
 
@@ -147,16 +146,10 @@ std::vector<Mesh> load_occluders(const BakeOptions& o, const Scene& scene, const
     }
   }
   if (o.floor) {
-    // A slab under the model (y up), its top at the lowest point of the baked and high meshes and
-    // of the occluders; 20 model diagonals wide, so a point of the model sees it as the ground to
-    // within atan(1/20) ~ 3 degrees of the horizon (the reach of any occluder within R).
     Bounds3 b = scene.bounds();
     if (high) b.extend(high->bounds());
     for (const Mesh& m : out) b.extend(m.bounds());
-    const float d = b.diagonal(), cx = 0.5f * (b.lo.x + b.hi.x), cz = 0.5f * (b.lo.z + b.hi.z);
-    Mesh floor = make_box({cx - 10 * d, b.lo.y - 0.05f * d, cz - 10 * d}, {cx + 10 * d, b.lo.y, cz + 10 * d});
-    floor.name = "floor";
-    out.push_back(std::move(floor));
+    out.push_back(make_floor_occluder(b));
   }
   return out;
 }

@@ -368,3 +368,25 @@ TEST(BakeCli, OptionsOfTheOtherMethodAreOneLineErrors) {
 
 }  // namespace
 }  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+TEST(BakeCli, FloorDarkensTheBaseAndOccludersAreNotBaked) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  const std::string args = " -o ao.exr --json -m raytraced --size 32 --samples 16 --padding 0";
+  const RunResult open = run_ao("bake cube.obj" + args, dir.path());
+  const RunResult floor = run_ao("bake cube.obj --floor" + args + " --per-vertex v.ply", dir.path());
+  ASSERT_EQ(open.exit_code, 0) << open.err;
+  ASSERT_EQ(floor.exit_code, 0) << floor.err;
+  EXPECT_EQ(nlohmann::json::parse(open.out)["mean_visibility"].get<double>(), 1.0);
+  // The bottom face (1/6 of the charts) is black on the floor, the four sides are half open: the
+  // mean is about (4 x 0.5 + 1) / 6 = 0.5.
+  EXPECT_NEAR(nlohmann::json::parse(floor.out)["mean_visibility"].get<double>(), 0.5, 0.05);
+  // The per-vertex output has the cube's vertices only, not the floor's.
+  EXPECT_EQ(load_scene_file(dir / "v.ply").vertex_count(), load_scene_file(dir / "cube.obj").vertex_count());
+}
+
+}  // namespace
+}  // namespace ao::test

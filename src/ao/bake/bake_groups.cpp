@@ -9,6 +9,7 @@
 #include <set>
 
 #include "ao/core/error.h"
+#include "ao/scene/procedural.h"
 
 namespace ao {
 
@@ -88,6 +89,15 @@ std::vector<BakeGroup> groups_per_mesh(const Scene& scene) {
   std::vector<BakeGroup> out;
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) out.push_back({scene.meshes[i].name, {i}, {}});
   return out;
+}
+
+Mesh make_floor_occluder(const Bounds3& b) {
+  const float d = b.diagonal(), cx = 0.5f * (b.lo.x + b.hi.x), cz = 0.5f * (b.lo.z + b.hi.z);
+  // A closed slab (5 % of a diagonal thick) rather than one quad, so it occludes from either side
+  // in both bakers (the histogram baker culls back faces).
+  Mesh floor = make_box({cx - 10 * d, b.lo.y - 0.05f * d, cz - 10 * d}, {cx + 10 * d, b.lo.y, cz + 10 * d});
+  floor.name = "floor";
+  return floor;
 }
 
 Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<Mesh>& occluders) {

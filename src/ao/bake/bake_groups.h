@@ -39,6 +39,11 @@ std::vector<BakeGroup> groups_from_lists(const Scene& scene, const std::vector<s
 /// One group per mesh: each mesh occluded only by itself.
 std::vector<BakeGroup> groups_per_mesh(const Scene& scene);
 
+/// A ground plane under a model with bounds `model` (y up): a slab whose top is at the model's
+/// lowest y, 20 model diagonals wide, so a point of the model sees it as the ground to within
+/// atan(1/20) ~ 3 degrees of the horizon. Named "floor", no UVs.
+Mesh make_floor_occluder(const Bounds3& model);
+
 /// The scene of one group: its meshes of `scene`, in order, followed by `occluders` (whose UVs
 /// are dropped so they are not baked).
 Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<Mesh>& occluders);

@@ -8,7 +8,7 @@
 #include "ao/core/sampling.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/reference/direct_light.h"
-#include "ao/reference/packets.h"
+#include "ao/reference/packets_internal.h"
 #include "ao/reference/raytraced.h"
 #include "bench_scenes.h"
 

@@ -24,6 +24,7 @@
 #include "ao/methods/containment.h"
 #include "ao/methods/interleave.h"
 #include "ao/methods/transfer.h"
+#include "ao/methods/transfer_internal.h"
 #include "ao/methods/volumetric.h"
 #include "ao/reference/direct_light.h"
 #include "bench_scenes.h"

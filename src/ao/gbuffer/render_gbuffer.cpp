@@ -3,7 +3,7 @@
 #include <array>
 
 #include "ao/core/parallel.h"
-#include "ao/reference/packets.h"
+#include "ao/reference/packets_internal.h"
 
 namespace ao {
 

@@ -1,4 +1,4 @@
-#include "ao/io/exr_common.h"
+#include "ao/io/exr_common_internal.h"
 
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStdIO.h>

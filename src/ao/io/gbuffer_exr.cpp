@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "ao/core/error.h"
-#include "ao/io/exr_common.h"
+#include "ao/io/exr_common_internal.h"
 
 namespace ao {
 

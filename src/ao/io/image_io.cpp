@@ -16,7 +16,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
-#include "ao/io/exr_common.h"
+#include "ao/io/exr_common_internal.h"
 
 namespace ao {
 

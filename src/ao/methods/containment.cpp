@@ -9,6 +9,7 @@
 #include "ao/core/parallel.h"
 #include "ao/methods/characteristic.h"
 #include "ao/methods/samples.h"
+#include "ao/methods/screen_space_internal.h"
 
 namespace ao {
 

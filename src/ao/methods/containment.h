@@ -49,14 +49,4 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
 /// The screen-space method: containment_ao with the G-buffer's depth buffer.
 Image<float> containment_ao(const GBuffer& g, const Falloff& falloff, const ContainmentParams& params, std::uint32_t seed);
 
-/// PixelRow::load for the covered pixels of [x0, x1) only, compacted: entry k of `row` (k <
-/// row.count) is pixel x0 + index[k], and every entry is covered. Background pixels (30% of the
-/// default scene) then cost the sample loops nothing. The values are PixelRow::load's, computed in
-/// passes GCC vectorises (AVX-512: 16 entries per vector). With `frame` false the rotated tangent
-/// frame (tx..bz) is left unset: volumetric AO needs only the position, normal, rotation and bias.
-/// Shared by containment.cpp and volumetric.cpp. containment.cpp is compiled with -fno-math-errno
-/// (src/CMakeLists.txt) so that the square roots of the auto bias vectorise.
-void load_pixel_row_simd(PixelRow& row, std::vector<int>& index, const GBuffer& g, int y, int x0, int x1,
-                         const std::array<Rotation, 16>& rotations, float bias_world, bool frame);
-
 }  // namespace ao

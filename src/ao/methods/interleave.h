@@ -3,13 +3,9 @@
 // rotations of one sample set about the surface normal (VAO: about the view axis for the pipes'
 // disk), repeated over the image; a 4x4 box filter then averages the 16 uncorrelated estimates,
 // skipping neighbours whose depth differs from the centre's by more than a limit.
-//
-// Also the per-pixel setup the kernels share: a row of pixels as structure-of-arrays (position,
-// rotated tangent frame, depth bias), so the loops over samples run across pixels in SIMD lanes.
 #pragma once
 
 #include <array>
-#include <initializer_list>
 #include <span>
 #include <vector>
 
@@ -32,31 +28,10 @@ struct InterleaveOptions {
 void add_interleave_options(nlohmann::json& j, const InterleaveOptions& o);
 /// Reads the options' fields present in `j`; InputError (naming `method`) for wrong types.
 void read_interleave_options(const nlohmann::json& j, InterleaveOptions& o, const char* method);
-/// InputError naming `method` and the key when `j` is not an object or has a key not in `keys`.
-void require_known_keys(const nlohmann::json& j, std::initializer_list<const char*> keys, const char* method);
 /// Validates the options (the depth limit must be finite and >= 0).
 void validate_interleave_options(const InterleaveOptions& o, const char* method);
 /// The depth limit the filter uses: `filter_depth_limit`, or R/4 when it is 0.
 float effective_depth_limit(const InterleaveOptions& o, float radius);
-
-/// A run of pixels [x0, x0 + count) of one row, structure-of-arrays. Uncovered pixels get a
-/// harmless dummy point far in front of the camera and covered = 0.
-struct PixelRow {
-  int y = 0, x0 = 0, count = 0;
-  std::vector<float> px, py, pz;  ///< Camera-space position of the shaded point x.
-  std::vector<float> nx, ny, nz;  ///< Unit normal N.
-  std::vector<float> tx, ty, tz;  ///< Tangent T, rotated by the pixel's interleaving angle about N.
-  std::vector<float> bx, by, bz;  ///< Binormal B = N x T, rotated likewise.
-  std::vector<float> rc, rs;      ///< The pixel's rotation (cos, sin), for samples in the view plane.
-  std::vector<float> bias;        ///< Depth-test bias, world units (see load()).
-  std::vector<unsigned char> covered;
-
-  /// Fills the row from the G-buffer. The depth bias of a pixel is `bias_world` when > 0, else
-  /// auto: one pixel footprint at its depth times (1 + tan theta_v) with theta_v the angle between
-  /// the normal and the view ray (clamped to tan 83 deg = 8): the most a nearest-pixel depth lookup
-  /// on the same surface can be off by, so planes do not shadow themselves.
-  void load(const GBuffer& g, int y, int x0, int x1, const std::array<Rotation, 16>& rotations, float bias_world);
-};
 
 /// 4x4 box filter of `image` over covered pixels, window offsets -2..+1 in x and y (so it holds each
 /// of the 16 pattern positions once), skipping uncovered neighbours and those whose depth differs

@@ -21,6 +21,8 @@
 #include "ao/methods/characteristic.h"
 #include "ao/methods/containment.h"
 #include "ao/methods/samples.h"
+#include "ao/methods/screen_space_internal.h"
+#include "ao/methods/transfer_internal.h"
 
 namespace ao {
 

@@ -68,15 +68,6 @@ struct TransferImage {
   Image<float> luminance;    ///< Rec. 709 luminance of W: the method's scalar visibility.
 };
 
-/// What a caller that renders every frame keeps between calls (the viewer, the benchmark): the
-/// result and the scratch planes, reused while the size stays the same. Fresh pages are not free:
-/// at 1280x720 a call writes ~33 MB, and faulting that in cost about as much as the tests.
-struct TransferBuffers {
-  TransferImage result;
-  std::array<Image<float>, 6> scratch;  ///< Unfiltered W (R, G, B) and O, filtered G and B.
-  Image<std::uint32_t> depth_and_palette;  ///< The depth with an albedo index in its low bits (transfer.cpp).
-};
-
 /// Ambient transfer with characteristic function `ch` (instantiated as containment_ao's) and the
 /// multi-bounce reflectance `indirect` (a~, normally the G-buffer's albedo; same size) read at
 /// occluded test points. With params.reflectance == Radiance the occluders' direct radiance is
@@ -86,14 +77,7 @@ template <class Characteristic>
 TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Image<Vec3>& indirect, const Falloff& falloff,
                           const TransferParams& params, std::uint32_t seed);
 
-/// The same into `buffers` (returns buffers.result), allocating only when the size changes.
-template <class Characteristic>
-const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, const Characteristic& ch, const Image<Vec3>& indirect,
-                                 const Falloff& falloff, const TransferParams& params, std::uint32_t seed);
-
 /// The screen-space method: depth buffer, G-buffer albedo.
 TransferImage transfer_ao(const GBuffer& g, const Falloff& falloff, const TransferParams& params, std::uint32_t seed);
-const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, const Falloff& falloff, const TransferParams& params,
-                                 std::uint32_t seed);
 
 }  // namespace ao

@@ -10,6 +10,7 @@
 #include "ao/methods/characteristic.h"
 #include "ao/methods/containment.h"
 #include "ao/methods/samples.h"
+#include "ao/methods/screen_space_internal.h"
 
 namespace ao {
 

@@ -6,7 +6,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
-#include "ao/reference/packets.h"
+#include "ao/reference/packets_internal.h"
 
 namespace ao {
 

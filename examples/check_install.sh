@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# The library boundary, checked as a user meets it (run by CTest as `install_and_examples` and
+# `installed_headers_without_embree`, or by hand: examples/check_install.sh BUILD_DIR [examples|headers]):
+#   1. installs the build into a temporary prefix;
+# examples (the default):
+#   2. builds examples/ as a separate CMake project with find_package(ao 0.2 REQUIRED) and runs the
+#      three programs on a small OBJ written here (a floor with UVs and a cube on it);
+#   3. builds a one-file program with `pkg-config --cflags --libs ao` and runs it;
+# headers:
+#   4. compiles every installed header in one translation unit with Embree's, assimp's, OpenEXR's,
+#      libpng's and FreeType's headers replaced by ones that fail: no installed header includes them.
+# Everything is written below a temporary folder, removed at the end.
+set -euo pipefail
+build=$(cd "${1:?usage: check_install.sh BUILD_DIR [examples|headers]}" && pwd)
+mode=${2:-examples}
+src=$(cd "$(dirname "$0")" && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+prefix=$tmp/prefix
+cxx=${CXX:-c++}
+
+echo "== install into $prefix"
+cmake --install "$build" --prefix "$prefix" >/dev/null
+PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name ao.pc)")"
+export PKG_CONFIG_PATH
+
+if [ "$mode" = examples ]; then
+echo "== examples/ as a separate project (find_package(ao 0.2 REQUIRED))"
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S "$src" -B "$tmp/examples" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" "${launcher[@]}" >/dev/null
+cmake --build "$tmp/examples" >/dev/null
+
+cat > "$tmp/scene.obj" <<'OBJ'
+o floor
+v -2 0 -2
+v 2 0 -2
+v 2 0 2
+v -2 0 2
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vn 0 1 0
+f 1/1/1 4/4/1 3/3/1 2/2/1
+o cube
+v -0.5 0 -0.5
+v 0.5 0 -0.5
+v 0.5 1 -0.5
+v -0.5 1 -0.5
+v -0.5 0 0.5
+v 0.5 0 0.5
+v 0.5 1 0.5
+v -0.5 1 0.5
+f 5 8 7 6
+f 9 10 11 12
+f 5 6 10 9
+f 8 12 11 7
+f 5 9 12 8
+f 6 7 11 10
+OBJ
+cd "$tmp"
+"$tmp/examples/mesh_to_exr" scene.obj ao.exr volumetric
+"$tmp/examples/own_gbuffer"
+"$tmp/examples/bake_map" scene.obj map.png 64
+for f in ao.exr own_gbuffer.pgm map.png; do [ -s "$f" ] || { echo "check_install: $f was not written" >&2; exit 1; }; done
+
+echo "== a one-file program with pkg-config --cflags --libs ao"
+cat > "$tmp/version.cpp" <<'CPP'
+#include <cstdio>
+#include <ao/ao.h>
+int main() {
+  const ao::Scene scene = ao::make_builtin_scene("plane");
+  std::printf("ao %d.%d.%d, %zu triangles\n", AO_VERSION_MAJOR, AO_VERSION_MINOR, AO_VERSION_PATCH, scene.triangle_count());
+  return AO_VERSION_MAJOR * 100 + AO_VERSION_MINOR == 2 ? 0 : 1;
+}
+CPP
+# shellcheck disable=SC2046
+"$cxx" -o "$tmp/version" "$tmp/version.cpp" $(pkg-config --cflags --libs ao)
+"$tmp/version"
+echo "check_install: examples passed"
+exit 0
+fi
+
+echo "== installed headers, without Embree, assimp, OpenEXR, libpng, FreeType"
+poison=$tmp/poison
+for h in embree3/rtcore.h embree3/rtcore_ray.h assimp/scene.h assimp/Importer.hpp OpenEXR/ImfHeader.h \
+         OpenEXR/ImfInputFile.h OpenEXR/ImfFrameBuffer.h png.h ft2build.h; do
+  mkdir -p "$poison/$(dirname "$h")"
+  echo "#error \"an installed ao header includes <$h>\"" > "$poison/$h"
+done
+(cd "$prefix/include" && find ao -name '*.h' | sort | sed 's/.*/#include <&>/') > "$tmp/all_headers.cpp"
+[ "$(grep -c . "$tmp/all_headers.cpp")" -gt 10 ] || { echo "check_install: too few headers installed" >&2; exit 1; }
+if grep -q "_internal.h" "$tmp/all_headers.cpp"; then echo "check_install: an internal header was installed" >&2; exit 1; fi
+"$cxx" -std=c++20 -fsyntax-only -I"$poison" -I"$prefix/include" $(pkg-config --cflags-only-other tbb nlohmann_json) "$tmp/all_headers.cpp"
+echo "check_install: headers passed"

@@ -1,0 +1,73 @@
+// ao: ambient occlusion on the CPU. The one header a program includes; it names every public
+// header of the library, grouped as the README's layout. Link ao::ao (CMake: find_package(ao 0.2),
+// or pkg-config ao); a program that needs only the G-buffer and in-memory-scene parts (core, scene,
+// methods but the registry, eval) may include those headers alone and link ao::core.
+//
+// A minimal program (examples/ has three complete ones; README "Use it as a library"):
+//   const ao::Scene scene = ao::load_scene_file("bunny.obj");
+//   const ao::RayScene rays(scene);
+//   const ao::GBuffer g = ao::render_gbuffer(rays, ao::frame_bounds(scene.bounds(), {0.55f, 0.5f, 1}, 40, 640, 360));
+//   const ao::MethodInfo& m = ao::find_method("volumetric");
+//   const ao::MethodOutput out = m.run({g, &rays, {ao::Membership::Step, 0.1f * scene.bounds().diagonal()}, 1}, m.default_params());
+//   ao::write_image("ao.exr", out.visibility);
+#pragma once
+
+#include "ao/version.h"
+
+// core: math, images, G-buffers, cameras, sampling, membership functions, parallel tiles, errors.
+#include "ao/core/camera.h"
+#include "ao/core/error.h"
+#include "ao/core/gbuffer.h"
+#include "ao/core/image.h"
+#include "ao/core/math.h"
+#include "ao/core/membership.h"
+#include "ao/core/parallel.h"
+#include "ao/core/progress.h"
+#include "ao/core/sampling.h"
+#include "ao/core/texture.h"
+
+// scene: meshes, scenes, built-in and analytic scenes.
+#include "ao/scene/analytic.h"
+#include "ao/scene/mesh.h"
+#include "ao/scene/procedural.h"
+
+// The ray-traced ground truth and the scene -> G-buffer pass (Embree stays behind RayScene).
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/reference/direct_light.h"
+#include "ao/reference/ray_scene.h"
+#include "ao/reference/raytraced.h"
+
+// methods: one paper per header, and the registry that runs any of them by name.
+#include "ao/methods/alchemy.h"
+#include "ao/methods/bilateral.h"
+#include "ao/methods/characteristic.h"
+#include "ao/methods/cone.h"
+#include "ao/methods/containment.h"
+#include "ao/methods/interleave.h"
+#include "ao/methods/registry.h"
+#include "ao/methods/samples.h"
+#include "ao/methods/transfer.h"
+#include "ao/methods/volumetric.h"
+#include "ao/methods/voxelize.h"
+
+// bake: AO maps (outside-in histogram, inside-out ray-traced), padding, per-vertex AO.
+#include "ao/bake/bake_result.h"
+#include "ao/bake/histogram.h"
+#include "ao/bake/ortho_raster.h"
+#include "ao/bake/padding.h"
+#include "ao/bake/per_vertex.h"
+#include "ao/bake/raytraced_bake.h"
+#include "ao/bake/sphere_directions.h"
+#include "ao/bake/texel_coverage.h"
+
+// eval: error metrics against a reference.
+#include "ao/eval/metrics.h"
+
+// io: mesh and image files, G-buffer EXR passes, glTF and PLY export, atomic writes, text.
+#include "ao/io/atomic_file.h"
+#include "ao/io/gbuffer_exr.h"
+#include "ao/io/gltf_export.h"
+#include "ao/io/image_io.h"
+#include "ao/io/mesh_io.h"
+#include "ao/io/ply_export.h"
+#include "ao/io/text.h"

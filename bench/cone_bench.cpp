@@ -9,6 +9,7 @@
 
 #include "ao/eval/metrics.h"
 #include "ao/gbuffer/render_gbuffer.h"
+#include "ao/methods/bilateral.h"
 #include "ao/methods/cone.h"
 #include "ao/reference/raytraced.h"
 #include "bench_scenes.h"
@@ -72,6 +73,37 @@ void cone_trace(benchmark::State& state, const std::string& file) {
   state.counters["covered"] = static_cast<double>(covered);
 }
 
+// The cone pass alone on the default scene at 640 x 360 (the size of `ao compare`): the per-pixel
+// jitter off/on (range 0) and the cone count (range 1), to measure their cost as ratios in one run
+// (--benchmark_enable_random_interleaving alternates them).
+void cone_trace_variants(benchmark::State& state) {
+  ConeFixture* f = fixture("default");
+  const GBuffer& g = f->gbuffer(640, 360);
+  ConeParams p = cone_preset(ConeQuality::Medium).resolved();
+  p.jitter = state.range(0) != 0;
+  p.cones = static_cast<int>(state.range(1));
+  const VoxelGrid grid = voxelize_world(f->scene, f->closure, p.voxelize_options(f->r_max));
+  Image<float> v(g.width(), g.height());
+  for (auto _ : state) compute_cone(g, grid, f->r_max, p, 1, v.view());
+}
+
+// The cross-bilateral filter alone on the same image (range 0: taps).
+void cone_filter(benchmark::State& state) {
+  ConeFixture* f = fixture("default");
+  const GBuffer& g = f->gbuffer(640, 360);
+  ConeParams p = cone_preset(ConeQuality::Medium).resolved();
+  const VoxelGrid grid = voxelize_world(f->scene, f->closure, p.voxelize_options(f->r_max));
+  Image<float> v(g.width(), g.height());
+  compute_cone(g, grid, f->r_max, p, 1, v.view());
+  BilateralParams b;
+  b.taps = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    Image<float> w = v;
+    bilateral_filter(g, w, b);
+    benchmark::DoNotOptimize(w);
+  }
+}
+
 // The whole frame after the G-buffer: voxelization + cone pass (Tables III and IV).
 void cone_frame(benchmark::State& state, const std::string& file) {
   ConeFixture* f = fixture(file);
@@ -111,6 +143,8 @@ BENCHMARK_CAPTURE(cone_trace, refined_elephant, std::string("refined_elephant.of
     ->Args({1024, 768, kMedium})->Args({1024, 768, kLow})->Args({1024, 768, kHigh})
     ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK_CAPTURE(cone_trace, default_scene, std::string("default"))->Args({1024, 768, kMedium})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(cone_trace_variants)->Args({0, 6})->Args({1, 6})->Args({1, 16})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(cone_filter)->Arg(5)->Arg(7)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 // Table III shape: one mesh, growing resolution.
 BENCHMARK_CAPTURE(cone_frame, table3_refined_elephant, std::string("refined_elephant.off"))
     ->Args({640, 480})->Args({800, 600})->Args({1024, 768})->Args({1280, 960})->Args({1600, 1200})

@@ -8,17 +8,23 @@
 #include <sstream>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "ao/bake/bake_groups.h"
+#include "ao/bake/high_to_low.h"
 #include "ao/bake/histogram.h"
 #include "ao/bake/padding.h"
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/raytraced_bake.h"
 #include "ao/core/error.h"
+#include "ao/core/memory.h"
 #include "ao/eval/metrics.h"
+#include "ao/io/atomic_file.h"
 #include "ao/io/gltf_export.h"
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
+#include "ao/io/output_set.h"
 #include "ao/io/ply_export.h"
 #include "ao/reference/ray_scene.h"
 #include "common.h"
@@ -34,6 +40,16 @@ struct BakeOptions {
   std::vector<std::string> inputs;
   std::string output, out_dir, per_vertex, gltf, bent, reference;
   std::string method = "histogram";
+  bool method_given = false;  // -m was on the command line (high-to-low then picks raytraced itself)
+  // Options given on the command line that only one baker reads, by name ("--directions", ...).
+  std::vector<std::string> histogram_only, raytraced_only;
+  // High to low (high_to_low.h).
+  std::vector<std::string> high;
+  std::string cage, miss_mask;
+  HighToLowParams h2l;
+  // Occluders and bake groups (bake_groups.h).
+  std::vector<std::string> occluders, groups;
+  bool floor = false, match_by_name = false, self_occlusion = false;
   int size = 1024;
   int uv_set = 0;
   int padding = kDefaultPadding;
@@ -110,10 +126,170 @@ void check_output_names(const BakeOptions& o, bool batch) {
   }
 }
 
+// The outputs of one mesh, each with the option that names it (for messages).
+struct MeshOutputs {
+  std::vector<std::pair<fs::path, std::string>> files;
+  fs::path map, miss, bent, gltf, per_vertex;  ///< Empty when not written.
+};
+
+bool wants_map(const BakeOptions& o) { return o.per_vertex.empty() || !o.output.empty() || !o.gltf.empty(); }
+
+MeshOutputs outputs_of(const fs::path& input, const BakeOptions& o, bool batch) {
+  MeshOutputs out;
+  if (wants_map(o)) {
+    out.map = batch_path(input, o.output, o.out_dir, batch, "-ao.png");
+    out.files.emplace_back(out.map, o.output.empty() ? "the default map output" : "-o");
+    if (!o.miss_mask.empty()) {
+      out.miss = batch_path(input, o.miss_mask, o.out_dir, batch, "-miss.png");
+      out.files.emplace_back(out.miss, "--miss-mask");
+    }
+    if (!o.bent.empty()) {
+      out.bent = batch_path(input, o.bent, o.out_dir, batch, "-bent.png");
+      out.files.emplace_back(out.bent, "--bent-normals");
+    }
+    if (!o.gltf.empty()) {
+      out.gltf = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
+      out.files.emplace_back(out.gltf, "--gltf");
+    }
+  }
+  if (!o.per_vertex.empty()) {
+    out.per_vertex = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
+    out.files.emplace_back(out.per_vertex, "--per-vertex");
+  }
+  return out;
+}
+
+// The transaction of one mesh's outputs (output_set.h): its inputs, then its outputs, checked now.
+// `of_mesh`: name the mesh in the option labels (a batch, where several meshes have a "-o").
+void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const MeshOutputs& outs, bool of_mesh = false) {
+  set.add_input(input, "the mesh " + input.string());
+  set.add_input(o.reference, "--reference");
+  set.add_input(o.cage, "--cage");
+  for (const std::string& f : o.high) set.add_input(f, "--high");
+  for (const std::string& f : o.occluders) set.add_input(f, "--occluder");
+  for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
+}
+
+// The high meshes of --high, one scene (their UVs are not used).
+Scene load_high_scene(const std::vector<std::string>& files) {
+  Scene high;
+  high.name = files.size() == 1 ? files.front() : "--high meshes";
+  for (const std::string& f : files) {
+    Scene s = load_scene_file(f);
+    for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
+    for (Mesh& m : s.meshes) high.meshes.push_back(std::move(m));
+  }
+  return high;
+}
+
+// --occluder meshes (UVs dropped: they occlude, they are not baked) and the --floor.
+std::vector<Mesh> load_occluders(const BakeOptions& o, const Scene& scene, const Scene* high) {
+  std::vector<Mesh> out;
+  for (const std::string& f : o.occluders) {
+    Scene s = load_scene_file(f);
+    for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
+    for (Mesh& m : s.meshes) {
+      m.uvs.clear();
+      out.push_back(std::move(m));
+    }
+  }
+  if (o.floor) {
+    Bounds3 b = scene.bounds();
+    if (high) b.extend(high->bounds());
+    for (const Mesh& m : out) b.extend(m.bounds());
+    out.push_back(make_floor_occluder(b));
+  }
+  return out;
+}
+
+// Bake groups: by name, explicit lists, one per mesh, or everything in one.
+std::vector<BakeGroup> make_groups(const BakeOptions& o, const Scene& scene, const Scene* high) {
+  std::vector<BakeGroup> groups;
+  if (o.match_by_name) {
+    std::vector<std::string> unused;
+    groups = groups_by_name(scene, *high, &unused);
+    for (const std::string& n : unused) std::cerr << "warning: --match-by-name: high mesh '" << n << "' matches no low mesh and is not used\n";
+    return groups;
+  }
+  if (!o.groups.empty()) {
+    std::vector<std::vector<std::string>> lists;
+    for (const std::string& g : o.groups) {
+      std::vector<std::string>& l = lists.emplace_back();
+      std::stringstream ss(g);
+      for (std::string name; std::getline(ss, name, ',');)
+        if (!name.empty()) l.push_back(name);
+    }
+    groups = groups_from_lists(scene, lists);
+  } else if (o.self_occlusion) {
+    groups = groups_per_mesh(scene);
+  } else {
+    BakeGroup all{"", {}, {}};
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) all.meshes.push_back(i);
+    groups.push_back(std::move(all));
+  }
+  if (high)
+    for (BakeGroup& g : groups)
+      for (std::size_t i = 0; i < high->meshes.size(); ++i) g.high.push_back(i);
+  return groups;
+}
+
+// The map baked group by group: high to low (AO at the group's high meshes, occluded by them and
+// the occluders), or the group's own meshes with the occluders.
+BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene* high, const std::vector<Mesh>& occluders, const BakeOptions& o,
+                          const RaytracedBakeParams& rt, const HistogramParams& hist, nlohmann::json& summary, const ProgressFn& progress) {
+  const std::vector<BakeGroup> groups = make_groups(o, scene, high);
+  std::optional<CagePositions> cage;  // of the whole low scene; each group takes its meshes' cages
+  HighToLowParams p = o.h2l;
+  p.ao = rt;
+  if (high) {
+    if (!o.cage.empty()) {
+      cage = cage_from_mesh(scene, load_scene_file(o.cage));
+    } else {
+      if (!p.cage_extrusion) p.cage_extrusion = kDefaultCageFraction * scene.bounds().diagonal();
+      cage = extrude_cage(scene, *p.cage_extrusion);
+    }
+  }
+  BakeResult r = bake_groups(scene, groups, high ? std::vector<Mesh>{} : occluders, o.size,
+                             [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
+                               if (!high) {
+                                 if (o.method == "histogram") return bake_histogram(gs, cov, hist, progress);
+                                 const RayScene rays(gs);
+                                 return bake_raytraced(rays, cov, rt, progress);
+                               }
+                               Scene targets;
+                               targets.name = high->name;
+                               for (std::size_t i : g.high) targets.meshes.push_back(high->meshes[i]);
+                               Scene blockers = targets;
+                               for (const Mesh& m : occluders) blockers.meshes.push_back(m);
+                               CagePositions gc;
+                               for (std::size_t i : g.meshes) gc.push_back((*cage)[i]);
+                               const RayScene target_rays(targets);
+                               if (occluders.empty()) return bake_high_to_low(gs, cov, gc, target_rays, target_rays, p, progress);
+                               const RayScene blocker_rays(blockers);
+                               return bake_high_to_low(gs, cov, gc, target_rays, blocker_rays, p, progress);
+                             });
+  if (groups.size() > 1) summary["groups"] = groups.size();
+  if (!occluders.empty()) summary["occluder_meshes"] = occluders.size();
+  if (high) {
+    summary["high"] = o.high;
+    summary["high_triangles"] = high->triangle_count();
+    summary["missed_texels"] = r.missed_texels;
+    summary["parameters"] = p;
+    if (r.missed_texels > 0)
+      std::cerr << "warning: " << input.string() << ": " << r.missed_texels << " of " << r.covered_texels
+                << " texels: every cage ray missed the high mesh; filled from their neighbours (raise --cage-extrusion or --max-back"
+                << (o.miss_mask.empty() ? "; --miss-mask shows where)" : ")") << "\n";
+  }
+  return r;
+}
+
 nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
   const bool progress = !global.quiet && stderr_is_terminal();
+  const MeshOutputs outs = outputs_of(input, o, batch);
+  OutputSet outputs;
+  declare(outputs, input, o, outs);
   Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.
@@ -127,25 +303,25 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   RaytracedBakeParams rt = o.rt;
   rt.seed = o.seed;
   rt.max_distance = o.max_distance;
-  if (o.max_distance) {
-    const auto m = parse_membership(o.membership);
-    if (!m || *m == Membership::Exp) throw InputError("--membership: use step, linear, sqrt or cubic for baking, got '" + o.membership + "'");
-    rt.membership = *m;
-  }
+  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
   HistogramParams hist = o.hist;
   hist.seed = o.seed;
-  if (o.method == "histogram" && o.max_distance)
-    throw InputError("--max-distance needs --method raytraced: the histogram baker sees occluders at any distance (paper eq. 1)");
   std::unique_ptr<RayScene> rays;
   auto ray_scene = [&]() -> RayScene& {
     if (!rays) {
+      check_memory(estimate_ray_scene_memory(scene.triangle_count(), scene.vertex_count()),
+                   input.string() + ": the BVH of " + std::to_string(scene.triangle_count()) + " triangles");
       rays = std::make_unique<RayScene>(scene);
       timings["bvh_ms"] = clock.lap_ms();
     }
     return *rays;
   };
 
-  const bool want_map = o.per_vertex.empty() || !o.output.empty() || !o.gltf.empty();
+  std::optional<Scene> high;
+  if (!o.high.empty()) high = load_high_scene(o.high);
+  const std::vector<Mesh> occluders = load_occluders(o, scene, high ? &*high : nullptr);
+  const bool grouped = high || !occluders.empty() || !o.groups.empty() || o.self_occlusion;
+  const bool want_map = wants_map(o);
   const bool has_uv = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return !m.uvs.empty(); });
   if (want_map && !has_uv)
     throw InputError(input.string() + ": the mesh has no UV coordinates, so it cannot be baked to a texture; use --per-vertex out.ply for per-vertex AO");
@@ -161,12 +337,13 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": " << w << "\n";
     {
       ProgressBar bar("bake " + input.filename().string(), progress);
-      if (o.method == "histogram") r = bake_histogram(scene, cov, hist, bar.callback());
+      if (grouped) r = bake_in_groups(input, scene, high ? &*high : nullptr, occluders, o, rt, hist, summary, bar.callback());
+      else if (o.method == "histogram") r = bake_histogram(scene, cov, hist, bar.callback());
       else r = bake_raytraced(ray_scene(), cov, rt, bar.callback());
       bake_ms = clock.lap_ms();
     }
     timings["bake_ms"] = bake_ms;
-    map_out = batch_path(input, o.output, o.out_dir, batch, "-ao.png");
+    map_out = outs.map;
     double sum = 0;
     for (std::size_t i = 0; i < r.mask.size(); ++i)
       if (r.mask[i]) sum += r.visibility[i];
@@ -190,7 +367,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     } else {
       summary["rays"] = r.rays;
       summary["rays_per_second"] = bake_ms > 0 ? static_cast<double>(r.rays) / (bake_ms / 1000.0) : 0.0;
-      summary["parameters"] = rt;
+      if (!high) summary["parameters"] = rt;
     }
     if (o.padding > 0) {
       const Image<std::int32_t> nearest = nearest_valid_texel(r.mask, o.padding);
@@ -205,59 +382,112 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     std::uint64_t nrays = 0;
     {
       ProgressBar bar("per-vertex " + input.filename().string(), progress);
+      // With occluders, the scene's meshes come first, so their vertices lead the result.
+      Scene with_occluders;
+      if (!occluders.empty()) {
+        with_occluders = scene;
+        for (const Mesh& m : occluders) with_occluders.meshes.push_back(m);
+      }
+      const Scene& vs = occluders.empty() ? scene : with_occluders;
       if (o.method == "histogram") {
         vertex_ao = bake_vertices_histogram(
-            scene, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed}, bar.callback());
-      } else {
+            vs, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed}, bar.callback());
+      } else if (occluders.empty()) {
         vertex_ao = bake_vertices_raytraced(ray_scene(), rt, &nrays, bar.callback());
+      } else {
+        const RayScene occluded(vs);
+        vertex_ao = bake_vertices_raytraced(occluded, rt, &nrays, bar.callback());
       }
+      vertex_ao.resize(scene.vertex_count());
     }
     vertex_ms = clock.lap_ms();
     timings["per_vertex_ms"] = vertex_ms;
     if (nrays) summary["per_vertex_rays"] = nrays;
   }
 
-  // Writes (each atomic).
+  // Writes: staged beside their destinations and renamed together once all are written.
   if (want_map) {
-    write_image(map_out, r.visibility, {.png_bits = o.png_bits});
-    if (!o.bent.empty() && !r.bent_normal.empty()) {
+    outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
+    if (!outs.miss.empty()) {
+      Image<float> miss(o.size, o.size, 0.0f);
+      for (std::size_t i = 0; i < r.missed.size(); ++i) miss[i] = r.missed[i];
+      outputs.write(outs.miss, [&] { write_image(outs.miss, miss, {}); });
+    }
+    if (!outs.bent.empty() && !r.bent_normal.empty()) {
       Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
       for (std::size_t i = 0; i < enc.size(); ++i)
         if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
-      write_rgb_image(batch_path(input, o.bent, o.out_dir, batch, "-bent.png"), enc, {.png_bits = o.png_bits});
+      outputs.write(outs.bent, [&] { write_rgb_image(outs.bent, enc, {.png_bits = o.png_bits}); });
     }
-    if (!o.gltf.empty()) {
+    if (!outs.gltf.empty()) {
       std::string png;
       if (map_out.extension() == ".png" || map_out.extension() == ".PNG") {
-        png = read_bytes(map_out);
+        png = read_bytes(outputs.staged(map_out));
       } else {
-        const fs::path tmp = fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png");
-        write_image(tmp, r.visibility, {.png_bits = 8});
-        png = read_bytes(tmp);
-        fs::remove(tmp);
+        const ScratchFile tmp(fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png"));
+        write_image(tmp.path(), r.visibility, {.png_bits = 8});
+        png = read_bytes(tmp.path());
       }
-      const fs::path glb = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
-      write_ao_glb(glb, scene, png, source ? &*source : nullptr);
-      summary["gltf_output"] = glb.string();
+      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, source ? &*source : nullptr); });
+      summary["gltf_output"] = outs.gltf.string();
     }
-    if (!o.json)
-      std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
-                   input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
-                   summary["texels_per_second"].get<double>() / 1e6);
   }
-  if (!o.per_vertex.empty()) {
-    const fs::path out = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
-    write_vertex_ao_ply(out, scene, vertex_ao);
-    summary["per_vertex_output"] = out.string();
-    if (!o.json) std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", out.string().c_str(), vertex_ao.size(), vertex_ms);
+  if (!outs.per_vertex.empty()) {
+    outputs.write(outs.per_vertex, [&] { write_vertex_ao_ply(outs.per_vertex, scene, vertex_ao); });
+    summary["per_vertex_output"] = outs.per_vertex.string();
   }
+  outputs.commit();
+  if (want_map && !o.json)
+    std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
+                 input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
+                 summary["texels_per_second"].get<double>() / 1e6);
+  if (!outs.per_vertex.empty() && !o.json)
+    std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", outs.per_vertex.string().c_str(), vertex_ao.size(), vertex_ms);
   timings["write_ms"] = clock.lap_ms();
   summary["timings"] = timings;
   return summary;
 }
 
+// High-to-low options: they need --high, the ray-traced baker, a texture map and one low mesh.
+void check_high_to_low_options(BakeOptions& o) {
+  const int grouping = (o.match_by_name ? 1 : 0) + (o.groups.empty() ? 0 : 1) + (o.self_occlusion ? 1 : 0);
+  if (grouping > 1) throw InputError("--match-by-name, --group and --self-occlusion: give one way of forming bake groups");
+  if (o.match_by_name && o.high.empty()) throw InputError("--match-by-name needs --high: it pairs low meshes NAME_low with high meshes NAME_high");
+  if (grouping > 0 && !o.per_vertex.empty()) throw InputError("--per-vertex with bake groups: per-vertex AO is baked with every mesh occluding; drop the grouping");
+  if (o.floor && o.method_given && o.method == "histogram")
+    throw InputError("--floor needs --method raytraced: the histogram baker renders views covering the whole scene, and a floor 20 model diagonals "
+                     "wide would make each view's pixels 400 times as many");
+  if (o.floor) o.method = "raytraced";
+  if (o.high.empty()) {
+    if (!o.cage.empty() || o.h2l.cage_extrusion || o.h2l.max_front || o.h2l.max_back || !o.miss_mask.empty())
+      throw InputError("--cage, --cage-extrusion, --max-front, --max-back and --miss-mask need --high (the high-poly mesh to bake from)");
+    return;
+  }
+  if (o.method_given && o.method == "histogram")
+    throw InputError(
+        "--high needs --method raytraced: the histogram baker scatters each view's pixels into the texels of the surface it sees, "
+        "and pixels of the high mesh have no texel in the low mesh's map without a cage ray per pixel, which is the ray-traced baker");
+  o.method = "raytraced";
+  if (!o.per_vertex.empty()) throw InputError("--per-vertex with --high: per-vertex AO is baked from the mesh itself; bake the high mesh's map, or drop --high");
+  if (!o.cage.empty() && o.h2l.cage_extrusion) throw InputError("--cage and --cage-extrusion: give one (an explicit cage, or the low mesh pushed out by a distance)");
+  if (!o.miss_mask.empty() && !is_supported_image_path(o.miss_mask))
+    throw InputError(o.miss_mask + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+  o.h2l.validate();
+}
+
 int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.method != "histogram" && o.method != "raytraced") throw InputError("--method: expected histogram or raytraced, got '" + o.method + "'");
+  check_high_to_low_options(o);
+  const std::vector<std::string>& foreign = o.method == "histogram" ? o.raytraced_only : o.histogram_only;
+  if (!foreign.empty())
+    throw InputError(foreign.front() + " does not apply to --method " + o.method + " (it is a " + (o.method == "histogram" ? "raytraced" : "histogram") +
+                     " option); drop it or choose --method " + (o.method == "histogram" ? "raytraced" : "histogram"));
+  if (!o.max_distance && std::find(o.raytraced_only.begin(), o.raytraced_only.end(), "--membership") != o.raytraced_only.end())
+    throw InputError("--membership needs --max-distance: with unlimited distance every occluder counts fully (there is no falloff)");
+  if (o.max_distance) {
+    const auto m = parse_membership(o.membership);
+    if (!m || *m == Membership::Exp) throw InputError("--membership: use step, linear, sqrt or cubic for baking, got '" + o.membership + "'");
+  }
   if (o.uv_set < 0 || o.uv_set > 7) throw InputError("--uv-set must be in [0, 7] (UV sets count from 0)");
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
   if (o.padding < 0 || o.padding > 1024) throw InputError("--padding must be in [0, 1024] texels");
@@ -273,7 +503,21 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   const std::vector<fs::path> inputs = expand_inputs(o.inputs);
   if (inputs.empty()) throw InputError("no mesh files to bake (folders are searched for .obj .ply .off .stl .gltf .glb)");
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
+  if (batch && !o.high.empty()) throw InputError("--high bakes one low mesh: give one low-poly mesh file, not " + std::to_string(inputs.size()) + " or a folder");
   check_output_names(o, batch);
+  // Every output of the run is checked against every input and every other output before any
+  // mesh is loaded (each mesh's outputs are then one transaction of their own).
+  {
+    OutputSet all;
+    for (const fs::path& in : inputs) all.add_input(in, "the mesh " + in.string());
+    for (const fs::path& in : inputs) declare(all, in, o, outputs_of(in, o, batch), batch);
+  }
+  if (wants_map(o)) {
+    const int threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    check_memory(estimate_bake_memory({.size = o.size, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
+                                       .pixels_per_texel = o.hist.pixels_per_texel, .threads = threads}),
+                 "ao bake: a " + std::to_string(o.size) + "x" + std::to_string(o.size) + " map");
+  }
   if (!batch) {
     const nlohmann::json s = bake_one(inputs.front(), o, false, global);
     if (o.json) std::cout << s.dump(2) << "\n";
@@ -307,7 +551,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("meshes", o->inputs, "Mesh files (OBJ, PLY, OFF, STL, glTF/GLB) or folders of them; several are baked in turn")->required()->type_name("MESH");
   cmd->add_option("-o,--output", o->output, "AO map: .png (linear, 8/16 bit) or .exr (float). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
-  cmd->add_option("-m,--method", o->method, "histogram (outside-in, McGraw & Sowers; unlimited distance) or raytraced (Embree)")->capture_default_str();
+  CLI::Option* method = cmd->add_option("-m,--method", o->method, "histogram (outside-in, McGraw & Sowers; unlimited distance) or raytraced (Embree)")->capture_default_str();
   cmd->add_option("-s,--size", o->size, "Map width = height, texels [1, 16384]")->capture_default_str();
   cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
@@ -333,7 +577,33 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--reference", o->reference, "Compare the map with this reference map (EXR/PNG, same size) over covered texels; RMSE etc. in --json");
   cmd->add_option("--seed", o->seed, "Seed of directions / sample sets")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary (texels covered, directions or rays, timings, texels/s, rays/s) on stdout");
-  cmd->callback([o, &global, &action] { action = [o, &global] { return run_bake(*o, global); }; });
+  cmd->add_option("--high", o->high, "High to low: bake the AO of this high-poly mesh into the low mesh's UVs (repeatable; ray-traced)")->type_name("MESH");
+  cmd->add_option("--cage", o->cage, "High to low: cage mesh (the low mesh's topology, pushed out); rays start on it and travel inwards");
+  cmd->add_option("--cage-extrusion", o->h2l.cage_extrusion,
+                  "High to low: without --cage, push the low mesh out along its smoothed normals by this distance, world units (default 0.01 x diagonal)");
+  cmd->add_option("--max-front", o->h2l.max_front, "High to low: rays start this far outside the low surface, world units (default: at the cage)");
+  cmd->add_option("--max-back", o->h2l.max_back, "High to low: rays look this far inside the low surface, world units (default: the cage distance)");
+  cmd->add_option("--occluder", o->occluders, "Mesh that occludes but is not baked (repeatable)")->type_name("MESH");
+  cmd->add_flag("--floor", o->floor, "Add a ground plane under the model (y up, at its lowest point) as an occluder");
+  cmd->add_option("--group", o->groups, "Bake group: comma-separated mesh names that occlude each other and nothing else (repeatable; meshes not named form one more group)")
+      ->type_name("NAMES");
+  cmd->add_flag("--self-occlusion", o->self_occlusion, "Each mesh is occluded only by itself (and --occluder, --floor)");
+  cmd->add_flag("--match-by-name", o->match_by_name, "With --high: low mesh NAME_low bakes only from high meshes NAME_high (or NAME), Substance's convention");
+  cmd->add_option("--miss-mask", o->miss_mask, "High to low: write 1 where every cage ray of a texel missed the high mesh (those texels are filled from neighbours)");
+  // Options that only one baker reads: giving them to the other is an error, not silently ignored.
+  std::vector<CLI::Option*> histogram_only, raytraced_only;
+  for (const char* name : {"--directions", "--direction-set", "--pixels-per-texel", "--point-size", "--normalization", "--min-samples", "--seam-fix",
+                           "--vertex-resolution"})
+    histogram_only.push_back(cmd->get_option(name));
+  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces"}) raytraced_only.push_back(cmd->get_option(name));
+  cmd->callback([o, method, histogram_only, raytraced_only, &global, &action] {
+    o->method_given = method->count() > 0;
+    for (const CLI::Option* opt : histogram_only)
+      if (opt->count() > 0) o->histogram_only.push_back(opt->get_name());
+    for (const CLI::Option* opt : raytraced_only)
+      if (opt->count() > 0) o->raytraced_only.push_back(opt->get_name());
+    action = [o, &global] { return run_bake(*o, global); };
+  });
 }
 
 }  // namespace ao::cli

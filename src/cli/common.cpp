@@ -2,22 +2,48 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/io/camera_json.h"
 #include "ao/io/mesh_io.h"
 #include "ao/scene/procedural.h"
 
 namespace ao::cli {
 
+namespace {
+// A lone word that is not a file names a built-in scene (an unknown one gets the list of names).
+bool names_builtin_scene(const std::vector<std::string>& args) {
+  if (args.size() != 1) return false;
+  const std::filesystem::path first(args[0]);
+  return !std::filesystem::exists(first) && !first.has_extension();
+}
+}  // namespace
+
+std::string scene_arguments_name(const std::vector<std::string>& args) {
+  if (args.empty()) return "default";
+  if (names_builtin_scene(args)) return args[0];
+  std::string name;
+  for (const std::string& a : args) {
+    if (!name.empty()) name += '+';
+    name += std::filesystem::path(a).filename().string();
+  }
+  return name;
+}
+
+void add_scene_inputs(OutputSet& outputs, const std::vector<std::string>& args) {
+  if (args.empty() || names_builtin_scene(args)) return;
+  for (const std::string& a : args) outputs.add_input(a, "the scene " + a);
+}
+
 Scene load_scene_arguments(const std::vector<std::string>& args) {
   if (args.empty()) return make_builtin_scene("default");
-  // A lone word that is not a file names a built-in scene (an unknown one gets the list of names).
-  const std::filesystem::path first(args[0]);
-  if (args.size() == 1 && !std::filesystem::exists(first) && !first.has_extension()) return make_builtin_scene(args[0]);
+  if (names_builtin_scene(args)) return make_builtin_scene(args[0]);
   Scene merged;
   for (const std::string& a : args) {
     Scene s = load_scene_file(a);
@@ -37,22 +63,63 @@ Vec3 parse_vec3(const std::string& text, const char* option) {
   return v;
 }
 
+// Mirrors Camera::validate's limits (camera.cpp), checked here before any file is read and with
+// the option's name.
+constexpr int kMaxImageSide = 32768;
+
+void check_camera_options(const CameraOptions& opt, bool size_given) {
+  if (size_given) {
+    if (opt.width < 1 || opt.width > kMaxImageSide)
+      throw InputError("--width must be in [1, " + std::to_string(kMaxImageSide) + "] pixels, got " + std::to_string(opt.width));
+    if (opt.height < 1 || opt.height > kMaxImageSide)
+      throw InputError("--height must be in [1, " + std::to_string(kMaxImageSide) + "] pixels, got " + std::to_string(opt.height));
+  }
+  if (opt.fov && !(*opt.fov > 0.0f && *opt.fov < 180.0f)) {
+    std::ostringstream v;
+    v << *opt.fov;
+    throw InputError("--fov must be in (0, 180) degrees, got " + v.str());
+  }
+  if (opt.eye) parse_vec3(*opt.eye, "--eye");
+  if (opt.target) parse_vec3(*opt.target, "--target");
+  if (opt.up) parse_vec3(*opt.up, "--up");
+}
+
+void check_falloff_options(const FalloffOptions& opt) {
+  const auto m = parse_membership(opt.membership);
+  if (!m) throw InputError("--membership: unknown '" + opt.membership + "' (known: " + membership_names() + ")");
+  if (opt.radius && !(*opt.radius > 0.0f && std::isfinite(*opt.radius)))
+    throw InputError("--radius must be a positive finite number of world units, got " + std::to_string(*opt.radius));
+  if (!opt.radius && !(opt.radius_fraction > 0.0f && opt.radius_fraction <= 10.0f))
+    throw InputError("--radius-fraction must be in (0, 10], got " + std::to_string(opt.radius_fraction));
+  if (!(opt.tau >= 0.0f && std::isfinite(opt.tau))) throw InputError("--tau must be >= 0 (0 selects 3/R), got " + std::to_string(opt.tau));
+}
+
 Camera choose_camera(const Scene& scene, const CameraOptions& opt) {
+  check_camera_options(opt);
   Camera cam;
-  if (scene.preferred_view) {
+  if (opt.file) {
+    Camera defaults;
+    defaults.width = opt.width;
+    defaults.height = opt.height;
+    cam = read_camera_file(*opt.file, defaults);
+    if (opt.width_set) cam.width = opt.width;
+    if (opt.height_set) cam.height = opt.height;
+  } else if (scene.preferred_view) {
     cam = *scene.preferred_view;
   } else {
     // Auto-framing: from the front, a little to the right and above, the usual product shot.
     cam = frame_bounds(scene.bounds(), {0.55f, 0.5f, 1.0f}, opt.fov.value_or(40.0f), opt.width, opt.height);
   }
-  cam.width = opt.width;
-  cam.height = opt.height;
+  if (!opt.file) {
+    cam.width = opt.width;
+    cam.height = opt.height;
+  }
   if (opt.fov) cam.vertical_fov_deg = *opt.fov;
   if (opt.up) cam.up = parse_vec3(*opt.up, "--up");
   if (opt.target) cam.target = parse_vec3(*opt.target, "--target");
   if (opt.eye) {
     cam.eye = parse_vec3(*opt.eye, "--eye");
-  } else if (opt.target && !scene.preferred_view) {
+  } else if (opt.target && !scene.preferred_view && !opt.file) {
     // Keep the framing distance and direction, looking at the new target.
     const Camera framed = frame_bounds(scene.bounds(), {0.55f, 0.5f, 1.0f}, cam.vertical_fov_deg, cam.width, cam.height);
     cam.eye = cam.target + (framed.eye - framed.target);
@@ -127,6 +194,20 @@ void apply_param_overrides(nlohmann::json& params, const std::vector<std::string
       throw InputError("--param: method " + std::string(method) + " has no parameter '" + key + "' (it has: " + known + ")");
     }
     nlohmann::json parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
+    // An integer parameter gets a whole number that fits its 32-bit field, checked here before
+    // the method narrows it (a double beyond the int range converts to garbage); the method's
+    // own range is checked by its validate().
+    if (params[key].is_number_integer() && !parsed.is_discarded()) {
+      const bool whole = parsed.is_number_integer() || (parsed.is_number_float() && std::isfinite(parsed.get<double>()) &&
+                                                        std::trunc(parsed.get<double>()) == parsed.get<double>());
+      if (!whole) throw InputError("--param " + key + "=" + value + ": " + key + " of method " + std::string(method) + " is a whole number");
+      const double d = parsed.get<double>();
+      if (d < static_cast<double>(std::numeric_limits<int>::min()) || d > static_cast<double>(std::numeric_limits<int>::max()))
+        throw InputError("--param " + key + "=" + value + ": " + key + " of method " + std::string(method) + " must be a whole number in [" +
+                         std::to_string(std::numeric_limits<int>::min()) + ", " + std::to_string(std::numeric_limits<int>::max()) +
+                         "] (the method's own range is narrower: see --json), got " + value);
+      parsed = static_cast<std::int64_t>(d);
+    }
     params[key] = parsed.is_discarded() ? nlohmann::json(value) : parsed;
   }
 }

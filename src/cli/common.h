@@ -13,6 +13,7 @@
 #include "ao/core/camera.h"
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
+#include "ao/io/output_set.h"
 #include "ao/scene/mesh.h"
 
 namespace ao::cli {
@@ -24,17 +25,30 @@ inline constexpr const char* kSceneHelp =
 /// Scene from positional arguments: none -> the built-in "default"; one built-in name (when no file
 /// of that name exists) -> that scene; otherwise mesh files, merged into one scene.
 Scene load_scene_arguments(const std::vector<std::string>& args);
+/// The name load_scene_arguments gives the scene, known before loading (for default output names):
+/// the built-in name, or the files' names joined by '+'.
+std::string scene_arguments_name(const std::vector<std::string>& args);
+/// Declares the mesh files among `args` as inputs of `outputs`, so no output may overwrite them.
+void add_scene_inputs(OutputSet& outputs, const std::vector<std::string>& args);
 
 /// Camera options as given on the command line; unset ones come from the scene.
 struct CameraOptions {
   std::optional<std::string> eye, target, up;  ///< "x,y,z" in world units.
   std::optional<float> fov;                    ///< Vertical, degrees.
   int width = 1280, height = 720;
+  /// A camera JSON (io/camera_json.h): its view, and its size unless --width/--height were given.
+  std::optional<std::string> file;
+  bool width_set = false, height_set = false;  ///< Whether --width/--height were given explicitly.
 };
-/// The scene's preferred view if it has one, else auto-framing of its bounds from above and in
+/// The camera file if given, else the scene's preferred view if it has one, else auto-framing of its bounds from above and in
 /// front; any option given overrides the corresponding field. Validated.
 Camera choose_camera(const Scene& scene, const CameraOptions& opt);
 Vec3 parse_vec3(const std::string& text, const char* option);
+/// The checks of choose_camera that need no scene, run before anything is loaded: --width and
+/// --height in [1, 32768] (when `size_given`: the size does not come from a file), --fov in
+/// (0, 180), and --eye/--target/--up as three finite numbers. InputError naming the option, its
+/// value and its valid range.
+void check_camera_options(const CameraOptions& opt, bool size_given = true);
 
 /// Falloff options: R in world units, or as a fraction of the scene diagonal.
 struct FalloffOptions {
@@ -44,6 +58,9 @@ struct FalloffOptions {
   float tau = 0.0f;
 };
 Falloff choose_falloff(const FalloffOptions& opt, float scene_diagonal);
+/// The checks of choose_falloff that need no scene (membership name, --radius, --radius-fraction,
+/// --tau), run before anything is loaded.
+void check_falloff_options(const FalloffOptions& opt);
 
 /// A progress bar on stderr, shown only when stderr is a terminal, not --quiet, and the stage has
 /// run for over a second. Thread-safe; redraws at most ten times a second.

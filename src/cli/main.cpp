@@ -1,6 +1,7 @@
 // ao: ambient occlusion on the CPU. The only place errors become exit codes:
-//   0 success, 1 bad input (file, option value), 2 bad usage (unknown option, missing argument),
-//   3 system failure (disk, library), 4 internal error.
+//   0 success, 1 bad input (file, option value, including a value of the wrong type), 2 bad usage
+//   (unknown option, missing argument), 3 system failure (disk, library, not enough memory),
+//   4 internal error.
 #include <cstdio>
 #include <exception>
 #include <functional>
@@ -11,6 +12,7 @@
 #include <tbb/global_control.h>
 
 #include "ao/core/error.h"
+#include "ao/io/atomic_file.h"
 #include "ao/version.h"
 #include "subcommands.h"
 
@@ -27,10 +29,21 @@ int main(int argc, char** argv) {
   ao::cli::add_bake_command(app, global, action);
   ao::cli::add_compare_command(app, global, action);
   ao::cli::add_params_command(app, global, action);
+  ao::cli::add_view_command(app, global, action);
 
+  // Interrupted runs remove their temporary files (atomic_file.h).
+  ao::remove_temporaries_on_signals();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // A value of the wrong type ("--width abc", "--seed -1") or outside an option's range is a bad
+    // value, exit 1 with one line, like the values the subcommands check. (Matched by exit code: the
+    // exception does not always reach here with its derived type.)
+    const int code = e.get_exit_code();
+    if (code == static_cast<int>(CLI::ExitCodes::ConversionError) || code == static_cast<int>(CLI::ExitCodes::ValidationError)) {
+      std::fprintf(stderr, "ao: error: %s\n", e.what());
+      return 1;
+    }
     return app.exit(e) == 0 ? 0 : 2;
   }
   std::unique_ptr<tbb::global_control> limit;

@@ -8,10 +8,12 @@
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
-#include "ao/core/texture.h"
+#include "ao/core/memory.h"
+#include "ao/eval/shading.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
+#include "ao/io/output_set.h"
 #include "ao/methods/registry.h"
 #include "ao/reference/direct_light.h"
 #include "ao/reference/ray_scene.h"
@@ -41,33 +43,6 @@ struct RenderOptions {
   bool json = false;
   bool extras = false;  ///< Also write the method's extra outputs (MethodOutput::extras) beside the output.
 };
-
-// Albedo x V x (ambient + soft key light): a picture for people, not data. The key light comes
-// from above-left of the camera; wrapping (n.l + w) / (1 + w) keeps faces turned away from it
-// from going black, so the AO stays readable everywhere. With an RGB result (ambient transfer's W
-// per channel) the ambient term is per channel too: L = a W La (AT eq. 2), La = the same lighting.
-// With a direct-light pass (--sun, or direct.* in --gbuffer-in) that pass replaces the key light:
-// L = (a V + Ld) La, or (a W + Ld) La (docs/methods/transfer.md), Ld being in units of La. La =
-// 0.5 display units, so that a white surface in the open (V = 1) facing a sun of E = pi (Ld = 1)
-// shows at 1.
-Image<Vec3> shade(const GBuffer& g, const Image<float>& v, const Image<Vec3>& color) {
-  const Vec3 light = normalize(Vec3{-0.4f, 0.8f, 0.45f});  // camera space
-  constexpr float kAmbient = 0.45f, kKey = 0.75f, kWrap = 0.5f;
-  constexpr float kSkyWithSun = 0.5f;
-  Image<Vec3> out(g.width(), g.height(), Vec3{1, 1, 1});
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (!g.coverage[i]) continue;
-    if (!g.direct.empty()) {
-      const Vec3 ambient = color.empty() ? g.albedo[i] * v[i] : g.albedo[i] * color[i];  // a V or a W
-      out[i] = (ambient + g.direct[i]) * kSkyWithSun;
-      continue;
-    }
-    const float wrap = std::max(0.0f, (dot(g.normal[i], light) + kWrap) / (1.0f + kWrap));
-    const float light_in = kAmbient + kKey * wrap;
-    out[i] = color.empty() ? g.albedo[i] * (v[i] * light_in) : g.albedo[i] * color[i] * light_in;
-  }
-  return out;
-}
 
 // --sun DX,DY,DZ[,E]: the direction towards the sun in world space (any non-zero length,
 // normalised here) and optionally its irradiance E in units of La (default pi, see
@@ -110,22 +85,6 @@ bool wants_direct_pass(const nlohmann::json& params) {
   return params.is_object() && params.contains("reflectance") && params["reflectance"] == "radiance";
 }
 
-// V from a baked AO map: the map's value at each covered pixel's UV (bilinear), for looking at a
-// map on its mesh. Every visible mesh needs UVs.
-MethodOutput visibility_from_map(const GBuffer& g, const Scene& scene, const Image<float>& map, const std::string& map_name) {
-  MethodOutput out;
-  out.visibility = Image<float>(g.width(), g.height(), 1.0f);
-  for (std::size_t i = 0; i < g.coverage.size(); ++i) {
-    if (!g.coverage[i]) continue;
-    const Mesh& mesh = scene.meshes[g.object_id[i] - 1];
-    if (mesh.uvs.empty())
-      throw InputError(scene.name + ": mesh '" + mesh.name + "' is visible but has no UVs, so --ao-map " + map_name + " cannot be shown on it");
-    out.visibility[i] = std::clamp(sample_bilinear(map, g.uv[i]), 0.0f, 1.0f);
-  }
-  out.stats = {{"ao_map", map_name}, {"map_width", map.width()}, {"map_height", map.height()}};
-  return out;
-}
-
 std::string default_output(const std::string& scene_name, const std::string& method) {
   std::string stem = std::filesystem::path(scene_name).stem().string();
   if (stem.empty()) stem = "gbuffer";
@@ -136,14 +95,13 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
   const bool progress = !global.quiet && stderr_is_terminal();
+  // Every option is checked before any file is read, so a typo costs nothing.
   const MethodInfo& method = find_method(o.method);
   const std::string method_name = o.ao_map.empty() ? std::string(method.name) : "ao-map";
   if (!o.gbuffer_in.empty() && !o.scene.empty()) throw InputError("give either a scene or --gbuffer-in, not both");
   if (!o.ao_map.empty() && !o.gbuffer_in.empty()) throw InputError("--ao-map needs the scene's UVs: give a scene, not --gbuffer-in");
   if (!o.ao_map.empty() && o.method != "raytraced") throw InputError("--ao-map shows a baked map instead of a method: drop --method");
-  const Image<float> ao_map = o.ao_map.empty() ? Image<float>() : read_image(o.ao_map);
-  if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
-  // Check output names before the work, so a typo costs nothing.
+  if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16, got " + std::to_string(o.png_bits));
   for (const std::string& out : {o.output, o.shaded})
     if (!out.empty() && !is_supported_image_path(out))
       throw InputError(out + ": unknown image extension (supported: " + supported_image_extensions() + ")");
@@ -151,6 +109,8 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     throw InputError(o.gbuffer_out + ": --gbuffer-out writes OpenEXR, give it a .exr name");
   if (!o.gbuffer_in.empty() && method.needs_scene)
     throw InputError("method " + std::string(method.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
+  check_camera_options(o.camera, /*size_given=*/o.gbuffer_in.empty());
+  check_falloff_options(o.falloff);
   nlohmann::json params = o.ao_map.empty() ? method.default_params() : nlohmann::json::object();
   // --spp and --target-error set the method's parameters of those names when given; otherwise
   // each method keeps its own default (256 rays for raytraced, the paper's count for the others).
@@ -172,6 +132,32 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     throw InputError("-p reflectance=radiance reads the occluders' direct light: give a sun with --sun DX,DY,DZ[,E] (or --gbuffer-in "
                      "with direct.R direct.G direct.B channels)");
 
+  // All outputs are declared before the work: one that names an input or another output is
+  // refused now, and they are renamed into place together at the end (OutputSet).
+  const std::string output =
+      o.output.empty() ? default_output(o.gbuffer_in.empty() ? scene_arguments_name(o.scene) : o.gbuffer_in, method_name) : o.output;
+  OutputSet outputs;
+  add_scene_inputs(outputs, o.scene);
+  outputs.add_input(o.gbuffer_in, "--gbuffer-in");
+  outputs.add_input(o.ao_map, "--ao-map");
+  outputs.add_output(output, o.output.empty() ? "the default output" : "-o");
+  if (!o.shaded.empty()) outputs.add_output(o.shaded, "--shaded");
+  if (!o.gbuffer_out.empty()) outputs.add_output(o.gbuffer_out, "--gbuffer-out");
+  // Cone tracing's voxel grid, from its parameters (their types and ranges are checked by the method).
+  std::uint64_t grid_bytes = 0;
+  if (method.name == "cone" && o.ao_map.empty() && params.value("columns", nlohmann::json()).is_number_integer() &&
+      params.value("depth_bits", nlohmann::json()).is_number_integer())
+    grid_bytes = estimate_cone_grid_memory(params["columns"].get<int>(), params["depth_bits"].get<int>());
+  if (o.gbuffer_in.empty())
+    check_memory(estimate_render_memory({.width = o.camera.width, .height = o.camera.height, .sun = sun.has_value(),
+                                         .shaded = !o.shaded.empty(), .gbuffer_out = !o.gbuffer_out.empty()}) +
+                     grid_bytes,
+                 "ao render: " + std::to_string(o.camera.width) + "x" + std::to_string(o.camera.height) + " pixels" +
+                     (grid_bytes ? " and a " + std::to_string(params["columns"].get<int>()) + "^2 x " +
+                                       std::to_string(params["depth_bits"].get<int>()) + " voxel grid"
+                                 : std::string()));
+
+  const Image<float> ao_map = o.ao_map.empty() ? Image<float>() : read_image(o.ao_map);
   std::optional<Scene> scene;
   std::unique_ptr<RayScene> rays;
   GBuffer g;
@@ -187,6 +173,8 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     scene = load_scene_arguments(o.scene);
     for (const std::string& w : scene->warnings) std::cerr << "warning: " << w << "\n";
     timings["load_ms"] = clock.lap_ms();
+    check_memory(estimate_ray_scene_memory(scene->triangle_count(), scene->vertex_count()),
+                 "ao render: the BVH of " + std::to_string(scene->triangle_count()) + " triangles");
     rays = std::make_unique<RayScene>(*scene);
     timings["bvh_ms"] = clock.lap_ms();
     const Camera cam = choose_camera(*scene, o.camera);
@@ -209,7 +197,8 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
 
   MethodOutput result;
   if (!ao_map.empty()) {
-    result = visibility_from_map(g, *scene, ao_map, o.ao_map);
+    result.visibility = visibility_from_ao_map(g, *scene, ao_map, o.ao_map);
+    result.stats = {{"ao_map", o.ao_map}, {"map_width", ao_map.width()}, {"map_height", ao_map.height()}};
   } else {
     ProgressBar bar(method_name, progress);
     result = method.run(MethodInput{g, rays.get(), falloff, o.seed, bar.callback(), scene ? &scene->analytic : nullptr}, params);
@@ -220,19 +209,20 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (result.stats.contains("warnings"))
     for (const auto& w : result.stats["warnings"]) std::cerr << "warning: " << w.get<std::string>() << "\n";
 
-  const std::string output = o.output.empty() ? default_output(scene ? scene->name : o.gbuffer_in, method_name) : o.output;
   const ImageWriteOptions write_opt{.png_bits = o.png_bits};
-  write_image(output, result.visibility, write_opt);
-  if (!o.shaded.empty()) write_rgb_image(o.shaded, shade(g, result.visibility, result.color), {.png_bits = o.png_bits, .srgb = true});
+  outputs.write(output, [&] { write_image(output, result.visibility, write_opt); });
+  if (!o.shaded.empty())
+    outputs.write(o.shaded, [&] { write_rgb_image(o.shaded, shade_for_display(g, result.visibility, result.color), {.png_bits = o.png_bits, .srgb = true}); });
   nlohmann::json extras_written = nlohmann::json::object();
   if (o.extras)
     for (const auto& [name, image] : result.extras) {  // <output-stem>-<name><ext>, beside the output
       const std::filesystem::path out_path(output);
       const std::filesystem::path path = out_path.parent_path() / (out_path.stem().string() + "-" + name + out_path.extension().string());
-      write_image(path, image, write_opt);
+      outputs.write(path, [&] { write_image(path, image, write_opt); }, "--extras");
       extras_written[name] = path.string();
     }
-  if (!o.gbuffer_out.empty()) write_gbuffer_exr(o.gbuffer_out, g);
+  if (!o.gbuffer_out.empty()) outputs.write(o.gbuffer_out, [&] { write_gbuffer_exr(o.gbuffer_out, g); });
+  outputs.commit();
   timings["write_ms"] = clock.lap_ms();
 
   double sum_v = 0;
@@ -308,6 +298,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: auto-framed)");
   cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
   cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
+  cmd->add_option("--camera", o->camera.file,
+                  "Camera JSON (eye, target, up, fov, width, height; written by ao view): its view, and its size unless --width/--height are given");
   cmd->add_option("--shaded", o->shaded,
                   "Also write albedo x ambient x V with a soft key light, for viewing (sRGB); transfer: a W La. With --sun (or direct.* "
                   "in --gbuffer-in) the sun replaces the key light: (a V + Ld) La, transfer (a W + Ld) La");
@@ -326,7 +318,11 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_flag("--extras", o->extras,
                 "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");
   cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
-  cmd->callback([o, &global, &action] { action = [o, &global] { return run_render(*o, global); }; });
+  cmd->callback([o, &global, &action, cmd] {
+    o->camera.width_set = cmd->get_option("--width")->count() > 0;
+    o->camera.height_set = cmd->get_option("--height")->count() > 0;
+    action = [o, &global] { return run_render(*o, global); };
+  });
 }
 
 }  // namespace ao::cli

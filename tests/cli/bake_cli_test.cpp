@@ -17,7 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kQuick = " --size 16 --directions 32 --pixels-per-texel 4 --padding 2 ";
+// Small, quick bakes with each method (options of one method are errors with the other).
+const std::string kQuick = " -m histogram --size 16 --directions 32 --pixels-per-texel 4 --padding 2 ";
+const std::string kQuickRays = " -m raytraced --size 16 --samples 8 --padding 2 ";
 
 // Unit cube [0,1]^3 as an OBJ with flat normals; with `uvs`, each face gets its own cell of a
 // 3 x 2 grid of the UV square (inset, so charts do not touch). Convex: V = 1 everywhere.
@@ -88,7 +90,7 @@ TEST(BakeCli, HistogramBakeWritesMapAndJsonSummary) {
 TEST(BakeCli, RaytracedBakeWritesExrWithExactValuesOnAConvexMesh) {
   TempDir dir;
   write_text(dir / "cube.obj", cube_obj(true));
-  const RunResult r = run_ao("bake cube.obj -o ao.exr --method raytraced --samples 8 --json" + kQuick, dir.path());
+  const RunResult r = run_ao("bake cube.obj -o ao.exr --json" + kQuickRays, dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["method"], "raytraced");
@@ -207,8 +209,8 @@ TEST(BakeCli, PerVertexAndGltfOutputsAreWrittenAndReadable) {
   write_text(dir / "cube.obj", cube_obj(true));
   for (const char* method : {"histogram", "raytraced"}) {
     const std::string m(method);
-    const RunResult r = run_ao("bake cube.obj -o ao-" + m + ".exr --per-vertex v-" + m + ".ply --gltf m-" + m + ".glb --method " + m +
-                                   " --samples 8 --vertex-resolution 64 --json" + kQuick,
+    const RunResult r = run_ao("bake cube.obj -o ao-" + m + ".exr --per-vertex v-" + m + ".ply --gltf m-" + m + ".glb --json" +
+                                   (m == "histogram" ? kQuick + " --vertex-resolution 64" : kQuickRays),
                                dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
@@ -269,6 +271,121 @@ TEST(BakeCli, AbsentUvSetIsAOneLineErrorAndWritesNothing) {
   expect_one_line_error(r, "quad.gltf: has 2 UV sets, --uv-set 2 asked for");
   EXPECT_FALSE(fs::exists(dir / "ao.png"));
   EXPECT_FALSE(fs::exists(dir / "out.glb"));
+}
+
+}  // namespace
+}  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+// The cube of cube_obj without UVs and with only the faces listed (1-based, cube_obj's order).
+std::string cube_faces_obj(std::initializer_list<int> faces) {
+  const std::string full = cube_obj(false);
+  std::istringstream in(full);
+  std::ostringstream out;
+  std::string line;
+  int face = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("f ", 0) == 0) {
+      ++face;
+      if (std::find(faces.begin(), faces.end(), face) == faces.end()) continue;
+    }
+    out << line << "\n";
+  }
+  return out.str();
+}
+
+TEST(BakeCliHighToLow, ConvexHighMeshBakesOpenWithNoMisses) {
+  TempDir dir;
+  write_text(dir / "low.obj", cube_obj(true));
+  write_text(dir / "high.obj", cube_obj(false));
+  const RunResult r = run_ao("bake low.obj --high high.obj --cage-extrusion 0.05 -o ao.exr --miss-mask miss.png --json --size 16 --samples 8 --padding 2",
+                             dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["method"], "raytraced");
+  EXPECT_EQ(j["missed_texels"], 0);
+  EXPECT_EQ(j["mean_visibility"].get<double>(), 1.0);
+  EXPECT_EQ(j["high_triangles"], 12);
+  const Image<float> miss = read_image(dir / "miss.png");
+  for (std::size_t i = 0; i < miss.size(); ++i) ASSERT_EQ(miss[i], 0.0f);
+}
+
+TEST(BakeCliHighToLow, MissesAreCountedMaskedWarnedAndNotBlack) {
+  TempDir dir;
+  write_text(dir / "low.obj", cube_obj(true));
+  write_text(dir / "high.obj", cube_faces_obj({1, 2, 3}));  // three faces of the cube: the other three miss
+  const RunResult r = run_ao("bake low.obj --high high.obj --cage-extrusion 0.05 -o ao.exr --miss-mask miss.png --json --size 16 --samples 8 --padding 2",
+                             dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const int missed = j["missed_texels"];
+  const int covered = j["texels_covered"];
+  // Three of six equal charts miss: about half the covered texels (texels where charts' borders meet
+  // are shared in the 16^2 map, hence the slack).
+  EXPECT_GT(missed, covered / 3);
+  EXPECT_LT(missed, 2 * covered / 3);
+  EXPECT_NE(r.err.find("missed the high mesh"), std::string::npos) << r.err;
+  const Image<float> miss = read_image(dir / "miss.png");
+  const Image<float> map = read_image(dir / "ao.exr");
+  int marked = 0;
+  for (std::size_t i = 0; i < miss.size(); ++i)
+    if (miss[i] > 0.5f) {
+      ++marked;
+      EXPECT_GT(map[i], 0.5f) << "texel " << i;  // filled from a neighbour that hit (an open face), not black
+    }
+  EXPECT_EQ(marked, missed);
+}
+
+TEST(BakeCliHighToLow, OptionsThatDoNotApplyAreOneLineErrors) {
+  TempDir dir;
+  write_text(dir / "low.obj", cube_obj(true));
+  write_text(dir / "high.obj", cube_obj(false));
+  write_text(dir / "half.obj", cube_faces_obj({1, 2, 3}));
+  expect_one_line_error(run_ao("bake low.obj --high high.obj -m histogram --size 16", dir.path()), "--high needs --method raytraced");
+  expect_one_line_error(run_ao("bake low.obj --cage-extrusion 0.1" + kQuickRays, dir.path()), "need --high");
+  expect_one_line_error(run_ao("bake low.obj --high high.obj --cage half.obj" + kQuickRays, dir.path()), "topology");
+  expect_one_line_error(run_ao("bake low.obj --high high.obj --cage-extrusion -1" + kQuickRays, dir.path()), "cage extrusion");
+  EXPECT_FALSE(fs::exists(dir / "low-ao.png"));
+}
+
+}  // namespace
+}  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+TEST(BakeCli, OptionsOfTheOtherMethodAreOneLineErrors) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  for (const char* opt : {"--ignore-back-faces", "--membership linear", "--offset 0.01", "--samples 4"})
+    expect_one_line_error(run_ao("bake cube.obj -m histogram --size 16 " + std::string(opt), dir.path()), "does not apply to --method histogram");
+  for (const char* opt : {"--directions 8", "--pixels-per-texel 2", "--no-seam-fix", "--normalization max"})
+    expect_one_line_error(run_ao("bake cube.obj -m raytraced --size 16 " + std::string(opt), dir.path()), "does not apply to --method raytraced");
+  EXPECT_FALSE(fs::exists(dir / "cube-ao.png"));
+}
+
+}  // namespace
+}  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+TEST(BakeCli, FloorDarkensTheBaseAndOccludersAreNotBaked) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  const std::string args = " -o ao.exr --json -m raytraced --size 32 --samples 16 --padding 0";
+  const RunResult open = run_ao("bake cube.obj" + args, dir.path());
+  const RunResult floor = run_ao("bake cube.obj --floor" + args + " --per-vertex v.ply", dir.path());
+  ASSERT_EQ(open.exit_code, 0) << open.err;
+  ASSERT_EQ(floor.exit_code, 0) << floor.err;
+  EXPECT_EQ(nlohmann::json::parse(open.out)["mean_visibility"].get<double>(), 1.0);
+  // The bottom face (1/6 of the charts) is black on the floor, the four sides are half open: the
+  // mean is about (4 x 0.5 + 1) / 6 = 0.5.
+  EXPECT_NEAR(nlohmann::json::parse(floor.out)["mean_visibility"].get<double>(), 0.5, 0.05);
+  // The per-vertex output has the cube's vertices only, not the floor's.
+  EXPECT_EQ(load_scene_file(dir / "v.ply").vertex_count(), load_scene_file(dir / "cube.obj").vertex_count());
 }
 
 }  // namespace

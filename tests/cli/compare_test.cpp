@@ -60,7 +60,10 @@ TEST(CompareCli, WritesTableSheetAndSweep) {
   const nlohmann::json& row = t["rows"][0];
   EXPECT_EQ(row["method"], "alchemy");
   for (const char* k : {"ms", "rmse", "psnr_db", "ssim", "mean_signed_error", "parameters"}) EXPECT_TRUE(row.contains(k)) << k;
-  EXPECT_EQ(row["reference"]["membership"], "alchemy");
+  // Alchemy's falloff at its defaults (u = 2r >= r) is step AO, and the reference says so.
+  EXPECT_EQ(row["reference"]["kind"], "obscurance");
+  EXPECT_EQ(row["reference"]["membership"], "step");
+  EXPECT_EQ(row["reference"]["label"], "step obscurance");
   EXPECT_GE(row["rmse"].get<double>(), 0.0);
   EXPECT_LE(row["rmse"].get<double>(), 1.0);
   const nlohmann::json s = read_json(out / "sweep.json");
@@ -165,6 +168,51 @@ TEST(CompareCli, BadSweepAndParamFailBeforeRendering) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("intensity"), std::string::npos) << "lists the method's parameters: " << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// Each method gets its matched reference by default; --reference NAME overrides for every method,
+// METHOD=NAME for one.
+TEST(CompareCli, ChoosesReferencesByName) {
+  const fs::path out = scratch("references");
+  const std::string base = "compare sphere-on-plane --methods volumetric,transfer --width 32 --height 24 --spp-reference 4 --out-dir ";
+  CliRun r = run_ao(base + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json t = read_json(out / "table.json");
+  EXPECT_EQ(t["rows"][0]["reference"]["kind"], "tangent-sphere");
+  EXPECT_EQ(t["rows"][1]["reference"]["kind"], "transfer");
+  r = run_ao(base + out.string() + " --reference obscurance");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  t = read_json(out / "table.json");
+  EXPECT_EQ(t["rows"][0]["reference"]["label"], "cubic obscurance");
+  EXPECT_EQ(t["rows"][1]["reference"]["label"], "step obscurance");
+  r = run_ao(base + out.string() + " --reference volumetric=obscurance");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  t = read_json(out / "table.json");
+  EXPECT_EQ(t["rows"][0]["reference"]["label"], "cubic obscurance");
+  EXPECT_EQ(t["rows"][1]["reference"]["kind"], "transfer");
+  const fs::path bad = scratch("bad-reference");
+  r = run_ao(base + bad.string() + " --reference cubic");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("unknown reference 'cubic'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+  r = run_ao(base + bad.string() + " --reference cone=obscurance");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+// Parameters print at the precision they were given: Alchemy's float bias of 1e-4 is "0.0001" in
+// both tables, not the double expansion of the float, 9.999999747378752e-05.
+TEST(CompareCli, TablesPrintFloatsAsGiven) {
+  const fs::path out = scratch("floats");
+  const CliRun r = run_ao("compare sphere-on-plane --methods alchemy --width 16 --height 12 --spp-reference 2 --out-dir " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream md(out / "table.md"), js(out / "table.json");
+  std::stringstream a, b;
+  a << md.rdbuf();
+  b << js.rdbuf();
+  EXPECT_NE(a.str().find("bias=0.0001"), std::string::npos) << a.str();
+  EXPECT_EQ(a.str().find("e-05"), std::string::npos) << a.str();
+  EXPECT_EQ(b.str().find("9.99999"), std::string::npos) << b.str();
 }
 
 }  // namespace

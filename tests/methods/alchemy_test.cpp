@@ -170,9 +170,11 @@ TEST(Alchemy, ReferenceFalloffFollowsRadiusAndIntensity) {
   f = alchemy_reference_falloff(p, 2.0f);
   EXPECT_EQ(f.radius, 0.5f);
   EXPECT_FLOAT_EQ(f.alchemy_u, 0.2f);
-  // The registry row hands the same falloff to `ao compare`.
+  // The registry row hands the same falloff to `ao compare --reference obscurance`; its matched
+  // reference names it as what it is at the defaults (u = 2r >= r): step obscurance.
   const MethodInfo& m = find_method("alchemy");
-  EXPECT_EQ(m.reference_falloff({Membership::Step, 2.0f}, m.default_params()).alchemy_u, 4.0f);
+  EXPECT_EQ(m.obscurance_falloff({Membership::Step, 2.0f}, m.default_params()).alchemy_u, 4.0f);
+  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, m.default_params()).falloff.membership, Membership::Step);
 }
 
 TEST(Alchemy, RejectsBadParameters) {

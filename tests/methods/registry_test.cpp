@@ -41,9 +41,10 @@ const Image<float>& compared(const MethodOutput& out, const char* method) {
   return std::string(method) == "transfer" ? out.extras.at("obscurance") : out.visibility;
 }
 
+// The obscurance each method approximates (`ao compare --reference obscurance`).
 Falloff reference_falloff(const char* method, const Falloff& requested) {
   const MethodInfo& m = find_method(method);
-  return m.reference_falloff(requested, m.default_params());
+  return m.obscurance_falloff(requested, m.default_params());
 }
 
 double covered_mean(const Image<float>& v, const GBuffer& g) {

@@ -18,10 +18,11 @@ std::string quote(const std::string& s) {
 }
 }  // namespace
 
-RunResult run_ao(const std::string& args, const std::filesystem::path& cwd) {
+namespace {
+RunResult run_command(const std::string& command, const std::string& args, const std::filesystem::path& cwd) {
   TempDir capture;
   const std::string cd = cwd.empty() ? "" : "cd " + quote(cwd.string()) + " && ";
-  const std::string cmd = cd + quote(AO_CLI_PATH) + " " + args + " </dev/null >" + quote((capture / "out").string()) + " 2>" +
+  const std::string cmd = cd + command + " " + args + " </dev/null >" + quote((capture / "out").string()) + " 2>" +
                           quote((capture / "err").string());
   const int status = std::system(cmd.c_str());
   RunResult r;
@@ -29,6 +30,18 @@ RunResult run_ao(const std::string& args, const std::filesystem::path& cwd) {
   r.out = read_text(capture / "out");
   r.err = read_text(capture / "err");
   return r;
+}
+}  // namespace
+
+RunResult run_ao(const std::string& args, const std::filesystem::path& cwd) { return run_command(quote(AO_CLI_PATH), args, cwd); }
+
+RunResult run_ao_under(const std::string& prefix, const std::string& args, const std::filesystem::path& cwd) {
+  return run_command(prefix + " " + quote(AO_CLI_PATH), args, cwd);
+}
+
+RunResult run_ao_limited(const std::string& ulimits, const std::string& args, const std::filesystem::path& cwd) {
+  const std::string script = "ulimit " + ulimits + " && trap '' XFSZ && exec \"$0\" \"$@\"";
+  return run_command("bash -c " + quote(script) + " " + quote(AO_CLI_PATH), args, cwd);
 }
 
 TempDir::TempDir() {

@@ -14,6 +14,13 @@ struct RunResult {
 
 /// Runs `AO_CLI_PATH args` through the shell in `cwd` (the current directory when empty).
 RunResult run_ao(const std::string& args, const std::filesystem::path& cwd = {});
+/// The same with `prefix` before the binary (e.g. "xvfb-run -a" for a command that opens a window).
+RunResult run_ao_under(const std::string& prefix, const std::string& args, const std::filesystem::path& cwd = {});
+
+/// run_ao under resource limits: `ulimits` are bash `ulimit` options ("-f 64": files of at most
+/// 64 KiB; "-v 4194304": 4 GiB of address space). SIGXFSZ is ignored, so a write beyond -f fails
+/// with EFBIG, as on a full disk, instead of killing the process.
+RunResult run_ao_limited(const std::string& ulimits, const std::string& args, const std::filesystem::path& cwd = {});
 
 /// A fresh empty directory under the system temp directory, removed by the destructor: one per
 /// test, so tests never see each other's files.

@@ -7,13 +7,14 @@
 // cosine-weighted direction about the interpolated normal there (pdf cos/pi cancels the cosine and
 // 1/pi), so V is the plain mean of mu over the samples. A point per ray, rather than one point at
 // the texel centre, is what keeps thin charts and texels that straddle several triangles from
-// aliasing. The ray loop is reference/raytraced.cpp's, with an origin per lane; it is repeated
-// here rather than shared because it adds per-lane origins, unlimited distance and back-face skipping.
+// aliasing. The patch sampling and the ray loop (reference/raytraced.cpp's, with an origin per lane,
+// unlimited distance and back-face skipping) are in texel_rays.h, shared with high_to_low.cpp.
 #include "ao/bake/raytraced_bake.h"
 
 #include <array>
 #include <cmath>
 
+#include "ao/bake/texel_rays.h"
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
@@ -25,136 +26,13 @@ namespace {
 
 constexpr int kTile = 16;
 constexpr int kMaxSamples = 1 << 20;
-constexpr int kMaxBackFaceSkips = 64;  // a ray crossing more back faces than this counts as occluded
 
-struct TriangleNormals {
-  std::vector<std::vector<Vec3>> per_mesh;  // geometric (face) normal per triangle
-};
-
-TriangleNormals face_normals(const Scene& s) {
-  TriangleNormals fn;
-  for (const Mesh& m : s.meshes) {
-    auto& v = fn.per_mesh.emplace_back(m.triangle_count());
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      const std::uint32_t* i = &m.indices[3 * t];
-      v[t] = normalize(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]));
-    }
-  }
-  return fn;
-}
-
-struct Tracer {
-  const RayScene& rs;
-  const Falloff& falloff;
-  const TriangleNormals& normals;
-  bool ignore_back;
-
-  // mu for one ray traced on its own (used to continue through back faces).
-  float trace1(RTCIntersectContext& ctx, Vec3 o, Vec3 d, float tnear) const {
-    const float reach = falloff.reach();
-    for (int k = 0; k < kMaxBackFaceSkips; ++k) {
-      RTCRayHit rh{};
-      rh.ray = {o.x, o.y, o.z, tnear, d.x, d.y, d.z, 0.0f, reach, 0xffffffffu, 0, 0};
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(rs.handle(), &ctx, &rh);
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 1.0f;
-      if (!ignore_back || dot(normals.per_mesh[rh.hit.geomID][rh.hit.primID], d) <= 0) return falloff.mu(rh.ray.tfar);
-      tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: look beyond it
-    }
-    return 0.0f;
-  }
-
-  // mu for `count` <= N rays with their own origins.
-  template <int N>
-  void trace(RTCIntersectContext& ctx, const Vec3* org, const Vec3* dir, int count, float* mu) const {
-    const float reach = falloff.reach();
-    const bool occlusion_only = falloff.membership == Membership::Step && !ignore_back;
-    if constexpr (N == 1) {
-      for (int k = 0; k < count; ++k) {
-        if (occlusion_only) {
-          RTCRay r{org[k].x, org[k].y, org[k].z, 0.0f, dir[k].x, dir[k].y, dir[k].z, 0.0f, reach, 0xffffffffu, 0, 0};
-          rtcOccluded1(rs.handle(), &ctx, &r);
-          mu[k] = r.tfar < 0 ? 0.0f : 1.0f;
-        } else {
-          mu[k] = trace1(ctx, org[k], dir[k], 0.0f);
-        }
-      }
-    } else {
-      alignas(64) typename detail::Packet<N>::RayHit rh;
-      alignas(64) std::array<int, N> valid;
-      for (int k = 0; k < N; ++k) {
-        const int s = k < count ? k : 0;
-        valid[k] = k < count ? -1 : 0;
-        detail::set_ray_hit(rh, k, org[s], dir[s], reach);
-      }
-      if (occlusion_only) {
-        detail::Packet<N>::occluded(valid.data(), rs.handle(), &ctx, &rh.ray);
-        for (int k = 0; k < count; ++k) mu[k] = rh.ray.tfar[k] < 0 ? 0.0f : 1.0f;
-      } else {
-        detail::Packet<N>::intersect(valid.data(), rs.handle(), &ctx, &rh);
-        for (int k = 0; k < count; ++k) {
-          if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
-            mu[k] = 1.0f;
-          } else if (ignore_back && dot(normals.per_mesh[rh.hit.geomID[k]][rh.hit.primID[k]], dir[k]) > 0) {
-            mu[k] = trace1(ctx, org[k], dir[k], std::nextafter(rh.ray.tfar[k], kInfinity));
-          } else {
-            mu[k] = falloff.mu(rh.ray.tfar[k]);
-          }
-        }
-      }
-    }
-  }
-};
-
-// A texel's patch as sub-triangles in texel-unit UV space, each with the mesh triangle it lies on
-// and its world area, for sampling points uniformly by area.
-struct PatchPiece {
-  std::uint32_t mesh, triangle;
-  Vec2 a, b, c;
-  double cdf;  // cumulative world area up to and including this piece
-};
-
-void build_patch(const Scene& s, const TexelCoverage& cov, std::size_t texel, std::vector<PatchPiece>& out) {
-  out.clear();
-  const int x = static_cast<int>(texel % cov.size), y = static_cast<int>(texel / cov.size);
-  double acc = 0;
-  for (std::uint32_t f = cov.offsets[texel]; f < cov.offsets[texel + 1]; ++f) {
-    const TexelFragment& fr = cov.fragments[f];
-    const Mesh& m = s.meshes[fr.mesh];
-    const std::uint32_t* i = &m.indices[3 * fr.triangle];
-    const ClipPolygon poly = clip_to_texel(texel_uv(m, i[0], cov.size), texel_uv(m, i[1], cov.size), texel_uv(m, i[2], cov.size), x, y);
-    const double stretch = fr.uv_area > 0 ? fr.world_area / fr.uv_area : 0.0;
-    for (int k = 1; k + 1 < poly.n; ++k) {  // fan of the convex clipped polygon
-      const Vec2 a = poly.p[0], b = poly.p[k], c = poly.p[k + 1];
-      const double area = 0.5 * std::abs((static_cast<double>(b.x) - a.x) * (c.y - a.y) - (static_cast<double>(c.x) - a.x) * (b.y - a.y));
-      if (!(area > 0)) continue;
-      acc += area * stretch;
-      out.push_back({fr.mesh, fr.triangle, a, b, c, acc});
-    }
-  }
-}
-
-struct SurfacePoint {
-  Vec3 p, n, ng;
-};
-
-// Point of mesh triangle `tri` at texel-unit UV `q` (barycentrics solved in UV space).
-SurfacePoint point_at_uv(const Scene& s, const TexelCoverage& cov, std::uint32_t mesh, std::uint32_t tri, Vec2 q, const TriangleNormals& fn) {
-  const Mesh& m = s.meshes[mesh];
-  const std::uint32_t* i = &m.indices[3 * tri];
-  const Vec2 a = texel_uv(m, i[0], cov.size), b = texel_uv(m, i[1], cov.size), c = texel_uv(m, i[2], cov.size);
-  const float det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-  float l1 = ((q.x - a.x) * (c.y - a.y) - (c.x - a.x) * (q.y - a.y)) / det;
-  float l2 = ((b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y)) / det;
-  l1 = std::clamp(l1, 0.0f, 1.0f);
-  l2 = std::clamp(l2, 0.0f, 1.0f - l1);
-  const float l0 = 1.0f - l1 - l2;
-  const Vec3 p = m.positions[i[0]] * l0 + m.positions[i[1]] * l1 + m.positions[i[2]] * l2;
-  Vec3 n = normalize(m.normals[i[0]] * l0 + m.normals[i[1]] * l1 + m.normals[i[2]] * l2);
-  const Vec3 ng = fn.per_mesh[mesh][tri];
-  if (!(length(n) > 0.5f)) n = ng;
-  return {p, n, ng};
-}
+using detail::face_normals;
+using detail::PatchPiece;
+using detail::point_at_uv;
+using detail::SurfacePoint;
+using detail::Tracer;
+using detail::TriangleNormals;
 
 }  // namespace
 
@@ -211,11 +89,10 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
         for (int x = t.x0; x < t.x1; ++x) {
           const std::size_t texel = static_cast<std::size_t>(y) * n + x;
           if (!cov.mask[texel]) continue;
-          build_patch(scene, cov, texel, patch);
+          detail::build_patch(scene, cov, texel, patch);
           if (patch.empty()) continue;
           const std::uint32_t key = pixel_seed(params.seed, x, y);
           const std::uint32_t key_point = hash_combine(key, 0x9017u), key_dir = hash_combine(key, 0xd1eu);
-          const double total = patch.back().cdf;
           double sum = 0;
           Vec3 bent{0, 0, 0};
           for (int first = 0; first < params.samples; first += batch) {
@@ -223,18 +100,10 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
             int live = 0;
             for (int k = 0; k < count; ++k) {
               const auto i = static_cast<std::uint32_t>(first + k);
-              // Point: choose a piece by world area, then a uniform point in it (the piece index is
-              // taken from u.x and u.x rescaled within the piece, which keeps the stratification).
-              const Vec2 u = sobol_owen_2d(i, key_point);
-              const double target = u.x * total;
-              std::size_t pi = 0;
-              while (pi + 1 < patch.size() && patch[pi].cdf <= target) ++pi;
-              const double lo = pi == 0 ? 0.0 : patch[pi - 1].cdf;
-              const float su = static_cast<float>(std::clamp((target - lo) / std::max(patch[pi].cdf - lo, 1e-300), 0.0, 1.0));
-              const float r = std::sqrt(su);
-              const PatchPiece& pc = patch[pi];
-              const Vec2 q{pc.a.x * (1 - r) + r * ((1 - u.y) * pc.b.x + u.y * pc.c.x), pc.a.y * (1 - r) + r * ((1 - u.y) * pc.b.y + u.y * pc.c.y)};
-              const SurfacePoint sp = point_at_uv(scene, cov, pc.mesh, pc.triangle, q, fn);
+              // Point: uniform by area over the patch (texel_rays.h).
+              const detail::PatchSample ps = detail::sample_patch(patch, sobol_owen_2d(i, key_point));
+              const PatchPiece& pc = patch[ps.piece];
+              const SurfacePoint sp = point_at_uv(scene, cov, pc.mesh, pc.triangle, ps.uv, fn);
               const Vec3 d = Frame::from_normal(sp.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
               if (dot(d, sp.ng) <= 0) continue;  // below the face: occluded by the surface itself (mu = 0)
               org[static_cast<std::size_t>(live)] = sp.p + sp.ng * offset;

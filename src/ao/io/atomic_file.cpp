@@ -1,10 +1,12 @@
 #include "ao/io/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstring>
 #include <string>
 #include <system_error>
 
@@ -17,6 +19,49 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string errno_text(int err) { return std::generic_category().message(err); }
+
+// --- registry of temporary paths, read by the signal handler -----------------------------------
+// A fixed table of slots, so the handler needs no allocation or lock: a slot is claimed with a
+// compare-exchange (free -> filling), filled, then published (ready); the handler touches only
+// ready slots and calls only unlink and rmdir, which are async-signal-safe.
+constexpr int kSlots = 64;
+constexpr std::size_t kMaxPath = 4096;
+enum SlotState : int { kFree = 0, kFilling = 1, kReady = 2 };
+struct Slot {
+  std::atomic<int> state{kFree};
+  bool directory = false;
+  char path[kMaxPath] = {};
+};
+Slot g_slots[kSlots];
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+
+int register_path(const fs::path& path, bool directory) {
+  std::error_code ec;
+  const std::string absolute = fs::absolute(path, ec).string();  // the handler must not depend on a later chdir
+  if (ec || absolute.size() >= kMaxPath) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = kFree;
+    if (!g_slots[i].state.compare_exchange_strong(expected, kFilling)) continue;
+    std::memcpy(g_slots[i].path, absolute.c_str(), absolute.size() + 1);
+    g_slots[i].directory = directory;
+    g_slots[i].state.store(kReady, std::memory_order_release);
+    return i;
+  }
+  return -1;
+}
+
+extern "C" void remove_temporaries_and_reraise(int sig) {
+  const int saved_errno = errno;
+  for (int pass = 0; pass < 2; ++pass)  // files first, then the (now empty) folders
+    for (Slot& s : g_slots) {
+      if (s.state.load(std::memory_order_acquire) != kReady || s.directory != (pass == 1)) continue;
+      if (s.directory) ::rmdir(s.path);
+      else ::unlink(s.path);
+    }
+  errno = saved_errno;
+  // The handler was installed with SA_RESETHAND, so the default action is back: end as the signal says.
+  ::raise(sig);
+}
 
 // Unique within the process (the counter) and across processes (the pid), so concurrent writers
 // of the same destination never share a temporary file.
@@ -41,7 +86,57 @@ void sync_file(const fs::path& file, const fs::path& reported) {
   if (rc != 0) throw SystemError(reported.string() + ": cannot flush to disk: " + errno_text(err));
 }
 
+thread_local detail::DeferredRenames* t_deferred = nullptr;
+
 }  // namespace
+
+TemporaryRegistration::TemporaryRegistration(const fs::path& path, bool directory) : slot_(register_path(path, directory)) {}
+
+TemporaryRegistration::~TemporaryRegistration() {
+  if (slot_ >= 0) g_slots[slot_].state.store(kFree, std::memory_order_release);
+}
+
+TemporaryRegistration::TemporaryRegistration(TemporaryRegistration&& other) noexcept : slot_(other.slot_) { other.slot_ = -1; }
+
+TemporaryRegistration& TemporaryRegistration::operator=(TemporaryRegistration&& other) noexcept {
+  if (this != &other) {
+    if (slot_ >= 0) g_slots[slot_].state.store(kFree, std::memory_order_release);
+    slot_ = other.slot_;
+    other.slot_ = -1;
+  }
+  return *this;
+}
+
+ScratchFile::ScratchFile(fs::path path) : path_(std::move(path)), registration_(path_) {}
+
+ScratchFile::~ScratchFile() {
+  std::error_code ec;
+  fs::remove(path_, ec);
+}
+
+void remove_temporaries_on_signals() {
+  struct sigaction action {};
+  action.sa_handler = remove_temporaries_and_reraise;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // A signal the parent chose to ignore (e.g. nohup's SIGHUP) stays ignored.
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &action, nullptr);
+  }
+}
+
+namespace detail {
+
+DeferredRenames::DeferredRenames(Keep keep) : keep_(std::move(keep)), outer_(t_deferred) { t_deferred = this; }
+DeferredRenames::~DeferredRenames() { t_deferred = outer_; }
+DeferredRenames* DeferredRenames::current() { return t_deferred; }
+void DeferredRenames::keep(const fs::path& temp, const fs::path& destination, TemporaryRegistration registration) const {
+  keep_(temp, destination, std::move(registration));
+}
+
+}  // namespace detail
 
 void write_file_atomically(const fs::path& path, const std::function<void(const fs::path& temp)>& write) {
   if (path.empty() || !path.has_filename()) throw InputError("'" + path.string() + "': output path names no file");
@@ -61,8 +156,10 @@ void write_file_atomically(const fs::path& path, const std::function<void(const 
 
   // Create the temporary file here (exclusively, so it cannot clobber anything) to report an
   // unwritable directory with the destination's name rather than a library's message about a
-  // temporary name the user never chose.
+  // temporary name the user never chose. It is registered before it exists, so a signal at any
+  // point after the open finds it.
   const fs::path temp = temp_path_for(target);
+  TemporaryRegistration registration(temp);
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) {
     const int err = errno;
@@ -73,6 +170,10 @@ void write_file_atomically(const fs::path& path, const std::function<void(const 
   try {
     write(temp);
     sync_file(temp, path);
+    if (const detail::DeferredRenames* deferred = detail::DeferredRenames::current()) {
+      deferred->keep(temp, target, std::move(registration));
+      return;
+    }
     fs::rename(temp, target, ec);
     if (ec) throw SystemError(path.string() + ": cannot rename the temporary file into place: " + ec.message());
   } catch (...) {

@@ -1,7 +1,9 @@
 // Atomic output: a file is written under a temporary name in its own directory and renamed over
 // the destination only once it is complete, so a failure (bad data, full disk, a crash) never
 // leaves a half-written file and never damages a file that was already there (SPEC, "Behaviour on
-// bad input").
+// bad input"). Temporary files are registered so that a program that installs
+// remove_temporaries_on_signals() removes them when it is interrupted (SIGINT, SIGTERM, SIGHUP).
+// Runs with several outputs group their writes with OutputSet (output_set.h).
 #pragma once
 
 #include <filesystem>
@@ -15,6 +17,7 @@ namespace ao {
 /// file already exists, empty; `write` must fill it and close it before returning. Then the
 /// temporary file is flushed to disk and renamed over `path`, which is replaced in one step
 /// (a symbolic link at `path` is followed, so the file it names is replaced and the link kept).
+/// Inside OutputSet::write the rename is left to OutputSet::commit.
 ///
 /// If `write` throws, the temporary file is removed and the exception propagates unchanged.
 /// Errors of its own are one line naming `path`: InputError when the destination cannot be used
@@ -22,5 +25,68 @@ namespace ao {
 /// (no permission to create the temporary file, cannot flush or rename).
 void write_file_atomically(const std::filesystem::path& path,
                            const std::function<void(const std::filesystem::path& temp)>& write);
+
+/// Installs handlers of SIGINT, SIGTERM and SIGHUP that remove every registered temporary file
+/// (those of write_file_atomically, OutputSet and ScratchFile not yet renamed or removed) and the
+/// empty folders an OutputSet created, then end the process by the same signal with its default
+/// action, so the parent sees the signal as usual. For programs (the CLI calls it first thing);
+/// the library never installs a handler by itself. Idempotent.
+void remove_temporaries_on_signals();
+
+/// A temporary path registered for removal by the handlers of remove_temporaries_on_signals while
+/// this object lives. It does not create or remove anything itself; the owner does. At most 64
+/// paths of up to 4095 bytes are registered at once; one that does not fit is simply not
+/// registered (it is still removed on the normal error paths, only not on a signal).
+class TemporaryRegistration {
+ public:
+  TemporaryRegistration() = default;
+  /// `directory`: removed with rmdir (only when empty), after the files.
+  explicit TemporaryRegistration(const std::filesystem::path& path, bool directory = false);
+  ~TemporaryRegistration();
+  TemporaryRegistration(TemporaryRegistration&& other) noexcept;
+  TemporaryRegistration& operator=(TemporaryRegistration&& other) noexcept;
+  TemporaryRegistration(const TemporaryRegistration&) = delete;
+  TemporaryRegistration& operator=(const TemporaryRegistration&) = delete;
+
+ private:
+  int slot_ = -1;
+};
+
+/// A scratch file that is nobody's output (e.g. an intermediate encoding): removed by the
+/// destructor, and by the signal handlers while it lives. The file is not created here.
+class ScratchFile {
+ public:
+  explicit ScratchFile(std::filesystem::path path);
+  ~ScratchFile();
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  TemporaryRegistration registration_;
+};
+
+namespace detail {
+
+/// While alive, write_file_atomically on this thread does not rename its complete temporary file:
+/// it calls `keep(temp, destination, registration)` and leaves the file to the callee (OutputSet).
+class DeferredRenames {
+ public:
+  using Keep = std::function<void(const std::filesystem::path& temp, const std::filesystem::path& destination, TemporaryRegistration registration)>;
+  explicit DeferredRenames(Keep keep);
+  ~DeferredRenames();
+  DeferredRenames(const DeferredRenames&) = delete;
+  DeferredRenames& operator=(const DeferredRenames&) = delete;
+  /// The innermost live scope of this thread, or null.
+  static DeferredRenames* current();
+  void keep(const std::filesystem::path& temp, const std::filesystem::path& destination, TemporaryRegistration registration) const;
+
+ private:
+  Keep keep_;
+  DeferredRenames* outer_;
+};
+
+}  // namespace detail
 
 }  // namespace ao

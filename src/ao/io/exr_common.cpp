@@ -134,7 +134,7 @@ void write_exr_atomically(const fs::path& path, const Imf::Header& header, const
     std::ofstream os(temp, std::ios::binary | std::ios::trunc);
     if (!os) throw SystemError(path.string() + ": cannot open the temporary file for writing");
     try {
-      Imf::StdOFStream stream(os, temp.c_str());
+      Imf::StdOFStream stream(os, path.c_str());  // the name OpenEXR's messages give: the user's, not the temporary one
       Imf::OutputFile out(stream, header);
       out.setFrameBuffer(frame);
       const Imath::Box2i& data = header.dataWindow();

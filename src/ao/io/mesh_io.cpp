@@ -423,12 +423,17 @@ std::string uv_set_error(unsigned sets, int asked) {
   return "has " + std::to_string(sets) + " UV set" + (sets == 1 ? "" : "s") + ", --uv-set " + std::to_string(asked) + " asked for";
 }
 
+/// Running out of memory inside assimp: the sizes were checked against the file before (PLY, OFF),
+/// so this is the machine's limit, a SystemError (exit 3), not bad input.
+[[noreturn]] void out_of_memory(const fs::path& path) {
+  throw SystemError(path.string() + ": out of memory while reading the mesh");
+}
+
 /// Explains assimp's error in the user's terms where we recognise it; keeps assimp's words otherwise.
 std::string explain_assimp_error(std::string_view error) {
   const std::string e = one_line(error);
   if (e.find("No suitable reader found") != std::string::npos)
     return "unknown or unreadable mesh format (supported: OBJ, PLY, OFF, STL, glTF/GLB and other formats assimp reads)";
-  if (e.find("bad_alloc") != std::string::npos) return "out of memory while reading: the file declares absurd sizes";
   if (e.find("No meshes remaining") != std::string::npos) return "the file has no triangles, only points or lines";
   if (e.find("mNumMeshes is 0") != std::string::npos) return "the file contains no meshes";
   return "malformed or truncated file (" + e + ")";
@@ -489,12 +494,13 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   try {
     raw = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
   } catch (const std::bad_alloc&) {
-    fail(path, explain_assimp_error("bad_alloc"));
+    out_of_memory(path);
   } catch (const std::exception& e) {
     fail(path, explain_assimp_error(e.what()));
   }
   if (raw == nullptr) {
     const std::string error = importer.GetErrorString();
+    if (error.find("bad_alloc") != std::string::npos) out_of_memory(path);
     // "No suitable reader" for a file named like a format assimp reads means damaged content.
     if (error.find("No suitable reader found") != std::string::npos && !ext.empty() && importer.IsExtensionSupported(ext))
       fail(path, "malformed or truncated " + printable(ext.substr(1)) + " file: its content is not recognised");
@@ -509,10 +515,16 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   const aiScene* ai = nullptr;
   try {
     ai = importer.ApplyPostProcessing(steps);
+  } catch (const std::bad_alloc&) {
+    out_of_memory(path);
   } catch (const std::exception& e) {
     fail(path, explain_assimp_error(e.what()));
   }
-  if (ai == nullptr) fail(path, explain_assimp_error(importer.GetErrorString()));
+  if (ai == nullptr) {
+    const std::string error = importer.GetErrorString();
+    if (error.find("bad_alloc") != std::string::npos) out_of_memory(path);
+    fail(path, explain_assimp_error(error));
+  }
 
   // The UV set asked for: a set above 0 that no mesh has is a mistake worth stopping on (set 0
   // missing is the "no UVs" case the callers report in their own terms).

@@ -189,22 +189,20 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
                 const float dx = rho * (row.rot_c[j] * pux - row.rot_s[j] * puy);
                 const float dy = rho * (row.rot_s[j] * pux + row.rot_c[j] * puy);
                 // +kCoordOffset keeps the coordinate positive, so truncation is floor.
-                const int ix = static_cast<int>(fx0 + static_cast<float>(j) + dx) - static_cast<int>(kCoordOffset);
-                const int iy = static_cast<int>(fy0 + dy) - static_cast<int>(kCoordOffset);
-                const bool inside = (static_cast<unsigned>(ix) < static_cast<unsigned>(w)) & (static_cast<unsigned>(iy) < static_cast<unsigned>(h));
-                // Masked rather than selected, so the compiler sees a plain gather base[index].
-                const Index idx = (static_cast<Index>(iy) * w + ix) & -static_cast<Index>(inside);
-                const float dp = depth_buffer[idx];
+                // Clamp-to-edge: a sample beyond the frame reads the nearest border pixel (the surfaces
+                // at the edge go on beyond it) rather than counting as empty space.
+                const int ix = std::clamp(static_cast<int>(fx0 + static_cast<float>(j) + dx) - static_cast<int>(kCoordOffset), 0, w - 1);
+                const int iy = std::clamp(static_cast<int>(fy0 + dy) - static_cast<int>(kCoordOffset), 0, h - 1);
+                const float dp = depth_buffer[static_cast<Index>(iy) * w + ix];
                 const float px = dp * (ax * (static_cast<float>(ix) + 0.5f) + bx);
                 const float py = dp * (ay * (static_cast<float>(iy) + 0.5f) + by);
                 const float pz = -dp;
                 const float vx = px - row.cx[j], vy = py - row.cy[j], vz = pz - row.cz[j];
                 const float vv = vx * vx + vy * vy + vz * vz;
                 const float vn = vx * row.nx[j] + vy * row.ny[j] + vz * row.nz[j] + row.bias[j];
-                // Off-screen and background samples (depth +inf, so vv is inf or NaN and fails vv < r^2)
-                // contribute nothing: the paper's assumption that unseen space is empty. vv < r^2 is
-                // eq. 9's H.
-                const bool use = inside & (vv < r2) & (vn > 0.0f);
+                // Background samples (depth +inf, so vv is inf or NaN and fails vv < r^2) contribute
+                // nothing: the paper's assumption that unseen space is empty. vv < r^2 is eq. 9's H.
+                const bool use = (vv < r2) & (vn > 0.0f);
                 const float term = vn / (vv + eps);
                 row.sum[j] += use ? term : 0.0f;
               }

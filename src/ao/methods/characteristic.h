@@ -12,7 +12,9 @@
 // Kinds (each a small, cheap-to-copy value type with an inline `distance`, so kernels templated
 // on the type copy it into locals and inline it into their vectorised loops; no virtual calls):
 //  - DepthBufferCharacteristic: the G-buffer's depth at p's projection (VAO fig. 2c). Points
-//    projecting outside the image or onto background are free (distance = +infinity).
+//    projecting outside the image read the nearest border pixel (clamp-to-edge: the surfaces at
+//    the frame's edge go on beyond it); points on background, or behind the camera, are free
+//    (distance = +infinity).
 //  - ImplicitCharacteristic: f(p) >= 0 for f = min of analytic primitives (planes, sphere
 //    exteriors), with the Taylor distance z* - p_z ~ -f / (df/dz) (VAO, eq. after fig. 2).
 //  - HeightFieldCharacteristic: a displacement map in a surface's tangent space, p_n >= h(p_t, p_b)
@@ -49,22 +51,26 @@ struct ScreenProjection {
     return {0.5f * static_cast<float>(c.width) / (t * c.aspect()), 0.5f * static_cast<float>(c.height) / t,
             0.5f * static_cast<float>(c.width), 0.5f * static_cast<float>(c.height), c.width, c.height};
   }
-  /// Sets `index` to y * width + x of the pixel containing p's projection and returns true, or
-  /// sets it to 0 and returns false when p is behind the camera or projects outside the image.
-  /// Branch-free, so loops over it vectorise (with gathers).
+  /// Sets `index` to y * width + x of the pixel containing p's projection, clamped to the image
+  /// (a point projecting outside it reads the nearest border pixel: clamp-to-edge), and returns
+  /// true; sets it to 0 and returns false when p is not in front of the camera. Branch-free, so
+  /// loops over it vectorise (with gathers).
   bool locate(float x, float y, float z, int& index) const {
     const float inv = -1.0f / z;
-    const float fx = x * inv * scale_x + centre_x;
-    const float fy = centre_y - y * inv * scale_y;
-    const bool valid = (z < 0.0f) & (fx >= 0.0f) & (fy >= 0.0f) & (fx < static_cast<float>(width)) & (fy < static_cast<float>(height));
-    const int ix = static_cast<int>(valid ? fx : 0.0f), iy = static_cast<int>(valid ? fy : 0.0f);
+    const bool valid = z < 0.0f;
+    // Clamped as floats, before the conversion (which is undefined out of int's range); a NaN
+    // (z = 0) is replaced by 0 first.
+    const float fx = valid ? x * inv * scale_x + centre_x : 0.0f;
+    const float fy = valid ? centre_y - y * inv * scale_y : 0.0f;
+    const int ix = static_cast<int>(std::min(std::max(fx, 0.0f), static_cast<float>(width - 1)));
+    const int iy = static_cast<int>(std::min(std::max(fy, 0.0f), static_cast<float>(height - 1)));
     index = iy * width + ix;
     return valid;
   }
 };
 
 /// VAO fig. 2c: the z-buffer separates inner from outer. z* is the linear depth stored at p's pixel
-/// (nearest pixel); background pixels hold +infinity, so they are free.
+/// (nearest pixel, clamped to the image); background pixels hold +infinity, so they are free.
 struct DepthBufferCharacteristic {
   ScreenProjection projection;
   const float* depth = nullptr;  ///< The G-buffer's depth, width * height values; must outlive this.
@@ -74,7 +80,7 @@ struct DepthBufferCharacteristic {
   float distance(float x, float y, float z) const {
     int i;
     const bool valid = projection.locate(x, y, z, i);
-    const float zs = depth[i];  // index 0 when off screen: always readable, so the gather is unconditional
+    const float zs = depth[i];  // index 0 behind the camera: always readable, so the gather is unconditional
     return valid ? zs + z : kInfinity;  // z* - depth(p) with depth(p) = -z
   }
 };

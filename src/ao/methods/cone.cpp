@@ -16,6 +16,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/methods/bilateral.h"
 
 namespace ao {
 
@@ -92,6 +93,10 @@ struct WorldSampler {
     }
   }
 
+  // Spheres that start nearer the apex than this (world units) are skipped: 1.5 voxels, within
+  // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
+  // voxel whose centre is inside) fills them.
+  float near_limit(Vec3) const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
   static int clamp_index(float x, int n) {  // clamp(floor(x), 0, n - 1), branch-free; NaN -> 0
     return static_cast<int>(std::min(std::max(0.0f, x), static_cast<float>(n - 1)));
   }
@@ -122,18 +127,21 @@ struct WorldSampler {
     return false;
   }
 
-  // centre in world space, sphere k of the chain; disk points are (u, v) in the world x-z plane.
-  float operator()(Vec3 c, int k, float rot_c, float rot_s) const {
+  // centre in world space, sphere k of the chain with its radius times `scale` (in (0, 1]: the
+  // jittered chain and the filler sphere, never larger, so sphere k's skipping reach stays
+  // conservative); disk points are (u, v) in the world x-z plane.
+  float operator()(Vec3 c, int k, float scale, float rot_c, float rot_s) const {
     const float gx = (c.x - g.origin.x) * inv.x, gy = (c.z - g.origin.z) * inv.y, gz = (c.y - g.origin.y) * inv.z;
     const Sphere& sp = spheres[k];
     // Empty-space skipping (not in the paper): an empty neighbourhood needs no prism lookups.
     if (!maybe_solid(sp, gx, gy, gz)) return 0.0f;
     const float* h = half.data() + static_cast<std::size_t>(k) * lanes;
     float len[64];  // solid length per prism, summed in prism order below (same sum at any width)
-    prisms(gx, gy, gz, sp.rx, sp.ry, h, rot_c, rot_s, len);
+    prisms(gx, gy, gz, sp.rx * scale, sp.ry * scale, h, scale, rot_c, rot_s, len);
     float solid = 0;
     for (int s = 0; s < np; ++s) solid += len[s];
-    return sp.chord > 0 ? std::min(1.0f, solid / sp.chord) : 0.0f;
+    const float chord = sp.chord * scale;
+    return chord > 0 ? std::min(1.0f, solid / chord) : 0.0f;
   }
 
   float scalar_prism(int s, float gx, float gy, float gz, float rx, float ry, float h, float rot_c, float rot_s) const {
@@ -146,7 +154,8 @@ struct WorldSampler {
 #if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__)
   // 8 prisms at once: column indices, z ranges, two gathered words per prism (the words of the end
   // voxels), masks and VPOPCNTQ. Prisms whose range spans more than two words go the scalar way.
-  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float rot_c, float rot_s, float* len) const {
+  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, float rot_c, float rot_s, float* len) const {
+    const __m256 vscale = _mm256_set1_ps(scale);
     const __m256 vrc = _mm256_set1_ps(rot_c), vrs = _mm256_set1_ps(rot_s);
     const __m256 zero = _mm256_setzero_ps(), fnx = _mm256_set1_ps(static_cast<float>(g.nx)), fny = _mm256_set1_ps(static_cast<float>(g.ny));
     const __m256 fbits = _mm256_set1_ps(static_cast<float>(g.depth_bits));
@@ -155,7 +164,7 @@ struct WorldSampler {
     const long long* base = reinterpret_cast<const long long*>(g.bits.data());
     for (int s0 = 0; s0 < np; s0 += 8) {
       const __mmask8 lane = static_cast<__mmask8>(np - s0 >= 8 ? 0xff : (1u << (np - s0)) - 1);
-      const __m256 u0 = _mm256_loadu_ps(du.data() + s0), v0 = _mm256_loadu_ps(dv.data() + s0), hh = _mm256_loadu_ps(h + s0);
+      const __m256 u0 = _mm256_loadu_ps(du.data() + s0), v0 = _mm256_loadu_ps(dv.data() + s0), hh = _mm256_mul_ps(_mm256_loadu_ps(h + s0), vscale);
       const __m256 u = _mm256_fmsub_ps(u0, vrc, _mm256_mul_ps(v0, vrs)), v = _mm256_fmadd_ps(u0, vrs, _mm256_mul_ps(v0, vrc));
       const __m256 fx = _mm256_fmadd_ps(u, _mm256_set1_ps(rx), _mm256_set1_ps(gx)), fy = _mm256_fmadd_ps(v, _mm256_set1_ps(ry), _mm256_set1_ps(gy));
       __m256 zlo = _mm256_sub_ps(_mm256_set1_ps(gz), hh), zhi = _mm256_add_ps(_mm256_set1_ps(gz), hh);
@@ -191,13 +200,13 @@ struct WorldSampler {
       _mm256_storeu_ps(len + s0, r);
       for (unsigned m = wide; m; m &= m - 1) {
         const int s = s0 + std::countr_zero(m);
-        len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s], rot_c, rot_s);
+        len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s] * scale, rot_c, rot_s);
       }
     }
   }
 #else
-  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float rot_c, float rot_s, float* len) const {
-    for (int s = 0; s < np; ++s) len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s], rot_c, rot_s);
+  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, float rot_c, float rot_s, float* len) const {
+    for (int s = 0; s < np; ++s) len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s] * scale, rot_c, rot_s);
   }
 #endif
 };
@@ -209,10 +218,21 @@ struct EyeSampler {
   int np;
   std::vector<float> radius;  // world units, per sphere of the chain
 
+  // As WorldSampler::near_limit, with the voxel of the column the point projects to: its depth
+  // 1 / voxels_per_unit and its width at the point's depth.
+  float near_limit(Vec3 c) const {
+    const float depth = -c.z;
+    if (!(depth > 0)) return 0.0f;
+    const float fx = c.x / depth * sx + ox, fy = c.y / depth * sy + oy;
+    const int i = std::clamp(static_cast<int>(fx), 0, g.nx - 1), j = std::clamp(static_cast<int>(fy), 0, g.ny - 1);
+    const float width = depth * std::max(1.0f / std::abs(sx), 1.0f / std::abs(sy));
+    return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
+  }
+
   // centre in camera space; the prisms run along the camera's z (the grid's columns are view rays:
   // over one sphere they are close to parallel, the approximation the paper's texture fetch makes).
-  float operator()(Vec3 c, int k, float rot_c, float rot_s) const {
-    const float r = radius[k];
+  float operator()(Vec3 c, int k, float scale, float rot_c, float rot_s) const {
+    const float r = radius[k] * scale;
     float solid = 0, chord = 0;
     const float depth = -c.z;
     if (!(depth > 0)) return 0.0f;
@@ -242,6 +262,10 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
   std::vector<float> distance(ns);
   for (int k = 0; k < ns; ++k) distance[k] = setup.sphere_distance[k] * r_max;
   const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
+  const float log_q = std::log(setup.chain_ratio);
+  const float inv_last_radius = 1.0f / setup.sphere_radius.back();  // both relative to R_max
+  std::vector<float> start(ns);  // where each sphere begins along the axis, world units
+  for (int k = 0; k < ns; ++k) start[k] = (setup.sphere_distance[k] - setup.sphere_radius[k]) * r_max;
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y)
@@ -256,25 +280,61 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
           n = normalize(basis.to_world(n));
         }
         const Frame frame = Frame::from_normal(n);
-        // Per-pixel rotations: psi of the cone pattern about the normal, beta of the prism pattern.
-        float psi_c = 1, psi_s = 0, rot_c = 1, rot_s = 0;
+        const float near = sample.near_limit(gb.position(x, y));
+        // Per-pixel jitter (deviation 5 of docs/methods/cone.md), all from hash(seed, pixel), so
+        // the image does not depend on the thread count: the prism pattern turns by beta, and each
+        // cone takes one random direction in its own cell of the hemisphere (stratified sampling
+        // of the cell's measure: theta uniform in the band's sin^2 theta or 1 - cos theta, phi
+        // uniform in its azimuth range) and one random scale of its sphere chain. Fixed
+        // directions and distances make the error a fixed function of the distance to each
+        // occluder, which shows as rings that no averaging over seeds removes.
+        const std::uint32_t ps = pixel_seed(seed, x, y);
+        float rot_c = 1, rot_s = 0;
         if (p.jitter) {
-          const std::uint32_t ps = pixel_seed(seed, x, y);
-          const float psi = 2.0f * kPi * to_unit_float(hash32(ps));
-          const float beta = 2.0f * kPi * to_unit_float(hash_combine(ps, 1u));
-          psi_c = std::cos(psi), psi_s = std::sin(psi);
+          const float beta = 2.0f * kPi * to_unit_float(hash32(ps));
           rot_c = std::cos(beta), rot_s = std::sin(beta);
         }
         float v = 0;
         for (int c = 0; c < nc; ++c) {
           const ConeSetup::Cone& cone = setup.cones[c];
-          const float cp = cone.cos_phi * psi_c - cone.sin_phi * psi_s, sp = cone.sin_phi * psi_c + cone.cos_phi * psi_s;
-          const Vec3 axis = frame.to_world({cone.sin_theta * cp, cone.sin_theta * sp, cone.cos_theta});
+          float st = cone.sin_theta, ct = cone.cos_theta, cp = cone.cos_phi, sp = cone.sin_phi, scale = 1.0f;
+          if (p.jitter) {
+            const std::uint32_t hc = hash_combine(ps, 1u + static_cast<std::uint32_t>(c));
+            const float u = cone.band0 + to_unit_float(hc) * (cone.band1 - cone.band0);
+            st = setup.cosine ? std::sqrt(u) : std::sqrt(std::max(0.0f, u * (2.0f - u)));  // 1 - cos = u
+            st = std::min(st, setup.sin_theta_max);
+            ct = std::sqrt(1.0f - st * st);
+            // phi = the cell's centre + delta, delta uniform in +-dphi / 2.
+            const float delta = (to_unit_float(hash_combine(hc, 1u)) - 0.5f) * cone.dphi;
+            float cd, sd;
+            if (cone.dphi <= 2.0f) {
+              // |delta| <= 1: Taylor series to delta^6 / delta^7, cheaper than sin and cos; the
+              // truncation error is at most delta^8 / 8! = 2.5e-5.
+              const float d2 = delta * delta;
+              cd = 1.0f - d2 * (0.5f - d2 * (1.0f / 24.0f - d2 * (1.0f / 720.0f)));
+              sd = delta * (1.0f - d2 * (1.0f / 6.0f - d2 * (1.0f / 120.0f - d2 * (1.0f / 5040.0f))));
+            } else {
+              cd = std::cos(delta), sd = std::sin(delta);  // a ring of one or two cones
+            }
+            cp = cone.cos_phi * cd - cone.sin_phi * sd, sp = cone.sin_phi * cd + cone.cos_phi * sd;
+            // Chain scale s = q^-xi in (1/q, 1]: one ratio step of random phase, the geometric
+            // analogue of jittering a uniform step.
+            scale = std::exp(-to_unit_float(hash_combine(hc, 2u)) * log_q);
+          }
+          const Vec3 axis = frame.to_world({st * cp, st * sp, ct});
           // Front-to-back along the cone (sec. III-C2, Fig. 8): each sphere absorbs its
           // obstructed fraction of the rays that reach it.
           float transmittance = 1.0f;
           for (int k = 0; k < ns && transmittance > kOpaque; ++k) {
-            transmittance *= 1.0f - sample(pos + axis * distance[k], k, rot_c, rot_s);
+            if (start[k] * scale < near) continue;
+            transmittance *= 1.0f - sample(pos + axis * (distance[k] * scale), k, scale, rot_c, rot_s);
+          }
+          // A scaled chain ends at s R_max; the filler sphere, inscribed in [s R_max, R_max] along
+          // the axis, samples the rest. Its radius (1 - s) R_max / 2 is at most the last sphere's
+          // (equal at s = 1/q), and it fits in the cone for s >= 1/q.
+          const float filler = 0.5f * (1.0f - scale) * inv_last_radius;  // radius / the last sphere's
+          if (filler > 1e-3f && transmittance > kOpaque) {
+            transmittance *= 1.0f - sample(pos + axis * (0.5f * (1.0f + scale) * r_max), ns - 1, filler, rot_c, rot_s);
           }
           v += weight * transmittance;
         }
@@ -366,15 +426,18 @@ const ParamTable<ConeParams>& cone_param_table() {
        P::enumeration<GridSpace>("grid", &ConeParams::grid, {{"world", GridSpace::World}, {"eye", GridSpace::Eye}}, "world grid, or the paper's eye-space grid"),
        P::enumeration<ConeWeighting>("weighting", &ConeParams::weighting, {{"cosine", ConeWeighting::Cosine}, {"uniform", ConeWeighting::Uniform}},
                                      "cone cells of equal cosine-weighted measure or of equal solid angle"),
-       P::enumeration<OpenMeshes>("open_meshes", &ConeParams::open_meshes, {{"slab", OpenMeshes::Slab}, {"parity", OpenMeshes::Parity}},
-                                  "thicken open meshes into slabs, or voxelize them by parity as the paper"),
+       P::enumeration<OpenMeshes>("open_meshes", &ConeParams::open_meshes,
+                                  {{"winding", OpenMeshes::Winding}, {"slab", OpenMeshes::Slab}, {"parity", OpenMeshes::Parity}},
+                                  "open meshes: the generalized-winding-number solid, slabs behind their front faces, or parity as the paper"),
        P::real("slab_fraction", &ConeParams::slab_fraction, Range::open_closed(0, 16), "R_max", "thickness of the slab behind open meshes"),
-       P::boolean("jitter", &ConeParams::jitter, "rotate the cone and prism patterns per pixel (noise instead of banding)")}};
+       P::boolean("jitter", &ConeParams::jitter, "per pixel: random cone axes in their cells, sphere-chain scale, prism turn (noise instead of rings)"),
+       P::integer("filter_taps", &ConeParams::filter_taps, Range::closed(1, 63), "", "taps per pass of the cross-bilateral filter on V, odd; 1 = no filter")}};
   return table;
 }
 
 void ConeParams::validate() const {
   cone_param_table().validate(*this);
+  if (filter_taps % 2 == 0) throw InputError("cone: filter_taps must be odd (1 = no filter), got " + std::to_string(filter_taps));
   voxelize_options(1.0f).validate();
 }
 
@@ -406,13 +469,16 @@ ConeSetup derive_cone_setup(const ConeParams& p) {
       theta = p.weighting == ConeWeighting::Cosine ? std::asin(std::sqrt(mid)) : std::acos(1.0f - mid);
     }
     theta = std::min(theta, 0.5f * kPi - alpha);
+    const float dphi = 2.0f * kPi / static_cast<float>(rings[ri]);
     for (int k = 0; k < rings[ri]; ++k) {
       // Odd rings are turned by half a step so that cones of neighbouring rings interleave.
-      const float phi = 2.0f * kPi * (static_cast<float>(k) + 0.5f * static_cast<float>(ri % 2)) / static_cast<float>(rings[ri]);
-      s.cones.push_back({std::sin(theta), std::cos(theta), std::cos(phi), std::sin(phi)});
+      const float phi = dphi * (static_cast<float>(k) + 0.5f * static_cast<float>(ri % 2));
+      s.cones.push_back({std::sin(theta), std::cos(theta), std::cos(phi), std::sin(phi), f0, f1, phi - 0.5f * dphi, dphi});
     }
     before += rings[ri];
   }
+  s.sin_theta_max = std::cos(alpha);
+  s.cosine = p.weighting == ConeWeighting::Cosine;
 
   // Sphere chain (Fig. 5b): a sphere at distance d from the apex, inscribed in a cone of
   // half-angle alpha, has radius r = d sin(alpha); tangency of neighbours,
@@ -420,6 +486,7 @@ ConeSetup derive_cone_setup(const ConeParams& p) {
   // ends at R_max: d_{K-1} (1 + sin a) = R_max. The first sphere then starts at
   // d_0 (1 - sin a) > 0, clear of the surface at the apex.
   const float q = (1.0f + sa) / (1.0f - sa);
+  s.chain_ratio = q;
   const int K = p.spheres.value_or(5);
   s.sphere_distance.resize(K);
   s.sphere_radius.resize(K);
@@ -479,8 +546,15 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
   r.visibility = Image<float>(gb.width(), gb.height(), 1.0f);
   compute_cone(gb, g, r_max, p, seed, r.visibility.view(), progress);
   const auto t2 = Clock::now();
+  if (p.filter_taps > 1) {
+    BilateralParams f;
+    f.taps = p.filter_taps;
+    bilateral_filter(gb, r.visibility, f);
+  }
+  const auto t3 = Clock::now();
   r.voxelize_ms = ms(t0, t1);
   r.trace_ms = ms(t1, t2);
+  r.filter_ms = ms(t2, t3);
   r.grid_nx = g.nx;
   r.grid_ny = g.ny;
   return r;
@@ -494,16 +568,23 @@ nlohmann::json cone_stats(const ConeResult& r) {
                        " voxel columns end with odd parity: the scene is not watertight there, voxels behind the leak are wrong");
   if (v.open_meshes > 0)
     warnings.push_back("cone: " + std::to_string(v.open_meshes) + " open surface(s) (" + std::to_string(v.boundary_edges) +
-                       " boundary edges in all meshes): filled as one-sided slabs behind their front faces (open_meshes=slab)");
+                       " boundary edges in all meshes): filled as one-sided slabs behind their front faces");
+  if (v.holed_meshes > 0)
+    warnings.push_back("cone: " + std::to_string(v.holed_meshes) + " mesh(es) not closed (" + std::to_string(v.holes) + " hole(s)): " +
+                       (v.capped_meshes > 0 ? "solid taken where the generalized winding number exceeds 1/2 (holes closed by fans)"
+                                            : "voxelized by parity, wrong in the columns through the holes"));
   return {{"grid_columns", {r.grid_nx, r.grid_ny}},
           {"triangles_rasterised", v.triangles},
           {"fragments", v.fragments},
           {"odd_columns", v.odd_columns},
           {"open_meshes", v.open_meshes},
           {"boundary_edges", v.boundary_edges},
+          {"holed_meshes", v.holed_meshes},
+          {"holes", v.holes},
           {"set_voxels", v.set_voxels},
           {"voxelize_ms", r.voxelize_ms},
           {"trace_ms", r.trace_ms},
+          {"filter_ms", r.filter_ms},
           {"warnings", warnings}};
 }
 

@@ -47,9 +47,12 @@ struct ConeParams {
   int columns = 512;         ///< Grid columns per side (world) or along the longer image side (eye). [8, 4096].
   GridSpace grid = GridSpace::World;               ///< "world" (default) or the paper's "eye".
   ConeWeighting weighting = ConeWeighting::Cosine; ///< "cosine" (default) or "uniform".
-  OpenMeshes open_meshes = OpenMeshes::Slab;       ///< "slab" (default) or "parity" (the paper).
+  OpenMeshes open_meshes = OpenMeshes::Winding;    ///< "winding" (default), "slab" or "parity" (the paper); voxelize.h.
   float slab_fraction = 1.0f;  ///< Thickness of the slab behind open meshes, as a fraction of R_max. (0, 16].
-  bool jitter = true;        ///< Rotate the cone and prism patterns per pixel (noise instead of banding).
+  bool jitter = true;        ///< Per pixel: each cone's axis at a random point of its cell, a random scale of its
+                             ///< sphere chain, a random turn of the prism pattern (noise instead of rings). false: the paper's fixed pattern.
+  int filter_taps = 5;       ///< Taps per pass of the cross-bilateral filter (bilateral.h) run on V to smooth the
+                             ///< jitter noise; odd, [1, 63]; 1 = no filter. Default 5: see docs/methods/cone.md, quality.
 
   /// Throws InputError naming the bad field.
   void validate() const;
@@ -58,7 +61,8 @@ struct ConeParams {
   VoxelizeOptions voxelize_options(float r_max) const;
 };
 /// Keys: preset ("low"|"medium"|"high"), cones, spheres, prisms, aperture_deg, depth_bits, columns,
-/// grid ("world"|"eye"), weighting ("cosine"|"uniform"), open_meshes ("slab"|"parity"), slab_fraction, jitter.
+/// grid ("world"|"eye"), weighting ("cosine"|"uniform"), open_meshes ("winding"|"slab"|"parity"), slab_fraction, jitter,
+/// filter_taps.
 void to_json(nlohmann::json& j, const ConeParams& p);
 /// Rejects unknown keys, wrong types, unknown enum names and values out of range with InputError.
 void from_json(const nlohmann::json& j, ConeParams& p);
@@ -71,7 +75,11 @@ ConeParams cone_preset(ConeQuality q);
 /// Derived constants of one parameter set: one pure function of the (resolved) parameters.
 struct ConeSetup {
   struct Cone {
-    float sin_theta, cos_theta, cos_phi, sin_phi;  ///< Axis in the normal's frame (theta from the normal).
+    float sin_theta, cos_theta, cos_phi, sin_phi;  ///< Unjittered axis in the normal's frame (theta from the normal).
+    /// The cone's cell of the hemisphere, in which jitter places its axis: the band [band0, band1)
+    /// of the measure's coordinate (sin^2 theta for cosine weighting, 1 - cos theta for uniform),
+    /// where every value is equally likely, and the azimuth range [phi0, phi0 + dphi).
+    float band0, band1, phi0, dphi;
   };
   struct Disk {
     float u, v, half_chord;  ///< Great-disk sample (unit radius) and sqrt(1 - u^2 - v^2).
@@ -80,6 +88,9 @@ struct ConeSetup {
   std::vector<float> sphere_distance;  ///< d_k / R_max, k = 0 nearest the apex.
   std::vector<float> sphere_radius;    ///< r_k / R_max = d_k sin(alpha).
   std::vector<Disk> disk;              ///< Prism positions on the unit great disk.
+  float sin_theta_max = 1;             ///< sin(90 deg - alpha): no axis lower, so cones stay above the tangent plane.
+  float chain_ratio = 1;               ///< q = d_{k+1} / d_k = (1 + sin alpha) / (1 - sin alpha).
+  bool cosine = true;                  ///< Bands in sin^2 theta (cosine weighting) or 1 - cos theta (uniform).
 };
 ConeSetup derive_cone_setup(const ConeParams& resolved);
 
@@ -93,17 +104,17 @@ void compute_cone(const GBuffer& gbuffer, const VoxelGrid& grid, float r_max, co
 struct ConeResult {
   Image<float> visibility;
   VoxelStats voxel_stats;
-  double voxelize_ms = 0, trace_ms = 0;
+  double voxelize_ms = 0, trace_ms = 0, filter_ms = 0;
   int grid_nx = 0, grid_ny = 0;
 };
 
-/// Voxelizes `scene` (rebuilt on every call: a dynamic-scene method) and runs the kernel.
+/// Voxelizes `scene` (rebuilt on every call: a dynamic-scene method), runs the kernel and the filter.
 /// `closure` comes from analyze_closure(scene) (topology, reusable across frames).
 ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, float r_max, const ConeParams& params,
                        std::uint32_t seed, const ProgressFn& progress = {});
 
 /// Numbers for --json: grid size, voxelization statistics, timings, and "warnings" (odd columns,
-/// open meshes thickened into slabs), one line each.
+/// open meshes thickened into slabs, meshes with holes), one line each, which the CLI prints.
 nlohmann::json cone_stats(const ConeResult& result);
 
 }  // namespace ao

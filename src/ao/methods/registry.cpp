@@ -1,5 +1,6 @@
 #include "ao/methods/registry.h"
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
@@ -10,26 +11,57 @@
 #include "ao/methods/characteristic.h"
 #include "ao/methods/cone.h"
 #include "ao/methods/containment.h"
+#include "ao/methods/gtao.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
 #include "ao/reference/raytraced.h"
+#include "ao/reference/reference.h"
 #include "ao/scene/procedural.h"
 
 namespace ao {
 
 namespace {
 
+// The reference kind raytraced renders (kReferenceParam), taken off `j` so that the rest goes to
+// RaytracedParams' from_json, which rejects unknown keys; absent means obscurance.
+ReferenceKind take_reference_kind(nlohmann::json& j) {
+  if (!j.is_object() || !j.contains(kReferenceParam)) return ReferenceKind::Obscurance;
+  const nlohmann::json value = j.at(kReferenceParam);
+  j.erase(kReferenceParam);
+  if (value.is_string())
+    if (const auto kind = parse_reference_kind(value.get<std::string>())) return *kind;
+  throw InputError("raytraced: reference must be one of " + reference_kind_names() + ", got " + value.dump());
+}
+
 MethodOutput run_raytraced(const MethodInput& in, const nlohmann::json& j) {
   if (!in.scene)
     throw InputError("method raytraced traces rays in the scene, and a G-buffer file has none: give a scene instead of --gbuffer-in");
-  RaytracedParams p = j.get<RaytracedParams>();
+  nlohmann::json rest = j;
+  const ReferenceKind kind = take_reference_kind(rest);
+  RaytracedParams p = rest.get<RaytracedParams>();
   p.validate();
-  RaytracedImage img = render_raytraced(*in.scene, in.gbuffer, in.falloff, p, in.seed, in.progress);
+  ReferenceImage img = render_reference(*in.scene, in.gbuffer, {kind, in.falloff}, p, in.seed, in.progress);
   MethodOutput out;
-  out.visibility = std::move(img.visibility);
-  out.stats = {{"rays", img.rays}, {"mean_std_error", img.mean_std_error}, {"max_std_error", img.max_std_error}};
+  out.visibility = std::move(img.scalar.visibility);
+  if (!img.color.empty()) out.color = std::move(img.color);
+  if (!img.obscurance.empty()) out.extras["obscurance"] = std::move(img.obscurance);
+  out.stats = {{"rays", img.scalar.rays}, {"mean_std_error", img.scalar.mean_std_error}, {"max_std_error", img.scalar.max_std_error}};
   return out;
 }
+
+nlohmann::json raytraced_defaults() {
+  nlohmann::json j = RaytracedParams{};
+  j[kReferenceParam] = to_string(ReferenceKind::Obscurance);
+  return j;
+}
+
+// The occluders' albedo scale a method's parameters carry (transfer's albedo_scale), else 1.
+float albedo_scale_of(const nlohmann::json& params) {
+  return params.is_object() && params.contains("albedo_scale") && params.at("albedo_scale").is_number() ? params.at("albedo_scale").get<float>()
+                                                                                                       : 1.0f;
+}
+
+Falloff requested_falloff(const Falloff& requested, const nlohmann::json&) { return requested; }
 
 // The characteristic functions a screen-space method can run with (registry.h,
 // kCharacteristicParam), in the order of characteristic_names().
@@ -82,22 +114,45 @@ CharacteristicKind take_characteristic(nlohmann::json& j, std::string_view metho
   throw InputError(std::string(method) + ": characteristic must be one of " + names + ", got " + value.dump());
 }
 
-// `j` read into Params, validated and written back; a screen-space method's characteristic choice
-// is checked and kept.
-template <auto Table, bool kScreenSpace>
+// The registry-level key a method's parameter object carries besides its table's.
+enum class Extra { None, Characteristic, Reference };
+
+// `j` read into Params, validated and written back; the registry-level key (characteristic of the
+// screen-space methods, reference of raytraced) is checked and kept.
+template <auto Table, Extra kExtra>
 nlohmann::json canonical(const nlohmann::json& j) {
   using Params = typename std::decay_t<decltype(Table())>::Struct;
   nlohmann::json rest = j;
-  std::optional<nlohmann::json> characteristic;
-  if (kScreenSpace && rest.is_object() && rest.contains(kCharacteristicParam)) {
-    characteristic = rest.at(kCharacteristicParam);
-    take_characteristic(rest, Table().owner());
+  nlohmann::json extra;
+  if (kExtra == Extra::Characteristic) {
+    extra = j.is_object() && j.contains(kCharacteristicParam) ? j.at(kCharacteristicParam) : nlohmann::json(kCharacteristicNames[0]);
+    take_characteristic(rest, Table().owner());  // refuses an unknown name, and removes the key
   }
+  if (kExtra == Extra::Reference) extra = to_string(take_reference_kind(rest));
   Params p = rest.get<Params>();
   p.validate();
   nlohmann::json out = p;
-  if (kScreenSpace) out[kCharacteristicParam] = characteristic ? *characteristic : nlohmann::json(kCharacteristicNames[0]);
+  if (kExtra == Extra::Characteristic) out[kCharacteristicParam] = extra;
+  if (kExtra == Extra::Reference) out[kReferenceParam] = extra;
   return out;
+}
+
+// raytraced's parameters: its table's, then the registry's reference choice.
+std::vector<ParamSpec> raytraced_specs() {
+  std::vector<ParamSpec> s = raytraced_param_table().specs();
+  ParamSpec r;
+  r.name = kReferenceParam;
+  r.type = ParamType::Enum;
+  const std::string names = reference_kind_names();
+  for (std::size_t start = 0; start <= names.size();) {
+    const std::size_t end = std::min(names.find(", ", start), names.size());
+    r.enum_names.push_back(names.substr(start, end - start));
+    start = end + 2;
+  }
+  r.help = "which reference to render: obscurance, the tangent sphere's visible fraction, or ambient transfer W";
+  r.default_value = to_string(ReferenceKind::Obscurance);
+  s.push_back(r);
+  return s;
 }
 
 // Builds the characteristic function of `kind` in the G-buffer's camera space and calls
@@ -209,36 +264,76 @@ MethodOutput run_alchemy(const MethodInput& in, const nlohmann::json& j) {
   return out;
 }
 
+MethodOutput run_gtao(const MethodInput& in, const nlohmann::json& j) {
+  const GtaoParams p = j.get<GtaoParams>();
+  GtaoImage img = gtao_ao(in.gbuffer, in.falloff.radius, p, in.seed);
+  MethodOutput out;
+  out.visibility = std::move(img.visibility);
+  out.color = std::move(img.color);
+  return out;
+}
+
 const std::array kMethods{
-    MethodInfo{"raytraced", "ground truth: Monte Carlo obscurance with Embree rays, any membership", true,
-               [] { return nlohmann::json(RaytracedParams{}); }, run_raytraced,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }, table_specs<raytraced_param_table>, canonical<raytraced_param_table, false>},
+    MethodInfo{"raytraced",
+               "ground truth with Embree rays: obscurance of any membership (-p reference=obscurance), the tangent sphere's visible "
+               "fraction (tangent-sphere) or ambient transfer W (transfer)",
+               true, raytraced_defaults, run_raytraced,
+               [](const Falloff& requested, const nlohmann::json& params) {
+                 nlohmann::json rest = params;
+                 return ReferenceSpec{take_reference_kind(rest), requested};
+               },
+               requested_falloff, raytraced_specs, canonical<raytraced_param_table, Extra::Reference>},
+    // Containment estimates the obscurance of the requested membership directly (eq. 5).
     MethodInfo{"containment", "containment tests against the depth buffer, r = mu^-1(xi) (volumetric AO eq. 5), any membership", false,
                screen_space_defaults<ContainmentParams>, run_containment,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }, screen_space_specs<containment_param_table>, canonical<containment_param_table, true>},
-    // Volumetric AO implies mu = (r/R)^3 with the same R (tangent sphere of radius R/2: distances up to R).
+               [](const Falloff& requested, const nlohmann::json&) { return obscurance_reference(requested); }, requested_falloff,
+               screen_space_specs<containment_param_table>, canonical<containment_param_table, Extra::Characteristic>},
+    // Volumetric AO's V is the free fraction of the tangent sphere of radius R/2 (eq. 6-7), whose
+    // ray-traced form is tangent_sphere.h. As an obscurance it implies mu = (r/R)^3 with the same R.
     MethodInfo{"volumetric", "free volume of the tangent sphere by pipes along z (volumetric AO eq. 6-7); implies cubic membership", false,
                screen_space_defaults<VolumetricParams>, run_volumetric,
+               [](const Falloff& requested, const nlohmann::json&) {
+                 return ReferenceSpec{ReferenceKind::TangentSphere, {Membership::Cubic, requested.radius}};
+               },
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Cubic, requested.radius}; },
-               screen_space_specs<volumetric_param_table>, canonical<volumetric_param_table, true>},
-    // W approaches the obscurance of the same membership as the albedo goes to 0.
+               screen_space_specs<volumetric_param_table>, canonical<volumetric_param_table, Extra::Characteristic>},
+    // W of eq. 9 estimates eq. 6 (transfer_reference.h) with the same membership and albedo scale;
+    // it approaches the obscurance of that membership as the albedo goes to 0. (Radiance mode's
+    // direct term is not in the reference: it would need the sun, which MethodInput does not carry.)
     MethodInfo{"transfer",
                "ambient transfer W: obscurance plus nearby bounces, RGB (ambient transfer eq. 9); extra: obscurance; "
                "-p reflectance=radiance adds the light of sunlit occluders (needs --sun)",
                false, screen_space_defaults<TransferParams>, run_transfer,
-               [](const Falloff& requested, const nlohmann::json&) { return requested; }, screen_space_specs<transfer_param_table>, canonical<transfer_param_table, true>},
+               [](const Falloff& requested, const nlohmann::json& params) {
+                 return ReferenceSpec{ReferenceKind::Transfer, requested, albedo_scale_of(params)};
+               },
+               requested_falloff, screen_space_specs<transfer_param_table>, canonical<transfer_param_table, Extra::Characteristic>},
     // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.
     MethodInfo{"cone", "voxel cone tracing: parity voxelization in bit columns, cones of spheres, prisms by popcount (Dalla Favera & Celes)", true,
                [] { return nlohmann::json(ConeParams{}); }, run_cone,
+               [](const Falloff& requested, const nlohmann::json&) { return obscurance_reference({Membership::Step, requested.radius}); },
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; },
-               table_specs<cone_param_table>, canonical<cone_param_table, false>},
-    // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r.
+               table_specs<cone_param_table>, canonical<cone_param_table, Extra::None>},
+    // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r;
+    // at its defaults u = 2r >= r, where that falloff is exactly step AO (obscurance_reference says so).
     MethodInfo{"alchemy", "Alchemy AO: screen-space disk samples, eq. 10 (sigma, k, beta, epsilon, r, s) + 13-tap cross-bilateral filter", false,
                [] { return nlohmann::json(AlchemyParams{}); }, run_alchemy,
                [](const Falloff& requested, const nlohmann::json& params) {
+                 return obscurance_reference(alchemy_reference_falloff(params.get<AlchemyParams>(), requested.radius));
+               },
+               [](const Falloff& requested, const nlohmann::json& params) {
                  return alchemy_reference_falloff(params.get<AlchemyParams>(), requested.radius);
                },
-               table_specs<alchemy_param_table>, canonical<alchemy_param_table, false>},
+               table_specs<alchemy_param_table>, canonical<alchemy_param_table, Extra::None>},
+    // GTAO with a radius cut estimates the cosine-weighted visibility within R: step obscurance with
+    // the user's R (the membership asked for does not change what it computes).
+    MethodInfo{"gtao",
+               "GTAO (Jimenez et al. 2016): horizons in screen-space slices, analytic cosine-weighted inner integral, 4x4 denoise; "
+               "-p multi_bounce=true adds its multi-bounce fit",
+               false, [] { return nlohmann::json(GtaoParams{}); }, run_gtao,
+               [](const Falloff& requested, const nlohmann::json&) { return obscurance_reference({Membership::Step, requested.radius}); },
+               [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; },
+               table_specs<gtao_param_table>, canonical<gtao_param_table, Extra::None>},
 };
 
 }  // namespace
@@ -246,6 +341,20 @@ const std::array kMethods{
 std::span<const MethodInfo> all_methods() { return kMethods; }
 
 std::span<const std::string_view> characteristic_names() { return kCharacteristicNames; }
+
+ReferenceSpec choose_reference(const MethodInfo& m, std::string_view name, const Falloff& requested, const nlohmann::json& params) {
+  if (name == kMatchedReference) return m.reference(requested, params);
+  const Falloff f = m.obscurance_falloff(requested, params);
+  const std::optional<ReferenceKind> kind = parse_reference_kind(name);
+  if (!kind)
+    throw InputError("unknown reference '" + std::string(name) + "' for " + std::string(m.name) + " (known: " + kMatchedReference + ", " +
+                     reference_kind_names() + ")");
+  switch (*kind) {
+    case ReferenceKind::TangentSphere: return {ReferenceKind::TangentSphere, {Membership::Cubic, f.radius}};
+    case ReferenceKind::Transfer: return {ReferenceKind::Transfer, f, albedo_scale_of(params)};
+    default: return obscurance_reference(f);
+  }
+}
 
 const MethodInfo& find_method(std::string_view name) {
   std::string names;

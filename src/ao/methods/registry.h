@@ -15,6 +15,7 @@
 #include "ao/core/membership.h"
 #include "ao/core/params.h"
 #include "ao/core/progress.h"
+#include "ao/reference/reference.h"
 #include "ao/scene/analytic.h"
 
 namespace ao {
@@ -69,10 +70,14 @@ struct MethodInfo {
   nlohmann::json (*default_params)();
   /// Validates `params` (unknown keys and bad values throw InputError) and runs the method.
   MethodOutput (*run)(const MethodInput& input, const nlohmann::json& params);
-  /// The ground-truth integral this method approximates, as the falloff `ao compare` gives the
-  /// ray-traced reference, from the falloff the user asked for and the method's parameters (e.g.
-  /// volumetric AO implies the cubic membership; cone tracing is classical AO with R = R_max).
-  Falloff (*reference_falloff)(const Falloff& requested, const nlohmann::json& params);
+  /// The reference that computes exactly the quantity this method estimates (same integral, normal
+  /// and R; derived in docs/methods/<name>.md), from the falloff the user asked for and the method's
+  /// parameters: what `ao compare` judges it against by default (e.g. volumetric AO: the tangent
+  /// sphere's visible fraction; ambient transfer: W with the occluders' albedo).
+  ReferenceSpec (*reference)(const Falloff& requested, const nlohmann::json& params);
+  /// The obscurance (VAO eq. 2) membership and R the method approximates or implies (volumetric AO:
+  /// cubic; cone tracing: step with R = R_max): `ao compare --reference obscurance`.
+  Falloff (*obscurance_falloff)(const Falloff& requested, const nlohmann::json& params);
   /// The parameters as described by the method's parameter table (core/params.h), in table order,
   /// plus the registry's own (kCharacteristicParam); null for a method without a table.
   std::vector<ParamSpec> (*param_specs)() = nullptr;
@@ -81,6 +86,21 @@ struct MethodInfo {
   /// a method without a table.
   nlohmann::json (*canonical_params)(const nlohmann::json& params) = nullptr;
 };
+
+/// The registry-level parameter of `raytraced` that chooses which reference it renders: one of
+/// reference_kind_names() (reference.h), default "obscurance". Like kCharacteristicParam it is not
+/// a field of RaytracedParams: the registry dispatches on it (render_reference).
+inline constexpr const char* kReferenceParam = "reference";
+
+/// The names `ao compare --reference` accepts, besides the kinds of reference.h: "matched" (the
+/// method's own, MethodInfo::reference; the default) and "obscurance" (MethodInfo::obscurance_falloff).
+inline constexpr const char* kMatchedReference = "matched";
+
+/// The reference called `name` for method `m` with parameters `params` (a complete parameter
+/// object, as default_params() gives): "matched", "obscurance", "tangent-sphere" (R of the method's
+/// obscurance falloff) or "transfer" (its membership and R; the method's albedo_scale when it has
+/// one). InputError naming the valid names otherwise.
+ReferenceSpec choose_reference(const MethodInfo& m, std::string_view name, const Falloff& requested, const nlohmann::json& params);
 
 /// All methods, in the order --help lists them.
 std::span<const MethodInfo> all_methods();

@@ -85,9 +85,10 @@ inline void blocked_rgb(bool by_palette, __m512i id, __mmask16 blocked, const fl
 // Sec. 4: I = prod_j I0(x + w r j/m), and a~ comes from the FIRST test point found occluded. The
 // tests run from the far end inwards and each occluded one overwrites `at`, so the nearest wins
 // without a loop-carried "already hit" test. at = -1: the ray is free; otherwise the pixel whose
-// albedo is a~ (the pixel's own when the occluded point projects off screen: locally homogeneous
-// material). The albedo is then read once per blocked ray only (AVX-512: masked gathers, through
-// the exact 32-entry palette when the image has one, else in place from the caller's image).
+// albedo is a~ (the pixel's own when the occluded point is behind the camera, which only an
+// analytic characteristic reports: locally homogeneous material). The albedo is then read once per
+// blocked ray only (AVX-512: masked gathers, through the exact 32-entry palette when the image has
+// one, else in place from the caller's image).
 // Each step is its own short loop over the lanes (projection; depth gather; test; accumulation):
 // fused, GCC 12 sinks the gathers into branches and the loop no longer if-converts.
 // kDirect (radiance mode): the blocked ray also reads the direct radiance Ld~ at the same pixel
@@ -123,10 +124,10 @@ void transfer_row(const Characteristic ch, const ScreenProjection projection, co
       for (int k = 0; k < count; ++k) {
         const float qx = px[k] + f * wx[k], qy = py[k] + f * wy[k], qz = pz[k] + f * wz[k];
         int p;
-        const bool on_screen = projection.locate(qx, qy, qz, p);
-        pixel[k] = on_screen ? p : -1;
+        const bool in_front = projection.locate(qx, qy, qz, p);  // clamp-to-edge: false only behind the camera
+        pixel[k] = in_front ? p : -1;
         if constexpr (kDepthBuffer)
-          dist[k] = qz + (on_screen ? 0.0f : kInfinity);  // + z* below: ch.distance, sharing the projection
+          dist[k] = qz + (in_front ? 0.0f : kInfinity);  // + z* below: ch.distance, sharing the projection
         else
           dist[k] = ch.distance(qx, qy, qz);
       }
@@ -214,7 +215,8 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
                                float* __restrict out_b, float* __restrict out_o, Vec3* __restrict out_rgb) {
   const __m512 scale_x = _mm512_set1_ps(projection.scale_x), scale_y = _mm512_set1_ps(projection.scale_y);
   const __m512 centre_x = _mm512_set1_ps(projection.centre_x), centre_y = _mm512_set1_ps(projection.centre_y);
-  const __m512i row_stride = _mm512_set1_epi32(projection.width), rows = _mm512_set1_epi32(projection.height);
+  const __m512i row_stride = _mm512_set1_epi32(projection.width);
+  const __m512 max_x = _mm512_set1_ps(static_cast<float>(projection.width - 1)), max_y = _mm512_set1_ps(static_cast<float>(projection.height - 1));
   const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), minus_one = _mm512_set1_ps(-1.0f);
   const __m512 far = _mm512_set1_ps(far_limit);
   const __m512i palette_mask = _mm512_set1_epi32(kPaletteMask);
@@ -255,13 +257,12 @@ void transfer_row_depth_avx512(const ScreenProjection& projection, const float* 
         const __m512 inv = _mm512_div_ps(minus_one, qz);
         const __m512 fx = _mm512_fmadd_ps(_mm512_mul_ps(qx, inv), scale_x, centre_x);
         const __m512 fy = _mm512_fnmadd_ps(_mm512_mul_ps(qy, inv), scale_y, centre_y);
-        // In the image iff 0 <= floor(f) < size: floor maps [-1, 0) to -1, and NaN or out-of-range
-        // values to INT_MIN, which the unsigned compares reject (the same lanes as locate's tests).
-        const __m512i ix = _mm512_cvt_roundps_epi32(fx, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-        const __m512i iy = _mm512_cvt_roundps_epi32(fy, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-        __mmask16 valid = _mm512_mask_cmp_ps_mask(live, qz, zero, _CMP_LT_OQ);
-        valid = _mm512_mask_cmplt_epu32_mask(valid, ix, row_stride);
-        valid = _mm512_mask_cmplt_epu32_mask(valid, iy, rows);
+        // Clamp-to-edge as ScreenProjection::locate: f clamped to [0, size - 1] as floats before the
+        // conversion (max_ps returns its second operand, 0, for a NaN first one); only points behind
+        // the camera are free.
+        const __m512i ix = _mm512_cvttps_epi32(_mm512_min_ps(_mm512_max_ps(fx, zero), max_x));
+        const __m512i iy = _mm512_cvttps_epi32(_mm512_min_ps(_mm512_max_ps(fy, zero), max_y));
+        const __mmask16 valid = _mm512_mask_cmp_ps_mask(live, qz, zero, _CMP_LT_OQ);
         const __m512i pixel = _mm512_add_epi32(_mm512_mullo_epi32(iy, row_stride), ix);
         __m512 d;  // z* - depth(p)
         __m512i id = pixel;

@@ -24,8 +24,8 @@
 // L = a W La + Ld.
 //
 // Output: `color` = W per channel, `visibility` = Rec. 709 luminance of W, extra "obscurance" = O.
-// The reference is the ray-traced obscurance of the user's membership (which W approaches as the
-// albedo goes to 0); a ray-traced ambient transfer reference is not implemented.
+// The reference is the ray-traced W of eq. 6 (reference/transfer_reference.h), the integral eq. 9
+// estimates; the obscurance of the membership, which W approaches as the albedo goes to 0, by name.
 #pragma once
 
 #include <array>

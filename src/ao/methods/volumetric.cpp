@@ -88,7 +88,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
         //   f_x = f_x0 + x_i a_x - y_i b_x,  f_y = f_y0 - x_i a_y - y_i b_y.
         const ScreenProjection pr = local_ch.projection;
         const float* __restrict depth = local_ch.depth;
-        const float width = static_cast<float>(pr.width), height = static_cast<float>(pr.height);
+        const float max_x = static_cast<float>(pr.width - 1), max_y = static_cast<float>(pr.height - 1);
         for (int k = 0; k < count; ++k) {
           const float inv = -1.0f / pcz[k], kx = inv * pr.scale_x, ky = inv * pr.scale_y;
           fx0[k] = pcx[k] * kx + pr.centre_x, fy0[k] = pr.centre_y - pcy[k] * ky;
@@ -102,10 +102,12 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
           for (int k = 0; k < count; ++k) {
             const float fx = fx0[k] + xi * cax[k] - yi * cbx[k], fy = fy0[k] - xi * cay[k] - yi * cby[k];
             const float z = pcz[k];
-            const bool valid = (z < 0.0f) & (fx >= 0.0f) & (fy >= 0.0f) & (fx < width) & (fy < height);
-            const int ix = static_cast<int>(valid ? fx : 0.0f), iy = static_cast<int>(valid ? fy : 0.0f);
+            // As ScreenProjection::locate: clamp-to-edge, free only behind the camera.
+            const bool valid = z < 0.0f;
+            const int ix = static_cast<int>(std::min(std::max(valid ? fx : 0.0f, 0.0f), max_x));
+            const int iy = static_cast<int>(std::min(std::max(valid ? fy : 0.0f, 0.0f), max_y));
             const float zs = depth[iy * pr.width + ix];
-            // As DepthBufferCharacteristic::distance (+inf off screen), then z* - z_entry = (z* - z_c) + (R/2) h_i.
+            // As DepthBufferCharacteristic::distance, then z* - z_entry = (z* - z_c) + (R/2) h_i.
             const float to_surface = (valid ? zs + z : kInfinity) + half_chord + bias[k];
             const float dz = std::min(std::max(to_surface, 0.0f), chord);  // fig. 7 a-c
             const bool distant = (to_surface < lim) & (to_surface > -1e30f);

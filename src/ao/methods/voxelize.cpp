@@ -42,6 +42,18 @@ struct Tri3 {
   Vec3 normal;  // geometric normal of the front face (counter-clockwise, mesh.h); set when kind 1
 };
 
+// The centroid of each hole's boundary vertices (each boundary edge contributes its two ends).
+std::vector<Vec3> hole_centroids(const Mesh& m, const MeshClosure& c) {
+  std::vector<Vec3> sum(c.holes, Vec3{0, 0, 0});
+  std::vector<float> n(c.holes, 0.0f);
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    sum[c.hole[e]] = sum[c.hole[e]] + m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
+    n[c.hole[e]] += 2.0f;
+  }
+  for (std::uint32_t h = 0; h < c.holes; ++h) sum[h] = sum[h] * (1.0f / n[h]);
+  return sum;
+}
+
 Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
   const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], c = m.positions[m.indices[3 * t + 2]];
   return {{a, b, c}, open ? 1 : 0, open ? normalize(cross(b - a, c - a)) : Vec3{}};
@@ -381,8 +393,17 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   struct Buckets {
     std::vector<std::uint32_t> start, index;  // bucket (kind * bands + band): index[start[k], start[k + 1])
   };
+  // A holed mesh voxelized by winding number (voxelize.h) gets one fan triangle per boundary
+  // edge after its own triangles: (b, a, centroid) for the boundary edge a -> b, so that every
+  // edge of the mesh and its fans is used twice and the parity pass sees a closed surface.
+  std::vector<std::vector<Vec3>> centre(scene.meshes.size());
   std::vector<std::size_t> first{0};
-  for (const Mesh& m : scene.meshes) first.push_back(first.back() + m.triangle_count());
+  std::size_t capped = 0;
+  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const bool cap = o.open_meshes == OpenMeshes::Winding && closure[mi].holed();
+    if (cap) centre[mi] = hole_centroids(scene.meshes[mi], closure[mi]), ++capped;
+    first.push_back(first.back() + scene.meshes[mi].triangle_count() + (cap ? closure[mi].boundary.size() : 0));
+  }
   const std::size_t total = first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
   std::vector<std::vector<GridTri>> tris(chunks);
@@ -394,8 +415,16 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     out.reserve(t1 - t0);
     for (std::size_t t = t0; t < t1; ++t) {
       while (t >= first[mi + 1]) ++mi;
-      const bool open = o.open_meshes == OpenMeshes::Slab && closure[mi].open_surface();
-      emit(out, source_triangle(scene.meshes[mi], t - first[mi], open));
+      const bool open = o.open_meshes != OpenMeshes::Parity && closure[mi].open_surface();
+      const Mesh& m = scene.meshes[mi];
+      const std::size_t local = t - first[mi];
+      if (local < m.triangle_count()) {
+        emit(out, source_triangle(m, local, open));
+      } else {
+        const std::size_t e = local - m.triangle_count();
+        const auto [a, b] = closure[mi].boundary[e];
+        emit(out, Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}});
+      }
     }
     Buckets& bk = buckets[c];
     bk.start.assign(3 * static_cast<std::size_t>(bands) + 1, 0);
@@ -430,7 +459,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   const std::size_t odd = scan_columns(g);
   bool any_open = false;
   for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
-  if (any_open && o.open_meshes == OpenMeshes::Slab) {
+  if (any_open && o.open_meshes != OpenMeshes::Parity) {
     raster_pass(g, 1);
     bool any_prism = false;
     for (const auto& chunk : tris)
@@ -451,9 +480,12 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     stats->odd_columns = odd;
     for (const MeshClosure& c : closure) {
       stats->open_meshes += c.open_surface() ? 1 : 0;
+      stats->holed_meshes += c.holed() ? 1 : 0;
+      stats->holes += c.holed() ? c.holes : 0;
       stats->boundary_edges += c.boundary_edges;
     }
     stats->set_voxels = set_voxels;
+    stats->capped_meshes = capped;
   }
 }
 
@@ -494,24 +526,55 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
       if (v > 0 && keyed[v].first != keyed[v - 1].first) ++next;
       id[keyed[v].second] = next;
     }
-    std::vector<std::uint64_t> edges;
+    // (undirected key, directed edge index 3 t + e) so that a boundary edge keeps its direction.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;
     edges.reserve(m.indices.size());
     for (std::size_t t = 0; t < m.triangle_count(); ++t)
       for (int e = 0; e < 3; ++e) {
         std::uint64_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
         if (a > b) std::swap(a, b);
-        edges.push_back(a << 32 | b);
+        edges.push_back({a << 32 | b, static_cast<std::uint32_t>(3 * t + e)});
       }
     std::sort(edges.begin(), edges.end());
     MeshClosure c;
     for (std::size_t i = 0; i < edges.size();) {
       std::size_t j = i;
-      while (j < edges.size() && edges[j] == edges[i]) ++j;
-      c.boundary_edges += (j - i) % 2;
+      while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+      if ((j - i) % 2) {
+        const std::uint32_t de = edges[i].second, t = de / 3, e = de % 3;
+        c.boundary.push_back({m.indices[3 * t + e], m.indices[3 * t + (e + 1) % 3]});
+      }
       ++c.edges;
       i = j;
     }
-    out.push_back(c);
+    c.boundary_edges = c.boundary.size();
+    if (!c.boundary.empty()) {
+      // Holes: connected components of the boundary edges over welded vertices (union-find).
+      std::vector<std::uint32_t> parent(next + 1);
+      for (std::uint32_t v = 0; v <= next; ++v) parent[v] = v;
+      const auto find = [&](std::uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+      };
+      for (const auto& [a, b] : c.boundary) parent[find(id[a])] = find(id[b]);
+      std::vector<std::uint32_t> number(next + 1, ~0u);
+      for (const auto& [a, b] : c.boundary) {
+        std::uint32_t& n = number[find(id[a])];
+        if (n == ~0u) n = c.holes++;
+        c.hole.push_back(n);
+      }
+      // The vector area of a closed surface is zero, so an open mesh's is minus that of any
+      // surface closing its holes: its length is the holes' area seen from their best direction.
+      double vx = 0, vy = 0, vz = 0, area = 0;
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
+        const Vec3 n = cross(b - a, d - a);
+        vx += 0.5 * n.x, vy += 0.5 * n.y, vz += 0.5 * n.z;
+        area += 0.5 * length(n);
+      }
+      c.cap_area_fraction = area > 0 ? static_cast<float>(std::sqrt(vx * vx + vy * vy + vz * vz) / area) : 1.0f;
+    }
+    out.push_back(std::move(c));
   }
   return out;
 }
@@ -532,7 +595,7 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
   // (a ground plane's slab hangs below it, a wall's prism stands behind it).
-  const float side = (any_open && o.open_meshes == OpenMeshes::Slab ? slab : 0.0f) + v0;
+  const float side = (any_open && o.open_meshes != OpenMeshes::Parity ? slab : 0.0f) + v0;
   const Vec3 lo = b.lo - Vec3{side, side, side};
   const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
   g.origin = lo;

@@ -26,6 +26,7 @@
 // Columns whose parity still ends odd are counted and reported.
 #pragma once
 
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -46,21 +47,34 @@ enum class GridSpace {
 
 /// What to do with meshes that are not closed (have boundary edges).
 enum class OpenMeshes {
-  Slab,    ///< Fill `slab_thickness` behind every front face, as a union (default).
-  Parity,  ///< Voxelize as they are: columns crossing them end odd (reported), as in the paper.
+  Winding,  ///< Default. Open surfaces (MeshClosure::open_surface) become slabs; a closed mesh with
+            ///< holes is voxelized as the solid where its generalized winding number exceeds 1/2,
+            ///< by closing each hole with a fan (see voxelize_world).
+  Slab,     ///< Open surfaces become slabs; closed meshes with holes are voxelized as they are (parity).
+  Parity,   ///< Voxelize everything as it is: columns crossing an open mesh end odd (reported), as in the paper.
 };
 
 /// Topology of one mesh, computed once per scene (positions may move, connectivity does not).
 struct MeshClosure {
   std::size_t boundary_edges = 0;  ///< Edges used by an odd number of triangles (positions compared exactly).
   std::size_t edges = 0;           ///< Distinct edges.
+  /// One directed edge (vertex indices, as a triangle lists it) per boundary edge, and the hole
+  /// (connected component of boundary edges) it belongs to, numbered from 0.
+  std::vector<std::array<std::uint32_t, 2>> boundary;
+  std::vector<std::uint32_t> hole;
+  std::uint32_t holes = 0;
+  /// |vector area of the mesh| / its area, at analysis. A closed surface's vector area is zero, so
+  /// an open mesh's is the (net, projected) area of its holes: about 1 for a sheet (a ground
+  /// plane, a wall, a terrain), small for a solid with holes.
+  float cap_area_fraction = 0;
   bool closed() const { return boundary_edges == 0; }
-  /// An open surface (a ground plane, a wall, a terrain) rather than a closed mesh with a few holes:
-  /// more than 1% of its edges are boundary. Only these become slabs. A scanned statue with a
-  /// handful of holes stays with parity, which is wrong only in the columns through the holes,
-  /// where slabs R_max thick behind every face would fill its thin parts and the space in front
-  /// of them.
-  bool open_surface() const { return boundary_edges * 100 > edges; }
+  /// An open surface (a ground plane, a wall, a terrain) rather than a closed mesh with holes: its
+  /// holes' area is more than 40% of its own (a hemisphere bowl: 50%, a torus with its bottom 15%
+  /// cut off: 27%, a sphere with its top tenth cut off: 9%). Only these become slabs; slabs R_max
+  /// thick behind every face of a statue would fill its thin parts and the space in front of them.
+  bool open_surface() const { return boundary_edges > 0 && cap_area_fraction > 0.4f; }
+  /// A closed mesh with holes: neither closed nor an open surface.
+  bool holed() const { return boundary_edges > 0 && !open_surface(); }
 };
 
 /// Boundary edges of every mesh of `scene`, in mesh order. Vertices are matched by exact position,
@@ -72,7 +86,7 @@ struct VoxelizeOptions {
   int columns = 512;              ///< World: columns along x and along z (columns x columns).
                                   ///< Eye: columns along the longer image side. [8, 4096].
   int depth_bits = 128;           ///< Voxels per column; a multiple of 32 in [32, 1024]. Paper: 128.
-  OpenMeshes open_meshes = OpenMeshes::Slab;
+  OpenMeshes open_meshes = OpenMeshes::Winding;
   float slab_thickness = 0.0f;    ///< World units behind open faces; 0 = two voxels. >= 0. The cone
                                   ///< method uses R_max: under an open ground a cone then meets
                                   ///< solid as deep as it can look, as under a closed floor.
@@ -87,6 +101,9 @@ struct VoxelStats {
   std::size_t fragments = 0;       ///< Column-centre hits.
   std::size_t odd_columns = 0;     ///< Columns whose parity ends at 1: open or leaky geometry.
   std::size_t open_meshes = 0;     ///< Meshes treated as open surfaces (slabs).
+  std::size_t holed_meshes = 0;    ///< Closed meshes with holes (MeshClosure::holed).
+  std::size_t holes = 0;           ///< Their holes.
+  std::size_t capped_meshes = 0;   ///< Holed meshes voxelized by winding number (OpenMeshes::Winding).
   std::size_t boundary_edges = 0;  ///< Over all meshes.
   std::size_t set_voxels = 0;      ///< Solid voxels in the finished grid.
 };
@@ -170,7 +187,17 @@ inline bool any_bits(const std::uint64_t* column, int words, int k0, int k1) {
 }
 
 /// World-space grid of options.columns x options.columns columns over `scene`'s bounds, columns
-/// along world y. The bounds are padded by a voxel, and below and at the sides by the slab
+/// along world y.
+///
+/// Closed meshes with holes (OpenMeshes::Winding): the solid is where the mesh's generalized
+/// winding number w (Jacobson, Kavan, Sorkine-Hornung, "Robust inside-outside segmentation using
+/// generalized winding numbers", SIGGRAPH 2013) exceeds 1/2. Each hole is closed by a fan C of
+/// triangles from its boundary edges to its centroid; the mesh plus C is closed, so its winding
+/// number is its parity indicator chi (what the parity pass computes exactly), and since w is a
+/// sum over triangles, w_mesh = chi - w_C. Off a planar fan |w_C| < 1/2 (the fan lies in a plane
+/// and subtends less than a hemisphere), so w_mesh > 1/2 exactly where chi = 1: parity of the mesh
+/// with its fans is the winding-number solid. For a non-planar hole the two differ between the fan
+/// and the w = 1/2 surface that spans the hole. The bounds are padded by a voxel, and below and at the sides by the slab
 /// thickness when there are open meshes. `closure` comes from analyze_closure(scene).
 VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& options, VoxelStats* stats = nullptr);
 

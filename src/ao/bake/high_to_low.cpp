@@ -1,0 +1,257 @@
+// High-to-low AO baking (see high_to_low.h). Per texel T of the low mesh's map:
+//   V(T) = (1/A(T)) * integral over the low patch S of V_high(h(p)) dp,
+// where h(p) is where the cage ray through p first meets a front face of the high mesh and V_high
+// is eq. 2 of the per-texel AO paper (with mu(D) when a distance R is set) at h with the high
+// mesh's interpolated normal. Sample i of a texel takes a point p uniform by area on S and a
+// cosine-weighted direction about the high normal at h (pdf cos/pi cancels the cosine and 1/pi),
+// so V(T) is the plain mean of mu over the samples whose cage ray hit.
+//
+// The cage ray: c(p) is the cage point with p's barycentrics (the extruded or explicit cage). The
+// ray runs along d = (p - c)/|p - c| (inwards) from p - f d to p + b d, f the front distance
+// (--max-front, default |p - c|: the ray starts on the cage) and b the back distance (--max-back,
+// default |p - c|). Where the cage meets the surface (|p - c| ~ 0) d is minus the interpolated
+// smoothed normal. Back faces of the high mesh (seen from inside it) are passed through, as
+// xNormal and Substance do by default, so a ray starting just inside a bump still finds the surface
+// beneath it.
+#include "ao/bake/high_to_low.h"
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <map>
+
+#include "ao/bake/padding.h"
+#include "ao/bake/texel_rays.h"
+#include "ao/core/error.h"
+#include "ao/core/parallel.h"
+#include "ao/core/sampling.h"
+#include "ao/reference/packets.h"
+
+namespace ao {
+
+namespace {
+
+constexpr int kTile = 16;
+constexpr int kMissFillRings = 64;
+constexpr int kMaxCageSkips = 64;  // back faces a cage ray may pass through before it counts as a miss
+
+using detail::PatchPiece;
+using detail::SurfacePoint;
+using detail::TriangleNormals;
+
+struct HighHit {
+  bool hit = false;
+  Vec3 p, n, ng;  // position, interpolated normal, face normal of the high mesh
+};
+
+// First front face of `targets` along o + t d, t in [0, tfar].
+HighHit trace_cage_ray(const RayScene& targets, const TriangleNormals& fn, RTCIntersectContext& ctx, Vec3 o, Vec3 d, float tfar) {
+  float tnear = 0.0f;
+  for (int k = 0; k < kMaxCageSkips; ++k) {
+    RTCRayHit rh{};
+    rh.ray = {o.x, o.y, o.z, tnear, d.x, d.y, d.z, 0.0f, tfar, 0xffffffffu, 0, 0};
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(targets.handle(), &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
+    const Vec3 ng = fn.per_mesh[rh.hit.geomID][rh.hit.primID];
+    if (dot(ng, d) < 0) {
+      // Embree's barycentrics: u weights vertex 1, v vertex 2.
+      const Mesh& m = targets.scene().meshes[rh.hit.geomID];
+      const std::uint32_t* i = &m.indices[3 * rh.hit.primID];
+      const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
+      const Vec3 p = m.positions[i[0]] * w + m.positions[i[1]] * u + m.positions[i[2]] * v;
+      Vec3 n = normalize(m.normals[i[0]] * w + m.normals[i[1]] * u + m.normals[i[2]] * v);
+      if (!(length(n) > 0.5f)) n = ng;
+      return {true, p, n, ng};
+    }
+    tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: the ray is inside the high mesh here
+  }
+  return {};
+}
+
+// Smoothed normal per vertex: the sum of the normals of every vertex at the same position, normalised.
+std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
+  std::map<std::array<float, 3>, Vec3> sum;
+  for (const Mesh& m : low.meshes)
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      Vec3& s = sum[{m.positions[v].x, m.positions[v].y, m.positions[v].z}];
+      s = s + m.normals[v];
+    }
+  std::vector<std::vector<Vec3>> out;
+  for (const Mesh& m : low.meshes) {
+    auto& o = out.emplace_back(m.positions.size());
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      const Vec3 s = sum[{m.positions[v].x, m.positions[v].y, m.positions[v].z}];
+      o[v] = length(s) > 0 ? normalize(s) : m.normals[v];
+    }
+  }
+  return out;
+}
+
+bool finite_nonnegative(const std::optional<float>& v) { return !v || (*v >= 0 && std::isfinite(*v)); }
+
+}  // namespace
+
+void HighToLowParams::validate() const {
+  ao.validate();
+  if (!finite_nonnegative(cage_extrusion)) throw InputError("high-to-low: cage extrusion must be a finite number >= 0 (world units)");
+  if (!finite_nonnegative(max_front)) throw InputError("high-to-low: max front distance must be a finite number >= 0 (world units)");
+  if (!finite_nonnegative(max_back)) throw InputError("high-to-low: max back distance must be a finite number >= 0 (world units)");
+}
+
+void to_json(nlohmann::json& j, const HighToLowParams& p) {
+  auto opt = [](const std::optional<float>& v, const char* otherwise) { return v ? nlohmann::json(*v) : nlohmann::json(otherwise); };
+  j = {{"ao", p.ao},
+       {"cage_extrusion", opt(p.cage_extrusion, "0.01 x low diagonal")},
+       {"max_front", opt(p.max_front, "cage")},
+       {"max_back", opt(p.max_back, "cage distance")}};
+}
+
+CagePositions extrude_cage(const Scene& low, float distance) {
+  const auto normals = smoothed_normals(low);
+  CagePositions cage;
+  for (std::size_t mi = 0; mi < low.meshes.size(); ++mi) {
+    const Mesh& m = low.meshes[mi];
+    auto& c = cage.emplace_back(m.positions.size());
+    for (std::size_t v = 0; v < m.positions.size(); ++v) c[v] = m.positions[v] + normals[mi][v] * distance;
+  }
+  return cage;
+}
+
+CagePositions cage_from_mesh(const Scene& low, const Scene& cage) {
+  if (cage.meshes.size() != low.meshes.size())
+    throw InputError(cage.name + ": the cage has " + std::to_string(cage.meshes.size()) + " meshes, the low mesh " + std::to_string(low.meshes.size()) +
+                     " (a cage must have the low mesh's topology)");
+  CagePositions out;
+  for (std::size_t mi = 0; mi < low.meshes.size(); ++mi) {
+    const Mesh& l = low.meshes[mi];
+    const Mesh& c = cage.meshes[mi];
+    if (c.positions.size() != l.positions.size() || c.indices != l.indices)
+      throw InputError(cage.name + ": mesh " + std::to_string(mi) + " has " + std::to_string(c.positions.size()) + " vertices and " +
+                       std::to_string(c.triangle_count()) + " triangles, the low mesh " + std::to_string(l.positions.size()) + " and " +
+                       std::to_string(l.triangle_count()) + " (or the triangles differ): a cage must have the low mesh's topology");
+    out.push_back(c.positions);
+  }
+  return out;
+}
+
+BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const CagePositions& cage, const RayScene& targets, const RayScene& occluders,
+                            const HighToLowParams& params, const ProgressFn& progress) {
+  params.validate();
+  if (cage.size() != low.meshes.size()) throw InputError("high-to-low: the cage has a different number of meshes than the low scene");
+  const Falloff falloff = params.ao.falloff();
+  const TriangleNormals low_fn = detail::face_normals(low);
+  const TriangleNormals target_fn = detail::face_normals(targets.scene());
+  const TriangleNormals occluder_fn = detail::face_normals(occluders.scene());
+  const auto smooth = smoothed_normals(low);
+  const detail::Tracer tracer{occluders, falloff, occluder_fn, params.ao.ignore_back_faces};
+  const float offset = params.ao.offset > 0 ? params.ao.offset : occluders.self_intersection_offset();
+  const int n = cov.size;
+  BakeResult out;
+  out.visibility = Image<float>(n, n, 0.0f);
+  out.mask = cov.mask;
+  out.missed = Image<std::uint8_t>(n, n, std::uint8_t{0});
+  out.covered_texels = cov.covered_texels;
+  out.warnings = cov.warnings();
+  if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(n, n, Vec3{0, 0, 0});
+  std::atomic<std::uint64_t> total_rays{0};
+  ProgressCounter counter(progress, static_cast<std::size_t>(n) * n);
+  detail::dispatch_packet_width(occluders.native_packet_width(), [&]<int N>() {
+    parallel_for_tiles(n, n, kTile, [&](const Tile& t) {
+      detail::flush_denormals_to_zero();
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::vector<PatchPiece> patch;
+      constexpr int batch = N == 1 ? 16 : N;
+      std::array<Vec3, batch> org, dir;
+      std::array<float, batch> mu;
+      std::uint64_t rays = 0;  // cage rays and AO rays of this tile
+      for (int y = t.y0; y < t.y1; ++y) {
+        for (int x = t.x0; x < t.x1; ++x) {
+          const std::size_t texel = static_cast<std::size_t>(y) * n + x;
+          if (!cov.mask[texel]) continue;
+          detail::build_patch(low, cov, texel, patch);
+          if (patch.empty()) continue;
+          const std::uint32_t key = pixel_seed(params.ao.seed, x, y);
+          const std::uint32_t key_point = hash_combine(key, 0x9017u), key_dir = hash_combine(key, 0xd1eu);
+          double sum = 0;
+          int hits = 0;
+          Vec3 bent{0, 0, 0};
+          for (int first = 0; first < params.ao.samples; first += batch) {
+            const int count = std::min(batch, params.ao.samples - first);
+            int live = 0;
+            for (int k = 0; k < count; ++k) {
+              const auto i = static_cast<std::uint32_t>(first + k);
+              const detail::PatchSample ps = detail::sample_patch(patch, sobol_owen_2d(i, key_point));
+              const PatchPiece& pc = patch[ps.piece];
+              const SurfacePoint sp = detail::point_at_uv(low, cov, pc.mesh, pc.triangle, ps.uv, low_fn);
+              const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
+              const auto& cg = cage[pc.mesh];
+              const Vec3 c = cg[vi[0]] * sp.bary.x + cg[vi[1]] * sp.bary.y + cg[vi[2]] * sp.bary.z;
+              const float cage_distance = length(c - sp.p);
+              Vec3 d;
+              if (cage_distance > 1e-6f * occluders.bounds().diagonal()) {
+                d = (sp.p - c) / cage_distance;
+              } else {
+                const auto& sn = smooth[pc.mesh];
+                d = -normalize(sn[vi[0]] * sp.bary.x + sn[vi[1]] * sp.bary.y + sn[vi[2]] * sp.bary.z);
+              }
+              const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
+              ++rays;
+              const HighHit h = trace_cage_ray(targets, target_fn, ctx, sp.p - d * front, d, front + back);
+              if (!h.hit) continue;
+              ++hits;
+              const Vec3 w = Frame::from_normal(h.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
+              if (dot(w, h.ng) <= 0) continue;  // below the high face: occluded by the surface itself (mu = 0)
+              org[static_cast<std::size_t>(live)] = h.p + h.ng * offset;
+              dir[static_cast<std::size_t>(live)] = w;
+              ++live;
+            }
+            tracer.template trace<N>(ctx, org.data(), dir.data(), live, mu.data());
+            rays += static_cast<std::uint64_t>(live);
+            for (int k = 0; k < live; ++k) {
+              sum += mu[static_cast<std::size_t>(k)];
+              bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
+            }
+          }
+          if (hits == 0) {
+            out.missed[texel] = 1;
+            continue;
+          }
+          out.visibility[texel] = static_cast<float>(sum / hits);
+          if (params.ao.bent_normals) out.bent_normal[texel] = normalize(bent);
+        }
+      }
+      total_rays += rays;
+      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
+    });
+  });
+  out.rays = total_rays.load();
+  for (std::size_t i = 0; i < out.missed.size(); ++i) out.missed_texels += out.missed[i];
+  fill_missed_texels(out);
+  out.stats = {{"rays", out.rays}, {"offset", offset}, {"missed_texels", out.missed_texels}};
+  return out;
+}
+
+void fill_missed_texels(BakeResult& r) {
+  if (r.missed_texels == 0 || r.missed.empty()) return;
+  Image<std::uint8_t> ok(r.mask.width(), r.mask.height(), std::uint8_t{0});
+  double sum = 0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < ok.size(); ++i)
+    if (r.mask[i] && !r.missed[i]) {
+      ok[i] = 1;
+      sum += r.visibility[i];
+      ++count;
+    }
+  const float mean = count ? static_cast<float>(sum / static_cast<double>(count)) : 1.0f;
+  const Image<std::int32_t> nearest = nearest_valid_texel(ok, kMissFillRings);
+  for (std::size_t i = 0; i < ok.size(); ++i) {
+    if (!r.missed[i]) continue;
+    const std::int32_t s = nearest[i];
+    r.visibility[i] = s >= 0 ? r.visibility[static_cast<std::size_t>(s)] : mean;
+    if (!r.bent_normal.empty() && s >= 0) r.bent_normal[i] = r.bent_normal[static_cast<std::size_t>(s)];
+  }
+}
+
+}  // namespace ao

@@ -1,0 +1,64 @@
+// High-to-low baking, as xNormal, Substance and Marmoset do it: the AO of a detailed (high-poly)
+// mesh transferred into the UV layout of a simple (low-poly) mesh. For each sample point p of a
+// texel's patch on the low mesh, a ray leaves the cage (the low mesh pushed outwards along its
+// smoothed normals, or an explicit cage mesh of the same topology) and travels inwards through p;
+// its first hit on a front face of the high mesh is where AO is computed, with the high mesh's
+// normal, against the high mesh and any extra occluders. The low mesh itself never occludes.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/bake/bake_result.h"
+#include "ao/bake/raytraced_bake.h"
+#include "ao/bake/texel_coverage.h"
+#include "ao/core/progress.h"
+#include "ao/reference/ray_scene.h"
+
+namespace ao {
+
+/// Default cage extrusion as a fraction of the low mesh's bounding-box diagonal (Substance's
+/// default frontal and rear distances, 0.01 of the bounding box).
+inline constexpr float kDefaultCageFraction = 0.01f;
+
+struct HighToLowParams {
+  RaytracedBakeParams ao;               ///< The AO at the high-poly hit: samples (rays per texel), distance, membership, offset, back faces, seed.
+  std::optional<float> cage_extrusion;  ///< D, world units, >= 0: cage = low vertex + D x smoothed normal; nullopt = kDefaultCageFraction x low diagonal. Ignored with an explicit cage.
+  std::optional<float> max_front;       ///< How far outside the low surface a ray starts, world units, >= 0; nullopt = at the cage.
+  std::optional<float> max_back;        ///< How far inside the low surface a ray still looks for the high mesh, world units, >= 0; nullopt = the cage distance at that point.
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+void to_json(nlohmann::json& j, const HighToLowParams& p);
+
+/// Per low mesh, the cage position of each vertex.
+using CagePositions = std::vector<std::vector<Vec3>>;
+
+/// The low meshes' vertices pushed out by `distance` along their smoothed normals: the normals of
+/// all vertices at one position (hard edges and UV seams split vertices) averaged, so the cage
+/// does not tear open at hard edges.
+CagePositions extrude_cage(const Scene& low, float distance);
+
+/// The vertex positions of `cage`, which must have the low scene's topology: the same meshes with
+/// the same vertex counts and triangle indices. Throws InputError naming `cage.name` otherwise.
+CagePositions cage_from_mesh(const Scene& low, const Scene& cage);
+
+/// V per covered texel of `coverage` (computed on `low`): the mean over `params.ao.samples`
+/// samples per texel, each a uniform point of the texel's patch, its cage ray to `targets` (the high
+/// meshes) and one cosine-weighted AO ray at the hit, traced in `occluders` (the high meshes and
+/// any extra occluders; may be the same RayScene as `targets`). Samples whose cage ray misses are
+/// left out of the mean; a texel where all miss is marked in BakeResult::missed, counted in
+/// missed_texels, and takes the value of the nearest texel that hit (fill_missed_texels).
+/// Deterministic at any thread count (per-texel scrambled Sobol sets, as bake_raytraced).
+BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& coverage, const CagePositions& cage, const RayScene& targets,
+                            const RayScene& occluders, const HighToLowParams& params, const ProgressFn& progress = {});
+
+/// Gives every missed texel the value of the nearest covered texel that was not missed (within 64
+/// texels; beyond that, the mean V of the map), so misses look like their surroundings instead of
+/// black. Bent normals are filled the same way.
+void fill_missed_texels(BakeResult& result);
+
+}  // namespace ao

@@ -107,7 +107,7 @@ void RaytracedParams::validate() const {
     throw InputError("raytraced: target error must be in [0, 0.5] (0 = off), got " + std::to_string(target_error));
   if (target_error > 0 && (min_samples < 16 || min_samples > samples))
     throw InputError("raytraced: min samples must be in [16, samples], got " + std::to_string(min_samples));
-  if (!(offset >= 0.0f) || !std::isfinite(offset)) throw InputError("raytraced: offset must be a finite number >= 0");
+  if (!(offset >= 0.0f && offset <= kMaxCoordinate)) throw InputError("raytraced: offset must be a number in [0, 1e9] world units (kMaxCoordinate)");
 }
 
 void to_json(nlohmann::json& j, const RaytracedParams& p) {

@@ -40,7 +40,7 @@ void RaytracedBakeParams::validate() const {
   if (samples < 1 || samples > kMaxSamples) throw InputError("bake raytraced: samples must be in [1, 1048576], got " + std::to_string(samples));
   if (max_distance && !(*max_distance > 0 && std::isfinite(*max_distance)))
     throw InputError("bake raytraced: max distance must be a finite number > 0 (omit it for unlimited distance)");
-  if (!(offset >= 0.0f) || !std::isfinite(offset)) throw InputError("bake raytraced: offset must be a finite number >= 0");
+  if (!(offset >= 0.0f && offset <= kMaxCoordinate)) throw InputError("bake raytraced: --offset must be a number in [0, 1e9] world units (kMaxCoordinate)");
   if (max_distance) falloff().validate();
 }
 

@@ -1,6 +1,9 @@
 #include "ao/core/camera.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
 #include <string>
 
 #include "ao/core/error.h"
@@ -8,11 +11,23 @@
 namespace ao {
 
 namespace {
+std::string format_vec(Vec3 v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%g,%g,%g", static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z));
+  return buf;
+}
+
+static_assert(kMaxCameraCoordinate == 1e11f, "Camera::validate's message names the limit");
+
 constexpr int kMaxImageSide = 32768;  // 32k x 32k float images are 4 GiB: beyond that is a typo
 }
 
 void Camera::validate() const {
   if (!is_finite(eye) || !is_finite(target) || !is_finite(up)) throw InputError("camera: eye, target and up must be finite");
+  // The target first: the CLI places an eye for a given target, which then shares its magnitude.
+  for (const auto& [name, p] : {std::pair{"--target", target}, std::pair{"--eye", eye}})
+    if (std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > kMaxCameraCoordinate)
+      throw InputError(std::string("camera: ") + name + " " + format_vec(p) + " is beyond +-1e11 world units, the largest camera position ao traces correctly");
   if (length(target - eye) <= 0) throw InputError("camera: eye and target are the same point");
   if (length(cross(normalize(target - eye), normalize(up))) < 1e-4f) throw InputError("camera: up is parallel to the view direction");
   if (!(vertical_fov_deg > 0.0f && vertical_fov_deg < 180.0f))

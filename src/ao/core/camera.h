@@ -6,9 +6,15 @@
 
 namespace ao {
 
+/// Largest coordinate magnitude (world units) of a camera's eye and target: 100 x the scene limit
+/// (kMaxCoordinate in scene/mesh.h), room to frame the largest scene from afar. `ao render` of a
+/// cube of half-side 1e9 seen from 5e11 away matches the unit cube's image (BENCHMARKS.md,
+/// "Input limits").
+inline constexpr float kMaxCameraCoordinate = 1e11f;
+
 struct Camera {
-  Vec3 eye{0, 0, 5};                ///< Centre of projection, world units.
-  Vec3 target{0, 0, 0};             ///< Point looked at, world units; must differ from eye.
+  Vec3 eye{0, 0, 5};                ///< Centre of projection, world units, each |coordinate| <= kMaxCameraCoordinate.
+  Vec3 target{0, 0, 0};             ///< Point looked at, world units, as eye; must differ from eye.
   Vec3 up{0, 1, 0};                 ///< Approximate up direction; must not be parallel to target - eye.
   float vertical_fov_deg = 45.0f;   ///< Full vertical field of view, degrees, in (0, 180).
   int width = 1280;                 ///< Image width, pixels, >= 1.

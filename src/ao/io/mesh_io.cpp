@@ -1,21 +1,25 @@
-// Mesh loading. Formats assimp reads well go through assimp; OFF has its own parser and PLY a
-// header check in front of assimp, because assimp 5.2's readers for them fail the SPEC's bad-input
-// rules. Measured with libassimp 5.2.5:
+// Mesh loading. OFF and PLY have readers of our own; OBJ, STL and glTF/GLB go through assimp, OBJ
+// and glTF after a check of our own (obj_check.h, gltf_check.h), because assimp 5.2's readers fail
+// the SPEC's bad-input rules. Measured with libassimp 5.2.5:
 //  - OFF: a face index past the vertex list loads without complaint, a header claiming 4e8 vertices
 //    allocates 7.8 GB and takes 24 s before failing, a file cut in the face list fails with
 //    "aiMesh::mFaces[2258].mIndices is nullptr", and JoinIdenticalVertices makes cow.off's 2904
 //    vertices 2903, so counts stop matching the header. OFF is a trivial format, so we parse it.
-//  - PLY: a file cut inside its header makes assimp loop forever; a header claiming 3e9 vertices
-//    ends in bad_alloc; a face list count of 4294967295 makes it allocate 16 GB; an ASCII file
-//    missing its last faces loads with invented ones; a damaged "property" line shifts the data
-//    until faces without indices abort the process in Triangulate's assertion. We check the header
-//    and walk the data (without allocating) before assimp sees the file.
+//  - PLY: see ply_reader.cpp (hangs, aborts, 16 GB allocations, invented faces, 400 bytes per
+//    triangle).
+//  - OBJ: `vt nan` is taken as a UV; one out-of-range UV index drops every UV of the file.
+//  - glTF/GLB: stack overflows on deep JSON or node chains, GLB chunk lengths trusted before the
+//    file size, out-of-range indices and bad accessors read silently.
 // Every other check (non-finite data, index ranges, empty faces, degenerate triangles) is shared: raw
 // assimp data is checked before post-processing can merge, hide or trip over it, then
-// validate_and_prepare runs on all. Found by tests and by fuzzing truncated and byte-flipped files.
+// validate_and_prepare runs on all. Found by tests and by fuzzing (fuzz/).
 #include "ao/io/mesh_io.h"
 
 #include <assimp/Importer.hpp>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -35,6 +39,9 @@
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/io/gltf_check.h"
+#include "ao/io/obj_check.h"
+#include "ao/io/ply_reader.h"
 
 namespace ao {
 namespace {
@@ -57,20 +64,43 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// Checks that the path is a readable, non-empty regular file and returns its contents.
-std::string read_whole_file(const fs::path& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) fail(path, "no such file");
-  if (fs::is_directory(st)) fail(path, "is a directory, not a mesh file");
-  if (!fs::is_regular_file(st)) fail(path, "is not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot be opened for reading");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail(path, "read error");
-  if (data.empty()) fail(path, "the file is empty");
-  return data;
-}
+/// A file's whole content, mapped read-only: big meshes are hundreds of MB, and a mapping costs
+/// neither a copy nor memory of our own (the pages are the page cache's).
+class MappedFile {
+ public:
+  /// Checks that the path is a readable, non-empty regular file and maps it.
+  explicit MappedFile(const fs::path& path) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (!fs::exists(st)) fail(path, "no such file");
+    if (fs::is_directory(st)) fail(path, "is a directory, not a mesh file");
+    if (!fs::is_regular_file(st)) fail(path, "is not a regular file");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) fail(path, "cannot be opened for reading");
+    struct stat info {};
+    if (::fstat(fd, &info) != 0) {
+      ::close(fd);
+      fail(path, "cannot read its size");
+    }
+    size_ = static_cast<std::size_t>(info.st_size);
+    if (size_ == 0) {
+      ::close(fd);
+      fail(path, "the file is empty");
+    }
+    void* addr = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+    ::close(fd);  // the mapping keeps the file
+    if (addr == MAP_FAILED) throw SystemError(path.string() + ": cannot map the file into memory (" + std::to_string(size_) + " bytes)");
+    data_ = static_cast<const char*>(addr);
+  }
+  ~MappedFile() { ::munmap(const_cast<char*>(data_), size_); }
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  std::string_view view() const { return {data_, size_}; }
+
+ private:
+  const char* data_ = nullptr;
+  std::size_t size_ = 0;
+};
 
 /// Splits text into lines with '#' comments removed, remembering 1-based line numbers for messages.
 class LineReader {
@@ -250,159 +280,6 @@ Scene read_off(const fs::path& path, std::string_view data) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// PLY structure check. assimp reads the data; this walks it first without allocating, so that
-// damaged files fail with a clear message instead of hanging, aborting or allocating gigabytes.
-
-bool looks_like_ply(std::string_view data) { return data.starts_with("ply\n") || data.starts_with("ply\r\n") || data.starts_with("PLY\n"); }
-
-/// Size in bytes of a PLY scalar type; 0 if unknown.
-int ply_type_size(std::string_view type) {
-  for (std::string_view t : {"char", "uchar", "int8", "uint8"})
-    if (type == t) return 1;
-  for (std::string_view t : {"short", "ushort", "int16", "uint16"})
-    if (type == t) return 2;
-  for (std::string_view t : {"int", "uint", "float", "int32", "uint32", "float32"})
-    if (type == t) return 4;
-  for (std::string_view t : {"double", "float64"})
-    if (type == t) return 8;
-  return 0;
-}
-
-struct PlyProperty {
-  bool is_list = false;
-  int count_size = 0;  ///< Bytes of a list's count, binary only.
-  bool count_signed = false;
-  int item_size = 0;   ///< Bytes of the scalar, or of each list item.
-};
-
-struct PlyElement {
-  std::string name;
-  long long count = 0;
-  long long min_bytes = 0;  ///< Smallest possible size of one element in this file's encoding.
-  std::vector<PlyProperty> properties;
-};
-
-/// Reads a binary list count of `size` bytes at `p`.
-long long read_ply_count(const char* p, int size, bool is_signed, bool big_endian) {
-  std::uint64_t u = 0;
-  for (int k = 0; k < size; ++k) {
-    const auto byte = static_cast<std::uint8_t>(p[big_endian ? k : size - 1 - k]);
-    u = (u << 8) | byte;
-  }
-  if (is_signed && size < 8 && (u >> (8 * size - 1)) != 0) return static_cast<long long>(u) - (1LL << (8 * size));
-  return static_cast<long long>(u);
-}
-
-void check_ply(const fs::path& path, std::string_view data) {
-  // A PLY header is a few hundred bytes; looking at the first 64 KiB bounds the work on garbage.
-  const std::size_t header_end = data.substr(0, 1 << 16).find("end_header");
-  // assimp 5.2.5 loops forever on a PLY file cut inside its header, so this check is not optional.
-  if (header_end == std::string_view::npos) fail(path, "truncated or malformed PLY header: no end_header line");
-  LineReader reader(data.substr(0, header_end));
-  std::string_view line;
-  std::string format;
-  std::vector<PlyElement> elements;
-  while (reader.next(line)) {
-    const std::vector<std::string_view> t = split(line);
-    const std::string at = "PLY header line " + std::to_string(reader.line_number());
-    if (t[0] == "ply" || t[0] == "comment" || t[0] == "obj_info") {
-      continue;
-    } else if (t[0] == "format" && t.size() >= 2) {
-      format = std::string(t[1]);
-    } else if (t[0] == "element") {
-      PlyElement e;
-      if (t.size() < 3 || !parse_number(t[2], e.count) || e.count < 0) fail(path, at + ": malformed element line");
-      if (e.count > std::numeric_limits<std::uint32_t>::max()) fail(path, at + ": absurd element count " + quote(t[2]));
-      e.name = printable(t[1]);
-      elements.push_back(e);
-    } else if (t[0] == "property") {
-      if (elements.empty()) fail(path, at + ": property before any element");
-      PlyProperty prop;
-      prop.is_list = t.size() >= 2 && t[1] == "list";
-      if (prop.is_list) {
-        if (t.size() < 5 || ply_type_size(t[2]) == 0 || ply_type_size(t[3]) == 0 || t[2] == "float" || t[2] == "float32" ||
-            t[2] == "double" || t[2] == "float64")
-          fail(path, at + ": malformed list property");
-        prop.count_size = ply_type_size(t[2]);
-        prop.count_signed = !t[2].starts_with("u");
-        prop.item_size = ply_type_size(t[3]);
-      } else {
-        if (t.size() < 3 || ply_type_size(t[1]) == 0) fail(path, at + ": malformed property line");
-        prop.item_size = ply_type_size(t[1]);
-      }
-      // ASCII: each value takes at least a digit and a separator. Binary: a list takes at least its
-      // count, a scalar its size.
-      elements.back().min_bytes += format == "ascii" ? 2 : (prop.is_list ? prop.count_size : prop.item_size);
-      elements.back().properties.push_back(prop);
-    } else {
-      // assimp skips a line it does not know, which for a damaged "property" line shifts every
-      // value after it (and once ended in an assertion abort); a damaged header is an error.
-      fail(path, at + ": unknown keyword " + quote(t[0]));
-    }
-  }
-  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-    fail(path, "PLY header has no valid format line");
-
-  const std::size_t body_start = std::min(data.find('\n', header_end), data.size() - 1) + 1;
-  const std::string_view body = data.substr(body_start);
-  long long min_bytes = 0;
-  std::string summary;
-  for (const PlyElement& e : elements) {
-    min_bytes += e.count * e.min_bytes;  // < 2^32 * 2^16 properties at most: no overflow
-    summary += (summary.empty() ? "" : ", ") + std::to_string(e.count) + " x '" + e.name + "'";
-  }
-  if (min_bytes > static_cast<long long>(body.size()))
-    fail(path, "header declares " + summary + " elements but the data has only " + std::to_string(body.size()) + " bytes");
-
-  // Walk the data. The size check above bounds this loop by the file size (an element without
-  // properties is skipped), and list counts are checked against what is left, because assimp
-  // allocates a list of whatever count it reads (4294967295 in a damaged file: 16 GB).
-  if (format == "ascii") {
-    // One element per line.
-    LineReader lines(body);
-    for (const PlyElement& e : elements) {
-      for (long long i = 0; i < e.count && !e.properties.empty(); ++i) {
-        if (!lines.next(line)) fail(path, "truncated: header declares " + summary + " elements, the data ends in '" + e.name + "' " + std::to_string(i));
-        const std::vector<std::string_view> t = split(line);
-        const std::string at = "data line " + std::to_string(lines.line_number()) + " ('" + e.name + "' " + std::to_string(i) + ")";
-        std::size_t next = 0;
-        for (const PlyProperty& prop : e.properties) {
-          long long n = 1;
-          if (prop.is_list) {
-            if (next >= t.size() || !parse_number(t[next], n) || n < 0) fail(path, at + ": missing or bad list count");
-            ++next;
-          }
-          if (static_cast<long long>(t.size() - next) < n)
-            fail(path, at + ": expects " + std::to_string(n) + " more values, the line has " + std::to_string(t.size() - next));
-          next += static_cast<std::size_t>(n);
-        }
-      }
-    }
-  } else {
-    const bool big_endian = format == "binary_big_endian";
-    std::size_t pos = 0;
-    for (const PlyElement& e : elements) {
-      for (long long i = 0; i < e.count && !e.properties.empty(); ++i) {
-        for (const PlyProperty& prop : e.properties) {
-          long long bytes = prop.item_size;
-          if (prop.is_list) {
-            if (body.size() - pos < static_cast<std::size_t>(prop.count_size)) bytes = prop.count_size;  // fails below
-            else {
-              const long long n = read_ply_count(body.data() + pos, prop.count_size, prop.count_signed, big_endian);
-              if (n < 0) fail(path, "'" + e.name + "' " + std::to_string(i) + " has a negative list count " + std::to_string(n));
-              bytes = prop.count_size + n * prop.item_size;
-            }
-          }
-          if (static_cast<long long>(body.size() - pos) < bytes)
-            fail(path, "truncated: header declares " + summary + " elements, the data ends in '" + e.name + "' " + std::to_string(i));
-          pos += static_cast<std::size_t>(bytes);
-        }
-      }
-    }
-  }
-}
-
-// ---------------------------------------------------------------------------------------------
 // assimp
 
 Vec3 material_albedo(const aiMaterial& material, bool format_has_materials) {
@@ -574,9 +451,10 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
 
 Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
   if (options.uv_set < 0) fail(path, "--uv-set " + std::to_string(options.uv_set) + " asked for, UV sets count from 0");
-  // The whole file is read once up front: both our parsers need it, the size check for counts
-  // needs its length, and it is at most a copy of what assimp reads anyway.
-  const std::string data = read_whole_file(path);
+  // The whole file is mapped up front: our readers and checks need it, and the size checks of
+  // counts need its length.
+  const MappedFile file(path);
+  const std::string_view data = file.view();
   const std::string ext = lower(path.extension().string());
   if (ext == ".off" || looks_like_off(data)) {
     if (options.uv_set > 0) fail(path, uv_set_error(0, options.uv_set));  // OFF has no UVs
@@ -584,8 +462,18 @@ Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
   }
   if (ext == ".ply" || looks_like_ply(data)) {
     if (!looks_like_ply(data)) fail(path, "not a PLY file: it does not start with 'ply'");
-    check_ply(path, data);
+    try {
+      Scene scene = read_ply(path, data);
+      if (options.uv_set > 0) fail(path, uv_set_error(scene.meshes[0].uvs.empty() ? 0 : 1, options.uv_set));
+      validate_and_prepare(scene);
+      return scene;
+    } catch (const std::bad_alloc&) {
+      // The reader allocates no more than the checked counts need, so this is a real shortage.
+      throw SystemError(path.string() + ": out of memory loading the mesh (" + std::to_string(data.size()) + " bytes of file)");
+    }
   }
+  if (looks_like_gltf(path, data)) check_gltf(path, data);
+  else if (ext == ".obj") check_obj(path, data);
   return read_with_assimp(path, data, options);
 }
 

@@ -1,5 +1,5 @@
-// Mesh files -> Scene. OFF is read by our own strict parser; everything else goes through assimp,
-// PLY after a structure check of our own (see mesh_io.cpp for why).
+// Mesh files -> Scene. OFF and PLY are read by our own strict readers; OBJ, STL and glTF/GLB go
+// through assimp, OBJ and glTF after checks of our own (see mesh_io.cpp for why).
 #pragma once
 
 #include <filesystem>
@@ -15,19 +15,21 @@ struct LoadOptions {
   int uv_set = 0;
 };
 
-/// Loads OBJ, PLY, OFF, STL, glTF/GLB (by content/extension, via assimp) into a Scene: one Mesh per
-/// assimp mesh (so per material), triangulated, with normals when the file has them, the UV set
+/// Loads OBJ, PLY, OFF, STL, glTF/GLB (by content/extension; OBJ, STL and glTF via assimp) into a
+/// Scene: one Mesh per assimp mesh (so per material; one for OFF and PLY), triangulated, with normals when the file has them, the UV set
 /// `options.uv_set` (default the first), and the material's diffuse colour (or glTF baseColorFactor) as albedo. Node transforms are applied
 /// (pre-transform vertices). Calls validate_and_prepare. Throws InputError with one line naming the
 /// file and problem: missing/unreadable file, unknown format, truncated/malformed content, bad counts,
-/// NaN/inf, indices out of range, empty scene.
+/// NaN/inf, coordinates beyond kMaxCoordinate, indices out of range, empty scene, and what
+/// check_gltf (gltf_check.h) and check_obj (obj_check.h) refuse. Throws SystemError when memory
+/// runs out reading a PLY whose counts the file does hold.
 ///
-/// Details: OFF keeps the header's vertex count and order (faces of n > 3 vertices are fan-triangulated,
+/// Details: OFF and PLY keep the file's vertex count and order (faces of n > 3 vertices are fan-triangulated,
 /// which assumes convex faces); OFF, PLY and STL have no materials, so their albedo is the Mesh default
 /// 0.8, as is that of assimp's stand-in "DefaultMaterial" (an OBJ without .mtl); STL facet normals are
 /// discarded so the triangle soup can be welded into a connected mesh with smooth normals.
 /// Scene::name is the file name without its folder; Mesh::name is the file's mesh name (the file stem
-/// for OFF). The file's cameras are not read.
+/// for OFF and PLY). The file's cameras are not read.
 Scene load_scene_file(const std::filesystem::path& path, const LoadOptions& options = {});
 
 }  // namespace ao

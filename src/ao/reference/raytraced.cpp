@@ -100,7 +100,8 @@ const ParamTable<RaytracedParams>& raytraced_param_table() {
                "stop a pixel once the standard error of its mean is at most this; 0 = off"),
        P::integer("min_samples", &RaytracedParams::min_samples, Range::closed(16, kMaxSamples), "",
                   "with target_error: rays a pixel takes before it may stop (at most samples)"),
-       P::real("offset", &RaytracedParams::offset, Range::at_least(0), "world units", "ray origin offset along the normal; 0 = RayScene's default")}};
+       P::real("offset", &RaytracedParams::offset, Range::closed(0, kMaxCoordinate), "world units",
+               "ray origin offset along the normal; 0 = RayScene's default; at most kMaxCoordinate (1e9), as scene coordinates")}};
   return table;
 }
 

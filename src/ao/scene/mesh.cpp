@@ -1,6 +1,8 @@
 #include "ao/scene/mesh.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "ao/core/error.h"
@@ -50,6 +52,12 @@ void generate_normals(Mesh& mesh) {
 
 namespace {
 
+std::string format_magnitude(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", static_cast<double>(v));
+  return buf;
+}
+
 std::string where(const Scene& scene, const Mesh& mesh) {
   return mesh.name.empty() || scene.meshes.size() == 1 ? scene.name : scene.name + " (mesh '" + mesh.name + "')";
 }
@@ -57,8 +65,14 @@ std::string where(const Scene& scene, const Mesh& mesh) {
 void validate_mesh(const Scene& scene, Mesh& mesh) {
   const std::string w = where(scene, mesh);
   if (mesh.indices.size() % 3 != 0) throw InputError(w + ": index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v)
-    if (!is_finite(mesh.positions[v])) throw InputError(w + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const Vec3 p = mesh.positions[v];
+    if (!is_finite(p)) throw InputError(w + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
+    const float m = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    if (m > kMaxCoordinate)
+      throw InputError(w + ": vertex " + std::to_string(v) + " has coordinate " + format_magnitude(m) + ", beyond the +-" +
+                       format_magnitude(kMaxCoordinate) + " ao traces correctly (scale the mesh down)");
+  }
   if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
     throw InputError(w + ": " + std::to_string(mesh.normals.size()) + " normals for " + std::to_string(mesh.positions.size()) + " vertices");
   if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())

@@ -13,6 +13,12 @@
 
 namespace ao {
 
+/// Largest coordinate magnitude (world units) a scene may have; validate_and_prepare refuses larger
+/// ones. Measured (BENCHMARKS.md, "Input limits"): `ao render` of a cube gives the same image at
+/// half-sides 1 to 2e9 and a different, wrong one from 3e9; Embree 3.13's own traversal misses
+/// from 1e13 and aborts on an assertion from about 2e18. 1e9 keeps a margin below the first failure.
+inline constexpr float kMaxCoordinate = 1e9f;
+
 /// One indexed triangle mesh with one material.
 struct Mesh {
   std::string name;
@@ -45,7 +51,8 @@ struct Scene {
 void generate_normals(Mesh& mesh);
 
 /// Checks and repairs a scene in place before it is used; `source` names it in messages.
-/// Throws InputError for non-finite coordinates or normals, indices out of range, an index count
+/// Throws InputError for non-finite coordinates or normals, coordinates beyond +-kMaxCoordinate,
+/// non-finite UVs, indices out of range, an index count
 /// not divisible by 3, per-vertex arrays of the wrong length, and a scene with no triangle left.
 /// Drops degenerate (zero-area) triangles, since real meshes carry a few of them, adds a warning
 /// with their count, and generates normals where missing (unit length is restored where loaded

@@ -1,0 +1,32 @@
+// A structure check of glTF 2.0 and GLB files, run before assimp reads them, because assimp 5.2
+// crashes on or silently misreads hostile ones (see gltf_check.cpp). Part of load_scene_file;
+// declared here for the fuzz harness and the tests.
+#pragma once
+
+#include <filesystem>
+#include <string_view>
+
+namespace ao {
+
+/// Deepest JSON nesting (objects and arrays) accepted in a glTF: real files stay below 20.
+inline constexpr int kMaxGltfJsonDepth = 128;
+/// Longest chain of nodes (root to deepest child) accepted in a glTF scene graph: real skeletons
+/// and scene hierarchies stay below a few hundred.
+inline constexpr int kMaxGltfNodeDepth = 1024;
+
+/// True for data that starts with the GLB magic "glTF" or, for a name ending in .gltf or .glb or
+/// data whose first non-blank character is '{', for what should be read as glTF.
+bool looks_like_gltf(const std::filesystem::path& path, std::string_view data);
+
+/// Checks `data`, the whole content of `path`, as glTF 2.0 JSON or GLB, without allocating more
+/// than a small multiple of its size: GLB chunk lengths against the file size; JSON nesting depth
+/// (kMaxGltfJsonDepth); the node graph (indices in range, one parent per node, no cycle, depth at
+/// most kMaxGltfNodeDepth); buffers (GLB BIN chunk, base64 data URI or a file beside `path`)
+/// against their byteLength; bufferViews and accessors inside their buffers; byteStride at least
+/// the element size; POSITION accessors VEC3 float, all attributes of a primitive of one count;
+/// index accessors unsigned SCALAR with every index below the primitive's vertex count; sparse
+/// accessors in range. Throws InputError "<file>: <what>, <which accessor/node/...>" on the first
+/// problem. glTF 1.0 (asset.version 1.x, GLB version 1) is refused.
+void check_gltf(const std::filesystem::path& path, std::string_view data);
+
+}  // namespace ao

@@ -1,0 +1,130 @@
+// OBJ line scan: numbers and indices, checked before assimp can take NaN UVs or drop UVs.
+// assimp resolves positive indices after reading the whole file (so they may point forwards) and
+// negative ones against the elements read so far; the scan counts the same way.
+#include "ao/io/obj_check.h"
+
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <system_error>
+
+#include "ao/core/error.h"
+
+namespace ao {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Next whitespace-separated token of `line` from `pos`; empty at the end.
+std::string_view next_token(std::string_view line, std::size_t& pos) {
+  while (pos < line.size() && std::isspace(static_cast<unsigned char>(line[pos]))) ++pos;
+  const std::size_t start = pos;
+  while (pos < line.size() && !std::isspace(static_cast<unsigned char>(line[pos]))) ++pos;
+  return line.substr(start, pos - start);
+}
+
+std::string printable(std::string_view token) {
+  std::string out;
+  for (char c : token.substr(0, 24)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+  return token.size() > 24 ? out + "..." : out;
+}
+
+struct Lines {
+  std::string_view text;
+  std::size_t pos = 0;
+  long long number = 0;
+  /// Next line without its comment and line end; false at the end.
+  bool next(std::string_view& line) {
+    if (pos >= text.size()) return false;
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++number;
+    line = line.substr(0, std::min(line.find('#'), line.size()));
+    return true;
+  }
+};
+
+enum Kind { kVertex, kUv, kNormal };
+constexpr std::array<const char*, 3> kNames{"vertex", "UV", "normal"};
+constexpr std::array<const char*, 3> kPlural{"vertices", "UVs", "normals"};
+
+}  // namespace
+
+void check_obj(const fs::path& path, std::string_view data) {
+  // Pass 1: totals, for positive indices.
+  std::array<long long, 3> total{0, 0, 0};
+  {
+    Lines lines{data};
+    std::string_view line;
+    while (lines.next(line)) {
+      std::size_t pos = 0;
+      const std::string_view key = next_token(line, pos);
+      if (key == "v") ++total[kVertex];
+      else if (key == "vt") ++total[kUv];
+      else if (key == "vn") ++total[kNormal];
+    }
+  }
+  // Pass 2: numbers and indices.
+  std::array<long long, 3> seen{0, 0, 0};
+  Lines lines{data};
+  std::string_view line;
+  while (lines.next(line)) {
+    const auto fail = [&](const std::string& problem) -> void {
+      throw InputError(path.string() + ": line " + std::to_string(lines.number) + ": " + problem);
+    };
+    std::size_t pos = 0;
+    const std::string_view key = next_token(line, pos);
+    if (key == "v" || key == "vt" || key == "vn") {
+      const Kind kind = key == "v" ? kVertex : key == "vt" ? kUv : kNormal;
+      ++seen[kind];
+      // Vertices and normals have x y z (a vertex may add w or a colour: not checked); UVs u [v [w]].
+      const int needed = kind == kUv ? 1 : 3, checked = 3;
+      for (int k = 0; k < checked; ++k) {
+        std::string_view token = next_token(line, pos);
+        if (token.empty()) {
+          if (k < needed) fail(std::string(kNames[kind]) + " has " + std::to_string(k) + " numbers, expected " + std::to_string(needed));
+          break;
+        }
+        if (token.front() == '+') token.remove_prefix(1);
+        double value = 0;
+        const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+        if (ptr != token.data() + token.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+          fail(std::string(kNames[kind]) + " " + std::to_string(seen[kind] - 1) + ": '" + printable(token) + "' is not a number");
+        // Beyond float range is infinite once stored as float.
+        if (ec == std::errc::result_out_of_range || !std::isfinite(value) || std::abs(value) > 3.4e38)
+          fail(std::string(kNames[kind]) + " " + std::to_string(seen[kind] - 1) + (kind == kVertex ? " has a non-finite coordinate" : " is not finite") +
+               " ('" + printable(token) + "')");
+      }
+    } else if (key == "f" || key == "l" || key == "p") {
+      for (std::string_view corner = next_token(line, pos); !corner.empty(); corner = next_token(line, pos)) {
+        if (corner == "\\") break;  // continued on the next line
+        // v, v/vt, v//vn or v/vt/vn
+        std::size_t start = 0;
+        for (int kind = kVertex; kind <= kNormal && start <= corner.size(); ++kind) {
+          const std::size_t slash = std::min(corner.find('/', start), corner.size());
+          const std::string_view part = corner.substr(start, slash - start);
+          start = slash + 1;
+          if (part.empty()) {
+            if (kind == kVertex) fail("face corner '" + printable(corner) + "' has no vertex index");
+            continue;
+          }
+          long long i = 0;
+          const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), i);
+          if (ec != std::errc() || ptr != part.data() + part.size())
+            fail("'" + printable(corner) + "' is not a face corner (v, v/vt, v//vn or v/vt/vn)");
+          if (i == 0) fail(std::string(kNames[kind]) + " index 0 is out of range, OBJ indices start at 1");
+          const bool ok = i > 0 ? i <= total[kind] : -i <= seen[kind];
+          if (!ok)
+            fail(std::string(kNames[kind]) + " index " + std::to_string(i) + " is out of range, the file has " + std::to_string(i > 0 ? total[kind] : seen[kind]) +
+                 " " + kPlural[kind] + (i > 0 ? "" : " before this line"));
+        }
+      }
+    }
+  }
+}
+
+}  // namespace ao

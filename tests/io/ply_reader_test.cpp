@@ -1,0 +1,175 @@
+// The PLY reader: every encoding and property type gives the same mesh, what it does not use is
+// skipped, what ply_export writes reads back exactly, and damaged files are refused naming the
+// element and the problem.
+#include "ao/io/ply_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/io/mesh_io.h"
+#include "ao/io/ply_export.h"
+#include "ao/scene/procedural.h"
+#include "support/run.h"
+
+namespace ao {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+
+std::string read_error(const std::string& name, const std::string& data) {
+  try {
+    read_ply(name, data);
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(name + ": ", 0), 0u) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    return msg;
+  }
+  ADD_FAILURE() << name << " was read, expected an InputError";
+  return {};
+}
+
+#define EXPECT_READ_ERROR(data, fragment)                                                                \
+  do {                                                                                                   \
+    const std::string msg_ = read_error("t.ply", data);                                                  \
+    EXPECT_NE(msg_.find(fragment), std::string::npos) << "expected '" << (fragment) << "' in: " << msg_; \
+  } while (0)
+
+/// Appends `value` as `T` in the given byte order.
+template <class T>
+void put(std::string& out, double value, bool big_endian = false) {
+  const T v = static_cast<T>(value);
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if (big_endian)
+    for (std::size_t k = 0; k < sizeof(T) / 2; ++k) std::swap(b[k], b[sizeof(T) - 1 - k]);
+  out.append(b, sizeof(T));
+}
+
+// A unit square (0,0,0) (1,0,0) (1,1,0) (0,1,0) as one quad face, with normals +z and UVs = xy.
+const std::vector<float> kSquare = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+
+void expect_square(const Scene& s) {
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const Mesh& m = s.meshes[0];
+  ASSERT_EQ(m.positions.size(), 4u);
+  for (std::size_t v = 0; v < 4; ++v) {
+    EXPECT_EQ(m.positions[v].x, kSquare[3 * v]);
+    EXPECT_EQ(m.positions[v].y, kSquare[3 * v + 1]);
+    EXPECT_EQ(m.positions[v].z, kSquare[3 * v + 2]);
+  }
+  // The quad 0 1 2 3 is fanned from its first corner, keeping its winding.
+  EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
+}
+
+std::string binary_square(bool big_endian) {
+  std::string out = std::string("ply\nformat binary_") + (big_endian ? "big" : "little") +
+                    "_endian 1.0\nelement vertex 4\nproperty double x\nproperty float y\nproperty short z\nproperty uchar red\n"
+                    "element face 1\nproperty list ushort uint vertex_indices\nproperty int flags\n"
+                    "element edge 1\nproperty list uchar int corners\nend_header\n";
+  for (int v = 0; v < 4; ++v) {
+    put<double>(out, kSquare[3 * v], big_endian);
+    put<float>(out, kSquare[3 * v + 1], big_endian);
+    put<std::int16_t>(out, kSquare[3 * v + 2], big_endian);
+    put<std::uint8_t>(out, 200);
+  }
+  put<std::uint16_t>(out, 4, big_endian);
+  for (int i : {0, 1, 2, 3}) put<std::uint32_t>(out, i, big_endian);
+  put<std::int32_t>(out, -7, big_endian);
+  put<std::uint8_t>(out, 2);
+  put<std::int32_t>(out, 0, big_endian);
+  put<std::int32_t>(out, 1, big_endian);
+  return out;
+}
+
+TEST(PlyReader, BinaryLittleAndBigEndianGiveTheSameMeshSkippingWhatIsNotUsed) {
+  expect_square(read_ply("le.ply", binary_square(false)));
+  expect_square(read_ply("be.ply", binary_square(true)));
+}
+
+TEST(PlyReader, AsciiReadsNormalsAndUvsUnderTheirCommonNames) {
+  for (const auto& [u, v] : {std::pair{"u", "v"}, std::pair{"s", "t"}, std::pair{"texture_u", "texture_v"}}) {
+    SCOPED_TRACE(u);
+    const std::string header = std::string("ply\nformat ascii 1.0\ncomment square\nelement vertex 4\nproperty float x\nproperty float y\n") +
+                               "property float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float " + u +
+                               "\nproperty float " + v + "\nelement face 1\nproperty list uchar int vertex_index\nend_header\n";
+    const Scene s = read_ply("a.ply", header + "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n");
+    expect_square(s);
+    ASSERT_EQ(s.meshes[0].normals.size(), 4u);
+    ASSERT_EQ(s.meshes[0].uvs.size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_EQ(s.meshes[0].normals[k].z, 1.0f);
+      EXPECT_EQ(s.meshes[0].uvs[k].x, kSquare[3 * k]);
+      EXPECT_EQ(s.meshes[0].uvs[k].y, kSquare[3 * k + 1]);
+    }
+  }
+}
+
+TEST(PlyReader, WhatPlyExportWritesReadsBackExactly) {
+  TempDir dir;
+  Scene s;
+  s.name = "sphere";
+  s.meshes.push_back(make_sphere({0.5f, 1, -2}, 0.75f, 24, 12));
+  validate_and_prepare(s);
+  const fs::path file = dir / "sphere.ply";
+  write_vertex_ao_ply(file, s, std::vector<float>(s.vertex_count(), 0.5f));
+  const Scene back = load_scene_file(file);
+  ASSERT_EQ(back.meshes.size(), 1u);
+  EXPECT_EQ(back.meshes[0].indices, s.meshes[0].indices);
+  ASSERT_EQ(back.meshes[0].positions.size(), s.meshes[0].positions.size());
+  for (std::size_t v = 0; v < s.meshes[0].positions.size(); ++v) {
+    EXPECT_EQ(back.meshes[0].positions[v].x, s.meshes[0].positions[v].x);
+    EXPECT_EQ(back.meshes[0].positions[v].y, s.meshes[0].positions[v].y);
+    EXPECT_EQ(back.meshes[0].positions[v].z, s.meshes[0].positions[v].z);
+    EXPECT_NEAR(back.meshes[0].normals[v].y, s.meshes[0].normals[v].y, 1e-6f);
+  }
+}
+
+const std::string kHeader3 =
+    "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+TEST(PlyReader, DamagedFilesAreRefusedNamingTheProblem) {
+  const std::string ascii = "ply\nformat ascii 1.0\n" + kHeader3;
+  EXPECT_READ_ERROR(ascii + "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "face 0 uses vertex 7, the file has 3");
+  EXPECT_READ_ERROR(ascii + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", "face 0 uses vertex -1");
+  EXPECT_READ_ERROR(ascii + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", "face 0 has 2 vertices, at least 3 are needed");
+  EXPECT_READ_ERROR(ascii + "0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", "'zero' is not a number");
+  EXPECT_READ_ERROR(ascii + "0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n", "is not an integer");
+  EXPECT_READ_ERROR(ascii + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "data line 2");
+  EXPECT_READ_ERROR("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nelement face 1\n"
+                    "property list uchar int vertex_indices\nend_header\n0 0\n1 0\n0 1\n3 0 1 2\n",
+                    "'vertex' element has no 'z' property");
+  EXPECT_READ_ERROR("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
+                    "no 'face' element");
+  EXPECT_READ_ERROR("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                    "property list uchar float vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                    "floating point");
+  EXPECT_READ_ERROR("ply\nformat binary_middle_endian 1.0\n" + kHeader3, "no valid format line");
+  // A negative list count in a signed binary count type.
+  std::string bin = "ply\nformat binary_little_endian 1.0\n" + std::string(kHeader3).replace(kHeader3.find("uchar"), 5, "int");
+  for (float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put<float>(bin, c);
+  put<std::int32_t>(bin, -3);
+  bin += std::string(12, '\0');
+  EXPECT_READ_ERROR(bin, "'face' 0 has a negative list count -3");
+}
+
+TEST(PlyReader, CountsAreCheckedAgainstTheFileBeforeAllocating) {
+  // 5e9 faces fail on the header; a million empty binary faces (one zero count byte each, which
+  // the size check lets through) fail on the first face.
+  EXPECT_READ_ERROR("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 5000000000\nproperty list uchar int vertex_indices\nend_header\n",
+                    "absurd element count");
+  std::string many = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element face 1000000\nproperty list uchar int vertex_indices\nend_header\n";
+  many += std::string(36 + 1000000, '\0');
+  EXPECT_READ_ERROR(many, "face 0 has 0 vertices");
+}
+
+}  // namespace
+}  // namespace ao

@@ -79,7 +79,8 @@ void AlchemyParams::validate() const {
   if (!(radius >= 0.0f) || !std::isfinite(radius)) throw InputError("alchemy: radius r must be >= 0 world units (0 = the falloff radius)");
   if (samples < 1 || samples > kMaxSamples)
     throw InputError("alchemy: samples s must be in [1, " + std::to_string(kMaxSamples) + "], got " + std::to_string(samples));
-  if (!(intensity >= 0.0f) || !std::isfinite(intensity)) throw InputError("alchemy: intensity sigma must be a finite number >= 0");
+  if (intensity && (!(*intensity >= 0.0f) || !std::isfinite(*intensity)))
+    throw InputError("alchemy: intensity sigma must be a finite number >= 0 (null = the preset's)");
   if (!(contrast > 0.0f) || !std::isfinite(contrast)) throw InputError("alchemy: contrast k must be a finite number > 0");
   if (!(bias >= 0.0f) || !std::isfinite(bias)) throw InputError("alchemy: bias beta must be a finite number >= 0");
   if (!(epsilon > 0.0f) || !std::isfinite(epsilon)) throw InputError("alchemy: epsilon must be a finite number > 0");
@@ -90,7 +91,8 @@ void AlchemyParams::validate() const {
 void to_json(nlohmann::json& j, const AlchemyParams& p) {
   j = {{"radius", p.radius},
        {"samples", p.samples},
-       {"intensity", p.intensity},
+       {"preset", p.preset == AlchemyPreset::Paper ? "paper" : "fitted"},
+       {"intensity", p.intensity ? nlohmann::json(*p.intensity) : nlohmann::json(nullptr)},
        {"contrast", p.contrast},
        {"bias", p.bias},
        {"epsilon", p.epsilon},
@@ -102,12 +104,17 @@ void to_json(nlohmann::json& j, const AlchemyParams& p) {
 }
 
 void from_json(const nlohmann::json& j, AlchemyParams& p) {
-  require_known_keys(j, {"radius", "samples", "intensity", "contrast", "bias", "epsilon", "meter", "filter", "filter_taps", "filter_spatial_sigma",
+  require_known_keys(j, {"radius", "samples", "preset", "intensity", "contrast", "bias", "epsilon", "meter", "filter", "filter_taps", "filter_spatial_sigma",
                          "filter_plane_sigma"});
   try {
     if (j.contains("radius")) p.radius = j.at("radius").get<float>();
     if (j.contains("samples")) p.samples = j.at("samples").get<int>();
-    if (j.contains("intensity")) p.intensity = j.at("intensity").get<float>();
+    if (j.contains("preset")) {
+      const std::string name = j.at("preset").get<std::string>();
+      if (name != "fitted" && name != "paper") throw InputError("alchemy: preset must be \"fitted\" or \"paper\", got \"" + name + "\"");
+      p.preset = name == "paper" ? AlchemyPreset::Paper : AlchemyPreset::Fitted;
+    }
+    if (j.contains("intensity")) p.intensity = j.at("intensity").is_null() ? std::nullopt : std::optional<float>(j.at("intensity").get<float>());
     if (j.contains("contrast")) p.contrast = j.at("contrast").get<float>();
     if (j.contains("bias")) p.bias = j.at("bias").get<float>();
     if (j.contains("epsilon")) p.epsilon = j.at("epsilon").get<float>();
@@ -129,7 +136,7 @@ AlchemyConstants alchemy_constants(const AlchemyParams& p, float default_radius)
   const float m = p.meter > 0 ? p.meter : r / 0.5f;
   // sigma is a length and epsilon an area in eq. 10 (v.n / v.v is 1/length); beta multiplies z_C and
   // is compared with v.n, both lengths, so it is a pure number and is not scaled.
-  return {r, m, p.intensity * m, p.epsilon * m * m, p.bias};
+  return {r, m, p.effective_intensity() * m, p.epsilon * m * m, p.bias};
 }
 
 Falloff alchemy_reference_falloff(const AlchemyParams& p, float default_radius) {

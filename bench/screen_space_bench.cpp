@@ -1,4 +1,4 @@
-// Screen-space AO passes (containment, volumetric, transfer) and the 4x4 depth-aware box filter,
+// Screen-space AO passes (containment, volumetric, transfer, gtao) and the 4x4 depth-aware box filter,
 // AO pass only: the G-buffer of the built-in default scene at 1280x720 is rendered once outside
 // the timed loops. 12 samples per pixel (VAO fig. 12's count), R = 0.1 x scene diagonal (the
 // CLI's default). Thread count: whatever TBB is given (run with taskset -c 0,1 for 2 threads).
@@ -22,6 +22,7 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/characteristic.h"
 #include "ao/methods/containment.h"
+#include "ao/methods/gtao.h"
 #include "ao/methods/interleave.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/transfer_internal.h"
@@ -57,9 +58,10 @@ void rate(benchmark::State& state) {
   state.counters["Mpix/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * state.iterations() / 1e6, benchmark::Counter::kIsRate);
 }
 
+// Args: filter (0/1), ray_steps m (1 = eq. 5's end point; the default is 3).
 void containment(benchmark::State& state) {
   Fixture& f = demo();
-  ContainmentParams p{.samples = kSamples};
+  ContainmentParams p{.samples = kSamples, .ray_steps = static_cast<int>(state.range(1))};
   p.interleave.filter = state.range(0) != 0;
   for (auto _ : state) benchmark::DoNotOptimize(containment_ao(f.g, {Membership::Step, f.radius}, p, 1));
   rate(state);
@@ -92,6 +94,15 @@ void transfer_radiance(benchmark::State& state) {
   TransferParams p{.samples = kSamples, .reflectance = TransferReflectance::Radiance};
   TransferBuffers buffers;
   for (auto _ : state) benchmark::DoNotOptimize(transfer_ao(buffers, g, {Membership::Step, f.radius}, p, 1).luminance.data());
+  rate(state);
+}
+
+// GTAO at its defaults (2 slices x 2 sides x 8 steps = 32 depth samples per pixel); arg: filter (0/1).
+void gtao(benchmark::State& state) {
+  Fixture& f = demo();
+  GtaoParams p;
+  p.interleave.filter = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(gtao_ao(f.g, f.radius, p, 1).visibility.data());
   rate(state);
 }
 
@@ -184,8 +195,9 @@ BENCHMARK(depth_test_floor)->Arg(12)->Arg(24)->Unit(benchmark::kMillisecond)->Us
 #endif
 
 // Arg: filter on (1) / off (0); transfer's second arg is m (tests per ray).
-BENCHMARK(containment)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(containment)->Args({0, 1})->Args({1, 1})->Args({0, 3})->Args({1, 3})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(volumetric)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(gtao)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(transfer)->Args({0, 1})->Args({0, 2})->Args({1, 1})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(transfer_radiance)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

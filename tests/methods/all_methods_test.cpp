@@ -107,6 +107,7 @@ nlohmann::json other_value(const ParamSpec& s) {
       return s.default_value == lo ? nlohmann::json(static_cast<int>(s.range.max_open ? s.range.max - 1 : s.range.max)) : nlohmann::json(lo);
     }
     case ParamType::Float:
+    case ParamType::OptionalFloat:
       for (double v : {0.3, 0.7, 1.5, 45.5})
         if (s.range.contains(v) && s.default_value != v) return v;
   }

@@ -99,7 +99,26 @@ TEST(Containment, VisibilityInUnitRangeAndMonotoneInRadius) {
   }
 }
 
+// AT sec. 4: with m tests along each ray a ray is free only if all are, and the end point (eq. 5's
+// one test) is among them, so every pixel is at most as open as with m = 1.
+TEST(Containment, MoreRayStepsNeverOpenAPixel) {
+  const auto s = test::builtin_gbuffer("default");
+  ContainmentParams one, three;
+  one.ray_steps = 1, three.ray_steps = 3;
+  one.interleave.filter = three.interleave.filter = false;
+  const Falloff f{Membership::Step, 1.5f};
+  const Image<float> a = containment_ao(s.g, f, one, 4), b = containment_ao(s.g, f, three, 4);
+  double sa = 0, sb = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_LE(b[i], a[i]) << "pixel " << i;
+    sa += a[i], sb += b[i];
+  }
+  EXPECT_LT(sb, sa) << "the inner tests find occluders the end points jump over";
+}
+
 TEST(Containment, RejectsBadParameters) {
+  EXPECT_THROW((ContainmentParams{.ray_steps = 0}.validate()), InputError);
+  EXPECT_THROW((ContainmentParams{.ray_steps = 9}.validate()), InputError);
   EXPECT_THROW((ContainmentParams{.samples = 0}.validate()), InputError);
   EXPECT_THROW((ContainmentParams{.samples = 100000}.validate()), InputError);
   EXPECT_THROW((ContainmentParams{.bias = -1.0f}.validate()), InputError);

@@ -48,6 +48,7 @@ TEST(Transfer, TendsToObscuranceAsAlbedoGoesToZero) {
   TransferParams p1;
   p1.ray_steps = 1;
   ContainmentParams c;
+  c.ray_steps = 1;
   const Image<float> o = transfer_ao(s.g, f, p1, 2).obscurance, v = containment_ao(s.g, f, c, 2);
   for (std::size_t i = 0; i < o.size(); ++i) ASSERT_FLOAT_EQ(o[i], v[i]);
 }

@@ -116,7 +116,8 @@ TEST(Volumetric, PaperClaimsOnDefaultScene) {
   std::printf("| n | containment raw | containment interleaved+filtered | volumetric raw (WIS) | volumetric raw (analytic F) | volumetric interleaved+filtered |\n");
   std::printf("|---|---|---|---|---|---|\n");
   for (int n : {4, 8, 16}) {
-    ContainmentParams cr{.samples = n}, ci{.samples = n};
+    // VAO's containment test is eq. 5: one test at each sample's end point (ray_steps = 1).
+    ContainmentParams cr{.samples = n, .ray_steps = 1}, ci{.samples = n, .ray_steps = 1};
     cr.interleave.interleave = false;
     VolumetricParams vr{.samples = n}, va{.samples = n}, vi{.samples = n};
     vr.interleave.interleave = va.interleave.interleave = false;

@@ -22,6 +22,7 @@ const char* type_name(ParamType t) {
     case ParamType::Bool: return "true or false";
     case ParamType::Enum: return "one of";
     case ParamType::OptionalInt: return "null or an integer";
+    case ParamType::OptionalFloat: return "null or a number";
   }
   return "";
 }
@@ -99,6 +100,7 @@ bool type_matches(const ParamSpec& spec, const nlohmann::json& j) {
   switch (spec.type) {
     case ParamType::Int: return j.is_number_integer();
     case ParamType::OptionalInt: return j.is_null() || j.is_number_integer();
+    case ParamType::OptionalFloat: return j.is_null() || j.is_number();
     case ParamType::Float: return j.is_number();
     case ParamType::Bool: return j.is_boolean();
     case ParamType::Enum:
@@ -111,14 +113,16 @@ bool type_matches(const ParamSpec& spec, const nlohmann::json& j) {
 }
 
 bool in_range(const ParamSpec& spec, const nlohmann::json& j) {
-  if (spec.type != ParamType::Int && spec.type != ParamType::Float && spec.type != ParamType::OptionalInt) return true;
-  if (j.is_null()) return spec.type == ParamType::OptionalInt;
+  const bool optional = spec.type == ParamType::OptionalInt || spec.type == ParamType::OptionalFloat;
+  const bool is_float = spec.type == ParamType::Float || spec.type == ParamType::OptionalFloat;
+  if (spec.type != ParamType::Int && spec.type != ParamType::Float && !optional) return true;
+  if (j.is_null()) return optional;
   if (!j.is_number()) return false;
   // Integers beyond int's range are out of every int range; floats are checked as the float they become.
   if (j.is_number_integer()) {
     const double v = j.get<double>();
-    if (spec.type != ParamType::Float && (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())) return false;
-    return spec.range.contains(spec.type == ParamType::Float ? static_cast<double>(static_cast<float>(v)) : v);
+    if (!is_float && (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())) return false;
+    return spec.range.contains(is_float ? static_cast<double>(static_cast<float>(v)) : v);
   }
   return spec.range.contains(static_cast<double>(j.get<float>()));
 }

@@ -31,7 +31,7 @@
 namespace ao {
 
 /// The JSON type of a parameter.
-enum class ParamType { Int, Float, Bool, Enum, OptionalInt };
+enum class ParamType { Int, Float, Bool, Enum, OptionalInt, OptionalFloat };
 
 /// A closed or open interval of valid values (Int, Float, OptionalInt).
 struct Range {
@@ -56,7 +56,7 @@ struct ParamSpec {
   std::string name;
   ParamType type = ParamType::Float;
   std::string unit;                     ///< "world units", "pixels", "degrees"; empty when a pure number.
-  Range range;                          ///< Int, Float, OptionalInt.
+  Range range;                          ///< Int, Float, OptionalInt, OptionalFloat.
   std::vector<std::string> enum_names;  ///< Enum: the accepted names, in the enum's order.
   std::string help;                     ///< One line.
   nlohmann::json default_value;         ///< As JSON (null: OptionalInt unset).
@@ -98,6 +98,11 @@ struct Param {
   static Param optional_integer(std::string name, Ref ref, Range range, std::string unit, std::string help) {
     return make<std::optional<int>>(std::move(name), ParamType::OptionalInt, ref, range, std::move(unit), std::move(help));
   }
+  /// std::optional<float>: JSON null = unset (e.g. "the preset's value").
+  template <class Ref>
+  static Param optional_real(std::string name, Ref ref, Range range, std::string unit, std::string help) {
+    return make<std::optional<float>>(std::move(name), ParamType::OptionalFloat, ref, range, std::move(unit), std::move(help));
+  }
   /// An enum, written by name; `names` pairs each name with its value, in the enum's order.
   template <class E, class Ref>
   static Param enumeration(std::string name, Ref ref, std::vector<std::pair<std::string, E>> names, std::string help) {
@@ -135,11 +140,13 @@ struct Param {
       const T& v = access(ref, const_cast<P&>(s));
       if constexpr (std::is_same_v<T, float>) return float_json(v);
       else if constexpr (std::is_same_v<T, std::optional<int>>) return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+      else if constexpr (std::is_same_v<T, std::optional<float>>) return v ? float_json(*v) : nlohmann::json(nullptr);
       else return nlohmann::json(v);
     };
     p.set = [ref](P& s, const nlohmann::json& j) {
       T& v = access(ref, s);
       if constexpr (std::is_same_v<T, std::optional<int>>) v = j.is_null() ? std::nullopt : std::optional<int>(j.get<int>());
+      else if constexpr (std::is_same_v<T, std::optional<float>>) v = j.is_null() ? std::nullopt : std::optional<float>(j.get<float>());
       else v = j.get<T>();
     };
     p.spec.default_value = p.get(P{});

@@ -72,7 +72,9 @@ const ParamTable<AlchemyParams>& alchemy_param_table() {
       "alchemy",
       {{P::real("radius", &AlchemyParams::radius, Range::at_least(0), "world units", "r of eq. 9-10; 0 = the falloff radius R"),
         P::integer("samples", &AlchemyParams::samples, Range::closed(1, kMaxSamples), "", "s of eq. 10: samples per pixel"),
-        P::real("intensity", &AlchemyParams::intensity, Range::at_least(0), "paper metres", "sigma of eq. 10"),
+        P::enumeration<AlchemyPreset>("preset", &AlchemyParams::preset, {{"fitted", AlchemyPreset::Fitted}, {"paper", AlchemyPreset::Paper}},
+                                      "sigma when intensity is null: fitted 0.4 (least RMSE against the reference), paper 1"),
+        P::optional_real("intensity", &AlchemyParams::intensity, Range::at_least(0), "paper metres", "sigma of eq. 10; null = the preset's"),
         P::real("contrast", &AlchemyParams::contrast, Range::above(0), "", "k of eq. 10"),
         P::real("bias", &AlchemyParams::bias, Range::at_least(0), "", "beta of eq. 10, multiplies z_C"),
         P::real("epsilon", &AlchemyParams::epsilon, Range::above(0), "paper square metres", "epsilon of eq. 10"),
@@ -97,7 +99,7 @@ AlchemyConstants alchemy_constants(const AlchemyParams& p, float default_radius)
   const float m = p.meter > 0 ? p.meter : r / 0.5f;
   // sigma is a length and epsilon an area in eq. 10 (v.n / v.v is 1/length); beta multiplies z_C and
   // is compared with v.n, both lengths, so it is a pure number and is not scaled.
-  return {r, m, p.intensity * m, p.epsilon * m * m, p.bias};
+  return {r, m, p.effective_intensity() * m, p.epsilon * m * m, p.bias};
 }
 
 Falloff alchemy_reference_falloff(const AlchemyParams& p, float default_radius) {

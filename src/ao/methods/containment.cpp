@@ -18,6 +18,7 @@ constexpr float kInfinityLike = 1e30f;  // below this a distance stands for -inf
 // Tiles of 128 x 16 pixels: a row segment of eight 16-lane vectors per sample loop, and few rows
 // per tile. Measured against 64 x 64 (bench containment/0, alternated): 5.7-5.9 vs 7.5-7.9 ms.
 constexpr int kTileWidth = 128, kTileHeight = 16;
+constexpr int kMaxRaySteps = 8;
 }
 
 const ParamTable<ContainmentParams>& containment_param_table() {
@@ -25,6 +26,8 @@ const ParamTable<ContainmentParams>& containment_param_table() {
   static const ParamTable<ContainmentParams> table{
       "containment",
       {{P::integer("samples", &ContainmentParams::samples, Range::closed(1, kMaxScreenSpaceSamples), "", "n in eq. 5: test points per pixel"),
+        P::integer("ray_steps", &ContainmentParams::ray_steps, Range::closed(1, kMaxRaySteps), "",
+                   "m: tests along each ray at (j/m) r, j = 1..m (AT sec. 4); 1 = eq. 5's end point only"),
         P::boolean("silhouette_elimination", &ContainmentParams::silhouette_elimination,
                    "AT 4.3: a point is occluded only if the surface in front of it is less than R in front"),
         P::real("bias", &ContainmentParams::bias, Range::at_least(0), "world units",
@@ -115,13 +118,15 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
   // AT 4.3: a test point is occluded only if R > z - z* > 0, i.e. distance in (-R, -bias).
   const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;
   const float inv_n = 1.0f / static_cast<float>(params.samples);
+  const int m = params.ray_steps;
+  const float inv_m = 1.0f / static_cast<float>(m);
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
     const Characteristic local_ch = ch;
     PixelRow row;
     std::vector<int> index;
-    std::vector<float> open(static_cast<std::size_t>(t.x1 - t.x0));
+    std::vector<float> open(static_cast<std::size_t>(t.x1 - t.x0)), blocked(static_cast<std::size_t>(t.x1 - t.x0));
     for (int y = t.y0; y < t.y1; ++y) {
       load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
       const int count = row.count;
@@ -134,24 +139,46 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
       const float* bias = row.bias.data();
       for (int i = 0; i < s.size(); ++i) {
         const float X = s.x[static_cast<std::size_t>(i)], Y = s.y[static_cast<std::size_t>(i)], Z = s.z[static_cast<std::size_t>(i)];
-        // Across the pixels of the row: SIMD lanes, one gather of the depth buffer per vector.
+        if (m == 1) {
+          // Across the pixels of the row: SIMD lanes, one gather of the depth buffer per vector.
 // Lane k writes only its own accumulator; the gathers read the (read-only) G-buffer.
 #pragma GCC ivdep
-        for (int k = 0; k < count; ++k) {
-          // VAO eq. 5: p_i = x + X_i T + Y_i B + Z_i N.
-          const float qx = px[k] + X * tx[k] + Y * bx[k] + Z * nx[k];
-          const float qy = py[k] + X * ty[k] + Y * by[k] + Z * ny[k];
-          const float qz = pz[k] + X * tz[k] + Y * bz[k] + Z * nz[k];
-          const float d = local_ch.distance(qx, qy, qz);
-          // AT 4.3; an analytic surface's -FLT_MAX ("inner along the whole line") is never a distant
-          // foreground object, as in volumetric.cpp and transfer.cpp. The depth buffer never gives
-          // it, and its loop keeps the plain form: with the extra test GCC 12 no longer vectorises
-          // it (3.5x slower, bench containment/0).
-          bool near = d > far_limit;
-          if constexpr (!std::is_same_v<Characteristic, DepthBufferCharacteristic>) near = near | (d < -kInfinityLike);
-          const bool occluded = (d < -bias[k]) & near;
-          o[k] += occluded ? 0.0f : 1.0f;
+          for (int k = 0; k < count; ++k) {
+            // VAO eq. 5: p_i = x + X_i T + Y_i B + Z_i N.
+            const float qx = px[k] + X * tx[k] + Y * bx[k] + Z * nx[k];
+            const float qy = py[k] + X * ty[k] + Y * by[k] + Z * ny[k];
+            const float qz = pz[k] + X * tz[k] + Y * bz[k] + Z * nz[k];
+            const float d = local_ch.distance(qx, qy, qz);
+            // AT 4.3; an analytic surface's -FLT_MAX ("inner along the whole line") is never a distant
+            // foreground object, as in volumetric.cpp and transfer.cpp. The depth buffer never gives
+            // it, and its loop keeps the plain form: with the extra test GCC 12 no longer vectorises
+            // it (3.5x slower, bench containment/0).
+            bool near = d > far_limit;
+            if constexpr (!std::is_same_v<Characteristic, DepthBufferCharacteristic>) near = near | (d < -kInfinityLike);
+            const bool occluded = (d < -bias[k]) & near;
+            o[k] += occluded ? 0.0f : 1.0f;
+          }
+          continue;
         }
+        // AT sec. 4: I = prod_j I0(x + w r j/m), the ray is free only if all m test points are.
+        std::fill(blocked.begin(), blocked.end(), 0.0f);
+        float* __restrict b = blocked.data();
+        for (int j = 1; j <= m; ++j) {
+          const float f = static_cast<float>(j) * inv_m;
+          const float fX = f * X, fY = f * Y, fZ = f * Z;
+#pragma GCC ivdep
+          for (int k = 0; k < count; ++k) {
+            const float qx = px[k] + fX * tx[k] + fY * bx[k] + fZ * nx[k];
+            const float qy = py[k] + fX * ty[k] + fY * by[k] + fZ * ny[k];
+            const float qz = pz[k] + fX * tz[k] + fY * bz[k] + fZ * nz[k];
+            const float d = local_ch.distance(qx, qy, qz);
+            bool near = d > far_limit;
+            if constexpr (!std::is_same_v<Characteristic, DepthBufferCharacteristic>) near = near | (d < -kInfinityLike);
+            const bool occluded = (d < -bias[k]) & near;
+            b[k] = occluded ? 1.0f : b[k];
+          }
+        }
+        for (int k = 0; k < count; ++k) o[k] += 1.0f - b[k];
       }
       for (int k = 0; k < count; ++k) v(t.x0 + index[static_cast<std::size_t>(k)], y) = o[k] * inv_n;
     }

@@ -97,6 +97,12 @@ struct WorldSampler {
   // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
   // voxel whose centre is inside) fills them.
   float near_limit(Vec3) const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
+  // The voxel at world point p (false outside the grid).
+  bool solid_at(Vec3 p) const {
+    const float gx = (p.x - g.origin.x) * inv.x, gy = (p.z - g.origin.z) * inv.y, gz = (p.y - g.origin.y) * inv.z;
+    if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
+    return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
+  }
   static int clamp_index(float x, int n) {  // clamp(floor(x), 0, n - 1), branch-free; NaN -> 0
     return static_cast<int>(std::min(std::max(0.0f, x), static_cast<float>(n - 1)));
   }
@@ -229,6 +235,18 @@ struct EyeSampler {
     return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
   }
 
+  // The voxel at camera-space point c (false outside the grid).
+  bool solid_at(Vec3 c) const {
+    const float depth = -c.z;
+    if (!(depth > 0)) return false;
+    const float fx = c.x / depth * sx + ox, fy = c.y / depth * sy + oy;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return false;
+    const std::size_t col = static_cast<std::size_t>(static_cast<int>(fy)) * g.nx + static_cast<int>(fx);
+    const float k = (depth - g.z_near[col]) * g.voxels_per_unit[col];
+    if (!(k >= 0.0f && k < static_cast<float>(g.depth_bits))) return false;
+    return g.voxel(static_cast<int>(fx), static_cast<int>(fy), static_cast<int>(k));
+  }
+
   // centre in camera space; the prisms run along the camera's z (the grid's columns are view rays:
   // over one sphere they are close to parallel, the approximation the paper's texture fetch makes).
   float operator()(Vec3 c, int k, float scale, float rot_c, float rot_s) const {
@@ -264,6 +282,7 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
   const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
   const float log_q = std::log(setup.chain_ratio);
   const float inv_last_radius = 1.0f / setup.sphere_radius.back();  // both relative to R_max
+  const std::vector<std::uint8_t>& capped = sample.g.capped;
   std::vector<float> start(ns);  // where each sphere begins along the axis, world units
   for (int k = 0; k < ns; ++k) start[k] = (setup.sphere_distance[k] - setup.sphere_radius[k]) * r_max;
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
@@ -281,6 +300,11 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
         }
         const Frame frame = Frame::from_normal(n);
         const float near = sample.near_limit(gb.position(x, y));
+        // The inside of a holed mesh's shell, seen through a hole, faces into its winding-number
+        // solid (voxelize.h); its occluders are the inside of the shell, so its cones count the
+        // complement of the solid as occluded (1 - the obstructed fraction): a hollow inside.
+        const std::uint32_t id = gb.object_id(x, y);
+        const bool inside = id > 0 && id <= capped.size() && capped[id - 1] && sample.solid_at(pos + n * near);
         // Per-pixel jitter (deviation 5 of docs/methods/cone.md), all from hash(seed, pixel), so
         // the image does not depend on the thread count: the prism pattern turns by beta, and each
         // cone takes one random direction in its own cell of the hemisphere (stratified sampling
@@ -327,14 +351,16 @@ void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, co
           float transmittance = 1.0f;
           for (int k = 0; k < ns && transmittance > kOpaque; ++k) {
             if (start[k] * scale < near) continue;
-            transmittance *= 1.0f - sample(pos + axis * (distance[k] * scale), k, scale, rot_c, rot_s);
+            const float f = sample(pos + axis * (distance[k] * scale), k, scale, rot_c, rot_s);
+            transmittance *= inside ? f : 1.0f - f;
           }
           // A scaled chain ends at s R_max; the filler sphere, inscribed in [s R_max, R_max] along
           // the axis, samples the rest. Its radius (1 - s) R_max / 2 is at most the last sphere's
           // (equal at s = 1/q), and it fits in the cone for s >= 1/q.
           const float filler = 0.5f * (1.0f - scale) * inv_last_radius;  // radius / the last sphere's
           if (filler > 1e-3f && transmittance > kOpaque) {
-            transmittance *= 1.0f - sample(pos + axis * (0.5f * (1.0f + scale) * r_max), ns - 1, filler, rot_c, rot_s);
+            const float f = sample(pos + axis * (0.5f * (1.0f + scale) * r_max), ns - 1, std::min(filler, 1.0f), rot_c, rot_s);
+            transmittance *= inside ? f : 1.0f - f;
           }
           v += weight * transmittance;
         }

@@ -402,6 +402,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const bool cap = o.open_meshes == OpenMeshes::Winding && closure[mi].holed();
     if (cap) centre[mi] = hole_centroids(scene.meshes[mi], closure[mi]), ++capped;
+    g.capped.push_back(cap ? 1 : 0);
     first.push_back(first.back() + scene.meshes[mi].triangle_count() + (cap ? closure[mi].boundary.size() : 0));
   }
   const std::size_t total = first.back();

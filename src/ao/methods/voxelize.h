@@ -148,6 +148,11 @@ struct VoxelGrid {
   std::vector<std::uint64_t> dilated;
   std::uint64_t near_mask(int t, int ci, int cj) const { return dilated[(static_cast<std::size_t>(cj) * dnx + ci) * (kReachCap + 1) + t]; }
 
+  /// Per mesh of the scene (G-buffer object id - 1): 1 when the mesh had holes and was voxelized as
+  /// its winding-number solid (OpenMeshes::Winding), so that a surface point of it whose front is
+  /// solid is the inside of its shell, seen through a hole.
+  std::vector<std::uint8_t> capped;
+
   /// Words of column (i, j), which must be inside the grid.
   const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
   /// Bit k of column (i, j).

@@ -266,6 +266,7 @@ const std::array kMethods{
                "GTAO (Jimenez et al. 2016): horizons in screen-space slices, analytic cosine-weighted inner integral, 4x4 denoise; "
                "-p multi_bounce=true adds its multi-bounce fit",
                false, [] { return nlohmann::json(GtaoParams{}); }, run_gtao,
+               [](const Falloff& requested, const nlohmann::json&) { return obscurance_reference({Membership::Step, requested.radius}); },
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; }},
 };
 

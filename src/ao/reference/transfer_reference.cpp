@@ -6,7 +6,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
-#include "ao/reference/pixel_loop.h"
+#include "ao/reference/pixel_loop_internal.h"
 
 namespace ao {
 

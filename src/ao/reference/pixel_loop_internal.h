@@ -11,7 +11,7 @@
 #include "ao/core/gbuffer.h"
 #include "ao/core/parallel.h"
 #include "ao/core/progress.h"
-#include "ao/reference/packets.h"
+#include "ao/reference/packets_internal.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 

@@ -21,11 +21,11 @@
 #include <map>
 
 #include "ao/bake/padding.h"
-#include "ao/bake/texel_rays.h"
+#include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
-#include "ao/reference/packets.h"
+#include "ao/reference/packets_internal.h"
 
 namespace ao {
 

@@ -14,7 +14,7 @@
 #include <array>
 #include <cmath>
 
-#include "ao/bake/texel_rays.h"
+#include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"

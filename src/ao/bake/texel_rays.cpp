@@ -1,5 +1,5 @@
 // Patch sampling for the inside-out bakers: see texel_rays.h.
-#include "ao/bake/texel_rays.h"
+#include "ao/bake/texel_rays_internal.h"
 
 #include <algorithm>
 

@@ -9,6 +9,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/methods/screen_space_internal.h"
 
 namespace ao {
 

@@ -10,7 +10,7 @@
 
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/membership.h"
-#include "ao/reference/packets.h"
+#include "ao/reference/packets_internal.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao::detail {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -185,6 +186,18 @@ double Stopwatch::lap_ms() {
 
 void apply_param_overrides(nlohmann::json& params, const std::vector<std::string>& overrides, std::string_view method) {
   for (const std::string& kv : overrides) {
+    if (!kv.empty() && kv[0] == '@') {  // a parameter file: {"parameters": {...}} (as ao tune writes) or the object itself
+      const std::string path = kv.substr(1);
+      std::ifstream in(path);
+      if (!in) throw InputError(path + ": cannot open the parameter file");
+      nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+      if (j.is_object() && j.contains("parameters")) j = j["parameters"];
+      if (!j.is_object()) throw InputError(path + ": not a JSON object of parameters");
+      std::vector<std::string> pairs;
+      for (const auto& [k, v] : j.items()) pairs.push_back(k + "=" + v.dump());
+      apply_param_overrides(params, pairs, method);
+      continue;
+    }
     const auto eq = kv.find('=');
     if (eq == std::string::npos || eq == 0) throw InputError("--param: expected key=value, got '" + kv + "'");
     const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   ao::cli::add_compare_command(app, global, action);
   ao::cli::add_params_command(app, global, action);
   ao::cli::add_view_command(app, global, action);
+  ao::cli::add_tune_command(app, global, action);
 
   // Interrupted runs remove their temporary files (atomic_file.h).
   ao::remove_temporaries_on_signals();

@@ -18,5 +18,6 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
 void add_compare_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);
 void add_params_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);
 void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);
+void add_tune_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);
 
 }  // namespace ao::cli

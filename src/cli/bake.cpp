@@ -113,7 +113,12 @@ void check_output_names(const BakeOptions& o, bool batch) {
   if (!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".ply")
     throw InputError(o.per_vertex + ": --per-vertex writes PLY, give it a .ply name");
   if (!o.gltf.empty() && lower_extension(o.gltf) != ".glb") throw InputError(o.gltf + ": --gltf writes binary glTF, give it a .glb name");
-  if (!o.out_dir.empty() && !fs::is_directory(o.out_dir)) throw InputError("--out-dir: " + o.out_dir + " is not a directory");
+  if (!o.out_dir.empty()) {
+    // Created when missing (asked for by name); an existing file of that name is an error.
+    std::error_code ec;
+    if (!fs::is_directory(o.out_dir) && !fs::create_directories(o.out_dir, ec))
+      throw InputError("--out-dir: cannot create folder " + o.out_dir + (ec ? ": " + ec.message() : std::string(" (a file has that name)")));
+  }
   if (batch) return;  // outputs go to --out-dir or beside each mesh
   for (const std::string& out : {o.output, o.bent, o.per_vertex, o.gltf}) {
     if (out.empty()) continue;
@@ -358,9 +363,12 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     if (nrays) summary["per_vertex_rays"] = nrays;
   }
 
-  // Writes (each atomic).
+  // Writes (each atomic). The map file is written when -o names it, or under its default name
+  // when no other output is asked for (--gltf, --bent-normals, --per-vertex, --miss-mask).
+  const bool write_map = !o.output.empty() || (o.gltf.empty() && o.bent.empty() && o.per_vertex.empty() && o.miss_mask.empty());
+  if (!write_map) summary.erase("output");
   if (want_map) {
-    write_image(map_out, r.visibility, {.png_bits = o.png_bits});
+    if (write_map) write_image(map_out, r.visibility, {.png_bits = o.png_bits});
     if (!o.miss_mask.empty()) {
       Image<float> miss(o.size, o.size, 0.0f);
       for (std::size_t i = 0; i < r.missed.size(); ++i) miss[i] = r.missed[i];
@@ -374,11 +382,12 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     }
     if (!o.gltf.empty()) {
       std::string png;
-      if (map_out.extension() == ".png" || map_out.extension() == ".PNG") {
+      if (write_map && (map_out.extension() == ".png" || map_out.extension() == ".PNG")) {
         png = read_bytes(map_out);
       } else {
+        // --png-bits applies to the embedded map too (glTF allows 16-bit PNG).
         const fs::path tmp = fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png");
-        write_image(tmp, r.visibility, {.png_bits = 8});
+        write_image(tmp, r.visibility, {.png_bits = o.png_bits});
         png = read_bytes(tmp);
         fs::remove(tmp);
       }
@@ -386,7 +395,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
       write_ao_glb(glb, scene, png, source ? &*source : nullptr);
       summary["gltf_output"] = glb.string();
     }
-    if (!o.json)
+    if (!o.json && write_map)
       std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
                    input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
                    summary["texels_per_second"].get<double>() / 1e6);
@@ -462,9 +471,17 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   }
   nlohmann::json all = nlohmann::json::array();
   int failed = 0;
-  for (const fs::path& in : inputs) {
+  // In a log (stderr not a terminal, so no progress bars) each mesh gets a start and an end line.
+  const bool log_lines = !global.quiet && !stderr_is_terminal();
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const fs::path& in = inputs[i];
+    const std::string head = "mesh " + std::to_string(i + 1) + " of " + std::to_string(inputs.size()) + ": " + in.filename().string();
+    if (log_lines) std::fprintf(stderr, "%s ...\n", head.c_str());
+    Stopwatch mesh_clock;
+    bool ok = false;
     try {
       all.push_back(bake_one(in, o, true, global));
+      ok = true;
     } catch (const InputError& e) {
       ++failed;
       std::fprintf(stderr, "ao: error: %s\n", e.what());
@@ -474,6 +491,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
       std::fprintf(stderr, "ao: error: %s\n", e.what());
       all.push_back({{"input", in.string()}, {"error", e.what()}});
     }
+    if (log_lines) std::fprintf(stderr, "%s ... %s in %.1f s\n", head.c_str(), ok ? "done" : "failed", mesh_clock.lap_ms() / 1000.0);
   }
   if (o.json) std::cout << all.dump(2) << "\n";
   if (failed) std::fprintf(stderr, "ao bake: %d of %zu meshes failed\n", failed, inputs.size());

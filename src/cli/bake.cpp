@@ -35,7 +35,10 @@ namespace fs = std::filesystem;
 struct BakeOptions {
   std::vector<std::string> inputs;
   std::string output, out_dir, per_vertex, gltf, bent, reference;
-  std::string method = "histogram";
+  // The default by measured quality per second: on refined_elephant_uv at 1024^2, raytraced at 64 rays
+  // per texel is within RMSE 0.02 of a 1024-ray bake in less time than any histogram setting
+  // reaches 0.035 (docs/methods/bake.md, "Defaults").
+  std::string method = "raytraced";
   bool method_given = false;  // -m was on the command line (high-to-low then picks raytraced itself)
   // Options given on the command line that only one baker reads, by name ("--directions", ...).
   std::vector<std::string> histogram_only, raytraced_only;
@@ -506,7 +509,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("meshes", o->inputs, "Mesh files (OBJ, PLY, OFF, STL, glTF/GLB) or folders of them; several are baked in turn")->required()->type_name("MESH");
   cmd->add_option("-o,--output", o->output, "AO map: .png (linear, 8/16 bit) or .exr (float). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
-  CLI::Option* method = cmd->add_option("-m,--method", o->method, "histogram (outside-in, McGraw & Sowers; unlimited distance) or raytraced (Embree)")->capture_default_str();
+  CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
   cmd->add_option("-s,--size", o->size, "Map width = height, texels [1, 16384]")->capture_default_str();
   cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();

@@ -119,7 +119,7 @@ TEST(BakeCli, MeshWithoutUvsIsAnErrorThatSuggestsPerVertex) {
   EXPECT_NE(r.err.find("--per-vertex"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "ao.png"));
   // And what it suggests works.
-  const RunResult pv = run_ao("bake nouv.obj --per-vertex v.ply --directions 32 --vertex-resolution 64", dir.path());
+  const RunResult pv = run_ao("bake nouv.obj --per-vertex v.ply --samples 16", dir.path());
   EXPECT_EQ(pv.exit_code, 0) << pv.err;
   EXPECT_TRUE(fs::exists(dir / "v.ply"));
   EXPECT_FALSE(fs::exists(dir / "nouv-ao.png"));

@@ -113,8 +113,8 @@ void check_output_names(const BakeOptions& o, bool batch) {
   for (const std::string& img : {o.output, o.bent})
     if (!img.empty() && !is_supported_image_path(img))
       throw InputError(img + ": unknown image extension (supported: " + supported_image_extensions() + ")");
-  if (!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".ply")
-    throw InputError(o.per_vertex + ": --per-vertex writes PLY, give it a .ply name");
+  if (!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".ply" && lower_extension(o.per_vertex) != ".glb")
+    throw InputError(o.per_vertex + ": --per-vertex writes PLY or binary glTF (COLOR_0), give it a .ply or .glb name");
   if (!o.gltf.empty() && lower_extension(o.gltf) != ".glb") throw InputError(o.gltf + ": --gltf writes binary glTF, give it a .glb name");
   if (!o.out_dir.empty()) {
     // Created when missing (asked for by name); an existing file of that name is an error.
@@ -251,7 +251,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.
   std::optional<GltfSource> source;
-  if (!o.gltf.empty() && is_gltf_file(input)) {
+  if ((!o.gltf.empty() || lower_extension(o.per_vertex) == ".glb") && is_gltf_file(input)) {
     source = load_gltf_materials(input, scene, o.uv_set);
     for (const std::string& w : source->warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   }
@@ -395,7 +395,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
         fs::remove(tmp);
       }
       const fs::path glb = batch_path(input, o.gltf, o.out_dir, batch, "-ao.glb");
-      write_ao_glb(glb, scene, png, source ? &*source : nullptr);
+      write_ao_glb(glb, scene, png, source ? &*source : nullptr, vertex_ao.empty() ? nullptr : &vertex_ao);
       summary["gltf_output"] = glb.string();
     }
     if (!o.json && write_map)
@@ -405,7 +405,8 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   }
   if (!o.per_vertex.empty()) {
     const fs::path out = batch_path(input, o.per_vertex, o.out_dir, batch, "-ao.ply");
-    write_vertex_ao_ply(out, scene, vertex_ao);
+    if (lower_extension(out) == ".glb") write_ao_glb(out, scene, "", source ? &*source : nullptr, &vertex_ao);
+    else write_vertex_ao_ply(out, scene, vertex_ao);
     summary["per_vertex_output"] = out.string();
     if (!o.json) std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", out.string().c_str(), vertex_ao.size(), vertex_ms);
   }

@@ -424,3 +424,21 @@ TEST(BakeCli, GlbEmbedsA16BitPngWhenAsked) {
 
 }  // namespace
 }  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+TEST(BakeCli, PerVertexAoAsGlbColor0) {
+  TempDir dir;
+  write_text(dir / "nouv.obj", cube_obj(false));
+  const RunResult r = run_ao("bake nouv.obj --per-vertex v.glb --samples 8", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string glb = read_text(dir / "v.glb");
+  ASSERT_EQ(glb.substr(0, 4), "glTF");
+  EXPECT_NE(glb.find("\"COLOR_0\""), std::string::npos);
+  EXPECT_EQ(load_scene_file(dir / "v.glb").triangle_count(), 12u);
+  EXPECT_FALSE(fs::exists(dir / "nouv-ao.png"));
+}
+
+}  // namespace
+}  // namespace ao::test

@@ -119,7 +119,7 @@ TEST(BakeCli, MeshWithoutUvsIsAnErrorThatSuggestsPerVertex) {
   EXPECT_NE(r.err.find("--per-vertex"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "ao.png"));
   // And what it suggests works.
-  const RunResult pv = run_ao("bake nouv.obj --per-vertex v.ply --directions 32 --vertex-resolution 64", dir.path());
+  const RunResult pv = run_ao("bake nouv.obj --per-vertex v.ply --samples 16", dir.path());
   EXPECT_EQ(pv.exit_code, 0) << pv.err;
   EXPECT_TRUE(fs::exists(dir / "v.ply"));
   EXPECT_FALSE(fs::exists(dir / "nouv-ao.png"));
@@ -127,8 +127,7 @@ TEST(BakeCli, MeshWithoutUvsIsAnErrorThatSuggestsPerVertex) {
 
 TEST(BakeCli, BatchBakesTheGoodMeshesAndNamesTheBrokenOne) {
   TempDir dir;
-  fs::create_directories(dir / "meshes");
-  fs::create_directories(dir / "out");
+  fs::create_directories(dir / "meshes");  // out/ is created by --out-dir
   write_text(dir / "meshes/a.obj", cube_obj(true));
   write_text(dir / "meshes/b_broken.obj", kBrokenObj);
   write_text(dir / "meshes/c.obj", cube_obj(true));
@@ -140,7 +139,12 @@ TEST(BakeCli, BatchBakesTheGoodMeshesAndNamesTheBrokenOne) {
   EXPECT_FALSE(fs::exists(dir / "out/b_broken-ao.png"));
   EXPECT_NE(r.err.find("ao: error: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("b_broken.obj"), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find("a.obj"), std::string::npos) << "only the broken mesh is an error: " << r.err;
+  EXPECT_EQ(r.err.find("error: meshes/a.obj"), std::string::npos) << "only the broken mesh is an error: " << r.err;
+  // stderr is not a terminal here: one line as each mesh starts and one as it ends.
+  EXPECT_NE(r.err.find("mesh 1 of 3: a.obj ...\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mesh 1 of 3: a.obj ... done in "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mesh 2 of 3: b_broken.obj ... failed in "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mesh 3 of 3: c.obj ... done in "), std::string::npos) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.size(), 3u);  // notes.txt is not a mesh file: skipped
   EXPECT_FALSE(j[0].contains("error"));
@@ -386,6 +390,54 @@ TEST(BakeCli, FloorDarkensTheBaseAndOccludersAreNotBaked) {
   EXPECT_NEAR(nlohmann::json::parse(floor.out)["mean_visibility"].get<double>(), 0.5, 0.05);
   // The per-vertex output has the cube's vertices only, not the floor's.
   EXPECT_EQ(load_scene_file(dir / "v.ply").vertex_count(), load_scene_file(dir / "cube.obj").vertex_count());
+}
+
+}  // namespace
+}  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+TEST(BakeCli, OnlyTheOutputsAskedForAreWritten) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  ASSERT_EQ(run_ao("bake cube.obj --gltf m.glb" + kQuickRays, dir.path()).exit_code, 0);
+  ASSERT_EQ(run_ao("bake cube.obj --bent-normals bent.png" + kQuickRays, dir.path()).exit_code, 0);
+  EXPECT_TRUE(fs::exists(dir / "m.glb"));
+  EXPECT_TRUE(fs::exists(dir / "bent.png"));
+  EXPECT_FALSE(fs::exists(dir / "cube-ao.png"));  // no map beside the input that nobody asked for
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir.path())) files += e.is_regular_file() ? 1 : 0;
+  EXPECT_EQ(files, 3u);  // cube.obj, m.glb, bent.png
+}
+
+TEST(BakeCli, GlbEmbedsA16BitPngWhenAsked) {
+  TempDir dir;
+  write_text(dir / "cube.obj", cube_obj(true));
+  ASSERT_EQ(run_ao("bake cube.obj --gltf m.glb --png-bits 16" + kQuickRays, dir.path()).exit_code, 0);
+  const std::string glb = read_text(dir / "m.glb");
+  const std::size_t png = glb.find("\x89PNG\r\n\x1a\n");
+  ASSERT_NE(png, std::string::npos);
+  // IHDR follows the 8-byte signature: length (4), "IHDR" (4), width (4), height (4), bit depth (1).
+  EXPECT_EQ(static_cast<int>(static_cast<unsigned char>(glb[png + 24])), 16);
+}
+
+}  // namespace
+}  // namespace ao::test
+
+namespace ao::test {
+namespace {
+
+TEST(BakeCli, PerVertexAoAsGlbColor0) {
+  TempDir dir;
+  write_text(dir / "nouv.obj", cube_obj(false));
+  const RunResult r = run_ao("bake nouv.obj --per-vertex v.glb --samples 8", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string glb = read_text(dir / "v.glb");
+  ASSERT_EQ(glb.substr(0, 4), "glTF");
+  EXPECT_NE(glb.find("\"COLOR_0\""), std::string::npos);
+  EXPECT_EQ(load_scene_file(dir / "v.glb").triangle_count(), 12u);
+  EXPECT_FALSE(fs::exists(dir / "nouv-ao.png"));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/core/error.h"
 #include "ao/io/gltf_export.h"
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
@@ -353,6 +354,41 @@ TEST(GltfExport, GltfPrimitiveWithoutMaterialGetsAFreshOne) {
   EXPECT_EQ(m["name"], "quad");
   EXPECT_FLOAT_EQ(m["pbrMetallicRoughness"]["metallicFactor"].get<float>(), 0.0f);
   EXPECT_TRUE(m.contains("occlusionTexture"));
+}
+
+}  // namespace
+}  // namespace ao
+
+namespace ao {
+namespace {
+
+TEST(GltfExport, PerVertexAoIsColor0OfEveryPrimitive) {
+  const test::TempDir dir;
+  const Scene s = textured_and_untextured();
+  std::vector<float> ao(s.vertex_count());
+  for (std::size_t i = 0; i < ao.size(); ++i) ao[i] = static_cast<float>(i) / static_cast<float>(ao.size());
+  write_ao_glb(dir / "out.glb", s, "", nullptr, &ao);
+  const Glb g = parse_glb(test::read_text(dir / "out.glb"));
+  EXPECT_FALSE(g.json.contains("textures"));  // no map given: no occlusion texture
+  std::size_t first = 0;
+  for (std::size_t mi = 0; mi < s.meshes.size(); ++mi) {
+    const auto& attr = g.json["meshes"][mi]["primitives"][0]["attributes"];
+    ASSERT_TRUE(attr.contains("COLOR_0"));
+    const auto& a = g.json["accessors"][attr["COLOR_0"].get<std::size_t>()];
+    EXPECT_EQ(a["type"], "VEC3");
+    EXPECT_EQ(a["componentType"], 5126);
+    ASSERT_EQ(a["count"].get<std::size_t>(), s.meshes[mi].positions.size());
+    const auto& v = g.json["bufferViews"][a["bufferView"].get<std::size_t>()];
+    std::vector<Vec3> c(s.meshes[mi].positions.size());
+    std::memcpy(c.data(), g.bin.data() + v.value("byteOffset", std::size_t{0}), c.size() * sizeof(Vec3));
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      EXPECT_EQ(c[k].x, ao[first + k]);
+      EXPECT_EQ(c[k].z, ao[first + k]);
+    }
+    first += c.size();
+  }
+  std::vector<float> wrong(3, 1.0f);
+  EXPECT_THROW(write_ao_glb(dir / "bad.glb", s, "", nullptr, &wrong), InputError);
 }
 
 }  // namespace

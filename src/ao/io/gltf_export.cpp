@@ -294,7 +294,11 @@ nlohmann::json fresh_material(const Mesh& m, std::size_t mi) {
 
 }  // namespace
 
-void write_ao_glb(const std::filesystem::path& path, const Scene& scene, const std::string& png, const GltfSource* source) {
+void write_ao_glb(const std::filesystem::path& path, const Scene& scene, const std::string& png, const GltfSource* source,
+                  const std::vector<float>* vertex_ao) {
+  if (vertex_ao && vertex_ao->size() != scene.vertex_count())
+    throw InputError(path.string() + ": per-vertex AO has " + std::to_string(vertex_ao->size()) + " values for " + std::to_string(scene.vertex_count()) + " vertices");
+  std::size_t first_vertex = 0;  // of the current mesh in vertex_ao
   using nlohmann::json;
   std::string bin;
   json views = json::array(), accessors = json::array(), meshes = json::array(), materials = json::array(), nodes = json::array();
@@ -359,6 +363,19 @@ void write_ao_glb(const std::filesystem::path& path, const Scene& scene, const s
       append_raw(bin, m.normals.data(), m.normals.size());
       accessors.push_back({{"bufferView", add_view(off, bin.size() - off, kArrayBuffer)}, {"componentType", kFloat}, {"count", m.normals.size()}, {"type", "VEC3"}});
       attributes["NORMAL"] = accessors.size() - 1;
+    }
+    if (vertex_ao) {
+      // COLOR_0 = (V, V, V), linear: glTF multiplies the base colour by it.
+      std::vector<Vec3> colour(m.positions.size());
+      for (std::size_t v = 0; v < colour.size(); ++v) {
+        const float ao = (*vertex_ao)[first_vertex + v];
+        colour[v] = {ao, ao, ao};
+      }
+      first_vertex += m.positions.size();
+      const std::size_t off = bin.size();
+      append_raw(bin, colour.data(), colour.size());
+      accessors.push_back({{"bufferView", add_view(off, bin.size() - off, kArrayBuffer)}, {"componentType", kFloat}, {"count", colour.size()}, {"type", "VEC3"}});
+      attributes["COLOR_0"] = accessors.size() - 1;
     }
     const bool has_uv = !m.uvs.empty();
     // TEXCOORD_0 is the baked set; the source's other sets used by its textures follow (glTF wants

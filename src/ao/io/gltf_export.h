@@ -70,6 +70,10 @@ GltfSource load_gltf_materials(const std::filesystem::path& path, const Scene& s
 /// convention (v up) to glTF's (v down). The baked UV set (Mesh::uvs) is always TEXCOORD_0 and the
 /// occlusion texture's texCoord is 0; with `source`, other UV sets its textures use follow as
 /// TEXCOORD_1.. (in source order) and their texCoord is remapped.
-void write_ao_glb(const std::filesystem::path& path, const Scene& scene, const std::string& png, const GltfSource* source = nullptr);
+/// With `vertex_ao` (V per vertex of every mesh, concatenated in mesh order, as the per-vertex
+/// bakers return it), each primitive also gets COLOR_0 = (V, V, V) as float VEC3; an empty `png`
+/// then writes no occlusion texture. A count other than the scene's vertex count is an InputError.
+void write_ao_glb(const std::filesystem::path& path, const Scene& scene, const std::string& png, const GltfSource* source = nullptr,
+                  const std::vector<float>* vertex_ao = nullptr);
 
 }  // namespace ao

@@ -43,6 +43,7 @@ struct CompareOptions {
   std::string out_dir;
   CameraOptions camera{.width = 640, .height = 360};
   FalloffOptions falloff;
+  std::string normal = "shading";    ///< --normal: GBufferOptions::normal.
   std::uint32_t seed = 1;
   std::vector<std::string> params;   ///< method.key=value.
   bool json = false;
@@ -195,9 +196,9 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   GBuffer g;
   {
     ProgressBar bar("G-buffer", progress);
-    g = render_gbuffer(rays, cam, bar.callback());
+    g = render_gbuffer(rays, cam, GBufferOptions{.normal = parse_surface_normal(o.normal)}, bar.callback());
   }
-  const Falloff requested = choose_falloff(o.falloff, scene.bounds().diagonal());
+  const Falloff requested = choose_falloff(o.falloff, interest_diagonal(scene));
   const double setup_ms = clock.lap_ms();
 
   std::map<FalloffKey, Reference> references;
@@ -262,6 +263,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
                                 {"camera", to_json(g.camera)},
                                 {"membership", to_string(requested.membership)},
                                 {"radius", requested.radius},
+                                {"normal", o.normal},
                                 {"seed", o.seed},
                                 {"spp_reference", o.spp_reference},
                                 {"setup_ms", setup_ms},
@@ -317,7 +319,8 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   if (o.json) {
     std::cout << table.dump(2) << "\n";
   } else {
-    std::fprintf(stderr, "wrote %s/: table.md, table.json, sheet.png%s\n", out_dir.string().c_str(), sweep_key.empty() ? "" : ", sweep.md, sweep.json");
+    std::fprintf(stderr, "wrote %s/: table.md, table.json, sheet.png%s (R = %.4g, %s normals)\n", out_dir.string().c_str(),
+                 sweep_key.empty() ? "" : ", sweep.md, sweep.json", requested.radius, o.normal.c_str());
     std::cerr << md.str().substr(md.str().find("| method"));
   }
   return 0;
@@ -339,8 +342,11 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   cmd->add_option("-p,--param", o->params, "Method parameter as method.key=value (JSON value), repeatable");
   cmd->add_option("--membership", o->falloff.membership, "Falloff mu(d) requested: " + membership_names() + " (methods may imply their own)")
       ->capture_default_str();
-  cmd->add_option("-R,--radius", o->falloff.radius, "Neighbourhood radius R, world units (default: --radius-fraction x scene diagonal)");
-  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal")->capture_default_str();
+  cmd->add_option("-R,--radius", o->falloff.radius,
+                  "Neighbourhood radius R, world units (default: --radius-fraction x the diagonal of the objects: the meshes that are not "
+                  "flat, so a ground plane or walls do not change it)");
+  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of that diagonal")->capture_default_str();
+  cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + "; the same for every method and its reference")->capture_default_str();
   cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
   cmd->add_option("--width", o->camera.width, "Image width, pixels")->capture_default_str();

@@ -18,6 +18,7 @@
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/packets.h"
+#include "ao/reference/ray_offset.h"
 
 namespace ao {
 
@@ -56,7 +57,7 @@ struct Tracer {
       RTCRayHit rh{};
       rh.ray = {o.x, o.y, o.z, tnear, d.x, d.y, d.z, 0.0f, reach, 0xffffffffu, 0, 0};
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(rs.handle(), &ctx, &rh);
+      rtcIntersect1(embree_scene(rs), &ctx, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 1.0f;
       if (!ignore_back || dot(normals.per_mesh[rh.hit.geomID][rh.hit.primID], d) <= 0) return falloff.mu(rh.ray.tfar);
       tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: look beyond it
@@ -73,7 +74,7 @@ struct Tracer {
       for (int k = 0; k < count; ++k) {
         if (occlusion_only) {
           RTCRay r{org[k].x, org[k].y, org[k].z, 0.0f, dir[k].x, dir[k].y, dir[k].z, 0.0f, reach, 0xffffffffu, 0, 0};
-          rtcOccluded1(rs.handle(), &ctx, &r);
+          rtcOccluded1(embree_scene(rs), &ctx, &r);
           mu[k] = r.tfar < 0 ? 0.0f : 1.0f;
         } else {
           mu[k] = trace1(ctx, org[k], dir[k], 0.0f);
@@ -88,10 +89,10 @@ struct Tracer {
         detail::set_ray_hit(rh, k, org[s], dir[s], reach);
       }
       if (occlusion_only) {
-        detail::Packet<N>::occluded(valid.data(), rs.handle(), &ctx, &rh.ray);
+        detail::Packet<N>::occluded(valid.data(), embree_scene(rs), &ctx, &rh.ray);
         for (int k = 0; k < count; ++k) mu[k] = rh.ray.tfar[k] < 0 ? 0.0f : 1.0f;
       } else {
-        detail::Packet<N>::intersect(valid.data(), rs.handle(), &ctx, &rh);
+        detail::Packet<N>::intersect(valid.data(), embree_scene(rs), &ctx, &rh);
         for (int k = 0; k < count; ++k) {
           if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
             mu[k] = 1.0f;
@@ -190,7 +191,6 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
   const int n = cov.size;
   BakeResult out;
   out.visibility = Image<float>(n, n, 0.0f);
@@ -237,6 +237,8 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
               const SurfacePoint sp = point_at_uv(scene, cov, pc.mesh, pc.triangle, q, fn);
               const Vec3 d = Frame::from_normal(sp.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
               if (dot(d, sp.ng) <= 0) continue;  // below the face: occluded by the surface itself (mu = 0)
+              // Off the triangle by the scale-free offset of ray_offset.h, or the user's fixed one.
+              const float offset = params.offset > 0 ? params.offset : ray_offset_distance(triangle_magnitude(scene.meshes[pc.mesh], pc.triangle));
               org[static_cast<std::size_t>(live)] = sp.p + sp.ng * offset;
               dir[static_cast<std::size_t>(live)] = d;
               ++live;
@@ -254,7 +256,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
     });
   });
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
-  out.stats = {{"rays", out.rays}, {"offset", offset}};
+  out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;
 }
 
@@ -265,7 +267,11 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  std::vector<float> mesh_offset;  // a vertex has no single triangle: the offset scale is its mesh's largest coordinate
+  for (const Mesh& m : scene.meshes) {
+    const Bounds3 b = m.bounds();
+    mesh_offset.push_back(params.offset > 0 ? params.offset : ray_offset_distance(std::max(max_abs_coordinate(b.lo), max_abs_coordinate(b.hi))));
+  }
   std::vector<std::pair<std::uint32_t, std::uint32_t>> verts;  // (mesh, vertex)
   for (std::size_t m = 0; m < scene.meshes.size(); ++m)
     for (std::size_t v = 0; v < scene.meshes[m].positions.size(); ++v) verts.emplace_back(static_cast<std::uint32_t>(m), static_cast<std::uint32_t>(v));
@@ -286,6 +292,7 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
         const Vec3 nrm = normalize(m.normals[v]);
         const Frame frame = Frame::from_normal(nrm);
         const std::uint32_t key = pixel_seed(params.seed, vi, 0);
+        const float offset = mesh_offset[verts[static_cast<std::size_t>(vi)].first];
         double sum = 0;
         for (int first = 0; first < params.samples; first += batch) {
           const int c = std::min(batch, params.samples - first);

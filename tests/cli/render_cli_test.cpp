@@ -354,10 +354,10 @@ TEST(RenderCli, NormalOptionChoosesTheGBufferNormal) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["normal"], n);
   }
-  const RunResult bad = run_ao("render plane -o v.png --normal smooth", dir.path());
+  const RunResult bad = run_ao("render plane -o bad.png --normal smooth", dir.path());
   EXPECT_EQ(bad.exit_code, 1);
   expect_one_line_error(bad, "--normal");
-  EXPECT_FALSE(std::filesystem::exists(dir / "v.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
 }
 
 }  // namespace

@@ -595,7 +595,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--samples,--spp", o->rt.samples, "raytraced: rays per texel (per vertex with --per-vertex)")->capture_default_str();
   cmd->add_option("--max-distance", o->max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");
   cmd->add_option("--membership", o->membership, "raytraced with --max-distance: falloff step, linear, sqrt or cubic")->capture_default_str();
-  cmd->add_option("--offset", o->rt.offset, "raytraced: ray origin offset along the face normal, world units (0: 1e-5 x scene diagonal)")->capture_default_str();
+  cmd->add_option("--offset", o->rt.offset, "raytraced: ray origin offset along the face normal, world units (0: scale-free, a few float spacings of the coordinates; docs/methods/raytraced.md)")->capture_default_str();
   cmd->add_flag("--ignore-back-faces", o->rt.ignore_back_faces, "raytraced: rays pass through back faces (xNormal/Substance 'ignore backface')");
   cmd->add_option("--padding", o->padding, "Fill texels up to this far outside the charts from the nearest chart texel [0, 1024]")->capture_default_str();
   cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();

@@ -129,6 +129,40 @@ Camera choose_camera(const Scene& scene, const CameraOptions& opt) {
   return cam;
 }
 
+namespace {
+
+// Every vertex within 1e-5 of the mesh's diagonal from the plane of its largest triangle.
+bool is_flat(const Mesh& m) {
+  float best = -1;
+  Vec3 n{0, 0, 0}, origin{0, 0, 0};
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], c = m.positions[m.indices[3 * t + 2]];
+    const Vec3 cr = cross(b - a, c - a);
+    const float area2 = length(cr);
+    if (area2 > best) best = area2, n = cr / area2, origin = a;
+  }
+  if (!(best > 0)) return true;
+  const float tolerance = 1e-5f * m.bounds().diagonal();
+  for (const Vec3& p : m.positions)
+    if (std::abs(dot(p - origin, n)) > tolerance) return false;
+  return true;
+}
+
+}  // namespace
+
+float interest_diagonal(const Scene& scene) {
+  Bounds3 objects;
+  for (const Mesh& m : scene.meshes)
+    if (!is_flat(m)) objects.extend(m.bounds());
+  return objects.empty() ? scene.bounds().diagonal() : objects.diagonal();
+}
+
+SurfaceNormal parse_surface_normal(const std::string& text) {
+  if (text == "shading") return SurfaceNormal::Shading;
+  if (text == "geometric") return SurfaceNormal::Geometric;
+  throw InputError("--normal: expected shading or geometric, got '" + text + "'");
+}
+
 Falloff choose_falloff(const FalloffOptions& opt, float scene_diagonal) {
   const auto m = parse_membership(opt.membership);
   if (!m) throw InputError("--membership: unknown '" + opt.membership + "' (known: " + membership_names() + ")");

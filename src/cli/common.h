@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ao/core/camera.h"
+#include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
 #include "ao/io/output_set.h"
@@ -50,17 +51,31 @@ Vec3 parse_vec3(const std::string& text, const char* option);
 /// value and its valid range.
 void check_camera_options(const CameraOptions& opt, bool size_given = true);
 
-/// Falloff options: R in world units, or as a fraction of the scene diagonal.
+/// Falloff options: R in world units, or as a fraction of the diagonal of the objects of interest.
 struct FalloffOptions {
   std::string membership = "step";
   std::optional<float> radius;    ///< World units.
-  float radius_fraction = 0.1f;   ///< Of the bounding-box diagonal, when radius is unset.
+  float radius_fraction = 0.1f;   ///< Of interest_diagonal(), when radius is unset.
   float tau = 0.0f;
 };
-Falloff choose_falloff(const FalloffOptions& opt, float scene_diagonal);
+/// `diagonal`: what radius_fraction multiplies (interest_diagonal for a scene).
+Falloff choose_falloff(const FalloffOptions& opt, float diagonal);
 /// The checks of choose_falloff that need no scene (membership name, --radius, --radius-fraction,
 /// --tau), run before anything is loaded.
 void check_falloff_options(const FalloffOptions& opt);
+
+/// The diagonal the default R is a fraction of: the bounding box of the objects of interest,
+/// which are the meshes that are not flat (a ground quad, a floor, a wall: every vertex within
+/// 1e-5 of its diagonal from one plane), or every mesh when all are flat. So a model keeps the
+/// same default R when a ground plane or walls are added around it; a room made of one closed
+/// mesh, or a terrain that is not exactly flat, counts as an object.
+float interest_diagonal(const Scene& scene);
+
+/// Help text and parser of --normal (GBufferOptions::normal).
+inline constexpr const char* kNormalHelp =
+    "Normal every method integrates about: shading (interpolated vertex normals, the smooth surface a mesh stands for) or geometric "
+    "(the triangle's own); it is the G-buffer's N";
+SurfaceNormal parse_surface_normal(const std::string& text);
 
 /// A progress bar on stderr, shown only when stderr is a terminal, not --quiet, and the stage has
 /// run for over a second. Thread-safe; redraws at most ten times a second.

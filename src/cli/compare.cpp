@@ -40,6 +40,7 @@ struct CompareOptions {
   std::string out_dir;
   CameraOptions camera{.width = 640, .height = 360};
   FalloffOptions falloff;
+  std::string normal = "shading";    ///< --normal: GBufferOptions::normal.
   std::uint32_t seed = 1;
   std::vector<std::string> params;   ///< method.key=value.
   std::string reference;             ///< NAME or method=NAME, comma-separated; empty = matched.
@@ -139,9 +140,9 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   GBuffer g;
   {
     ProgressBar bar("G-buffer", progress);
-    g = render_gbuffer(rays, cam, bar.callback());
+    g = render_gbuffer(rays, cam, GBufferOptions{.normal = parse_surface_normal(o.normal)}, bar.callback());
   }
-  settings.falloff = choose_falloff(o.falloff, scene.bounds().diagonal());
+  settings.falloff = choose_falloff(o.falloff, interest_diagonal(scene));
   const double setup_ms = clock.lap_ms();
 
   // One progress bar per stage, each closed when the next starts.
@@ -164,8 +165,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   table["setup_ms"] = setup_ms;
   const std::string md = compare_table_markdown(result, scene.name);
 
-  write_output_text("table.json", table.dump(2) + "\n");
-  write_output_text("table.md", md);
+  settings.falloff = choose_falloff(o.falloff, interest_diagonal(scene));
   std::vector<SheetRow> sheet_rows;
   for (const CompareRow& row : result.rows) {
     std::vector<std::string> label = {row.method};
@@ -190,8 +190,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   if (o.json) {
     std::cout << table.dump(2) << "\n";
   } else {
-    std::fprintf(stderr, "wrote %s/: table.md, table.json, sheet.png%s\n", out_dir.string().c_str(), result.sweep_key.empty() ? "" : ", sweep.md, sweep.json");
-    std::cerr << md.substr(md.find("| method"));
+  settings.falloff = choose_falloff(o.falloff, interest_diagonal(scene));
   }
   return 0;
 }
@@ -215,8 +214,11 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
                   "the default), obscurance (the obscurance of the membership it implies), tangent-sphere or transfer");
   cmd->add_option("--membership", o->falloff.membership, "Falloff mu(d) requested: " + membership_names() + " (methods may imply their own)")
       ->capture_default_str();
-  cmd->add_option("-R,--radius", o->falloff.radius, "Neighbourhood radius R, world units (default: --radius-fraction x scene diagonal)");
-  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal")->capture_default_str();
+  cmd->add_option("-R,--radius", o->falloff.radius,
+                  "Neighbourhood radius R, world units (default: --radius-fraction x the diagonal of the objects: the meshes that are not "
+                  "flat, so a ground plane or walls do not change it)");
+  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of that diagonal")->capture_default_str();
+  cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + "; the same for every method and its reference")->capture_default_str();
   cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
   cmd->add_option("--width", o->camera.width, "Image width, pixels")->capture_default_str();

@@ -34,6 +34,7 @@ struct RenderOptions {
   std::string ao_map;
   CameraOptions camera;
   FalloffOptions falloff;
+  std::optional<std::string> normal;  ///< --normal shading|geometric (GBufferOptions::normal); default shading.
   std::optional<int> samples;         ///< Overrides the method's own default sample count.
   std::optional<float> target_error;
   std::uint32_t seed = 1;
@@ -123,6 +124,9 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     params["target_error"] = *o.target_error;
   }
   apply_param_overrides(params, o.params, method.name);
+  if (o.normal && !o.gbuffer_in.empty())
+    throw InputError("--normal chooses the normal a scene's G-buffer is rendered with; a --gbuffer-in file brings its own N");
+  const GBufferOptions gbuffer_options{.normal = o.normal ? parse_surface_normal(*o.normal) : SurfaceNormal::Shading};
   const std::optional<Sun> sun = o.sun ? std::optional<Sun>(parse_sun(*o.sun)) : std::nullopt;
   if (sun && !o.gbuffer_in.empty())
     throw InputError("--sun traces shadow rays in the scene, and --gbuffer-in gives only a G-buffer: give a scene, or a G-buffer EXR with "
@@ -180,10 +184,10 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     const Camera cam = choose_camera(*scene, o.camera);
     {
       ProgressBar bar("G-buffer", progress);
-      g = render_gbuffer(*rays, cam, bar.callback());
+      g = render_gbuffer(*rays, cam, gbuffer_options, bar.callback());
     }
     timings["gbuffer_ms"] = clock.lap_ms();
-    diagonal = scene->bounds().diagonal();
+    diagonal = interest_diagonal(*scene);
     if (sun) {
       ProgressBar bar("sun", progress);
       g.direct = render_direct_light(*rays, g, *sun, bar.callback());
@@ -240,6 +244,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
       {"parameters", params},
       {"membership", to_string(falloff.membership)},
       {"radius", falloff.radius},
+      {"normal", o.gbuffer_in.empty() ? (gbuffer_options.normal == SurfaceNormal::Geometric ? "geometric" : "shading") : "file"},
       {"seed", o.seed},
       {"width", g.width()},
       {"height", g.height()},
@@ -284,9 +289,12 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   for (const MethodInfo& m : all_methods()) methods += "\n  " + std::string(m.name) + ": " + std::string(m.summary);
   cmd->add_option("-m,--method", o->method, "AO method:" + methods)->capture_default_str();
   cmd->add_option("--membership", o->falloff.membership, "Falloff mu(d): " + membership_names())->capture_default_str();
-  cmd->add_option("-R,--radius", o->falloff.radius, "Neighbourhood radius R, world units (default: --radius-fraction x scene diagonal)");
-  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal, when --radius is not given")
+  cmd->add_option("-R,--radius", o->falloff.radius,
+                  "Neighbourhood radius R, world units (default: --radius-fraction x the diagonal of the objects: the meshes that are not "
+                  "flat, so a ground plane or walls do not change it; with --gbuffer-in, of the visible points)");
+  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of that diagonal, when --radius is not given")
       ->capture_default_str();
+  cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + " (default: shading)")->type_name("shading|geometric");
   cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
   cmd->add_option("--spp,--samples", o->samples,
                   "Samples per pixel (default: the method's own; 256 rays for raytraced, the maximum with --target-error)");

@@ -46,7 +46,7 @@ int run_view_command(const ViewOptions& o, const GlobalOptions& global) {
   setup.scene = load_scene_arguments(o.scene);
   for (const std::string& w : setup.scene.warnings) std::cerr << "warning: " << w << "\n";
   setup.camera = choose_camera(setup.scene, o.camera);
-  setup.radius_basis = setup.scene.bounds().diagonal();
+  setup.radius_basis = interest_diagonal(setup.scene);
   setup.falloff = choose_falloff(o.falloff, setup.radius_basis);
   setup.method = o.method;
   setup.params = params;

@@ -9,6 +9,7 @@
 #include "ao/bake/high_to_low.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/error.h"
+#include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 
@@ -101,7 +102,7 @@ TEST(HighToLow, BumpySphereMatchesARayTracedRenderOfTheHighMesh) {
       RTCRayHit rh{};
       rh.ray = {2 * d.x, 2 * d.y, 2 * d.z, 0, -d.x, -d.y, -d.z, 0, 10, 0xffffffffu, 0, 0};  // from outside, towards the centre
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(high_rays.handle(), &ctx, &rh);
+      rtcIntersect1(embree_scene(high_rays), &ctx, &rh);
       ASSERT_NE(rh.hit.geomID, RTC_INVALID_GEOMETRY_ID) << d.x << " " << d.y << " " << d.z;
       const Mesh& hm = high.meshes[0];
       const std::uint32_t* i = &hm.indices[3 * rh.hit.primID];

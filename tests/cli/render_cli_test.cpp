@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <utility>
 #include <vector>
 
@@ -324,6 +325,38 @@ TEST(RenderCli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(run_ao("render --no-such-option").exit_code, 2);
   EXPECT_EQ(run_ao("").exit_code, 2);
   EXPECT_EQ(run_ao("render --help").exit_code, 0);
+}
+
+// Default R comes from the objects, not the ground they stand on: a box alone and the same box
+// on a quad 100 times its size get the same R (0.1 x the box's diagonal, sqrt(3) here).
+TEST(RenderCli, DefaultRadiusIgnoresAFlatGround) {
+  TempDir dir;
+  std::ofstream(dir / "box.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                    "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n";
+  std::ofstream(dir / "ground.obj") << "v -50 0 -50\nv 50 0 -50\nv 50 0 50\nv -50 0 50\nf 1 3 2\nf 1 4 3\n";
+  auto radius = [&](const std::string& scene) {
+    const RunResult r = run_ao("render " + scene + kSmall + "-o v.png --json", dir.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out)["radius"].get<double>();
+  };
+  EXPECT_NEAR(radius("box.obj"), 0.1 * std::sqrt(3.0), 1e-5);
+  EXPECT_NEAR(radius("box.obj ground.obj"), 0.1 * std::sqrt(3.0), 1e-5);
+  EXPECT_NEAR(radius("ground.obj"), 0.1 * 100 * std::sqrt(2.0), 1e-3) << "all flat: the whole scene";
+  const RunResult r = run_ao("render box.obj ground.obj" + kSmall + "-o v.png", dir.path());
+  EXPECT_NE(r.err.find("R = 0.1732"), std::string::npos) << "the summary line states R: " << r.err;
+}
+
+TEST(RenderCli, NormalOptionChoosesTheGBufferNormal) {
+  TempDir dir;
+  for (const char* n : {"shading", "geometric"}) {
+    const RunResult r = run_ao("render sphere-on-plane" + kSmall + "-o v.png --json --normal " + n, dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["normal"], n);
+  }
+  const RunResult bad = run_ao("render plane -o bad.png --normal smooth", dir.path());
+  EXPECT_EQ(bad.exit_code, 1);
+  expect_one_line_error(bad, "--normal");
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
 }
 
 }  // namespace

@@ -114,6 +114,26 @@ TEST(GBufferExr, DirectLightPassRoundTripsExactlyAndIsOptional) {
   EXPECT_TRUE(read_gbuffer_exr(dir / "left-out.exr").direct.empty());
 }
 
+// The triangle index (primid) is optional: files without it, like those of other renderers and
+// of earlier versions, read with an empty primitive_id.
+TEST(GBufferExr, PrimitiveIdsRoundTripExactlyAndAreOptional) {
+  TempDir dir;
+  GBuffer g = sphere_gbuffer(test_camera());
+  write_gbuffer_exr(dir / "none.exr", g);
+  EXPECT_TRUE(read_gbuffer_exr(dir / "none.exr").primitive_id.empty());
+
+  g.primitive_id = Image<std::uint32_t>(g.width(), g.height(), 0u);
+  for (std::size_t i = 0; i < g.primitive_id.size(); ++i)
+    if (g.coverage[i]) g.primitive_id[i] = static_cast<std::uint32_t>(i * 2654435761u % 4000000000u);
+  write_gbuffer_exr(dir / "g.exr", g);
+  const GBuffer back = read_gbuffer_exr(dir / "g.exr");
+  ASSERT_EQ(back.primitive_id.width(), g.width());
+  for (std::size_t i = 0; i < g.primitive_id.size(); ++i) ASSERT_EQ(back.primitive_id[i], g.primitive_id[i]) << "pixel " << i;
+
+  write_gbuffer_exr(dir / "left-out.exr", g, {.primitive_ids = false});
+  EXPECT_TRUE(read_gbuffer_exr(dir / "left-out.exr").primitive_id.empty());
+}
+
 TEST(GBufferExr, BadDirectLightPassIsAnError) {
   TempDir dir;
   GBuffer g = sphere_gbuffer(test_camera());

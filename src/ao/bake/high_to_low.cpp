@@ -25,7 +25,9 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/ray_offset.h"
 
 namespace ao {
 
@@ -51,7 +53,7 @@ HighHit trace_cage_ray(const RayScene& targets, const TriangleNormals& fn, RTCIn
     RTCRayHit rh{};
     rh.ray = {o.x, o.y, o.z, tnear, d.x, d.y, d.z, 0.0f, tfar, 0xffffffffu, 0, 0};
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(targets.handle(), &ctx, &rh);
+    rtcIntersect1(embree_scene(targets), &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
     const Vec3 ng = fn.per_mesh[rh.hit.geomID][rh.hit.primID];
     if (dot(ng, d) < 0) {
@@ -145,7 +147,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   const TriangleNormals occluder_fn = detail::face_normals(occluders.scene());
   const auto smooth = smoothed_normals(low);
   const detail::Tracer tracer{occluders, falloff, occluder_fn, params.ao.ignore_back_faces};
-  const float offset = params.ao.offset > 0 ? params.ao.offset : occluders.self_intersection_offset();
+  const float offset = params.ao.offset > 0 ? params.ao.offset : ray_offset_distance(bounds_magnitude(occluders.bounds()));
   const int n = cov.size;
   BakeResult out;
   out.visibility = Image<float>(n, n, 0.0f);

@@ -19,6 +19,7 @@
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/ray_offset.h"
 
 namespace ao {
 
@@ -68,7 +69,6 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
   const int n = cov.size;
   BakeResult out;
   out.visibility = Image<float>(n, n, 0.0f);
@@ -106,6 +106,8 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
               const SurfacePoint sp = point_at_uv(scene, cov, pc.mesh, pc.triangle, ps.uv, fn);
               const Vec3 d = Frame::from_normal(sp.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
               if (dot(d, sp.ng) <= 0) continue;  // below the face: occluded by the surface itself (mu = 0)
+              // Off the triangle by the scale-free offset of ray_offset.h, or the user's fixed one.
+              const float offset = params.offset > 0 ? params.offset : ray_offset_distance(triangle_magnitude(scene.meshes[pc.mesh], pc.triangle));
               org[static_cast<std::size_t>(live)] = sp.p + sp.ng * offset;
               dir[static_cast<std::size_t>(live)] = d;
               ++live;
@@ -123,7 +125,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
     });
   });
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
-  out.stats = {{"rays", out.rays}, {"offset", offset}};
+  out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;
 }
 
@@ -134,7 +136,11 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  std::vector<float> mesh_offset;  // a vertex has no single triangle: the offset scale is its mesh's largest coordinate
+  for (const Mesh& m : scene.meshes) {
+    const Bounds3 b = m.bounds();
+    mesh_offset.push_back(params.offset > 0 ? params.offset : ray_offset_distance(std::max(max_abs_coordinate(b.lo), max_abs_coordinate(b.hi))));
+  }
   std::vector<std::pair<std::uint32_t, std::uint32_t>> verts;  // (mesh, vertex)
   for (std::size_t m = 0; m < scene.meshes.size(); ++m)
     for (std::size_t v = 0; v < scene.meshes[m].positions.size(); ++v) verts.emplace_back(static_cast<std::uint32_t>(m), static_cast<std::uint32_t>(v));
@@ -155,6 +161,7 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
         const Vec3 nrm = normalize(m.normals[v]);
         const Frame frame = Frame::from_normal(nrm);
         const std::uint32_t key = pixel_seed(params.seed, vi, 0);
+        const float offset = mesh_offset[verts[static_cast<std::size_t>(vi)].first];
         double sum = 0;
         for (int first = 0; first < params.samples; first += batch) {
           const int c = std::min(batch, params.samples - first);

@@ -21,7 +21,7 @@ struct RaytracedBakeParams {
   int samples = 64;                      ///< Rays per texel (or vertex), each from its own point of the patch. [1, 1048576]. 64: the fewest that bake refined_elephant_uv at 1024^2 within RMSE 0.02 of a 1024-ray bake (docs/methods/bake.md).
   std::optional<float> max_distance;     ///< R, world units, > 0; nullopt = unlimited distance (the paper's eq. 1).
   Membership membership = Membership::Step;  ///< mu(d) when max_distance is set; unlimited distance is a step at infinity.
-  float offset = 0.0f;                   ///< Ray origin offset along the face normal, world units, [0, kMaxCoordinate]; 0 = RayScene's default (1e-5 x diagonal).
+  float offset = 0.0f;                   ///< Ray origin offset along the face normal, world units, [0, kMaxCoordinate]; 0 = the scale-free offset of reference/ray_offset.h.
   bool ignore_back_faces = false;        ///< Rays pass through back faces (what xNormal's and Substance's "ignore backface" do).
   bool bent_normals = false;             ///< Also average the unoccluded directions per texel.
   std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.

@@ -11,6 +11,7 @@
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/membership.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao::detail {
@@ -65,7 +66,7 @@ struct Tracer {
       RTCRayHit rh{};
       rh.ray = {o.x, o.y, o.z, tnear, d.x, d.y, d.z, 0.0f, reach, 0xffffffffu, 0, 0};
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(rs.handle(), &ctx, &rh);
+      rtcIntersect1(embree_scene(rs), &ctx, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 1.0f;
       if (!ignore_back || dot(normals.per_mesh[rh.hit.geomID][rh.hit.primID], d) <= 0) return falloff.mu(rh.ray.tfar);
       tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: look beyond it
@@ -82,7 +83,7 @@ struct Tracer {
       for (int k = 0; k < count; ++k) {
         if (occlusion_only) {
           RTCRay r{org[k].x, org[k].y, org[k].z, 0.0f, dir[k].x, dir[k].y, dir[k].z, 0.0f, reach, 0xffffffffu, 0, 0};
-          rtcOccluded1(rs.handle(), &ctx, &r);
+          rtcOccluded1(embree_scene(rs), &ctx, &r);
           mu[k] = r.tfar < 0 ? 0.0f : 1.0f;
         } else {
           mu[k] = trace1(ctx, org[k], dir[k], 0.0f);
@@ -98,10 +99,10 @@ struct Tracer {
         set_ray_hit(rh, k, org[s], dir[s], reach);
       }
       if (occlusion_only) {
-        Packet<N>::occluded(valid.data(), rs.handle(), &ctx, &rh.ray);
+        Packet<N>::occluded(valid.data(), embree_scene(rs), &ctx, &rh.ray);
         for (int k = 0; k < count; ++k) mu[k] = rh.ray.tfar[k] < 0 ? 0.0f : 1.0f;
       } else {
-        Packet<N>::intersect(valid.data(), rs.handle(), &ctx, &rh);
+        Packet<N>::intersect(valid.data(), embree_scene(rs), &ctx, &rh);
         for (int k = 0; k < count; ++k) {
           if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
             mu[k] = 1.0f;

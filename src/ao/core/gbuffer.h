@@ -10,11 +10,17 @@
 
 namespace ao {
 
+/// Which normal a G-buffer's `normal` holds, and so which hemisphere every method integrates over.
+enum class SurfaceNormal {
+  Shading,    ///< Interpolated vertex normals: the smooth surface the mesh approximates (default).
+  Geometric,  ///< The visible triangle's own normal: the integral of the faceted geometry as it is.
+};
+
 struct GBuffer {
   Camera camera;              ///< Intrinsics (fov, size) and, when known, the world placement.
   Image<Vec3> position;       ///< Camera-space position of the visible surface; (0,0,0) where not covered.
   Image<float> depth;         ///< Linear depth = -position.z (> 0); +infinity where not covered.
-  Image<Vec3> normal;         ///< Unit camera-space shading normal, facing the camera; (0,0,0) where not covered.
+  Image<Vec3> normal;         ///< Unit camera-space normal facing the camera (the shading normal unless rendered with SurfaceNormal::Geometric); (0,0,0) where not covered.
   Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered.
   Image<std::uint32_t> object_id;  ///< 1 + index of the mesh in its scene; 0 where not covered.
   Image<std::uint8_t> coverage;    ///< 1 where a surface is visible, 0 for background.
@@ -24,6 +30,11 @@ struct GBuffer {
   /// (Ld = 1: as bright as the sky), >= 0; 0 where not covered. Empty (the default) = no such
   /// pass. Read by ambient transfer's radiance mode (transfer.h) and by shading.
   Image<Vec3> direct;
+  /// Optional: index of the visible triangle within mesh object_id - 1 (0 where not covered).
+  /// Together with object_id it names the triangle, which lets ray-traced passes start their rays
+  /// off it robustly (reference/ray_offset.h). Filled by render_gbuffer; empty when unknown (a
+  /// G-buffer read from a file without a `primid` channel, or built by hand).
+  Image<std::uint32_t> primitive_id;
 
   GBuffer() = default;
   explicit GBuffer(const Camera& cam)

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <span>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "ao/core/error.h"
@@ -24,6 +27,32 @@ struct ImageView {
   std::size_t size() const { return static_cast<std::size_t>(width) * height; }
 };
 
+namespace detail {
+/// An allocator whose containers leave new pixels uninitialised, so that
+/// Image::resize does not write (and page in) memory the caller is about to overwrite.
+template <class T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <class U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  // Pixel types (float, Vec3, ...) are trivially copyable aggregates: implicit-lifetime types,
+  // whose objects exist in the allocated storage without a constructor call (C++20 [intro.object]),
+  // so even their default member initialisers are skipped. Others are default-initialised.
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    if constexpr (!(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>)) ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    std::allocator_traits<std::allocator<T>>::construct(static_cast<std::allocator<T>&>(*this), p, std::forward<Args>(args)...);
+  }
+};
+}  // namespace detail
+
 template <class T>
 class Image {
  public:
@@ -34,7 +63,9 @@ class Image {
   }
 
   /// Gives the image a new size, keeping its storage when that is large enough: a caller that
-  /// renders every frame then touches no fresh pages. Pixel values are unspecified afterwards.
+  /// renders every frame then touches no fresh pages. Pixel values are unspecified afterwards
+  /// (new pixels of trivial types are not even written, so a kernel that fills every pixel in
+  /// parallel pays for the fresh pages in parallel, once).
   void resize(int width, int height) {
     AO_ASSERT(width >= 0 && height >= 0);
     width_ = width, height_ = height;
@@ -62,7 +93,7 @@ class Image {
  private:
   int width_ = 0;
   int height_ = 0;
-  std::vector<T> pixels_;
+  std::vector<T, detail::DefaultInitAllocator<T>> pixels_;
 };
 
 }  // namespace ao

@@ -7,14 +7,27 @@
 
 namespace ao {
 
+/// What render_gbuffer puts in the G-buffer.
+struct GBufferOptions {
+  /// Which normal `normal` holds (and so which hemisphere every method integrates over). Default:
+  /// shading, the smooth surface scanned and modelled meshes stand for (docs/methods/raytraced.md).
+  SurfaceNormal normal = SurfaceNormal::Shading;
+};
+
 /// Traces one primary ray through each pixel centre of `camera` (which must validate) and fills
 /// every G-buffer channel: camera-space position interpolated on the hit triangle, linear depth,
-/// the interpolated shading normal turned to face the camera, the mesh's albedo and id. The
+/// the normal chosen by `options` turned to face the camera (the shading normal onto the side of
+/// the geometric one), the mesh's albedo and id, the triangle's index (primitive_id) and UVs. The
 /// optional direct-light pass is left empty (reference/direct_light.h computes one).
+GBuffer render_gbuffer(const RayScene& scene, const Camera& camera, const GBufferOptions& options, const ProgressFn& progress = {});
+/// The same with default options.
 GBuffer render_gbuffer(const RayScene& scene, const Camera& camera, const ProgressFn& progress = {});
 
 /// The same into an existing G-buffer, reusing its storage when the size matches (a renderer
 /// that draws frame after frame pays for the allocation once). Every pixel is written.
+void render_gbuffer(const RayScene& scene, const Camera& camera, const GBufferOptions& options, GBuffer& out,
+                    const ProgressFn& progress = {});
+/// The same with default options.
 void render_gbuffer(const RayScene& scene, const Camera& camera, GBuffer& out, const ProgressFn& progress = {});
 
 }  // namespace ao

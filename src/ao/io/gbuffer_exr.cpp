@@ -165,13 +165,14 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
   const bool has_p = has("P.X") && has("P.Y") && has("P.Z");
   const bool has_albedo = has("albedo.R") && has("albedo.G") && has("albedo.B");
   const bool has_id = has("id");
+  const bool has_primitive = has("primid");
   const bool has_a = has("A");
   const int direct_channels = int{has("direct.R")} + int{has("direct.G")} + int{has("direct.B")};
   if (direct_channels != 0 && direct_channels != 3)
     throw InputError(path.string() + ": the direct-light pass needs all of direct.R direct.G direct.B (the file has: " + channel_list(channels) + ")");
   const bool has_direct = direct_channels == 3;
   std::vector<float> z(n, kInfinity), nx(n, 0.0f), ny(n, 0.0f), nz(n, 0.0f), px, py, pz, ar, ag, ab, a, dr, dg, db;
-  std::vector<std::uint32_t> id;
+  std::vector<std::uint32_t> id, primitive;
   std::vector<ExrChannelTarget> targets = {{"Z", Imf::FLOAT, z.data()},
                                            {"N.X", Imf::FLOAT, nx.data()},
                                            {"N.Y", Imf::FLOAT, ny.data()},
@@ -200,10 +201,15 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
     id.assign(n, 0u);
     targets.push_back({"id", Imf::UINT, id.data()});
   }
+  if (has_primitive) {
+    primitive.assign(n, 0u);
+    targets.push_back({"primid", Imf::UINT, primitive.data()});
+  }
   read_exr_channels(file, w, targets);
 
   GBuffer g(camera);
   if (has_direct) g.direct = Image<Vec3>(w.width, w.height);  // 0 where not covered
+  if (has_primitive) g.primitive_id = Image<std::uint32_t>(w.width, w.height, 0u);
   const Frame basis = camera.basis();
   for (int y = 0; y < w.height; ++y) {
     for (int x = 0; x < w.width; ++x) {
@@ -236,6 +242,7 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
       g.normal(x, y) = normalize(normal);  // passes are often filtered or stored as half: renormalise
       g.albedo(x, y) = albedo;
       g.object_id(x, y) = has_id ? id[i] : 1u;
+      if (has_primitive) g.primitive_id(x, y) = primitive[i];
       g.coverage(x, y) = 1;
     }
   }
@@ -248,7 +255,8 @@ void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWrit
   const int width = g.width(), height = g.height();
   const auto same_size = [&](const auto& image) { return image.width() == width && image.height() == height; };
   if (width < 1 || height < 1 || !same_size(g.position) || !same_size(g.depth) || !same_size(g.normal) || !same_size(g.albedo) ||
-      !same_size(g.object_id) || !same_size(g.coverage) || (!g.direct.empty() && !same_size(g.direct)))
+      !same_size(g.object_id) || !same_size(g.coverage) || (!g.direct.empty() && !same_size(g.direct)) ||
+      (!g.primitive_id.empty() && !same_size(g.primitive_id)))
     throw InputError(path.string() + ": G-buffer images do not all match the camera's " + std::to_string(width) + "x" +
                      std::to_string(height) + " pixels");
 
@@ -284,6 +292,7 @@ void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWrit
   insert_vec3("N.X", "N.Y", "N.Z", g.normal);
   if (opt.albedo) insert_vec3("albedo.R", "albedo.G", "albedo.B", g.albedo);
   if (opt.object_ids) insert("id", Imf::UINT, g.object_id.data(), sizeof(std::uint32_t));
+  if (opt.primitive_ids && !g.primitive_id.empty()) insert("primid", Imf::UINT, g.primitive_id.data(), sizeof(std::uint32_t));
   if (opt.coverage) insert("A", Imf::FLOAT, alpha.data(), sizeof(float));
   if (opt.direct && !g.direct.empty()) insert_vec3("direct.R", "direct.G", "direct.B", g.direct);
   write_exr_atomically(path, header, frame);

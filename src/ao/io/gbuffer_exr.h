@@ -16,6 +16,7 @@ struct GBufferWriteOptions {
   bool positions = true;   ///< P.X P.Y P.Z (else rebuilt from Z and the camera on reading).
   bool albedo = true;      ///< albedo.R albedo.G albedo.B.
   bool object_ids = true;  ///< id.
+  bool primitive_ids = true;  ///< primid (triangle index within mesh id - 1), when the G-buffer has one.
   bool coverage = true;    ///< A.
   bool camera = true;      ///< worldToCamera and the ao:* camera attributes (fov included).
   bool direct = true;      ///< direct.R direct.G direct.B, when the G-buffer has a direct-light pass.
@@ -23,7 +24,7 @@ struct GBufferWriteOptions {
 
 /// Writes every G-buffer channel (P.X P.Y P.Z, Z, N.X N.Y N.Z, albedo.R albedo.G albedo.B as
 /// FLOAT; id as UINT; A = coverage as FLOAT 0/1; direct.R direct.G direct.B as FLOAT when
-/// gbuffer.direct is not empty) to one scanline, ZIP-compressed EXR, with the
+/// gbuffer.direct is not empty; primid as UINT when gbuffer.primitive_id is not empty) to one scanline, ZIP-compressed EXR, with the
 /// camera in the header: the standard `worldToCamera` matrix (OpenEXR's left-handed camera space,
 /// see docs/gbuffer.md) and `ao:verticalFov` (degrees), `ao:eye`, `ao:target`, `ao:up` (world units).
 /// Values are written exactly, +infinity background depth included. The images must all have the
@@ -49,6 +50,7 @@ struct GBufferReadOptions {
 /// - P.*: reconstructed from Z through each pixel centre (P = camera_direction(x+0.5, y+0.5) * Z);
 /// - A: covered where Z is finite, > 0 and below `background_depth`; with A, covered where A >= 0.5;
 /// - albedo.*: 0.8 grey where covered; id: 1 where covered;
+/// - primid: the triangle index (GBuffer::primitive_id); without it primitive_id stays empty;
 /// - direct.*: the direct-light pass (Ld / La, GBuffer::direct); without them GBuffer::direct
 ///   stays empty. Some but not all three is an error; at covered pixels they must be finite, >= 0.
 /// The image is the display window (pixels outside the data window are background). The camera

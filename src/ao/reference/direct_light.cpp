@@ -7,6 +7,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/gbuffer_rays_internal.h"
 
 namespace ao {
 
@@ -21,34 +22,35 @@ struct ShadowQuery {
   Vec3 radiance;     // a/pi E n.l, before visibility
 };
 
-ShadowQuery query(const GBuffer& g, const Frame& basis, Vec3 eye, Vec3 light, float e_over_pi, float offset, int x, int y) {
+ShadowQuery query(const detail::PixelSurfaceContext& surface, Vec3 light, float e_over_pi, int x, int y) {
   ShadowQuery q;
+  const GBuffer& g = surface.g;
   if (!g.covered(x, y)) return q;
-  const Vec3 n = normalize(basis.to_world(g.normal(x, y)));
-  const float cos_theta = dot(n, light);
+  const detail::PixelSurface s = surface(x, y);
+  const float cos_theta = dot(s.normal, light);
   if (!(cos_theta > 0.0f)) return q;  // facing away (or grazing): no direct light, no ray
-  q.lit = true;
-  q.origin = basis.to_world(g.position(x, y)) + eye + n * offset;
   q.radiance = g.albedo(x, y) * (e_over_pi * cos_theta);  // a/pi * E * max(0, n.l)
+  // A sun below the triangle's own plane (possible with a shading normal) is behind the surface:
+  // shadowed without a ray, as a ray would enter the surface at once.
+  q.lit = dot(s.geometric, light) > 0.0f;
+  q.origin = s.position + s.geometric * s.offset;
   return q;
 }
 
 template <int N>
-void shade_tile(const RayScene& rs, const GBuffer& g, const Frame& basis, Vec3 light, float e_over_pi, float offset, Image<Vec3>& out,
-                const Tile& t) {
+void shade_tile(const RayScene& rs, const detail::PixelSurfaceContext& surface, Vec3 light, float e_over_pi, Image<Vec3>& out, const Tile& t) {
   detail::flush_denormals_to_zero();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   // Parallel rays from neighbouring pixels: as coherent as primary rays.
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  const Vec3 eye = g.camera.eye;
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
-        const ShadowQuery q = query(g, basis, eye, light, e_over_pi, offset, x, y);
+        const ShadowQuery q = query(surface, light, e_over_pi, x, y);
         if (!q.lit) continue;
         RTCRay ray{q.origin.x, q.origin.y, q.origin.z, 0.0f, light.x, light.y, light.z, 0.0f, kInfinity, 0xffffffffu, 0, 0};
-        rtcOccluded1(rs.handle(), &ctx, &ray);
+        rtcOccluded1(embree_scene(rs), &ctx, &ray);
         if (ray.tfar >= 0.0f) out(x, y) = q.radiance;  // Embree sets tfar = -inf on a hit
       }
   } else {
@@ -63,14 +65,14 @@ void shade_tile(const RayScene& rs, const GBuffer& g, const Frame& basis, Vec3 l
         for (int k = 0; k < N; ++k) {
           const int x = bx + k % bw, y = by + k / bw;
           const bool inside = x < t.x1 && y < t.y1;
-          const ShadowQuery q = inside ? query(g, basis, eye, light, e_over_pi, offset, x, y) : ShadowQuery{};
+          const ShadowQuery q = inside ? query(surface, light, e_over_pi, x, y) : ShadowQuery{};
           valid[static_cast<std::size_t>(k)] = q.lit ? -1 : 0;
           radiance[static_cast<std::size_t>(k)] = q.radiance;
           detail::set_ray(rays, k, q.origin, light, kInfinity);
           any = any || q.lit;
         }
         if (!any) continue;
-        detail::Packet<N>::occluded(valid.data(), rs.handle(), &ctx, &rays);
+        detail::Packet<N>::occluded(valid.data(), embree_scene(rs), &ctx, &rays);
         for (int k = 0; k < N; ++k)
           if (valid[static_cast<std::size_t>(k)] && rays.tfar[k] >= 0.0f) out(bx + k % bw, by + k / bw) = radiance[static_cast<std::size_t>(k)];
       }
@@ -90,14 +92,13 @@ Image<Vec3> render_direct_light(const RayScene& rs, const GBuffer& g, const Sun&
   sun.validate();
   const int w = g.width(), h = g.height();
   Image<Vec3> out(w, h);  // 0: written only where lit and unshadowed
-  const Frame basis = g.camera.basis();
   const Vec3 light = normalize(sun.direction);
   const float e_over_pi = sun.irradiance / kPi;  // the diffuse BRDF a/pi times E
-  const float offset = rs.self_intersection_offset();
+  const detail::PixelSurfaceContext surface(g, rs.scene(), rs.bounds(), 0.0f);
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-      shade_tile<N>(rs, g, basis, light, e_over_pi, offset, out, t);
+      shade_tile<N>(rs, surface, light, e_over_pi, out, t);
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
     });
   });

@@ -29,9 +29,10 @@ struct Sun {
 };
 
 /// Ld per pixel of `g` (whose camera must carry its world placement, as render_gbuffer's does):
-/// one shadow ray per covered pixel facing the sun (n.l > 0, n the G-buffer's shading normal),
-/// from the world position offset along n by RayScene::self_intersection_offset() (as the
-/// ray-traced reference offsets its rays). 0 where not covered, facing away, or shadowed.
+/// one shadow ray per covered pixel facing the sun (n.l > 0, n the G-buffer's normal), from the
+/// world position moved off its triangle by the robust offset of ray_offset.h (as the ray-traced
+/// reference starts its rays). A sun below the triangle's own plane counts as shadowed. 0 where
+/// not covered, facing away, or shadowed.
 /// Deterministic and independent of the thread count (no sampling).
 Image<Vec3> render_direct_light(const RayScene& scene, const GBuffer& g, const Sun& sun, const ProgressFn& progress = {});
 

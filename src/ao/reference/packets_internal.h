@@ -7,6 +7,7 @@
 #include <xmmintrin.h>
 
 #include "ao/core/math.h"
+#include "ao/reference/embree_scene_internal.h"
 
 namespace ao::detail {
 
@@ -45,6 +46,11 @@ inline void flush_denormals_to_zero() {
 template <int N>
 struct Packet;
 
+template <>
+struct Packet<1> {  // single rays: kernels call rtcIntersect1 / rtcOccluded1 themselves
+  using RayHit = RTCRayHit;
+  using Ray = RTCRay;
+};
 template <>
 struct Packet<4> {
   using RayHit = RTCRayHit4;

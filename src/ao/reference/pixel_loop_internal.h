@@ -12,6 +12,7 @@
 #include "ao/core/parallel.h"
 #include "ao/core/progress.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 
@@ -76,7 +77,7 @@ void trace_closest(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, in
       RTCRayHit rh{};
       rh.ray = {origin.x, origin.y, origin.z, 0.0f, d.x, d.y, d.z, 0.0f, tfar(i), 0xffffffffu, 0, 0};
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(rs.handle(), &ctx, &rh);
+      rtcIntersect1(embree_scene(rs), &ctx, &rh);
       const bool missed = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
       hit(i, missed ? kInfinity : rh.ray.tfar, rh.hit.geomID);
     }
@@ -90,7 +91,7 @@ void trace_closest(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, in
         const int i = first + std::min(k, lanes - 1);
         set_ray_hit(rh, k, origin, dir(i), tfar(i));
       }
-      Packet<N>::intersect(valid, rs.handle(), &ctx, &rh);
+      Packet<N>::intersect(valid, embree_scene(rs), &ctx, &rh);
       for (int k = 0; k < lanes; ++k) {
         const bool missed = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID;
         hit(first + k, missed ? kInfinity : rh.ray.tfar[k], rh.hit.geomID[k]);

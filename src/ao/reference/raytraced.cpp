@@ -1,12 +1,16 @@
 #include "ao/reference/raytraced.h"
 
+#include <algorithm>
 #include <array>
+#include <vector>
 #include <cmath>
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/gbuffer_rays_internal.h"
+#include "ao/reference/ray_offset.h"
 
 namespace ao {
 
@@ -15,19 +19,86 @@ namespace {
 constexpr int kTile = 16;
 constexpr int kMaxSamples = 1 << 20;
 
+// The sample set of every point: the first `samples` points of the 2-D Sobol sequence, stored as
+// what the direction mapping needs, and randomised per point by a Cranley-Patterson rotation
+// (a random shift modulo 1 in each dimension). Each shifted point is uniform on the square, so
+// the estimate is unbiased; the shifted set keeps Sobol's low discrepancy (every power-of-two
+// prefix of dimension 0 stays one point per stratum); and points with different shifts are
+// independent, so the per-pixel standard error is honest. The shift of dimension 1 is a rotation
+// about the normal, applied to the tangent frame once per point instead of to every direction.
+//
+// Directions: u0 -> r^2 (polar map of the square to the unit disk, r = sqrt(u0), phi = 2 pi u1),
+// lifted to the hemisphere, z = sqrt(1 - r^2) (Malley's method): cosine-weighted, pdf cos/pi.
+struct SampleTable {
+  int count = 0;                // samples, rounded up to a whole packet
+  std::vector<float> u0;        // Sobol dimension 0 in [0, 1)
+  std::vector<float> cos_phi;   // cos(2 pi u1), u1 = Sobol dimension 1
+  std::vector<float> sin_phi;   // sin(2 pi u1)
+};
+
+std::uint32_t reverse_bits32(std::uint32_t x) {
+  x = (x << 16) | (x >> 16);
+  x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+  x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+  x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+  return x;
+}
+
+// Sobol dimension 1: direction numbers of the primitive polynomial x + 1, v_{k+1} = v_k ^ (v_k >> 1).
+std::uint32_t sobol_dim1(std::uint32_t i) {
+  std::uint32_t result = 0;
+  for (std::uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
+    if (i & 1u) result ^= v;
+  return result;
+}
+
+SampleTable make_sample_table(int samples, int packet) {
+  SampleTable t;
+  t.count = (samples + packet - 1) / packet * packet;
+  t.u0.assign(static_cast<std::size_t>(t.count), 0.0f);
+  t.cos_phi.assign(static_cast<std::size_t>(t.count), 1.0f);
+  t.sin_phi.assign(static_cast<std::size_t>(t.count), 0.0f);
+  for (int i = 0; i < samples; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    t.u0[k] = to_unit_float(reverse_bits32(static_cast<std::uint32_t>(i)));
+    const double phi = 2.0 * 3.14159265358979323846 * to_unit_float(sobol_dim1(static_cast<std::uint32_t>(i)));
+    t.cos_phi[k] = static_cast<float>(std::cos(phi));
+    t.sin_phi[k] = static_cast<float>(std::sin(phi));
+  }
+  return t;
+}
+
+// One point to estimate: where its rays start and the frame they are drawn in.
+struct PointSetup {
+  Vec3 origin;        // world space, off the surface
+  Vec3 t, b, n;       // tangent frame about the integration normal, rotated by the point's azimuth shift
+  Vec3 ng;            // unit geometric normal on the side the rays leave from
+  float shift = 0;    // Cranley-Patterson shift of dimension 0, [0, 1)
+};
+
+PointSetup setup_point(Vec3 p, Vec3 n, Vec3 ng, float offset, std::uint32_t key) {
+  PointSetup s;
+  s.origin = p + ng * offset;
+  const Frame f = Frame::from_normal(n);
+  const float a = 2.0f * kPi * to_unit_float(hash_combine(key, 2u));
+  const float ca = std::cos(a), sa = std::sin(a);
+  s.t = f.t * ca + f.b * sa;
+  s.b = f.b * ca - f.t * sa;
+  s.n = n;
+  s.ng = ng;
+  s.shift = to_unit_float(hash_combine(key, 1u));
+  return s;
+}
+
 // Running sums for one point; doubles so a million samples of mu in [0,1] stay exact enough.
 struct Accumulator {
   double sum = 0, sum_sq = 0;
   int n = 0;
 
-  void add(float mu) {
-    sum += mu;
-    sum_sq += static_cast<double>(mu) * mu;
-    ++n;
-  }
   double mean() const { return n > 0 ? sum / n : 1.0; }
-  // Standard error of the mean from the unbiased sample variance. With scrambled Sobol samples the
-  // true error is usually smaller, so this is a conservative stopping rule and report.
+  // Standard error of the mean from the unbiased sample variance. With stratified (Sobol) samples
+  // the true error is usually smaller, so this is a conservative stopping rule and report.
   double std_error() const {
     if (n < 2) return 0.0;
     const double var = std::max(0.0, (sum_sq - sum * sum / n) / (n - 1));
@@ -35,59 +106,123 @@ struct Accumulator {
   }
 };
 
-// Traces samples [first, first + count) of one point's sample set. count <= N.
+// Directions of samples [first, first + N) of point `s` into the packet, with valid[k] = -1 for
+// the lanes to trace: inside the sample count and above the geometric tangent plane. A direction
+// below it (possible about a shading normal) enters the surface at once: occluded, mu = 0,
+// counted without a ray. Branch-free so the compiler vectorises it across lanes.
 template <int N>
-void trace_batch(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, const Frame& frame, const Falloff& falloff, std::uint32_t seed,
-                 int first, int count, Accumulator& acc) {
+int fill_directions(const SampleTable& tbl, const PointSetup& s, int first, int end, float* __restrict dir_x, float* __restrict dir_y,
+                    float* __restrict dir_z, int* __restrict valid) {
+  const float* __restrict u0 = tbl.u0.data() + first;
+  const float* __restrict cp = tbl.cos_phi.data() + first;
+  const float* __restrict sp = tbl.sin_phi.data() + first;
+  int live = 0;
+  for (int k = 0; k < N; ++k) {
+    float u = u0[k] + s.shift;
+    u = u >= 1.0f ? u - 1.0f : u;
+    const float r = std::sqrt(u), z = std::sqrt(std::max(0.0f, 1.0f - u));
+    const float x = r * cp[k], y = r * sp[k];
+    const float dx = s.t.x * x + s.b.x * y + s.n.x * z;
+    const float dy = s.t.y * x + s.b.y * y + s.n.y * z;
+    const float dz = s.t.z * x + s.b.z * y + s.n.z * z;
+    dir_x[k] = dx;
+    dir_y[k] = dy;
+    dir_z[k] = dz;
+    const bool above = dx * s.ng.x + dy * s.ng.y + dz * s.ng.z > 0.0f;
+    const bool on = first + k < end && above;
+    valid[k] = on ? -1 : 0;
+    live += on;
+  }
+  return live;
+}
+
+// Traces samples [first, end) of one point, at most N, and adds their mu to acc.
+template <int N>
+void trace_batch(RTCScene bvh, RTCIntersectContext& ctx, const SampleTable& tbl, const PointSetup& s, const Falloff& falloff, int first,
+                 int end, typename detail::Packet<N>::RayHit& rh, Accumulator& acc) {
   const float reach = falloff.reach();
-  const bool step = falloff.membership == Membership::Step;
+  alignas(64) std::array<int, N> valid;
   if constexpr (N == 1) {
-    for (int i = first; i < first + count; ++i) {
-      const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(i), seed)));
-      RTCRayHit rh{};
-      rh.ray = {origin.x, origin.y, origin.z, 0.0f, d.x, d.y, d.z, 0.0f, reach, 0xffffffffu, 0, 0};
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      if (step) {
-        rtcOccluded1(rs.handle(), &ctx, &rh.ray);
-        acc.add(rh.ray.tfar < 0 ? 0.0f : 1.0f);
+    fill_directions<1>(tbl, s, first, end, &rh.ray.dir_x, &rh.ray.dir_y, &rh.ray.dir_z, valid.data());
+    rh.ray.tfar = reach;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    float mu = 0.0f;
+    if (valid[0]) {
+      if (falloff.membership == Membership::Step) {
+        rtcOccluded1(bvh, &ctx, &rh.ray);
+        mu = rh.ray.tfar < 0 ? 0.0f : 1.0f;
       } else {
-        rtcIntersect1(rs.handle(), &ctx, &rh);
-        acc.add(rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0f : falloff.mu(rh.ray.tfar));
+        rtcIntersect1(bvh, &ctx, &rh);
+        mu = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0f : falloff.mu(rh.ray.tfar);
       }
     }
+    acc.sum += mu;
+    acc.sum_sq += static_cast<double>(mu) * mu;
+    acc.n += 1;
   } else {
-    alignas(64) typename detail::Packet<N>::RayHit rh;
-    alignas(64) std::array<int, N> valid;
-    for (int k = 0; k < N; ++k) {
-      valid[k] = k < count ? -1 : 0;
-      const Vec3 d = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), seed)));
-      detail::set_ray_hit(rh, k, origin, d, reach);
-    }
-    if (step) {
-      // Classical AO needs only "is anything closer than R", the cheaper occlusion query.
-      detail::Packet<N>::occluded(valid.data(), rs.handle(), &ctx, &rh.ray);
-      for (int k = 0; k < count; ++k) acc.add(rh.ray.tfar[k] < 0 ? 0.0f : 1.0f);
+    const int live = fill_directions<N>(tbl, s, first, end, rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z, valid.data());
+    acc.n += std::min(N, end - first);  // lanes below the surface count as mu = 0
+    if (live == 0) return;
+    for (int k = 0; k < N; ++k) rh.ray.tfar[k] = reach;
+    if (falloff.membership == Membership::Step) {
+      // Classical AO needs only "is anything closer than R", the cheaper occlusion query, and
+      // mu is 0 or 1, so sum = sum of squares = the number of open rays.
+      detail::Packet<N>::occluded(valid.data(), bvh, &ctx, &rh.ray);
+      int open = 0;
+      for (int k = 0; k < N; ++k) open += (valid[k] != 0) & (rh.ray.tfar[k] >= 0.0f);
+      acc.sum += open;
+      acc.sum_sq += open;
     } else {
-      detail::Packet<N>::intersect(valid.data(), rs.handle(), &ctx, &rh);
-      for (int k = 0; k < count; ++k) acc.add(rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? 1.0f : falloff.mu(rh.ray.tfar[k]));
+      for (int k = 0; k < N; ++k) rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      detail::Packet<N>::intersect(valid.data(), bvh, &ctx, &rh);
+      float sum = 0, sum_sq = 0;
+      for (int k = 0; k < N; ++k) {
+        if (!valid[k]) continue;
+        const float mu = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? 1.0f : falloff.mu(rh.ray.tfar[k]);
+        sum += mu;
+        sum_sq += mu * mu;
+      }
+      acc.sum += sum;
+      acc.sum_sq += sum_sq;
     }
   }
 }
 
 template <int N>
-VisibilityEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 p, Vec3 n, const Falloff& falloff, const RaytracedParams& params,
-                            float offset, std::uint32_t seed) {
-  const Frame frame = Frame::from_normal(n);
-  const Vec3 origin = p + n * offset;
-  constexpr int batch = N == 1 ? 16 : N;
+void init_packet(typename detail::Packet<N>::RayHit& rh) {
+  if constexpr (N == 1) {
+    rh = {};
+    rh.ray.mask = 0xffffffffu;
+  } else {
+    for (int k = 0; k < N; ++k) detail::set_ray_hit(rh, k, {}, {0, 0, 1}, 0.0f);
+  }
+}
+
+template <int N>
+VisibilityEstimate estimate(RTCScene bvh, RTCIntersectContext& ctx, const SampleTable& tbl, const PointSetup& s, const Falloff& falloff,
+                            const RaytracedParams& params, typename detail::Packet<N>::RayHit& rh) {
+  if constexpr (N == 1) {
+    rh.ray.org_x = s.origin.x;
+    rh.ray.org_y = s.origin.y;
+    rh.ray.org_z = s.origin.z;
+  } else {
+    for (int k = 0; k < N; ++k) {
+      rh.ray.org_x[k] = s.origin.x;
+      rh.ray.org_y[k] = s.origin.y;
+      rh.ray.org_z[k] = s.origin.z;
+    }
+  }
   Accumulator acc;
   const bool adaptive = params.target_error > 0;
+  constexpr int batch = N == 1 ? 1 : N;
   for (int first = 0; first < params.samples; first += batch) {
-    trace_batch<N>(rs, ctx, origin, frame, falloff, seed, first, std::min(batch, params.samples - first), acc);
-    if (adaptive && acc.n >= params.min_samples && acc.std_error() <= params.target_error) break;
+    trace_batch<N>(bvh, ctx, tbl, s, falloff, first, params.samples, rh, acc);
+    if (adaptive && acc.n >= params.min_samples && acc.n % 16 == 0 && acc.std_error() <= params.target_error) break;
   }
   return {static_cast<float>(acc.mean()), static_cast<float>(acc.std_error()), acc.n};
 }
+
+int table_packet(int native_width) { return std::max(native_width, 1); }
 
 }  // namespace
 
@@ -119,9 +254,17 @@ VisibilityEstimate estimate_visibility(const RayScene& rs, Vec3 p, Vec3 n, const
   params.validate();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  const SampleTable tbl = make_sample_table(params.samples, table_packet(rs.native_packet_width()));
+  // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
+  const Bounds3& b = rs.bounds();
+  const float magnitude = std::max({max_abs_coordinate(p), max_abs_coordinate(b.lo), max_abs_coordinate(b.hi)});
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(magnitude);
+  const Vec3 nn = normalize(n);
+  const PointSetup s = setup_point(p, nn, nn, offset, seed);
   return detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    return estimate<N>(rs, ctx, p, normalize(n), falloff, params, offset, seed);
+    alignas(64) typename detail::Packet<N>::RayHit rh;
+    init_packet<N>(rh);
+    return estimate<N>(embree_scene(rs), ctx, tbl, s, falloff, params, rh);
   });
 }
 
@@ -130,23 +273,36 @@ RaytracedImage render_raytraced(const RayScene& rs, const GBuffer& g, const Fall
   falloff.validate();
   params.validate();
   const int w = g.width(), h = g.height();
-  RaytracedImage out{Image<float>(w, h, 1.0f), Image<float>(w, h, 0.0f)};
-  Image<int> samples(w, h, 0);
-  const Frame basis = g.camera.basis();
-  const Vec3 eye = g.camera.eye;
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  // Every pixel is written by the tiles (uncovered ones: V = 1, no error, no rays), so the images
+  // are only sized here and their fresh pages are first touched in parallel.
+  RaytracedImage out;
+  out.visibility.resize(w, h);
+  out.std_error.resize(w, h);
+  Image<int> samples;
+  samples.resize(w, h);
+  const detail::PixelSurfaceContext surface(g, rs.scene(), rs.bounds(), params.offset);
+  const SampleTable tbl = make_sample_table(params.samples, table_packet(rs.native_packet_width()));
+  const RTCScene bvh = embree_scene(rs);
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
       detail::flush_denormals_to_zero();
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
+      ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;  // directions spread over the hemisphere
+      alignas(64) typename detail::Packet<N>::RayHit rh;
+      init_packet<N>(rh);
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x) {
-          if (!g.covered(x, y)) continue;
-          const Vec3 p = basis.to_world(g.position(x, y)) + eye;
-          const Vec3 n = normalize(basis.to_world(g.normal(x, y)));
-          const VisibilityEstimate e = estimate<N>(rs, ctx, p, n, falloff, params, offset, pixel_seed(seed, x, y));
+          if (!g.covered(x, y)) {
+            out.visibility(x, y) = 1.0f;
+            out.std_error(x, y) = 0.0f;
+            samples(x, y) = 0;
+            continue;
+          }
+          const detail::PixelSurface ps = surface(x, y);
+          const PointSetup s = setup_point(ps.position, ps.normal, ps.geometric, ps.offset, pixel_seed(seed, x, y));
+          const VisibilityEstimate e = estimate<N>(bvh, ctx, tbl, s, falloff, params, rh);
           out.visibility(x, y) = e.visibility;
           out.std_error(x, y) = e.std_error;
           samples(x, y) = e.samples;

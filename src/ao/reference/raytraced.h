@@ -21,7 +21,7 @@ struct RaytracedParams {
   int samples = 256;           ///< Rays per pixel; with target_error, the most a pixel may take. [1, 1048576].
   float target_error = 0.0f;   ///< Stop a pixel once the standard error of its mean is <= this; 0 = off. [0, 0.5].
   int min_samples = 64;        ///< With target_error: rays a pixel takes before it may stop. [16, samples].
-  float offset = 0.0f;         ///< Ray origin offset along the normal, world units, [0, kMaxCoordinate]; 0 = RayScene's default.
+  float offset = 0.0f;         ///< Ray origin offset along the geometric normal, world units, [0, kMaxCoordinate]; 0 = the scale-free offset of ray_offset.h.
 
   /// Throws InputError naming the bad field.
   void validate() const;

@@ -59,7 +59,7 @@ VisibilityEstimate estimate_tangent_sphere(const RayScene& rs, Vec3 p, Vec3 n, f
   params.validate();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
   return detail::dispatch_packet_width(rs.native_packet_width(),
                                        [&]<int N>() { return estimate<N>(rs, ctx, p, normalize(n), radius, params, offset, seed); });
 }
@@ -71,7 +71,7 @@ RaytracedImage render_tangent_sphere(const RayScene& rs, const GBuffer& g, float
   const int w = g.width(), h = g.height();
   RaytracedImage out{Image<float>(w, h, 1.0f), Image<float>(w, h, 0.0f)};
   Image<int> samples(w, h, 0);
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
   detail::for_each_covered_pixel(rs, g, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, Vec3 p, Vec3 n) {
     const VisibilityEstimate e = estimate<N>(rs, ctx, p, n, radius, params, offset, pixel_seed(seed, x, y));
     out.visibility(x, y) = e.visibility;

@@ -96,7 +96,7 @@ TransferEstimate estimate_transfer(const RayScene& rs, Vec3 p, Vec3 n, const Fal
   const std::vector<Vec3> albedo = scaled_albedos(rs, albedo_scale);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
   return detail::dispatch_packet_width(rs.native_packet_width(),
                                        [&]<int N>() { return estimate<N>(rs, ctx, p, normalize(n), falloff, albedo, params, offset, seed); });
 }
@@ -110,7 +110,7 @@ TransferReferenceImage render_transfer_reference(const RayScene& rs, const GBuff
   TransferReferenceImage out{Image<Vec3>(w, h, Vec3{1.0f, 1.0f, 1.0f}), {Image<float>(w, h, 1.0f), Image<float>(w, h, 0.0f)},
                              Image<float>(w, h, 1.0f)};
   Image<int> samples(w, h, 0);
-  const float offset = params.offset > 0 ? params.offset : rs.self_intersection_offset();
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
   detail::for_each_covered_pixel(rs, g, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, Vec3 p, Vec3 n) {
     const TransferEstimate e = estimate<N>(rs, ctx, p, n, falloff, albedo, params, offset, pixel_seed(seed, x, y));
     out.transfer(x, y) = e.transfer;

@@ -6,6 +6,7 @@
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/pixel_loop_internal.h"
+#include "ao/reference/ray_offset.h"
 
 namespace ao {
 

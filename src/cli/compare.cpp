@@ -165,7 +165,8 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   table["setup_ms"] = setup_ms;
   const std::string md = compare_table_markdown(result, scene.name);
 
-  settings.falloff = choose_falloff(o.falloff, interest_diagonal(scene));
+  write_output_text("table.json", table.dump(2) + "\n");
+  write_output_text("table.md", md);
   std::vector<SheetRow> sheet_rows;
   for (const CompareRow& row : result.rows) {
     std::vector<std::string> label = {row.method};
@@ -190,7 +191,9 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   if (o.json) {
     std::cout << table.dump(2) << "\n";
   } else {
-  settings.falloff = choose_falloff(o.falloff, interest_diagonal(scene));
+    std::fprintf(stderr, "wrote %s/: table.md, table.json, sheet.png%s (R = %.4g, %s normals)\n", out_dir.string().c_str(),
+                 result.sweep_key.empty() ? "" : ", sweep.md, sweep.json", settings.falloff.radius, o.normal.c_str());
+    std::cerr << md.substr(md.find("| method"));
   }
   return 0;
 }

@@ -85,7 +85,7 @@ TEST(OutputsCli, BakeLateWriteFailureKeepsTheEarlierOutputsAndLeavesNoTemporaryF
   write_text(dir / "ao.png", "previous map");
   // A 16 x 16 map is under 1 KiB; the per-vertex PLY of 10,201 vertices and 20,000 triangles is
   // about 450 KB, over the 64 KiB limit: it is written last and fails.
-  const std::string args = "bake grid.obj -o ao.png --per-vertex v.ply --size 16 --directions 16 --vertex-resolution 64";
+  const std::string args = "bake grid.obj -m histogram -o ao.png --per-vertex v.ply --size 16 --directions 16 --vertex-resolution 64";
   const RunResult r = run_ao_with_file_limit(args, dir.path(), 64);
   EXPECT_EQ(r.exit_code, 3) << r.err;
   expect_one_line_error(r, "v.ply");
@@ -100,7 +100,7 @@ TEST(OutputsCli, OutputThatIsAnInputOrAnotherOutputIsRefusedBeforeAnyWork) {
   TempDir dir;
   ASSERT_EQ(run_ao("render plane --width 40 --height 30 --spp 4 -o v.png --gbuffer-out g.exr", dir.path()).exit_code, 0);
   write_text(dir / "grid.obj", grid_obj(4));
-  ASSERT_EQ(run_ao("bake grid.obj --size 16 --directions 16 -o ao.png --per-vertex in.ply --gltf in.glb", dir.path()).exit_code, 0);
+  ASSERT_EQ(run_ao("bake grid.obj -m histogram --size 16 --directions 16 -o ao.png --per-vertex in.ply --gltf in.glb", dir.path()).exit_code, 0);
   fs::create_symlink("g.exr", dir / "link.exr");
   const std::string g = read_text(dir / "g.exr"), ply = read_text(dir / "in.ply"), glb = read_text(dir / "in.glb");
   const std::pair<const char*, const char*> cases[] = {

@@ -167,9 +167,9 @@ TEST_P(AllMethods, BadParameterValuesAreRefused) {
         // Just outside each finite bound; the message states the range.
         const bool real = s.type == ao::ParamType::Float;
         if (std::isfinite(s.range.min))
-          refused(real ? nlohmann::json(s.range.min - (s.range.min_open ? 0.0 : 0.5)) : nlohmann::json(static_cast<long long>(s.range.min) - 1));
+          refused(real ? nlohmann::json(s.range.min_open ? s.range.min : s.range.min - std::max(0.5, 1e-3 * std::abs(s.range.min))) : nlohmann::json(static_cast<long long>(s.range.min) - 1));
         if (std::isfinite(s.range.max))
-          refused(real ? nlohmann::json(s.range.max + (s.range.max_open ? 0.0 : 0.5)) : nlohmann::json(static_cast<long long>(s.range.max) + 1));
+          refused(real ? nlohmann::json(s.range.max_open ? s.range.max : s.range.max + std::max(0.5, 1e-3 * std::abs(s.range.max))) : nlohmann::json(static_cast<long long>(s.range.max) + 1));
     }
   }
 }

@@ -42,7 +42,9 @@ TEST(Interleave, FilterSkipsNeighboursAcrossADepthEdgeAndBackground) {
   const Image<float> f = depth_aware_box_filter(v, g, 0.5f);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 16; ++x)
-      if (g.covered(x, y)) EXPECT_FLOAT_EQ(f(x, y), x < 8 ? 0.25f : 1.0f) << x << "," << y;
+      if (g.covered(x, y)) {
+        EXPECT_FLOAT_EQ(f(x, y), x < 8 ? 0.25f : 1.0f) << x << "," << y;
+      }
   EXPECT_EQ(f(2, 2), 100.0f) << "uncovered pixels keep their value";
   // With a limit above the step the edge blurs.
   EXPECT_GT(depth_aware_box_filter(v, g, 10.0f)(7, 4), 0.25f);

@@ -57,7 +57,9 @@ TEST(RayOffset, NoAcneOnTiltedPlaneFarFromOrigin) {
   // The sun pass starts its shadow rays the same way: a sun on the visible side lights every pixel.
   const Image<Vec3> ld = render_direct_light(rs, g, Sun{normalize(side + u * 0.3f), kPi});
   for (std::size_t i = 0; i < ld.size(); ++i)
-    if (g.coverage[i]) ASSERT_GT(ld[i].x, 0.0f) << "pixel " << i << " shadowed by its own plane";
+    if (g.coverage[i]) {
+      ASSERT_GT(ld[i].x, 0.0f) << "pixel " << i << " shadowed by its own plane";
+    }
 }
 
 // A convex mesh (a UV sphere's polyhedron) 1e-4 across seen from outside: about the geometric

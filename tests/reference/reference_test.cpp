@@ -25,8 +25,8 @@ TEST(Reference, EachMethodIsJudgedAgainstWhatItEstimates) {
   EXPECT_EQ(matched("transfer", f).kind, ReferenceKind::Transfer);
   EXPECT_EQ(matched("transfer", f).label(), "transfer (linear)");
   EXPECT_EQ(matched("cone", f).label(), "step obscurance");
-  // Alchemy at its defaults: u = 2r >= r, exactly step AO, and named so.
-  EXPECT_EQ(matched("alchemy", f).label(), "step obscurance");
+  // Alchemy at its fitted default sigma 0.4 (u = 0.8 r < r) has its own falloff, named so.
+  EXPECT_EQ(matched("alchemy", f).label(), "alchemy obscurance");
 }
 
 TEST(Reference, OldReferencesRemainAvailableByName) {

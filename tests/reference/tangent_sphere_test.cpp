@@ -49,7 +49,9 @@ TEST(TangentSphere, FloorBeforeWallIsTheSphereMinusTheCap) {
     const VisibilityEstimate e = estimate_tangent_sphere(rs, {0.2f, 0, d}, {0, 1, 0}, R, {.samples = 4096}, 11);
     const double expected = floor_before_wall(d, R);
     EXPECT_NEAR(e.visibility, expected, kSigmas * e.std_error + 1e-3) << "d = " << d;
-    if (d >= 0.5f) EXPECT_EQ(e.visibility, 1.0f) << "d = " << d;
+    if (d >= 0.5f) {
+      EXPECT_EQ(e.visibility, 1.0f) << "d = " << d;
+    }
   }
   // The formula itself: V(0) = 1/2, V(R/2) = 1, and the cap of d = R/4 (t = 1/2): 1 - 0.25 * 2.5 / 4.
   EXPECT_DOUBLE_EQ(floor_before_wall(0, 1), 0.5);

@@ -23,6 +23,8 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
   nlohmann::json current = s.start.is_null() ? m.default_params() : s.start;
   for (const TuneParameter& p : s.parameters) {
     if (!current.contains(p.key)) throw InputError("tune: method " + s.method + " has no parameter '" + p.key + "'");
+    // An optional number left unset ("the preset's value") starts at the middle of its range.
+    if (current.at(p.key).is_null()) current[p.key] = 0.5 * (p.lo + p.hi);
     if (!current.at(p.key).is_number()) throw InputError("tune: parameter '" + p.key + "' of " + s.method + " is not a number");
     if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
       throw InputError("tune: the range of '" + p.key + "' must be finite with lo < hi");

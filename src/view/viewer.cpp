@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "ao/core/error.h"
+#include "ao/core/params.h"
 #include "ao/eval/metrics.h"
 #include "ao/eval/shading.h"
 #include "ao/gbuffer/render_gbuffer.h"
@@ -582,31 +583,73 @@ class Viewer {
     if (!text.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text.c_str());
   }
 
-  // One widget per parameter of the method, by the type of its value.
+  // One widget per parameter of the method, generated from its parameter table (core/params.h):
+  // checkboxes, enum combos, integer and number fields clamped to the valid range, and the unit,
+  // range and one-line help as the tooltip. A value the table refuses shows its one-line error.
   void draw_parameters() {
+    const MethodInfo& m = find_method(method_);
     nlohmann::json& params = current_params();
-    for (auto& [key, value] : params.items()) {
+    const std::vector<ParamSpec> specs = m.param_specs ? m.param_specs() : std::vector<ParamSpec>{};
+    for (const ParamSpec& spec : specs) {
+      if (!params.contains(spec.name)) continue;
+      nlohmann::json& value = params[spec.name];
+      const char* label = spec.name.c_str();
+      const auto clamp_to = [&](double v) {
+        const double lo = std::isfinite(spec.range.min) ? spec.range.min : v, hi = std::isfinite(spec.range.max) ? spec.range.max : v;
+        return std::clamp(v, lo, hi);
+      };
       bool changed = false;
-      if (value.is_boolean()) {
-        bool b = value.get<bool>();
-        changed = ImGui::Checkbox(key.c_str(), &b);
-        if (changed) value = b;
-      } else if (value.is_number_integer()) {
-        int v = value.get<int>();
-        changed = ImGui::InputInt(key.c_str(), &v, 1, 10, ImGuiInputTextFlags_EnterReturnsTrue);
-        if (changed) value = v;
-      } else if (value.is_number()) {
-        float v = value.get<float>();
-        changed = ImGui::InputFloat(key.c_str(), &v, 0, 0, "%.6g", ImGuiInputTextFlags_EnterReturnsTrue);
-        if (changed) value = v;
-      } else if (value.is_string()) {
-        std::string v = value.get<std::string>();
-        changed = ImGui::InputText(key.c_str(), &v, ImGuiInputTextFlags_EnterReturnsTrue);
-        if (changed) value = v;
-      } else {
-        ImGui::Text("%s = %s", key.c_str(), value.dump().c_str());
+      if (value.is_null()) {  // an optional parameter left to its preset: say so, offer to set it
+        ImGui::TextDisabled("%s: from the preset", label);
+        ImGui::SameLine();
+        if ((changed = ImGui::SmallButton(("set##" + spec.name).c_str())))
+          value = spec.type == ParamType::OptionalInt ? nlohmann::json(static_cast<int>(clamp_to(1))) : nlohmann::json(static_cast<float>(clamp_to(1)));
+        tooltip(spec.help + "\n" + spec.valid_text());
+        if (changed) dirty_method_ = true;
+        continue;
       }
+      switch (spec.type) {
+        case ParamType::Bool: {
+          bool b = value.get<bool>();
+          if ((changed = ImGui::Checkbox(label, &b))) value = b;
+          break;
+        }
+        case ParamType::Enum: {
+          const std::string current = value.get<std::string>();
+          if (ImGui::BeginCombo(label, current.c_str())) {
+            for (const std::string& name : spec.enum_names)
+              if (ImGui::Selectable(name.c_str(), name == current)) {
+                value = name;
+                changed = true;
+              }
+            ImGui::EndCombo();
+          }
+          break;
+        }
+        case ParamType::Int:
+        case ParamType::OptionalInt: {
+          int v = value.get<int>();
+          if ((changed = ImGui::InputInt(label, &v, 1, 10, ImGuiInputTextFlags_EnterReturnsTrue))) value = static_cast<int>(clamp_to(v));
+          break;
+        }
+        case ParamType::Float:
+        case ParamType::OptionalFloat: {
+          float v = value.get<float>();
+          if ((changed = ImGui::InputFloat(label, &v, 0, 0, "%.6g", ImGuiInputTextFlags_EnterReturnsTrue))) value = static_cast<float>(clamp_to(v));
+          break;
+        }
+      }
+      tooltip(spec.help + "\n" + spec.valid_text());
       if (changed) dirty_method_ = true;
+    }
+    // Registry-level keys without a table row (e.g. characteristic, reference): a text field.
+    for (auto& [key, value] : params.items()) {
+      if (std::any_of(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == key; }) || !value.is_string()) continue;
+      std::string v = value.get<std::string>();
+      if (ImGui::InputText(key.c_str(), &v, ImGuiInputTextFlags_EnterReturnsTrue)) {
+        value = v;
+        dirty_method_ = true;
+      }
     }
   }
 

@@ -42,6 +42,7 @@ void ProgressiveReference::restart(ReferenceJob job) {
 void ProgressiveReference::stop() {
   std::lock_guard lock(mutex_);
   has_job_ = false;
+  job_.gbuffer.reset();  // a batch in flight keeps its own copy of the pointer until it ends
   ++generation_;
 }
 

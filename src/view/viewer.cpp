@@ -318,6 +318,7 @@ class Viewer {
   void camera_moved() {
     moved_ = true;
     dirty_gbuffer_ = true;
+    progressive_.stop();  // lets go of the G-buffer, so the next one can reuse its storage
   }
 
   // --set key=value: the viewer's own settings, else a parameter of the current method.
@@ -428,8 +429,12 @@ class Viewer {
         const Clock::time_point t = Clock::now();
         Camera cam = current_camera();
         cam.validate();
-        auto g = std::make_shared<GBuffer>(render_gbuffer(rays_, cam));
-        gbuffer_ = std::move(g);
+        // Render into the G-buffer of the previous frame when the reference no longer holds it: a
+        // moving camera then touches no fresh pages (half of a cold G-buffer is page faults).
+        if (gbuffer_ && gbuffer_.use_count() == 1)
+          render_gbuffer(rays_, cam, *gbuffer_);
+        else
+          gbuffer_ = std::make_shared<GBuffer>(render_gbuffer(rays_, cam));
         times.gbuffer = ms_since(t);
         dirty_gbuffer_ = false;
         dirty_method_ = true;

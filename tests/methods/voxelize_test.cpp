@@ -70,7 +70,7 @@ TEST(Voxelize, SphereVolumeMatchesFourThirdsPiRCubed) {
 
 TEST(Voxelize, BitCountOverRangesCrossingWordsMatchesNaiveCount) {
   std::mt19937_64 rng(5);
-  std::uint64_t col[4];
+  std::uint64_t col[4] = {};
   for (auto& w : col) w = rng();
   for (int k0 = -3; k0 <= 259; k0 += 1)
     for (int k1 = k0; k1 <= 259; k1 += 7) {

@@ -173,17 +173,7 @@ class Viewer {
       if (s_.benchmark) dirty_gbuffer_ = true;
       update(times);
       const Clock::time_point display_start = Clock::now();
-      upload_if_needed();
-      draw_image();
-      if (show_hud_) draw_hud();
-      ImGui::Render();
-      int fbw = 0, fbh = 0;
-      glfwGetFramebufferSize(window_, &fbw, &fbh);
-      glViewport(0, 0, fbw, fbh);
-      glClearColor(0.1f, 0.1f, 0.1f, 1.0f);
-      glClear(GL_COLOR_BUFFER_BIT);
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      glFinish();  // so the display stage counts the drawing, not just its submission
+      const auto [fbw, fbh] = draw_frame();
       times.display = ms_since(display_start);
       if (screenshot_pending_) take_screenshot(fbw, fbh);
       glfwSwapBuffers(window_);
@@ -783,6 +773,14 @@ class Viewer {
     ImGui::NewFrame();
     if (show_panel_) draw_panel();
     dirty_display_ = true;
+    const auto [fbw, fbh] = draw_frame();
+    take_screenshot(fbw, fbh);
+  }
+
+  // Uploads the image if it changed, draws it with the HUD and the panel built this frame into the
+  // back buffer, and waits for the drawing (so the display stage counts it, not just its
+  // submission). Returns the framebuffer's size.
+  std::pair<int, int> draw_frame() {
     upload_if_needed();
     draw_image();
     if (show_hud_) draw_hud();
@@ -794,7 +792,7 @@ class Viewer {
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     glFinish();
-    take_screenshot(fbw, fbh);
+    return {fbw, fbh};
   }
 
   nlohmann::json summary() const {

@@ -129,12 +129,13 @@ TEST(CameraJson, BadFilesAreOneLineErrors) {
   EXPECT_NE(bad(R"({"eye":[0,0,5],"target":[0,0,0],"up":[0,1,0],"fov":40,"width":0})").find("'width'"), std::string::npos);
 }
 
-// xvfb-run with a server number of this test's own: parallel tests starting Xvfb with -a can pick
-// the same display.
+// xvfb-run searching for a free display from a number of this test's own: parallel tests starting
+// Xvfb with -a from the same number can pick the same display, and a stale lock (a killed Xvfb)
+// must not fail the test.
 std::string xvfb() {
   static std::atomic<int> counter{0};
   const int server = 200 + static_cast<int>(getpid() % 500) * 8 + (counter++ % 8);
-  return "xvfb-run -n " + std::to_string(server) + " -s '-screen 0 640x480x24'";
+  return "xvfb-run -a -n " + std::to_string(server) + " -s '-screen 0 640x480x24'";
 }
 
 const std::string kSize = " --width 160 --height 90 ";

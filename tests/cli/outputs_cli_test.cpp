@@ -233,6 +233,9 @@ TEST(OutputsCli, OptionsAreCheckedBeforeTheMeshIsRead) {
 }
 
 TEST(OutputsCli, RunsTooBigForTheMemoryAreRefusedUpFrontWithTheEstimate) {
+#ifdef AO_SANITIZED
+  GTEST_SKIP() << "address-space limits and peak memory mean nothing under AddressSanitizer's shadow memory";
+#endif
   TempDir dir;
   // A 4 GiB address-space limit makes the available memory known and small on any machine.
   const auto limited = [&](const std::string& args) { return run_ao_limited("-v 4194304", args, dir.path()); };
@@ -259,6 +262,9 @@ TEST(OutputsCli, RunsTooBigForTheMemoryAreRefusedUpFrontWithTheEstimate) {
 // (transfer) stays below it, and is not far below it (within 3x, so the estimate refuses no run
 // that needs a third of the memory).
 TEST(OutputsCli, RenderMemoryEstimateBoundsTheMeasuredPeak) {
+#ifdef AO_SANITIZED
+  GTEST_SKIP() << "address-space limits and peak memory mean nothing under AddressSanitizer's shadow memory";
+#endif
   TempDir dir;
   const int w = 1024;
   const pid_t pid = spawn_ao("render plane -m transfer --width 1024 --height 1024 -o v.png --shaded s.png", dir.path());

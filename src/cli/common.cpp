@@ -55,6 +55,15 @@ Scene load_scene_arguments(const std::vector<std::string>& args) {
   return merged;
 }
 
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, sep))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 Vec3 parse_vec3(const std::string& text, const char* option) {
   std::istringstream in(text);
   Vec3 v;

@@ -45,6 +45,8 @@ struct CameraOptions {
 /// front; any option given overrides the corresponding field. Validated.
 Camera choose_camera(const Scene& scene, const CameraOptions& opt);
 Vec3 parse_vec3(const std::string& text, const char* option);
+/// The non-empty items of `s` between separators `sep` ("a,,b" -> a, b).
+std::vector<std::string> split(const std::string& s, char sep);
 /// The checks of choose_camera that need no scene, run before anything is loaded: --width and
 /// --height in [1, 32768] (when `size_given`: the size does not come from a file), --fov in
 /// (0, 180), and --eye/--target/--up as three finite numbers. InputError naming the option, its

@@ -35,15 +35,6 @@ struct TuneOptions {
   std::uint32_t seed = 1;
 };
 
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, sep))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 // "key=lo:hi" -> a parameter of the starting point's type (integer when its value is).
 TuneParameter parse_fit(const std::string& text, const nlohmann::json& start) {
   const auto eq = text.find('='), colon = text.find(':');

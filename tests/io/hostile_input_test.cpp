@@ -296,6 +296,15 @@ TEST(HostileInput, CoordinatesBeyondTheLimitAreRefusedInEveryFormat) {
   EXPECT_EQ(load_scene_file(dir.write("edge.off", "OFF\n3 1 0\n0 0 0\n1e9 0 0\n0 1e9 0\n3 0 1 2\n")).triangle_count(), 1u);
 }
 
+TEST(HostileInput, AFileMentioningBadAllocIsBadInputNotOutOfMemory) {
+  // A damaged ASCII STL whose stray token was "bad_alloc": assimp's error quoted it, and the loader
+  // took the quote for assimp running out of memory (a SystemError) - found by scripts/fuzz.
+  TempDir dir;
+  EXPECT_LOAD_ERROR(dir.write("token.stl", "solid q\nfacet normal loop\nvertex 1bad_alloc 0 0\nendloop\nendfacet\nendsolid q\n"),
+                    "token.stl");
+  EXPECT_LOAD_ERROR(dir.write("quoted.stl", "solid std::bad_alloc\nfacet normal 0 0 1\nouter loop\nvertex std::bad_alloc\n"), "quoted.stl");
+}
+
 TEST(HostileInput, CameraAndOffsetValuesBeyondTheLimitAreRefused) {
   Camera c;
   c.eye = {1e19f, 0, 0};

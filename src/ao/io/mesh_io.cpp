@@ -32,6 +32,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <new>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -306,6 +307,10 @@ std::string uv_set_error(unsigned sets, int asked) {
   throw SystemError(path.string() + ": out of memory while reading the mesh");
 }
 
+/// assimp catches std::bad_alloc itself and keeps only its what() as the error string. The match is
+/// exact: assimp's messages quote the file's own tokens, and a file may well contain "bad_alloc".
+bool assimp_ran_out_of_memory(std::string_view error) { return error == std::bad_alloc().what(); }
+
 /// Explains assimp's error in the user's terms where we recognise it; keeps assimp's words otherwise.
 std::string explain_assimp_error(std::string_view error) {
   const std::string e = one_line(error);
@@ -377,7 +382,7 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   }
   if (raw == nullptr) {
     const std::string error = importer.GetErrorString();
-    if (error.find("bad_alloc") != std::string::npos) out_of_memory(path);
+    if (assimp_ran_out_of_memory(error)) out_of_memory(path);
     // "No suitable reader" for a file named like a format assimp reads means damaged content.
     if (error.find("No suitable reader found") != std::string::npos && !ext.empty() && importer.IsExtensionSupported(ext))
       fail(path, "malformed or truncated " + printable(ext.substr(1)) + " file: its content is not recognised");
@@ -399,7 +404,7 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   }
   if (ai == nullptr) {
     const std::string error = importer.GetErrorString();
-    if (error.find("bad_alloc") != std::string::npos) out_of_memory(path);
+    if (assimp_ran_out_of_memory(error)) out_of_memory(path);
     fail(path, explain_assimp_error(error));
   }
 

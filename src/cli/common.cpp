@@ -10,6 +10,8 @@
 #include <mutex>
 #include <sstream>
 
+#include <CLI/CLI.hpp>
+
 #include "ao/core/error.h"
 #include "ao/io/camera_json.h"
 #include "ao/io/mesh_io.h"
@@ -25,6 +27,23 @@ bool names_builtin_scene(const std::vector<std::string>& args) {
   return !std::filesystem::exists(first) && !first.has_extension();
 }
 }  // namespace
+
+void add_camera_options(CLI::App& cmd, CameraOptions& camera, const std::string& size_of) {
+  cmd.add_option("--width", camera.width, size_of + " width, pixels")->capture_default_str();
+  cmd.add_option("--height", camera.height, size_of + " height, pixels")->capture_default_str();
+  cmd.add_option("--fov", camera.fov, "Vertical field of view, degrees (default: the scene's, or 40)");
+  cmd.add_option("--eye", camera.eye, "Camera position x,y,z (default: framing the scene from above and in front)");
+  cmd.add_option("--target", camera.target, "Point looked at x,y,z (default: the scene's centre)");
+  cmd.add_option("--up", camera.up, "Up direction x,y,z (default: 0,1,0)");
+  cmd.add_option("--camera", camera.file,
+                 "Camera JSON (eye, target, up, fov, width, height; written by ao view): its view, and its size unless --width/--height are "
+                 "given; the options above override its fields");
+}
+
+void note_camera_size_given(const CLI::App& cmd, CameraOptions& camera) {
+  camera.width_set = cmd.get_option("--width")->count() > 0;
+  camera.height_set = cmd.get_option("--height")->count() > 0;
+}
 
 std::string scene_arguments_name(const std::vector<std::string>& args) {
   if (args.empty()) return "default";

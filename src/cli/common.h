@@ -17,6 +17,10 @@
 #include "ao/io/output_set.h"
 #include "ao/scene/mesh.h"
 
+namespace CLI {
+class App;
+}
+
 namespace ao::cli {
 
 /// Help text of the positional scene argument, shared by the subcommands that take a scene.
@@ -41,6 +45,12 @@ struct CameraOptions {
   std::optional<std::string> file;
   bool width_set = false, height_set = false;  ///< Whether --width/--height were given explicitly.
 };
+/// Declares --width, --height (of the image, or of the `size_of` named), --fov, --eye, --target,
+/// --up and --camera on `cmd`, writing into `camera`; call note_camera_size_given from the
+/// subcommand's callback.
+void add_camera_options(CLI::App& cmd, CameraOptions& camera, const std::string& size_of = "Image");
+/// Records whether --width/--height were given (a camera file's size applies only when not).
+void note_camera_size_given(const CLI::App& cmd, CameraOptions& camera);
 /// The camera file if given, else the scene's preferred view if it has one, else auto-framing of its bounds from above and in
 /// front; any option given overrides the corresponding field. Validated.
 Camera choose_camera(const Scene& scene, const CameraOptions& opt);

@@ -215,16 +215,14 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + "; the same for every method and its reference")->capture_default_str();
   cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
-  cmd->add_option("--width", o->camera.width, "Image width, pixels")->capture_default_str();
-  cmd->add_option("--height", o->camera.height, "Image height, pixels")->capture_default_str();
-  cmd->add_option("--fov", o->camera.fov, "Vertical field of view, degrees (default: the scene's, or 40)");
-  cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: auto-framed)");
-  cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
-  cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
+  add_camera_options(*cmd, o->camera);
   cmd->add_flag("--json", o->json, "Print table.json on stdout");
   cmd->footer(std::string("Environment: AO_FONT, the font file of sheet.png's labels (default ") + kDejaVuSansPath +
               "; without a readable font the sheet has no labels).");
-  cmd->callback([o, &global, &action] { action = [o, &global] { return run_compare(*o, global); }; });
+  cmd->callback([o, &global, &action, cmd] {
+    note_camera_size_given(*cmd, o->camera);
+    action = [o, &global] { return run_compare(*o, global); };
+  });
 }
 
 }  // namespace ao::cli

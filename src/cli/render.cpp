@@ -300,14 +300,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
                   "Samples per pixel (default: the method's own; 256 rays for raytraced, the maximum with --target-error)");
   cmd->add_option("--target-error", o->target_error, "Stop a pixel once its standard error is below this (raytraced; default off)");
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
-  cmd->add_option("--width", o->camera.width, "Image width, pixels")->capture_default_str();
-  cmd->add_option("--height", o->camera.height, "Image height, pixels")->capture_default_str();
-  cmd->add_option("--fov", o->camera.fov, "Vertical field of view, degrees (default: the scene's, or 40)");
-  cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: auto-framed)");
-  cmd->add_option("--target", o->camera.target, "Point looked at x,y,z (default: the scene's centre)");
-  cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
-  cmd->add_option("--camera", o->camera.file,
-                  "Camera JSON (eye, target, up, fov, width, height; written by ao view): its view, and its size unless --width/--height are given");
+  add_camera_options(*cmd, o->camera);
   cmd->add_option("--shaded", o->shaded,
                   "Also write albedo x ambient x V with a soft key light, for viewing (sRGB); transfer: a W La. With --sun (or direct.* "
                   "in --gbuffer-in) the sun replaces the key light: (a V + Ld) La, transfer (a W + Ld) La");
@@ -327,8 +320,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
                 "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");
   cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
   cmd->callback([o, &global, &action, cmd] {
-    o->camera.width_set = cmd->get_option("--width")->count() > 0;
-    o->camera.height_set = cmd->get_option("--height")->count() > 0;
+    note_camera_size_given(*cmd, o->camera);
     action = [o, &global] { return run_render(*o, global); };
   });
 }

@@ -76,13 +76,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal")->capture_default_str();
   cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
-  cmd->add_option("--width", o->camera.width, "Window width, pixels")->capture_default_str();
-  cmd->add_option("--height", o->camera.height, "Window height, pixels")->capture_default_str();
-  cmd->add_option("--fov", o->camera.fov, "Vertical field of view, degrees (default: the scene's, or 40)");
-  cmd->add_option("--eye", o->camera.eye, "Camera position x,y,z (default: as ao render)");
-  cmd->add_option("--target", o->camera.target, "Point looked at x,y,z");
-  cmd->add_option("--up", o->camera.up, "Up direction x,y,z (default: 0,1,0)");
-  cmd->add_option("--camera", o->camera.file, "Start from a camera JSON (written by ao view's screenshot key or --camera-out)");
+  add_camera_options(*cmd, o->camera, "Window");
   cmd->add_option("-p,--param", o->params, "Method parameter as key=value, repeatable (as ao render)");
   cmd->add_option("--ao-map", o->ao_map, "A baked AO map to show on the mesh (view 'map')");
   cmd->add_option("--set", o->sets,
@@ -98,8 +92,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--camera-out", o->camera_out, "With --screenshot: also write the camera as JSON (ao render --camera reads it)");
   cmd->add_flag("--json", o->json, "On exit, print per-stage ms, fps and the reference's state as JSON on stdout");
   cmd->callback([o, &global, &action, cmd] {
-    o->camera.width_set = cmd->get_option("--width")->count() > 0;
-    o->camera.height_set = cmd->get_option("--height")->count() > 0;
+    note_camera_size_given(*cmd, o->camera);
     action = [o, &global] { return run_view_command(*o, global); };
   });
 }

@@ -136,8 +136,8 @@ void box_filter_planes4(benchmark::State& state) {
 #if defined(__AVX512F__)
 // The floor under the depth-buffer methods on this machine: N depth tests per covered pixel and
 // nothing else (a point at distance R in one of N fixed directions, projected, one 16-lane depth
-// gather, one compare, a count), over the same G-buffer and threads. Transfer at m = 2 makes 24
-// such tests per pixel and containment 12, plus their per-pixel setup, sample frames and
+// gather, one compare, a count), over the same G-buffer and threads. At their defaults transfer
+// (m = 2) makes 24 such tests per pixel and containment (m = 3) 36, plus their per-pixel setup, sample frames and
 // accumulation; this says how much of their time the tests alone need. Counter: ns per 16-lane
 // test (CPU time of all threads / tests).
 void depth_test_floor(benchmark::State& state) {

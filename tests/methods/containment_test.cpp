@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <string>
 
 #include "ao/core/error.h"
 #include "ao/methods/characteristic.h"
@@ -51,9 +53,11 @@ TEST(Containment, ApproachesTheRaytracedReferenceOfItsMembership) {
     ContainmentParams p;
     p.samples = 32;
     const double e = test::rmse_against(containment_ao(s.g, f, p, 1), ref.visibility, s.g);
-    // Measured 0.154 (step) and 0.12 (cubic) at 160x120: the floor is screen space's (one depth
-    // layer; what is hidden or off screen does not occlude), not noise (docs/methods/containment.md).
-    EXPECT_LT(e, m == Membership::Step ? 0.18 : 0.15) << to_string(m);
+    // Measured 0.094 (step) and 0.101 (cubic) at the default ray_steps = 3: the floor is screen
+    // space's (one depth layer; what is hidden or off screen does not occlude), not noise
+    // (docs/methods/containment.md). The bound leaves a margin of about 20%.
+    std::printf("containment vs ray-traced %s reference, 160x120: RMSE %.4f\n", std::string(to_string(m)).c_str(), e);
+    EXPECT_LT(e, 0.12) << to_string(m);
   }
 }
 

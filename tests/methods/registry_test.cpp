@@ -1,8 +1,7 @@
 // The registry's characteristic-function choice for the screen-space methods (registry.h,
 // kCharacteristicParam): the paper's other characteristic functions (VAO fig. 2a implicit, 2b height
 // field, fig. 12 depth x height field) on the built-in scenes that describe them, against known
-// answers and the ray-traced reference, and the bad inputs. The measurements quoted in
-// docs/methods/containment.md come from the printouts of:
+// answers and the ray-traced reference, and the bad inputs. The tests print what they measure:
 //   ./build/tests/ao_tests --gtest_filter='Registry.*'
 #include "ao/methods/registry.h"
 
@@ -102,7 +101,7 @@ TEST(Registry, ImplicitOpenPlaneIsFullyVisible) {
 // The wedge (floor y >= 0 and wall z >= 0) as two half-spaces, R = 0.5, against the ray-traced
 // reference of each method's integral (1024 rays: standard error ~0.001, negligible). The implicit
 // function knows the solid behind the wall and the floor, which the depth buffer guesses from what
-// is visible. Tolerances: containment and transfer (step: every test point at distance R) are left
+// is visible. Tolerances: containment and transfer (step membership: a test point counts wherever on the ray it lies) are left
 // with their sampling noise, 12 points per pixel averaged over the 4x4 filter, sqrt(V(1-V)/192) <=
 // 0.036 per pixel; measured RMSE 0.032 (depth buffer: 0.047 and 0.037). Volumetric's error is the
 // method's own (the free fraction of the tangent sphere is not exactly the cubic obscurance: a ray

@@ -102,7 +102,7 @@ TEST(Volumetric, ApproachesTheCubicReferenceWithTheSameRadius) {
 
 // The papers' claims, on the default scene at 160x120 with R = 0.1 x diagonal, against a
 // 1024-ray cubic reference; RMSE averaged over 4 seeds. Asserted where the ordering holds with a
-// margin (see the docs for the measured table).
+// margin (the test prints the measured table).
 TEST(Volumetric, PaperClaimsOnDefaultScene) {
   const auto s = test::builtin_gbuffer("default");
   const float R = 0.1f * s.scene.bounds().diagonal();

@@ -51,7 +51,7 @@ struct Row {
 };
 
 // sqrt(x) for x in [0, 1]: std::sqrt keeps a branch to set errno on negative input, which stops the
-// sample loop from vectorising (we may not pass -fno-math-errno), so: the classic reciprocal square
+// sample loop from vectorising (this file is built without -fno-math-errno), so: the classic reciprocal square
 // root bit trick and two Newton steps, relative error < 5e-6 (far below a pixel at any disk radius).
 inline float sqrt_unit(float x) {
   float r = std::bit_cast<float>(0x5f3759dfu - (std::bit_cast<std::uint32_t>(x) >> 1));

@@ -16,7 +16,7 @@ namespace ao {
 namespace {
 constexpr float kInfinityLike = 1e30f;  // below this a distance stands for -infinity (characteristic.h)
 // Tiles of 128 x 16 pixels: a row segment of eight 16-lane vectors per sample loop, and few rows
-// per tile. Measured against 64 x 64 (bench containment/0, alternated): 5.7-5.9 vs 7.5-7.9 ms.
+// per tile; faster than 64 x 64 tiles in bench containment/0.
 constexpr int kTileWidth = 128, kTileHeight = 16;
 constexpr int kMaxRaySteps = 8;
 }
@@ -152,7 +152,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
             // AT 4.3; an analytic surface's -FLT_MAX ("inner along the whole line") is never a distant
             // foreground object, as in volumetric.cpp and transfer.cpp. The depth buffer never gives
             // it, and its loop keeps the plain form: with the extra test GCC 12 no longer vectorises
-            // it (3.5x slower, bench containment/0).
+            // it (several times slower, bench containment/0).
             bool near = d > far_limit;
             if constexpr (!std::is_same_v<Characteristic, DepthBufferCharacteristic>) near = near | (d < -kInfinityLike);
             const bool occluded = (d < -bias[k]) & near;

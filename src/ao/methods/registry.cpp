@@ -315,7 +315,8 @@ const std::array kMethods{
                [](const Falloff& requested, const nlohmann::json&) { return Falloff{Membership::Step, requested.radius}; },
                table_specs<cone_param_table>, canonical<cone_param_table, Extra::None>},
     // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r;
-    // at its defaults u = 2r >= r, where that falloff is exactly step AO (obscurance_reference says so).
+    // with preset=paper (u = 2r >= r) that falloff is exactly step AO; at the fitted default sigma
+    // (u = 0.8 r) it is not, and obscurance_reference labels it as Alchemy's own (docs/methods/alchemy.md).
     MethodInfo{"alchemy", "Alchemy AO: screen-space disk samples, eq. 10 (sigma, k, beta, epsilon, r, s) + 13-tap cross-bilateral filter", false,
                [] { return nlohmann::json(AlchemyParams{}); }, run_alchemy,
                [](const Falloff& requested, const nlohmann::json& params) {

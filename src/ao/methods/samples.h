@@ -29,7 +29,7 @@ enum class PoissonDomain {
 /// Largest n the sample generators accept (Lloyd relaxation is O(n) per density point).
 inline constexpr int kMaxScreenSpaceSamples = 256;
 
-/// n points of a Poisson-disk (centroidal Voronoi) distribution in `domain`, by 64 Lloyd iterations
+/// n points of a Poisson-disk (centroidal Voronoi) distribution in `domain`, by 32 Lloyd iterations
 /// from a fixed pseudo-random start over a fixed set of density points. Deterministic: the same n
 /// and domain give the same points on every run and thread. Cached: the first call for a (domain, n)
 /// computes the set (~1 ms for n = 16), later calls return the cached one. Thread-safe.

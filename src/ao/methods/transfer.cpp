@@ -28,8 +28,8 @@ namespace ao {
 
 namespace {
 constexpr float kInfinityLike = 1e30f;
-// Tiles of 128 x 16 pixels (against 64 x 64: bench transfer/0/2 15-15.5 vs 19-20 ms, alternated);
-// the generic kernel's per-row arrays hold one tile row.
+// Tiles of 128 x 16 pixels (faster than 64 x 64 in bench transfer/0/2); the generic kernel's
+// per-row arrays hold one tile row.
 constexpr int kTileWidth = 128, kTileHeight = 16;
 constexpr int kMaxRaySteps = 8;
 constexpr int kPaletteSize = 32;                  // distinct reflectances a packed palette holds

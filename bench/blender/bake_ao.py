@@ -1,0 +1,55 @@
+# Blender (Cycles) AO bake of one OBJ into its UVs: the peer baker `ao bake` is compared with.
+# Run by bench/blender/compare.sh; by hand:
+#   blender -b --factory-startup --python bench/blender/bake_ao.py -- MESH.obj SIZE SAMPLES OUT.exr THREADS
+# Writes OUT.exr (linear float RGB, AO in every channel; texels the bake does not reach are -1) and
+# prints one line "bake_seconds S" (the bpy.ops.object.bake call alone: BVH build and baking).
+import sys
+import time
+
+import bpy
+
+args = sys.argv[sys.argv.index("--") + 1:]
+mesh_path, size, samples, out_path, threads = args[0], int(args[1]), int(args[2]), args[3], int(args[4])
+
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"
+scene.cycles.device = "CPU"
+scene.cycles.samples = samples
+scene.cycles.use_denoising = False
+scene.cycles.use_adaptive_sampling = False
+scene.render.threads_mode = "FIXED"
+scene.render.threads = threads
+
+# The OBJ as written (no axis change matters for AO; keep the file's coordinates).
+bpy.ops.import_scene.obj(filepath=mesh_path, axis_forward="-Z", axis_up="Y", split_mode="OFF")
+obj = [o for o in scene.objects if o.type == "MESH"][0]
+bpy.context.view_layer.objects.active = obj
+obj.select_set(True)
+
+# Unlimited AO distance, as `ao bake` without --max-distance: Cycles' AO bake reads the world's.
+world = bpy.data.worlds.new("World")
+scene.world = world
+world.light_settings.distance = 1e6
+
+image = bpy.data.images.new("ao", width=size, height=size, float_buffer=True, alpha=False)
+image.generated_color = (-1.0, -1.0, -1.0, 1.0)
+material = bpy.data.materials.new("bake")
+material.use_nodes = True
+node = material.node_tree.nodes.new("ShaderNodeTexImage")
+node.image = image
+material.node_tree.nodes.active = node
+obj.data.materials.clear()
+obj.data.materials.append(material)
+
+bake = scene.render.bake
+bake.margin = 0
+bake.use_clear = False
+start = time.perf_counter()
+bpy.ops.object.bake(type="AO", margin=0, use_clear=False)
+print(f"bake_seconds {time.perf_counter() - start:.3f}")
+
+image.filepath_raw = out_path
+image.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+image.save()

@@ -1,7 +1,7 @@
 # Blender (Cycles) AO bake of one OBJ into its UVs: the peer baker `ao bake` is compared with.
 # Run by bench/blender/compare.sh; by hand:
 #   blender -b --factory-startup --python bench/blender/bake_ao.py -- MESH.obj SIZE SAMPLES OUT.exr THREADS
-# Writes OUT.exr (linear float RGB, AO in every channel; texels the bake does not reach are -1) and
+# Writes OUT.exr (linear float RGB, AO in every channel) and
 # prints one line "bake_seconds S" (the bpy.ops.object.bake call alone: BVH build and baking).
 import sys
 import time
@@ -33,7 +33,8 @@ scene.world = world
 world.light_settings.distance = 1e6
 
 image = bpy.data.images.new("ao", width=size, height=size, float_buffer=True, alpha=False)
-image.generated_color = (-1.0, -1.0, -1.0, 1.0)
+# Data, not colour: without this the saved EXR holds sRGB-encoded values.
+image.colorspace_settings.name = "Non-Color"
 material = bpy.data.materials.new("bake")
 material.use_nodes = True
 node = material.node_tree.nodes.new("ShaderNodeTexImage")
@@ -51,5 +52,4 @@ print(f"bake_seconds {time.perf_counter() - start:.3f}")
 
 image.filepath_raw = out_path
 image.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
 image.save()

@@ -83,7 +83,6 @@ constexpr float kSteep = 0.5f;
 struct WorldMap {
   Vec3 origin, inv_size;
   float slab;
-  static constexpr bool kPerspective = false;
   void operator()(Vec3 p, float& x, float& y, float& a) const {
     x = (p.x - origin.x) * inv_size.x;
     y = (p.z - origin.z) * inv_size.y;
@@ -97,7 +96,6 @@ struct EyeMap {
   float sx, sy, ox, oy;  // column = (x / depth) * sx + ox, (y / depth) * sy + oy
   float z_clip;
   float slab;
-  static constexpr bool kPerspective = true;
 };
 
 // Sets the rows of a mapped triangle; false when no column centre of the grid can be inside.

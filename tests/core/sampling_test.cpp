@@ -27,6 +27,39 @@ TEST(Sampling, SobolPrefixIsStratifiedInEveryElementaryInterval) {
   }
 }
 
+// The definition, written out plainly: Burley's nested uniform scramble of the index, Sobol's first
+// two dimensions (bit reversal; the direction numbers of x + 1 XORed over the index's set bits),
+// each scrambled again. sobol_owen_2d computes the same bits with fewer reversals and tables.
+std::uint32_t reverse32(std::uint32_t x) {
+  std::uint32_t r = 0;
+  for (int b = 0; b < 32; ++b) r |= ((x >> b) & 1u) << (31 - b);
+  return r;
+}
+std::uint32_t owen(std::uint32_t x, std::uint32_t seed) {
+  x = reverse32(x) + seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return reverse32(x);
+}
+std::uint32_t sobol1(std::uint32_t i) {
+  std::uint32_t r = 0, v = 1u << 31;
+  for (int b = 0; b < 32; ++b, v ^= v >> 1)
+    if (i >> b & 1u) r ^= v;
+  return r;
+}
+
+TEST(Sampling, SobolOwenIsTheDefinitionBitForBit) {
+  for (std::uint32_t seed : {0u, 1u, 7u, 0xdeadbeefu})
+    for (std::uint32_t i : {0u, 1u, 2u, 3u, 63u, 64u, 1000u, 65535u, 0x12345678u, 0xffffffffu}) {
+      const std::uint32_t s = owen(i, hash_combine(seed, 0xa511e9b3u));
+      const Vec2 u = sobol_owen_2d(i, seed);
+      EXPECT_EQ(u.x, to_unit_float(owen(reverse32(s), hash_combine(seed, 1u)))) << i << " " << seed;
+      EXPECT_EQ(u.y, to_unit_float(owen(sobol1(s), hash_combine(seed, 2u)))) << i << " " << seed;
+    }
+}
+
 TEST(Sampling, DifferentSeedsGiveDifferentPoints) {
   EXPECT_NE(sobol_owen_2d(3, 1).x, sobol_owen_2d(3, 2).x);
   EXPECT_EQ(sobol_owen_2d(3, 1).x, sobol_owen_2d(3, 1).x);

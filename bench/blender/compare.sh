@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# `ao bake` against Blender Cycles' AO bake of the same mesh and UVs at equal error (BENCHMARKS.md,
+# "bake"). Needs Debian's blender and python3-numpy (not installed by scripts/setup: a benchmark
+# check, not a dependency of ao).
+#   bench/blender/compare.sh [MESH.obj] [SIZE] [OUT_DIR]
+# Both bakers get 2 threads; each row is one run, ao and Blender alternated. Error: RMSE against a
+# converged ao bake (1024 rays per texel) over the texels both maps cover (bench/blender/rmse.py).
+# Time: the bake call itself (ao: timings.bake_ms + bvh_ms; Blender: bpy.ops.object.bake), and the
+# whole process (load, BVH, bake, write) as wall seconds.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+ao="${AO:-$here/../../build/src/ao}"
+mesh="${1:-$here/../../../shared/data/meshes/refined_elephant_uv.obj}"
+size="${2:-1024}"
+out="${3:-$(mktemp -d)}"
+mkdir -p "$out"
+bl() { blender -b --factory-startup --python "$@" 2>/dev/null; }
+rmse() { bl "$here/rmse.py" -- "$1" "$out/reference.exr" | sed -n 's/^rmse \([0-9.]*\).*/\1/p'; }
+now() { date +%s.%N; }
+
+if [ ! -f "$out/reference.exr" ]; then
+  echo "reference: ao bake, 1024 rays per texel" >&2
+  "$ao" --threads 2 bake "$mesh" -s "$size" --samples 1024 --seed 99 --padding 0 -o "$out/reference.exr" >&2
+fi
+
+echo "| baker | setting | RMSE | bake s | process s |"
+echo "|---|---|---:|---:|---:|"
+secs() { python3 -c "print(f'{$2 - $1:.2f}')"; }
+for spp in 32 64 128 256; do
+  if [ "$spp" -le 128 ]; then
+    t0=$(now)
+    json=$("$ao" --threads 2 bake "$mesh" -s "$size" --samples "$spp" --padding 0 -o "$out/ao-$spp.exr" --json 2>/dev/null)
+    t1=$(now)
+    bake=$(printf '%s' "$json" | python3 -c 'import json,sys; t=json.load(sys.stdin)["timings"]; print("%.2f" % ((t["bake_ms"] + t["bvh_ms"]) / 1000))')
+    echo "| ao | $spp rays/texel | $(rmse "$out/ao-$spp.exr") | $bake | $(secs "$t0" "$t1") |"
+  fi
+  t0=$(now)
+  bake=$(bl "$here/bake_ao.py" -- "$mesh" "$size" "$spp" "$out/blender-$spp.exr" 2 | sed -n 's/^bake_seconds //p')
+  t1=$(now)
+  echo "| Blender Cycles | $spp samples | $(rmse "$out/blender-$spp.exr") | $bake | $(secs "$t0" "$t1") |"
+done

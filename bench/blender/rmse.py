@@ -1,0 +1,33 @@
+# RMSE of a baked AO map against a reference map over the texels both cover, read with Blender's
+# image loader (both files go through the same one, so row order cannot differ between them).
+#   blender -b --factory-startup --python bench/blender/rmse.py -- MAP.exr REFERENCE.exr [--flip]
+# The texels compared are those both maps cover: `ao bake --padding 0` writes 0 outside the charts,
+# and Cycles (margin 0) leaves its black background where no texel centre falls inside a triangle
+# (ao also covers texels a chart only partly overlaps, with the area-weighted mean). A covered texel
+# with V below 1e-6 would be left out too; there are none in practice.
+# --flip compares MAP upside down (a check of the UV convention). Prints "rmse R texels N mean_signed S".
+import sys
+
+import bpy
+import numpy as np
+
+args = sys.argv[sys.argv.index("--") + 1:]
+flip = "--flip" in args
+paths = [a for a in args if a != "--flip"]
+
+
+def pixels(path):
+    image = bpy.data.images.load(path)
+    image.colorspace_settings.name = "Non-Color"
+    w, h = image.size
+    data = np.empty(w * h * 4, dtype=np.float32)
+    image.pixels.foreach_get(data)
+    return data.reshape(h, w, 4)
+
+
+a, b = pixels(paths[0]), pixels(paths[1])
+if flip:
+    a = a[::-1]
+mask = (a[..., 0] > 1e-6) & (b[..., 0] > 0)
+diff = a[..., 0][mask] - b[..., 0][mask]
+print(f"rmse {np.sqrt(np.mean(diff * diff)):.5f} texels {int(mask.sum())} mean_signed {diff.mean():+.5f}")

@@ -219,7 +219,9 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     outputs.write(o.shaded, [&] { write_rgb_image(o.shaded, shade_for_display(g, result.visibility, result.color), {.png_bits = o.png_bits, .srgb = true}); });
   nlohmann::json extras_written = nlohmann::json::object();
   if (o.extras)
-    for (const auto& [name, image] : result.extras) {  // <output-stem>-<name><ext>, beside the output
+    for (const auto& extra : result.extras) {  // <output-stem>-<name><ext>, beside the output
+      const std::string& name = extra.first;
+      const auto& image = extra.second;  // a named reference: Clang 14 cannot capture structured bindings
       const std::filesystem::path out_path(output);
       const std::filesystem::path path = out_path.parent_path() / (out_path.stem().string() + "-" + name + out_path.extension().string());
       outputs.write(path, [&] { write_image(path, image, write_opt); }, "--extras");

@@ -455,7 +455,7 @@ class Viewer {
         if (method_ == "raytraced") {
           result_ = MethodOutput{};  // the view shows the progressive reference itself
         } else {
-          result_ = m.run(MethodInput{*gbuffer_, &rays_, falloff_, s_.seed, {}, &s_.scene.analytic}, params);
+          result_ = m.run(MethodInput{*gbuffer_, &rays_, falloff_, s_.seed, {}, &s_.scene.analytic, &method_cache_}, params);
         }
         times.method = ms_since(t);
         if (result_.stats.contains("filter_ms")) {
@@ -904,6 +904,7 @@ class Viewer {
   Falloff falloff_;
   std::shared_ptr<GBuffer> gbuffer_;
   MethodOutput result_;
+  MethodCache method_cache_;  // cone's voxel grid, transfer's scratch images: kept from frame to frame
   Image<Vec3> shaded_;
   Image<float> map_v_;
   double rmse_ = -1;

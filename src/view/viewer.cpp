@@ -591,8 +591,8 @@ class Viewer {
   // Builds what changed and uploads it into the persistent texture of its format with
   // glTexSubImage2D (glTexImage2D only when the size changes). The formats are the textures' own
   // (R8 from GL_RED bytes, RGBA8 from GL_RGBA bytes), so Mesa copies rows without converting. No
-  // pixel buffer object: on a software driver (llvmpipe) the texture lives in the same memory as
-  // the client's bytes, and a PBO would only add a copy. When only the reference changed and the
+  // pixel buffer object: a software driver (llvmpipe) copies from one on the CPU just the same, and
+  // there is no transfer to a device to overlap with the next frame. When only the reference changed and the
   // view shows the method left of the wipe, only the columns right of it are rebuilt and sent.
   // Returns whether anything was uploaded.
   bool upload_if_needed() {
@@ -949,9 +949,9 @@ int run_view(ViewSetup setup) {
   // Every frame allocates and frees images of the same few sizes (G-buffer planes, method outputs
   // and scratch). glibc would return most of them to the kernel (blocks above the mmap threshold,
   // and the heap's free top beyond the trim threshold), and the next frame would fault in fresh
-  // zeroed pages: 8-17% of a frame's CPU time in perf profiles of `ao view --benchmark`. Keep
-  // freed memory in the process instead: blocks up to 32 MB (glibc's largest mmap threshold) come
-  // from the heap, and the heap is never trimmed. The peak memory is that of one frame.
+  // zeroed pages (BENCHMARKS.md, "ao view", measures what that cost). Keep freed memory in the
+  // process instead: blocks up to 32 MB (glibc's largest mmap threshold) come from the heap, and
+  // the heap is never trimmed, so the process keeps the most memory it ever used at once.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
   Viewer viewer(std::move(setup));

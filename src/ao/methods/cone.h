@@ -134,6 +134,8 @@ class ConeContext {
   ConeResult render(const GBuffer& gbuffer, float r_max, const ConeParams& params, std::uint32_t seed, const ProgressFn& progress = {});
   /// How many grids have been built so far.
   int grid_builds() const { return builds_; }
+  /// The scene it was made for.
+  const Scene& scene() const { return scene_; }
 
  private:
   bool grid_is_current(const GBuffer& gbuffer, GridSpace space, const VoxelizeOptions& options) const;

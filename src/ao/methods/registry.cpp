@@ -256,7 +256,10 @@ MethodOutput run_cone(const MethodInput& in, const nlohmann::json& j) {
   const ConeParams p = j.get<ConeParams>();
   ConeResult r;
   if (in.cache) {
-    r = in.cache->entry<ConeContext>("cone", in.scene->scene()).render(in.gbuffer, in.falloff.radius, p, in.seed, in.progress);
+    const Scene& scene = in.scene->scene();
+    ConeContext* context = &in.cache->entry<ConeContext>("cone", scene);
+    if (&context->scene() != &scene) context = &in.cache->replace<ConeContext>("cone", scene);
+    r = context->render(in.gbuffer, in.falloff.radius, p, in.seed, in.progress);
   } else {
     const std::vector<MeshClosure> closure = analyze_closure(in.scene->scene());
     r = render_cone(in.scene->scene(), closure, in.gbuffer, in.falloff.radius, p, in.seed, in.progress);

@@ -27,8 +27,9 @@ class RayScene;
 /// What methods keep between calls on one scene, for a caller that renders frame after frame (a
 /// viewer, a benchmark): cone's mesh closure and voxel grid (ConeContext), transfer's scratch
 /// images. A method's output is the same with and without it. The caller owns it, passes it with
-/// every call on the same scene and makes a new one for another scene. Each method keeps one entry,
-/// of one type, under its name.
+/// every call on the same scene and makes a new one for another scene (cone also starts over when
+/// handed another Scene object). Each method keeps one entry, of one type, under its name. Not for
+/// concurrent calls.
 class MethodCache {
  public:
   /// The entry of `method`, constructed from `args` on first use.
@@ -37,6 +38,13 @@ class MethodCache {
     auto it = entries_.find(method);
     if (it == entries_.end()) it = entries_.emplace(std::string(method), std::make_shared<T>(std::forward<Args>(args)...)).first;
     return *static_cast<T*>(it->second.get());
+  }
+  /// A new entry of `method` constructed from `args`, in place of the old one.
+  template <class T, class... Args>
+  T& replace(std::string_view method, Args&&... args) {
+    std::shared_ptr<void>& slot = entries_[std::string(method)];
+    slot = std::make_shared<T>(std::forward<Args>(args)...);
+    return *static_cast<T*>(slot.get());
   }
 
  private:

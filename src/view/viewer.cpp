@@ -6,7 +6,9 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui_stdlib.h>
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cctype>
@@ -17,6 +19,8 @@
 #include <deque>
 #include <filesystem>
 #include <iostream>
+#include <limits>
+#include <malloc.h>
 #include <memory>
 #include <thread>
 
@@ -53,6 +57,7 @@ constexpr int kReferenceMax = 4096;
 // Per-stage wall times of one frame, ms; a stage that did not run this frame is 0.
 struct StageTimes {
   double gbuffer = 0, method = 0, filter = 0, display = 0, frame = 0;
+  double image = 0;  // the part of display that builds and uploads the 8-bit image (0: unchanged)
 };
 
 // Averages over the frames of the last second (the HUD) and over the whole run (--json).
@@ -68,6 +73,7 @@ class StageStats {
     if (t.method > 0) last_.method = t.method;
     if (t.filter > 0) last_.filter = t.filter;
     if (t.display > 0) last_.display = t.display;
+    total_.image += t.image, runs_.image += t.image > 0;
     ++frames_;
   }
   /// The time of each stage the last time it ran.
@@ -92,6 +98,7 @@ class StageStats {
             {"method_ms", mean(total_.method, runs_.method)},
             {"filter_ms", mean(total_.filter, runs_.filter)},
             {"display_ms", mean(total_.display, runs_.display)},
+            {"image_ms", mean(total_.image, runs_.image)},
             {"gbuffer_runs", runs_.gbuffer},
             {"method_runs", runs_.method}};
   }
@@ -104,10 +111,12 @@ class StageStats {
 };
 
 std::uint8_t to_byte(float v) {
-  // As the PNG writer quantises linear V (io/image_io.cpp), so a screenshot of the AO view holds the
-  // same 8-bit values as `ao render -o x.png`. NaN lands on 0.
+  // As the PNG writer quantises linear V (io/image_io.cpp: lround(c * 255) of the clamped value), so
+  // a screenshot of the AO view holds the same 8-bit values as `ao render -o x.png`. For c * 255 in
+  // [0, 255] the double sum c * 255 + 0.5 is exact, so truncating it is lround, without its libm
+  // call per channel. NaN lands on 0.
   const float c = v > 0.0f ? std::min(v, 1.0f) : 0.0f;
-  return static_cast<std::uint8_t>(std::lround(c * 255.0f));
+  return static_cast<std::uint8_t>(static_cast<int>(static_cast<double>(c * 255.0f) + 0.5));
 }
 
 // IEC 61966-2-1, as the PNG writer encodes --shaded pictures.
@@ -175,6 +184,7 @@ class Viewer {
       const Clock::time_point display_start = Clock::now();
       const auto [fbw, fbh] = draw_frame();
       times.display = ms_since(display_start);
+      times.image = image_ms_;
       if (screenshot_pending_) take_screenshot(fbw, fbh);
       glfwSwapBuffers(window_);
       times.frame = ms_since(frame_start);
@@ -215,12 +225,21 @@ class Viewer {
     ImGui::StyleColorsDark();
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
-    glGenTextures(1, &texture_);
+    for (Texture* t : {&grey_texture_, &rgba_texture_}) {
+      glGenTextures(1, &t->id);
+      glBindTexture(GL_TEXTURE_2D, t->id);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    const GLint grey_swizzle[] = {GL_RED, GL_RED, GL_RED, GL_ONE};  // grey codes drawn as (v, v, v, 1)
+    glBindTexture(GL_TEXTURE_2D, grey_texture_.id);
+    glTexParameteriv(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_RGBA, grey_swizzle);
   }
 
   void close_window() {
     progressive_.stop();
-    glDeleteTextures(1, &texture_);
+    glDeleteTextures(1, &grey_texture_.id);
+    glDeleteTextures(1, &rgba_texture_.id);
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
@@ -436,7 +455,7 @@ class Viewer {
         if (method_ == "raytraced") {
           result_ = MethodOutput{};  // the view shows the progressive reference itself
         } else {
-          result_ = m.run(MethodInput{*gbuffer_, &rays_, falloff_, s_.seed, {}, &s_.scene.analytic}, params);
+          result_ = m.run(MethodInput{*gbuffer_, &rays_, falloff_, s_.seed, {}, &s_.scene.analytic, &method_cache_}, params);
         }
         times.method = ms_since(t);
         if (result_.stats.contains("filter_ms")) {
@@ -459,7 +478,10 @@ class Viewer {
       ref_ = progressive_.snapshot();
       if (const std::string e = progressive_.error(); !e.empty()) error_ = "reference: " + e;
       update_rmse();
-      if (view_ == ViewMode::Error || wipe_ < 1 || method_ == "raytraced") dirty_display_ = true;
+      if (view_ == ViewMode::Error || method_ == "raytraced")
+        dirty_display_ = true;
+      else if (wipe_ < 1)
+        dirty_reference_side_ = true;
     }
   }
 
@@ -508,66 +530,112 @@ class Viewer {
     }
   }
 
-  // The method's V (or what the view asks for) as RGBA8, left of the wipe; the reference right of it.
-  void build_display() {
-    if (!gbuffer_) return;
+  // The AO and map views are grey: one byte per pixel into a GL_R8 texture whose swizzle repeats
+  // red into green and blue (a quarter of the bytes to build and upload). The others are RGBA8.
+  bool grey_view() const { return view_ == ViewMode::AO || view_ == ViewMode::Map; }
+
+  // The method's V (or what the view asks for) as 8-bit codes, left of the wipe; the reference
+  // right of it. Only the columns [x0, w) are built (x0 > 0: the reference side alone changed).
+  // Rows in parallel: every pixel is independent.
+  void build_display(int x0) {
     const GBuffer& g = *gbuffer_;
     const int w = g.width(), h = g.height();
-    pixels_.assign(static_cast<std::size_t>(w) * h * 4, 255);
+    const bool grey = grey_view();
+    const int channels = grey ? 1 : 4;
+    pixels_.resize(static_cast<std::size_t>(w) * h * channels);
     const bool have_ref = !ref_.visibility.empty() && ref_.visibility.width() == w && ref_.visibility.height() == h;
     const Image<float>& method_v = method_ == "raytraced" && have_ref ? ref_.visibility : result_.visibility;
-    const int split = static_cast<int>(std::lround(wipe_ * w));
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        std::uint8_t* px = &pixels_[4 * i];
-        const bool reference_side = x >= split && have_ref;
-        Vec3 c{1, 1, 1};
-        if (view_ == ViewMode::Error) {
-          if (!g.coverage[i]) {
-            c = {0.5f, 0.5f, 0.5f};
-          } else if (have_ref && !method_v.empty()) {
-            c = signed_error_colour(method_v[i] - ref_.visibility[i], kHeatRange);
-          }
-        } else if (reference_side) {
-          const float v = ref_.visibility[i];
-          c = {v, v, v};
-        } else if (view_ == ViewMode::Transfer && !result_.color.empty()) {
-          c = result_.color[i];
-        } else if (view_ == ViewMode::Shaded && !shaded_.empty()) {
-          c = {srgb(shaded_[i].x), srgb(shaded_[i].y), srgb(shaded_[i].z)};
-        } else if (view_ == ViewMode::Map && !map_v_.empty()) {
-          c = Vec3{1, 1, 1} * map_v_[i];
-        } else if (!method_v.empty()) {
-          const float v = method_v[i];
-          c = {v, v, v};
+    const int split = have_ref ? static_cast<int>(std::lround(wipe_ * w)) : w;
+    const ViewMode view = view_;
+    const bool transfer = view == ViewMode::Transfer && !result_.color.empty();
+    const bool shaded = view == ViewMode::Shaded && !shaded_.empty();
+    const bool map = view == ViewMode::Map && !map_v_.empty();
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        const std::size_t row = static_cast<std::size_t>(y) * w;
+        std::uint8_t* out = &pixels_[row * channels];
+        if (grey) {
+          // Method side, then reference side: two plain loops.
+          const float* v = map ? &map_v_[row] : method_v.empty() ? nullptr : &method_v[row];
+          for (int x = x0; x < std::min(split, w); ++x) out[x] = v ? to_byte(v[x]) : 255;
+          for (int x = std::max(x0, split); x < w; ++x) out[x] = to_byte(ref_.visibility[row + x]);
+          continue;
         }
-        px[0] = to_byte(c.x), px[1] = to_byte(c.y), px[2] = to_byte(c.z), px[3] = 255;
+        for (int x = x0; x < w; ++x) {
+          const std::size_t i = row + x;
+          Vec3 c{1, 1, 1};
+          if (view == ViewMode::Error) {
+            if (!g.coverage[i]) {
+              c = {0.5f, 0.5f, 0.5f};
+            } else if (have_ref && !method_v.empty()) {
+              c = signed_error_colour(method_v[i] - ref_.visibility[i], kHeatRange);
+            }
+          } else if (x >= split) {
+            const float v = ref_.visibility[i];
+            c = {v, v, v};
+          } else if (transfer) {
+            c = result_.color[i];
+          } else if (shaded) {
+            c = {srgb(shaded_[i].x), srgb(shaded_[i].y), srgb(shaded_[i].z)};
+          } else if (!method_v.empty()) {
+            const float v = method_v[i];
+            c = {v, v, v};
+          }
+          std::uint8_t* px = out + 4 * x;
+          px[0] = to_byte(c.x), px[1] = to_byte(c.y), px[2] = to_byte(c.z), px[3] = 255;
+        }
       }
+    });
   }
 
-  void upload_if_needed() {
-    if (!dirty_display_ || !gbuffer_) return;
-    prepare_view();
-    build_display();
+  // Builds what changed and uploads it into the persistent texture of its format with
+  // glTexSubImage2D (glTexImage2D only when the size changes). The formats are the textures' own
+  // (R8 from GL_RED bytes, RGBA8 from GL_RGBA bytes), so Mesa copies rows without converting. No
+  // pixel buffer object: a software driver (llvmpipe) copies from one on the CPU just the same, and
+  // there is no transfer to a device to overlap with the next frame. When only the reference changed and the
+  // view shows the method left of the wipe, only the columns right of it are rebuilt and sent.
+  // Returns whether anything was uploaded.
+  bool upload_if_needed() {
+    if (!gbuffer_ || (!dirty_display_ && !dirty_reference_side_)) return false;
     const int w = gbuffer_->width(), h = gbuffer_->height();
-    glBindTexture(GL_TEXTURE_2D, texture_);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    if (w != texture_w_ || h != texture_h_) {
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
-      texture_w_ = w, texture_h_ = h;
+    const bool grey = grey_view();
+    Texture& tex = grey ? grey_texture_ : rgba_texture_;
+    int x0 = 0;
+    if (dirty_display_ || grey != shown_grey_ || tex.w != w || tex.h != h) {
+      prepare_view();
     } else {
-      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
+      x0 = std::clamp(static_cast<int>(std::lround(wipe_ * w)), 0, w);
     }
-    dirty_display_ = false;
+    dirty_display_ = dirty_reference_side_ = false;
+    shown_grey_ = grey;
+    if (x0 >= w) return false;
+    build_display(x0);
+    const GLenum format = grey ? GL_RED : GL_RGBA;
+    glBindTexture(GL_TEXTURE_2D, tex.id);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, w);
+    glPixelStorei(GL_UNPACK_SKIP_PIXELS, x0);
+    if (w != tex.w || h != tex.h) {
+      glTexImage2D(GL_TEXTURE_2D, 0, grey ? GL_R8 : GL_RGBA8, w, h, 0, format, GL_UNSIGNED_BYTE, pixels_.data());
+      tex.w = w, tex.h = h;
+    } else {
+      glTexSubImage2D(GL_TEXTURE_2D, 0, x0, 0, w - x0, h, format, GL_UNSIGNED_BYTE, pixels_.data());
+    }
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+    return true;
   }
 
   void draw_image() {
-    if (texture_w_ == 0) return;
+    const Texture& tex = shown_grey_ ? grey_texture_ : rgba_texture_;
+    if (tex.w == 0) return;
     const ImVec2 size = ImGui::GetIO().DisplaySize;
-    ImGui::GetBackgroundDrawList()->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(texture_)), ImVec2(0, 0), size);
+    // The image is opaque and covers the window: drawn without blending, llvmpipe does not read the
+    // framebuffer under it. The backend restores its own state (blending on) after it.
+    ImDrawList* list = ImGui::GetBackgroundDrawList();
+    list->AddCallback([](const ImDrawList*, const ImDrawCmd*) { glDisable(GL_BLEND); }, nullptr);
+    list->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(tex.id)), ImVec2(0, 0), size);
+    list->AddCallback(ImDrawCallback_ResetRenderState, nullptr);
     if (wipe_ > 0 && wipe_ < 1 && view_ != ViewMode::Error) {
       const float x = std::round(wipe_ * size.x);
       ImGui::GetForegroundDrawList()->AddLine(ImVec2(x, 0), ImVec2(x, size.y), IM_COL32(255, 200, 0, 255), 1.0f);
@@ -781,7 +849,8 @@ class Viewer {
   // back buffer, and waits for the drawing (so the display stage counts it, not just its
   // submission). Returns the framebuffer's size.
   std::pair<int, int> draw_frame() {
-    upload_if_needed();
+    const Clock::time_point image_start = Clock::now();
+    image_ms_ = upload_if_needed() ? ms_since(image_start) : 0.0;
     draw_image();
     if (show_hud_) draw_hud();
     ImGui::Render();
@@ -821,8 +890,12 @@ class Viewer {
   ReferenceSnapshot ref_{};
   std::uint64_t reference_version_ = 0;
   GLFWwindow* window_ = nullptr;
-  unsigned texture_ = 0;
-  int texture_w_ = 0, texture_h_ = 0;
+  struct Texture {
+    GLuint id = 0;
+    int w = 0, h = 0;
+  };
+  Texture grey_texture_, rgba_texture_;  // the grey views' GL_R8 and the others' GL_RGBA8
+  bool shown_grey_ = true;               // which of them the frame shows
   std::vector<std::uint8_t> pixels_;
   int width_ = 0, height_ = 0, scale_ = 1, threads_ = 0;
   long frame_ = 0;
@@ -831,6 +904,7 @@ class Viewer {
   Falloff falloff_;
   std::shared_ptr<GBuffer> gbuffer_;
   MethodOutput result_;
+  MethodCache method_cache_;  // cone's voxel grid, transfer's scratch images: kept from frame to frame
   Image<Vec3> shaded_;
   Image<float> map_v_;
   double rmse_ = -1;
@@ -839,10 +913,12 @@ class Viewer {
   float wipe_ = 1.0f;
   bool moved_ = false, show_panel_ = true, show_hud_ = true;
   bool dirty_gbuffer_ = true, dirty_method_ = true, dirty_display_ = true;
+  bool dirty_reference_side_ = false;  // only the reference (right of the wipe) changed
   bool screenshot_pending_ = false;
   std::string screenshot_path_, camera_path_;
   std::unique_ptr<tbb::global_control> limit_;
   StageStats stats_;
+  double image_ms_ = 0;  // building and uploading the image in the last draw_frame
 };
 
 }  // namespace
@@ -870,6 +946,14 @@ ScriptedEvent parse_event(const std::string& text) {
 }
 
 int run_view(ViewSetup setup) {
+  // Every frame allocates and frees images of the same few sizes (G-buffer planes, method outputs
+  // and scratch). glibc would return most of them to the kernel (blocks above the mmap threshold,
+  // and the heap's free top beyond the trim threshold), and the next frame would fault in fresh
+  // zeroed pages (BENCHMARKS.md, "ao view", measures what that cost). Keep freed memory in the
+  // process instead: blocks up to 32 MB (glibc's largest mmap threshold) come from the heap, and
+  // the heap is never trimmed, so the process keeps the most memory it ever used at once.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
   Viewer viewer(std::move(setup));
   return viewer.run();
 }

@@ -268,6 +268,54 @@ TEST(Cone, VisibilityInUnitIntervalAndSameAtOneAndTwoThreads) {
   }
 }
 
+// ConeContext keeps the grid between calls: the same pixels as render_cone for every parameter
+// change, a new grid exactly when a voxelization input changes (world grid: the options; eye grid:
+// also the G-buffer, whose camera lays out the columns).
+TEST(ConeContext, CachedGridGivesTheSamePixelsAndRebuildsOnlyWhenItsInputsChange) {
+  const Scene s = make_builtin_scene("default");
+  const auto closure = analyze_closure(s);
+  const GBuffer g = small_gbuffer(s, 64, 40);
+  const auto same_as_uncached = [&](ConeContext& ctx, const GBuffer& gb, float r, const ConeParams& p, std::uint32_t seed, bool reused) {
+    const ConeResult cached = ctx.render(gb, r, p, seed);
+    EXPECT_EQ(cached.grid_reused, reused);
+    const Image<float> plain = render_cone(s, closure, gb, r, p, seed).visibility;
+    ASSERT_EQ(cached.visibility.size(), plain.size());
+    for (std::size_t i = 0; i < plain.size(); ++i) ASSERT_EQ(cached.visibility[i], plain[i]) << "pixel " << i;
+  };
+  ConeContext ctx(s);
+  ConeParams p;
+  p.columns = 128;
+  same_as_uncached(ctx, g, 1.5f, p, 4, false);
+  EXPECT_EQ(ctx.grid_builds(), 1);
+  // Trace-only parameters and the seed: the same grid.
+  same_as_uncached(ctx, g, 1.5f, p, 4, true);
+  p.spheres = 3, p.prisms = 12, p.jitter = false, p.filter_taps = 1, p.aperture_deg = 40;
+  same_as_uncached(ctx, g, 1.5f, p, 9, true);
+  EXPECT_EQ(ctx.grid_builds(), 1);
+  // Another view of the same scene: a world grid does not depend on the camera.
+  Camera moved = g.camera;
+  moved.eye = moved.eye + Vec3{0.3f, 0.2f, 0.0f};
+  const GBuffer g2 = render_gbuffer(RayScene(s), moved);
+  same_as_uncached(ctx, g2, 1.5f, p, 9, true);
+  // Each voxelization input: a new grid.
+  p.columns = 96;
+  same_as_uncached(ctx, g2, 1.5f, p, 9, false);
+  p.depth_bits = 256;
+  same_as_uncached(ctx, g2, 1.5f, p, 9, false);
+  p.open_meshes = OpenMeshes::Slab;
+  same_as_uncached(ctx, g2, 1.5f, p, 9, false);
+  p.slab_fraction = 0.5f;
+  same_as_uncached(ctx, g2, 1.5f, p, 9, false);
+  same_as_uncached(ctx, g2, 1.2f, p, 9, false);  // R_max sets the slab thickness
+  EXPECT_EQ(ctx.grid_builds(), 6);
+  // Eye grid: rebuilt for another grid space and for another camera, reused for the same one.
+  p.grid = GridSpace::Eye;
+  same_as_uncached(ctx, g2, 1.2f, p, 9, false);
+  same_as_uncached(ctx, g2, 1.2f, p, 3, true);
+  same_as_uncached(ctx, g, 1.2f, p, 3, false);
+  EXPECT_EQ(ctx.grid_builds(), 8);
+}
+
 TEST(Cone, PresetsFollowTableOneAndExplicitCountsOverride) {
   const ConeParams low = cone_preset(ConeQuality::Low).resolved(), high = cone_preset(ConeQuality::High).resolved();
   EXPECT_EQ(*low.cones, 6);

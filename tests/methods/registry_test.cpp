@@ -82,6 +82,31 @@ TEST(Registry, DepthCharacteristicIsTheScreenSpaceMethodBitForBit) {
   }
 }
 
+// A MethodCache kept across calls (what ao view does frame after frame) changes no pixel: cone
+// through its kept voxel grid, transfer through its kept scratch images, for two calls each, the
+// second with another seed, and another method's entry beside them; then another scene.
+TEST(Registry, MethodCacheGivesTheSameImagesAsNoCache) {
+  const auto s = test::builtin_gbuffer("default");
+  const Falloff f{Membership::Step, 1.0f};
+  MethodCache cache;
+  for (const char* method : {"cone", "transfer", "cone"})
+    for (std::uint32_t seed : {3u, 8u}) {
+      const MethodInfo& m = find_method(method);
+      const nlohmann::json p = m.default_params();
+      const MethodOutput plain = m.run(MethodInput{s.g, s.rays.get(), f, seed, {}, &s.scene.analytic}, p);
+      const MethodOutput cached = m.run(MethodInput{s.g, s.rays.get(), f, seed, {}, &s.scene.analytic, &cache}, p);
+      ASSERT_EQ(plain.visibility.size(), cached.visibility.size());
+      for (std::size_t i = 0; i < plain.visibility.size(); ++i) ASSERT_EQ(plain.visibility[i], cached.visibility[i]) << method << " pixel " << i;
+      for (std::size_t i = 0; i < plain.color.size(); ++i) ASSERT_EQ(plain.color[i], cached.color[i]) << method << " pixel " << i;
+    }
+  // The same cache handed another scene: cone voxelizes that scene, not the kept grid.
+  const auto other = test::builtin_gbuffer("sphere-on-plane");
+  const MethodInfo& cone = find_method("cone");
+  const MethodOutput plain = cone.run(MethodInput{other.g, other.rays.get(), f, 3, {}, &other.scene.analytic}, cone.default_params());
+  const MethodOutput cached = cone.run(MethodInput{other.g, other.rays.get(), f, 3, {}, &other.scene.analytic, &cache}, cone.default_params());
+  for (std::size_t i = 0; i < plain.visibility.size(); ++i) ASSERT_EQ(plain.visibility[i], cached.visibility[i]) << "pixel " << i;
+}
+
 // An open plane as the half-space y >= 0: every sample point of the hemisphere (containment,
 // transfer) and every pipe of the tangent sphere (volumetric) lies in it, and the Taylor distance
 // of a plane is exact, so V = 1 at every pixel, without the depth buffer's perspective error.

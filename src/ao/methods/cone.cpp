@@ -557,17 +557,28 @@ void compute_cone(const GBuffer& gb, const VoxelGrid& g, float r_max, const Cone
   }
 }
 
-ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, float r_max, const ConeParams& params,
-                       std::uint32_t seed, const ProgressFn& progress) {
+namespace {
+
+double ms_between(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+ConeParams checked_resolved(const ConeParams& params, float r_max) {
   const ConeParams p = params.resolved();
   p.validate();
-  using Clock = std::chrono::steady_clock;
-  const auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
-  ConeResult r;
-  const auto t0 = Clock::now();
   if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
-  const VoxelGrid g = p.grid == GridSpace::World ? voxelize_world(scene, closure, p.voxelize_options(r_max), &r.voxel_stats)
-                                                 : voxelize_eye(scene, closure, gb, p.voxelize_options(r_max), &r.voxel_stats);
+  return p;
+}
+
+VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max, VoxelStats* stats) {
+  return p.grid == GridSpace::World ? voxelize_world(scene, closure, p.voxelize_options(r_max), stats)
+                                    : voxelize_eye(scene, closure, gb, p.voxelize_options(r_max), stats);
+}
+
+// The kernel and the filter on a built grid; `p` resolved and checked.
+void trace_and_filter(const GBuffer& gb, const VoxelGrid& g, float r_max, const ConeParams& p, std::uint32_t seed, const ProgressFn& progress,
+                      ConeResult& r) {
+  using Clock = std::chrono::steady_clock;
   const auto t1 = Clock::now();
   r.visibility = Image<float>(gb.width(), gb.height(), 1.0f);
   compute_cone(gb, g, r_max, p, seed, r.visibility.view(), progress);
@@ -577,12 +588,59 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
     f.taps = p.filter_taps;
     bilateral_filter(gb, r.visibility, f);
   }
-  const auto t3 = Clock::now();
-  r.voxelize_ms = ms(t0, t1);
-  r.trace_ms = ms(t1, t2);
-  r.filter_ms = ms(t2, t3);
+  r.trace_ms = ms_between(t1, t2);
+  r.filter_ms = ms_between(t2, Clock::now());
   r.grid_nx = g.nx;
   r.grid_ny = g.ny;
+}
+
+}  // namespace
+
+ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, float r_max, const ConeParams& params,
+                       std::uint32_t seed, const ProgressFn& progress) {
+  const ConeParams p = checked_resolved(params, r_max);
+  ConeResult r;
+  const auto t0 = std::chrono::steady_clock::now();
+  const VoxelGrid g = voxelize(scene, closure, gb, p, r_max, &r.voxel_stats);
+  r.voxelize_ms = ms_between(t0, std::chrono::steady_clock::now());
+  trace_and_filter(gb, g, r_max, p, seed, progress, r);
+  return r;
+}
+
+ConeContext::ConeContext(const Scene& scene) : scene_(scene), closure_(analyze_closure(scene)) {}
+
+bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const VoxelizeOptions& o) const {
+  if (!valid_ || grid_.space != space || o.columns != options_.columns || o.depth_bits != options_.depth_bits ||
+      o.open_meshes != options_.open_meshes || o.slab_thickness != options_.slab_thickness)
+    return false;
+  if (space == GridSpace::World) return true;
+  const Camera& c = gb.camera;
+  return c.eye == camera_.eye && c.target == camera_.target && c.up == camera_.up && c.vertical_fov_deg == camera_.vertical_fov_deg &&
+         c.width == camera_.width && c.height == camera_.height && std::equal(gb.depth.data(), gb.depth.data() + gb.depth.size(), depth_.begin(), depth_.end()) &&
+         std::equal(gb.coverage.data(), gb.coverage.data() + gb.coverage.size(), coverage_.begin(), coverage_.end());
+}
+
+ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams& params, std::uint32_t seed, const ProgressFn& progress) {
+  const ConeParams p = checked_resolved(params, r_max);
+  const VoxelizeOptions options = p.voxelize_options(r_max);
+  ConeResult r;
+  const auto t0 = std::chrono::steady_clock::now();
+  r.grid_reused = grid_is_current(gb, p.grid, options);
+  if (!r.grid_reused) {
+    valid_ = false;  // until the new grid is complete (a build that throws leaves none)
+    grid_ = voxelize(scene_, closure_, gb, p, r_max, &stats_);
+    options_ = options;
+    if (p.grid == GridSpace::Eye) {
+      camera_ = gb.camera;
+      depth_.assign(gb.depth.data(), gb.depth.data() + gb.depth.size());
+      coverage_.assign(gb.coverage.data(), gb.coverage.data() + gb.coverage.size());
+    }
+    valid_ = true;
+    ++builds_;
+    r.voxelize_ms = ms_between(t0, std::chrono::steady_clock::now());
+  }
+  r.voxel_stats = stats_;
+  trace_and_filter(gb, grid_, r_max, p, seed, progress, r);
   return r;
 }
 
@@ -611,6 +669,7 @@ nlohmann::json cone_stats(const ConeResult& r) {
           {"voxelize_ms", r.voxelize_ms},
           {"trace_ms", r.trace_ms},
           {"filter_ms", r.filter_ms},
+          {"grid_reused", r.grid_reused},
           {"warnings", warnings}};
 }
 

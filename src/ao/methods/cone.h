@@ -106,12 +106,52 @@ struct ConeResult {
   VoxelStats voxel_stats;
   double voxelize_ms = 0, trace_ms = 0, filter_ms = 0;
   int grid_nx = 0, grid_ny = 0;
+  bool grid_reused = false;  ///< ConeContext: the grid of an earlier call was traced (no voxelization).
 };
 
 /// Voxelizes `scene` (rebuilt on every call: a dynamic-scene method), runs the kernel and the filter.
 /// `closure` comes from analyze_closure(scene) (topology, reusable across frames).
 ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, float r_max, const ConeParams& params,
                        std::uint32_t seed, const ProgressFn& progress = {});
+
+/// A scene prepared for cone tracing frame after frame: its mesh closure (analyze_closure) and the
+/// last voxel grid with its coarse occupancy masks (voxelize.h), kept between calls. The paper
+/// voxelizes every frame (a dynamic scene) and names building the grid once for static scenes as
+/// future work (sec. V); this is that. The grid is rebuilt only when what it depends on changes:
+///  - world grid: the voxelization options (columns, depth_bits, open_meshes, and the slab
+///    thickness slab_fraction * R_max); the camera does not enter, so an orbiting view reuses it;
+///  - eye grid (the paper's): also the G-buffer, whose camera lays out the columns and whose depths
+///    give z_nearest (eq. 2); it is reused only while the camera and the depths stay the same.
+/// Every other parameter (cones, spheres, prisms, aperture, weighting, jitter, filter, seed) only
+/// enters the trace. The output is bit-identical to render_cone's with the same arguments.
+/// The scene is held by reference: it must outlive the context and not change while it is used
+/// (for another scene, make another context).
+class ConeContext {
+ public:
+  explicit ConeContext(const Scene& scene);
+  /// As render_cone(scene, closure, gbuffer, r_max, params, seed, progress), voxelizing only when
+  /// the grid's inputs changed (voxelize_ms is then the time of that; 0 with grid_reused).
+  ConeResult render(const GBuffer& gbuffer, float r_max, const ConeParams& params, std::uint32_t seed, const ProgressFn& progress = {});
+  /// How many grids have been built so far.
+  int grid_builds() const { return builds_; }
+  /// The scene it was made for.
+  const Scene& scene() const { return scene_; }
+
+ private:
+  bool grid_is_current(const GBuffer& gbuffer, GridSpace space, const VoxelizeOptions& options) const;
+
+  const Scene& scene_;
+  std::vector<MeshClosure> closure_;
+  VoxelGrid grid_;
+  VoxelStats stats_;
+  bool valid_ = false;  // grid_ is complete and was built from the members below
+  int builds_ = 0;
+  // What grid_ was built from.
+  VoxelizeOptions options_;
+  Camera camera_;                     // eye grid only
+  std::vector<float> depth_;          // eye grid only: the G-buffer's depth
+  std::vector<std::uint8_t> coverage_;  // eye grid only
+};
 
 /// Numbers for --json: grid size, voxelization statistics, timings, and "warnings" (odd columns,
 /// open meshes thickened into slabs, meshes with holes), one line each, which the CLI prints.

@@ -13,6 +13,7 @@
 #include "ao/methods/containment.h"
 #include "ao/methods/gtao.h"
 #include "ao/methods/transfer.h"
+#include "ao/methods/transfer_internal.h"
 #include "ao/methods/volumetric.h"
 #include "ao/reference/raytraced.h"
 #include "ao/reference/reference.h"
@@ -234,7 +235,14 @@ MethodOutput run_transfer(const MethodInput& in, const nlohmann::json& j) {
   with_characteristic(in, kind, "transfer", p.silhouette_elimination, in.falloff.radius, [&](const auto& ch, bool kernel_elimination) {
     TransferParams q = p;
     q.silhouette_elimination = kernel_elimination;
-    TransferImage img = transfer_ao(in.gbuffer, ch, in.gbuffer.albedo, in.falloff, q, in.seed);
+    TransferImage img;
+    if (in.cache) {  // the scratch images of the last call, reused
+      TransferBuffers& buffers = in.cache->entry<TransferBuffers>("transfer");
+      transfer_ao(buffers, in.gbuffer, ch, in.gbuffer.albedo, in.falloff, q, in.seed);
+      img = std::move(buffers.result);
+    } else {
+      img = transfer_ao(in.gbuffer, ch, in.gbuffer.albedo, in.falloff, q, in.seed);
+    }
     out.visibility = std::move(img.luminance);
     out.color = std::move(img.transfer);
     out.extras["obscurance"] = std::move(img.obscurance);
@@ -246,8 +254,16 @@ MethodOutput run_transfer(const MethodInput& in, const nlohmann::json& j) {
 MethodOutput run_cone(const MethodInput& in, const nlohmann::json& j) {
   if (!in.scene) throw InputError("method cone voxelizes the scene, and a G-buffer file has none: give a scene instead of --gbuffer-in");
   const ConeParams p = j.get<ConeParams>();
-  const std::vector<MeshClosure> closure = analyze_closure(in.scene->scene());
-  ConeResult r = render_cone(in.scene->scene(), closure, in.gbuffer, in.falloff.radius, p, in.seed, in.progress);
+  ConeResult r;
+  if (in.cache) {
+    const Scene& scene = in.scene->scene();
+    ConeContext* context = &in.cache->entry<ConeContext>("cone", scene);
+    if (&context->scene() != &scene) context = &in.cache->replace<ConeContext>("cone", scene);
+    r = context->render(in.gbuffer, in.falloff.radius, p, in.seed, in.progress);
+  } else {
+    const std::vector<MeshClosure> closure = analyze_closure(in.scene->scene());
+    r = render_cone(in.scene->scene(), closure, in.gbuffer, in.falloff.radius, p, in.seed, in.progress);
+  }
   MethodOutput out;
   out.stats = cone_stats(r);
   out.visibility = std::move(r.visibility);

@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -22,6 +24,33 @@ namespace ao {
 
 class RayScene;
 
+/// What methods keep between calls on one scene, for a caller that renders frame after frame (a
+/// viewer, a benchmark): cone's mesh closure and voxel grid (ConeContext), transfer's scratch
+/// images. A method's output is the same with and without it. The caller owns it, passes it with
+/// every call on the same scene and makes a new one for another scene (cone also starts over when
+/// handed another Scene object). Each method keeps one entry, of one type, under its name. Not for
+/// concurrent calls.
+class MethodCache {
+ public:
+  /// The entry of `method`, constructed from `args` on first use.
+  template <class T, class... Args>
+  T& entry(std::string_view method, Args&&... args) {
+    auto it = entries_.find(method);
+    if (it == entries_.end()) it = entries_.emplace(std::string(method), std::make_shared<T>(std::forward<Args>(args)...)).first;
+    return *static_cast<T*>(it->second.get());
+  }
+  /// A new entry of `method` constructed from `args`, in place of the old one.
+  template <class T, class... Args>
+  T& replace(std::string_view method, Args&&... args) {
+    std::shared_ptr<void>& slot = entries_[std::string(method)];
+    slot = std::make_shared<T>(std::forward<Args>(args)...);
+    return *static_cast<T*>(slot.get());
+  }
+
+ private:
+  std::map<std::string, std::shared_ptr<void>, std::less<>> entries_;
+};
+
 /// Everything a method may read. Screen-space methods read only the G-buffer (and, when asked for
 /// an analytic characteristic function, the scene's analytic description); object-space methods
 /// (the ray-traced reference) also need the scene, which is absent when the G-buffer came from a file.
@@ -34,6 +63,8 @@ struct MethodInput {
   /// The scene's analytic surfaces (Scene::analytic, world space; the G-buffer's camera takes them
   /// to camera space). Null when running from --gbuffer-in; may be set and empty.
   const AnalyticSurfaces* surfaces = nullptr;
+  /// Null, or what the methods keep between calls on this scene (MethodCache).
+  MethodCache* cache = nullptr;
 };
 
 /// The registry-level parameter of containment, volumetric and transfer that chooses their

@@ -64,14 +64,16 @@ void set_rate(benchmark::State& state, double rays_per_iteration) {
   state.counters["Mrays/s"] = benchmark::Counter(rays_per_iteration * static_cast<double>(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
 }
 
-// ao's G-buffer, rendered into a reused GBuffer as a renderer drawing frame after frame would.
-void gbuffer_ao(benchmark::State& state, const char* mesh) {
+// ao's G-buffer, rendered into a reused GBuffer as a renderer drawing frame after frame would:
+// the channels `ao render --method raytraced` renders (no albedo, no UVs), or with `full` all.
+void gbuffer_ao(benchmark::State& state, const char* mesh, bool full) {
   Fixture* f = fixture(mesh);
   const Camera cam = f->gbuffer.camera;
+  const GBufferOptions options{.albedo = full, .uv = full};
   GBuffer g;
-  render_gbuffer(f->rays, cam, g);
+  render_gbuffer(f->rays, cam, options, g);
   for (auto _ : state) {
-    render_gbuffer(f->rays, cam, g);
+    render_gbuffer(f->rays, cam, options, g);
     benchmark::DoNotOptimize(g.depth.data());
   }
   set_rate(state, static_cast<double>(cam.width) * cam.height);
@@ -172,12 +174,15 @@ void sampling_error(benchmark::State& state, const char* mesh) {
 BENCHMARK_CAPTURE(sampling_error, elephant_on_ground, kElephant)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_CAPTURE(sampling_error, dragon_on_ground, kDragon)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_CAPTURE(direct_light, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK_CAPTURE(gbuffer_ao, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK_CAPTURE(gbuffer_bare, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK_CAPTURE(gbuffer_ao, elephant_on_ground, kElephant)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK_CAPTURE(gbuffer_bare, elephant_on_ground, kElephant)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK_CAPTURE(gbuffer_ao, dragon_on_ground, kDragon)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK_CAPTURE(gbuffer_bare, dragon_on_ground, kDragon)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_ao, default_scene, "default", false)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_ao, default_scene_all_channels, "default", true)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_bare, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_ao, elephant_on_ground, kElephant, false)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_ao, elephant_on_ground_all_channels, kElephant, true)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_bare, elephant_on_ground, kElephant)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_ao, dragon_on_ground, kDragon, false)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_ao, dragon_on_ground_all_channels, kDragon, true)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(gbuffer_bare, dragon_on_ground, kDragon)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(reference_ao, elephant_on_ground_64spp, kElephant)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK_CAPTURE(reference_bare, elephant_on_ground_64spp, kElephant)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK_CAPTURE(reference_ao, dragon_on_ground_64spp, kDragon)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);

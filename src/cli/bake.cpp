@@ -60,6 +60,7 @@ struct BakeOptions {
   bool json = false;
   HistogramParams hist;
   std::string direction_set = "fibonacci", normalization = "area";
+  std::string normal = "shading";  // --normal, parsed into rt.normal
   RaytracedBakeParams rt;
   std::optional<float> max_distance;
   std::string membership = "step";
@@ -518,6 +519,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (!norm) throw InputError("--normalization: expected area or max, got '" + o.normalization + "'");
   o.hist.normalization = *norm;
   o.hist.bent_normals = o.rt.bent_normals = !o.bent.empty();
+  o.rt.normal = parse_surface_normal(o.normal);
   o.hist.validate();
   if (o.size < 1 || o.size > 16384) throw InputError("--size must be in [1, 16384]");
   const std::vector<fs::path> inputs = expand_inputs(o.inputs);
@@ -596,6 +598,12 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--max-distance", o->max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");
   cmd->add_option("--membership", o->membership, "raytraced with --max-distance: falloff step, linear, sqrt or cubic")->capture_default_str();
   cmd->add_option("--offset", o->rt.offset, "raytraced: ray origin offset along the face normal, world units (0: scale-free, a few float spacings of the coordinates; docs/methods/raytraced.md)")->capture_default_str();
+  cmd->add_option("--normal", o->normal,
+                  "raytraced: hemisphere about the interpolated shading normal (default: the smooth surface the mesh stands for) or the "
+                  "triangle's geometric normal (per vertex: the area-weighted mean over its triangles); the histogram baker integrates the "
+                  "whole sphere of views and takes no normal")
+      ->type_name("shading|geometric")
+      ->capture_default_str();
   cmd->add_flag("--ignore-back-faces", o->rt.ignore_back_faces, "raytraced: rays pass through back faces (xNormal/Substance 'ignore backface')");
   cmd->add_option("--padding", o->padding, "Fill texels up to this far outside the charts from the nearest chart texel [0, 1024]")->capture_default_str();
   cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
@@ -624,7 +632,8 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   for (const char* name : {"--directions", "--direction-set", "--pixels-per-texel", "--point-size", "--normalization", "--min-samples", "--seam-fix",
                            "--vertex-resolution"})
     histogram_only.push_back(cmd->get_option(name));
-  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces"}) raytraced_only.push_back(cmd->get_option(name));
+  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal"})
+    raytraced_only.push_back(cmd->get_option(name));
   cmd->callback([o, method, histogram_only, raytraced_only, &global, &action] {
     o->method_given = method->count() > 0;
     for (const CLI::Option* opt : histogram_only)

@@ -126,8 +126,13 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   apply_param_overrides(params, o.params, method.name);
   if (o.normal && !o.gbuffer_in.empty())
     throw InputError("--normal chooses the normal a scene's G-buffer is rendered with; a --gbuffer-in file brings its own N");
-  const GBufferOptions gbuffer_options{.normal = o.normal ? parse_surface_normal(*o.normal) : SurfaceNormal::Shading};
   const std::optional<Sun> sun = o.sun ? std::optional<Sun>(parse_sun(*o.sun)) : std::nullopt;
+  // Only the channels something reads: screen-space methods (transfer, GTAO's multi-bounce), the
+  // sun, --shaded and --gbuffer-out read the albedo; the ray tracers take it from the scene. UVs
+  // serve --ao-map only.
+  const GBufferOptions gbuffer_options{.normal = o.normal ? parse_surface_normal(*o.normal) : SurfaceNormal::Shading,
+                                       .albedo = !method.needs_scene || sun || !o.shaded.empty() || !o.gbuffer_out.empty(),
+                                       .uv = !o.ao_map.empty()};
   if (sun && !o.gbuffer_in.empty())
     throw InputError("--sun traces shadow rays in the scene, and --gbuffer-in gives only a G-buffer: give a scene, or a G-buffer EXR with "
                      "direct.R direct.G direct.B channels");

@@ -363,10 +363,11 @@ namespace {
 TEST(BakeCli, OptionsOfTheOtherMethodAreOneLineErrors) {
   TempDir dir;
   write_text(dir / "cube.obj", cube_obj(true));
-  for (const char* opt : {"--ignore-back-faces", "--membership linear", "--offset 0.01", "--samples 4"})
+  for (const char* opt : {"--ignore-back-faces", "--membership linear", "--offset 0.01", "--samples 4", "--normal geometric"})
     expect_one_line_error(run_ao("bake cube.obj -m histogram --size 16 " + std::string(opt), dir.path()), "does not apply to --method histogram");
   for (const char* opt : {"--directions 8", "--pixels-per-texel 2", "--no-seam-fix", "--normalization max"})
     expect_one_line_error(run_ao("bake cube.obj -m raytraced --size 16 " + std::string(opt), dir.path()), "does not apply to --method raytraced");
+  expect_one_line_error(run_ao("bake cube.obj --size 16 --normal face", dir.path()), "--normal: expected shading or geometric");
   EXPECT_FALSE(fs::exists(dir / "cube-ao.png"));
 }
 

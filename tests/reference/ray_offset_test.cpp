@@ -7,11 +7,15 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <utility>
 
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/mesh_io.h"
 #include "ao/reference/direct_light.h"
 #include "ao/reference/raytraced.h"
+#include "ao/reference/tangent_sphere.h"
+#include "ao/reference/transfer_reference.h"
 #include "ao/scene/procedural.h"
 #include "support/scenes.h"
 
@@ -178,6 +182,49 @@ TEST(RayOffset, UnbiasedOnSharedScannedMeshesWithLargeGround) {
     expect_unbiased(s, 1, b.diagonal(), name);
   }
   if (found == 0) GTEST_SKIP() << "../shared/data/meshes absent; UnbiasedOnBumpyMeshWithLargeGround covers the generated mesh";
+}
+
+// Every ray-traced reference starts its rays as raytraced.cpp does (gbuffer_rays_internal.h: per
+// triangle, along the geometric normal). A concave crease 1 cm across at the origin, and a quad
+// out of view at 1e4: an offset from the scene's magnitude (64 float spacings of 1e4, 7.6 cm)
+// would start every ray beyond R = 5 mm from the crease, so V = 1 everywhere; the per-triangle
+// offset (64 spacings of 1e-2) agrees with an offset 8 times smaller within 2 standard errors.
+TEST(RayOffset, ReferencesOffsetPerTriangleNotByTheScene) {
+  const float c = 0.01f;
+  const Scene s = test::scene_of({make_quad({0, 0, c}, {c, 0, c}, {c, 0, 0}, {0, 0, 0}), make_quad({0, 0, 0}, {c, 0, 0}, {c, c, 0}, {0, c, 0}),
+                                  make_quad({1e4f, 0, 1e4f}, {1e4f + 1, 0, 1e4f}, {1e4f + 1, 1, 1e4f}, {1e4f, 1, 1e4f})});
+  const RayScene rs(s);
+  const GBuffer g = render_gbuffer(rs, looking_at({0.7f * c, 0.6f * c, 1.4f * c}, {0.4f * c, 0.2f * c, 0.3f * c}, 64, 48, 50.0f));
+  const float radius = 0.5f * c;
+  const float tiny = ray_offset_distance(max_abs_coordinate(g.camera.eye) + c) * (8.0f / kRayOffsetUlps);
+  const float scene_rule = ray_offset_distance(bounds_magnitude(s.bounds()));
+  // Mean of V over covered pixels and its standard error, for each reference and offset.
+  const auto mean_of = [&](const RaytracedImage& img) {
+    double sum = 0, var = 0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < img.visibility.size(); ++i) {
+      if (!g.coverage[i]) continue;
+      sum += img.visibility[i];
+      var += static_cast<double>(img.std_error[i]) * img.std_error[i];
+      ++n;
+    }
+    EXPECT_GT(n, 500u);
+    return MeanV{sum / static_cast<double>(n), std::sqrt(var) / static_cast<double>(n)};
+  };
+  const auto tangent = [&](float offset, std::uint32_t seed) {
+    return mean_of(render_tangent_sphere(rs, g, radius, {.samples = 64, .offset = offset}, seed));
+  };
+  const auto transfer = [&](float offset, std::uint32_t seed) {
+    return mean_of(render_transfer_reference(rs, g, {Membership::Step, radius}, 0.0f, {.samples = 64, .offset = offset}, seed).scalar);
+  };
+  for (const auto& [name, run] : {std::pair<const char*, std::function<MeanV(float, std::uint32_t)>>{"tangent sphere", tangent},
+                                  {"transfer", transfer}}) {
+    const MeanV ours = run(0.0f, 1), small = run(tiny, 2), old_rule = run(scene_rule, 3);
+    const double se = std::sqrt(ours.std_error * ours.std_error + small.std_error * small.std_error);
+    EXPECT_LT(small.mean, 0.99) << name << ": the crease must occlude for the test to mean anything";
+    EXPECT_LE(std::abs(ours.mean - small.mean), 2 * se) << name << ": default " << ours.mean << ", tiny offset " << small.mean;
+    EXPECT_GT(old_rule.mean - small.mean, 2 * se) << name << ": the scene-magnitude offset should be visibly biased here";
+  }
 }
 
 TEST(RayOffset, OffsetFollowsTheCoordinatesNotTheScene) {

@@ -203,7 +203,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
               const HighHit h = trace_cage_ray(targets, target_fn, ctx, sp.p - d * front, d, front + back);
               if (!h.hit) continue;
               ++hits;
-              const Vec3 w = Frame::from_normal(h.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
+              const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
               if (dot(w, h.ng) <= 0) continue;  // below the high face: occluded by the surface itself (mu = 0)
               org[static_cast<std::size_t>(live)] = h.p + h.ng * offset;
               dir[static_cast<std::size_t>(live)] = w;

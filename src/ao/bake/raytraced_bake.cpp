@@ -11,7 +11,9 @@
 // unlimited distance and back-face skipping) are in texel_rays.h, shared with high_to_low.cpp.
 #include "ao/bake/raytraced_bake.h"
 
+#include <algorithm>
 #include <array>
+#include <span>
 #include <cmath>
 
 #include "ao/bake/texel_rays_internal.h"
@@ -29,6 +31,37 @@ constexpr int kTile = 16;
 constexpr int kMaxSamples = 1 << 20;
 
 using detail::face_normals;
+
+// The triangles around each vertex of a mesh (CSR: those of vertex v are triangles[first[v] ..
+// first[v + 1])) with their running area sum, for the geometric-normal per-vertex bake.
+struct VertexFaces {
+  std::vector<std::uint32_t> first, triangles;
+  std::vector<float> cumulative_area;
+};
+
+std::vector<VertexFaces> vertex_faces(const Scene& scene) {
+  std::vector<VertexFaces> out;
+  for (const Mesh& m : scene.meshes) {
+    VertexFaces& vf = out.emplace_back();
+    vf.first.assign(m.positions.size() + 1, 0);
+    for (const std::uint32_t i : m.indices) ++vf.first[i + 1];
+    for (std::size_t v = 0; v < m.positions.size(); ++v) vf.first[v + 1] += vf.first[v];
+    vf.triangles.resize(m.indices.size());
+    vf.cumulative_area.resize(m.indices.size());
+    std::vector<std::uint32_t> fill(vf.first.begin(), vf.first.end() - 1);
+    for (std::size_t t = 0; t < m.triangle_count(); ++t)
+      for (int c = 0; c < 3; ++c) vf.triangles[fill[m.indices[3 * t + c]]++] = static_cast<std::uint32_t>(t);
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      float sum = 0;
+      for (std::uint32_t j = vf.first[v]; j < vf.first[v + 1]; ++j) {
+        const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(vf.triangles[j])];
+        sum += 0.5f * length(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]));
+        vf.cumulative_area[j] = sum;
+      }
+    }
+  }
+  return out;
+}
 using detail::PatchPiece;
 using detail::point_at_uv;
 using detail::SurfacePoint;
@@ -60,11 +93,13 @@ void to_json(nlohmann::json& j, const RaytracedBakeParams& p) {
        {"offset", p.offset},
        {"ignore_back_faces", p.ignore_back_faces},
        {"bent_normals", p.bent_normals},
+       {"normal", p.normal == SurfaceNormal::Geometric ? "geometric" : "shading"},
        {"seed", p.seed}};
 }
 
 BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const RaytracedBakeParams& params, const ProgressFn& progress) {
   params.validate();
+  const bool geometric = params.normal == SurfaceNormal::Geometric;
   const Scene& scene = rs.scene();
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
@@ -104,7 +139,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
               const detail::PatchSample ps = detail::sample_patch(patch, sobol_owen_2d(i, key_point));
               const PatchPiece& pc = patch[ps.piece];
               const SurfacePoint sp = point_at_uv(scene, cov, pc.mesh, pc.triangle, ps.uv, fn);
-              const Vec3 d = Frame::from_normal(sp.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
+              const Vec3 d = Frame::from_normal(geometric ? sp.ng : sp.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
               if (dot(d, sp.ng) <= 0) continue;  // below the face: occluded by the surface itself (mu = 0)
               // Off the triangle by the scale-free offset of ray_offset.h, or the user's fixed one.
               const float offset = params.offset > 0 ? params.offset : ray_offset_distance(triangle_magnitude(scene.meshes[pc.mesh], pc.triangle));
@@ -136,6 +171,8 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
+  const bool geometric = params.normal == SurfaceNormal::Geometric;
+  const std::vector<VertexFaces> faces = geometric ? vertex_faces(scene) : std::vector<VertexFaces>{};
   std::vector<float> mesh_offset;  // a vertex has no single triangle: the offset scale is its mesh's largest coordinate
   for (const Mesh& m : scene.meshes) {
     const Bounds3 b = m.bounds();
@@ -158,16 +195,35 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
       for (int vi = t.x0; vi < t.x1; ++vi) {
         const Mesh& m = scene.meshes[verts[static_cast<std::size_t>(vi)].first];
         const std::uint32_t v = verts[static_cast<std::size_t>(vi)].second;
+        const std::uint32_t mi = verts[static_cast<std::size_t>(vi)].first;
         const Vec3 nrm = normalize(m.normals[v]);
         const Frame frame = Frame::from_normal(nrm);
         const std::uint32_t key = pixel_seed(params.seed, vi, 0);
-        const float offset = mesh_offset[verts[static_cast<std::size_t>(vi)].first];
+        const float offset = mesh_offset[mi];
+        // Geometric: sample k takes the face whose share of the vertex's cumulative triangle area
+        // contains (k + 0.5) / samples (stratified by area), and its direction about that face.
+        std::span<const std::uint32_t> tris;
+        std::span<const float> cdf;
+        if (geometric) {
+          const VertexFaces& vf = faces[mi];
+          tris = std::span(vf.triangles).subspan(vf.first[v], vf.first[v + 1] - vf.first[v]);
+          cdf = std::span(vf.cumulative_area).subspan(vf.first[v], vf.first[v + 1] - vf.first[v]);
+        }
         double sum = 0;
         for (int first = 0; first < params.samples; first += batch) {
           const int c = std::min(batch, params.samples - first);
           for (int k = 0; k < c; ++k) {
+            Frame f = frame;
+            if (!tris.empty()) {
+              const float target = (static_cast<float>(first + k) + 0.5f) / static_cast<float>(params.samples) * cdf.back();
+              const std::size_t j = std::min<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), target) - cdf.begin(), tris.size() - 1);
+              f = Frame::from_normal(fn.per_mesh[mi][tris[j]]);
+            }
+            // Off along the vertex normal in both modes: it leans away from every face at the
+            // vertex, so the origin clears all of them (a face normal would leave it on the plane
+            // of a neighbouring face in a crease).
             org[static_cast<std::size_t>(k)] = m.positions[v] + nrm * offset;
-            dir[static_cast<std::size_t>(k)] = frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), key)));
+            dir[static_cast<std::size_t>(k)] = f.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), key)));
           }
           tracer.template trace<N>(ctx, org.data(), dir.data(), c, mu.data());
           for (int k = 0; k < c; ++k) sum += mu[static_cast<std::size_t>(k)];

@@ -11,6 +11,7 @@
 
 #include "ao/bake/bake_result.h"
 #include "ao/bake/texel_coverage.h"
+#include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
 #include "ao/reference/ray_scene.h"
@@ -23,6 +24,11 @@ struct RaytracedBakeParams {
   Membership membership = Membership::Step;  ///< mu(d) when max_distance is set; unlimited distance is a step at infinity.
   float offset = 0.0f;                   ///< Ray origin offset along the face normal, world units, [0, kMaxCoordinate]; 0 = the scale-free offset of reference/ray_offset.h.
   bool ignore_back_faces = false;        ///< Rays pass through back faces (what xNormal's and Substance's "ignore backface" do).
+  /// The hemisphere each point integrates over. Shading (default, as the G-buffer's): about the
+  /// interpolated vertex normal, the smooth surface the mesh stands for. Geometric: about the face
+  /// normal of the triangle the point lies on; at a vertex (per-vertex bakes), the area-weighted
+  /// mean over the vertex's triangles of the integral about each face normal.
+  SurfaceNormal normal = SurfaceNormal::Shading;
   bool bent_normals = false;             ///< Also average the unoccluded directions per texel.
   std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
 

@@ -21,10 +21,10 @@ struct GBuffer {
   Image<Vec3> position;       ///< Camera-space position of the visible surface; (0,0,0) where not covered.
   Image<float> depth;         ///< Linear depth = -position.z (> 0); +infinity where not covered.
   Image<Vec3> normal;         ///< Unit camera-space normal facing the camera (the shading normal unless rendered with SurfaceNormal::Geometric); (0,0,0) where not covered.
-  Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered.
+  Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered. Empty when rendered without it (GBufferOptions::albedo).
   Image<std::uint32_t> object_id;  ///< 1 + index of the mesh in its scene; 0 where not covered.
   Image<std::uint8_t> coverage;    ///< 1 where a surface is visible, 0 for background.
-  Image<Vec2> uv;                  ///< First UV set of the visible surface; (0,0) where not covered or the mesh has none.
+  Image<Vec2> uv;                  ///< First UV set of the visible surface; (0,0) where not covered or the mesh has none. Empty when rendered without it (GBufferOptions::uv).
   /// Optional direct-light pass: the radiance Ld the visible surface reflects of direct lights
   /// (sun, point lights; not the ambient light), per channel, in units of the ambient radiance La
   /// (Ld = 1: as bright as the sky), >= 0; 0 where not covered. Empty (the default) = no such

@@ -1,6 +1,11 @@
 #include "ao/gbuffer/render_gbuffer.h"
 
+#include <algorithm>
 #include <array>
+#include <cstdint>
+#include <cstring>
+
+#include <emmintrin.h>
 
 #include "ao/core/parallel.h"
 #include "ao/reference/packets_internal.h"
@@ -9,7 +14,9 @@ namespace ao {
 
 namespace {
 
-constexpr int kTile = 32;  // pixels per tile side: a tile is one TBB task
+// A tile (one TBB task) is kTileWidth x kTileHeight pixels, traced and written in strips one
+// packet block high (at most kStripHeight rows): long rows make long streamed runs per channel.
+constexpr int kTileWidth = 64, kTileHeight = 16, kStripHeight = 4;
 
 // World-space direction through pixel centre (x + 0.5, y + 0.5) as origin + x * dx + y * dy: the
 // per-pixel work of Camera::camera_direction with the trigonometry done once per image.
@@ -25,62 +32,21 @@ struct RayGenerator {
   Vec3 operator()(int x, int y) const { return origin + dx * static_cast<float>(x) + dy * static_cast<float>(y); }
 };
 
-// Writes the G-buffer entry of pixel (x, y) for a hit on triangle `prim` of mesh `geom` at
-// barycentric (u, v), or the background values when geom is invalid.
-void shade_hit(const Scene& scene, const Camera& cam, const Frame& basis, SurfaceNormal which, GBuffer& g, int x, int y, unsigned geom,
-               unsigned prim, float u, float v) {
-  if (geom == RTC_INVALID_GEOMETRY_ID) {
-    g.position(x, y) = {};
-    g.depth(x, y) = kInfinity;
-    g.normal(x, y) = {};
-    g.albedo(x, y) = {};
-    g.object_id(x, y) = 0;
-    g.primitive_id(x, y) = 0;
-    g.coverage(x, y) = 0;
-    g.uv(x, y) = {};
-    return;
-  }
-  const Mesh& m = scene.meshes[geom];
-  const std::uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1], i2 = m.indices[3 * prim + 2];
-  const float w = 1.0f - u - v;
-  // Interpolating the vertices puts the point on the triangle to float rounding, which is more
-  // accurate than eye + t * direction far from the camera.
-  const Vec3 p = m.positions[i0] * w + m.positions[i1] * u + m.positions[i2] * v;
-  const Vec3 pc = basis.to_local(p - cam.eye);
-  Vec3 ng = basis.to_local(normalize(cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0])));
-  // Both sides of a surface can be seen (open meshes, rooms): AO is for the side facing the
-  // viewer, so turn the geometric normal towards the camera and the shading normal onto its side.
-  if (dot(ng, pc) > 0) ng = -ng;
-  Vec3 n = ng;
-  if (which == SurfaceNormal::Shading) {
-    n = basis.to_local(normalize(m.normals[i0] * w + m.normals[i1] * u + m.normals[i2] * v));
-    if (dot(n, ng) < 0) n = -n;
-    if (!(length(n) > 0.5f)) n = ng;
-  }
-  g.position(x, y) = pc;
-  g.depth(x, y) = -pc.z;
-  g.normal(x, y) = n;
-  g.albedo(x, y) = m.albedo;
-  g.object_id(x, y) = geom + 1;
-  g.primitive_id(x, y) = prim;
-  g.coverage(x, y) = 1;
-  if (!m.uvs.empty()) {
-    const Vec2 t0 = m.uvs[i0], t1 = m.uvs[i1], t2 = m.uvs[i2];
-    g.uv(x, y) = {t0.x * w + t1.x * u + t2.x * v, t0.y * w + t1.y * u + t2.y * v};
-  } else {
-    g.uv(x, y) = {};
-  }
-}
+// What the primary rays of one tile found, per pixel in row-major order within the tile (SoA):
+// the tracing phase fills it packet by packet, the shading phase reads it row by row.
+struct TileHits {
+  static constexpr int kPixels = kTileWidth * kStripHeight;
+  unsigned geom[kPixels], prim[kPixels];
+  float u[kPixels], v[kPixels];
+};
 
+// Traces the primary rays of tile t into `hits`.
 template <int N>
-void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const RayGenerator& gen, SurfaceNormal which, GBuffer& g,
-                 const Tile& t) {
-  detail::flush_denormals_to_zero();
+void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const Tile& t, TileHits& hits) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  const Scene& scene = rs.scene();
-  const RTCScene bvh = embree_scene(rs);
+  const int tw = t.x1 - t.x0;
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
@@ -89,7 +55,8 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
         rh.ray = {cam.eye.x, cam.eye.y, cam.eye.z, 0.0f, d.x, d.y, d.z, 0.0f, kInfinity, 0xffffffffu, 0, 0};
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(bvh, &ctx, &rh);
-        shade_hit(scene, cam, basis, which, g, x, y, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+        const int j = (y - t.y0) * tw + (x - t.x0);
+        hits.geom[j] = rh.hit.geomID, hits.prim[j] = rh.hit.primID, hits.u[j] = rh.hit.u, hits.v[j] = rh.hit.v;
       }
   } else {
     // Blocks of 4 x (N/4) pixels: square-ish footprints keep the packet's rays coherent. The
@@ -112,11 +79,135 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
           rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
         }
         detail::Packet<N>::intersect(valid.data(), bvh, &ctx, &rh);
-        for (int k = 0; k < N; ++k)
-          if (valid[k])
-            shade_hit(scene, cam, basis, which, g, bx + k % bw, by + k / bw, rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
+        for (int k = 0; k < N; ++k) {
+          if (!valid[k]) continue;
+          const int j = (by + k / bw - t.y0) * tw + (bx + k % bw - t.x0);
+          hits.geom[j] = rh.hit.geomID[k], hits.prim[j] = rh.hit.primID[k], hits.u[j] = rh.hit.u[k], hits.v[j] = rh.hit.v[k];
+        }
       }
   }
+}
+
+// Copies `bytes` bytes from src to dst with non-temporal (streaming) stores where dst is 16-byte
+// aligned, plain stores at the unaligned ends. The G-buffer (57 bytes a pixel, tens of MB) is
+// written once and read later by another pass, so streaming it skips reading every destination
+// cache line into the cache before overwriting it: half the memory traffic of plain stores.
+// Callers issue _mm_sfence() before other threads may read what was written.
+void stream_copy(void* dst, const void* src, std::size_t bytes) {
+  auto* d = static_cast<unsigned char*>(dst);
+  const auto* s = static_cast<const unsigned char*>(src);
+  const std::size_t head = std::min(bytes, (16 - reinterpret_cast<std::uintptr_t>(d) % 16) % 16);
+  std::memcpy(d, s, head);
+  d += head, s += head, bytes -= head;
+  for (; bytes >= 16; d += 16, s += 16, bytes -= 16)
+    _mm_stream_si128(reinterpret_cast<__m128i*>(d), _mm_loadu_si128(reinterpret_cast<const __m128i*>(s)));
+  std::memcpy(d, s, bytes);
+}
+
+// One tile row of every G-buffer channel, assembled in cache and then streamed to the images.
+struct RowBuffer {
+  Vec3 position[kTileWidth], normal[kTileWidth], albedo[kTileWidth];
+  float depth[kTileWidth];
+  std::uint32_t object_id[kTileWidth], primitive_id[kTileWidth];
+  std::uint8_t coverage[kTileWidth];
+  Vec2 uv[kTileWidth];
+
+  // Channels a G-buffer rendered without albedo or UVs leaves empty are not written.
+  void stream_to(GBuffer& g, int x0, int y, int n) const {
+    stream_copy(&g.position(x0, y), position, n * sizeof(Vec3));
+    stream_copy(&g.normal(x0, y), normal, n * sizeof(Vec3));
+    if (!g.albedo.empty()) stream_copy(&g.albedo(x0, y), albedo, n * sizeof(Vec3));
+    stream_copy(&g.depth(x0, y), depth, n * sizeof(float));
+    stream_copy(&g.object_id(x0, y), object_id, n * sizeof(std::uint32_t));
+    stream_copy(&g.primitive_id(x0, y), primitive_id, n * sizeof(std::uint32_t));
+    stream_copy(&g.coverage(x0, y), coverage, n * sizeof(std::uint8_t));
+    if (!g.uv.empty()) stream_copy(&g.uv(x0, y), uv, n * sizeof(Vec2));
+  }
+};
+
+// Writes the G-buffer rows of tile t from its hits: each row is assembled in a RowBuffer and
+// streamed out, one contiguous run per channel.
+template <SurfaceNormal kWhich>
+void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
+  const int tw = t.x1 - t.x0;
+  const bool want_uv = !g.uv.empty();
+  RowBuffer row;
+  Vec3* const position = row.position;
+  Vec3* const normal = row.normal;
+  Vec3* const albedo = row.albedo;
+  float* const depth = row.depth;
+  std::uint32_t* const object_id = row.object_id;
+  std::uint32_t* const primitive_id = row.primitive_id;
+  std::uint8_t* const coverage = row.coverage;
+  Vec2* const uv = row.uv;
+  for (int y = t.y0; y < t.y1; ++y) {
+    const TileHits* const h = &hits;
+    const int r = (y - t.y0) * tw;
+    for (int i = 0; i < tw; ++i) {
+      const unsigned geom = h->geom[r + i];
+      if (geom == RTC_INVALID_GEOMETRY_ID) {
+        position[i] = {};
+        depth[i] = kInfinity;
+        normal[i] = {};
+        albedo[i] = {};
+        object_id[i] = 0;
+        primitive_id[i] = 0;
+        coverage[i] = 0;
+        uv[i] = {};
+        continue;
+      }
+      const Mesh& m = scene.meshes[geom];
+      const unsigned prim = h->prim[r + i];
+      const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(prim)];
+      const float bu = h->u[r + i], bv = h->v[r + i], bw = 1.0f - bu - bv;
+      const Vec3 p0 = m.positions[tri[0]], p1 = m.positions[tri[1]], p2 = m.positions[tri[2]];
+      // Interpolating the vertices puts the point on the triangle to float rounding, which is
+      // more accurate than eye + t * direction far from the camera (the ray offsets rely on it).
+      const Vec3 pc = basis.to_local(p0 * bw + p1 * bu + p2 * bv - cam.eye);
+      Vec3 ng = basis.to_local(normalize(cross(p1 - p0, p2 - p0)));
+      // Both sides of a surface can be seen (open meshes, rooms): AO is for the side facing the
+      // viewer, so turn the geometric normal towards the camera and the shading normal onto its side.
+      if (dot(ng, pc) > 0) ng = -ng;
+      position[i] = pc;
+      depth[i] = -pc.z;
+      albedo[i] = m.albedo;
+      object_id[i] = geom + 1;
+      primitive_id[i] = prim;
+      coverage[i] = 1;
+      Vec3 n = ng;
+      if constexpr (kWhich == SurfaceNormal::Shading) {
+        n = basis.to_local(normalize(m.normals[tri[0]] * bw + m.normals[tri[1]] * bu + m.normals[tri[2]] * bv));
+        if (dot(n, ng) < 0) n = -n;
+        if (!(length(n) > 0.5f)) n = ng;
+      }
+      normal[i] = n;
+      if (want_uv && !m.uvs.empty()) {
+        const Vec2 t0 = m.uvs[tri[0]], t1 = m.uvs[tri[1]], t2 = m.uvs[tri[2]];
+        uv[i] = {t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv};
+      } else {
+        uv[i] = {};
+      }
+    }
+    row.stream_to(g, t.x0, y, tw);
+  }
+}
+
+template <int N>
+void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const RayGenerator& gen, SurfaceNormal which, GBuffer& g,
+                 const Tile& t) {
+  detail::flush_denormals_to_zero();
+  // Strips one packet block high: a strip's streamed stores drain while the next strip's rays
+  // traverse the BVH, and its hits stay in the L1 cache between the two phases.
+  constexpr int kStrip = N == 1 ? 1 : N / 4;
+  static_assert(kStrip <= kStripHeight);
+  TileHits hits;
+  for (int y = t.y0; y < t.y1; y += kStrip) {
+    const Tile s{t.x0, y, t.x1, std::min(y + kStrip, t.y1)};
+    trace_tile<N>(embree_scene(rs), cam, gen, s, hits);
+    if (which == SurfaceNormal::Shading) shade_tile<SurfaceNormal::Shading>(rs.scene(), cam, basis, hits, g, s);
+    else shade_tile<SurfaceNormal::Geometric>(rs.scene(), cam, basis, hits, g, s);
+  }
+  _mm_sfence();  // the streamed rows are visible to whichever thread reads the G-buffer next
 }
 
 }  // namespace
@@ -141,10 +232,12 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   g.position.resize(w, h);
   g.depth.resize(w, h);
   g.normal.resize(w, h);
-  g.albedo.resize(w, h);
+  if (options.albedo) g.albedo.resize(w, h);
+  else g.albedo = Image<Vec3>();
   g.object_id.resize(w, h);
   g.coverage.resize(w, h);
-  g.uv.resize(w, h);
+  if (options.uv) g.uv.resize(w, h);
+  else g.uv = Image<Vec2>();
   g.primitive_id.resize(w, h);
   g.camera = camera;
   g.direct = Image<Vec3>();  // belongs to the lighting of the previous view: render_direct_light makes a new one
@@ -152,7 +245,7 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   const RayGenerator gen(camera, basis);
   ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(camera.width, camera.height, kTile, [&](const Tile& t) {
+    parallel_for_tiles(camera.width, camera.height, kTileWidth, kTileHeight, [&](const Tile& t) {
       render_tile<N>(rs, camera, basis, gen, options.normal, g, t);
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
     });

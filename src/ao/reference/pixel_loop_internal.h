@@ -1,6 +1,7 @@
 // The per-pixel loop the ray-traced references share (tangent_sphere.cpp, transfer_reference.cpp):
-// every covered pixel of a G-buffer, in parallel tiles, with its world-space position and unit
-// normal, an Embree intersect context per task, and the packet width chosen once for the scene.
+// every covered pixel of a G-buffer, in parallel tiles, with the ray setup of
+// gbuffer_rays_internal.h (the one raytraced.cpp uses), an Embree intersect context per task, and
+// the packet width chosen once for the scene.
 // Internal to src/ao/reference/.
 #pragma once
 
@@ -13,6 +14,7 @@
 #include "ao/core/progress.h"
 #include "ao/reference/packets_internal.h"
 #include "ao/reference/embree_scene_internal.h"
+#include "ao/reference/gbuffer_rays_internal.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 
@@ -39,15 +41,15 @@ struct MeanAccumulator {
   }
 };
 
-/// Calls fn.template operator()<N>(ctx, x, y, p, n) for every covered pixel (x, y) of `g`, with p
-/// its world-space position and n its unit world-space normal, N the scene's packet width; in
-/// parallel over 16x16 tiles, reporting progress per tile.
+/// Calls fn.template operator()<N>(ctx, x, y, s) for every covered pixel (x, y) of `g`, with s
+/// its PixelSurface (gbuffer_rays_internal.h: world position, unit normal, the geometric normal
+/// and scale-free offset rays start along, or `fixed_offset` when > 0), N the scene's packet
+/// width; in parallel over 16x16 tiles, reporting progress per tile.
 template <class Fn>
-void for_each_covered_pixel(const RayScene& rs, const GBuffer& g, const ProgressFn& progress, Fn&& fn) {
+void for_each_covered_pixel(const RayScene& rs, const GBuffer& g, float fixed_offset, const ProgressFn& progress, Fn&& fn) {
   constexpr int kTile = 16;
   const int w = g.width(), h = g.height();
-  const Frame basis = g.camera.basis();
-  const Vec3 eye = g.camera.eye;
+  const PixelSurfaceContext surface(g, rs.scene(), rs.bounds(), fixed_offset);
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
@@ -57,9 +59,7 @@ void for_each_covered_pixel(const RayScene& rs, const GBuffer& g, const Progress
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x) {
           if (!g.covered(x, y)) continue;
-          const Vec3 p = basis.to_world(g.position(x, y)) + eye;
-          const Vec3 n = normalize(basis.to_world(g.normal(x, y)));
-          fn.template operator()<N>(ctx, x, y, p, n);
+          fn.template operator()<N>(ctx, x, y, surface(x, y));
         }
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
     });

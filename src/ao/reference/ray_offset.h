@@ -44,6 +44,10 @@ inline float ray_offset_distance(float magnitude) { return kRayOffsetUlps * 0x1p
 /// (a conservative bound for every point of the scene).
 inline float bounds_magnitude(const Bounds3& b) { return std::max(max_abs_coordinate(b.lo), max_abs_coordinate(b.hi)); }
 
+/// Offset scale for a ray from point p when its triangle is not known (the single-point
+/// estimates): the largest coordinate of p and of the scene bounds `b`.
+inline float point_magnitude(Vec3 p, const Bounds3& b) { return std::max(max_abs_coordinate(p), bounds_magnitude(b)); }
+
 /// p moved along the unit geometric normal `ng` (on the side the ray leaves from) by
 /// ray_offset_distance(magnitude).
 inline Vec3 offset_ray_origin(Vec3 p, Vec3 ng, float magnitude) { return p + ng * ray_offset_distance(magnitude); }

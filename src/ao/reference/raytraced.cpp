@@ -10,6 +10,7 @@
 #include "ao/core/sampling.h"
 #include "ao/reference/packets_internal.h"
 #include "ao/reference/gbuffer_rays_internal.h"
+#include "ao/reference/pixel_loop_internal.h"
 #include "ao/reference/ray_offset.h"
 
 namespace ao {
@@ -256,9 +257,7 @@ VisibilityEstimate estimate_visibility(const RayScene& rs, Vec3 p, Vec3 n, const
   rtcInitIntersectContext(&ctx);
   const SampleTable tbl = make_sample_table(params.samples, table_packet(rs.native_packet_width()));
   // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
-  const Bounds3& b = rs.bounds();
-  const float magnitude = std::max({max_abs_coordinate(p), max_abs_coordinate(b.lo), max_abs_coordinate(b.hi)});
-  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(magnitude);
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
   const Vec3 nn = normalize(n);
   const PointSetup s = setup_point(p, nn, nn, offset, seed);
   return detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
@@ -310,16 +309,7 @@ RaytracedImage render_raytraced(const RayScene& rs, const GBuffer& g, const Fall
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
     });
   });
-  std::size_t covered = 0;
-  double sum_se = 0;
-  for (std::size_t i = 0; i < out.std_error.size(); ++i) {
-    if (!g.coverage[i]) continue;
-    ++covered;
-    sum_se += out.std_error[i];
-    out.max_std_error = std::max(out.max_std_error, static_cast<double>(out.std_error[i]));
-    out.rays += static_cast<std::uint64_t>(samples[i]);
-  }
-  out.mean_std_error = covered > 0 ? sum_se / static_cast<double>(covered) : 0.0;
+  detail::summarise(out, samples, g);
   return out;
 }
 

@@ -22,13 +22,13 @@ Vec3 cosine_cubed_hemisphere(Vec2 u) {
   return {s * std::cos(phi), s * std::sin(phi), c};
 }
 
-// One point's estimate: batches of 16 rays (a multiple of every packet width) until `samples`, or
-// with a target error until it is met after min_samples.
+// One point's estimate about unit normal n, rays from `origin` (the point moved off its surface,
+// ray_offset.h): batches of 16 rays (a multiple of every packet width) until `samples`, or with a
+// target error until it is met after min_samples.
 template <int N>
-VisibilityEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 p, Vec3 n, float radius, const RaytracedParams& params,
-                            float offset, std::uint32_t seed) {
+VisibilityEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, Vec3 n, float radius, const RaytracedParams& params,
+                            std::uint32_t seed) {
   const Frame frame = Frame::from_normal(n);
-  const Vec3 origin = p + n * offset;
   constexpr int kBatch = 16;
   detail::MeanAccumulator acc;
   Vec3 local[kBatch];
@@ -60,9 +60,11 @@ VisibilityEstimate estimate_tangent_sphere(const RayScene& rs, Vec3 p, Vec3 n, f
   params.validate();
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
+  // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
+  const Vec3 nn = normalize(n);
   return detail::dispatch_packet_width(rs.native_packet_width(),
-                                       [&]<int N>() { return estimate<N>(rs, ctx, p, normalize(n), radius, params, offset, seed); });
+                                       [&]<int N>() { return estimate<N>(rs, ctx, p + nn * offset, nn, radius, params, seed); });
 }
 
 RaytracedImage render_tangent_sphere(const RayScene& rs, const GBuffer& g, float radius, const RaytracedParams& params, std::uint32_t seed,
@@ -72,9 +74,9 @@ RaytracedImage render_tangent_sphere(const RayScene& rs, const GBuffer& g, float
   const int w = g.width(), h = g.height();
   RaytracedImage out{Image<float>(w, h, 1.0f), Image<float>(w, h, 0.0f)};
   Image<int> samples(w, h, 0);
-  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
-  detail::for_each_covered_pixel(rs, g, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, Vec3 p, Vec3 n) {
-    const VisibilityEstimate e = estimate<N>(rs, ctx, p, n, radius, params, offset, pixel_seed(seed, x, y));
+  detail::for_each_covered_pixel(rs, g, params.offset, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, const detail::PixelSurface& s) {
+    const Vec3 origin = s.position + s.geometric * s.offset;
+    const VisibilityEstimate e = estimate<N>(rs, ctx, origin, s.normal, radius, params, pixel_seed(seed, x, y));
     out.visibility(x, y) = e.visibility;
     out.std_error(x, y) = e.std_error;
     samples(x, y) = e.samples;

@@ -47,11 +47,12 @@ struct RatioAccumulator {
   }
 };
 
+// One point's estimate about unit normal n, rays from `origin` (the point moved off its surface,
+// ray_offset.h).
 template <int N>
-TransferEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 p, Vec3 n, const Falloff& falloff,
-                          const std::vector<Vec3>& albedo, const RaytracedParams& params, float offset, std::uint32_t seed) {
+TransferEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, Vec3 n, const Falloff& falloff,
+                          const std::vector<Vec3>& albedo, const RaytracedParams& params, std::uint32_t seed) {
   const Frame frame = Frame::from_normal(n);
-  const Vec3 origin = p + n * offset;
   const float reach = falloff.reach();
   constexpr int kBatch = 16;
   RatioAccumulator acc;
@@ -97,9 +98,11 @@ TransferEstimate estimate_transfer(const RayScene& rs, Vec3 p, Vec3 n, const Fal
   const std::vector<Vec3> albedo = scaled_albedos(rs, albedo_scale);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
+  // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
+  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
+  const Vec3 nn = normalize(n);
   return detail::dispatch_packet_width(rs.native_packet_width(),
-                                       [&]<int N>() { return estimate<N>(rs, ctx, p, normalize(n), falloff, albedo, params, offset, seed); });
+                                       [&]<int N>() { return estimate<N>(rs, ctx, p + nn * offset, nn, falloff, albedo, params, seed); });
 }
 
 TransferReferenceImage render_transfer_reference(const RayScene& rs, const GBuffer& g, const Falloff& falloff, float albedo_scale,
@@ -111,9 +114,9 @@ TransferReferenceImage render_transfer_reference(const RayScene& rs, const GBuff
   TransferReferenceImage out{Image<Vec3>(w, h, Vec3{1.0f, 1.0f, 1.0f}), {Image<float>(w, h, 1.0f), Image<float>(w, h, 0.0f)},
                              Image<float>(w, h, 1.0f)};
   Image<int> samples(w, h, 0);
-  const float offset = params.offset > 0 ? params.offset : ray_offset_distance(bounds_magnitude(rs.bounds()));
-  detail::for_each_covered_pixel(rs, g, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, Vec3 p, Vec3 n) {
-    const TransferEstimate e = estimate<N>(rs, ctx, p, n, falloff, albedo, params, offset, pixel_seed(seed, x, y));
+  detail::for_each_covered_pixel(rs, g, params.offset, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, const detail::PixelSurface& s) {
+    const Vec3 origin = s.position + s.geometric * s.offset;
+    const TransferEstimate e = estimate<N>(rs, ctx, origin, s.normal, falloff, albedo, params, pixel_seed(seed, x, y));
     out.transfer(x, y) = e.transfer;
     out.scalar.visibility(x, y) = e.luminance;
     out.scalar.std_error(x, y) = e.std_error;

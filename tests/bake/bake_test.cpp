@@ -3,6 +3,7 @@
 // built here, at small map sizes, so the whole file runs in a few seconds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/global_control.h>
@@ -266,6 +267,23 @@ TEST(Bake, PerVertexBothMethodsOnOpenQuadAndWall) {
     EXPECT_NEAR(r[v], wall_visibility(1, 1), 0.02);  // 1024 rays: std. error 0.011
     EXPECT_NEAR(h[v], wall_visibility(1, 1), 0.03);  // 512 directions, shadow-map bias
   }
+}
+
+TEST(Bake, PerVertexRaytracedIsTheSameAtAnyThreadCount) {
+  // Vertices are traced in Morton order, in tiles spread over the threads; each vertex's samples
+  // are keyed by its index, so neither the order nor the thread count may change a value.
+  const Scene s = make_builtin_scene("default");
+  const RayScene rs(s);
+  const RaytracedBakeParams params{.samples = 4, .max_distance = 0.5f};
+  const std::vector<float> many = bake_vertices_raytraced(rs, params);
+  std::vector<float> one;
+  {
+    tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
+    one = bake_vertices_raytraced(rs, params);
+  }
+  ASSERT_EQ(many.size(), s.vertex_count());
+  EXPECT_EQ(one, many);
+  EXPECT_LT(*std::min_element(many.begin(), many.end()), 1.0f);  // something is occluded
 }
 
 TEST(Bake, MeshWithoutUvsIsAClearError) {

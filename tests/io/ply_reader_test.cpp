@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -157,6 +158,84 @@ TEST(PlyReader, DamagedFilesAreRefusedNamingTheProblem) {
   put<std::int32_t>(bin, -3);
   bin += std::string(12, '\0');
   EXPECT_READ_ERROR(bin, "'face' 0 has a negative list count -3");
+}
+
+// A grid of n x n quads as triangles: (n + 1)^2 vertices, 2 n^2 faces, in a binary little-endian
+// file with the common face layout (uchar count, int indices) that is read in parallel, and in
+// ASCII, which is read by the general path.
+struct GridPly {
+  std::string binary, ascii;
+  std::vector<std::uint32_t> indices;
+  long long vertices = 0;
+};
+GridPly grid_ply(int n) {
+  GridPly g;
+  g.vertices = static_cast<long long>(n + 1) * (n + 1);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const auto at = [n](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+      g.indices.insert(g.indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y), at(x + 1, y + 1), at(x, y + 1)});
+    }
+  const std::string header = "element vertex " + std::to_string(g.vertices) + "\nproperty float x\nproperty float y\nproperty float z\n" +
+                             "element face " + std::to_string(g.indices.size() / 3) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  g.binary = "ply\nformat binary_little_endian 1.0\n" + header;
+  g.ascii = "ply\nformat ascii 1.0\n" + header;
+  for (long long v = 0; v < g.vertices; ++v) {
+    const float c[3] = {static_cast<float>(v % (n + 1)) * 0.25f, static_cast<float>(v / (n + 1)) * 0.5f, static_cast<float>(v % 7)};
+    for (float f : c) put<float>(g.binary, f);
+    for (float f : c) {
+      g.ascii += std::to_string(f);
+      g.ascii += ' ';
+    }
+    g.ascii += '\n';
+  }
+  for (std::size_t t = 0; t < g.indices.size(); t += 3) {
+    put<std::uint8_t>(g.binary, 3);
+    g.ascii += "3";
+    for (int k = 0; k < 3; ++k) {
+      put<std::int32_t>(g.binary, g.indices[t + k]);
+      g.ascii += ' ';
+      g.ascii += std::to_string(g.indices[t + k]);
+    }
+    g.ascii += "\n";
+  }
+  return g;
+}
+
+/// Byte offset of face f's record in grid_ply(n).binary (13 bytes a face after 12 a vertex).
+std::size_t face_offset(const GridPly& g, std::size_t f) { return g.binary.size() - (g.indices.size() / 3 - f) * 13; }
+
+TEST(PlyReader, BinaryTrianglesReadInParallelEqualTheAsciiFile) {
+  const GridPly g = grid_ply(150);  // 45,000 faces: several parallel blocks
+  const Scene bin = read_ply("grid.ply", g.binary), asc = read_ply("grid.ply", g.ascii);
+  EXPECT_EQ(bin.meshes[0].indices, g.indices);
+  EXPECT_EQ(asc.meshes[0].indices, g.indices);
+  ASSERT_EQ(bin.meshes[0].positions.size(), asc.meshes[0].positions.size());
+  for (std::size_t v = 0; v < bin.meshes[0].positions.size(); ++v) {
+    EXPECT_EQ(bin.meshes[0].positions[v].x, asc.meshes[0].positions[v].x);
+    EXPECT_EQ(bin.meshes[0].positions[v].z, asc.meshes[0].positions[v].z);
+  }
+}
+
+TEST(PlyReader, BinaryFacesOtherThanTrianglesAndBadIndicesTakeTheGeneralPath) {
+  GridPly g = grid_ply(150);
+  // The last face a quad: one byte more, which the fast path detects and leaves to the general one.
+  std::string quad = g.binary.substr(0, face_offset(g, g.indices.size() / 3 - 1));
+  put<std::uint8_t>(quad, 4);
+  for (int i : {0, 1, 152, 151}) put<std::int32_t>(quad, i);
+  const Scene s = read_ply("quad.ply", quad);
+  const std::vector<std::uint32_t>& got = s.meshes[0].indices;
+  ASSERT_EQ(got.size(), g.indices.size() + 3);
+  EXPECT_TRUE(std::equal(g.indices.begin(), g.indices.end() - 3, got.begin()));
+  EXPECT_EQ(std::vector<std::uint32_t>(got.end() - 6, got.end()), (std::vector<std::uint32_t>{0, 1, 152, 0, 152, 151}));
+  // Out-of-range indices in two blocks: the first in file order is named, negative ones too.
+  std::string bad = g.binary;
+  const std::int32_t big = 22801, negative = -1;
+  std::memcpy(&bad[face_offset(g, 40000) + 5], &big, 4);
+  std::memcpy(&bad[face_offset(g, 33000) + 9], &negative, 4);
+  EXPECT_READ_ERROR(bad, "face 33000 uses vertex -1, the file has 22801");
+  std::memcpy(&bad[face_offset(g, 33000) + 9], &big, 4);
+  EXPECT_READ_ERROR(bad, "face 33000 uses vertex 22801, the file has 22801");
 }
 
 TEST(PlyReader, CountsAreCheckedAgainstTheFileBeforeAllocating) {

@@ -15,6 +15,11 @@
 #include <array>
 #include <span>
 #include <cmath>
+#include <cstdint>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
@@ -164,6 +169,41 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   return out;
 }
 
+namespace {
+
+/// 10 bits of x spread to every third bit (bits 0, 3, ..., 27).
+std::uint32_t spread_bits(std::uint32_t x) {
+  x &= 0x3ffu;
+  x = (x | (x << 16)) & 0x030000ffu;
+  x = (x | (x << 8)) & 0x0300f00fu;
+  x = (x | (x << 4)) & 0x030c30c3u;
+  x = (x | (x << 2)) & 0x09249249u;
+  return x;
+}
+
+/// Indices into `verts` sorted by the 30-bit Morton code of the vertex positions in the scene's
+/// bounds (ties keep index order, so the order is deterministic).
+std::vector<std::uint32_t> morton_order(const Scene& scene, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& verts) {
+  const Bounds3 b = scene.bounds();
+  const Vec3 extent = b.extent();
+  const float side = std::max({extent.x, extent.y, extent.z, 1e-30f});
+  std::vector<std::uint64_t> keyed(verts.size());  // code << 32 | index
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, verts.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      const Vec3 p = (scene.meshes[verts[i].first].positions[verts[i].second] - b.lo) / side;
+      const auto cell = [](float c) { return static_cast<std::uint32_t>(std::clamp(c * 1024.0f, 0.0f, 1023.0f)); };
+      const std::uint32_t code = spread_bits(cell(p.x)) | (spread_bits(cell(p.y)) << 1) | (spread_bits(cell(p.z)) << 2);
+      keyed[i] = (static_cast<std::uint64_t>(code) << 32) | i;
+    }
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> order(verts.size());
+  for (std::size_t i = 0; i < verts.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
+  return order;
+}
+
+}  // namespace
+
 std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBakeParams& params, std::uint64_t* rays_traced,
                                            const ProgressFn& progress) {
   params.validate();
@@ -183,6 +223,11 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
     for (std::size_t v = 0; v < scene.meshes[m].positions.size(); ++v) verts.emplace_back(static_cast<std::uint32_t>(m), static_cast<std::uint32_t>(v));
   std::vector<float> out(verts.size(), 1.0f);
   const int count = static_cast<int>(verts.size());
+  // Vertices are traced in Morton order of their positions, so consecutive vertices (one tile, one
+  // thread) are close in space and reuse the BVH nodes and triangles in cache; a file's own vertex
+  // order can jump across the model. The sample set and the output slot stay keyed by the vertex's
+  // index, so the result is the same in any order.
+  const std::vector<std::uint32_t> order = morton_order(scene, verts);
   ProgressCounter counter(progress, verts.size());
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     // One "row" of vertices, tiled 256 at a time.
@@ -192,7 +237,8 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
       constexpr int batch = N == 1 ? 16 : N;
       std::array<Vec3, batch> org, dir;
       std::array<float, batch> mu;
-      for (int vi = t.x0; vi < t.x1; ++vi) {
+      for (int oi = t.x0; oi < t.x1; ++oi) {
+        const auto vi = static_cast<int>(order[static_cast<std::size_t>(oi)]);
         const Mesh& m = scene.meshes[verts[static_cast<std::size_t>(vi)].first];
         const std::uint32_t v = verts[static_cast<std::size_t>(vi)].second;
         const std::uint32_t mi = verts[static_cast<std::size_t>(vi)].first;

@@ -220,7 +220,7 @@ Scene read_off(const fs::path& path, std::string_view data) {
 
   Mesh mesh;
   mesh.name = path.stem().string();
-  mesh.positions.reserve(static_cast<std::size_t>(vertex_count));
+  mesh.positions.reserve(static_cast<std::size_t>(vertex_count) + kVertexPadding);  // see kVertexPadding
   if (has_normals) mesh.normals.reserve(static_cast<std::size_t>(vertex_count));
   const std::size_t coords_per_vertex = has_normals ? 6 : 3;
   for (long long v = 0; v < vertex_count; ++v) {
@@ -428,7 +428,7 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
     if ((in.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
     Mesh mesh;
     mesh.name = in.mName.C_Str();
-    mesh.positions.reserve(in.mNumVertices);
+    mesh.positions.reserve(in.mNumVertices + kVertexPadding);  // see kVertexPadding
     for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.positions.push_back({in.mVertices[v].x, in.mVertices[v].y, in.mVertices[v].z});
     if (in.HasNormals()) {
       mesh.normals.reserve(in.mNumVertices);

@@ -1,5 +1,6 @@
 #include "ao/reference/ray_scene.h"
 
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -24,7 +25,8 @@ void check(RTCDevice device, const char* what) {
 
 }  // namespace
 
-RayScene::RayScene(const Scene& scene) : source_(scene), bounds_(scene.bounds()), handles_(std::make_unique<Handles>()) {
+RayScene::RayScene(const Scene& scene, const BvhOptions& options)
+    : source_(scene), bounds_(scene.bounds()), handles_(std::make_unique<Handles>()) {
   RTCDevice& device = handles_->device;
   RTCScene& bvh = handles_->scene;
   device = rtcNewDevice(nullptr);
@@ -34,19 +36,31 @@ RayScene::RayScene(const Scene& scene) : source_(scene), bounds_(scene.bounds())
   else if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) packet_width_ = 8;
   else if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED)) packet_width_ = 4;
 
+  // The size rule of kCompactBvhTriangles (measured in BENCHMARKS.md, "Loading big meshes").
+  const bool big = scene.triangle_count() > kCompactBvhTriangles;
+  quality_ = options.quality.value_or(big ? BvhQuality::Medium : BvhQuality::High);
+  compact_ = options.compact.value_or(big);
   bvh = rtcNewScene(device);
-  rtcSetSceneBuildQuality(bvh, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneBuildQuality(bvh, quality_ == BvhQuality::High ? RTC_BUILD_QUALITY_HIGH
+                               : quality_ == BvhQuality::Medium ? RTC_BUILD_QUALITY_MEDIUM
+                                                                : RTC_BUILD_QUALITY_LOW);
+  if (compact_) rtcSetSceneFlags(bvh, RTC_SCENE_FLAG_COMPACT);
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const Mesh& m = scene.meshes[i];
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Embree-owned buffers: Embree pads them so its SIMD loads may read past the last element.
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), m.positions.size()));
-    auto* t = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.triangle_count()));
-    check(device, "allocating geometry buffers");
-    std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(Vec3));
-    std::memcpy(t, m.indices.data(), m.indices.size() * sizeof(unsigned));
+    // Embree's SIMD loads read 16 bytes from the last vertex, 4 past its end: the mesh's own array
+    // is shared when its spare capacity covers that (validate_and_prepare reserves it), else copied
+    // into a buffer Embree pads itself.
+    if (m.positions.capacity() >= m.positions.size() + kVertexPadding) {
+      rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0, sizeof(Vec3), m.positions.size());
+    } else {
+      auto* v = static_cast<Vec3*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), m.positions.size()));
+      check(device, "allocating a vertex buffer");
+      std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(Vec3));
+    }
+    // Indices are read one triangle (12 bytes) at a time: no padding needed.
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0, 3 * sizeof(std::uint32_t), m.triangle_count());
+    check(device, "setting geometry buffers");
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(bvh, geom, static_cast<unsigned>(i));
     rtcReleaseGeometry(geom);

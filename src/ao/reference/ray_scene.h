@@ -3,17 +3,41 @@
 // internal header ao/reference/embree_scene_internal.h, which is not part of the installed API.
 #pragma once
 
+#include <cstddef>
 #include <memory>
+#include <optional>
 
 #include "ao/scene/mesh.h"
 
 namespace ao {
 
+/// How hard the BVH builder works (Embree's build qualities).
+enum class BvhQuality {
+  Low,     ///< Morton-code build: fastest to build, slowest to trace.
+  Medium,  ///< Binned SAH build.
+  High,    ///< SAH with spatial splits: fastest to trace, slowest to build, most memory.
+};
+
+/// Scenes of more triangles than this get a Medium, compact BVH by default; smaller ones a High
+/// one. The High build's spatial splits and vertex copies in its leaves take about 100 bytes per
+/// triangle; the compact Medium BVH about a third of that, for traces that are slower by the
+/// ratio given in BENCHMARKS.md ("Loading big meshes", where the rule is measured).
+inline constexpr std::size_t kCompactBvhTriangles = 4'000'000;
+
+/// BVH build settings; every field left empty is chosen from the triangle count.
+struct BvhOptions {
+  std::optional<BvhQuality> quality;  ///< Empty: High up to kCompactBvhTriangles, Medium above.
+  std::optional<bool> compact;        ///< Leaves that index the mesh's vertices instead of copying them. Empty: above kCompactBvhTriangles.
+};
+
 class RayScene {
  public:
-  /// Builds the BVH for `scene`, which must outlive this object and have passed
-  /// validate_and_prepare. Mesh i becomes geometry i. Throws SystemError when Embree fails.
-  explicit RayScene(const Scene& scene);
+  /// Builds the BVH for `scene`, which must outlive this object, stay unmodified while it lives,
+  /// and have passed validate_and_prepare. Mesh i becomes geometry i. Embree reads the meshes'
+  /// positions and indices in place (no copy) when the positions have the spare capacity
+  /// validate_and_prepare reserves (kVertexPadding); otherwise it copies them. Throws SystemError
+  /// when Embree fails.
+  explicit RayScene(const Scene& scene, const BvhOptions& options = {});
   ~RayScene();
   RayScene(const RayScene&) = delete;
   RayScene& operator=(const RayScene&) = delete;
@@ -24,6 +48,10 @@ class RayScene {
   /// Widest ray packet (16, 8, 4 or 1) this Embree build supports natively on this CPU.
   int native_packet_width() const { return packet_width_; }
 
+  /// The build settings used, with the automatic choices resolved.
+  BvhQuality quality() const { return quality_; }
+  bool compact() const { return compact_; }
+
   /// Embree's device and scene; defined in ao/reference/embree_scene_internal.h (internal).
   struct Handles;
   const Handles& handles() const { return *handles_; }
@@ -33,6 +61,8 @@ class RayScene {
   Bounds3 bounds_;
   std::unique_ptr<Handles> handles_;
   int packet_width_ = 1;
+  BvhQuality quality_ = BvhQuality::High;
+  bool compact_ = false;
 };
 
 }  // namespace ao

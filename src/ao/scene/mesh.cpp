@@ -2,8 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <string>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include "ao/core/error.h"
 
@@ -33,21 +43,64 @@ std::size_t Scene::vertex_count() const {
   return n;
 }
 
+namespace {
+
+/// Triangles (or vertices) per parallel task: big enough that scheduling costs nothing, small
+/// enough that two cores share a million-element pass evenly.
+constexpr std::size_t kGrain = 1 << 15;
+
+/// Smallest i in [0, n) with bad(i), or n when there is none: in parallel, the same answer at any
+/// thread count, so the error a file gets does not depend on the machine.
+template <class Bad>
+std::size_t first_where(std::size_t n, const Bad& bad) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kGrain), n,
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t found) {
+        if (found < r.begin()) return found;
+        for (std::size_t i = r.begin(); i < r.end(); ++i)
+          if (bad(i)) return std::min(found, i);
+        return found;
+      },
+      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+}
+
+}  // namespace
+
 void generate_normals(Mesh& mesh) {
-  mesh.normals.assign(mesh.positions.size(), Vec3{});
-  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-    const std::uint32_t i[3] = {mesh.indices[t], mesh.indices[t + 1], mesh.indices[t + 2]};
-    const Vec3 p[3] = {mesh.positions[i[0]], mesh.positions[i[1]], mesh.positions[i[2]]};
-    const Vec3 n = normalize(cross(p[1] - p[0], p[2] - p[0]));
-    for (int k = 0; k < 3; ++k) {
-      // Angle weighting makes the result independent of how a flat region is triangulated.
-      const Vec3 e0 = normalize(p[(k + 1) % 3] - p[k]);
-      const Vec3 e1 = normalize(p[(k + 2) % 3] - p[k]);
-      const float angle = std::acos(std::clamp(dot(e0, e1), -1.0f, 1.0f));
-      mesh.normals[i[k]] += n * angle;
+  // Each task owns a range of vertices and walks all triangles in order, adding only to its own
+  // vertices: every vertex sums its triangles in triangle order, as a serial loop would, so the
+  // normals do not depend on the thread count, and no two tasks write the same vertex. The walk
+  // over the indices is repeated per task, but it is a sequential read; the angles, the costly
+  // part, are computed once per corner.
+  const std::size_t nv = mesh.positions.size(), nc = mesh.indices.size() - mesh.indices.size() % 3;
+  mesh.normals.resize(nv);
+  const auto parts = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, parts, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t part = r.begin(); part < r.end(); ++part) {
+      const std::size_t v0 = nv * part / parts, size = nv * (part + 1) / parts - v0;
+      std::fill(mesh.normals.begin() + static_cast<std::ptrdiff_t>(v0), mesh.normals.begin() + static_cast<std::ptrdiff_t>(v0 + size), Vec3{});
+      for (std::size_t t = 0; t < nc; t += 3) {
+        const std::uint32_t i[3] = {mesh.indices[t], mesh.indices[t + 1], mesh.indices[t + 2]};
+        // i - v0 < size, unsigned, tests v0 <= i < v0 + size.
+        const bool own[3] = {i[0] - v0 < size, i[1] - v0 < size, i[2] - v0 < size};
+        if (!(own[0] || own[1] || own[2])) continue;
+        const Vec3 p[3] = {mesh.positions[i[0]], mesh.positions[i[1]], mesh.positions[i[2]]};
+        const Vec3 n = normalize(cross(p[1] - p[0], p[2] - p[0]));
+        for (int k = 0; k < 3; ++k) {
+          if (!own[k]) continue;
+          // Angle weighting makes the result independent of how a flat region is triangulated.
+          const Vec3 e0 = normalize(p[(k + 1) % 3] - p[k]);
+          const Vec3 e1 = normalize(p[(k + 2) % 3] - p[k]);
+          const float angle = std::acos(std::clamp(dot(e0, e1), -1.0f, 1.0f));
+          mesh.normals[i[k]] += n * angle;
+        }
+      }
+      for (std::size_t v = v0; v < v0 + size; ++v) {
+        Vec3& n = mesh.normals[v];
+        n = length(n) > 0 ? normalize(n) : Vec3{0, 0, 1};
+      }
     }
-  }
-  for (Vec3& n : mesh.normals) n = length(n) > 0 ? normalize(n) : Vec3{0, 0, 1};
+  }, tbb::simple_partitioner());
 }
 
 namespace {
@@ -65,51 +118,87 @@ std::string where(const Scene& scene, const Mesh& mesh) {
 void validate_mesh(const Scene& scene, Mesh& mesh) {
   const std::string w = where(scene, mesh);
   if (mesh.indices.size() % 3 != 0) throw InputError(w + ": index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+  // Every check below runs in parallel and reports the first offender in file order.
+  const auto bad_position = [&](std::size_t v) {
+    const Vec3 p = mesh.positions[v];
+    return !is_finite(p) || std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > kMaxCoordinate;
+  };
+  if (const std::size_t v = first_where(mesh.positions.size(), bad_position); v < mesh.positions.size()) {
     const Vec3 p = mesh.positions[v];
     if (!is_finite(p)) throw InputError(w + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
     const float m = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    if (m > kMaxCoordinate)
-      throw InputError(w + ": vertex " + std::to_string(v) + " has coordinate " + format_magnitude(m) + ", beyond the +-" +
-                       format_magnitude(kMaxCoordinate) + " ao traces correctly (scale the mesh down)");
+    throw InputError(w + ": vertex " + std::to_string(v) + " has coordinate " + format_magnitude(m) + ", beyond the +-" +
+                     format_magnitude(kMaxCoordinate) + " ao traces correctly (scale the mesh down)");
   }
   if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
     throw InputError(w + ": " + std::to_string(mesh.normals.size()) + " normals for " + std::to_string(mesh.positions.size()) + " vertices");
   if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
     throw InputError(w + ": " + std::to_string(mesh.uvs.size()) + " UVs for " + std::to_string(mesh.positions.size()) + " vertices");
-  for (std::size_t v = 0; v < mesh.uvs.size(); ++v)
-    if (!std::isfinite(mesh.uvs[v].x) || !std::isfinite(mesh.uvs[v].y)) throw InputError(w + ": UV " + std::to_string(v) + " is not finite");
+  const auto bad_uv = [&](std::size_t v) { return !std::isfinite(mesh.uvs[v].x) || !std::isfinite(mesh.uvs[v].y); };
+  if (const std::size_t v = first_where(mesh.uvs.size(), bad_uv); v < mesh.uvs.size())
+    throw InputError(w + ": UV " + std::to_string(v) + " is not finite");
   for (float c : {mesh.albedo.x, mesh.albedo.y, mesh.albedo.z})
     if (!std::isfinite(c)) throw InputError(w + ": albedo is not finite");
   mesh.albedo = min(max(mesh.albedo, Vec3{0, 0, 0}), Vec3{1, 1, 1});
 
-  const std::size_t vertex_count = mesh.positions.size();
+  // Triangles, in blocks of kGrain: each block checks its indices and moves the triangles it keeps
+  // to its own front (in place: a kept triangle never moves up); the blocks are then joined in
+  // order, which keeps the file's triangle order.
+  const std::size_t vertex_count = mesh.positions.size(), triangle_count = mesh.indices.size() / 3;
+  const std::size_t blocks = (triangle_count + kGrain - 1) / kGrain;
+  struct Block {
+    std::size_t kept = 0;
+    std::size_t bad_triangle = SIZE_MAX;  ///< First triangle with an index out of range.
+    std::uint32_t bad_index = 0;
+  };
+  std::vector<Block> block(blocks);
+  std::uint32_t* const idx = mesh.indices.data();
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    const std::size_t t0 = b * kGrain, t1 = std::min(triangle_count, t0 + kGrain);
+    std::size_t kept = t0;
+    for (std::size_t t = t0; t < t1; ++t) {
+      const std::uint32_t a = idx[3 * t], bb = idx[3 * t + 1], c = idx[3 * t + 2];
+      for (std::uint32_t i : {a, bb, c})
+        if (i >= vertex_count) {
+          block[b] = {0, t, i};
+          return;
+        }
+      const Vec3 n = cross(mesh.positions[bb] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
+      if (a == bb || bb == c || a == c || !(dot(n, n) > 0.0f)) continue;
+      idx[3 * kept] = a;
+      idx[3 * kept + 1] = bb;
+      idx[3 * kept + 2] = c;
+      ++kept;
+    }
+    block[b].kept = kept - t0;
+  });
   std::size_t kept = 0;
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    const std::uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
-    for (std::uint32_t i : {a, b, c})
-      if (i >= vertex_count)
-        throw InputError(w + ": triangle " + std::to_string(t / 3) + " uses vertex " + std::to_string(i) + ", the mesh has " +
-                         std::to_string(vertex_count));
-    const Vec3 n = cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
-    if (a == b || b == c || a == c || !(dot(n, n) > 0.0f)) continue;
-    mesh.indices[kept++] = a;
-    mesh.indices[kept++] = b;
-    mesh.indices[kept++] = c;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    if (block[b].bad_triangle != SIZE_MAX)
+      throw InputError(w + ": triangle " + std::to_string(block[b].bad_triangle) + " uses vertex " + std::to_string(block[b].bad_index) +
+                       ", the mesh has " + std::to_string(vertex_count));
+    if (kept != b * kGrain) std::memmove(idx + 3 * kept, idx + 3 * b * kGrain, 3 * block[b].kept * sizeof(std::uint32_t));
+    kept += block[b].kept;
   }
   // Degenerate triangles have no area, so they can neither occlude nor be seen: dropping them
   // changes no result but spares the ray tracer and the bakers a division by zero. The caller
   // reports how many went.
-  mesh.indices.resize(kept);
+  mesh.indices.resize(3 * kept);
   if (!mesh.normals.empty()) {
-    for (std::size_t v = 0; v < mesh.normals.size(); ++v) {
-      if (!is_finite(mesh.normals[v])) throw InputError(w + ": normal " + std::to_string(v) + " is not finite");
-      const float len = length(mesh.normals[v]);
-      mesh.normals[v] = len > 0 ? mesh.normals[v] / len : Vec3{0, 0, 1};
-    }
+    const auto bad_normal = [&](std::size_t v) { return !is_finite(mesh.normals[v]); };
+    if (const std::size_t v = first_where(mesh.normals.size(), bad_normal); v < mesh.normals.size())
+      throw InputError(w + ": normal " + std::to_string(v) + " is not finite");
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.normals.size(), kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v < r.end(); ++v) {
+        const float len = length(mesh.normals[v]);
+        mesh.normals[v] = len > 0 ? mesh.normals[v] / len : Vec3{0, 0, 1};
+      }
+    });
   } else {
     generate_normals(mesh);
   }
+  // Loaders reserve this up front; a reallocation here only happens for meshes built in code.
+  if (mesh.positions.capacity() < mesh.positions.size() + kVertexPadding) mesh.positions.reserve(mesh.positions.size() + kVertexPadding);
 }
 
 }  // namespace

@@ -19,6 +19,11 @@ namespace ao {
 /// from 1e13 and aborts on an assertion from about 2e18. 1e9 keeps a margin below the first failure.
 inline constexpr float kMaxCoordinate = 1e9f;
 
+/// Spare elements of capacity that validate_and_prepare keeps behind Mesh::positions, so that a ray
+/// tracer may share the array and read 16 bytes from the last vertex (Embree's SIMD loads read 4
+/// bytes past its end; two Vec3 are 24 bytes).
+inline constexpr std::size_t kVertexPadding = 2;
+
 /// One indexed triangle mesh with one material.
 struct Mesh {
   std::string name;
@@ -47,7 +52,8 @@ struct Scene {
 };
 
 /// Smooth per-vertex normals, weighting each face normal by its angle at the vertex, for a mesh
-/// whose `normals` is empty. Vertices used by no triangle get +z.
+/// whose `normals` is empty and whose indices are in range. Vertices used by no triangle get +z.
+/// Runs in parallel (oneTBB); the result does not depend on the thread count.
 void generate_normals(Mesh& mesh);
 
 /// Checks and repairs a scene in place before it is used; `source` names it in messages.

@@ -53,7 +53,8 @@ struct BakeOptions {
   // Occluders and bake groups (bake_groups.h).
   std::vector<std::string> occluders, groups;
   bool floor = false, match_by_name = false, self_occlusion = false;
-  int size = 1024;
+  std::string size_text = "1024";  // -s: N (square) or WxH
+  int width = 1024, height = 1024;  // from size_text
   int uv_set = 0;
   int padding = kDefaultPadding;
   int png_bits = 8;
@@ -103,6 +104,21 @@ fs::path batch_path(const fs::path& in, const std::string& given, const std::str
   const fs::path dir = out_dir.empty() ? in.parent_path() : fs::path(out_dir);
   if (given.empty()) return dir / (in.stem().string() + fallback_suffix);
   return dir / (in.stem().string() + "-" + fs::path(given).filename().string());
+}
+
+// "1024" -> 1024 x 1024, "2048x1024" -> 2048 x 1024; nullopt unless each side is a whole number in [1, 16384].
+std::optional<std::pair<int, int>> parse_map_size(const std::string& text) {
+  auto side = [](const std::string& s) -> std::optional<int> {
+    if (s.empty() || s.size() > 5 || !std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); })) return std::nullopt;
+    const int v = std::stoi(s);
+    if (v < 1 || v > 16384) return std::nullopt;
+    return v;
+  };
+  const std::size_t x = text.find_first_of("xX");
+  const auto w = side(text.substr(0, x));
+  const auto h = x == std::string::npos ? w : side(text.substr(x + 1));
+  if (!w || !h) return std::nullopt;
+  return std::pair{*w, *h};
 }
 
 std::string lower_extension(const fs::path& p) {
@@ -261,7 +277,7 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
       cage = extrude_cage(scene, *p.cage_extrusion);
     }
   }
-  BakeResult r = bake_groups(scene, groups, high ? std::vector<Mesh>{} : occluders, o.size,
+  BakeResult r = bake_groups(scene, groups, high ? std::vector<Mesh>{} : occluders, o.width, o.height,
                              [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
                                if (!high) {
                                  if (o.method == "histogram") return bake_histogram(gs, cov, hist, progress);
@@ -344,7 +360,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   double bake_ms = 0;
   fs::path map_out;
   if (want_map) {
-    const TexelCoverage cov = compute_texel_coverage(scene, o.size);
+    const TexelCoverage cov = compute_texel_coverage(scene, o.width, o.height);
     timings["uv_coverage_ms"] = clock.lap_ms();
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": " << w << "\n";
     {
@@ -360,7 +376,9 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     for (std::size_t i = 0; i < r.mask.size(); ++i)
       if (r.mask[i]) sum += r.visibility[i];
     summary["output"] = map_out.string();
-    summary["size"] = o.size;
+    if (o.width == o.height) summary["size"] = o.width;
+    summary["width"] = o.width;
+    summary["height"] = o.height;
     summary["texels_covered"] = r.covered_texels;
     summary["mean_visibility"] = r.covered_texels ? sum / static_cast<double>(r.covered_texels) : 1.0;
     summary["texels_per_second"] = bake_ms > 0 ? static_cast<double>(r.covered_texels) / (bake_ms / 1000.0) : 0.0;
@@ -425,12 +443,12 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   if (want_map) {
     if (write_map) outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
     if (!outs.miss.empty()) {
-      Image<float> miss(o.size, o.size, 0.0f);
+      Image<float> miss(o.width, o.height, 0.0f);
       for (std::size_t i = 0; i < r.missed.size(); ++i) miss[i] = r.missed[i];
       outputs.write(outs.miss, [&] { write_image(outs.miss, miss, {}); });
     }
     if (!outs.bent.empty() && !r.bent_normal.empty()) {
-      Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
+      Image<Vec3> enc(o.width, o.height, Vec3{0.5f, 0.5f, 0.5f});
       for (std::size_t i = 0; i < enc.size(); ++i)
         if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
       outputs.write(outs.bent, [&] { write_rgb_image(outs.bent, enc, {.png_bits = o.png_bits}); });
@@ -459,7 +477,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   outputs.commit();
   if (want_map && write_map && !o.json)
     std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
-                 input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
+                 input.filename().string().c_str(), o.method.c_str(), o.width, o.height, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
                  summary["texels_per_second"].get<double>() / 1e6);
   if (!outs.per_vertex.empty() && !o.json)
     std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", outs.per_vertex.string().c_str(), vertex_ao.size(), vertex_ms);
@@ -519,7 +537,10 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   o.hist.normalization = *norm;
   o.hist.bent_normals = o.rt.bent_normals = !o.bent.empty();
   o.hist.validate();
-  if (o.size < 1 || o.size > 16384) throw InputError("--size must be in [1, 16384]");
+  const auto size = parse_map_size(o.size_text);
+  if (!size) throw InputError("--size: expected N or WIDTHxHEIGHT (2048x1024), each in [1, 16384] texels, got '" + o.size_text + "'");
+  o.width = size->first;
+  o.height = size->second;
   const std::vector<fs::path> inputs = expand_inputs(o.inputs);
   if (inputs.empty()) throw InputError("no mesh files to bake (folders are searched for .obj .ply .off .stl .gltf .glb)");
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
@@ -534,9 +555,9 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   }
   if (wants_map(o)) {
     const int threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-    check_memory(estimate_bake_memory({.size = o.size, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
+    check_memory(estimate_bake_memory({.size = o.width, .height = o.height, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
                                        .pixels_per_texel = o.hist.pixels_per_texel, .threads = threads}),
-                 "ao bake: a " + std::to_string(o.size) + "x" + std::to_string(o.size) + " map");
+                 "ao bake: a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " map");
   }
   if (!batch) {
     const nlohmann::json s = bake_one(inputs.front(), o, false, global);
@@ -581,7 +602,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("-o,--output", o->output, "AO map: .png (linear, 8/16 bit) or .exr (float). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
-  cmd->add_option("-s,--size", o->size, "Map width = height, texels [1, 16384]")->capture_default_str();
+  cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();
   cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
   cmd->add_option("--direction-set", o->direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();

@@ -1,0 +1,105 @@
+// `ao bake` output formats as a pipeline meets them: non-square maps, ORM packing, TGA/TIFF/JPEG,
+// UDIM tiles, glTF outputs. Meshes are tiny OBJ files written here; maps are a few dozen texels.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/io/image_io.h"
+#include "ao/io/mesh_io.h"
+#include "support/run.h"
+
+namespace ao::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kRays = " -m raytraced --samples 8 --padding 2 ";
+
+// A unit quad in the xz-plane facing up (V = 1 everywhere: every ray leaves into the open
+// hemisphere) whose UVs cover [u0, u1] x [v0, v1].
+std::string quad_obj(double u0, double v0, double u1, double v1, const std::string& name = "quad") {
+  std::ostringstream s;
+  s << "o " << name << "\nv 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nvn 0 1 0\n";
+  s << "vt " << u0 << " " << v0 << "\nvt " << u1 << " " << v0 << "\nvt " << u1 << " " << v1 << "\nvt " << u0 << " " << v1 << "\n";
+  s << "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  return s.str();
+}
+
+void expect_one_line_error(const RunResult& r, const std::string& needle) {
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
+}
+
+std::uint32_t be32(const std::string& s, std::size_t at) {
+  return (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at])) << 24) | (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 1])) << 16) |
+         (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 2])) << 8) | static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 3]));
+}
+
+// --- non-square maps ---------------------------------------------------------------------------
+
+TEST(BakeFormats, NonSquareSizeGoesToEveryPerTexelOutput) {
+  TempDir dir;
+  // The quad fills the left half of the UV square: on a 32 x 8 map, columns 0..15.
+  write_text(dir / "quad.obj", quad_obj(0, 0, 0.5, 1));
+  const RunResult r = run_ao("bake quad.obj -s 32x8 -o ao.png --bent-normals bent.exr --gltf m.glb --json" + kRays, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["width"], 32);
+  EXPECT_EQ(j["height"], 8);
+  EXPECT_FALSE(j.contains("size"));
+  EXPECT_EQ(j["texels_covered"], 16 * 8);
+  const Image<float> map = read_image(dir / "ao.png");
+  ASSERT_EQ(map.width(), 32);
+  ASSERT_EQ(map.height(), 8);
+  // Open quad: V = 1 on the chart; padding (2 texels) reaches columns 16, 17 only.
+  EXPECT_EQ(map(3, 3), 1.0f);
+  EXPECT_EQ(map(17, 3), 1.0f);
+  EXPECT_EQ(map(25, 3), 0.0f);
+  const Image<Vec3> bent = read_rgb_image(dir / "bent.exr");
+  EXPECT_EQ(bent.width(), 32);
+  EXPECT_EQ(bent.height(), 8);
+  // The map embedded in the GLB has the same size (PNG IHDR: width, height after "IHDR").
+  const std::string glb = read_text(dir / "m.glb");
+  const std::size_t png = glb.find("\x89PNG\r\n\x1a\n");
+  ASSERT_NE(png, std::string::npos);
+  EXPECT_EQ(be32(glb, png + 16), 32u);
+  EXPECT_EQ(be32(glb, png + 20), 8u);
+}
+
+TEST(BakeFormats, NonSquareWithTheHistogramBaker) {
+  TempDir dir;
+  write_text(dir / "quad.obj", quad_obj(0, 0, 1, 1));
+  const RunResult r = run_ao("bake quad.obj -m histogram -s 8x24 --directions 32 --pixels-per-texel 4 -o ao.exr --json", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image<float> map = read_image(dir / "ao.exr");
+  EXPECT_EQ(map.width(), 8);
+  EXPECT_EQ(map.height(), 24);
+  EXPECT_EQ(nlohmann::json::parse(r.out)["texels_covered"], 8 * 24);
+}
+
+TEST(BakeFormats, SquareSizeStillTakesOneNumber) {
+  TempDir dir;
+  write_text(dir / "quad.obj", quad_obj(0, 0, 1, 1));
+  const RunResult r = run_ao("bake quad.obj -s 12 -o ao.png --json" + kRays, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["size"], 12);
+  EXPECT_EQ(read_image(dir / "ao.png").height(), 12);
+}
+
+TEST(BakeFormats, BadSizesAreOneLineErrors) {
+  TempDir dir;
+  write_text(dir / "quad.obj", quad_obj(0, 0, 1, 1));
+  for (const char* bad : {"0", "16x", "x16", "16x0", "16385x4", "4x16385", "abc", "16x8x2", "-4", "1e3", "99999999999"}) {
+    expect_one_line_error(run_ao(std::string("bake quad.obj -o ao.png -s ") + bad, dir.path()), "--size");
+    EXPECT_FALSE(fs::exists(dir / "ao.png")) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace ao::test

@@ -55,6 +55,8 @@ struct BakeOptions {
   bool floor = false, match_by_name = false, self_occlusion = false;
   std::string size_text = "1024";  // -s: N (square) or WxH
   int width = 1024, height = 1024;  // from size_text
+  bool size_given = false, png_bits_given = false;
+  std::string orm;  // --orm: the ORM texture whose red channel the map replaces
   int uv_set = 0;
   int padding = kDefaultPadding;
   int png_bits = 8;
@@ -193,6 +195,7 @@ void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const 
   set.add_input(input, "the mesh " + input.string());
   set.add_input(o.reference, "--reference");
   set.add_input(o.cage, "--cage");
+  set.add_input(o.orm, "--orm");
   for (const std::string& f : o.high) set.add_input(f, "--high");
   for (const std::string& f : o.occluders) set.add_input(f, "--occluder");
   for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
@@ -441,7 +444,14 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   const bool write_map = writes_map_file(o);
   if (!write_map) summary.erase("output");
   if (want_map) {
-    if (write_map) outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
+    if (write_map && !o.orm.empty()) {
+      // The ORM texture with V in its red channel (glTF's occlusion channel); G, B, A and the depth as they were.
+      StoredPng packed = read_stored_png(o.orm);
+      replace_channel(packed, 0, r.visibility);
+      outputs.write(map_out, [&] { write_stored_png(map_out, packed); });
+    } else if (write_map) {
+      outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
+    }
     if (!outs.miss.empty()) {
       Image<float> miss(o.width, o.height, 0.0f);
       for (std::size_t i = 0; i < r.missed.size(); ++i) miss[i] = r.missed[i];
@@ -513,6 +523,25 @@ void check_high_to_low_options(BakeOptions& o) {
   o.h2l.validate();
 }
 
+// --orm: one mesh, a PNG map output, a texture with red, green and blue; the map takes its size
+// unless -s is given (then they must agree) and its bit depth (so --png-bits does not apply).
+void check_orm(BakeOptions& o, bool batch) {
+  if (batch) throw InputError("--orm packs the map of one mesh into one texture: give one mesh, not several or a folder");
+  if (!wants_map(o) || !writes_map_file(o)) throw InputError("--orm writes the map file: give -o out.png (it is not written with only --gltf, --bent-normals or --per-vertex)");
+  if (!o.output.empty() && lower_extension(o.output) != ".png") throw InputError(o.output + ": with --orm the map is the ORM texture with AO in red, a PNG; give -o a .png name");
+  if (o.png_bits_given) throw InputError("--png-bits with --orm: the output keeps the ORM texture's own bit depth; drop --png-bits");
+  const StoredPng orm = read_stored_png(o.orm);
+  if (orm.channels < 3)
+    throw InputError(o.orm + ": --orm needs an RGB or RGBA texture (occlusion, roughness, metalness in R, G, B); this one is greyscale");
+  if (!o.size_given) {
+    o.width = orm.width;
+    o.height = orm.height;
+  } else if (orm.width != o.width || orm.height != o.height) {
+    throw InputError(o.orm + ": the ORM texture is " + std::to_string(orm.width) + "x" + std::to_string(orm.height) + " and the map -s " + std::to_string(o.width) +
+                     "x" + std::to_string(o.height) + "; give -s " + std::to_string(orm.width) + "x" + std::to_string(orm.height) + " or leave -s out");
+  }
+}
+
 int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.method != "histogram" && o.method != "raytraced") throw InputError("--method: expected histogram or raytraced, got '" + o.method + "'");
   check_high_to_low_options(o);
@@ -546,6 +575,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
   if (batch && !o.high.empty()) throw InputError("--high bakes one low mesh: give one low-poly mesh file, not " + std::to_string(inputs.size()) + " or a folder");
   check_output_names(o, batch);
+  if (!o.orm.empty()) check_orm(o, batch);
   // Every output of the run is checked against every input and every other output before any
   // mesh is loaded (each mesh's outputs are then one transaction of their own).
   {
@@ -599,10 +629,10 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   auto o = std::make_shared<BakeOptions>();
   CLI::App* cmd = app.add_subcommand("bake", "Bake an AO map (mesh UV space), per-vertex AO or a glTF with the map, for one or more meshes.");
   cmd->add_option("meshes", o->inputs, "Mesh files (OBJ, PLY, OFF, STL, glTF/GLB) or folders of them; several are baked in turn")->required()->type_name("MESH");
-  cmd->add_option("-o,--output", o->output, "AO map: .png (linear, 8/16 bit) or .exr (float). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
+  cmd->add_option("-o,--output", o->output, "AO map: .png or .tif (8/16 bit), .tga (8 bit), .jpg (8 bit and LOSSY: block artefacts in the data), .exr (float); linear. Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
-  cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();
+  CLI::Option* size_opt = cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();
   cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
   cmd->add_option("--direction-set", o->direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();
@@ -619,7 +649,11 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--offset", o->rt.offset, "raytraced: ray origin offset along the face normal, world units (0: scale-free, a few float spacings of the coordinates; docs/methods/raytraced.md)")->capture_default_str();
   cmd->add_flag("--ignore-back-faces", o->rt.ignore_back_faces, "raytraced: rays pass through back faces (xNormal/Substance 'ignore backface')");
   cmd->add_option("--padding", o->padding, "Fill texels up to this far outside the charts from the nearest chart texel [0, 1024]")->capture_default_str();
-  cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
+  CLI::Option* png_bits_opt = cmd->add_option("--png-bits", o->png_bits, "PNG and TIFF bit depth, 8 or 16 (TGA and JPEG are 8-bit)")->capture_default_str();
+  cmd->add_option("--orm", o->orm,
+                  "Write the map into the red channel of this ORM texture (PNG, RGB/RGBA, 8/16 bit): -o gets a copy with AO in R and G, B, A, depth "
+                  "as they were; the map takes its size")
+      ->type_name("PNG");
   cmd->add_option("--bent-normals", o->bent, "Also write the bent normals (average open direction, world space, n*0.5+0.5) to this image");
   cmd->add_option("--per-vertex", o->per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO to this PLY (colour + float quality)");
   cmd->add_option("--vertex-resolution", o->vertex_resolution, "histogram --per-vertex: view size in pixels [64, 8192]")->capture_default_str();
@@ -646,8 +680,10 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
                            "--vertex-resolution"})
     histogram_only.push_back(cmd->get_option(name));
   for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces"}) raytraced_only.push_back(cmd->get_option(name));
-  cmd->callback([o, method, histogram_only, raytraced_only, &global, &action] {
+  cmd->callback([o, method, size_opt, png_bits_opt, histogram_only, raytraced_only, &global, &action] {
     o->method_given = method->count() > 0;
+    o->size_given = size_opt->count() > 0;
+    o->png_bits_given = png_bits_opt->count() > 0;
     for (const CLI::Option* opt : histogram_only)
       if (opt->count() > 0) o->histogram_only.push_back(opt->get_name());
     for (const CLI::Option* opt : raytraced_only)

@@ -156,7 +156,9 @@ TEST(Bake, NonSquareCoverageFollowsTheTexelGrid) {
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 32; ++x) {
       EXPECT_EQ(cov.mask(x, y), x < 16 && y < 4 ? 1 : 0) << x << "," << y;
-      if (cov.mask(x, y)) EXPECT_NEAR(cov.uv_area(x, y), 1.0f, 1e-4f) << x << "," << y;
+      if (cov.mask(x, y)) {
+        EXPECT_NEAR(cov.uv_area(x, y), 1.0f, 1e-4f) << x << "," << y;
+      }
       world += cov.world_area(x, y);
     }
   EXPECT_NEAR(world, 4.0, 1e-4);

@@ -101,5 +101,68 @@ TEST(BakeFormats, BadSizesAreOneLineErrors) {
   }
 }
 
+// --- --orm ---------------------------------------------------------------------------------------
+
+// A W x H ORM texture whose G, B (and A) vary per pixel, so any shuffling shows.
+StoredPng orm_texture(int w, int h, int channels, int bits) {
+  StoredPng t{w, h, channels, bits, {}};
+  const int max = bits == 16 ? 65535 : 255;
+  for (int i = 0; i < w * h; ++i)
+    for (int c = 0; c < channels; ++c) t.samples.push_back(static_cast<std::uint16_t>((i * 37 + c * 101) % (max + 1)));
+  return t;
+}
+
+TEST(BakeFormats, OrmGetsAoInRedAndKeepsEverythingElse) {
+  for (const auto& [channels, bits] : {std::pair{4, 16}, std::pair{3, 8}}) {
+    TempDir dir;
+    write_text(dir / "quad.obj", quad_obj(0, 0, 0.5, 1));
+    const StoredPng orm = orm_texture(16, 8, channels, bits);
+    write_stored_png(dir / "orm.png", orm);
+    const std::string before = read_text(dir / "orm.png");
+    // No -s: the map takes the texture's size (16 x 8).
+    const RunResult r = run_ao("bake quad.obj --orm orm.png -o packed.png --json" + kRays, dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["width"], 16);
+    EXPECT_EQ(read_text(dir / "orm.png"), before);  // the input is never modified
+    const StoredPng out = read_stored_png(dir / "packed.png");
+    ASSERT_EQ(out.width, 16);
+    ASSERT_EQ(out.height, 8);
+    ASSERT_EQ(out.channels, channels);
+    ASSERT_EQ(out.bits, bits);
+    const int max = bits == 16 ? 65535 : 255;
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 16; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y * 16 + x) * static_cast<std::size_t>(channels);
+        for (int c = 1; c < channels; ++c) EXPECT_EQ(out.samples[i + static_cast<std::size_t>(c)], orm.samples[i + static_cast<std::size_t>(c)]) << x << "," << y << " channel " << c;
+        // The open quad covers columns 0..7 (V = 1 exactly); padding (2) reaches 8, 9; beyond, V = 0.
+        if (x < 10) {
+          EXPECT_EQ(out.samples[i], max) << x << "," << y;
+        } else if (x > 11) {
+          EXPECT_EQ(out.samples[i], 0) << x << "," << y;
+        }
+      }
+  }
+}
+
+TEST(BakeFormats, OrmMisuseIsAOneLineErrorAndWritesNothing) {
+  TempDir dir;
+  write_text(dir / "quad.obj", quad_obj(0, 0, 1, 1));
+  write_stored_png(dir / "orm.png", orm_texture(16, 8, 3, 8));
+  write_stored_png(dir / "grey.png", orm_texture(16, 8, 1, 8));
+  const std::string before = read_text(dir / "orm.png");
+  expect_one_line_error(run_ao("bake quad.obj --orm orm.png -s 16 -o out.png" + kRays, dir.path()), "give -s 16x8 or leave -s out");
+  expect_one_line_error(run_ao("bake quad.obj --orm grey.png -o out.png" + kRays, dir.path()), "greyscale");
+  expect_one_line_error(run_ao("bake quad.obj --orm orm.png -o out.exr" + kRays, dir.path()), ".png");
+  expect_one_line_error(run_ao("bake quad.obj --orm orm.png --png-bits 16 -o out.png" + kRays, dir.path()), "--png-bits");
+  expect_one_line_error(run_ao("bake quad.obj --orm missing.png -o out.png" + kRays, dir.path()), "missing.png");
+  expect_one_line_error(run_ao("bake quad.obj --orm quad.obj -o out.png" + kRays, dir.path()), "quad.obj");
+  expect_one_line_error(run_ao("bake quad.obj quad.obj --orm orm.png" + kRays, dir.path()), "one mesh");
+  // Writing over the ORM texture itself is refused before any work: it is an input.
+  expect_one_line_error(run_ao("bake quad.obj --orm orm.png -o orm.png" + kRays, dir.path()), "orm.png");
+  EXPECT_EQ(read_text(dir / "orm.png"), before);
+  EXPECT_FALSE(fs::exists(dir / "out.png"));
+  EXPECT_FALSE(fs::exists(dir / "out.exr"));
+}
+
 }  // namespace
 }  // namespace ao::test

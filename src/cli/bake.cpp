@@ -17,6 +17,7 @@
 #include "ao/bake/padding.h"
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/raytraced_bake.h"
+#include "ao/bake/udim.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/eval/metrics.h"
@@ -362,7 +363,50 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   BakeResult r;
   double bake_ms = 0;
   fs::path map_out;
-  if (want_map) {
+  // UDIM: -o names a pattern (<UDIM> or .1001.); each tile with triangles is a map of its own.
+  const bool udim = want_map && writes_map_file(o) && is_udim_pattern(outs.map);
+  if (udim) {
+    const std::vector<UdimTile> tiles = udim_tiles(scene);
+    for (const UdimTile& t : tiles)  // tile 1001 of "ao.1001.png" is the -o path itself, already declared
+      if (udim_tile_path(outs.map, t.number()) != outs.map) outputs.add_output(udim_tile_path(outs.map, t.number()), "tile " + std::to_string(t.number()) + " of -o");
+    nlohmann::json tile_summary = nlohmann::json::array();
+    std::size_t covered = 0;
+    for (const UdimTile& t : tiles) {
+      const Scene ts = udim_tile_scene(scene, t);
+      BakeResult tr;
+      {
+        ProgressBar bar("bake " + input.filename().string() + " tile " + std::to_string(t.number()), progress);
+        if (grouped) {
+          tr = bake_in_groups(input, ts, high ? &*high : nullptr, occluders, o, rt, hist, summary, bar.callback());
+        } else {
+          const TexelCoverage cov = compute_texel_coverage(ts, o.width, o.height);
+          if (o.method == "histogram") {
+            tr = bake_histogram(ts, cov, hist, bar.callback());
+          } else {
+            const RayScene tile_rays(ts);  // the UVs differ per tile, and the baker reads them from its scene
+            tr = bake_raytraced(tile_rays, cov, rt, bar.callback());
+          }
+        }
+      }
+      if (tr.covered_texels == 0) continue;  // a tile without texels is not written
+      if (o.padding > 0) pad(tr.visibility, nearest_valid_texel(tr.mask, o.padding));
+      double sum = 0;
+      for (std::size_t i = 0; i < tr.mask.size(); ++i)
+        if (tr.mask[i]) sum += tr.visibility[i];
+      const fs::path path = udim_tile_path(outs.map, t.number());
+      outputs.write(path, [&] { write_image(path, tr.visibility, {.png_bits = o.png_bits}); });
+      covered += tr.covered_texels;
+      tile_summary.push_back({{"tile", t.number()}, {"output", path.string()}, {"texels_covered", tr.covered_texels},
+                              {"mean_visibility", sum / static_cast<double>(tr.covered_texels)}});
+    }
+    bake_ms = clock.lap_ms();
+    timings["bake_ms"] = bake_ms;
+    summary["udim_tiles"] = tile_summary;
+    summary["width"] = o.width;
+    summary["height"] = o.height;
+    summary["texels_covered"] = covered;
+  }
+  if (want_map && !udim) {
     const TexelCoverage cov = compute_texel_coverage(scene, o.width, o.height);
     timings["uv_coverage_ms"] = clock.lap_ms();
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": " << w << "\n";
@@ -441,9 +485,9 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   // Writes: staged beside their destinations and renamed together once all are written. The map
   // file is written when -o names it, or under its default name when no other output is asked for
   // (--gltf, --bent-normals, --per-vertex, --miss-mask).
-  const bool write_map = writes_map_file(o);
+  const bool write_map = writes_map_file(o) && !udim;  // UDIM tiles were written above
   if (!write_map) summary.erase("output");
-  if (want_map) {
+  if (want_map && !udim) {
     if (write_map && !o.orm.empty()) {
       // The ORM texture with V in its red channel (glTF's occlusion channel); G, B, A and the depth as they were.
       StoredPng packed = read_stored_png(o.orm);
@@ -485,6 +529,10 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     summary["per_vertex_output"] = outs.per_vertex.string();
   }
   outputs.commit();
+  if (udim && !o.json)
+    for (const auto& t : summary["udim_tiles"])
+      std::fprintf(stderr, "wrote %s: %s, tile %d, %dx%d, %zu texels covered, mean V = %.4f\n", t["output"].get<std::string>().c_str(), input.filename().string().c_str(),
+                   t["tile"].get<int>(), o.width, o.height, t["texels_covered"].get<std::size_t>(), t["mean_visibility"].get<double>());
   if (want_map && write_map && !o.json)
     std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
                  input.filename().string().c_str(), o.method.c_str(), o.width, o.height, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
@@ -576,6 +624,15 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (batch && !o.high.empty()) throw InputError("--high bakes one low mesh: give one low-poly mesh file, not " + std::to_string(inputs.size()) + " or a folder");
   check_output_names(o, batch);
   if (!o.orm.empty()) check_orm(o, batch);
+  if (is_udim_pattern(o.output)) {
+    const std::pair<bool, const char*> single_map_options[] = {{!o.gltf.empty(), "--gltf (a material takes one occlusion texture)"},
+                                                              {!o.bent.empty(), "--bent-normals"},
+                                                              {!o.miss_mask.empty(), "--miss-mask"},
+                                                              {!o.orm.empty(), "--orm"},
+                                                              {!o.reference.empty(), "--reference"}};
+    for (const auto& [given, what] : single_map_options)
+      if (given) throw InputError(o.output + ": UDIM tiles are written for the map only; " + what + " needs a single map, drop it or the tile pattern");
+  }
   // Every output of the run is checked against every input and every other output before any
   // mesh is loaded (each mesh's outputs are then one transaction of their own).
   {
@@ -629,7 +686,8 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   auto o = std::make_shared<BakeOptions>();
   CLI::App* cmd = app.add_subcommand("bake", "Bake an AO map (mesh UV space), per-vertex AO or a glTF with the map, for one or more meshes.");
   cmd->add_option("meshes", o->inputs, "Mesh files (OBJ, PLY, OFF, STL, glTF/GLB) or folders of them; several are baked in turn")->required()->type_name("MESH");
-  cmd->add_option("-o,--output", o->output, "AO map: .png or .tif (8/16 bit), .tga (8 bit), .jpg (8 bit and LOSSY: block artefacts in the data), .exr (float); linear. Default <mesh>-ao.png; in a batch, <mesh>-<name>");
+  cmd->add_option("-o,--output", o->output, "AO map: .png or .tif (8/16 bit), .tga (8 bit), .jpg (8 bit and LOSSY: block artefacts in the data), .exr (float); linear. A name with <UDIM> "
+                  "or .1001. writes one map per UDIM tile (ao.<UDIM>.png -> ao.1001.png, ao.1002.png, ...). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
   CLI::Option* size_opt = cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();

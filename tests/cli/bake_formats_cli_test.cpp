@@ -164,5 +164,60 @@ TEST(BakeFormats, OrmMisuseIsAOneLineErrorAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir / "out.exr"));
 }
 
+// --- UDIM ----------------------------------------------------------------------------------------
+
+// Two quads in two UDIM tiles: a floor (y = 0, facing up) with UVs in tile 1001 and, `gap` above
+// it, a roof (facing down) with UVs in tile 1002. Each occludes the other.
+std::string two_tile_obj(double gap) {
+  std::ostringstream s;
+  s << "o floor\nv 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nvn 0 1 0\n";
+  s << "vt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\n";
+  s << "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  s << "o roof\nv 0 " << gap << " 0\nv 0 " << gap << " -1\nv 1 " << gap << " -1\nv 1 " << gap << " 0\nvn 0 -1 0\n";
+  s << "vt 1.1 0.1\nvt 1.1 0.9\nvt 1.9 0.9\nvt 1.9 0.1\n";
+  s << "f 5/5/2 6/6/2 7/7/2\nf 5/5/2 7/7/2 8/8/2\n";
+  return s.str();
+}
+
+TEST(BakeFormats, UdimTilesAreBakedIntoOneMapEachAndOccludeEachOther) {
+  TempDir dir;
+  write_text(dir / "two.obj", two_tile_obj(0.2));
+  const RunResult r = run_ao("bake two.obj -s 16 -o 'ao.<UDIM>.png' --json" + kRays, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir / "ao.1001.png"));
+  ASSERT_TRUE(fs::exists(dir / "ao.1002.png"));
+  EXPECT_EQ(dir.file_count(), 3);  // two.obj and the two tiles: no file for empty tiles, none named <UDIM>
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["udim_tiles"].size(), 2u);
+  EXPECT_EQ(j["udim_tiles"][0]["tile"], 1001);
+  EXPECT_EQ(j["udim_tiles"][1]["tile"], 1002);
+  // Each quad covers UVs [0.1, 0.9]^2 of its tile: texels 2..13 of 16 are inside in both maps.
+  // A floor 0.2 below a roof of the same size is mostly occluded (the view factor of the roof from
+  // the floor's centre is 1 - sin(atan(0.2 / 0.5)) ~ 0.81, so V < 0.5 everywhere under it) and
+  // the roof sees the floor the same way: the other tile's triangles occlude.
+  for (const char* name : {"ao.1001.png", "ao.1002.png"}) {
+    const Image<float> map = read_image(dir / name);
+    ASSERT_EQ(map.width(), 16);
+    EXPECT_LT(map(8, 8), 0.5f) << name;
+    EXPECT_GT(map(8, 8), 0.0f) << name;
+  }
+  // Apart, each is an open quad (V = 1): the tiles really hold different surfaces.
+  write_text(dir / "apart.obj", two_tile_obj(1000.0));
+  ASSERT_EQ(run_ao("bake apart.obj -s 16 -o apart.1001.exr" + kRays, dir.path()).exit_code, 0);
+  EXPECT_EQ(read_image(dir / "apart.1001.exr")(8, 8), 1.0f);
+  EXPECT_EQ(read_image(dir / "apart.1002.exr")(8, 8), 1.0f);
+  EXPECT_FALSE(fs::exists(dir / "apart.1003.exr"));
+}
+
+TEST(BakeFormats, UdimMisuseIsAOneLineError) {
+  TempDir dir;
+  write_text(dir / "two.obj", two_tile_obj(0.2));
+  expect_one_line_error(run_ao("bake two.obj -o 'ao.<UDIM>.png' --gltf m.glb" + kRays, dir.path()), "--gltf");
+  // UVs outside the UDIM range (u < 0).
+  write_text(dir / "neg.obj", quad_obj(-0.9, 0.1, -0.1, 0.9));
+  expect_one_line_error(run_ao("bake neg.obj -o 'ao.<UDIM>.png'" + kRays, dir.path()), "outside the UDIM tiles");
+  EXPECT_EQ(dir.file_count(), 2);
+}
+
 }  // namespace
 }  // namespace ao::test

@@ -17,6 +17,7 @@
 #include "ao/bake/padding.h"
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/raytraced_bake.h"
+#include "ao/bake/udim.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/eval/metrics.h"
@@ -53,7 +54,10 @@ struct BakeOptions {
   // Occluders and bake groups (bake_groups.h).
   std::vector<std::string> occluders, groups;
   bool floor = false, match_by_name = false, self_occlusion = false;
-  int size = 1024;
+  std::string size_text = "1024";  // -s: N (square) or WxH
+  int width = 1024, height = 1024;  // from size_text
+  bool size_given = false, png_bits_given = false;
+  std::string orm;  // --orm: the ORM texture whose red channel the map replaces
   int uv_set = 0;
   int padding = kDefaultPadding;
   int png_bits = 8;
@@ -104,6 +108,21 @@ fs::path batch_path(const fs::path& in, const std::string& given, const std::str
   const fs::path dir = out_dir.empty() ? in.parent_path() : fs::path(out_dir);
   if (given.empty()) return dir / (in.stem().string() + fallback_suffix);
   return dir / (in.stem().string() + "-" + fs::path(given).filename().string());
+}
+
+// "1024" -> 1024 x 1024, "2048x1024" -> 2048 x 1024; nullopt unless each side is a whole number in [1, 16384].
+std::optional<std::pair<int, int>> parse_map_size(const std::string& text) {
+  auto side = [](const std::string& s) -> std::optional<int> {
+    if (s.empty() || s.size() > 5 || !std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); })) return std::nullopt;
+    const int v = std::stoi(s);
+    if (v < 1 || v > 16384) return std::nullopt;
+    return v;
+  };
+  const std::size_t x = text.find_first_of("xX");
+  const auto w = side(text.substr(0, x));
+  const auto h = x == std::string::npos ? w : side(text.substr(x + 1));
+  if (!w || !h) return std::nullopt;
+  return std::pair{*w, *h};
 }
 
 std::string lower_extension(const fs::path& p) {
@@ -178,6 +197,7 @@ void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const 
   set.add_input(input, "the mesh " + input.string());
   set.add_input(o.reference, "--reference");
   set.add_input(o.cage, "--cage");
+  set.add_input(o.orm, "--orm");
   for (const std::string& f : o.high) set.add_input(f, "--high");
   for (const std::string& f : o.occluders) set.add_input(f, "--occluder");
   for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
@@ -262,7 +282,7 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
       cage = extrude_cage(scene, *p.cage_extrusion);
     }
   }
-  BakeResult r = bake_groups(scene, groups, high ? std::vector<Mesh>{} : occluders, o.size,
+  BakeResult r = bake_groups(scene, groups, high ? std::vector<Mesh>{} : occluders, o.width, o.height,
                              [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
                                if (!high) {
                                  if (o.method == "histogram") return bake_histogram(gs, cov, hist, progress);
@@ -344,8 +364,51 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   BakeResult r;
   double bake_ms = 0;
   fs::path map_out;
-  if (want_map) {
-    const TexelCoverage cov = compute_texel_coverage(scene, o.size);
+  // UDIM: -o names a pattern (<UDIM> or .1001.); each tile with triangles is a map of its own.
+  const bool udim = want_map && writes_map_file(o) && is_udim_pattern(outs.map);
+  if (udim) {
+    const std::vector<UdimTile> tiles = udim_tiles(scene);
+    for (const UdimTile& t : tiles)  // tile 1001 of "ao.1001.png" is the -o path itself, already declared
+      if (udim_tile_path(outs.map, t.number()) != outs.map) outputs.add_output(udim_tile_path(outs.map, t.number()), "tile " + std::to_string(t.number()) + " of -o");
+    nlohmann::json tile_summary = nlohmann::json::array();
+    std::size_t covered = 0;
+    for (const UdimTile& t : tiles) {
+      const Scene ts = udim_tile_scene(scene, t);
+      BakeResult tr;
+      {
+        ProgressBar bar("bake " + input.filename().string() + " tile " + std::to_string(t.number()), progress);
+        if (grouped) {
+          tr = bake_in_groups(input, ts, high ? &*high : nullptr, occluders, o, rt, hist, summary, bar.callback());
+        } else {
+          const TexelCoverage cov = compute_texel_coverage(ts, o.width, o.height);
+          if (o.method == "histogram") {
+            tr = bake_histogram(ts, cov, hist, bar.callback());
+          } else {
+            const RayScene tile_rays(ts);  // the UVs differ per tile, and the baker reads them from its scene
+            tr = bake_raytraced(tile_rays, cov, rt, bar.callback());
+          }
+        }
+      }
+      if (tr.covered_texels == 0) continue;  // a tile without texels is not written
+      if (o.padding > 0) pad(tr.visibility, nearest_valid_texel(tr.mask, o.padding));
+      double sum = 0;
+      for (std::size_t i = 0; i < tr.mask.size(); ++i)
+        if (tr.mask[i]) sum += tr.visibility[i];
+      const fs::path path = udim_tile_path(outs.map, t.number());
+      outputs.write(path, [&] { write_image(path, tr.visibility, {.png_bits = o.png_bits}); });
+      covered += tr.covered_texels;
+      tile_summary.push_back({{"tile", t.number()}, {"output", path.string()}, {"texels_covered", tr.covered_texels},
+                              {"mean_visibility", sum / static_cast<double>(tr.covered_texels)}});
+    }
+    bake_ms = clock.lap_ms();
+    timings["bake_ms"] = bake_ms;
+    summary["udim_tiles"] = tile_summary;
+    summary["width"] = o.width;
+    summary["height"] = o.height;
+    summary["texels_covered"] = covered;
+  }
+  if (want_map && !udim) {
+    const TexelCoverage cov = compute_texel_coverage(scene, o.width, o.height);
     timings["uv_coverage_ms"] = clock.lap_ms();
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": " << w << "\n";
     {
@@ -361,7 +424,9 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     for (std::size_t i = 0; i < r.mask.size(); ++i)
       if (r.mask[i]) sum += r.visibility[i];
     summary["output"] = map_out.string();
-    summary["size"] = o.size;
+    if (o.width == o.height) summary["size"] = o.width;
+    summary["width"] = o.width;
+    summary["height"] = o.height;
     summary["texels_covered"] = r.covered_texels;
     summary["mean_visibility"] = r.covered_texels ? sum / static_cast<double>(r.covered_texels) : 1.0;
     summary["texels_per_second"] = bake_ms > 0 ? static_cast<double>(r.covered_texels) / (bake_ms / 1000.0) : 0.0;
@@ -421,17 +486,24 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   // Writes: staged beside their destinations and renamed together once all are written. The map
   // file is written when -o names it, or under its default name when no other output is asked for
   // (--gltf, --bent-normals, --per-vertex, --miss-mask).
-  const bool write_map = writes_map_file(o);
+  const bool write_map = writes_map_file(o) && !udim;  // UDIM tiles were written above
   if (!write_map) summary.erase("output");
-  if (want_map) {
-    if (write_map) outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
+  if (want_map && !udim) {
+    if (write_map && !o.orm.empty()) {
+      // The ORM texture with V in its red channel (glTF's occlusion channel); G, B, A and the depth as they were.
+      StoredPng packed = read_stored_png(o.orm);
+      replace_channel(packed, 0, r.visibility);
+      outputs.write(map_out, [&] { write_stored_png(map_out, packed); });
+    } else if (write_map) {
+      outputs.write(map_out, [&] { write_image(map_out, r.visibility, {.png_bits = o.png_bits}); });
+    }
     if (!outs.miss.empty()) {
-      Image<float> miss(o.size, o.size, 0.0f);
+      Image<float> miss(o.width, o.height, 0.0f);
       for (std::size_t i = 0; i < r.missed.size(); ++i) miss[i] = r.missed[i];
       outputs.write(outs.miss, [&] { write_image(outs.miss, miss, {}); });
     }
     if (!outs.bent.empty() && !r.bent_normal.empty()) {
-      Image<Vec3> enc(o.size, o.size, Vec3{0.5f, 0.5f, 0.5f});
+      Image<Vec3> enc(o.width, o.height, Vec3{0.5f, 0.5f, 0.5f});
       for (std::size_t i = 0; i < enc.size(); ++i)
         if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
       outputs.write(outs.bent, [&] { write_rgb_image(outs.bent, enc, {.png_bits = o.png_bits}); });
@@ -458,9 +530,13 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     summary["per_vertex_output"] = outs.per_vertex.string();
   }
   outputs.commit();
+  if (udim && !o.json)
+    for (const auto& t : summary["udim_tiles"])
+      std::fprintf(stderr, "wrote %s: %s, tile %d, %dx%d, %zu texels covered, mean V = %.4f\n", t["output"].get<std::string>().c_str(), input.filename().string().c_str(),
+                   t["tile"].get<int>(), o.width, o.height, t["texels_covered"].get<std::size_t>(), t["mean_visibility"].get<double>());
   if (want_map && write_map && !o.json)
     std::fprintf(stderr, "wrote %s: %s, %s, %dx%d, %zu texels covered, mean V = %.4f, %.0f ms (%.2f M texels/s)\n", map_out.string().c_str(),
-                 input.filename().string().c_str(), o.method.c_str(), o.size, o.size, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
+                 input.filename().string().c_str(), o.method.c_str(), o.width, o.height, r.covered_texels, summary["mean_visibility"].get<double>(), bake_ms,
                  summary["texels_per_second"].get<double>() / 1e6);
   if (!outs.per_vertex.empty() && !o.json)
     std::fprintf(stderr, "wrote %s: %zu vertices, %.0f ms\n", outs.per_vertex.string().c_str(), vertex_ao.size(), vertex_ms);
@@ -496,6 +572,25 @@ void check_high_to_low_options(BakeOptions& o) {
   o.h2l.validate();
 }
 
+// --orm: one mesh, a PNG map output, a texture with red, green and blue; the map takes its size
+// unless -s is given (then they must agree) and its bit depth (so --png-bits does not apply).
+void check_orm(BakeOptions& o, bool batch) {
+  if (batch) throw InputError("--orm packs the map of one mesh into one texture: give one mesh, not several or a folder");
+  if (!wants_map(o) || !writes_map_file(o)) throw InputError("--orm writes the map file: give -o out.png (it is not written with only --gltf, --bent-normals or --per-vertex)");
+  if (!o.output.empty() && lower_extension(o.output) != ".png") throw InputError(o.output + ": with --orm the map is the ORM texture with AO in red, a PNG; give -o a .png name");
+  if (o.png_bits_given) throw InputError("--png-bits with --orm: the output keeps the ORM texture's own bit depth; drop --png-bits");
+  const StoredPng orm = read_stored_png(o.orm);
+  if (orm.channels < 3)
+    throw InputError(o.orm + ": --orm needs an RGB or RGBA texture (occlusion, roughness, metalness in R, G, B); this one is greyscale");
+  if (!o.size_given) {
+    o.width = orm.width;
+    o.height = orm.height;
+  } else if (orm.width != o.width || orm.height != o.height) {
+    throw InputError(o.orm + ": the ORM texture is " + std::to_string(orm.width) + "x" + std::to_string(orm.height) + " and the map -s " + std::to_string(o.width) +
+                     "x" + std::to_string(o.height) + "; give -s " + std::to_string(orm.width) + "x" + std::to_string(orm.height) + " or leave -s out");
+  }
+}
+
 int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.method != "histogram" && o.method != "raytraced") throw InputError("--method: expected histogram or raytraced, got '" + o.method + "'");
   check_high_to_low_options(o);
@@ -521,12 +616,25 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   o.hist.bent_normals = o.rt.bent_normals = !o.bent.empty();
   o.rt.normal = parse_surface_normal(o.normal);
   o.hist.validate();
-  if (o.size < 1 || o.size > 16384) throw InputError("--size must be in [1, 16384]");
+  const auto size = parse_map_size(o.size_text);
+  if (!size) throw InputError("--size: expected N or WIDTHxHEIGHT (2048x1024), each in [1, 16384] texels, got '" + o.size_text + "'");
+  o.width = size->first;
+  o.height = size->second;
   const std::vector<fs::path> inputs = expand_inputs(o.inputs);
   if (inputs.empty()) throw InputError("no mesh files to bake (folders are searched for .obj .ply .off .stl .gltf .glb)");
   const bool batch = inputs.size() > 1 || fs::is_directory(o.inputs.front());
   if (batch && !o.high.empty()) throw InputError("--high bakes one low mesh: give one low-poly mesh file, not " + std::to_string(inputs.size()) + " or a folder");
   check_output_names(o, batch);
+  if (!o.orm.empty()) check_orm(o, batch);
+  if (is_udim_pattern(o.output)) {
+    const std::pair<bool, const char*> single_map_options[] = {{!o.gltf.empty(), "--gltf (a material takes one occlusion texture)"},
+                                                              {!o.bent.empty(), "--bent-normals"},
+                                                              {!o.miss_mask.empty(), "--miss-mask"},
+                                                              {!o.orm.empty(), "--orm"},
+                                                              {!o.reference.empty(), "--reference"}};
+    for (const auto& [given, what] : single_map_options)
+      if (given) throw InputError(o.output + ": UDIM tiles are written for the map only; " + what + " needs a single map, drop it or the tile pattern");
+  }
   // Every output of the run is checked against every input and every other output before any
   // mesh is loaded (each mesh's outputs are then one transaction of their own).
   {
@@ -536,9 +644,9 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   }
   if (wants_map(o)) {
     const int threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-    check_memory(estimate_bake_memory({.size = o.size, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
+    check_memory(estimate_bake_memory({.size = o.width, .height = o.height, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
                                        .pixels_per_texel = o.hist.pixels_per_texel, .threads = threads}),
-                 "ao bake: a " + std::to_string(o.size) + "x" + std::to_string(o.size) + " map");
+                 "ao bake: a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " map");
   }
   if (!batch) {
     const nlohmann::json s = bake_one(inputs.front(), o, false, global);
@@ -580,10 +688,11 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   auto o = std::make_shared<BakeOptions>();
   CLI::App* cmd = app.add_subcommand("bake", "Bake an AO map (mesh UV space), per-vertex AO or a glTF with the map, for one or more meshes.");
   cmd->add_option("meshes", o->inputs, "Mesh files (OBJ, PLY, OFF, STL, glTF/GLB) or folders of them; several are baked in turn")->required()->type_name("MESH");
-  cmd->add_option("-o,--output", o->output, "AO map: .png (linear, 8/16 bit) or .exr (float). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
+  cmd->add_option("-o,--output", o->output, "AO map: .png or .tif (8/16 bit), .tga (8 bit), .jpg (8 bit and LOSSY: block artefacts in the data), .exr (float); linear. A name with <UDIM> "
+                  "or .1001. writes one map per UDIM tile (ao.<UDIM>.png -> ao.1001.png, ao.1002.png, ...). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
-  cmd->add_option("-s,--size", o->size, "Map width = height, texels [1, 16384]")->capture_default_str();
+  CLI::Option* size_opt = cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();
   cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
   cmd->add_option("--direction-set", o->direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();
@@ -606,7 +715,11 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
       ->capture_default_str();
   cmd->add_flag("--ignore-back-faces", o->rt.ignore_back_faces, "raytraced: rays pass through back faces (xNormal/Substance 'ignore backface')");
   cmd->add_option("--padding", o->padding, "Fill texels up to this far outside the charts from the nearest chart texel [0, 1024]")->capture_default_str();
-  cmd->add_option("--png-bits", o->png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
+  CLI::Option* png_bits_opt = cmd->add_option("--png-bits", o->png_bits, "PNG and TIFF bit depth, 8 or 16 (TGA and JPEG are 8-bit)")->capture_default_str();
+  cmd->add_option("--orm", o->orm,
+                  "Write the map into the red channel of this ORM texture (PNG, RGB/RGBA, 8/16 bit): -o gets a copy with AO in R and G, B, A, depth "
+                  "as they were; the map takes its size")
+      ->type_name("PNG");
   cmd->add_option("--bent-normals", o->bent, "Also write the bent normals (average open direction, world space, n*0.5+0.5) to this image");
   cmd->add_option("--per-vertex", o->per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO to this PLY (colour + float quality)");
   cmd->add_option("--vertex-resolution", o->vertex_resolution, "histogram --per-vertex: view size in pixels [64, 8192]")->capture_default_str();
@@ -634,8 +747,10 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
     histogram_only.push_back(cmd->get_option(name));
   for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal"})
     raytraced_only.push_back(cmd->get_option(name));
-  cmd->callback([o, method, histogram_only, raytraced_only, &global, &action] {
+  cmd->callback([o, method, size_opt, png_bits_opt, histogram_only, raytraced_only, &global, &action] {
     o->method_given = method->count() > 0;
+    o->size_given = size_opt->count() > 0;
+    o->png_bits_given = png_bits_opt->count() > 0;
     for (const CLI::Option* opt : histogram_only)
       if (opt->count() > 0) o->histogram_only.push_back(opt->get_name());
     for (const CLI::Option* opt : raytraced_only)

@@ -44,7 +44,7 @@ double mean_covered(const BakeResult& r) {
 BakeResult bake(const Scene& s, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders) {
   RaytracedBakeParams p;
   p.samples = 32;
-  return bake_groups(s, groups, occluders, 16, [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup&) {
+  return bake_groups(s, groups, occluders, 16, 16, [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup&) {
     const RayScene rays(gs);
     return bake_raytraced(rays, cov, p);
   });

@@ -260,12 +260,13 @@ TEST(ImageIo, ExtensionIsCaseInsensitiveAndReadingGoesByContent) {
   fs::copy_file(dir / "v.PNG", dir / "really-a-png.exr");
   EXPECT_EQ(read_image(dir / "really-a-png.exr")(2, 2), 1.0f);
   EXPECT_TRUE(is_supported_image_path("a/B.Exr"));
-  EXPECT_FALSE(is_supported_image_path("a/b.jpg"));
+  EXPECT_TRUE(is_supported_image_path("a/b.JPG"));
+  EXPECT_FALSE(is_supported_image_path("a/b.webp"));
 }
 
 TEST(ImageIo, UnknownExtensionIsAnErrorListingTheSupportedOnes) {
   TempDir dir;
-  expect_one_line_error<InputError>([&] { write_image(dir / "v.jpg", ramp(2, 2)); }, dir / "v.jpg", ".exr, .png");
+  expect_one_line_error<InputError>([&] { write_image(dir / "v.webp", ramp(2, 2)); }, dir / "v.webp", ".exr, .png, .tif");
   expect_one_line_error<InputError>([&] { write_rgb_image(dir / "v", colour_ramp(2, 2)); }, dir / "v", "supported");
   EXPECT_EQ(dir.file_count(), 0);
 }
@@ -274,6 +275,8 @@ TEST(ImageIo, BadOptionsAndEmptyImagesAreRejected) {
   TempDir dir;
   EXPECT_THROW(write_image(dir / "v.png", ramp(2, 2), {.png_bits = 12}), InputError);
   EXPECT_THROW(write_image(dir / "v.exr", ramp(2, 2), {.exr_channel = ""}), InputError);
+  EXPECT_THROW(write_image(dir / "v.jpg", ramp(2, 2), {.jpeg_quality = 0}), InputError);
+  EXPECT_THROW(write_image(dir / "v.jpg", ramp(2, 2), {.jpeg_quality = 101}), InputError);
   expect_one_line_error<InputError>([&] { write_image(dir / "v.exr", Image<float>()); }, dir / "v.exr", "empty");
   EXPECT_EQ(dir.file_count(), 0);
 }

@@ -111,22 +111,22 @@ Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<
   return s;
 }
 
-BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders, int size,
+BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders, int width, int height,
                        const std::function<BakeResult(const Scene&, const TexelCoverage&, const BakeGroup&)>& bake) {
   BakeResult out;
-  Image<double> weighted(size, size, 0.0), area(size, size, 0.0);
+  Image<double> weighted(width, height, 0.0), area(width, height, 0.0);
   Image<Vec3> bent;
   bool any = false;
   for (const BakeGroup& g : groups) {
     const Scene gs = group_scene(scene, g, occluders);
     if (!has_uvs(gs)) continue;
-    const TexelCoverage cov = compute_texel_coverage(gs, size);
+    const TexelCoverage cov = compute_texel_coverage(gs, width, height);
     BakeResult r = bake(gs, cov, g);
     if (!any) {
-      out.visibility = Image<float>(size, size, 0.0f);
-      out.mask = Image<std::uint8_t>(size, size, std::uint8_t{0});
-      if (!r.missed.empty()) out.missed = Image<std::uint8_t>(size, size, std::uint8_t{0});
-      if (!r.bent_normal.empty()) out.bent_normal = Image<Vec3>(size, size, Vec3{0, 0, 0});
+      out.visibility = Image<float>(width, height, 0.0f);
+      out.mask = Image<std::uint8_t>(width, height, std::uint8_t{0});
+      if (!r.missed.empty()) out.missed = Image<std::uint8_t>(width, height, std::uint8_t{0});
+      if (!r.bent_normal.empty()) out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
       any = true;
     }
     for (std::size_t i = 0; i < cov.mask.size(); ++i) {

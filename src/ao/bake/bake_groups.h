@@ -48,11 +48,11 @@ Mesh make_floor_occluder(const Bounds3& model);
 /// are dropped so they are not baked).
 Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<Mesh>& occluders);
 
-/// Bakes each group with `bake(group_scene, coverage)` (coverage computed on the group scene at
-/// `size`) and merges the maps: each texel is the area-weighted mean of the groups covering it
+/// Bakes each group with `bake(group_scene, coverage)` (coverage computed on the group scene for a
+/// `width` x `height` map) and merges the maps: each texel is the area-weighted mean of the groups covering it
 /// (one group, except where charts of different groups overlap). Groups whose meshes have no UVs
 /// are skipped. Rays, fragments and missed texels are summed; warnings are concatenated.
-BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders, int size,
+BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders, int width, int height,
                        const std::function<BakeResult(const Scene&, const TexelCoverage&, const BakeGroup&)>& bake);
 
 }  // namespace ao

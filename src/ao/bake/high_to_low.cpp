@@ -148,18 +148,18 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   const auto smooth = smoothed_normals(low);
   const detail::Tracer tracer{occluders, falloff, occluder_fn, params.ao.ignore_back_faces};
   const float offset = params.ao.offset > 0 ? params.ao.offset : ray_offset_distance(bounds_magnitude(occluders.bounds()));
-  const int n = cov.size;
+  const int width = cov.width, height = cov.height;
   BakeResult out;
-  out.visibility = Image<float>(n, n, 0.0f);
+  out.visibility = Image<float>(width, height, 0.0f);
   out.mask = cov.mask;
-  out.missed = Image<std::uint8_t>(n, n, std::uint8_t{0});
+  out.missed = Image<std::uint8_t>(width, height, std::uint8_t{0});
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
-  if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(n, n, Vec3{0, 0, 0});
+  if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
   std::atomic<std::uint64_t> total_rays{0};
-  ProgressCounter counter(progress, static_cast<std::size_t>(n) * n);
+  ProgressCounter counter(progress, cov.texel_count());
   detail::dispatch_packet_width(occluders.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(n, n, kTile, [&](const Tile& t) {
+    parallel_for_tiles(width, height, kTile, [&](const Tile& t) {
       detail::flush_denormals_to_zero();
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
@@ -170,7 +170,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
       std::uint64_t rays = 0;  // cage rays and AO rays of this tile
       for (int y = t.y0; y < t.y1; ++y) {
         for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * n + x;
+          const std::size_t texel = static_cast<std::size_t>(y) * width + x;
           if (!cov.mask[texel]) continue;
           detail::build_patch(low, cov, texel, patch);
           if (patch.empty()) continue;

@@ -71,22 +71,22 @@ std::vector<double> box_weights(float size) {
   return w;
 }
 
-void box_filter(std::vector<double>& img, int n, const std::vector<double>& kw) {
+void box_filter(std::vector<double>& img, int width, int height, const std::vector<double>& kw) {
   const int r = static_cast<int>(kw.size() / 2);
   std::vector<double> tmp(img.size(), 0.0);
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
       double s = 0;
       for (int k = -r; k <= r; ++k)
-        if (x + k >= 0 && x + k < n) s += kw[static_cast<std::size_t>(k + r)] * img[static_cast<std::size_t>(y) * n + x + k];
-      tmp[static_cast<std::size_t>(y) * n + x] = s;
+        if (x + k >= 0 && x + k < width) s += kw[static_cast<std::size_t>(k + r)] * img[static_cast<std::size_t>(y) * width + x + k];
+      tmp[static_cast<std::size_t>(y) * width + x] = s;
     }
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
       double s = 0;
       for (int k = -r; k <= r; ++k)
-        if (y + k >= 0 && y + k < n) s += kw[static_cast<std::size_t>(k + r)] * tmp[static_cast<std::size_t>(y + k) * n + x];
-      img[static_cast<std::size_t>(y) * n + x] = s;
+        if (y + k >= 0 && y + k < height) s += kw[static_cast<std::size_t>(k + r)] * tmp[static_cast<std::size_t>(y + k) * width + x];
+      img[static_cast<std::size_t>(y) * width + x] = s;
     }
 }
 
@@ -122,9 +122,9 @@ float histogram_pixel_size(const TexelCoverage& coverage, float pixels_per_texel
 
 BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const HistogramParams& params, const ProgressFn& progress) {
   params.validate();
-  const int n = cov.size;
+  const int width = cov.width, height = cov.height;
   const std::size_t texels = cov.texel_count();
-  const RasterMesh mesh = make_raster_mesh(scene, n);
+  const RasterMesh mesh = make_raster_mesh(scene, width, height);
   const std::vector<Vec3> dirs = sphere_directions(params.direction_set, params.directions, params.seed);
 
   // The view resolution matches the texel density: an average texel seen face-on spans
@@ -173,7 +173,7 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
           const float u = ua.x + l1 * (ub.x - ua.x) + l2 * (uc.x - ua.x);
           const float v = ua.y + l1 * (ub.y - ua.y) + l2 * (uc.y - ua.y);
           const int tx = static_cast<int>(std::floor(u)), ty = static_cast<int>(std::floor(v));
-          if (tx < 0 || ty < 0 || tx >= n || ty >= n) continue;
+          if (tx < 0 || ty < 0 || tx >= width || ty >= height) continue;
           // (w . n) with the interpolated normal, as the paper's fragment program computes it;
           // directions below the shading normal's horizon contribute nothing.
           const float cos_s = std::max(0.0f, acc.cos_v[i0] + l1 * (acc.cos_v[i1] - acc.cos_v[i0]) + l2 * (acc.cos_v[i2] - acc.cos_v[i0]));
@@ -185,7 +185,7 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
           float weight = cos_s * jac * (area_norm ? mesh.stretch[t] / (pixel_size * pixel_size) : 1.0f);
           weight = std::min(weight, kMaxWeight);
           const auto q = static_cast<std::uint64_t>(static_cast<double>(weight) * kFixedScale + 0.5);
-          const std::size_t texel = static_cast<std::size_t>(ty) * n + tx;
+          const std::size_t texel = static_cast<std::size_t>(ty) * width + tx;
           acc.sum[texel] += q;
           ++acc.fragments;
           if (bent) {
@@ -223,11 +223,11 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
     // Sec. 3.2: splats of point_size texels = a box convolution of the histogram. The area
     // normalisation convolves its denominator too, so the result stays a weighted mean of V.
     const std::vector<double> kw = box_weights(params.point_size);
-    box_filter(num, n, kw);
-    box_filter(den, n, kw);
+    box_filter(num, width, height, kw);
+    box_filter(den, width, height, kw);
   }
 
-  out.visibility = Image<float>(n, n, 0.0f);
+  out.visibility = Image<float>(width, height, 0.0f);
   out.mask = cov.mask;
   out.covered_texels = cov.covered_texels;
   out.directions = params.directions;
@@ -246,7 +246,7 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
     out.visibility[i] = static_cast<float>(std::clamp(v, 0.0, 1.0));
   }
   if (bent) {
-    out.bent_normal = Image<Vec3>(n, n, Vec3{0, 0, 0});
+    out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
     for (std::size_t i = 0; i < texels; ++i)
       if (cov.mask[i])
         out.bent_normal[i] = normalize(Vec3{static_cast<float>(bent_sum[3 * i]), static_cast<float>(bent_sum[3 * i + 1]), static_cast<float>(bent_sum[3 * i + 2])});
@@ -259,7 +259,7 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
   // a handful of samples the estimate is mostly noise). Such texels are not estimated: they take
   // the value of the nearest texel that is (below).
   const double samples_per_pixel_area = static_cast<double>(params.directions) / 4.0;
-  Image<std::uint8_t> reliable(n, n, 0);
+  Image<std::uint8_t> reliable(width, height, 0);
   std::size_t unreliable = 0, unfilled = 0;
   for (std::size_t i = 0; i < texels; ++i) {
     if (!cov.mask[i]) continue;
@@ -296,7 +296,7 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
   refill(reliable, kUnreliableRings, true);
   // Last resort for texels that no pixel reached at all (V = 0/den says nothing): the nearest
   // texel that some pixel reached, if any within kUnreliableRings.
-  Image<std::uint8_t> sampled(n, n, 0);
+  Image<std::uint8_t> sampled(width, height, 0);
   for (std::size_t i = 0; i < texels; ++i) sampled[i] = cov.mask[i] && (num[i] > 0 || refilled[i]) ? 1 : 0;
   for (std::size_t i = 0; i < texels; ++i)
     if (cov.mask[i] && !sampled[i] && reliable[i]) sampled[i] = 1;  // reached by no pixel but expected to be: truly occluded

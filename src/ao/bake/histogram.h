@@ -39,8 +39,9 @@ struct HistogramParams {
 };
 void to_json(nlohmann::json& j, const HistogramParams& p);
 
-/// Bakes V per texel of an N x N map (N = coverage.size) for the meshes of `scene` that have UVs;
-/// meshes without UVs still occlude. `coverage` must come from compute_texel_coverage(scene, N).
+/// Bakes V per texel of a W x H map (coverage.width x coverage.height) for the meshes of `scene`
+/// that have UVs; meshes without UVs still occlude. `coverage` must come from
+/// compute_texel_coverage(scene, W, H).
 /// Distance is unlimited (eq. 1): a texel is open in a direction when no surface is in front of it.
 /// Deterministic for a seed at any thread count (fixed-point accumulation, see the .cpp).
 BakeResult bake_histogram(const Scene& scene, const TexelCoverage& coverage, const HistogramParams& params, const ProgressFn& progress = {});

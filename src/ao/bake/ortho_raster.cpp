@@ -11,18 +11,18 @@
 
 namespace ao {
 
-RasterMesh make_raster_mesh(const Scene& scene, int map_size) {
+RasterMesh make_raster_mesh(const Scene& scene, int map_width, int map_height) {
   RasterMesh r;
   Bounds3 bounds;
   for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     const auto base = static_cast<std::uint32_t>(r.positions.size());
     r.first_vertex.push_back(base);
-    const bool uv = !m.uvs.empty() && map_size > 0;
+    const bool uv = !m.uvs.empty() && map_width > 0 && map_height > 0;
     for (std::size_t v = 0; v < m.positions.size(); ++v) {
       r.positions.push_back(m.positions[v]);
       r.normals.push_back(m.normals.empty() ? Vec3{0, 0, 1} : m.normals[v]);
-      r.uvs.push_back(uv ? texel_uv(m, static_cast<std::uint32_t>(v), map_size) : Vec2{});
+      r.uvs.push_back(uv ? texel_uv(m, static_cast<std::uint32_t>(v), map_width, map_height) : Vec2{});
       bounds.extend(m.positions[v]);
     }
     for (std::size_t t = 0; t < m.triangle_count(); ++t) {

@@ -30,8 +30,8 @@ struct RasterMesh {
   std::size_t triangle_count() const { return indices.size() / 3; }
 };
 
-/// Flattens a validated scene. `map_size` scales UVs to texel units (0: no map, UVs unused).
-RasterMesh make_raster_mesh(const Scene& scene, int map_size);
+/// Flattens a validated scene. `map_width` x `map_height` scales UVs to texel units (0: no map, UVs unused).
+RasterMesh make_raster_mesh(const Scene& scene, int map_width, int map_height);
 
 /// An orthographic view along -w. Pixel (i, j) has its centre at image coordinates
 /// (i + 0.5, j + 0.5); image x = dot(p - origin, t) / pixel_size, y = dot(p - origin, b) / pixel_size,

@@ -29,7 +29,7 @@ void VertexHistogramParams::validate() const {
 
 std::vector<float> bake_vertices_histogram(const Scene& scene, const VertexHistogramParams& params, const ProgressFn& progress) {
   params.validate();
-  const RasterMesh mesh = make_raster_mesh(scene, 0);
+  const RasterMesh mesh = make_raster_mesh(scene, 0, 0);
   const std::vector<Vec3> dirs = sphere_directions(params.direction_set, params.directions, params.seed);
   const float pixel_size = 2.0f * mesh.radius / static_cast<float>(params.resolution);
   const std::size_t nv = mesh.positions.size();

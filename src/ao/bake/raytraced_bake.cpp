@@ -109,16 +109,16 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
-  const int n = cov.size;
+  const int w = cov.width, h = cov.height;
   BakeResult out;
-  out.visibility = Image<float>(n, n, 0.0f);
+  out.visibility = Image<float>(w, h, 0.0f);
   out.mask = cov.mask;
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
-  if (params.bent_normals) out.bent_normal = Image<Vec3>(n, n, Vec3{0, 0, 0});
-  ProgressCounter counter(progress, static_cast<std::size_t>(n) * n);
+  if (params.bent_normals) out.bent_normal = Image<Vec3>(w, h, Vec3{0, 0, 0});
+  ProgressCounter counter(progress, cov.texel_count());
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(n, n, kTile, [&](const Tile& t) {
+    parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
       std::vector<PatchPiece> patch;
@@ -127,7 +127,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
       std::array<float, batch> mu;
       for (int y = t.y0; y < t.y1; ++y)
         for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * n + x;
+          const std::size_t texel = static_cast<std::size_t>(y) * w + x;
           if (!cov.mask[texel]) continue;
           detail::build_patch(scene, cov, texel, patch);
           if (patch.empty()) continue;

@@ -84,11 +84,15 @@ std::vector<std::string> TexelCoverage::warnings() const {
   return w;
 }
 
-TexelCoverage compute_texel_coverage(const Scene& scene, int size) {
-  if (size < 1 || size > kMaxSize) throw InputError("bake: map size must be in [1, " + std::to_string(kMaxSize) + "], got " + std::to_string(size));
+TexelCoverage compute_texel_coverage(const Scene& scene, int size) { return compute_texel_coverage(scene, size, size); }
+
+TexelCoverage compute_texel_coverage(const Scene& scene, int width, int height) {
+  for (const int side : {width, height})
+    if (side < 1 || side > kMaxSize) throw InputError("bake: map width and height must be in [1, " + std::to_string(kMaxSize) + "], got " + std::to_string(width) + "x" + std::to_string(height));
   TexelCoverage cov;
-  cov.size = size;
-  const std::size_t texels = static_cast<std::size_t>(size) * size;
+  cov.width = width;
+  cov.height = height;
+  const std::size_t texels = cov.texel_count();
 
   // Total areas, for the relative degeneracy test.
   double total_world = 0, total_uv = 0;
@@ -99,7 +103,7 @@ TexelCoverage compute_texel_coverage(const Scene& scene, int size) {
     for (std::size_t t = 0; t < m.triangle_count(); ++t) {
       const std::uint32_t* i = &m.indices[3 * t];
       total_world += length(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]])) * 0.5;
-      const Vec2 a = texel_uv(m, i[0], size), b = texel_uv(m, i[1], size), c = texel_uv(m, i[2], size);
+      const Vec2 a = texel_uv(m, i[0], width, height), b = texel_uv(m, i[1], width, height), c = texel_uv(m, i[2], width, height);
       total_uv += std::abs((static_cast<double>(b.x) - a.x) * (c.y - a.y) - (static_cast<double>(c.x) - a.x) * (b.y - a.y)) * 0.5;
     }
   }
@@ -127,7 +131,7 @@ TexelCoverage compute_texel_coverage(const Scene& scene, int size) {
     for (std::size_t t = blk.first; t < blk.last; ++t) {
       const std::uint32_t* i = &m.indices[3 * t];
       const double world = length(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]])) * 0.5;
-      const Vec2 a = texel_uv(m, i[0], size), b = texel_uv(m, i[1], size), c = texel_uv(m, i[2], size);
+      const Vec2 a = texel_uv(m, i[0], width, height), b = texel_uv(m, i[1], width, height), c = texel_uv(m, i[2], width, height);
       const double uv = std::abs((static_cast<double>(b.x) - a.x) * (c.y - a.y) - (static_cast<double>(c.x) - a.x) * (b.y - a.y)) * 0.5;
       if (!(uv > kDegenerateRatio * mean_ratio * world) || uv <= 0) {
         ++degenerate[bi];
@@ -136,14 +140,14 @@ TexelCoverage compute_texel_coverage(const Scene& scene, int size) {
       const double stretch = world / uv;  // world units^2 per texel^2 on this triangle
       const float lo_x = std::min({a.x, b.x, c.x}), hi_x = std::max({a.x, b.x, c.x});
       const float lo_y = std::min({a.y, b.y, c.y}), hi_y = std::max({a.y, b.y, c.y});
-      if (lo_x < 0 || lo_y < 0 || hi_x > size || hi_y > size) ++outside[bi];
-      const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(size - 1, static_cast<int>(std::floor(hi_x)));
-      const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(size - 1, static_cast<int>(std::floor(hi_y)));
+      if (lo_x < 0 || lo_y < 0 || hi_x > width || hi_y > height) ++outside[bi];
+      const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(width - 1, static_cast<int>(std::floor(hi_x)));
+      const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(height - 1, static_cast<int>(std::floor(hi_y)));
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
           const float area = clip_to_texel(a, b, c, x, y).area();
           if (!(area > 0)) continue;
-          pending[bi].push_back({static_cast<std::uint32_t>(static_cast<std::size_t>(y) * size + x),
+          pending[bi].push_back({static_cast<std::uint32_t>(static_cast<std::size_t>(y) * width + x),
                                  {blk.mesh, static_cast<std::uint32_t>(t), area, static_cast<float>(area * stretch)}});
         }
     }
@@ -161,9 +165,9 @@ TexelCoverage compute_texel_coverage(const Scene& scene, int size) {
   for (std::size_t i = 0; i < texels; ++i) cov.offsets[i + 1] += cov.offsets[i];
   cov.fragments.resize(total);
   std::vector<std::uint32_t> cursor(cov.offsets.begin(), cov.offsets.end() - 1);
-  cov.world_area = Image<float>(size, size, 0.0f);
-  cov.uv_area = Image<float>(size, size, 0.0f);
-  cov.mask = Image<std::uint8_t>(size, size, std::uint8_t{0});
+  cov.world_area = Image<float>(width, height, 0.0f);
+  cov.uv_area = Image<float>(width, height, 0.0f);
+  cov.mask = Image<std::uint8_t>(width, height, std::uint8_t{0});
   for (auto& blk : pending) {
     for (const Pending& p : blk) {
       cov.fragments[cursor[p.texel]++] = p.frag;

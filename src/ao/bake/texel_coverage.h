@@ -3,9 +3,10 @@
 // texel's world-space area, the denominator of the paper's eq. 2), the ray-traced baker to spread
 // its sample points over the texel's patch of surface.
 //
-// Conventions: texel (x, y) of an N x N map covers u in [x/N, (x+1)/N] and v in
-// [1 - (y+1)/N, 1 - y/N]: v = 0 is the bottom row of the image (OpenGL / OBJ convention, which is
-// how the mesh loader stores UVs). "Texel units" below are u * N and (1 - v) * N.
+// Conventions: texel (x, y) of a W x H map covers u in [x/W, (x+1)/W] and v in
+// [1 - (y+1)/H, 1 - y/H]: v = 0 is the bottom row of the image (OpenGL / OBJ convention, which is
+// how the mesh loader stores UVs). "Texel units" below are u * W and (1 - v) * H, so a texel is the
+// unit square whatever the map's aspect ratio.
 #pragma once
 
 #include <cstdint>
@@ -26,9 +27,10 @@ struct TexelFragment {
   float world_area = 0;        ///< The same piece of surface in world units^2.
 };
 
-/// The UV layout of every mesh in a scene rasterised exactly onto an N x N grid.
+/// The UV layout of every mesh in a scene rasterised exactly onto a W x H grid.
 struct TexelCoverage {
-  int size = 0;                             ///< N.
+  int width = 0;                            ///< W, texels.
+  int height = 0;                           ///< H, texels.
   std::vector<std::uint32_t> offsets;       ///< CSR: fragments of texel i are [offsets[i], offsets[i+1]).
   std::vector<TexelFragment> fragments;     ///< Sorted by texel.
   Image<float> world_area;                  ///< Per texel: world area of the surface it covers (eq. 2's denominator).
@@ -39,19 +41,22 @@ struct TexelCoverage {
   std::size_t degenerate_uv_triangles = 0;  ///< Triangles with surface area but (near) zero UV area: they get no texel.
   std::size_t outside_triangles = 0;        ///< Triangles partly outside [0,1]^2: the part outside is not baked.
 
-  std::size_t texel_count() const { return static_cast<std::size_t>(size) * size; }
+  std::size_t texel_count() const { return static_cast<std::size_t>(width) * height; }
   /// One-line warnings for the user (overlaps, degenerate and out-of-range UVs); empty when clean.
   std::vector<std::string> warnings() const;
 };
 
 /// Clips every triangle of every mesh with UVs against the texel grid (Sutherland-Hodgman against
 /// each texel square it overlaps). Meshes without UVs are skipped (they may still occlude).
-/// `size` in [1, 16384]. Throws InputError when no mesh has UVs or all UV triangles are degenerate.
+/// `width` and `height` in [1, 16384]. Throws InputError when no mesh has UVs or all UV triangles
+/// are degenerate.
+TexelCoverage compute_texel_coverage(const Scene& scene, int width, int height);
+/// A square `size` x `size` map.
 TexelCoverage compute_texel_coverage(const Scene& scene, int size);
 
-/// Texel-unit UV of vertex v of a mesh: (u * N, (1 - v) * N).
-inline Vec2 texel_uv(const Mesh& m, std::uint32_t v, int size) {
-  return {m.uvs[v].x * static_cast<float>(size), (1.0f - m.uvs[v].y) * static_cast<float>(size)};
+/// Texel-unit UV of vertex v of a mesh on a W x H map: (u * W, (1 - v) * H).
+inline Vec2 texel_uv(const Mesh& m, std::uint32_t v, int width, int height) {
+  return {m.uvs[v].x * static_cast<float>(width), (1.0f - m.uvs[v].y) * static_cast<float>(height)};
 }
 
 /// A convex polygon in texel units (a triangle clipped to a square has at most 7 vertices).

@@ -19,13 +19,14 @@ TriangleNormals face_normals(const Scene& s) {
 
 void build_patch(const Scene& s, const TexelCoverage& cov, std::size_t texel, std::vector<PatchPiece>& out) {
   out.clear();
-  const int x = static_cast<int>(texel % cov.size), y = static_cast<int>(texel / cov.size);
+  const int x = static_cast<int>(texel % static_cast<std::size_t>(cov.width)), y = static_cast<int>(texel / static_cast<std::size_t>(cov.width));
   double acc = 0;
   for (std::uint32_t f = cov.offsets[texel]; f < cov.offsets[texel + 1]; ++f) {
     const TexelFragment& fr = cov.fragments[f];
     const Mesh& m = s.meshes[fr.mesh];
     const std::uint32_t* i = &m.indices[3 * fr.triangle];
-    const ClipPolygon poly = clip_to_texel(texel_uv(m, i[0], cov.size), texel_uv(m, i[1], cov.size), texel_uv(m, i[2], cov.size), x, y);
+    const ClipPolygon poly = clip_to_texel(texel_uv(m, i[0], cov.width, cov.height), texel_uv(m, i[1], cov.width, cov.height),
+                                            texel_uv(m, i[2], cov.width, cov.height), x, y);
     const double stretch = fr.uv_area > 0 ? fr.world_area / fr.uv_area : 0.0;
     for (int k = 1; k + 1 < poly.n; ++k) {  // fan of the convex clipped polygon
       const Vec2 a = poly.p[0], b = poly.p[k], c = poly.p[k + 1];
@@ -53,7 +54,7 @@ PatchSample sample_patch(const std::vector<PatchPiece>& patch, Vec2 u) {
 SurfacePoint point_at_uv(const Scene& s, const TexelCoverage& cov, std::uint32_t mesh, std::uint32_t tri, Vec2 q, const TriangleNormals& fn) {
   const Mesh& m = s.meshes[mesh];
   const std::uint32_t* i = &m.indices[3 * tri];
-  const Vec2 a = texel_uv(m, i[0], cov.size), b = texel_uv(m, i[1], cov.size), c = texel_uv(m, i[2], cov.size);
+  const Vec2 a = texel_uv(m, i[0], cov.width, cov.height), b = texel_uv(m, i[1], cov.width, cov.height), c = texel_uv(m, i[2], cov.width, cov.height);
   const float det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
   float l1 = ((q.x - a.x) * (c.y - a.y) - (c.x - a.x) * (q.y - a.y)) / det;
   float l2 = ((b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y)) / det;

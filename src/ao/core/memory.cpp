@@ -98,7 +98,8 @@ std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t verti
 }
 
 std::uint64_t estimate_bake_memory(const BakeMemoryInput& in) {
-  const std::uint64_t texels = static_cast<std::uint64_t>(std::max(in.size, 0)) * static_cast<std::uint64_t>(std::max(in.size, 0));
+  const int height = in.height > 0 ? in.height : in.size;
+  const std::uint64_t texels = static_cast<std::uint64_t>(std::max(in.size, 0)) * static_cast<std::uint64_t>(std::max(height, 0));
   const std::uint64_t threads = static_cast<std::uint64_t>(std::max(in.threads, 1));
   std::uint64_t bytes = kBaseBytes + texels * (kCoverageBytes + kResultBytes + (in.bent_normals ? kBentResultBytes : 0));
   // Measured (grid of 20,000 triangles, 2 threads, 2048^2 minus 256^2, /usr/bin/time -v): histogram

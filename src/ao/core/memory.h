@@ -36,7 +36,8 @@ std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t verti
 
 /// What `ao bake` allocates that grows with the map.
 struct BakeMemoryInput {
-  int size = 0;               ///< Map width = height, texels.
+  int size = 0;               ///< Map width, texels.
+  int height = 0;             ///< Map height, texels; 0: equal to `size` (a square map).
   bool histogram = true;      ///< The histogram baker (per-thread accumulators and views), else raytraced.
   bool bent_normals = false;  ///< Bent normals are accumulated and written too.
   float pixels_per_texel = 1; ///< Histogram view resolution (HistogramParams::pixels_per_texel).

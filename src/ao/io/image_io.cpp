@@ -17,6 +17,7 @@
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/exr_common_internal.h"
+#include "ao/io/image_formats_internal.h"
 
 namespace ao {
 
@@ -27,7 +28,7 @@ static_assert(sizeof(Vec3) == 3 * sizeof(float), "Vec3 images are handed to Open
 
 namespace {
 
-enum class Format { Exr, Png };
+enum class Format { Exr, Png, Tga, Tiff, Jpeg };
 
 std::string lower_extension(const fs::path& path) {
   std::string ext = path.extension().string();
@@ -39,11 +40,13 @@ Format output_format(const fs::path& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".exr") return Format::Exr;
   if (ext == ".png") return Format::Png;
+  if (ext == ".tga") return Format::Tga;
+  if (ext == ".tif" || ext == ".tiff") return Format::Tiff;
+  if (ext == ".jpg" || ext == ".jpeg") return Format::Jpeg;
   throw InputError(path.string() + ": unsupported image format '" + ext + "'; supported: " + supported_image_extensions());
 }
 
-// IEC 61966-2-1 transfer functions.
-float srgb_encode(float v) { return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f; }
+// IEC 61966-2-1 decoding (encoding: io_detail::quantise).
 float srgb_decode(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
 
 // ---------------------------------------------------------------------------------------------
@@ -65,7 +68,7 @@ void on_png_warning(png_structp, png_const_charp) {}  // benign (bad ancillary c
 // Interleaved samples, big-endian when 16-bit, exactly as stored in PNG rows.
 struct PngPixels {
   png_uint_32 width = 0, height = 0;
-  int channels = 0;  // 1 (grey) or 3 (RGB)
+  int channels = 0;  // 1 (grey) or 3 (RGB); with alpha kept also 2 (grey + alpha) or 4 (RGBA)
   int bits = 0;      // 8 or 16
   std::vector<unsigned char> bytes;
   std::vector<png_bytep> rows;
@@ -76,6 +79,15 @@ struct PngPixels {
     for (png_uint_32 y = 0; y < height; ++y) rows[y] = bytes.data() + y * stride;
   }
 };
+
+int png_color_type(int channels) {
+  switch (channels) {
+    case 1: return PNG_COLOR_TYPE_GRAY;
+    case 2: return PNG_COLOR_TYPE_GRAY_ALPHA;
+    case 3: return PNG_COLOR_TYPE_RGB;
+    default: return PNG_COLOR_TYPE_RGB_ALPHA;
+  }
+}
 
 bool write_png_stream(std::FILE* fp, PngPixels& pixels, bool srgb, PngMessage& message) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, on_png_error, on_png_warning);
@@ -90,7 +102,7 @@ bool write_png_stream(std::FILE* fp, PngPixels& pixels, bool srgb, PngMessage& m
     return false;
   }
   png_init_io(png, fp);
-  png_set_IHDR(png, info, pixels.width, pixels.height, pixels.bits, pixels.channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB,
+  png_set_IHDR(png, info, pixels.width, pixels.height, pixels.bits, png_color_type(pixels.channels),
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   if (srgb) png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
   png_write_info(png, info);
@@ -102,7 +114,7 @@ bool write_png_stream(std::FILE* fp, PngPixels& pixels, bool srgb, PngMessage& m
 
 enum class PngReadResult { Ok, Corrupt, TooLarge, OutOfMemory };
 
-PngReadResult read_png_stream(std::FILE* fp, PngPixels& pixels, PngMessage& message) {
+PngReadResult read_png_stream(std::FILE* fp, PngPixels& pixels, PngMessage& message, bool keep_alpha) {
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &message, on_png_error, on_png_warning);
   if (png == nullptr) return PngReadResult::OutOfMemory;
   png_infop info = png_create_info_struct(png);
@@ -126,15 +138,17 @@ PngReadResult read_png_stream(std::FILE* fp, PngPixels& pixels, PngMessage& mess
     return PngReadResult::TooLarge;
   }
   // Normalise every colour type to grey or RGB at 8 or 16 bits: palettes and low bit depths are
-  // expanded, alpha is dropped (AO maps carry no meaning in it).
+  // expanded, alpha is dropped (AO maps carry no meaning in it) unless `keep_alpha` (then a tRNS
+  // chunk becomes an alpha channel).
   png_set_expand(png);
-  png_set_strip_alpha(png);
+  if (!keep_alpha) png_set_strip_alpha(png);
   png_read_update_info(png, info);
   pixels.width = w;
   pixels.height = h;
   pixels.channels = png_get_channels(png, info);
   pixels.bits = png_get_bit_depth(png, info);
-  const bool supported = (pixels.channels == 1 || pixels.channels == 3) && (pixels.bits == 8 || pixels.bits == 16) &&
+  const bool supported = (pixels.channels == 1 || pixels.channels == 3 || (keep_alpha && (pixels.channels == 2 || pixels.channels == 4))) &&
+                         (pixels.bits == 8 || pixels.bits == 16) &&
                          png_get_rowbytes(png, info) == static_cast<std::size_t>(w) * pixels.channels * (pixels.bits / 8);
   if (!supported) png_error(png, "unsupported pixel layout");
   try {
@@ -166,10 +180,7 @@ void write_png(const fs::path& path, int width, int height, int channels, const 
   const float max_code = opt.png_bits == 16 ? 65535.0f : 255.0f;
   pixels.bytes.resize(count * (opt.png_bits / 8));
   for (std::size_t i = 0; i < count; ++i) {
-    // NaN compares false, so it lands on 0 here; the clamp is the documented PNG behaviour.
-    float v = samples[i] > 0.0f ? std::min(samples[i], 1.0f) : 0.0f;
-    if (opt.srgb) v = srgb_encode(v);
-    const auto code = static_cast<unsigned>(std::lround(v * max_code));
+    const unsigned code = quantise(samples[i], opt.srgb, max_code);
     if (opt.png_bits == 16) {
       pixels.bytes[2 * i] = static_cast<unsigned char>(code >> 8);  // PNG stores 16-bit samples big-endian
       pixels.bytes[2 * i + 1] = static_cast<unsigned char>(code & 0xffu);
@@ -190,12 +201,12 @@ void write_png(const fs::path& path, int width, int height, int channels, const 
   });
 }
 
-PngPixels read_png(const fs::path& path) {
+PngPixels read_png(const fs::path& path, bool keep_alpha = false) {
   FilePtr fp(std::fopen(path.c_str(), "rb"));
   if (!fp) throw InputError(path.string() + ": cannot open for reading");
   PngPixels pixels;
   PngMessage message;
-  switch (read_png_stream(fp.get(), pixels, message)) {
+  switch (read_png_stream(fp.get(), pixels, message, keep_alpha)) {
     case PngReadResult::Ok:
       return pixels;
     case PngReadResult::TooLarge:
@@ -298,6 +309,23 @@ Format input_format(const fs::path& path) {
   throw InputError(path.string() + ": not an image this tool reads (expected OpenEXR or PNG content)");
 }
 
+// PNG here; TGA, TIFF and JPEG in image_formats.cpp.
+void write_8_or_16_bit(const fs::path& path, Format format, int width, int height, int channels, const float* samples, const ImageWriteOptions& opt) {
+  if (format == Format::Png) return write_png(path, width, height, channels, samples, opt);
+  // The formats' own limits: 16-bit sizes in the TGA header, JPEG_MAX_DIMENSION in libjpeg.
+  const int max_side = format == Format::Tga ? 65535 : format == Format::Jpeg ? 65500 : 1 << 30;
+  if (width > max_side || height > max_side)
+    throw InputError(path.string() + ": " + std::to_string(width) + "x" + std::to_string(height) + " is too large for " + lower_extension(path) + " (at most " +
+                     std::to_string(max_side) + " per side)");
+  write_file_atomically(path, [&](const fs::path& temp) {
+    switch (format) {
+      case Format::Tga: return write_tga_file(path, temp, width, height, channels, samples, opt.srgb);
+      case Format::Tiff: return write_tiff_file(path, temp, width, height, channels, samples, opt.png_bits, opt.srgb);
+      default: return write_jpeg_file(path, temp, width, height, channels, samples, opt.jpeg_quality, opt.srgb);
+    }
+  });
+}
+
 template <class T>
 void require_nonempty(const fs::path& path, const Image<T>& image) {
   if (image.width() < 1 || image.height() < 1) throw InputError(path.string() + ": cannot write an empty image");
@@ -307,14 +335,15 @@ void require_nonempty(const fs::path& path, const Image<T>& image) {
 
 void ImageWriteOptions::validate() const {
   if (png_bits != 8 && png_bits != 16) throw InputError("png_bits must be 8 or 16, got " + std::to_string(png_bits));
+  if (jpeg_quality < 1 || jpeg_quality > 100) throw InputError("jpeg_quality must be in [1, 100], got " + std::to_string(jpeg_quality));
   if (exr_channel.empty()) throw InputError("exr_channel must not be empty");
 }
 
-std::string supported_image_extensions() { return ".exr, .png"; }
+std::string supported_image_extensions() { return ".exr, .png, .tif, .tiff, .tga, .jpg, .jpeg"; }
 
 bool is_supported_image_path(const fs::path& path) {
   const std::string ext = lower_extension(path);
-  return ext == ".exr" || ext == ".png";
+  return ext == ".exr" || ext == ".png" || ext == ".tif" || ext == ".tiff" || ext == ".tga" || ext == ".jpg" || ext == ".jpeg";
 }
 
 void write_image(const fs::path& path, const Image<float>& image, const ImageWriteOptions& opt) {
@@ -325,7 +354,7 @@ void write_image(const fs::path& path, const Image<float>& image, const ImageWri
     const std::string name = opt.exr_channel;
     write_exr(path, image.width(), image.height(), std::span(&name, 1), image.data());
   } else {
-    write_png(path, image.width(), image.height(), 1, image.data(), opt);
+    write_8_or_16_bit(path, format, image.width(), image.height(), 1, image.data(), opt);
   }
 }
 
@@ -338,7 +367,7 @@ void write_rgb_image(const fs::path& path, const Image<Vec3>& image, const Image
     const std::string names[] = {"R", "G", "B"};
     write_exr(path, image.width(), image.height(), names, samples);
   } else {
-    write_png(path, image.width(), image.height(), 3, samples, opt);
+    write_8_or_16_bit(path, format, image.width(), image.height(), 3, samples, opt);
   }
 }
 
@@ -363,6 +392,65 @@ Image<Vec3> read_rgb_image(const fs::path& path, const ImageReadOptions& opt) {
     }
   }
   return image;
+}
+
+StoredPng read_stored_png(const fs::path& path) {
+  require_input_file(path);
+  if (!is_png_magic(read_magic(path, 8))) throw InputError(path.string() + ": not a PNG file");
+  const PngPixels p = read_png(path, true);
+  StoredPng out;
+  out.width = static_cast<int>(p.width);
+  out.height = static_cast<int>(p.height);
+  out.channels = p.channels;
+  out.bits = p.bits;
+  const std::size_t count = static_cast<std::size_t>(p.width) * p.height * static_cast<std::size_t>(p.channels);
+  out.samples.resize(count);
+  for (std::size_t i = 0; i < count; ++i)
+    out.samples[i] = p.bits == 16 ? static_cast<std::uint16_t>((p.bytes[2 * i] << 8) | p.bytes[2 * i + 1]) : p.bytes[i];
+  return out;
+}
+
+void write_stored_png(const fs::path& path, const StoredPng& image) {
+  const bool layout_ok = image.width >= 1 && image.height >= 1 && image.channels >= 1 && image.channels <= 4 && (image.bits == 8 || image.bits == 16) &&
+                         image.samples.size() == static_cast<std::size_t>(image.width) * image.height * static_cast<std::size_t>(image.channels);
+  if (!layout_ok) throw InputError(path.string() + ": cannot write a PNG of " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
+                                   std::to_string(image.channels) + " channels, " + std::to_string(image.bits) + " bits from " +
+                                   std::to_string(image.samples.size()) + " samples");
+  if (lower_extension(path) != ".png") throw InputError(path.string() + ": this image is written as PNG; give it a .png name");
+  PngPixels pixels;
+  pixels.width = static_cast<png_uint_32>(image.width);
+  pixels.height = static_cast<png_uint_32>(image.height);
+  pixels.channels = image.channels;
+  pixels.bits = image.bits;
+  pixels.bytes.resize(image.samples.size() * static_cast<std::size_t>(image.bits / 8));
+  for (std::size_t i = 0; i < image.samples.size(); ++i) {
+    if (image.bits == 16) {
+      pixels.bytes[2 * i] = static_cast<unsigned char>(image.samples[i] >> 8);  // big-endian, as PNG stores it
+      pixels.bytes[2 * i + 1] = static_cast<unsigned char>(image.samples[i] & 0xffu);
+    } else {
+      pixels.bytes[i] = static_cast<unsigned char>(image.samples[i]);
+    }
+  }
+  pixels.point_rows();
+  write_file_atomically(path, [&](const fs::path& temp) {
+    FilePtr fp(std::fopen(temp.c_str(), "wb"));
+    if (!fp) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+    PngMessage message;
+    if (!write_png_stream(fp.get(), pixels, false, message))
+      throw SystemError(path.string() + ": cannot write PNG: " + one_line(message.text[0] ? message.text : "out of memory"));
+    const bool flushed = std::fflush(fp.get()) == 0 && std::ferror(fp.get()) == 0;
+    if (std::fclose(fp.release()) != 0 || !flushed) throw SystemError(path.string() + ": write failed (disk full?)");
+  });
+}
+
+void replace_channel(StoredPng& image, int channel, const Image<float>& values) {
+  if (channel < 0 || channel >= image.channels) throw InputError("replace_channel: channel " + std::to_string(channel) + " of a " + std::to_string(image.channels) + "-channel image");
+  if (values.width() != image.width || values.height() != image.height)
+    throw InputError("replace_channel: values are " + std::to_string(values.width()) + "x" + std::to_string(values.height()) + ", the image " +
+                     std::to_string(image.width) + "x" + std::to_string(image.height));
+  const float max_code = image.bits == 16 ? 65535.0f : 255.0f;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    image.samples[i * static_cast<std::size_t>(image.channels) + static_cast<std::size_t>(channel)] = static_cast<std::uint16_t>(quantise(values[i], false, max_code));
 }
 
 }  // namespace ao

@@ -1,4 +1,5 @@
-// Image files: OpenEXR (float32, lossless) and PNG (8 or 16 bit). Writes are atomic
+// Image files: OpenEXR (float32, lossless), PNG and TIFF (8 or 16 bit, lossless), TGA (8 bit) and
+// JPEG (8 bit, lossy: for previews, not for data). Reads: EXR and PNG. Writes are atomic
 // (atomic_file.h). Reads check the size before allocating and turn every library failure into an
 // InputError of one line that names the file.
 //
@@ -6,13 +7,16 @@
 // - EXR keeps floats exactly, NaN and infinity included (what they mean is the caller's business).
 //   A single-channel image is stored as the luminance channel `Y`, the name OpenEXR and compositors
 //   use for greyscale. Files are scanline, ZIP-compressed.
-// - PNG values are linear (values in [0,1] map to 0..255 or 0..65535) and carry no colour-space
-//   chunk, as AO maps and other data textures conventionally do; with `srgb` they are sRGB-encoded
-//   and tagged with an sRGB chunk. Values are clamped to [0,1] and NaN is written as 0.
+// - PNG, TIFF, TGA and JPEG values are linear (values in [0,1] map to 0..255 or 0..65535) and
+//   carry no colour-space tag, as AO maps and other data textures conventionally do; with `srgb`
+//   they are sRGB-encoded (and a PNG is tagged with an sRGB chunk). Values are clamped to [0,1]
+//   and NaN is written as 0. Row 0 is the top of the image in every format.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "ao/core/image.h"
 #include "ao/core/math.h"
@@ -21,7 +25,8 @@ namespace ao {
 
 /// How images are written.
 struct ImageWriteOptions {
-  int png_bits = 8;          ///< PNG sample depth: 8 or 16. Ignored for EXR.
+  int png_bits = 8;          ///< PNG and TIFF sample depth: 8 or 16. Ignored for EXR, TGA and JPEG (always 8).
+  int jpeg_quality = 95;     ///< JPEG quality in [1, 100] (libjpeg's scale); 95 keeps a smooth AO map within ~1/255 of the 8-bit PNG.
   bool srgb = false;         ///< PNG only: sRGB-encode the linear values (for viewing, not for data). Default linear.
   std::string exr_channel = "Y";  ///< EXR channel name of single-channel images; non-empty. Ignored for RGB.
 
@@ -34,19 +39,19 @@ struct ImageReadOptions {
   bool srgb = false;  ///< PNG only: the stored values are sRGB-encoded; decode them to linear. Default: stored values as is.
 };
 
-/// Comma-separated list of the supported extensions (".exr, .png"), for errors and --help.
+/// Comma-separated list of the extensions write_image supports (".exr, .png, ..."), for errors and --help.
 std::string supported_image_extensions();
 /// True when `path` has an extension write_image understands (case-insensitive).
 bool is_supported_image_path(const std::filesystem::path& path);
 
-/// Writes single-channel values (visibility, error maps) to `.exr` or `.png`, chosen by the
-/// extension (case-insensitive). The image must not be empty. Throws InputError for an unknown
+/// Writes single-channel values (visibility, error maps) to `.exr`, `.png`, `.tif`/`.tiff`,
+/// `.tga` or `.jpg`/`.jpeg`, chosen by the extension (case-insensitive). The image must not be empty. Throws InputError for an unknown
 /// extension (listing the supported ones), bad options or an empty image, and the errors of
 /// write_file_atomically; SystemError when the library fails to write.
 void write_image(const std::filesystem::path& path, const Image<float>& image, const ImageWriteOptions& opt = {});
 
 /// Writes RGB values (linear, nominally [0,1]; shaded images, contact sheets): EXR channels R, G, B
-/// (float32) or PNG RGB. Same rules as write_image.
+/// (float32) or RGB in the 8/16-bit formats. Same rules as write_image.
 void write_rgb_image(const std::filesystem::path& path, const Image<Vec3>& image, const ImageWriteOptions& opt = {});
 
 /// Reads one channel as floats. The format is recognised by content, not by extension.
@@ -64,5 +69,27 @@ Image<float> read_image(const std::filesystem::path& path, const ImageReadOption
 /// repeats its single channel (as read_image chooses it) in all three. PNG: greyscale is repeated,
 /// alpha ignored. Otherwise as read_image.
 Image<Vec3> read_rgb_image(const std::filesystem::path& path, const ImageReadOptions& opt = {});
+
+/// A PNG's samples exactly as stored, to change one channel and write the rest back unchanged
+/// (`ao bake --orm`: AO into the red channel of an occlusion/roughness/metalness texture).
+struct StoredPng {
+  int width = 0, height = 0;
+  int channels = 0;                    ///< 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
+  int bits = 0;                        ///< 8 or 16.
+  std::vector<std::uint16_t> samples;  ///< Interleaved codes (0..255 or 0..65535), row 0 at the top.
+};
+
+/// Reads a PNG keeping its channels (alpha included) and bit depth. Palette images become RGB (or
+/// RGBA with a tRNS chunk) at 8 bits and grey below 8 bits becomes 8 bits; ancillary chunks (text,
+/// gamma, colour space) are not kept. Same errors and size limits as read_image.
+StoredPng read_stored_png(const std::filesystem::path& path);
+
+/// Writes `image` as a PNG of its channels and depth, with no colour-space chunk, atomically.
+/// InputError when the samples do not match the layout or the name does not end in .png.
+void write_stored_png(const std::filesystem::path& path, const StoredPng& image);
+
+/// Replaces channel `channel` of every pixel with `values` (linear, clamped to [0,1], NaN -> 0,
+/// rounded to the image's depth). InputError when the channel or the size does not match.
+void replace_channel(StoredPng& image, int channel, const Image<float>& values);
 
 }  // namespace ao

@@ -706,7 +706,9 @@ class Viewer {
       if (changed) dirty_method_ = true;
     }
     // Registry-level keys without a table row (e.g. characteristic, reference): a text field.
-    for (auto& [key, value] : params.items()) {
+    for (auto item : params.items()) {  // no structured binding: Clang 14 cannot capture one in the lambda
+      const std::string& key = item.key();
+      nlohmann::json& value = item.value();
       if (std::any_of(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == key; }) || !value.is_string()) continue;
       std::string v = value.get<std::string>();
       if (ImGui::InputText(key.c_str(), &v, ImGuiInputTextFlags_EnterReturnsTrue)) {

@@ -21,10 +21,12 @@ struct GBufferOptions {
 };
 
 /// Traces one primary ray through each pixel centre of `camera` (which must validate) and fills
-/// every G-buffer channel: camera-space position interpolated on the hit triangle, linear depth,
-/// the normal chosen by `options` turned to face the camera (the shading normal onto the side of
-/// the geometric one), the mesh's albedo and id, the triangle's index (primitive_id) and UVs. The
-/// optional direct-light pass is left empty (reference/direct_light.h computes one).
+/// the G-buffer: camera-space position interpolated on the hit triangle, linear depth, the normal
+/// chosen by `options` turned to face the camera (the shading normal onto the side of the
+/// geometric one), the mesh's id, the triangle's index (primitive_id), and the mesh's albedo and
+/// the UVs unless `options` leave them out (then those images are empty). The optional
+/// direct-light pass is left empty (reference/direct_light.h computes one). The images are
+/// written with non-temporal stores: they are not left in the cache.
 GBuffer render_gbuffer(const RayScene& scene, const Camera& camera, const GBufferOptions& options, const ProgressFn& progress = {});
 /// The same with default options.
 GBuffer render_gbuffer(const RayScene& scene, const Camera& camera, const ProgressFn& progress = {});

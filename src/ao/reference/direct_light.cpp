@@ -91,6 +91,8 @@ void Sun::validate() const {
 Image<Vec3> render_direct_light(const RayScene& rs, const GBuffer& g, const Sun& sun, const ProgressFn& progress) {
   sun.validate();
   const int w = g.width(), h = g.height();
+  if (g.albedo.width() != w || g.albedo.height() != h)
+    throw InputError("direct light: the G-buffer has no albedo image (render it with GBufferOptions::albedo = true)");
   Image<Vec3> out(w, h);  // 0: written only where lit and unshadowed
   const Vec3 light = normalize(sun.direction);
   const float e_over_pi = sun.irradiance / kPi;  // the diffuse BRDF a/pi times E

@@ -9,7 +9,7 @@
 // baked AO map) written to each format by each library, alternating ao / OIIO, median wall time
 // of the repetitions; file sizes. Robustness: every file is damaged (truncated at 1/8 .. 7/8 of its
 // length; 64 single bytes overwritten at seeded random offsets) and read by OIIO and, for the formats
-// ao reads (PNG, EXR), by ao, each read in a forked child so a crash or hang is counted, not fatal.
+// ao reads (PNG, EXR), by ao, each read in a process of its own so a crash or hang is counted, not fatal.
 #include <OpenImageIO/imageio.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -81,15 +81,16 @@ std::string read_all(const fs::path& p) {
 
 enum class Outcome { Read, Error, Crash, Hang };
 
-// Runs `read` in a child process: 0 = the file was read, 1 = a reported error, a signal = crash,
-// more than 10 s = hang.
-template <class F>
-Outcome in_child(F read) {
+// Reads `file` with `reader` ("oiio" or "ao") in a fresh process (this program with --read): 0 =
+// read, 1 = a reported error, a signal = crash, more than 10 s = hang. A fresh process, not a bare
+// fork, because a fork of a process whose libraries already started threads may deadlock in them.
+Outcome in_child(const char* self, const char* reader, const fs::path& file) {
   std::fflush(stdout);
   const pid_t pid = fork();
   if (pid == 0) {
     alarm(10);
-    std::_Exit(read() ? 0 : 1);
+    execl(self, self, "--read", reader, file.c_str(), static_cast<char*>(nullptr));
+    std::_Exit(127);
   }
   int status = 0;
   waitpid(pid, &status, 0);
@@ -121,6 +122,7 @@ bool read_ao(const fs::path& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "--read") return (std::string(argv[2]) == "oiio" ? read_oiio(argv[3]) : read_ao(argv[3])) ? 0 : 1;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // lines appear as they are measured, and forked children inherit no buffered output
   const int n = argc > 1 ? std::atoi(argv[1]) : 2048;
   const int reps = argc > 2 ? std::atoi(argv[2]) : 5;
@@ -168,8 +170,17 @@ int main(int argc, char** argv) {
     for (const std::string& d : damaged) {
       const fs::path p = dir / (std::string("damaged") + f.ext);
       std::ofstream(p, std::ios::binary).write(d.data(), static_cast<std::streamsize>(d.size()));
-      ++oiio[static_cast<int>(in_child([&] { return read_oiio(p); }))];
-      if (ao_reads) ++aor[static_cast<int>(in_child([&] { return read_ao(p); }))];
+      for (const char* reader : {"oiio", "ao"}) {
+        if (std::string(reader) == "ao" && !ao_reads) continue;
+        const Outcome o = in_child("/proc/self/exe", reader, p);
+        ++(std::string(reader) == "ao" ? aor : oiio)[static_cast<int>(o)];
+        if (o == Outcome::Crash || o == Outcome::Hang) {  // kept for a look: the file and how it was damaged
+          const fs::path keep = fs::temp_directory_path() / ("ao-image-formats-" + std::string(o == Outcome::Crash ? "crash-" : "hang-") + reader + "-" +
+                                                             std::to_string(&d - damaged.data()) + f.ext);
+          fs::copy_file(p, keep, fs::copy_options::overwrite_existing);
+          std::printf("(kept %s)\n", keep.c_str());
+        }
+      }
     }
     std::printf("| %s | %d / %d / %d / %d | ", f.name, oiio[0], oiio[1], oiio[2], oiio[3]);
     if (ao_reads) std::printf("%d / %d / %d / %d |\n", aor[0], aor[1], aor[2], aor[3]);

@@ -721,7 +721,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
                   "as they were; the map takes its size")
       ->type_name("PNG");
   cmd->add_option("--bent-normals", o->bent, "Also write the bent normals (average open direction, world space, n*0.5+0.5) to this image");
-  cmd->add_option("--per-vertex", o->per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO to this PLY (colour + float quality)");
+  cmd->add_option("--per-vertex", o->per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO: .ply (colour + float quality) or .glb (glTF COLOR_0)");
   cmd->add_option("--vertex-resolution", o->vertex_resolution, "histogram --per-vertex: view size in pixels [64, 8192]")->capture_default_str();
   cmd->add_option("--gltf", o->gltf, "Also write a .glb of the mesh with the map as its material's occlusion texture");
   cmd->add_option("--reference", o->reference, "Compare the map with this reference map (EXR/PNG, same size) over covered texels; RMSE etc. in --json");

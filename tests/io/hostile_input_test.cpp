@@ -19,6 +19,7 @@
 #include "ao/io/gltf_check.h"
 #include "ao/io/mesh_io.h"
 #include "ao/reference/raytraced.h"
+#include "support/load_error.h"
 #include "support/run.h"
 
 namespace ao {
@@ -28,25 +29,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using test::TempDir;
 
-/// The message of the InputError loading `path` must throw; checks it is one line naming the file.
-std::string load_error(const fs::path& path) {
-  try {
-    load_scene_file(path);
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(path.filename().string()), std::string::npos) << "message does not name the file: " << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "message is not one line: " << msg;
-    return msg;
-  }
-  ADD_FAILURE() << path << " loaded, expected an InputError";
-  return {};
-}
-
-#define EXPECT_LOAD_ERROR(path, fragment)                                                                \
-  do {                                                                                                   \
-    const std::string msg_ = load_error(path);                                                           \
-    EXPECT_NE(msg_.find(fragment), std::string::npos) << "expected '" << (fragment) << "' in: " << msg_; \
-  } while (0)
+using test::load_error;
 
 std::string base64(const std::string& bytes) {
   static const char* const kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

@@ -22,6 +22,7 @@
 
 #include "ao/core/error.h"
 #include "ao/scene/procedural.h"
+#include "support/load_error.h"
 #include "support/run.h"
 
 namespace ao {
@@ -31,26 +32,7 @@ namespace fs = std::filesystem;
 
 using test::TempDir;
 
-/// Loads a file that must be rejected; returns the message after checking that it is one line and
-/// names the file.
-std::string load_error(const fs::path& path) {
-  try {
-    load_scene_file(path);
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(path.filename().string()), std::string::npos) << "message does not name the file: " << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "message is not one line: " << msg;
-    return msg;
-  }
-  ADD_FAILURE() << path << " loaded, expected an InputError";
-  return {};
-}
-
-#define EXPECT_LOAD_ERROR(path, fragment)                                                         \
-  do {                                                                                            \
-    const std::string msg_ = load_error(path);                                                    \
-    EXPECT_NE(msg_.find(fragment), std::string::npos) << "expected '" << (fragment) << "' in: " << msg_; \
-  } while (0)
+using test::load_error;
 
 void expect_near(Vec3 a, Vec3 b) {
   EXPECT_NEAR(a.x, b.x, 1e-6f);

@@ -28,6 +28,7 @@
 #include "ao/io/output_set.h"
 #include "ao/io/ply_export.h"
 #include "ao/reference/ray_scene.h"
+#include "bake_gltf.h"
 #include "common.h"
 #include "subcommands.h"
 
@@ -316,6 +317,64 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
   return r;
 }
 
+// A glTF input baked to --gltf or --per-vertex .glb: the document's round trip (bake_gltf.h).
+bool is_gltf_round_trip(const fs::path& input, const BakeOptions& o) {
+  return (!o.gltf.empty() || lower_extension(o.per_vertex) == ".glb") && is_gltf_file(input);
+}
+
+nlohmann::json bake_gltf_input(const fs::path& input, const BakeOptions& o, const MeshOutputs& outs, OutputSet& outputs, const GlobalOptions& global) {
+  const std::pair<bool, const char*> unsupported[] = {{!o.high.empty(), "--high"},
+                                                      {!o.groups.empty() || o.self_occlusion || o.match_by_name, "bake groups"},
+                                                      {!o.bent.empty(), "--bent-normals"},
+                                                      {!o.orm.empty(), "--orm"},
+                                                      {!o.reference.empty(), "--reference"},
+                                                      {!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".glb", "--per-vertex .ply"},
+                                                      {is_udim_pattern(o.output), "UDIM tiles"}};
+  for (const auto& [given, what] : unsupported)
+    if (given)
+      throw InputError(input.string() + ": a glTF input baked to a .glb keeps its document, one map per glTF mesh; " + what +
+                       " does not apply to it (bake without --gltf/--per-vertex .glb for the flattened scene)");
+  const bool progress = !global.quiet && stderr_is_terminal();
+  RaytracedBakeParams rt = o.rt;
+  rt.seed = o.seed;
+  rt.max_distance = o.max_distance;
+  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
+  HistogramParams hist = o.hist;
+  hist.seed = o.seed;
+  GltfRoundTrip job;
+  job.input = input;
+  job.gltf = outs.gltf;
+  job.per_vertex = outs.per_vertex;
+  if (writes_map_file(o) && !o.output.empty()) job.map = outs.map;
+  job.uv_set = o.uv_set;
+  job.width = o.width;
+  job.height = o.height;
+  job.png_bits = o.png_bits;
+  job.padding = o.padding;
+  job.json = o.json;
+  job.occluders = [&](const Scene& world) { return load_occluders(o, world, nullptr); };
+  job.bake_map = [&](const Scene& scene, const std::string& label) {
+    const TexelCoverage cov = compute_texel_coverage(scene, o.width, o.height);
+    for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": mesh " << label << ": " << w << "\n";
+    ProgressBar bar("bake " + input.filename().string() + " " + label, progress);
+    if (o.method == "histogram") return bake_histogram(scene, cov, hist, bar.callback());
+    const RayScene rays(scene);
+    return bake_raytraced(rays, cov, rt, bar.callback());
+  };
+  job.bake_vertices = [&](const Scene& scene, std::uint64_t* nrays) {
+    ProgressBar bar("per-vertex " + input.filename().string(), progress);
+    if (o.method == "histogram")
+      return bake_vertices_histogram(scene, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed},
+                                     bar.callback());
+    const RayScene rays(scene);
+    return bake_vertices_raytraced(rays, rt, nrays, bar.callback());
+  };
+  nlohmann::json summary = bake_gltf_round_trip(job, outputs);
+  summary["method"] = o.method;
+  outputs.commit();
+  return summary;
+}
+
 nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
@@ -323,6 +382,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   const MeshOutputs outs = outputs_of(input, o, batch);
   OutputSet outputs;
   declare(outputs, input, o, outs);
+  if (is_gltf_round_trip(input, o)) return bake_gltf_input(input, o, outs, outputs, global);
   Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.

@@ -385,12 +385,6 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   if (is_gltf_round_trip(input, o)) return bake_gltf_input(input, o, outs, outputs, global);
   Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
-  // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.
-  std::optional<GltfSource> source;
-  if ((!o.gltf.empty() || lower_extension(o.per_vertex) == ".glb") && is_gltf_file(input)) {
-    source = load_gltf_materials(input, scene, o.uv_set);
-    for (const std::string& w : source->warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
-  }
   timings["load_ms"] = clock.lap_ms();
   nlohmann::json summary = {{"input", input.string()}, {"method", o.method}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   RaytracedBakeParams rt = o.rt;
@@ -578,13 +572,13 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
         write_image(tmp.path(), r.visibility, {.png_bits = o.png_bits});
         png = read_bytes(tmp.path());
       }
-      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, source ? &*source : nullptr, vertex_ao.empty() ? nullptr : &vertex_ao); });
+      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, nullptr, vertex_ao.empty() ? nullptr : &vertex_ao); });
       summary["gltf_output"] = outs.gltf.string();
     }
   }
   if (!outs.per_vertex.empty()) {
     outputs.write(outs.per_vertex, [&] {
-      if (lower_extension(outs.per_vertex) == ".glb") write_ao_glb(outs.per_vertex, scene, "", source ? &*source : nullptr, &vertex_ao);
+      if (lower_extension(outs.per_vertex) == ".glb") write_ao_glb(outs.per_vertex, scene, "", nullptr, &vertex_ao);
       else write_vertex_ao_ply(outs.per_vertex, scene, vertex_ao);
     });
     summary["per_vertex_output"] = outs.per_vertex.string();

@@ -497,6 +497,10 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set) : impl_(std::make_u
     fail(path, "malformed glTF (" + one_line(e.what()) + ")");
   }
   if (!ok) fail(path, "malformed glTF (" + one_line(err.empty() ? warn : err) + ")");
+  // Compressed geometry lives in the extension, not in the accessors this reads.
+  for (const std::string& e : d.model.extensionsRequired)
+    if (e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression")
+      fail(path, "its geometry is compressed with " + e + ", which ao cannot decode; export it uncompressed to bake it");
   d.merge_buffers();
   d.collect_instances();
 

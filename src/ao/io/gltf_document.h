@@ -36,8 +36,8 @@ class GltfDocument {
   /// Buffers are merged into one (the GLB's binary chunk), and images given by URI (data: or a
   /// file in that folder) are moved into it still encoded; an image file that cannot be read keeps
   /// its URI, with a warning. `uv_set` is the TEXCOORD_n baked into. Throws InputError "<file>: <problem>"
-  /// for what check_gltf refuses, what tinygltf cannot parse, primitives whose accessors cannot
-  /// be read, a `uv_set` above 0 that no primitive has ("has K UV sets, --uv-set N asked for"),
+  /// for what check_gltf refuses, what tinygltf cannot parse, geometry compressed with
+  /// KHR_draco_mesh_compression or EXT_meshopt_compression, primitives whose accessors cannot be read, a `uv_set` above 0 that no primitive has ("has K UV sets, --uv-set N asked for"),
   /// and a document with no triangles in its scene.
   GltfDocument(const std::filesystem::path& path, int uv_set);
   ~GltfDocument();

@@ -747,7 +747,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
   CLI::Option* size_opt = cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();
-  cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
+  cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); --gltf writes it as TEXCOORD_0 for OBJ/PLY/STL, keeps it (texCoord n) for glTF")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
   cmd->add_option("--direction-set", o->direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();
   cmd->add_option("--pixels-per-texel", o->hist.pixels_per_texel, "histogram: view resolution, pixels per texel edge (0, 8]")->capture_default_str();
@@ -777,7 +777,8 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--bent-normals", o->bent, "Also write the bent normals (average open direction, world space, n*0.5+0.5) to this image");
   cmd->add_option("--per-vertex", o->per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO: .ply (colour + float quality) or .glb (glTF COLOR_0)");
   cmd->add_option("--vertex-resolution", o->vertex_resolution, "histogram --per-vertex: view size in pixels [64, 8192]")->capture_default_str();
-  cmd->add_option("--gltf", o->gltf, "Also write a .glb of the mesh with the map as its material's occlusion texture");
+  cmd->add_option("--gltf", o->gltf, "Also write a .glb of the mesh with the map as its material's occlusion texture; a glTF input keeps its nodes, instances and "
+                  "materials, one map per glTF mesh (docs/bake.md)");
   cmd->add_option("--reference", o->reference, "Compare the map with this reference map (EXR/PNG, same size) over covered texels; RMSE etc. in --json");
   cmd->add_option("--seed", o->seed, "Seed of directions / sample sets")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary (texels covered, directions or rays, timings, texels/s, rays/s) on stdout");

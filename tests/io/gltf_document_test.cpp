@@ -251,10 +251,13 @@ TEST(GltfDocument, BadDocumentsAreOneLineInputErrors) {
   deep["extras"] = nest;
   json no_position = g.json;
   no_position["meshes"][0]["primitives"][0]["attributes"].erase("POSITION");
+  json material = g.json;  // found by fuzz/fuzz_gltf_document.cpp: followed before it was checked
+  material["meshes"][0]["primitives"][0]["material"] = 5;
   json draco = g.json;
   draco["extensionsUsed"] = draco["extensionsRequired"] = {"KHR_draco_mesh_compression"};
   const std::pair<std::string, std::string> cases[] = {
       {make_glb(index, g.bin), "99"},
+      {make_glb(material, g.bin), "uses material 5, the file has 1"},
       {make_glb(draco, g.bin), "compressed with KHR_draco_mesh_compression"},
       {make_glb(deep, g.bin), "nests deeper"},
       {make_glb(no_position, g.bin), "bad.glb"},

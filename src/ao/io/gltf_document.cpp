@@ -354,6 +354,14 @@ struct GltfDocument::Impl {
   /// All buffers into buffer 0 (GLB has one binary chunk), each at a multiple of 16 bytes so every
   /// accessor keeps its alignment; images given by URI are appended as bufferViews.
   void merge_buffers() {
+    if (model.buffers.size() == 1) {
+      model.buffers[0].uri.clear();  // a lone buffer becomes the binary chunk as it is, without a copy
+    } else {
+      merge_several_buffers();
+    }
+    embed_images();
+  }
+  void merge_several_buffers() {
     std::vector<unsigned char> bin;
     std::vector<std::size_t> base;
     for (const tinygltf::Buffer& b : model.buffers) {
@@ -374,6 +382,9 @@ struct GltfDocument::Impl {
     }
     merged.data = std::move(bin);
     model.buffers.assign(1, std::move(merged));
+  }
+  void embed_images() {
+    if (model.buffers.empty()) model.buffers.emplace_back();
     for (std::size_t i = 0; i < model.images.size(); ++i) {
       tinygltf::Image& im = model.images[i];
       if (im.bufferView >= 0) continue;
@@ -470,37 +481,48 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set) : impl_(std::make_u
   if (uv_set < 0) fail(path, "--uv-set " + std::to_string(uv_set) + " asked for, UV sets count from 0");
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) fail(path, fs::exists(path, ec) ? "is not a regular file" : "no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot be opened for reading");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail(path, "cannot be read");
-  if (data.empty()) fail(path, "the file is empty");
-  if (data.size() > std::numeric_limits<std::uint32_t>::max()) fail(path, "larger than 4 GB, more than glTF and GLB can address");
-  check_gltf(path, data);  // structure, sizes and nesting first: tinygltf trusts them
-
+  std::string err, warn;
+  bool ok = false;
   Folder folder;
   folder.dir = fs::weakly_canonical(fs::absolute(path, ec).parent_path(), ec);
-  tinygltf::TinyGLTF loader;
-  loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &folder});
-  loader.SetImageLoader(&keep_encoded, nullptr);
-  std::string err, warn;
-  const std::string base = folder.dir.string();
-  bool ok = false;
-  try {
-    if (data.size() >= 4 && data.compare(0, 4, "glTF") == 0)
-      ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn, reinterpret_cast<const unsigned char*>(data.data()), static_cast<unsigned>(data.size()), base);
-    else
-      ok = loader.LoadASCIIFromString(&d.model, &err, &warn, data.data(), static_cast<unsigned>(data.size()), base);
-  } catch (const std::bad_alloc&) {
-    throw SystemError(path.string() + ": out of memory while reading the glTF document");
-  } catch (const std::exception& e) {
-    fail(path, "malformed glTF (" + one_line(e.what()) + ")");
+  {
+    // The file's bytes live only for the parse: tinygltf copies the buffers out of them.
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, "cannot be opened for reading");
+    const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) fail(path, "cannot be read");
+    if (data.empty()) fail(path, "the file is empty");
+    if (data.size() > std::numeric_limits<std::uint32_t>::max()) fail(path, "larger than 4 GB, more than glTF and GLB can address");
+    check_gltf(path, data);  // structure, sizes and nesting first: tinygltf trusts them
+
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &folder});
+    loader.SetImageLoader(&keep_encoded, nullptr);
+    const std::string base = folder.dir.string();
+    try {
+      if (data.size() >= 4 && data.compare(0, 4, "glTF") == 0)
+        ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn, reinterpret_cast<const unsigned char*>(data.data()), static_cast<unsigned>(data.size()), base);
+      else
+        ok = loader.LoadASCIIFromString(&d.model, &err, &warn, data.data(), static_cast<unsigned>(data.size()), base);
+    } catch (const std::bad_alloc&) {
+      throw SystemError(path.string() + ": out of memory while reading the glTF document");
+    } catch (const std::exception& e) {
+      fail(path, "malformed glTF (" + one_line(e.what()) + ")");
+    }
   }
   if (!ok) fail(path, "malformed glTF (" + one_line(err.empty() ? warn : err) + ")");
   // Compressed geometry lives in the extension, not in the accessors this reads.
   for (const std::string& e : d.model.extensionsRequired)
     if (e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression")
       fail(path, "its geometry is compressed with " + e + ", which ao cannot decode; export it uncompressed to bake it");
+  // Indices this code follows (check_gltf covers the node graph, buffers, views and accessors).
+  for (std::size_t m = 0; m < d.model.meshes.size(); ++m)
+    for (std::size_t p = 0; p < d.model.meshes[m].primitives.size(); ++p) {
+      const int mat = d.model.meshes[m].primitives[p].material;
+      if (mat < -1 || mat >= static_cast<int>(d.model.materials.size()))
+        fail(path, "mesh " + d.label(static_cast<int>(m)) + " primitive " + std::to_string(p) + " uses material " + std::to_string(mat) + ", the file has " +
+                       std::to_string(d.model.materials.size()));
+    }
   d.merge_buffers();
   d.collect_instances();
 

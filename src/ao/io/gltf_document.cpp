@@ -574,7 +574,9 @@ std::size_t GltfDocument::world_triangle_count() const {
     for (const tinygltf::Primitive& p : d.model.meshes[static_cast<std::size_t>(i.mesh)].primitives) {
       if (!Impl::is_triangles(p) || !p.attributes.count("POSITION")) continue;
       const int a = p.indices >= 0 ? p.indices : p.attributes.at("POSITION");
-      if (a >= 0 && static_cast<std::size_t>(a) < d.model.accessors.size()) n += d.model.accessors[static_cast<std::size_t>(a)].count / 3 + 1;
+      if (a < 0 || static_cast<std::size_t>(a) >= d.model.accessors.size()) continue;
+      const std::size_t count = d.model.accessors[static_cast<std::size_t>(a)].count;
+      n += p.mode == TINYGLTF_MODE_TRIANGLE_STRIP || p.mode == TINYGLTF_MODE_TRIANGLE_FAN ? (count > 2 ? count - 2 : 0) : count / 3;
     }
   return n;
 }

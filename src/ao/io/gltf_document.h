@@ -54,7 +54,9 @@ class GltfDocument {
   std::string mesh_label(int mesh) const;
   /// Nodes of the displayed scene that use the mesh.
   int instance_count(int mesh) const;
-  /// Triangles and vertices of every instance of every mesh, what a world scene holds (for memory estimates).
+  /// Triangles and vertices of every instance of every mesh, what a world scene holds: up to the
+  /// file's vertices times its nodes, so check them before world_scene (ao bake estimates the
+  /// memory of their BVH and refuses a run that does not fit).
   std::size_t world_triangle_count() const;
   std::size_t world_vertex_count() const;
 

@@ -321,6 +321,8 @@ TEST(GltfInstances, BadTransformsAreRefusedNamingTheNode) {
                     "node 'flat' has a transform with determinant 0");
   EXPECT_LOAD_ERROR(dir.write("far.gltf", two_cubes_gltf({{"name", "far"}, {"translation", {3e9, 0, 0}}})),
                     "node 'far' moves its mesh to coordinate 3e+09, beyond the +-1e+09");
+  // A node name from the file stays one printable line in the message.
+  EXPECT_LOAD_ERROR(dir.write("name.gltf", two_cubes_gltf({{"name", "two\nlines"}, {"scale", {1, 1, 0}}})), "node 'two?lines' has a transform");
   // A parent's scale of 0 flattens its child: the child is named.
   const json nodes = json::array({{{"name", "fine"}, {"mesh", 0}}, {{"name", "squash"}, {"scale", {0, 1, 1}}, {"children", {2}}},
                                   {{"name", "child"}, {"mesh", 0}}});

@@ -33,10 +33,10 @@ constexpr std::uint64_t kGBufferOutBytes = 16;     // OpenEXR's line buffers and
 // (~90 B), with room for the builder's temporary primitive array (32 B per triangle).
 constexpr std::uint64_t kBvhBytesPerTriangle = 12 + 90 + 32;
 constexpr std::uint64_t kBvhBytesPerVertex = 16;
-// An instance (scene/mesh.h): Embree's instance geometry object with its transform, and its share
-// of the top-level BVH (a leaf reference, node space, the build's primitive array), plus the
-// Scene's own Instance and the per-instance normal matrix. Set from the measurement in
-// BENCHMARKS.md ("Instanced glTF"), with a margin.
+// An instance (scene/mesh.h): Embree's instance geometry object with its transform, its share of
+// the top-level BVH, the Scene's Instance and the per-instance normal matrix. Measured
+// (BENCHMARKS.md, "Instanced glTF"): 2.2 KB per instance at the peak, load included (assimp's
+// nodes and JSON, freed before the BVH is built), so 2 KB bounds what the BVH adds.
 constexpr std::uint64_t kBytesPerInstance = 2048;
 
 // --- bake, bytes per texel ---------------------------------------------------------------------

@@ -13,7 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/bake/high_to_low.h"
 #include "ao/bake/raytraced_bake.h"
+#include "ao/bake/texel_coverage.h"
 #include "ao/core/camera.h"
 #include "ao/core/error.h"
 #include "ao/gbuffer/render_gbuffer.h"
@@ -352,6 +354,76 @@ TEST(GltfInstances, BadTransformsAreRefusedNamingTheNode) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "built: node 'c' uses mesh 7, the scene has 1");
   }
+}
+
+// A unit sphere (lat-long, 48 x 24), counter-clockwise seen from outside.
+Mesh unit_sphere() {
+  Mesh m;
+  const int seg = 48, rings = 24;
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j < seg; ++j) {
+      const float th = kPi * static_cast<float>(i) / rings, ph = 2 * kPi * static_cast<float>(j) / seg;
+      m.positions.push_back({std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph)});
+    }
+  const auto id = [&](int i, int j) { return static_cast<std::uint32_t>(i * seg + j % seg); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < seg; ++j) m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+  return m;
+}
+
+TEST(GltfInstances, HighToLowBakeOnInstancedTargetsMatchesCopies) {
+  // Low: the cube with each face in its own cell of a 3 x 2 UV atlas. High: a sphere stored at half
+  // size and turned 90 degrees about y, placed by one instance that undoes both (radius 1.2 around
+  // the cube's centre) and a second one beside it (an occluder). Targets and occluders with
+  // instances must bake what their flattened copies bake: the cage rays (trace_cage_ray) and the AO
+  // rays (Tracer, passing back faces) resolve hits through the instance.
+  const FlatMesh c = cube();
+  Scene low;
+  low.name = "low";
+  Mesh lm;
+  for (std::size_t v = 0; v < c.positions.size() / 3; ++v) {
+    lm.positions.push_back({c.positions[3 * v], c.positions[3 * v + 1], c.positions[3 * v + 2]});
+    const std::size_t face = v / 4, corner = v % 4;
+    const float u = (corner == 1 || corner == 2) ? 1.0f : 0.0f, w = corner >= 2 ? 1.0f : 0.0f;
+    lm.uvs.push_back({(static_cast<float>(face % 3) + 0.05f + 0.9f * u) / 3.0f, (static_cast<float>(face / 3) + 0.05f + 0.9f * w) / 2.0f});
+  }
+  lm.indices.assign(c.indices.begin(), c.indices.end());
+  low.meshes.push_back(lm);
+  validate_and_prepare(low);
+
+  Scene high;
+  high.name = "high";
+  Mesh sm = unit_sphere();
+  for (Vec3& p : sm.positions) p = Vec3{p.z, p.y, -p.x} * 0.5f;  // turned +90 degrees about y, half size
+  high.meshes.push_back(sm);
+  Affine3 undo;  // scale 2.4, turned -90 degrees about y: radius 1.2
+  undo.c0 = {0, 0, 2.4f}, undo.c1 = {0, 2.4f, 0}, undo.c2 = {-2.4f, 0, 0};
+  Affine3 beside = undo;
+  beside.c3 = {3.0f, 0, 0};
+  high.instances = {{0, undo, "target"}, {0, beside, "neighbour"}};
+  validate_and_prepare(high);
+  const Scene copies = flatten_instances(high);
+  const RayScene hi(high), hc(copies);
+
+  HighToLowParams p;
+  p.ao.samples = 32;
+  p.cage_extrusion = 0.5f;
+  const TexelCoverage cov = compute_texel_coverage(low, 32);
+  const BakeResult a = bake_high_to_low(low, cov, extrude_cage(low, 0.5f), hi, hi, p);
+  const BakeResult b = bake_high_to_low(low, cov, extrude_cage(low, 0.5f), hc, hc, p);
+  ASSERT_GT(a.covered_texels, 100u);
+  EXPECT_EQ(a.missed_texels, b.missed_texels);
+  // Same rays; a ray's fate differs only where it grazes an edge (1/32 of a texel's value).
+  // The neighbour occludes: some texels are darker than open.
+  std::size_t differ = 0;
+  float darkest = 1;
+  for (std::size_t i = 0; i < a.visibility.size(); ++i) {
+    if (!a.mask[i]) continue;
+    if (std::abs(a.visibility[i] - b.visibility[i]) > 1e-5f) ++differ;
+    darkest = std::min(darkest, a.visibility[i]);
+  }
+  EXPECT_LE(differ, a.covered_texels / 100);
+  EXPECT_LT(darkest, 0.9f);
 }
 
 TEST(GltfInstances, BakersRefuseInstancesAndTheLoaderFlattensForThem) {

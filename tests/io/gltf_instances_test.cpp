@@ -329,6 +329,10 @@ TEST(GltfInstances, BadTransformsAreRefusedNamingTheNode) {
   const json nodes = json::array({{{"name", "fine"}, {"mesh", 0}}, {{"name", "squash"}, {"scale", {0, 1, 1}}, {"children", {2}}},
                                   {{"name", "child"}, {"mesh", 0}}});
   EXPECT_LOAD_ERROR(dir.write("parent.gltf", gltf_text({cube()}, nodes, {0, 1})), "node 'child' has a transform with determinant 0");
+  // An instanced mesh whose only triangle is degenerate goes with its instances: nothing is left.
+  const FlatMesh line{{0, 0, 0, 1, 0, 0, 2, 0, 0}, {0, 0, 1, 0, 0, 1, 0, 0, 1}, {0, 1, 2}};
+  EXPECT_LOAD_ERROR(dir.write("line.gltf", gltf_text({line}, json::array({{{"mesh", 0}}, {{"mesh", 0}, {"translation", {0, 1, 0}}}}), {0, 1})),
+                    "no triangles with nonzero area");
   // JSON has no NaN, so a non-finite transform is checked on a scene built in code.
   Scene s;
   s.name = "built";

@@ -204,12 +204,16 @@ void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const 
   for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
 }
 
+// Bakes write per-vertex values and UV maps of each placed mesh, so glTF instances are loaded as
+// copies (LoadOptions::flatten_instances).
+constexpr LoadOptions kBakeLoad{.flatten_instances = true};
+
 // The high meshes of --high, one scene (their UVs are not used).
 Scene load_high_scene(const std::vector<std::string>& files) {
   Scene high;
   high.name = files.size() == 1 ? files.front() : "--high meshes";
   for (const std::string& f : files) {
-    Scene s = load_scene_file(f);
+    Scene s = load_scene_file(f, kBakeLoad);
     for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
     for (Mesh& m : s.meshes) high.meshes.push_back(std::move(m));
   }
@@ -220,7 +224,7 @@ Scene load_high_scene(const std::vector<std::string>& files) {
 std::vector<Mesh> load_occluders(const BakeOptions& o, const Scene& scene, const Scene* high) {
   std::vector<Mesh> out;
   for (const std::string& f : o.occluders) {
-    Scene s = load_scene_file(f);
+    Scene s = load_scene_file(f, kBakeLoad);
     for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
     for (Mesh& m : s.meshes) {
       m.uvs.clear();
@@ -277,7 +281,7 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
   p.ao = rt;
   if (high) {
     if (!o.cage.empty()) {
-      cage = cage_from_mesh(scene, load_scene_file(o.cage));
+      cage = cage_from_mesh(scene, load_scene_file(o.cage, kBakeLoad));
     } else {
       if (!p.cage_extrusion) p.cage_extrusion = kDefaultCageFraction * scene.bounds().diagonal();
       cage = extrude_cage(scene, *p.cage_extrusion);
@@ -383,7 +387,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   OutputSet outputs;
   declare(outputs, input, o, outs);
   if (is_gltf_round_trip(input, o)) return bake_gltf_input(input, o, outs, outputs, global);
-  Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
+  Scene scene = load_scene_file(input, {.uv_set = o.uv_set, .flatten_instances = true});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   timings["load_ms"] = clock.lap_ms();
   nlohmann::json summary = {{"input", input.string()}, {"method", o.method}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};

@@ -36,7 +36,7 @@ struct RayGenerator {
 // the tracing phase fills it packet by packet, the shading phase reads it row by row.
 struct TileHits {
   static constexpr int kPixels = kTileWidth * kStripHeight;
-  unsigned geom[kPixels], prim[kPixels];
+  unsigned geom[kPixels], inst[kPixels], prim[kPixels];
   float u[kPixels], v[kPixels];
 };
 
@@ -56,7 +56,7 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(bvh, &ctx, &rh);
         const int j = (y - t.y0) * tw + (x - t.x0);
-        hits.geom[j] = rh.hit.geomID, hits.prim[j] = rh.hit.primID, hits.u[j] = rh.hit.u, hits.v[j] = rh.hit.v;
+        hits.geom[j] = rh.hit.geomID, hits.inst[j] = rh.hit.instID[0], hits.prim[j] = rh.hit.primID, hits.u[j] = rh.hit.u, hits.v[j] = rh.hit.v;
       }
   } else {
     // Blocks of 4 x (N/4) pixels: square-ish footprints keep the packet's rays coherent. The
@@ -82,7 +82,8 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
         for (int k = 0; k < N; ++k) {
           if (!valid[k]) continue;
           const int j = (by + k / bw - t.y0) * tw + (bx + k % bw - t.x0);
-          hits.geom[j] = rh.hit.geomID[k], hits.prim[j] = rh.hit.primID[k], hits.u[j] = rh.hit.u[k], hits.v[j] = rh.hit.v[k];
+          hits.geom[j] = rh.hit.geomID[k], hits.inst[j] = rh.hit.instID[0][k], hits.prim[j] = rh.hit.primID[k], hits.u[j] = rh.hit.u[k],
+          hits.v[j] = rh.hit.v[k];
         }
       }
   }
@@ -128,7 +129,8 @@ struct RowBuffer {
 // Writes the G-buffer rows of tile t from its hits: each row is assembled in a RowBuffer and
 // streamed out, one contiguous run per channel.
 template <SurfaceNormal kWhich>
-void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
+void shade_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
+  const Scene& scene = rs.scene();
   const int tw = t.x1 - t.x0;
   const bool want_uv = !g.uv.empty();
   RowBuffer row;
@@ -156,11 +158,15 @@ void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const
         uv[i] = {};
         continue;
       }
-      const Mesh& m = scene.meshes[geom];
-      const unsigned prim = h->prim[r + i];
+      // An instance's triangle is moved to the world vertex by vertex, so the point, the normal and
+      // their rounding are those of the same triangle stored in world space.
+      const HitRef hit = resolve(rs, geom, h->inst[r + i], h->prim[r + i]);
+      const Mesh& m = scene.meshes[hit.mesh];
+      const unsigned prim = hit.triangle;
       const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(prim)];
       const float bu = h->u[r + i], bv = h->v[r + i], bw = 1.0f - bu - bv;
-      const Vec3 p0 = m.positions[tri[0]], p1 = m.positions[tri[1]], p2 = m.positions[tri[2]];
+      Vec3 p0, p1, p2;
+      world_triangle(rs, hit, p0, p1, p2);
       // Interpolating the vertices puts the point on the triangle to float rounding, which is
       // more accurate than eye + t * direction far from the camera (the ray offsets rely on it).
       const Vec3 pc = basis.to_local(p0 * bw + p1 * bu + p2 * bv - cam.eye);
@@ -171,12 +177,15 @@ void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const
       position[i] = pc;
       depth[i] = -pc.z;
       albedo[i] = m.albedo;
-      object_id[i] = geom + 1;
+      object_id[i] = hit.object + 1;
       primitive_id[i] = prim;
       coverage[i] = 1;
       Vec3 n = ng;
       if constexpr (kWhich == SurfaceNormal::Shading) {
-        n = basis.to_local(normalize(m.normals[tri[0]] * bw + m.normals[tri[1]] * bu + m.normals[tri[2]] * bv));
+        Vec3 n0 = m.normals[tri[0]], n1 = m.normals[tri[1]], n2 = m.normals[tri[2]];
+        if (const Affine3* nt = hit.normal_to_world)  // vertex normals as flatten_instances stores them
+          n0 = normalize(nt->vector(n0)), n1 = normalize(nt->vector(n1)), n2 = normalize(nt->vector(n2));
+        n = basis.to_local(normalize(n0 * bw + n1 * bu + n2 * bv));
         if (dot(n, ng) < 0) n = -n;
         if (!(length(n) > 0.5f)) n = ng;
       }
@@ -204,8 +213,8 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
   for (int y = t.y0; y < t.y1; y += kStrip) {
     const Tile s{t.x0, y, t.x1, std::min(y + kStrip, t.y1)};
     trace_tile<N>(embree_scene(rs), cam, gen, s, hits);
-    if (which == SurfaceNormal::Shading) shade_tile<SurfaceNormal::Shading>(rs.scene(), cam, basis, hits, g, s);
-    else shade_tile<SurfaceNormal::Geometric>(rs.scene(), cam, basis, hits, g, s);
+    if (which == SurfaceNormal::Shading) shade_tile<SurfaceNormal::Shading>(rs, cam, basis, hits, g, s);
+    else shade_tile<SurfaceNormal::Geometric>(rs, cam, basis, hits, g, s);
   }
   _mm_sfence();  // the streamed rows are visible to whichever thread reads the G-buffer next
 }

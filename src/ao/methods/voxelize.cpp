@@ -394,14 +394,22 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // A holed mesh voxelized by winding number (voxelize.h) gets one fan triangle per boundary
   // edge after its own triangles: (b, a, centroid) for the boundary edge a -> b, so that every
   // edge of the mesh and its fans is used twice and the parity pass sees a closed surface.
+  // The triangles are those of every object (Scene::objects(): a world-space mesh, or an instance
+  // whose mesh's triangles go through its transform); closure and hole centroids are per mesh, as
+  // an affine map keeps both (it maps centroids to centroids).
+  const std::vector<SceneObject> objects = scene.objects();
   std::vector<std::vector<Vec3>> centre(scene.meshes.size());
-  std::vector<std::size_t> first{0};
+  std::vector<std::uint8_t> mesh_capped(scene.meshes.size(), 0);
   std::size_t capped = 0;
   for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const bool cap = o.open_meshes == OpenMeshes::Winding && closure[mi].holed();
     if (cap) centre[mi] = hole_centroids(scene.meshes[mi], closure[mi]), ++capped;
-    g.capped.push_back(cap ? 1 : 0);
-    first.push_back(first.back() + scene.meshes[mi].triangle_count() + (cap ? closure[mi].boundary.size() : 0));
+    mesh_capped[mi] = cap ? 1 : 0;
+  }
+  std::vector<std::size_t> first{0};
+  for (const SceneObject& ob : objects) {
+    g.capped.push_back(mesh_capped[ob.mesh]);
+    first.push_back(first.back() + scene.meshes[ob.mesh].triangle_count() + (mesh_capped[ob.mesh] ? closure[ob.mesh].boundary.size() : 0));
   }
   const std::size_t total = first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
@@ -409,21 +417,29 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   std::vector<Buckets> buckets(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
     const std::size_t t0 = c * kChunk, t1 = std::min(total, t0 + kChunk);
-    std::size_t mi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
+    std::size_t oi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
     auto& out = tris[c];
     out.reserve(t1 - t0);
     for (std::size_t t = t0; t < t1; ++t) {
-      while (t >= first[mi + 1]) ++mi;
+      while (t >= first[oi + 1]) ++oi;
+      const std::size_t mi = objects[oi].mesh;
+      const Affine3* tf = objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[oi].instance].object_to_world;
       const bool open = o.open_meshes != OpenMeshes::Parity && closure[mi].open_surface();
       const Mesh& m = scene.meshes[mi];
-      const std::size_t local = t - first[mi];
+      const std::size_t local = t - first[oi];
+      Tri3 tri;
       if (local < m.triangle_count()) {
-        emit(out, source_triangle(m, local, open));
+        tri = source_triangle(m, local, open);
       } else {
         const std::size_t e = local - m.triangle_count();
         const auto [a, b] = closure[mi].boundary[e];
-        emit(out, Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}});
+        tri = Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}};
       }
+      if (tf) {
+        for (Vec3& v : tri.v) v = tf->point(v);
+        if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+      }
+      emit(out, tri);
     }
     Buckets& bk = buckets[c];
     bk.start.assign(3 * static_cast<std::size_t>(bands) + 1, 0);

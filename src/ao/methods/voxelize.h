@@ -148,7 +148,7 @@ struct VoxelGrid {
   std::vector<std::uint64_t> dilated;
   std::uint64_t near_mask(int t, int ci, int cj) const { return dilated[(static_cast<std::size_t>(cj) * dnx + ci) * (kReachCap + 1) + t]; }
 
-  /// Per mesh of the scene (G-buffer object id - 1): 1 when the mesh had holes and was voxelized as
+  /// Per object of the scene (Scene::objects(), G-buffer object id - 1): 1 when its mesh had holes and was voxelized as
   /// its winding-number solid (OpenMeshes::Winding), so that a surface point of it whose front is
   /// solid is the inside of its shell, seen through a hole.
   std::vector<std::uint8_t> capped;

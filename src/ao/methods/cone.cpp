@@ -23,7 +23,8 @@ namespace ao {
 namespace {
 
 constexpr int kTile = 16;
-// Below this transmittance a cone stops (see transmittance()).
+// A cone stops once its transmittance T <= kOpaque: its remaining spheres can lower T by at most
+// kOpaque, so V (the mean over cones) by at most kOpaque = 1e-4, far below an 8-bit step (1/255).
 constexpr float kOpaque = 1e-4f;
 
 // Length of [zlo, zhi) (voxel units along the column) covered by solid voxels, counting the two
@@ -96,34 +97,7 @@ struct WorldSampler {
     if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
     return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
   }
-  static int clamp_index(float x, int n) {  // clamp(floor(x), 0, n - 1), branch-free; NaN -> 0
-    return static_cast<int>(std::min(std::max(0.0f, x), static_cast<float>(n - 1)));
-  }
 
-  // Empty-space skipping (not in the paper; exact: a skipped sphere's prisms read no solid voxel).
-  // A sphere centred at (gx, gy, gz) with radii (rx, ry, rz) voxels reads columns within
-  // (ex, ey) = rho_max * (rx, ry) of its centre and voxels within ez = half_max * rz along them
-  // (floor(a) - floor(a - b) <= ceil(b); the margins cover rounding). Its box of columns lies in
-  // the window (voxelize.h) anchored at the box's lowest cell, w = the larger span in cells (the
-  // box clamped into the grid, which only drops columns no prism can read): `window` gives the
-  // mask's index and the z cells, any_in_window tests them (one load and a shift). A box wider
-  // than the largest window goes to maybe_solid_blocks.
-  struct Window {
-    std::uint32_t index;  // of the mask in VoxelGrid::window
-    int lo, span;         // z cells lo..lo + span, span <= 63
-    int wide;             // 1: the box is wider than the largest window
-  };
-  Window window(float gx, float gy, float gz, float ex, float ey, float ez) const {
-    constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
-    ex = ex * 1.001f + 1e-3f, ey = ey * 1.001f + 1e-3f, ez = ez * 1.001f + 1e-3f;
-    const int x0 = clamp_index((gx - ex) * kInvC, g.dnx), x1 = clamp_index((gx + ex) * kInvC, g.dnx);
-    const int y0 = clamp_index((gy - ey) * kInvC, g.dny), y1 = clamp_index((gy + ey) * kInvC, g.dny);
-    const int w = std::max(x1 - x0, y1 - y0);
-    const int cl = clamp_index(gz - ez, g.depth_bits) >> g.cell_shift, ch = clamp_index(gz + ez, g.depth_bits) >> g.cell_shift;
-    return {static_cast<std::uint32_t>((y0 * g.dnx + x0) * (VoxelGrid::kWindowCap + 1) + std::min(w, VoxelGrid::kWindowCap)), cl, ch - cl,
-            w > VoxelGrid::kWindowCap ? 1 : 0};
-  }
-  bool any_in_window(std::uint32_t index, int lo, int span) const { return ((g.window[index] >> lo) & (~std::uint64_t{0} >> (63 - span))) != 0; }
   // For spheres wider than the largest window: the OR of every block the sphere's box touches.
   bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
     constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
@@ -159,7 +133,7 @@ struct WorldSampler {
     return solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - h, gz + h);
   }
 
-#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__)
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__) && !defined(AO_NO_GATHER)
   // 8 prisms at once: column indices, z ranges, two gathered words per prism (the words of the end
   // voxels), masks and VPOPCNTQ. Prisms whose range spans more than two words go the scalar way.
   void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, float rot_c, float rot_s, float* len) const {
@@ -361,9 +335,7 @@ void chain_spheres(const ConeSetup& setup, float r_max, float near, float chain_
 }
 
 // Front-to-back along one cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed fraction
-// f of the rays that reach it, T *= 1 - f. Once T <= kOpaque the cone's remaining spheres can
-// lower its T by at most kOpaque, so V (the mean over cones) by at most kOpaque = 1e-4, far below
-// an 8-bit step (1/255): they are not sampled.
+// f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
 // `inside`: a surface point facing into the winding-number solid counts the complement.
 template <class Fraction>
 float transmittance(const ChainSphere* chain, int n, bool inside, Fraction&& fraction) {
@@ -397,8 +369,9 @@ bool faces_inside(const GBuffer& gb, const Sampler& sample, int x, int y, Vec3 p
 // radius is more than 1e-3 of the last sphere's.
 struct SphereSlots {
   int n = 0, per_cone = 0;
+  int padded = 0;  // n rounded up to a multiple of 16 with slots that are never sampled: whole vectors
   std::vector<float> dist_a, dist_b, rad_a, rad_b, use_a, use_b;
-  std::vector<float> ex, ey, ez;  // half extents of the prisms' box at radius scale 1, voxels (WorldSampler::window)
+  std::vector<float> ex, ey, ez;  // half extents of the prisms' box at radius scale 1, voxels (PixelSpheres::place)
   std::vector<int> k;             // sphere of the chain whose prisms it uses
 
   SphereSlots(const ConeSetup& setup, const WorldSampler& sample, float r_max, int cones) {
@@ -423,57 +396,93 @@ struct SphereSlots {
         ex.push_back(sample.rho_max * sp.rx), ey.push_back(sample.rho_max * sp.ry), ez.push_back(sample.half_max * sp.rz);
         k.push_back(kj);
       }
+    padded = (n + 15) / 16 * 16;
+    for (int i = n; i < padded; ++i) {
+      dist_a.push_back(0.0f), dist_b.push_back(0.0f), rad_a.push_back(0.0f), rad_b.push_back(0.0f), use_a.push_back(0.0f), use_b.push_back(-1.0f);
+      ex.push_back(0.0f), ey.push_back(0.0f), ez.push_back(0.0f), k.push_back(0);
+    }
   }
 };
 
 // One pixel's spheres, placed and tested against the coarse masks: flat loops over the slots with
-// no branch, so the placement and the window arithmetic vectorise and the mask loads of all
+// no branch, so the placement and the window arithmetic vectorise, and the mask loads of all
 // spheres are issued back to back (their cache misses overlap).
 struct PixelSpheres {
-  std::vector<float> scale, ax, ay, az;  // in: per slot, its cone's chain scale and axis (voxels)
-  std::vector<float> cx, cy, cz, rs;     // out: centre (voxels), radius scale
+  // In, per cone: chain scale and axis (voxels).
+  std::vector<float> scale, ax, ay, az;
+  std::vector<float> s_, ax_, ay_, az_;  // the same per slot
+  // Per slot: centre (voxels), radius scale, whether it is sampled, the coarse test's mask index,
+  // z cells and "wider than the largest window", and the verdict: sampled and the coarse masks
+  // say maybe (wide: maybe_solid_blocks decides).
+  std::vector<float> cx, cy, cz, rs;
   std::vector<int> used, lo, span, wide;
   std::vector<std::uint32_t> index;
-  std::vector<std::uint8_t> pass;  // sampled and the coarse masks say maybe (wide: maybe_solid_blocks)
+  std::vector<std::uint8_t> pass;
+  // The pixel.
+  int x = 0, y = 0;
+  bool inside = false;
+  float rot_c = 1, rot_s = 0;
 
-  explicit PixelSpheres(int n)
-      : scale(n), ax(n), ay(n), az(n), cx(n), cy(n), cz(n), rs(n), used(n), lo(n), span(n), wide(n), index(n), pass(n) {}
+  PixelSpheres(int cones, int n)
+      : scale(cones), ax(cones), ay(cones), az(cones), s_(n), ax_(n), ay_(n), az_(n), cx(n), cy(n), cz(n), rs(n), used(n), lo(n), span(n), wide(n), index(n), pass(n) {}
 
   void place(const SphereSlots& q, const WorldSampler& sample, float gx, float gy, float gz) {
-    const int n = q.n, dnx = sample.g.dnx, dny = sample.g.dny, cap = VoxelGrid::kWindowCap, shift = sample.g.cell_shift;
+    const int n = q.padded, per_cone = q.per_cone, dnx = sample.g.dnx, dny = sample.g.dny, cap = VoxelGrid::kWindowCap, shift = sample.g.cell_shift;
     const float fdnx = static_cast<float>(dnx - 1), fdny = static_cast<float>(dny - 1), fbits = static_cast<float>(sample.g.depth_bits - 1);
     constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
-    const float* __restrict s = scale.data();
-    const float *__restrict dxa = ax.data(), *__restrict dya = ay.data(), *__restrict dza = az.data();
     const float *__restrict da = q.dist_a.data(), *__restrict db = q.dist_b.data(), *__restrict ra = q.rad_a.data(), *__restrict rb = q.rad_b.data();
     const float *__restrict ua = q.use_a.data(), *__restrict ub = q.use_b.data();
     const float *__restrict qex = q.ex.data(), *__restrict qey = q.ey.data(), *__restrict qez = q.ez.data();
     float *__restrict ox = cx.data(), *__restrict oy = cy.data(), *__restrict oz = cz.data(), *__restrict orr = rs.data();
     int *__restrict ou = used.data(), *__restrict olo = lo.data(), *__restrict osp = span.data(), *__restrict owi = wide.data();
     std::uint32_t* __restrict oi = index.data();
+    // Each slot's cone: scale and axis, copied per slot so that the loop below is flat.
+    for (int c = 0; c < q.n / per_cone; ++c)
+      for (int i = c * per_cone; i < (c + 1) * per_cone; ++i) s_[i] = scale[c], ax_[i] = ax[c], ay_[i] = ay[c], az_[i] = az[c];
+    const float *__restrict ss = s_.data(), *__restrict sx = ax_.data(), *__restrict sy = ay_.data(), *__restrict sz = az_.data();
 #pragma GCC ivdep  // the arrays do not overlap (GCC does not apply __restrict to local pointers)
     for (int i = 0; i < n; ++i) {
-      const float d = da[i] * s[i] + db[i];
-      const float x = gx + dxa[i] * d, y = gy + dya[i] * d, z = gz + dza[i] * d;
-      const float r = std::min(ra[i] * s[i] + rb[i], 1.0f);
-      ox[i] = x, oy[i] = y, oz[i] = z, orr[i] = r;
-      ou[i] = ua[i] * s[i] + ub[i] >= 0.0f ? 1 : 0;
-      // WorldSampler::window, written out so that it vectorises: the box with margins, clamped.
+      const float s = ss[i];
+      const float d = da[i] * s + db[i];
+      const float px = gx + sx[i] * d, py = gy + sy[i] * d, pz = gz + sz[i] * d;
+      const float r = std::min(ra[i] * s + rb[i], 1.0f);
+      ox[i] = px, oy[i] = py, oz[i] = pz, orr[i] = r;
+      ou[i] = ua[i] * s + ub[i] >= 0.0f ? 1 : 0;
+      // Empty-space skipping (not in the paper; exact: a skipped sphere's prisms read no solid
+      // voxel). The sphere's prisms read columns within (ex, ey) = rho_max * (rx, ry) of its
+      // centre and voxels within ez = half_max * rz along them (floor(a) - floor(a - b) <=
+      // ceil(b); the margins cover rounding). That box of columns lies in the window (voxelize.h)
+      // anchored at its lowest cell, w = its larger span in cells (clamped into the grid, which
+      // only drops columns no prism can read); test() checks the window's z cells cl..ch. A box
+      // wider than the largest window goes to maybe_solid_blocks. Indices are
+      // int(min(max(0, x), n - 1)): clamp(floor(x), 0, n - 1) for x >= 0, and 0 for NaN.
       const float ex = qex[i] * r * 1.001f + 1e-3f, ey = qey[i] * r * 1.001f + 1e-3f, ez = qez[i] * r * 1.001f + 1e-3f;
-      const int x0 = static_cast<int>(std::min(std::max(0.0f, (x - ex) * kInvC), fdnx)), x1 = static_cast<int>(std::min(std::max(0.0f, (x + ex) * kInvC), fdnx));
-      const int y0 = static_cast<int>(std::min(std::max(0.0f, (y - ey) * kInvC), fdny)), y1 = static_cast<int>(std::min(std::max(0.0f, (y + ey) * kInvC), fdny));
+      const int x0 = static_cast<int>(std::min(std::max(0.0f, (px - ex) * kInvC), fdnx)), x1 = static_cast<int>(std::min(std::max(0.0f, (px + ex) * kInvC), fdnx));
+      const int y0 = static_cast<int>(std::min(std::max(0.0f, (py - ey) * kInvC), fdny)), y1 = static_cast<int>(std::min(std::max(0.0f, (py + ey) * kInvC), fdny));
       const int w = std::max(x1 - x0, y1 - y0);
-      const int cl = static_cast<int>(std::min(std::max(0.0f, z - ez), fbits)) >> shift, ch = static_cast<int>(std::min(std::max(0.0f, z + ez), fbits)) >> shift;
+      const int cl = static_cast<int>(std::min(std::max(0.0f, pz - ez), fbits)) >> shift, ch = static_cast<int>(std::min(std::max(0.0f, pz + ez), fbits)) >> shift;
       oi[i] = static_cast<std::uint32_t>((y0 * dnx + x0) * (cap + 1) + std::min(w, cap));
       olo[i] = cl, osp[i] = ch - cl, owi[i] = w > cap ? 1 : 0;
     }
+  }
+
+  void test(const WorldSampler& sample, const SphereSlots& q) {
     const std::uint64_t* __restrict win = sample.g.window.data();
+    const int *__restrict ou = used.data(), *__restrict olo = lo.data(), *__restrict osp = span.data(), *__restrict owi = wide.data();
+    const std::uint32_t* __restrict oi = index.data();
     std::uint8_t* __restrict op = pass.data();
+    const int n = q.n;
 #pragma GCC ivdep
     for (int i = 0; i < n; ++i) {
       const bool any = ((win[oi[i]] >> olo[i]) & (~std::uint64_t{0} >> (63 - osp[i]))) != 0;  // z cells lo..lo + span
       op[i] = static_cast<std::uint8_t>(ou[i] & (any | owi[i]));
     }
+  }
+  // The verdicts of slots i0 .. i0 + count - 1 as bits (count <= 17: spheres per cone + 1).
+  std::uint32_t passed(int i0, int count) const {
+    std::uint32_t m = 0;
+    for (int j = 0; j < count; ++j) m |= static_cast<std::uint32_t>(pass[i0 + j]) << j;
+    return m;
   }
 };
 
@@ -491,9 +500,36 @@ void trace_world(const GBuffer& gb, const WorldSampler& sample, float r_max, con
   const int per_cone = slots.per_cone;
   const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
   const float near = sample.near_limit();
+  // Front to back along each cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
+  // fraction f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
+  const auto finish = [&](PixelSpheres& ps) {
+    const auto fraction = [&](int i) {
+      const WorldSampler::Sphere& sp = sample.spheres[slots.k[i]];
+      const float r = ps.rs[i];
+      if (ps.wide[i] && !sample.maybe_solid_blocks(ps.cx[i], ps.cy[i], ps.cz[i], sp.rx * r, sp.ry * r, sp.rz * r)) return 0.0f;
+      return sample.fraction(ps.cx[i], ps.cy[i], ps.cz[i], slots.k[i], r, ps.rot_c, ps.rot_s);
+    };
+    float v = 0;
+    for (int c = 0; c < nc; ++c) {
+      float tr = 1.0f;
+      const int i0 = c * per_cone;
+      if (!ps.inside) {
+        // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
+        // ones, in order (bit j: sphere j of the cone).
+        for (std::uint32_t m = ps.passed(i0, per_cone); m && tr > kOpaque; m &= m - 1) tr *= 1.0f - fraction(i0 + std::countr_zero(m));
+      } else {
+        // The inside of a shell counts the complement (faces_inside): T *= f, and an empty sphere
+        // (f = 0) closes the cone.
+        for (int i = i0; i < i0 + per_cone && tr > kOpaque; ++i)
+          if (ps.used[i]) tr *= ps.pass[i] ? fraction(i) : 0.0f;
+      }
+      v += weight * tr;
+    }
+    out(ps.x, ps.y) = std::clamp(v, 0.0f, 1.0f);
+  };
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-    PixelSpheres ps(slots.n);
+    PixelSpheres ps(nc, slots.padded);
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         if (!gb.covered(x, y)) {
@@ -502,37 +538,18 @@ void trace_world(const GBuffer& gb, const WorldSampler& sample, float r_max, con
         }
         const Vec3 pos = basis.to_world(gb.position(x, y)) + eye, n = normalize(basis.to_world(gb.normal(x, y)));
         const Frame frame = Frame::from_normal(n);
-        const bool inside = faces_inside(gb, sample, x, y, pos, n, near);
+        ps.x = x, ps.y = y;
+        ps.inside = faces_inside(gb, sample, x, y, pos, n, near);
         const int slot = pat.slot(x, y);
-        const float rot_c = pat.rot[2 * slot], rot_s = pat.rot[2 * slot + 1];
+        ps.rot_c = pat.rot[2 * slot], ps.rot_s = pat.rot[2 * slot + 1];
         const ConePattern::Cone* cones = pat.cone.data() + static_cast<std::size_t>(slot) * nc;
         for (int c = 0; c < nc; ++c) {
           const Vec3 a = frame.to_world({cones[c].x, cones[c].y, cones[c].z});
-          for (int i = c * per_cone; i < (c + 1) * per_cone; ++i)  // the axis in voxels
-            ps.scale[i] = cones[c].scale, ps.ax[i] = a.x * inv.x, ps.ay[i] = a.z * inv.y, ps.az[i] = a.y * inv.z;
+          ps.scale[c] = cones[c].scale, ps.ax[c] = a.x * inv.x, ps.ay[c] = a.z * inv.y, ps.az[c] = a.y * inv.z;  // the axis in voxels
         }
         ps.place(slots, sample, (pos.x - g.origin.x) * inv.x, (pos.z - g.origin.z) * inv.y, (pos.y - g.origin.y) * inv.z);
-        float v = 0;
-        for (int c = 0; c < nc; ++c) {
-          float tr = 1.0f;
-          // Front to back along the cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
-          // fraction f of the rays that reach it, T *= 1 - f. Once T <= kOpaque the remaining
-          // spheres can lower T by at most kOpaque, so V (the mean over cones) by at most
-          // kOpaque = 1e-4, far below an 8-bit step (1/255): they are not sampled.
-          for (int i = c * per_cone; i < (c + 1) * per_cone && tr > kOpaque; ++i) {
-            if (!ps.used[i]) continue;
-            float f = 0.0f;
-            if (ps.pass[i]) {
-              const WorldSampler::Sphere& sp = sample.spheres[slots.k[i]];
-              const float r = ps.rs[i];
-              if (!ps.wide[i] || sample.maybe_solid_blocks(ps.cx[i], ps.cy[i], ps.cz[i], sp.rx * r, sp.ry * r, sp.rz * r))
-                f = sample.fraction(ps.cx[i], ps.cy[i], ps.cz[i], slots.k[i], r, rot_c, rot_s);
-            }
-            tr *= inside ? f : 1.0f - f;  // the inside of a shell counts the complement (faces_inside)
-          }
-          v += weight * tr;
-        }
-        out(x, y) = std::clamp(v, 0.0f, 1.0f);
+        ps.test(sample, slots);
+        finish(ps);
       }
     counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
   });

@@ -33,12 +33,10 @@ namespace ao {
 
 namespace {
 
-constexpr int kTile = 16;
 constexpr int kMissFillRings = 64;
 constexpr int kMaxCageSkips = 64;  // back faces a cage ray may pass through before it counts as a miss
 
 using detail::PatchPiece;
-using detail::SurfacePoint;
 using detail::TriangleNormals;
 
 struct HighHit {
@@ -148,7 +146,6 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   params.validate();
   if (cage.size() != low.meshes.size()) throw InputError("high-to-low: the cage has a different number of meshes than the low scene");
   const Falloff falloff = params.ao.falloff();
-  const TriangleNormals low_fn = detail::face_normals(low);
   const TriangleNormals target_fn = detail::face_normals(targets.scene());
   const TriangleNormals occluder_fn = detail::face_normals(occluders.scene());
   const auto smooth = smoothed_normals(low);
@@ -162,79 +159,42 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
   if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
-  std::atomic<std::uint64_t> total_rays{0};
-  ProgressCounter counter(progress, cov.texel_count());
-  detail::dispatch_packet_width(occluders.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(width, height, kTile, [&](const Tile& t) {
-      detail::flush_denormals_to_zero();
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      std::vector<PatchPiece> patch;
-      constexpr int batch = N == 1 ? 16 : N;
-      std::array<Vec3, batch> org, dir;
-      std::array<float, batch> mu;
-      std::uint64_t rays = 0;  // cage rays and AO rays of this tile
-      for (int y = t.y0; y < t.y1; ++y) {
-        for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * width + x;
-          if (!cov.mask[texel]) continue;
-          detail::build_patch(low, cov, texel, patch);
-          if (patch.empty()) continue;
-          const std::uint32_t key = pixel_seed(params.ao.seed, x, y);
-          const std::uint32_t key_point = hash_combine(key, 0x9017u), key_dir = hash_combine(key, 0xd1eu);
-          double sum = 0;
-          int hits = 0;
-          Vec3 bent{0, 0, 0};
-          for (int first = 0; first < params.ao.samples; first += batch) {
-            const int count = std::min(batch, params.ao.samples - first);
-            int live = 0;
-            for (int k = 0; k < count; ++k) {
-              const auto i = static_cast<std::uint32_t>(first + k);
-              const detail::PatchSample ps = detail::sample_patch(patch, sobol_owen_2d(i, key_point));
-              const PatchPiece& pc = patch[ps.piece];
-              const SurfacePoint sp = detail::point_at_uv(low, cov, pc.mesh, pc.triangle, ps.uv, low_fn);
-              const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
-              const auto& cg = cage[pc.mesh];
-              const Vec3 c = cg[vi[0]] * sp.bary.x + cg[vi[1]] * sp.bary.y + cg[vi[2]] * sp.bary.z;
-              const float cage_distance = length(c - sp.p);
-              Vec3 d;
-              if (cage_distance > 1e-6f * occluders.bounds().diagonal()) {
-                d = (sp.p - c) / cage_distance;
-              } else {
-                const auto& sn = smooth[pc.mesh];
-                d = -normalize(sn[vi[0]] * sp.bary.x + sn[vi[1]] * sp.bary.y + sn[vi[2]] * sp.bary.z);
-              }
-              const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
-              ++rays;
-              const HighHit h = trace_cage_ray(targets, target_fn, ctx, sp.p - d * front, d, front + back);
-              if (!h.hit) continue;
-              ++hits;
-              const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
-              if (dot(w, h.ng) <= 0) continue;  // below the high face: occluded by the surface itself (mu = 0)
-              org[static_cast<std::size_t>(live)] = h.p + h.ng * offset;
-              dir[static_cast<std::size_t>(live)] = w;
-              ++live;
-            }
-            tracer.template trace<N>(ctx, org.data(), dir.data(), live, mu.data());
-            rays += static_cast<std::uint64_t>(live);
-            for (int k = 0; k < live; ++k) {
-              sum += mu[static_cast<std::size_t>(k)];
-              bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
-            }
-          }
-          if (hits == 0) {
-            out.missed[texel] = 1;
-            continue;
-          }
-          out.visibility[texel] = static_cast<float>(sum / hits);
-          if (params.ao.bent_normals) out.bent_normal[texel] = normalize(bent);
-        }
-      }
-      total_rays += rays;
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-    });
-  });
-  out.rays = total_rays.load();
+  const float surface_eps = 1e-6f * occluders.bounds().diagonal();  // cage this close to the surface: no direction from it
+  std::atomic<std::uint64_t> traced{0};
+  const auto make_ray = [&](RTCIntersectContext& ctx, const detail::TexelSample& s, Vec3& org, Vec3& dir) {
+    const PatchPiece& pc = *s.point.piece;
+    const Vec3 p = s.point.position(), bary = s.point.barycentrics();
+    const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
+    const auto& cg = cage[pc.mesh];
+    const Vec3 c = cg[vi[0]] * bary.x + cg[vi[1]] * bary.y + cg[vi[2]] * bary.z;
+    const float cage_distance = length(c - p);
+    Vec3 d;
+    if (cage_distance > surface_eps) {
+      d = (p - c) / cage_distance;
+    } else {
+      const auto& sn = smooth[pc.mesh];
+      d = -normalize(sn[vi[0]] * bary.x + sn[vi[1]] * bary.y + sn[vi[2]] * bary.z);
+    }
+    const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
+    const HighHit h = trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
+    if (!h.hit) return detail::SampleRay::Skip;
+    const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(s.u_direction));
+    if (dot(w, h.ng) <= 0) return detail::SampleRay::Occluded;  // below the high face: occluded by the surface itself (mu = 0)
+    org = h.p + h.ng * offset;
+    dir = w;
+    return detail::SampleRay::Trace;
+  };
+  const auto finish = [&](std::size_t texel, const detail::TexelSums& sums) {
+    traced += static_cast<std::uint64_t>(sums.traced);
+    if (sums.counted == 0) {
+      out.missed[texel] = 1;
+      return;
+    }
+    out.visibility[texel] = static_cast<float>(sums.mu / sums.counted);
+    if (params.ao.bent_normals) out.bent_normal[texel] = normalize(sums.bent);
+  };
+  const std::size_t texels = detail::bake_texels(low, cov, tracer, params.ao.samples, params.ao.seed, progress, make_ray, finish);
+  out.rays = static_cast<std::uint64_t>(texels) * static_cast<std::uint64_t>(params.ao.samples) + traced.load();  // a cage ray per sample, plus the AO rays
   for (std::size_t i = 0; i < out.missed.size(); ++i) out.missed_texels += out.missed[i];
   fill_missed_texels(out);
   out.stats = {{"rays", out.rays}, {"offset", offset}, {"missed_texels", out.missed_texels}};

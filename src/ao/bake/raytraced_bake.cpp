@@ -7,8 +7,10 @@
 // cosine-weighted direction about the interpolated normal there (pdf cos/pi cancels the cosine and
 // 1/pi), so V is the plain mean of mu over the samples. A point per ray, rather than one point at
 // the texel centre, is what keeps thin charts and texels that straddle several triangles from
-// aliasing. The patch sampling and the ray loop (reference/raytraced.cpp's, with an origin per lane,
-// unlimited distance and back-face skipping) are in texel_rays.h, shared with high_to_low.cpp.
+// aliasing. The patch (its pieces with world-space corners, built once per texel), the sample set
+// and the tile loop with its ray packets (reference/raytraced.cpp's tracing, with an origin per
+// lane, unlimited distance and back-face skipping) are in texel_rays_internal.h, shared with
+// high_to_low.cpp.
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>
@@ -32,7 +34,6 @@ namespace ao {
 
 namespace {
 
-constexpr int kTile = 16;
 constexpr int kMaxSamples = 1 << 20;
 
 using detail::face_normals;
@@ -68,8 +69,6 @@ std::vector<VertexFaces> vertex_faces(const Scene& scene) {
   return out;
 }
 using detail::PatchPiece;
-using detail::point_at_uv;
-using detail::SurfacePoint;
 using detail::Tracer;
 using detail::TriangleNormals;
 
@@ -109,61 +108,26 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
-  const int w = cov.width, h = cov.height;
   BakeResult out;
-  out.visibility = Image<float>(w, h, 0.0f);
+  out.visibility = Image<float>(cov.width, cov.height, 0.0f);
   out.mask = cov.mask;
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
-  if (params.bent_normals) out.bent_normal = Image<Vec3>(w, h, Vec3{0, 0, 0});
-  ProgressCounter counter(progress, cov.texel_count());
-  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      std::vector<PatchPiece> patch;
-      constexpr int batch = N == 1 ? 16 : N;
-      std::array<Vec3, batch> org, dir;
-      std::array<float, batch> mu;
-      for (int y = t.y0; y < t.y1; ++y)
-        for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * w + x;
-          if (!cov.mask[texel]) continue;
-          detail::build_patch(scene, cov, texel, patch);
-          if (patch.empty()) continue;
-          const std::uint32_t key = pixel_seed(params.seed, x, y);
-          const std::uint32_t key_point = hash_combine(key, 0x9017u), key_dir = hash_combine(key, 0xd1eu);
-          double sum = 0;
-          Vec3 bent{0, 0, 0};
-          for (int first = 0; first < params.samples; first += batch) {
-            const int count = std::min(batch, params.samples - first);
-            int live = 0;
-            for (int k = 0; k < count; ++k) {
-              const auto i = static_cast<std::uint32_t>(first + k);
-              // Point: uniform by area over the patch (texel_rays.h).
-              const detail::PatchSample ps = detail::sample_patch(patch, sobol_owen_2d(i, key_point));
-              const PatchPiece& pc = patch[ps.piece];
-              const SurfacePoint sp = point_at_uv(scene, cov, pc.mesh, pc.triangle, ps.uv, fn);
-              const Vec3 d = Frame::from_normal(geometric ? sp.ng : sp.n).to_world(cosine_hemisphere(sobol_owen_2d(i, key_dir)));
-              if (dot(d, sp.ng) <= 0) continue;  // below the face: occluded by the surface itself (mu = 0)
-              // Off the triangle by the scale-free offset of ray_offset.h, or the user's fixed one.
-              const float offset = params.offset > 0 ? params.offset : ray_offset_distance(triangle_magnitude(scene.meshes[pc.mesh], pc.triangle));
-              org[static_cast<std::size_t>(live)] = sp.p + sp.ng * offset;
-              dir[static_cast<std::size_t>(live)] = d;
-              ++live;
-            }
-            tracer.template trace<N>(ctx, org.data(), dir.data(), live, mu.data());
-            for (int k = 0; k < live; ++k) {
-              sum += mu[static_cast<std::size_t>(k)];
-              bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
-            }
-          }
-          out.visibility[texel] = static_cast<float>(sum / params.samples);
-          if (params.bent_normals) out.bent_normal[texel] = normalize(bent);
-        }
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-    });
-  });
+  if (params.bent_normals) out.bent_normal = Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0});
+  const auto make_ray = [&](RTCIntersectContext&, const detail::TexelSample& s, Vec3& org, Vec3& dir) {
+    const PatchPiece& pc = *s.point.piece;
+    const Vec3 d = Frame::from_normal(geometric ? pc.ng : s.point.normal()).to_world(cosine_hemisphere(s.u_direction));
+    if (dot(d, pc.ng) <= 0) return detail::SampleRay::Occluded;  // below the face: occluded by the surface itself (mu = 0)
+    // Off the triangle by the scale-free offset of ray_offset.h, or the user's fixed one.
+    org = s.point.position() + pc.ng * (params.offset > 0 ? params.offset : pc.offset);
+    dir = d;
+    return detail::SampleRay::Trace;
+  };
+  const auto finish = [&](std::size_t texel, const detail::TexelSums& sums) {
+    out.visibility[texel] = static_cast<float>(sums.mu / params.samples);
+    if (params.bent_normals) out.bent_normal[texel] = normalize(sums.bent);
+  };
+  detail::bake_texels(scene, cov, tracer, params.samples, params.seed, progress, make_ray, finish);
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
   out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;

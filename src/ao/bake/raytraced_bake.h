@@ -41,8 +41,9 @@ void to_json(nlohmann::json& j, const RaytracedBakeParams& p);
 
 /// V per covered texel, the area-weighted mean of the obscurance integral over the texel's patch
 /// (eq. 2 of the per-texel AO paper, with mu(D) in place of V when R is set). Sample i of texel
-/// (x, y) takes its point and its cosine-weighted direction from two independently scrambled
-/// Sobol sequences keyed by pixel_seed(seed, x, y): deterministic at any thread count.
+/// (x, y) takes its cosine-weighted direction and its point from point i of one 4-D Owen-scrambled
+/// Sobol set keyed by pixel_seed(seed, x, y) (direction and point jointly stratified):
+/// deterministic at any thread count.
 /// Rays whose direction lies below the face (possible with smooth normals) count as occluded.
 BakeResult bake_raytraced(const RayScene& rays, const TexelCoverage& coverage, const RaytracedBakeParams& params,
                           const ProgressFn& progress = {});

@@ -1,15 +1,21 @@
 // Pieces shared by the inside-out bakers (raytraced_bake.cpp, high_to_low.cpp): a texel's patch of
-// surface as sub-triangles for sampling points by area, the surface point at a UV, and the ray
-// tracer that turns a batch of rays into mu(D). Internal to src/ao/bake (namespace detail).
+// surface as sub-triangles for sampling points by area, the ray tracer that turns a batch of rays
+// into mu(D), and the tile loop both bakers run (bake_texels). Internal to src/ao/bake (namespace
+// detail).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/membership.h"
+#include "ao/core/parallel.h"
+#include "ao/core/progress.h"
+#include "ao/core/sampling.h"
 #include "ao/reference/packets_internal.h"
 #include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/ray_scene.h"
@@ -30,33 +36,51 @@ inline Vec3 hit_face_normal(const RayScene& rs, const TriangleNormals& fn, unsig
 }
 TriangleNormals face_normals(const Scene& s);
 
-/// A texel's patch as sub-triangles in texel-unit UV space, each with the mesh triangle it lies on
-/// and its world area, for sampling points uniformly by area.
+/// One sub-triangle of a texel's patch (a fan triangle of a mesh triangle clipped to the texel),
+/// with what a sample needs at its three corners. Position, interpolated normal and barycentrics
+/// are affine in UV over a mesh triangle, so at a point with corner weights w they are the
+/// w-weighted sums of the corner values: no barycentric solve per sample.
 struct PatchPiece {
   std::uint32_t mesh, triangle;
-  Vec2 a, b, c;
-  double cdf;  ///< Cumulative world area up to and including this piece.
+  std::array<Vec3, 3> p;     ///< World positions of the corners.
+  std::array<Vec3, 3> n;     ///< Interpolated vertex normals at the corners (not normalised: normalise after weighting).
+  std::array<Vec3, 3> bary;  ///< Barycentrics (l0, l1, l2) of the corners in the mesh triangle.
+  Vec3 ng;                   ///< Face normal, unit.
+  float offset;              ///< Scale-free ray origin offset of the mesh triangle (reference/ray_offset.h), world units.
+  float cdf;                 ///< Cumulative world area of the texel's pieces up to and including this one.
 };
-/// The pieces of texel `texel` of `cov` (computed on `s`), in fragment order.
-void build_patch(const Scene& s, const TexelCoverage& cov, std::size_t texel, std::vector<PatchPiece>& out);
+/// The pieces of texel `texel` of `cov` (computed on `s`), in fragment order. `fn` = face_normals(s).
+void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::size_t texel, std::vector<PatchPiece>& out);
+
+/// A point of a patch: its piece and the weights of the piece's corners (summing to 1).
+struct PatchSample {
+  const PatchPiece* piece;
+  Vec3 w;
+  Vec3 position() const { return piece->p[0] * w.x + piece->p[1] * w.y + piece->p[2] * w.z; }
+  /// Unit interpolated normal; the face normal where the vertex normals cancel.
+  Vec3 normal() const {
+    const Vec3 n = piece->n[0] * w.x + piece->n[1] * w.y + piece->n[2] * w.z;
+    const float len = length(n);
+    return len > 1e-6f ? n / len : piece->ng;
+  }
+  Vec3 barycentrics() const { return piece->bary[0] * w.x + piece->bary[1] * w.y + piece->bary[2] * w.z; }
+};
 
 /// A uniform-by-area point of a non-empty patch for u in [0,1)^2: the piece is chosen by world area
 /// from u.x, u.x is rescaled within the piece (keeping the stratification of u), and the point is
-/// uniform in the piece's triangle. Returns the piece index and the texel-unit UV.
-struct PatchSample {
-  std::size_t piece;
-  Vec2 uv;
-};
-PatchSample sample_patch(const std::vector<PatchPiece>& patch, Vec2 u);
-
-struct SurfacePoint {
-  Vec3 p;      ///< World position.
-  Vec3 n;      ///< Interpolated (shading) normal, unit.
-  Vec3 ng;     ///< Face normal, unit.
-  Vec3 bary;   ///< Barycentrics (l0, l1, l2) of the triangle's vertices.
-};
-/// Point of mesh triangle `tri` at texel-unit UV `q` (barycentrics solved in UV space and clamped to the triangle).
-SurfacePoint point_at_uv(const Scene& s, const TexelCoverage& cov, std::uint32_t mesh, std::uint32_t tri, Vec2 q, const TriangleNormals& fn);
+/// uniform in the piece's triangle.
+inline PatchSample sample_patch(const std::vector<PatchPiece>& patch, Vec2 u) {
+  const float target = u.x * patch.back().cdf;
+  std::size_t pi = 0;
+  while (pi + 1 < patch.size() && patch[pi].cdf <= target) ++pi;
+  const float lo = pi == 0 ? 0.0f : patch[pi - 1].cdf;
+  const float span = patch[pi].cdf - lo;
+  const float su = span > 0 ? std::clamp((target - lo) / span, 0.0f, 1.0f) : 0.0f;
+  // Uniform point of triangle a b c: a + sqrt(s) ((1 - t)(b - a) + t (c - a)), i.e. corner
+  // weights (1 - r, r (1 - t), r t) with r = sqrt(s).
+  const float r = std::sqrt(su);
+  return {&patch[pi], {1.0f - r, r * (1.0f - u.y), r * u.y}};
+}
 
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {
@@ -124,5 +148,86 @@ struct Tracer {
     }
   }
 };
+
+/// One sample of a texel: its point on the patch and the two uniforms its direction is made from.
+struct TexelSample {
+  PatchSample point;
+  Vec2 u_direction;
+};
+
+/// What a baker makes of a sample: a ray to trace (origin and direction set), a sample that counts
+/// as occluded without a ray (mu = 0: a direction below the face), or one left out of the texel's
+/// mean (a high-to-low cage ray that found no surface).
+enum class SampleRay { Trace, Occluded, Skip };
+
+/// A texel's totals over its samples.
+struct TexelSums {
+  double mu = 0;      ///< Sum of mu over the counted samples.
+  int counted = 0;    ///< Samples not skipped (traced or occluded).
+  int traced = 0;     ///< Rays traced.
+  Vec3 bent{0, 0, 0}; ///< Sum of direction x mu over the traced rays.
+};
+
+/// The tile loop of the inside-out bakers. For each covered texel of `cov` (computed on
+/// `surface`) with a non-empty patch: `samples` samples, sample i the point i of a 4-D
+/// Owen-scrambled Sobol set keyed by pixel_seed(seed, x, y) (dimensions 0-1 make the direction,
+/// 2-3 pick the point on the patch: one jointly stratified set), `make_ray(ctx, sample, origin, direction)` turns each into a
+/// SampleRay, the rays are traced by `tracer` in packets of its scene's native width, and
+/// `finish(texel, sums)` receives the texel's totals. Each texel's work depends only on its
+/// coordinates and the seed, so the result is the same at any thread count. Returns the number of
+/// texels finished.
+template <class MakeRay, class Finish>
+std::size_t bake_texels(const Scene& surface, const TexelCoverage& cov, const Tracer& tracer, int samples, std::uint32_t seed,
+                        const ProgressFn& progress, MakeRay&& make_ray, Finish&& finish) {
+  constexpr int kTile = 16;  // texels per tile side: neighbouring texels lie close on the surface, so a tile's rays share BVH nodes in cache
+  const TriangleNormals fn = face_normals(surface);
+  std::atomic<std::size_t> finished{0};
+  ProgressCounter counter(progress, cov.texel_count());
+  dispatch_packet_width(tracer.rs.native_packet_width(), [&]<int N>() {
+    parallel_for_tiles(cov.width, cov.height, kTile, [&](const Tile& t) {
+      flush_denormals_to_zero();
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::vector<PatchPiece> patch;
+      constexpr int batch = N == 1 ? 16 : N;
+      std::array<Vec3, batch> org, dir;
+      std::array<float, batch> mu;
+      std::size_t done = 0;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x) {
+          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+          if (!cov.mask[texel]) continue;
+          build_patch(surface, cov, fn, texel, patch);
+          if (patch.empty()) continue;
+          const std::uint32_t key = pixel_seed(seed, x, y);
+          TexelSums sums;
+          for (int first = 0; first < samples; first += batch) {
+            const int count = std::min(batch, samples - first);
+            int live = 0;
+            for (int k = 0; k < count; ++k) {
+              // Directions on dimensions 0-1, whose 2-D projection is the best stratified: the
+              // visibility varies far more over the hemisphere than over the texel's patch.
+              const std::array<float, 4> u = sobol_owen_4d(static_cast<std::uint32_t>(first + k), key);
+              const TexelSample s{sample_patch(patch, {u[2], u[3]}), {u[0], u[1]}};
+              const SampleRay r = make_ray(ctx, s, org[static_cast<std::size_t>(live)], dir[static_cast<std::size_t>(live)]);
+              if (r != SampleRay::Skip) ++sums.counted;
+              if (r == SampleRay::Trace) ++live;
+            }
+            tracer.template trace<N>(ctx, org.data(), dir.data(), live, mu.data());
+            sums.traced += live;
+            for (int k = 0; k < live; ++k) {
+              sums.mu += mu[static_cast<std::size_t>(k)];
+              sums.bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
+            }
+          }
+          finish(texel, sums);
+          ++done;
+        }
+      finished += done;
+      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0));
+    });
+  });
+  return finished.load();
+}
 
 }  // namespace ao::detail

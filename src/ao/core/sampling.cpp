@@ -1,6 +1,7 @@
 #include "ao/core/sampling.h"
 
 #include <cmath>
+#include <initializer_list>
 
 namespace ao {
 
@@ -27,15 +28,12 @@ std::uint32_t laine_karras(std::uint32_t x, std::uint32_t seed) {
   return x;
 }
 
-// Dimension 1 of Sobol: the direction numbers of the primitive polynomial x + 1,
-// v_0 = 2^31, v_{k+1} = v_k ^ (v_k >> 1), XORed over the set bits of the index. The map is linear
-// over GF(2), so it is four lookups of 256-entry tables, one per byte of the index.
-struct SobolDim1Tables {
+// A Sobol dimension is linear over GF(2): point i is the XOR of the direction numbers v_k over the
+// set bits k of i. The tables hold that XOR for every byte value at each of the index's four byte
+// positions, so a point is four lookups.
+struct SobolTables {
   std::uint32_t t[4][256];
-  constexpr SobolDim1Tables() : t{} {
-    std::uint32_t v[32] = {};
-    v[0] = 1u << 31;
-    for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+  constexpr explicit SobolTables(const std::uint32_t (&v)[32]) : t{} {
     for (int byte = 0; byte < 4; ++byte)
       for (std::uint32_t x = 0; x < 256; ++x) {
         std::uint32_t r = 0;
@@ -44,12 +42,38 @@ struct SobolDim1Tables {
         t[byte][x] = r;
       }
   }
+  constexpr std::uint32_t operator()(std::uint32_t i) const { return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24]; }
 };
-constexpr SobolDim1Tables kSobolDim1{};
 
-std::uint32_t sobol_dim1(std::uint32_t i) {
-  return kSobolDim1.t[0][i & 0xffu] ^ kSobolDim1.t[1][(i >> 8) & 0xffu] ^ kSobolDim1.t[2][(i >> 16) & 0xffu] ^ kSobolDim1.t[3][i >> 24];
-}
+// Direction numbers v_k = m_k 2^(31 - k) of the Sobol dimension with primitive polynomial of
+// degree s and inner coefficients a (bit s-2 of a is the coefficient of x^(s-1), ...) and initial
+// m_1..m_s, by the recurrence v_k = v_(k-s) ^ (v_(k-s) >> s) ^ XOR_(j=1..s-1) a_j v_(k-j)
+// (Bratley and Fox 1988, Algorithm 659).
+struct DirectionNumbers {
+  std::uint32_t v[32];
+  constexpr DirectionNumbers(int s, std::uint32_t a, std::initializer_list<std::uint32_t> m) : v{} {
+    int k = 0;
+    for (const std::uint32_t mk : m) {
+      v[k] = mk << (31 - k);
+      ++k;
+    }
+    for (; k < 32; ++k) {
+      std::uint32_t x = v[k - s] ^ (v[k - s] >> s);
+      for (int j = 1; j < s; ++j)
+        if (a >> (s - 1 - j) & 1u) x ^= v[k - j];
+      v[k] = x;
+    }
+  }
+};
+
+// Dimensions 1-3: the primitive polynomials x + 1, x^2 + x + 1 and x^3 + x + 1 with Joe and
+// Kuo's initial numbers (new-joe-kuo-6.21201, its dimensions 2-4). Dimension 1's recurrence is
+// v_(k+1) = v_k ^ (v_k >> 1).
+constexpr SobolTables kSobolDim1{DirectionNumbers(1, 0, {1}).v};
+constexpr SobolTables kSobolDim2{DirectionNumbers(2, 1, {1, 3}).v};
+constexpr SobolTables kSobolDim3{DirectionNumbers(3, 1, {1, 3, 1}).v};
+
+std::uint32_t sobol_dim1(std::uint32_t i) { return kSobolDim1(i); }
 
 }  // namespace
 
@@ -60,6 +84,15 @@ Vec2 sobol_owen_2d(std::uint32_t index, std::uint32_t seed) {
   const std::uint32_t x = reverse_bits(laine_karras(shuffled, hash_combine(seed, 1u)));
   const std::uint32_t y = reverse_bits(laine_karras(reverse_bits(sobol_dim1(shuffled)), hash_combine(seed, 2u)));
   return {to_unit_float(x), to_unit_float(y)};
+}
+
+std::array<float, 4> sobol_owen_4d(std::uint32_t index, std::uint32_t seed) {
+  // Dimension 0 is the bit reversal of the index, which cancels the scramble's inner reversal.
+  const std::uint32_t d0 = reverse_bits(laine_karras(index, hash_combine(seed, 0x50b01u)));
+  const std::uint32_t d1 = reverse_bits(laine_karras(reverse_bits(kSobolDim1(index)), hash_combine(seed, 0x50b02u)));
+  const std::uint32_t d2 = reverse_bits(laine_karras(reverse_bits(kSobolDim2(index)), hash_combine(seed, 0x50b03u)));
+  const std::uint32_t d3 = reverse_bits(laine_karras(reverse_bits(kSobolDim3(index)), hash_combine(seed, 0x50b04u)));
+  return {to_unit_float(d0), to_unit_float(d1), to_unit_float(d2), to_unit_float(d3)};
 }
 
 Vec3 cosine_hemisphere(Vec2 u) {

@@ -2,6 +2,7 @@
 // from thread-local state, so results do not depend on the thread count.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "ao/core/math.h"
@@ -32,6 +33,13 @@ constexpr float to_unit_float(std::uint32_t bits) { return static_cast<float>(bi
 /// Every prefix of 2^k points is stratified in all elementary intervals; different seeds give
 /// statistically independent sets, so the per-pixel mean has an honest sample variance.
 Vec2 sobol_owen_2d(std::uint32_t index, std::uint32_t seed);
+
+/// Point `index` of the first four dimensions of the Sobol sequence (0 and 1 as in sobol_owen_2d,
+/// 2 and 3 from the polynomials x^2 + x + 1 and x^3 + x + 1 with Joe and Kuo's direction numbers),
+/// each dimension Owen-scrambled with its own key from `seed` (Burley 2020's hash, no index
+/// shuffle). Every prefix of 2^k points is stratified in all elementary intervals of dimensions
+/// 0 and 1 and is a net of the four dimensions jointly; different seeds give independent sets.
+std::array<float, 4> sobol_owen_4d(std::uint32_t index, std::uint32_t seed);
 
 /// Cosine-weighted direction on the hemisphere about +z from u in [0,1)^2: Shirley-Chiu concentric
 /// disk mapping, lifted to the hemisphere (Malley's method). pdf = cos(theta) / pi.

@@ -17,6 +17,7 @@
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/methods/bilateral.h"
+#include "ao/methods/cone_pattern_internal.h"
 
 namespace ao {
 
@@ -245,72 +246,6 @@ struct EyeSampler {
     return chord > 0 ? std::min(1.0f, solid / chord) : 0.0f;
   }
 };
-
-// The per-pixel jitter of deviation 5 (docs/methods/cone.md), tabulated once per call: pixel
-// (x, y) takes slot (x mod P, y mod P) of a P x P table whose entries come from
-// pixel_seed(seed, slot), so the image does not depend on the thread count and each pixel's cones
-// are as random as with a hash per pixel; only pixels P apart repeat a pattern. Per slot: the
-// prism pattern turns by beta, and each cone takes one random direction in its own cell of the
-// hemisphere (stratified sampling of the cell's measure: theta uniform in the band's sin^2 theta
-// or 1 - cos theta, phi uniform in its azimuth range) and one random scale of its sphere chain.
-// Fixed directions and distances make the error a fixed function of the distance to each
-// occluder, which shows as rings that no averaging over seeds removes. What is left per pixel and
-// cone is turning the tabulated axis into the normal's frame.
-struct ConePattern {
-  // 32: a multiple of the tile size, far beyond the 5-tap filter's reach, and 32 x 32 slots x 6
-  // cones of 16 bytes stay in the L2 cache (98 KB).
-  static constexpr int kPeriod = 32;
-  struct Cone {
-    float x, y, z;  ///< Axis in the normal's frame (z along the normal).
-    float scale;    ///< Chain scale s = q^-xi in (1/q, 1].
-  };
-  int period = 1;
-  int cones = 0;
-  std::vector<float> rot;  // per slot: cos and sin of the prism pattern's turn
-  std::vector<Cone> cone;  // per slot, `cones` in order
-  int slot(int x, int y) const { return (y & (period - 1)) * period + (x & (period - 1)); }
-};
-
-ConePattern make_pattern(const ConeSetup& setup, bool jitter, std::uint32_t seed) {
-  ConePattern pat;
-  pat.period = jitter ? ConePattern::kPeriod : 1;
-  pat.cones = static_cast<int>(setup.cones.size());
-  const int slots = pat.period * pat.period;
-  pat.rot.resize(2 * static_cast<std::size_t>(slots));
-  pat.cone.resize(static_cast<std::size_t>(slots) * pat.cones);
-  const float log_q = std::log(setup.chain_ratio);
-  for (int sy = 0; sy < pat.period; ++sy)
-    for (int sx = 0; sx < pat.period; ++sx) {
-      const int slot = pat.slot(sx, sy);
-      const std::uint32_t ps = pixel_seed(seed, sx, sy);
-      float rot_c = 1, rot_s = 0;
-      if (jitter) {
-        const float beta = 2.0f * kPi * to_unit_float(hash32(ps));
-        rot_c = std::cos(beta), rot_s = std::sin(beta);
-      }
-      pat.rot[2 * slot] = rot_c, pat.rot[2 * slot + 1] = rot_s;
-      for (int c = 0; c < pat.cones; ++c) {
-        const ConeSetup::Cone& cone = setup.cones[c];
-        float st = cone.sin_theta, ct = cone.cos_theta, cp = cone.cos_phi, sp = cone.sin_phi, scale = 1.0f;
-        if (jitter) {
-          const std::uint32_t hc = hash_combine(ps, 1u + static_cast<std::uint32_t>(c));
-          const float u = cone.band0 + to_unit_float(hc) * (cone.band1 - cone.band0);
-          st = setup.cosine ? std::sqrt(u) : std::sqrt(std::max(0.0f, u * (2.0f - u)));  // 1 - cos = u
-          st = std::min(st, setup.sin_theta_max);
-          ct = std::sqrt(1.0f - st * st);
-          // phi = the cell's centre + delta, delta uniform in +-dphi / 2.
-          const float delta = (to_unit_float(hash_combine(hc, 1u)) - 0.5f) * cone.dphi;
-          const float cd = std::cos(delta), sd = std::sin(delta);
-          cp = cone.cos_phi * cd - cone.sin_phi * sd, sp = cone.sin_phi * cd + cone.cos_phi * sd;
-          // Chain scale s = q^-xi in (1/q, 1]: one ratio step of random phase, the geometric
-          // analogue of jittering a uniform step.
-          scale = std::exp(-to_unit_float(hash_combine(hc, 2u)) * log_q);
-        }
-        pat.cone[static_cast<std::size_t>(slot) * pat.cones + c] = {st * cp, st * sp, ct, scale};
-      }
-    }
-  return pat;
-}
 
 // Per sphere of a cone: where along the axis it sits (world units), which sphere of the chain it
 // is (its prisms' half chords) and the scale of its radius. The chain of sphere k is scaled by the
@@ -590,51 +525,6 @@ void trace_eye(const GBuffer& gb, const EyeSampler& sample, float r_max, const C
   });
 }
 
-// Poisson-disk points on the unit disk: best-candidate dart throwing (Mitchell 1991) from a fixed
-// hash sequence, relaxed by Lloyd iterations on a fine grid over the disk so that the points are
-// evenly spread and well inside (a sample on the rim has a zero chord and would be wasted).
-std::vector<ConeSetup::Disk> poisson_disk(int n) {
-  std::vector<Vec2> pts;
-  auto disk_point = [](std::uint32_t i) {
-    const float r = std::sqrt(to_unit_float(hash32(2 * i + 17))), a = 2.0f * kPi * to_unit_float(hash32(2 * i + 18));
-    return Vec2{r * std::cos(a), r * std::sin(a)};
-  };
-  std::uint32_t next = 0;
-  for (int k = 0; k < n; ++k) {
-    Vec2 best{};
-    float best_d = -1;
-    for (int c = 0; c < 16 * (k + 1); ++c) {
-      const Vec2 q = disk_point(next++);
-      float d = kInfinity;
-      for (const Vec2& o : pts) d = std::min(d, (q.x - o.x) * (q.x - o.x) + (q.y - o.y) * (q.y - o.y));
-      if (d > best_d) best_d = d, best = q;
-    }
-    pts.push_back(best);
-  }
-  constexpr int kGrid = 48, kIterations = 30;
-  for (int it = 0; it < kIterations; ++it) {
-    std::vector<Vec2> sum(n);
-    std::vector<int> count(n, 0);
-    for (int gy = 0; gy < kGrid; ++gy)
-      for (int gx = 0; gx < kGrid; ++gx) {
-        const float x = -1.0f + (gx + 0.5f) * 2.0f / kGrid, y = -1.0f + (gy + 0.5f) * 2.0f / kGrid;
-        if (x * x + y * y > 1.0f) continue;
-        int best = 0;
-        float best_d = kInfinity;
-        for (int k = 0; k < n; ++k) {
-          const float d = (x - pts[k].x) * (x - pts[k].x) + (y - pts[k].y) * (y - pts[k].y);
-          if (d < best_d) best_d = d, best = k;
-        }
-        sum[best].x += x, sum[best].y += y, ++count[best];
-      }
-    for (int k = 0; k < n; ++k)
-      if (count[k] > 0) pts[k] = {sum[k].x / count[k], sum[k].y / count[k]};
-  }
-  std::vector<ConeSetup::Disk> out;
-  for (const Vec2& q : pts) out.push_back({q.x, q.y, std::sqrt(std::max(0.0f, 1.0f - q.x * q.x - q.y * q.y))});
-  return out;
-}
-
 }  // namespace
 
 ConeParams cone_preset(ConeQuality q) {
@@ -750,7 +640,7 @@ ConeSetup derive_cone_setup(const ConeParams& p) {
     const int n_prisms = p.prisms.value_or(6);
     const std::lock_guard<std::mutex> lock(mutex);
     auto it = cache.find(n_prisms);
-    if (it == cache.end()) it = cache.emplace(n_prisms, poisson_disk(n_prisms)).first;
+    if (it == cache.end()) it = cache.emplace(n_prisms, cone_disk_points(n_prisms)).first;
     s.disk = it->second;
   }
   return s;
@@ -763,7 +653,7 @@ void compute_cone(const GBuffer& gb, const VoxelGrid& g, float r_max, const Cone
   if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
   if (out.width != gb.width() || out.height != gb.height()) throw InputError("cone: output and G-buffer sizes differ");
   const ConeSetup setup = derive_cone_setup(params);
-  const ConePattern pattern = make_pattern(setup, params.jitter, seed);
+  const ConePattern pattern = make_cone_pattern(setup, params.jitter, seed);
   if (g.space == GridSpace::World) {
     trace_world(gb, WorldSampler(g, setup, r_max), r_max, setup, pattern, out, progress);
   } else {

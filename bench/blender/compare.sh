@@ -2,8 +2,9 @@
 # `ao bake` against Blender Cycles' AO bake of the same mesh and UVs at equal error (BENCHMARKS.md,
 # "bake"). Needs Debian's blender and python3-numpy (not installed by scripts/setup: a benchmark
 # check, not a dependency of ao).
-#   bench/blender/compare.sh [MESH.obj] [SIZE] [OUT_DIR]
-# Both bakers get 2 threads; each row is one run, ao and Blender alternated. Error: RMSE against a
+#   [SAMPLES="32 64 128 256"] [ROUNDS=1] bench/blender/compare.sh [MESH.obj] [SIZE] [OUT_DIR]
+# Both bakers get 2 threads; each row is one run, ao and Blender alternated, ROUNDS times over the
+# sample counts (ao runs only up to 128 rays). Error: RMSE against a
 # converged ao bake (1024 rays per texel) over the texels both maps cover (bench/blender/rmse.py).
 # Time: the bake call itself (ao: timings.bake_ms + bvh_ms; Blender: bpy.ops.object.bake), and the
 # whole process (load, BVH, bake, write) as wall seconds.
@@ -26,7 +27,8 @@ fi
 echo "| baker | setting | RMSE | bake s | process s |"
 echo "|---|---|---:|---:|---:|"
 secs() { python3 -c "print(f'{$2 - $1:.2f}')"; }
-for spp in 32 64 128 256; do
+for round in $(seq "${ROUNDS:-1}"); do
+for spp in ${SAMPLES:-32 64 128 256}; do
   if [ "$spp" -le 128 ]; then
     t0=$(now)
     json=$("$ao" --threads 2 bake "$mesh" -s "$size" --samples "$spp" --padding 0 -o "$out/ao-$spp.exr" --json 2>/dev/null)
@@ -38,4 +40,5 @@ for spp in 32 64 128 256; do
   bake=$(bl "$here/bake_ao.py" -- "$mesh" "$size" "$spp" "$out/blender-$spp.exr" 2 | sed -n 's/^bake_seconds //p')
   t1=$(now)
   echo "| Blender Cycles | $spp samples | $(rmse "$out/blender-$spp.exr") | $bake | $(secs "$t0" "$t1") |"
+done
 done

@@ -125,67 +125,79 @@ struct RowBuffer {
   }
 };
 
+// The visible triangle in camera space: what every pixel that sees it interpolates. Consecutive
+// pixels mostly see the same triangle, so it is built once per run of such pixels instead of
+// once per pixel (the vertex fetches, the cross product and the transforms to camera space).
+struct CameraTriangle {
+  unsigned geom = RTC_INVALID_GEOMETRY_ID, prim = 0;
+  Vec3 q0, q1, q2;  ///< Vertices, camera space (relative to the eye).
+  Vec3 ng;          ///< Unit geometric normal, camera space, as wound (not yet turned to the camera).
+  Vec3 n0, n1, n2;  ///< Vertex normals, camera space (SurfaceNormal::Shading only).
+  Vec2 t0, t1, t2;  ///< Vertex UVs; zero when the mesh has none or UVs are not wanted.
+
+  template <SurfaceNormal kWhich>
+  void load(const Scene& scene, const Camera& cam, const Frame& basis, unsigned g, unsigned p, bool want_uv) {
+    geom = g, prim = p;
+    const Mesh& m = scene.meshes[g];
+    const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(p)];
+    const Vec3 p0 = m.positions[tri[0]], p1 = m.positions[tri[1]], p2 = m.positions[tri[2]];
+    // Moving the vertices to camera space and interpolating there puts each point on the triangle
+    // to a few float spacings of the coordinates and the eye, which the ray offsets rely on
+    // (reference/ray_offset.h); eye + t * direction would be off by the error of t.
+    q0 = basis.to_local(p0 - cam.eye), q1 = basis.to_local(p1 - cam.eye), q2 = basis.to_local(p2 - cam.eye);
+    ng = basis.to_local(normalize(cross(p1 - p0, p2 - p0)));
+    if constexpr (kWhich == SurfaceNormal::Shading)
+      n0 = basis.to_local(m.normals[tri[0]]), n1 = basis.to_local(m.normals[tri[1]]), n2 = basis.to_local(m.normals[tri[2]]);
+    if (want_uv && !m.uvs.empty()) t0 = m.uvs[tri[0]], t1 = m.uvs[tri[1]], t2 = m.uvs[tri[2]];
+    else t0 = t1 = t2 = {};
+  }
+};
+
 // Writes the G-buffer rows of tile t from its hits: each row is assembled in a RowBuffer and
-// streamed out, one contiguous run per channel.
-template <SurfaceNormal kWhich>
+// streamed out, one contiguous run per channel. kExtras: albedo and UVs are wanted (else their
+// images are empty and nothing is computed for them).
+template <SurfaceNormal kWhich, bool kExtras>
 void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
   const int tw = t.x1 - t.x0;
-  const bool want_uv = !g.uv.empty();
+  const bool want_uv = kExtras && !g.uv.empty();
   RowBuffer row;
-  Vec3* const position = row.position;
-  Vec3* const normal = row.normal;
-  Vec3* const albedo = row.albedo;
-  float* const depth = row.depth;
-  std::uint32_t* const object_id = row.object_id;
-  std::uint32_t* const primitive_id = row.primitive_id;
-  std::uint8_t* const coverage = row.coverage;
-  Vec2* const uv = row.uv;
+  CameraTriangle tri;
   for (int y = t.y0; y < t.y1; ++y) {
-    const TileHits* const h = &hits;
     const int r = (y - t.y0) * tw;
     for (int i = 0; i < tw; ++i) {
-      const unsigned geom = h->geom[r + i];
+      const unsigned geom = hits.geom[r + i];
       if (geom == RTC_INVALID_GEOMETRY_ID) {
-        position[i] = {};
-        depth[i] = kInfinity;
-        normal[i] = {};
-        albedo[i] = {};
-        object_id[i] = 0;
-        primitive_id[i] = 0;
-        coverage[i] = 0;
-        uv[i] = {};
+        row.position[i] = {};
+        row.depth[i] = kInfinity;
+        row.normal[i] = {};
+        row.object_id[i] = 0;
+        row.primitive_id[i] = 0;
+        row.coverage[i] = 0;
+        if constexpr (kExtras) row.albedo[i] = {}, row.uv[i] = {};
         continue;
       }
-      const Mesh& m = scene.meshes[geom];
-      const unsigned prim = h->prim[r + i];
-      const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(prim)];
-      const float bu = h->u[r + i], bv = h->v[r + i], bw = 1.0f - bu - bv;
-      const Vec3 p0 = m.positions[tri[0]], p1 = m.positions[tri[1]], p2 = m.positions[tri[2]];
-      // Interpolating the vertices puts the point on the triangle to float rounding, which is
-      // more accurate than eye + t * direction far from the camera (the ray offsets rely on it).
-      const Vec3 pc = basis.to_local(p0 * bw + p1 * bu + p2 * bv - cam.eye);
-      Vec3 ng = basis.to_local(normalize(cross(p1 - p0, p2 - p0)));
+      const unsigned prim = hits.prim[r + i];
+      if (geom != tri.geom || prim != tri.prim) tri.load<kWhich>(scene, cam, basis, geom, prim, want_uv);
+      const float bu = hits.u[r + i], bv = hits.v[r + i], bw = 1.0f - bu - bv;
+      const Vec3 pc = tri.q0 * bw + tri.q1 * bu + tri.q2 * bv;
       // Both sides of a surface can be seen (open meshes, rooms): AO is for the side facing the
       // viewer, so turn the geometric normal towards the camera and the shading normal onto its side.
-      if (dot(ng, pc) > 0) ng = -ng;
-      position[i] = pc;
-      depth[i] = -pc.z;
-      albedo[i] = m.albedo;
-      object_id[i] = geom + 1;
-      primitive_id[i] = prim;
-      coverage[i] = 1;
+      const Vec3 ng = dot(tri.ng, pc) > 0 ? -tri.ng : tri.ng;
       Vec3 n = ng;
       if constexpr (kWhich == SurfaceNormal::Shading) {
-        n = basis.to_local(normalize(m.normals[tri[0]] * bw + m.normals[tri[1]] * bu + m.normals[tri[2]] * bv));
+        n = normalize(tri.n0 * bw + tri.n1 * bu + tri.n2 * bv);
         if (dot(n, ng) < 0) n = -n;
-        if (!(length(n) > 0.5f)) n = ng;
+        if (!(dot(n, n) > 0.25f)) n = ng;  // zero where the vertex normals cancel
       }
-      normal[i] = n;
-      if (want_uv && !m.uvs.empty()) {
-        const Vec2 t0 = m.uvs[tri[0]], t1 = m.uvs[tri[1]], t2 = m.uvs[tri[2]];
-        uv[i] = {t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv};
-      } else {
-        uv[i] = {};
+      row.position[i] = pc;
+      row.depth[i] = -pc.z;
+      row.normal[i] = n;
+      row.object_id[i] = geom + 1;
+      row.primitive_id[i] = prim;
+      row.coverage[i] = 1;
+      if constexpr (kExtras) {
+        row.albedo[i] = scene.meshes[geom].albedo;
+        row.uv[i] = {tri.t0.x * bw + tri.t1.x * bu + tri.t2.x * bv, tri.t0.y * bw + tri.t1.y * bu + tri.t2.y * bv};
       }
     }
     row.stream_to(g, t.x0, y, tw);
@@ -204,8 +216,14 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
   for (int y = t.y0; y < t.y1; y += kStrip) {
     const Tile s{t.x0, y, t.x1, std::min(y + kStrip, t.y1)};
     trace_tile<N>(embree_scene(rs), cam, gen, s, hits);
-    if (which == SurfaceNormal::Shading) shade_tile<SurfaceNormal::Shading>(rs.scene(), cam, basis, hits, g, s);
-    else shade_tile<SurfaceNormal::Geometric>(rs.scene(), cam, basis, hits, g, s);
+    const bool extras = !g.albedo.empty() || !g.uv.empty();
+    if (which == SurfaceNormal::Shading) {
+      if (extras) shade_tile<SurfaceNormal::Shading, true>(rs.scene(), cam, basis, hits, g, s);
+      else shade_tile<SurfaceNormal::Shading, false>(rs.scene(), cam, basis, hits, g, s);
+    } else {
+      if (extras) shade_tile<SurfaceNormal::Geometric, true>(rs.scene(), cam, basis, hits, g, s);
+      else shade_tile<SurfaceNormal::Geometric, false>(rs.scene(), cam, basis, hits, g, s);
+    }
   }
   _mm_sfence();  // the streamed rows are visible to whichever thread reads the G-buffer next
 }

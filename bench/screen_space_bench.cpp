@@ -145,7 +145,7 @@ void depth_test_floor(benchmark::State& state) {
   const int tests = static_cast<int>(state.range(0));
   std::vector<float> px, py, pz;
   for (std::size_t i = 0; i < f.g.position.size(); ++i)
-    if (f.g.coverage[i]) px.push_back(f.g.position[i].x), py.push_back(f.g.position[i].y), pz.push_back(f.g.position[i].z);
+    if (f.g.covered(i)) px.push_back(f.g.position[i].x), py.push_back(f.g.position[i].y), pz.push_back(f.g.position[i].z);
   const std::size_t n = px.size(), vectors = n / 16;
   std::vector<float> dx(static_cast<std::size_t>(tests)), dy(dx.size()), dz(dx.size());
   for (int t = 0; t < tests; ++t) {  // a spiral over the sphere, radius R
@@ -155,7 +155,8 @@ void depth_test_floor(benchmark::State& state) {
     dz[static_cast<std::size_t>(t)] = f.radius * zc;
   }
   const ScreenProjection pr = ScreenProjection::from_camera(f.g.camera);
-  const float* depth = f.g.depth.data();
+  const Image<float> depth_image = depth_plane(f.g);
+  const float* depth = depth_image.data();
   std::atomic<long long> total{0};
   for (auto _ : state) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vectors, 64), [&](const tbb::blocked_range<std::size_t>& r) {

@@ -89,7 +89,7 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
 }
 
 // Copies `bytes` bytes from src to dst with non-temporal (streaming) stores where dst is 16-byte
-// aligned, plain stores at the unaligned ends. The G-buffer (57 bytes a pixel, tens of MB) is
+// aligned, plain stores at the unaligned ends. The G-buffer (32-52 bytes a pixel, tens of MB) is
 // written once and read later by another pass, so streaming it skips reading every destination
 // cache line into the cache before overwriting it: half the memory traffic of plain stores.
 // Callers issue _mm_sfence() before other threads may read what was written.
@@ -107,9 +107,7 @@ void stream_copy(void* dst, const void* src, std::size_t bytes) {
 // One tile row of every G-buffer channel, assembled in cache and then streamed to the images.
 struct RowBuffer {
   Vec3 position[kTileWidth], normal[kTileWidth], albedo[kTileWidth];
-  float depth[kTileWidth];
   std::uint32_t object_id[kTileWidth], primitive_id[kTileWidth];
-  std::uint8_t coverage[kTileWidth];
   Vec2 uv[kTileWidth];
 
   // Channels a G-buffer rendered without albedo or UVs leaves empty are not written.
@@ -117,10 +115,8 @@ struct RowBuffer {
     stream_copy(&g.position(x0, y), position, n * sizeof(Vec3));
     stream_copy(&g.normal(x0, y), normal, n * sizeof(Vec3));
     if (!g.albedo.empty()) stream_copy(&g.albedo(x0, y), albedo, n * sizeof(Vec3));
-    stream_copy(&g.depth(x0, y), depth, n * sizeof(float));
     stream_copy(&g.object_id(x0, y), object_id, n * sizeof(std::uint32_t));
     stream_copy(&g.primitive_id(x0, y), primitive_id, n * sizeof(std::uint32_t));
-    stream_copy(&g.coverage(x0, y), coverage, n * sizeof(std::uint8_t));
     if (!g.uv.empty()) stream_copy(&g.uv(x0, y), uv, n * sizeof(Vec2));
   }
 };
@@ -168,11 +164,9 @@ void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const
       const unsigned geom = hits.geom[r + i];
       if (geom == RTC_INVALID_GEOMETRY_ID) {
         row.position[i] = {};
-        row.depth[i] = kInfinity;
         row.normal[i] = {};
         row.object_id[i] = 0;
         row.primitive_id[i] = 0;
-        row.coverage[i] = 0;
         if constexpr (kExtras) row.albedo[i] = {}, row.uv[i] = {};
         continue;
       }
@@ -190,11 +184,9 @@ void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const
         if (!(dot(n, n) > 0.25f)) n = ng;  // zero where the vertex normals cancel
       }
       row.position[i] = pc;
-      row.depth[i] = -pc.z;
       row.normal[i] = n;
       row.object_id[i] = geom + 1;
       row.primitive_id[i] = prim;
-      row.coverage[i] = 1;
       if constexpr (kExtras) {
         row.albedo[i] = scene.meshes[geom].albedo;
         row.uv[i] = {tri.t0.x * bw + tri.t1.x * bu + tri.t2.x * bv, tri.t0.y * bw + tri.t1.y * bu + tri.t2.y * bv};
@@ -248,12 +240,10 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   // the right size is kept, and fresh pages are first touched by the parallel tiles.
   const int w = camera.width, h = camera.height;
   g.position.resize(w, h);
-  g.depth.resize(w, h);
   g.normal.resize(w, h);
   if (options.albedo) g.albedo.resize(w, h);
   else g.albedo = Image<Vec3>();
   g.object_id.resize(w, h);
-  g.coverage.resize(w, h);
   if (options.uv) g.uv.resize(w, h);
   else g.uv = Image<Vec2>();
   g.primitive_id.resize(w, h);

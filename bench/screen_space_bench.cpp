@@ -106,6 +106,18 @@ void gtao(benchmark::State& state) {
   rate(state);
 }
 
+// The contiguous depth plane (GBuffer::depth of every pixel) each depth-reading pass builds once
+// from the positions and ids: what the G-buffer no longer stores costs the passes this much.
+void depth_plane_build(benchmark::State& state) {
+  Fixture& f = demo();
+  Image<float> plane;
+  for (auto _ : state) {
+    depth_plane(f.g, plane);
+    benchmark::DoNotOptimize(plane.data());
+  }
+  rate(state);
+}
+
 void box_filter(benchmark::State& state) {
   Fixture& f = demo();
   const Image<float> v(kWidth, kHeight, 0.5f);
@@ -201,6 +213,7 @@ BENCHMARK(volumetric)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTim
 BENCHMARK(gtao)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(transfer)->Args({0, 1})->Args({0, 2})->Args({1, 1})->Args({1, 2})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(transfer_radiance)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(depth_plane_build)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter_rgb)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(box_filter_planes4)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

@@ -142,7 +142,7 @@ BENCHMARK_CAPTURE(cone_voxelize, refined_elephant, std::string("refined_elephant
 BENCHMARK_CAPTURE(cone_trace, refined_elephant, std::string("refined_elephant.off"))
     ->Args({1024, 768, kMedium})->Args({1024, 768, kLow})->Args({1024, 768, kHigh})
     ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
-BENCHMARK_CAPTURE(cone_trace, default_scene, std::string("default"))->Args({1024, 768, kMedium})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK_CAPTURE(cone_trace, default_scene, std::string("default"))->Args({1024, 768, kMedium})->Args({960, 540, kMedium})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK(cone_trace_variants)->Args({0, 6})->Args({1, 6})->Args({1, 16})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK(cone_filter)->Arg(5)->Arg(7)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 // Table III shape: one mesh, growing resolution.

@@ -9,8 +9,9 @@
 int main(int argc, char** argv) try {
   if (argc < 2) return std::fprintf(stderr, "usage: %s MESH_WITH_UVS [OUT.png] [SIZE]\n", argv[0]), 2;
   const int size = argc > 3 ? std::atoi(argv[3]) : 256;
-  // 1. Load the mesh; its first UV set is the map's layout.
-  const ao::Scene scene = ao::load_scene_file(argv[1]);
+  // 1. Load the mesh; its first UV set is the map's layout. A glTF's instances become copies: each
+  //    placed mesh gets its own AO.
+  const ao::Scene scene = ao::load_scene_file(argv[1], {.flatten_instances = true});
   // 2. Which surface point each texel of the size x size map covers.
   const ao::TexelCoverage coverage = ao::compute_texel_coverage(scene, size);
   // 3. Bake: z-buffered views from 128 directions, histogrammed per texel.

@@ -1,8 +1,10 @@
 // Load, BVH and trace costs of one mesh file, as BENCHMARKS.md's "Loading big meshes" reports them:
-//   ao_load_timer /tmp/elephant-30M.ply [--quality low|medium|high] [--compact 0|1] [--trace] [--bake N [--distance R]]
+//   ao_load_timer /tmp/elephant-30M.ply [--quality low|medium|high] [--compact 0|1] [--flatten] [--trace] [--bake N [--distance R]]
 // prints the triangle count, the load's wall and CPU seconds, the BVH build's wall and CPU seconds
 // (all threads), and the peak resident memory after each step, per triangle. --quality and
-// --compact override RayScene's size rule (BvhOptions). --trace then renders a 480x270 G-buffer
+// --compact override RayScene's size rule (BvhOptions). --flatten loads a glTF's instances as
+// copies (LoadOptions::flatten_instances); the triangle count printed is of the triangles drawn.
+// --trace then renders a 480x270 G-buffer
 // of the auto-framed scene and 64 ray-traced AO rays per pixel with R = 2% of the scene's diagonal,
 // and prints the trace's CPU seconds and rays per CPU second: the trace speed of a BVH. --bake N
 // runs the ray-traced per-vertex bake with N rays per vertex (unlimited distance, or R with
@@ -49,19 +51,21 @@ const char* quality_name(ao::BvhQuality q) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const char* usage = "usage: ao_load_timer MESH [--quality low|medium|high] [--compact 0|1] [--trace] [--bake N [--distance R]]\n";
+  const char* usage = "usage: ao_load_timer MESH [--quality low|medium|high] [--compact 0|1] [--flatten] [--trace] [--bake N [--distance R]]\n";
   if (argc < 2) {
     std::fputs(usage, stderr);
     return 2;
   }
   ao::BvhOptions options;
-  bool trace = false;
+  bool trace = false, flatten = false;
   int bake_samples = 0;
   float distance = 0;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--trace") {
       trace = true;
+    } else if (a == "--flatten") {
+      flatten = true;
     } else if (a == "--quality" && i + 1 < argc) {
       const std::string q = argv[++i];
       options.quality = q == "low" ? ao::BvhQuality::Low : q == "medium" ? ao::BvhQuality::Medium : ao::BvhQuality::High;
@@ -78,16 +82,16 @@ int main(int argc, char** argv) {
   }
   try {
     double wall = now(), cpu = cpu_seconds();
-    const ao::Scene scene = ao::load_scene_file(argv[1]);
+    const ao::Scene scene = ao::load_scene_file(argv[1], {.flatten_instances = flatten});
     const double load_wall = now() - wall, load_cpu = cpu_seconds() - cpu, load_peak = peak_rss_bytes();
     const double triangles = static_cast<double>(scene.triangle_count());
     wall = now();
     cpu = cpu_seconds();
     const ao::RayScene rs(scene, options);
     const double bvh_wall = now() - wall, bvh_cpu = cpu_seconds() - cpu, bvh_peak = peak_rss_bytes();
-    std::printf("%s: %.0f triangles; load %.2f s wall, %.2f s CPU, peak %.0f MB (%.0f B/triangle); "
+    std::printf("%s: %.0f triangles (%zu stored, %zu instances); load %.2f s wall, %.2f s CPU, peak %.0f MB (%.0f B/triangle); "
                 "BVH (%s%s) %.2f s wall, %.2f s CPU, peak %.0f MB (%.0f B/triangle)\n",
-                argv[1], triangles, load_wall, load_cpu, load_peak / 1e6, load_peak / triangles, quality_name(rs.quality()),
+                argv[1], triangles, scene.stored_triangle_count(), scene.instances.size(), load_wall, load_cpu, load_peak / 1e6, load_peak / triangles, quality_name(rs.quality()),
                 rs.compact() ? ", compact" : "", bvh_wall, bvh_cpu, bvh_peak / 1e6, bvh_peak / triangles);
     if (trace) {
       const ao::Bounds3 b = scene.bounds();

@@ -28,6 +28,7 @@
 #include "ao/io/output_set.h"
 #include "ao/io/ply_export.h"
 #include "ao/reference/ray_scene.h"
+#include "bake_gltf.h"
 #include "common.h"
 #include "subcommands.h"
 
@@ -203,12 +204,16 @@ void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const 
   for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
 }
 
+// Bakes write per-vertex values and UV maps of each placed mesh, so glTF instances are loaded as
+// copies (LoadOptions::flatten_instances).
+constexpr LoadOptions kBakeLoad{.flatten_instances = true};
+
 // The high meshes of --high, one scene (their UVs are not used).
 Scene load_high_scene(const std::vector<std::string>& files) {
   Scene high;
   high.name = files.size() == 1 ? files.front() : "--high meshes";
   for (const std::string& f : files) {
-    Scene s = load_scene_file(f);
+    Scene s = load_scene_file(f, kBakeLoad);
     for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
     for (Mesh& m : s.meshes) high.meshes.push_back(std::move(m));
   }
@@ -219,7 +224,7 @@ Scene load_high_scene(const std::vector<std::string>& files) {
 std::vector<Mesh> load_occluders(const BakeOptions& o, const Scene& scene, const Scene* high) {
   std::vector<Mesh> out;
   for (const std::string& f : o.occluders) {
-    Scene s = load_scene_file(f);
+    Scene s = load_scene_file(f, kBakeLoad);
     for (const std::string& w : s.warnings) std::cerr << "warning: " << f << ": " << w << "\n";
     for (Mesh& m : s.meshes) {
       m.uvs.clear();
@@ -276,7 +281,7 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
   p.ao = rt;
   if (high) {
     if (!o.cage.empty()) {
-      cage = cage_from_mesh(scene, load_scene_file(o.cage));
+      cage = cage_from_mesh(scene, load_scene_file(o.cage, kBakeLoad));
     } else {
       if (!p.cage_extrusion) p.cage_extrusion = kDefaultCageFraction * scene.bounds().diagonal();
       cage = extrude_cage(scene, *p.cage_extrusion);
@@ -316,6 +321,64 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
   return r;
 }
 
+// A glTF input baked to --gltf or --per-vertex .glb: the document's round trip (bake_gltf.h).
+bool is_gltf_round_trip(const fs::path& input, const BakeOptions& o) {
+  return (!o.gltf.empty() || lower_extension(o.per_vertex) == ".glb") && is_gltf_file(input);
+}
+
+nlohmann::json bake_gltf_input(const fs::path& input, const BakeOptions& o, const MeshOutputs& outs, OutputSet& outputs, const GlobalOptions& global) {
+  const std::pair<bool, const char*> unsupported[] = {{!o.high.empty(), "--high"},
+                                                      {!o.groups.empty() || o.self_occlusion || o.match_by_name, "bake groups"},
+                                                      {!o.bent.empty(), "--bent-normals"},
+                                                      {!o.orm.empty(), "--orm"},
+                                                      {!o.reference.empty(), "--reference"},
+                                                      {!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".glb", "--per-vertex .ply"},
+                                                      {is_udim_pattern(o.output), "UDIM tiles"}};
+  for (const auto& [given, what] : unsupported)
+    if (given)
+      throw InputError(input.string() + ": a glTF input baked to a .glb keeps its document, one map per glTF mesh; " + what +
+                       " does not apply to it (bake without --gltf/--per-vertex .glb for the flattened scene)");
+  const bool progress = !global.quiet && stderr_is_terminal();
+  RaytracedBakeParams rt = o.rt;
+  rt.seed = o.seed;
+  rt.max_distance = o.max_distance;
+  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
+  HistogramParams hist = o.hist;
+  hist.seed = o.seed;
+  GltfRoundTrip job;
+  job.input = input;
+  job.gltf = outs.gltf;
+  job.per_vertex = outs.per_vertex;
+  if (writes_map_file(o) && !o.output.empty()) job.map = outs.map;
+  job.uv_set = o.uv_set;
+  job.width = o.width;
+  job.height = o.height;
+  job.png_bits = o.png_bits;
+  job.padding = o.padding;
+  job.json = o.json;
+  job.occluders = [&](const Scene& world) { return load_occluders(o, world, nullptr); };
+  job.bake_map = [&](const Scene& scene, const std::string& label) {
+    const TexelCoverage cov = compute_texel_coverage(scene, o.width, o.height);
+    for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": mesh " << label << ": " << w << "\n";
+    ProgressBar bar("bake " + input.filename().string() + " " + label, progress);
+    if (o.method == "histogram") return bake_histogram(scene, cov, hist, bar.callback());
+    const RayScene rays(scene);
+    return bake_raytraced(rays, cov, rt, bar.callback());
+  };
+  job.bake_vertices = [&](const Scene& scene, std::uint64_t* nrays) {
+    ProgressBar bar("per-vertex " + input.filename().string(), progress);
+    if (o.method == "histogram")
+      return bake_vertices_histogram(scene, {.directions = hist.directions, .direction_set = hist.direction_set, .resolution = o.vertex_resolution, .seed = o.seed},
+                                     bar.callback());
+    const RayScene rays(scene);
+    return bake_vertices_raytraced(rays, rt, nrays, bar.callback());
+  };
+  nlohmann::json summary = bake_gltf_round_trip(job, outputs);
+  summary["method"] = o.method;
+  outputs.commit();
+  return summary;
+}
+
 nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch, const GlobalOptions& global) {
   Stopwatch clock;
   nlohmann::json timings;
@@ -323,14 +386,9 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   const MeshOutputs outs = outputs_of(input, o, batch);
   OutputSet outputs;
   declare(outputs, input, o, outs);
-  Scene scene = load_scene_file(input, {.uv_set = o.uv_set});
+  if (is_gltf_round_trip(input, o)) return bake_gltf_input(input, o, outs, outputs, global);
+  Scene scene = load_scene_file(input, {.uv_set = o.uv_set, .flatten_instances = true});
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
-  // A glTF input keeps its materials (factors, textures, ...) in the --gltf output, with the map added.
-  std::optional<GltfSource> source;
-  if ((!o.gltf.empty() || lower_extension(o.per_vertex) == ".glb") && is_gltf_file(input)) {
-    source = load_gltf_materials(input, scene, o.uv_set);
-    for (const std::string& w : source->warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
-  }
   timings["load_ms"] = clock.lap_ms();
   nlohmann::json summary = {{"input", input.string()}, {"method", o.method}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   RaytracedBakeParams rt = o.rt;
@@ -518,13 +576,13 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
         write_image(tmp.path(), r.visibility, {.png_bits = o.png_bits});
         png = read_bytes(tmp.path());
       }
-      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, source ? &*source : nullptr, vertex_ao.empty() ? nullptr : &vertex_ao); });
+      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, nullptr, vertex_ao.empty() ? nullptr : &vertex_ao); });
       summary["gltf_output"] = outs.gltf.string();
     }
   }
   if (!outs.per_vertex.empty()) {
     outputs.write(outs.per_vertex, [&] {
-      if (lower_extension(outs.per_vertex) == ".glb") write_ao_glb(outs.per_vertex, scene, "", source ? &*source : nullptr, &vertex_ao);
+      if (lower_extension(outs.per_vertex) == ".glb") write_ao_glb(outs.per_vertex, scene, "", nullptr, &vertex_ao);
       else write_vertex_ao_ply(outs.per_vertex, scene, vertex_ao);
     });
     summary["per_vertex_output"] = outs.per_vertex.string();
@@ -693,7 +751,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--out-dir", o->out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   CLI::Option* method = cmd->add_option("-m,--method", o->method, "raytraced (Embree, inside-out; default) or histogram (outside-in, McGraw & Sowers; unlimited distance)")->capture_default_str();
   CLI::Option* size_opt = cmd->add_option("-s,--size", o->size_text, "Map size in texels: N (N x N) or WIDTHxHEIGHT (2048x1024), each in [1, 16384]")->capture_default_str();
-  cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); the .glb of --gltf writes it as TEXCOORD_0")->capture_default_str();
+  cmd->add_option("--uv-set", o->uv_set, "UV set to bake into, from 0 (glTF TEXCOORD_n); --gltf writes it as TEXCOORD_0 for OBJ/PLY/STL, keeps it (texCoord n) for glTF")->capture_default_str();
   cmd->add_option("-d,--directions", o->hist.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
   cmd->add_option("--direction-set", o->direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();
   cmd->add_option("--pixels-per-texel", o->hist.pixels_per_texel, "histogram: view resolution, pixels per texel edge (0, 8]")->capture_default_str();
@@ -723,7 +781,8 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--bent-normals", o->bent, "Also write the bent normals (average open direction, world space, n*0.5+0.5) to this image");
   cmd->add_option("--per-vertex", o->per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO: .ply (colour + float quality) or .glb (glTF COLOR_0)");
   cmd->add_option("--vertex-resolution", o->vertex_resolution, "histogram --per-vertex: view size in pixels [64, 8192]")->capture_default_str();
-  cmd->add_option("--gltf", o->gltf, "Also write a .glb of the mesh with the map as its material's occlusion texture");
+  cmd->add_option("--gltf", o->gltf, "Also write a .glb of the mesh with the map as its material's occlusion texture; a glTF input keeps its nodes, instances and "
+                  "materials, one map per glTF mesh (docs/bake.md)");
   cmd->add_option("--reference", o->reference, "Compare the map with this reference map (EXR/PNG, same size) over covered texels; RMSE etc. in --json");
   cmd->add_option("--seed", o->seed, "Seed of directions / sample sets")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary (texels covered, directions or rays, timings, texels/s, rays/s) on stdout");

@@ -68,6 +68,11 @@ Scene load_scene_arguments(const std::vector<std::string>& args) {
   for (const std::string& a : args) {
     Scene s = load_scene_file(a);
     merged.name += (merged.name.empty() ? "" : "+") + s.name;
+    const auto first_mesh = static_cast<std::uint32_t>(merged.meshes.size());
+    for (Instance& in : s.instances) {
+      in.mesh += first_mesh;
+      merged.instances.push_back(std::move(in));
+    }
     for (Mesh& m : s.meshes) merged.meshes.push_back(std::move(m));
     for (std::string& w : s.warnings) merged.warnings.push_back(std::move(w));
   }
@@ -180,8 +185,11 @@ bool is_flat(const Mesh& m) {
 
 float interest_diagonal(const Scene& scene) {
   Bounds3 objects;
-  for (const Mesh& m : scene.meshes)
-    if (!is_flat(m)) objects.extend(m.bounds());
+  for (const SceneObject& o : scene.objects()) {
+    const Mesh& m = scene.meshes[o.mesh];
+    if (is_flat(m)) continue;  // flatness survives an affine map
+    objects.extend(o.instance == SceneObject::kNoInstance ? m.bounds() : transform_bounds(scene.instances[o.instance].object_to_world, m.bounds()));
+  }
   return objects.empty() ? scene.bounds().diagonal() : objects.diagonal();
 }
 

@@ -182,8 +182,8 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     scene = load_scene_arguments(o.scene);
     for (const std::string& w : scene->warnings) std::cerr << "warning: " << w << "\n";
     timings["load_ms"] = clock.lap_ms();
-    check_memory(estimate_ray_scene_memory(scene->triangle_count(), scene->vertex_count()),
-                 "ao render: the BVH of " + std::to_string(scene->triangle_count()) + " triangles");
+    check_memory(estimate_ray_scene_memory(scene->stored_triangle_count(), scene->vertex_count(), scene->instances.size()),
+                 "ao render: the BVH of " + std::to_string(scene->stored_triangle_count()) + " triangles");
     rays = std::make_unique<RayScene>(*scene);
     timings["bvh_ms"] = clock.lap_ms();
     const Camera cam = choose_camera(*scene, o.camera);
@@ -267,6 +267,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (sun) summary["sun"] = {{"direction", to_json(sun->direction)}, {"irradiance", sun->irradiance}};
   if (scene) {
     summary["triangles"] = scene->triangle_count();
+    summary["instances"] = scene->instances.size();
     summary["warnings"] = scene->warnings;
   }
   if (result.stats.contains("rays") && ao_ms > 0)

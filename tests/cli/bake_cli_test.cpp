@@ -252,8 +252,9 @@ TEST(BakeCli, UvSetPicksTheSecondSetAndTheGlbKeepsTheMaterial) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_GT(j["texels_covered"].get<int>(), 30);
   EXPECT_LT(j["texels_covered"].get<int>(), 70);
-  // The .glb's TEXCOORD_0 is the baked set (read back by the loader in its v-up convention).
-  const Scene glb = load_scene_file(dir / "out.glb");
+  // The .glb keeps both sets (the glTF round trip); TEXCOORD_1 is the baked one (read back by the
+  // loader in its v-up convention) and the occlusion texture's texCoord.
+  const Scene glb = load_scene_file(dir / "out.glb", {.uv_set = 1});
   ASSERT_EQ(glb.meshes.size(), 1u);
   ASSERT_EQ(glb.meshes[0].uvs.size(), 4u);
   for (const Vec2& t : glb.meshes[0].uvs) {
@@ -264,7 +265,7 @@ TEST(BakeCli, UvSetPicksTheSecondSetAndTheGlbKeepsTheMaterial) {
   const std::string bytes = read_text(dir / "out.glb");
   EXPECT_NE(bytes.find("\"name\":\"Keep me\""), std::string::npos);
   EXPECT_NE(bytes.find("\"doubleSided\":true"), std::string::npos);
-  EXPECT_NE(bytes.find("\"occlusionTexture\""), std::string::npos);
+  EXPECT_NE(bytes.find("\"occlusionTexture\":{\"index\":0,\"texCoord\":1}"), std::string::npos);
 }
 
 TEST(BakeCli, AbsentUvSetIsAOneLineErrorAndWritesNothing) {

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/gltf_docs.h"
 #include "support/run.h"
 
 namespace ao::test {
@@ -75,7 +76,12 @@ TEST(GltfValidator, EveryKindOfGlbTheTestsWriteHasNoErrorsOrWarnings) {
   ASSERT_EQ(run_ao("bake cube.obj --gltf wide.glb --samples 4 -s 32x8", dir.path()).exit_code, 0);
   ASSERT_EQ(run_ao("bake cube.obj --per-vertex vertex.glb --samples 4", dir.path()).exit_code, 0);
   ASSERT_EQ(run_ao("bake map.glb --gltf again.glb" + rays, dir.path()).exit_code, 0);
-  const std::vector<fs::path> glbs = {dir / "map.glb", dir / "map16.glb", dir / "wide.glb", dir / "vertex.glb", dir / "again.glb"};
+  write_text(dir / "pair.glb", instanced_cubes_glb());
+  write_text(dir / "shared.glb", shared_material_glb());
+  ASSERT_EQ(run_ao("bake pair.glb --gltf pair-map.glb --per-vertex pair-vertex.glb" + rays, dir.path()).exit_code, 0);
+  ASSERT_EQ(run_ao("bake shared.glb --gltf shared-maps.glb --png-bits 16" + rays, dir.path()).exit_code, 0);
+  const std::vector<fs::path> glbs = {dir / "map.glb",      dir / "map16.glb",        dir / "wide.glb",         dir / "vertex.glb",
+                                      dir / "again.glb",    dir / "pair-map.glb",     dir / "pair-vertex.glb", dir / "shared-maps.glb"};
   const Validation v = validate(glbs);
   if (!v.ran) GTEST_SKIP() << "gltf-validator did not run: " << v.why_not << " (scripts/setup installs it when the npm registry is reachable)";
   ASSERT_EQ(v.files.size(), glbs.size());

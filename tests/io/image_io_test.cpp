@@ -3,6 +3,8 @@
 #include "ao/io/image_io.h"
 
 #include <gtest/gtest.h>
+#include <linux/capability.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -108,13 +110,42 @@ TEST(AtomicFile, DirectoryAsTargetIsAnError) {
                                     "is a directory");
 }
 
+// While alive, the calling thread obeys file permission bits even as root: the capabilities that
+// override them (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH, CAP_FOWNER) are cleared from the thread's
+// effective set and restored from its permitted set on destruction. Linux capabilities are per
+// thread, and the code under test writes from the calling thread.
+class PermissionBitsApply {
+ public:
+  PermissionBitsApply() {
+    header_.version = _LINUX_CAPABILITY_VERSION_3;
+    header_.pid = 0;
+    if (::syscall(SYS_capget, &header_, saved_) != 0) return;
+    __user_cap_data_struct reduced[2] = {saved_[0], saved_[1]};
+    for (const int cap : {CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH, CAP_FOWNER})
+      reduced[cap / 32].effective &= ~(1u << (cap % 32));
+    active_ = ::syscall(SYS_capset, &header_, reduced) == 0;
+  }
+  ~PermissionBitsApply() {
+    if (active_) ::syscall(SYS_capset, &header_, saved_);
+  }
+  PermissionBitsApply(const PermissionBitsApply&) = delete;
+  PermissionBitsApply& operator=(const PermissionBitsApply&) = delete;
+
+ private:
+  __user_cap_header_struct header_{};
+  __user_cap_data_struct saved_[2]{};
+  bool active_ = false;
+};
+
 TEST(AtomicFile, UnwritableDirectoryIsASystemErrorNamingThePath) {
-  if (::geteuid() == 0) GTEST_SKIP() << "root can write anywhere";
   TempDir dir;
   fs::create_directory(dir / "ro");
   fs::permissions(dir / "ro", fs::perms::owner_read | fs::perms::owner_exec);
-  expect_one_line_error<SystemError>([&] { write_file_atomically(dir / "ro" / "x.png", [](const fs::path&) {}); },
-                                     dir / "ro" / "x.png", "cannot create");
+  {
+    const PermissionBitsApply as_an_ordinary_user;
+    expect_one_line_error<SystemError>([&] { write_file_atomically(dir / "ro" / "x.png", [](const fs::path&) {}); },
+                                       dir / "ro" / "x.png", "cannot create");
+  }
   fs::permissions(dir / "ro", fs::perms::owner_all);
 }
 

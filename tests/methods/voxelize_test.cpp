@@ -158,6 +158,31 @@ TEST(Voxelize, EyeGridIsSolidInsideABoxAndEmptyInFront) {
   }
 }
 
+// The window masks (voxelize.h) against their definition, brute force: bit ck of window w at
+// (ci, cj) is set exactly when a voxel of a cell (ci'..., ck) with ci <= ci' <= ci + w,
+// cj <= cj' <= cj + w is solid. Grid sizes that are not multiples of the cell clip the windows.
+TEST(Voxelize, WindowMasksAreTheOrOfTheirCells) {
+  const Scene s = scene_of({make_sphere({0.1f, 0.2f, -0.3f}, 1.0f, 32, 16), make_box({-2, -1, -2}, {-1.5f, 0.5f, 1.5f})});
+  for (int columns : {61, 64}) {
+    VoxelizeOptions o;
+    o.columns = columns;
+    o.depth_bits = 256;  // 2 voxels per mask bit
+    const VoxelGrid g = voxelize_world(s, analyze_closure(s), o);
+    ASSERT_EQ(g.cell_bits, 4);
+    constexpr int C = VoxelGrid::kCellXY;
+    for (int cj = 0; cj < g.dny; ++cj)
+      for (int ci = 0; ci < g.dnx; ++ci)
+        for (int w = 0; w <= VoxelGrid::kWindowCap; w += 3) {
+          std::uint64_t expected = 0;
+          for (int j = cj * C; j < std::min(g.ny, (cj + w + 1) * C); ++j)
+            for (int i = ci * C; i < std::min(g.nx, (ci + w + 1) * C); ++i)
+              for (int k = 0; k < g.depth_bits; ++k)
+                if (g.voxel(i, j, k)) expected |= std::uint64_t{1} << (k / g.cell_bits);
+          ASSERT_EQ(g.window_mask(w, ci, cj), expected) << columns << " columns, cell " << ci << ", " << cj << ", w " << w;
+        }
+  }
+}
+
 TEST(Voxelize, SameGridAtOneAndTwoThreads) {
   const Scene s = make_builtin_scene("default");
   const auto closure = analyze_closure(s);

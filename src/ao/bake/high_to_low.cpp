@@ -55,14 +55,20 @@ HighHit trace_cage_ray(const RayScene& targets, const TriangleNormals& fn, RTCIn
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(embree_scene(targets), &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
-    const Vec3 ng = fn.per_mesh[rh.hit.geomID][rh.hit.primID];
+    const HitRef hit = resolve(targets, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID);
+    const Affine3* nt = hit.normal_to_world;  // null: the mesh is in world space
+    const Vec3 ng = nt ? normalize(nt->vector(fn.per_mesh[hit.mesh][hit.triangle])) : fn.per_mesh[hit.mesh][hit.triangle];
     if (dot(ng, d) < 0) {
       // Embree's barycentrics: u weights vertex 1, v vertex 2.
-      const Mesh& m = targets.scene().meshes[rh.hit.geomID];
-      const std::uint32_t* i = &m.indices[3 * rh.hit.primID];
+      const Mesh& m = targets.scene().meshes[hit.mesh];
+      const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(hit.triangle)];
       const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-      const Vec3 p = m.positions[i[0]] * w + m.positions[i[1]] * u + m.positions[i[2]] * v;
-      Vec3 n = normalize(m.normals[i[0]] * w + m.normals[i[1]] * u + m.normals[i[2]] * v);
+      Vec3 p0, p1, p2;
+      world_triangle(targets, hit, p0, p1, p2);
+      const Vec3 p = p0 * w + p1 * u + p2 * v;
+      Vec3 n0 = m.normals[i[0]], n1 = m.normals[i[1]], n2 = m.normals[i[2]];
+      if (nt) n0 = normalize(nt->vector(n0)), n1 = normalize(nt->vector(n1)), n2 = normalize(nt->vector(n2));
+      Vec3 n = normalize(n0 * w + n1 * u + n2 * v);
       if (!(length(n) > 0.5f)) n = ng;
       return {true, p, n, ng};
     }

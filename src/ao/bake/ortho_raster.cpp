@@ -12,6 +12,7 @@
 namespace ao {
 
 RasterMesh make_raster_mesh(const Scene& scene, int map_width, int map_height) {
+  require_no_instances(scene);
   RasterMesh r;
   Bounds3 bounds;
   for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {

@@ -208,6 +208,7 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
                                            const ProgressFn& progress) {
   params.validate();
   const Scene& scene = rs.scene();
+  require_no_instances(scene);
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};

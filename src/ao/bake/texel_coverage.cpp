@@ -86,7 +86,14 @@ std::vector<std::string> TexelCoverage::warnings() const {
 
 TexelCoverage compute_texel_coverage(const Scene& scene, int size) { return compute_texel_coverage(scene, size, size); }
 
+void require_no_instances(const Scene& scene) {
+  if (!scene.instances.empty())
+    throw InputError(scene.name + ": has " + std::to_string(scene.instances.size()) +
+                     " mesh instances; baking needs every placed mesh as a copy of its own (load it with flatten_instances)");
+}
+
 TexelCoverage compute_texel_coverage(const Scene& scene, int width, int height) {
+  require_no_instances(scene);
   for (const int side : {width, height})
     if (side < 1 || side > kMaxSize) throw InputError("bake: map width and height must be in [1, " + std::to_string(kMaxSize) + "], got " + std::to_string(width) + "x" + std::to_string(height));
   TexelCoverage cov;

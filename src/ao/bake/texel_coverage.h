@@ -19,6 +19,12 @@
 
 namespace ao {
 
+/// Bakers write values per mesh vertex and per UV texel, which an instanced mesh (one set of UVs
+/// and vertices, several placements with different AO) cannot hold: they take scenes whose every
+/// mesh is placed once. Throws InputError naming the scene when `scene.instances` is not empty
+/// (load with LoadOptions::flatten_instances, or flatten_instances()).
+void require_no_instances(const Scene& scene);
+
 /// One triangle's share of one texel.
 struct TexelFragment {
   std::uint32_t mesh = 0;      ///< Index of the mesh in the scene.

@@ -16,10 +16,18 @@
 
 namespace ao::detail {
 
-/// Geometric (face) normal of every triangle, per mesh.
+/// Geometric (face) normal of every triangle, per mesh, in the mesh's own coordinates (world
+/// space, but for an instanced mesh; hit_face_normal moves it to the world).
 struct TriangleNormals {
   std::vector<std::vector<Vec3>> per_mesh;
 };
+
+/// World-space face normal (not unit for an instance) of the triangle a ray hit.
+inline Vec3 hit_face_normal(const RayScene& rs, const TriangleNormals& fn, unsigned geom_id, unsigned inst_id, unsigned prim_id) {
+  const HitRef h = resolve(rs, geom_id, inst_id, prim_id);
+  const Vec3 n = fn.per_mesh[h.mesh][h.triangle];
+  return h.normal_to_world ? h.normal_to_world->vector(n) : n;
+}
 TriangleNormals face_normals(const Scene& s);
 
 /// A texel's patch as sub-triangles in texel-unit UV space, each with the mesh triangle it lies on
@@ -68,7 +76,7 @@ struct Tracer {
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(embree_scene(rs), &ctx, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 1.0f;
-      if (!ignore_back || dot(normals.per_mesh[rh.hit.geomID][rh.hit.primID], d) <= 0) return falloff.mu(rh.ray.tfar);
+      if (!ignore_back || dot(hit_face_normal(rs, normals, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID), d) <= 0) return falloff.mu(rh.ray.tfar);
       tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: look beyond it
     }
     return 0.0f;
@@ -106,7 +114,7 @@ struct Tracer {
         for (int k = 0; k < count; ++k) {
           if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
             mu[k] = 1.0f;
-          } else if (ignore_back && dot(normals.per_mesh[rh.hit.geomID[k]][rh.hit.primID[k]], dir[k]) > 0) {
+          } else if (ignore_back && dot(hit_face_normal(rs, normals, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k]), dir[k]) > 0) {
             mu[k] = trace1(ctx, org[k], dir[k], std::nextafter(rh.ray.tfar[k], kInfinity));
           } else {
             mu[k] = falloff.mu(rh.ray.tfar[k]);

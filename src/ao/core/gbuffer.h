@@ -24,8 +24,9 @@ struct GBuffer {
   Image<Vec3> position;       ///< Camera-space position of the visible surface, z < 0; (0,0,0) where not covered.
   Image<Vec3> normal;         ///< Unit camera-space normal facing the camera (the shading normal unless rendered with SurfaceNormal::Geometric); (0,0,0) where not covered.
   Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered. Empty when rendered without it (GBufferOptions::albedo).
-  /// 1 + index of the mesh in its scene where a surface is visible; 0 where not covered (the
-  /// background): this is the coverage (covered()).
+  /// 1 + index of the object in its scene (Scene::objects(): the mesh, or a glTF instance of it)
+  /// where a surface is visible; 0 where not covered (the background): this is the coverage
+  /// (covered()).
   Image<std::uint32_t> object_id;
   Image<Vec2> uv;                  ///< First UV set of the visible surface; (0,0) where not covered or the mesh has none. Empty when rendered without it (GBufferOptions::uv).
   /// Optional direct-light pass: the radiance Ld the visible surface reflects of direct lights

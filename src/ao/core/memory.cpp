@@ -34,6 +34,11 @@ constexpr std::uint64_t kGBufferOutBytes = 16;     // OpenEXR's line buffers and
 // (~90 B), with room for the builder's temporary primitive array (32 B per triangle).
 constexpr std::uint64_t kBvhBytesPerTriangle = 12 + 90 + 32;
 constexpr std::uint64_t kBvhBytesPerVertex = 16;
+// An instance (scene/mesh.h): Embree's instance geometry object with its transform, its share of
+// the top-level BVH, the Scene's Instance and the per-instance normal matrix. Measured
+// (BENCHMARKS.md, "Instanced glTF"): 2.2 KB per instance at the peak, load included (assimp's
+// nodes and JSON, freed before the BVH is built), so 2 KB bounds what the BVH adds.
+constexpr std::uint64_t kBytesPerInstance = 2048;
 
 // --- bake, bytes per texel ---------------------------------------------------------------------
 // Texel coverage (texel_coverage.h): offsets 4 + world area 4 + UV area 4 + mask 1 + about two
@@ -94,8 +99,8 @@ std::uint64_t estimate_cone_grid_memory(int columns, int depth_bits) {
   return c * c * (static_cast<std::uint64_t>(std::clamp(depth_bits, 0, 1024)) / 4 + 16);
 }
 
-std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t vertices) {
-  return kBvhBytesPerTriangle * triangles + kBvhBytesPerVertex * vertices;
+std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t vertices, std::size_t instances) {
+  return kBvhBytesPerTriangle * triangles + kBvhBytesPerVertex * vertices + kBytesPerInstance * instances;
 }
 
 std::uint64_t estimate_bake_memory(const BakeMemoryInput& in) {

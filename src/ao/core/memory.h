@@ -31,8 +31,9 @@ std::uint64_t estimate_render_memory(const RenderMemoryInput& in);
 std::uint64_t estimate_cone_grid_memory(int columns, int depth_bits);
 
 /// Peak bytes of the ray-traced scene (Embree BVH and its copy of the geometry) for a scene of
-/// `triangles` triangles and `vertices` vertices, beyond the Scene itself.
-std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t vertices);
+/// `triangles` triangles and `vertices` vertices held in memory (Scene::stored_triangle_count,
+/// an instanced mesh once) and `instances` instances, beyond the Scene itself.
+std::uint64_t estimate_ray_scene_memory(std::size_t triangles, std::size_t vertices, std::size_t instances = 0);
 
 /// What `ao bake` allocates that grows with the map.
 struct BakeMemoryInput {

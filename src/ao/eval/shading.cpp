@@ -28,9 +28,10 @@ Image<Vec3> shade_for_display(const GBuffer& g, const Image<float>& v, const Ima
 
 Image<float> visibility_from_ao_map(const GBuffer& g, const Scene& scene, const Image<float>& map, const std::string& map_name) {
   Image<float> v(g.width(), g.height(), 1.0f);
+  const std::vector<SceneObject> objects = scene.objects();  // object id - 1 -> mesh
   for (std::size_t i = 0; i < g.object_id.size(); ++i) {
     if (!g.covered(i)) continue;
-    const Mesh& mesh = scene.meshes[g.object_id[i] - 1];
+    const Mesh& mesh = scene.meshes[objects[g.object_id[i] - 1].mesh];
     if (mesh.uvs.empty())
       throw InputError(scene.name + ": mesh '" + mesh.name + "' is visible but has no UVs, so the AO map " + map_name + " cannot be shown on it");
     v[i] = std::clamp(sample_bilinear(map, g.uv[i]), 0.0f, 1.0f);

@@ -25,8 +25,8 @@ namespace ao {
 Image<Vec3> shade_for_display(const GBuffer& g, const Image<float>& visibility, const Image<Vec3>& color = {});
 
 /// V from a baked AO map: the map's value at each covered pixel's UV (bilinear, clamped to the
-/// edge texels, then to [0, 1]); 1 where the G-buffer is not covered. `g.object_id` indexes
-/// `scene.meshes` (as render_gbuffer writes it). InputError naming `map_name` and the mesh when a
+/// edge texels, then to [0, 1]); 1 where the G-buffer is not covered. `g.object_id` - 1 indexes
+/// `scene.objects()` (as render_gbuffer writes it; an instance shows its mesh's map). InputError naming `map_name` and the mesh when a
 /// visible mesh has no UVs. `map` must not be empty.
 Image<float> visibility_from_ao_map(const GBuffer& g, const Scene& scene, const Image<float>& map, const std::string& map_name);
 

@@ -36,7 +36,7 @@ struct RayGenerator {
 // the tracing phase fills it packet by packet, the shading phase reads it row by row.
 struct TileHits {
   static constexpr int kPixels = kTileWidth * kStripHeight;
-  unsigned geom[kPixels], prim[kPixels];
+  unsigned geom[kPixels], inst[kPixels], prim[kPixels];
   float u[kPixels], v[kPixels];
 };
 
@@ -56,7 +56,7 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(bvh, &ctx, &rh);
         const int j = (y - t.y0) * tw + (x - t.x0);
-        hits.geom[j] = rh.hit.geomID, hits.prim[j] = rh.hit.primID, hits.u[j] = rh.hit.u, hits.v[j] = rh.hit.v;
+        hits.geom[j] = rh.hit.geomID, hits.inst[j] = rh.hit.instID[0], hits.prim[j] = rh.hit.primID, hits.u[j] = rh.hit.u, hits.v[j] = rh.hit.v;
       }
   } else {
     // Blocks of 4 x (N/4) pixels: square-ish footprints keep the packet's rays coherent. The
@@ -82,7 +82,8 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
         for (int k = 0; k < N; ++k) {
           if (!valid[k]) continue;
           const int j = (by + k / bw - t.y0) * tw + (bx + k % bw - t.x0);
-          hits.geom[j] = rh.hit.geomID[k], hits.prim[j] = rh.hit.primID[k], hits.u[j] = rh.hit.u[k], hits.v[j] = rh.hit.v[k];
+          hits.geom[j] = rh.hit.geomID[k], hits.inst[j] = rh.hit.instID[0][k], hits.prim[j] = rh.hit.primID[k], hits.u[j] = rh.hit.u[k],
+          hits.v[j] = rh.hit.v[k];
         }
       }
   }
@@ -125,25 +126,37 @@ struct RowBuffer {
 // pixels mostly see the same triangle, so it is built once per run of such pixels instead of
 // once per pixel (the vertex fetches, the cross product and the transforms to camera space).
 struct CameraTriangle {
-  unsigned geom = RTC_INVALID_GEOMETRY_ID, prim = 0;
+  unsigned geom = RTC_INVALID_GEOMETRY_ID, inst = RTC_INVALID_GEOMETRY_ID, prim = 0;  ///< Embree's ids of the hit.
+  std::uint32_t object = 0;    ///< Index into Scene::objects() (object id - 1).
+  std::uint32_t triangle = 0;  ///< Triangle within its mesh.
+  Vec3 albedo;
   Vec3 q0, q1, q2;  ///< Vertices, camera space (relative to the eye).
   Vec3 ng;          ///< Unit geometric normal, camera space, as wound (not yet turned to the camera).
   Vec3 n0, n1, n2;  ///< Vertex normals, camera space (SurfaceNormal::Shading only).
   Vec2 t0, t1, t2;  ///< Vertex UVs; zero when the mesh has none or UVs are not wanted.
 
   template <SurfaceNormal kWhich>
-  void load(const Scene& scene, const Camera& cam, const Frame& basis, unsigned g, unsigned p, bool want_uv) {
-    geom = g, prim = p;
-    const Mesh& m = scene.meshes[g];
-    const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(p)];
-    const Vec3 p0 = m.positions[tri[0]], p1 = m.positions[tri[1]], p2 = m.positions[tri[2]];
+  void load(const RayScene& rs, const Camera& cam, const Frame& basis, unsigned g, unsigned i, unsigned p, bool want_uv) {
+    geom = g, inst = i, prim = p;
+    // An instance's triangle is moved to the world vertex by vertex, so the point, the normal and
+    // their rounding are those of the same triangle stored in world space.
+    const HitRef hit = resolve(rs, g, i, p);
+    const Mesh& m = rs.scene().meshes[hit.mesh];
+    object = hit.object, triangle = hit.triangle, albedo = m.albedo;
+    const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(hit.triangle)];
+    Vec3 p0, p1, p2;
+    world_triangle(rs, hit, p0, p1, p2);
     // Moving the vertices to camera space and interpolating there puts each point on the triangle
     // to a few float spacings of the coordinates and the eye, which the ray offsets rely on
     // (reference/ray_offset.h); eye + t * direction would be off by the error of t.
     q0 = basis.to_local(p0 - cam.eye), q1 = basis.to_local(p1 - cam.eye), q2 = basis.to_local(p2 - cam.eye);
     ng = basis.to_local(normalize(cross(p1 - p0, p2 - p0)));
-    if constexpr (kWhich == SurfaceNormal::Shading)
-      n0 = basis.to_local(m.normals[tri[0]]), n1 = basis.to_local(m.normals[tri[1]]), n2 = basis.to_local(m.normals[tri[2]]);
+    if constexpr (kWhich == SurfaceNormal::Shading) {
+      Vec3 w0 = m.normals[tri[0]], w1 = m.normals[tri[1]], w2 = m.normals[tri[2]];
+      if (const Affine3* nt = hit.normal_to_world)  // vertex normals as flatten_instances stores them
+        w0 = normalize(nt->vector(w0)), w1 = normalize(nt->vector(w1)), w2 = normalize(nt->vector(w2));
+      n0 = basis.to_local(w0), n1 = basis.to_local(w1), n2 = basis.to_local(w2);
+    }
     if (want_uv && !m.uvs.empty()) t0 = m.uvs[tri[0]], t1 = m.uvs[tri[1]], t2 = m.uvs[tri[2]];
     else t0 = t1 = t2 = {};
   }
@@ -153,7 +166,7 @@ struct CameraTriangle {
 // streamed out, one contiguous run per channel. kExtras: albedo and UVs are wanted (else their
 // images are empty and nothing is computed for them).
 template <SurfaceNormal kWhich, bool kExtras>
-void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
+void shade_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
   const int tw = t.x1 - t.x0;
   const bool want_uv = kExtras && !g.uv.empty();
   RowBuffer row;
@@ -170,8 +183,8 @@ void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const
         if constexpr (kExtras) row.albedo[i] = {}, row.uv[i] = {};
         continue;
       }
-      const unsigned prim = hits.prim[r + i];
-      if (geom != tri.geom || prim != tri.prim) tri.load<kWhich>(scene, cam, basis, geom, prim, want_uv);
+      const unsigned inst = hits.inst[r + i], prim = hits.prim[r + i];
+      if (geom != tri.geom || prim != tri.prim || inst != tri.inst) tri.load<kWhich>(rs, cam, basis, geom, inst, prim, want_uv);
       const float bu = hits.u[r + i], bv = hits.v[r + i], bw = 1.0f - bu - bv;
       const Vec3 pc = tri.q0 * bw + tri.q1 * bu + tri.q2 * bv;
       // Both sides of a surface can be seen (open meshes, rooms): AO is for the side facing the
@@ -185,10 +198,10 @@ void shade_tile(const Scene& scene, const Camera& cam, const Frame& basis, const
       }
       row.position[i] = pc;
       row.normal[i] = n;
-      row.object_id[i] = geom + 1;
-      row.primitive_id[i] = prim;
+      row.object_id[i] = tri.object + 1;
+      row.primitive_id[i] = tri.triangle;
       if constexpr (kExtras) {
-        row.albedo[i] = scene.meshes[geom].albedo;
+        row.albedo[i] = tri.albedo;
         row.uv[i] = {tri.t0.x * bw + tri.t1.x * bu + tri.t2.x * bv, tri.t0.y * bw + tri.t1.y * bu + tri.t2.y * bv};
       }
     }
@@ -210,11 +223,11 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
     trace_tile<N>(embree_scene(rs), cam, gen, s, hits);
     const bool extras = !g.albedo.empty() || !g.uv.empty();
     if (which == SurfaceNormal::Shading) {
-      if (extras) shade_tile<SurfaceNormal::Shading, true>(rs.scene(), cam, basis, hits, g, s);
-      else shade_tile<SurfaceNormal::Shading, false>(rs.scene(), cam, basis, hits, g, s);
+      if (extras) shade_tile<SurfaceNormal::Shading, true>(rs, cam, basis, hits, g, s);
+      else shade_tile<SurfaceNormal::Shading, false>(rs, cam, basis, hits, g, s);
     } else {
-      if (extras) shade_tile<SurfaceNormal::Geometric, true>(rs.scene(), cam, basis, hits, g, s);
-      else shade_tile<SurfaceNormal::Geometric, false>(rs.scene(), cam, basis, hits, g, s);
+      if (extras) shade_tile<SurfaceNormal::Geometric, true>(rs, cam, basis, hits, g, s);
+      else shade_tile<SurfaceNormal::Geometric, false>(rs, cam, basis, hits, g, s);
     }
   }
   _mm_sfence();  // the streamed rows are visible to whichever thread reads the G-buffer next

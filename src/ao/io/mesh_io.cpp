@@ -359,7 +359,97 @@ void check_raw_meshes(const fs::path& path, const aiScene& scene, unsigned uv_se
   }
 }
 
-Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOptions& options) {
+Affine3 to_affine(const aiMatrix4x4& m) {
+  // aiMatrix4x4 is row-major with the translation in the fourth column (a4, b4, c4).
+  return {{m.a1, m.b1, m.c1}, {m.a2, m.b2, m.c2}, {m.a3, m.b3, m.c3}, {m.a4, m.b4, m.c4}};
+}
+
+/// Every use of a mesh by the node tree: the mesh and its node's world transform (the product of
+/// the transforms from the root down), in depth-first node order. Iterative: the depth is bounded
+/// by check_gltf, but an explicit stack does not depend on that.
+struct MeshUse {
+  unsigned mesh;
+  aiMatrix4x4 world;
+  const aiNode* node;
+};
+std::vector<MeshUse> mesh_uses(const aiScene& scene) {
+  std::vector<MeshUse> uses;
+  if (scene.mRootNode == nullptr) return uses;
+  std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{{scene.mRootNode, scene.mRootNode->mTransformation}};
+  while (!stack.empty()) {
+    const auto [node, world] = stack.back();
+    stack.pop_back();
+    for (unsigned i = 0; i < node->mNumMeshes; ++i)
+      if (node->mMeshes[i] < scene.mNumMeshes) uses.push_back({node->mMeshes[i], world, node});
+    // Children pushed in reverse so that they are visited in the file's order.
+    for (unsigned c = node->mNumChildren; c-- > 0;)
+      if (node->mChildren[c] != nullptr) stack.emplace_back(node->mChildren[c], world * node->mChildren[c]->mTransformation);
+  }
+  return uses;
+}
+
+/// True when the node tree uses some mesh more than once.
+bool uses_a_mesh_twice(const aiScene& scene) {
+  std::vector<unsigned> refs(scene.mNumMeshes, 0);
+  for (const MeshUse& u : mesh_uses(scene))
+    if (++refs[u.mesh] > 1) return true;
+  return false;
+}
+
+/// One assimp mesh as a Mesh, in the coordinates the file gives it.
+Mesh convert_mesh(const aiScene& ai, const aiMesh& in, unsigned uv_set, bool format_has_materials) {
+  Mesh mesh;
+  mesh.name = in.mName.C_Str();
+  mesh.positions.reserve(in.mNumVertices + kVertexPadding);  // see kVertexPadding
+  for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.positions.push_back({in.mVertices[v].x, in.mVertices[v].y, in.mVertices[v].z});
+  if (in.HasNormals()) {
+    mesh.normals.reserve(in.mNumVertices);
+    for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.normals.push_back({in.mNormals[v].x, in.mNormals[v].y, in.mNormals[v].z});
+  }
+  if (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && in.HasTextureCoords(uv_set)) {
+    mesh.uvs.reserve(in.mNumVertices);
+    for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.uvs.push_back({in.mTextureCoords[uv_set][v].x, in.mTextureCoords[uv_set][v].y});
+  }
+  mesh.indices.reserve(static_cast<std::size_t>(in.mNumFaces) * 3);
+  for (unsigned f = 0; f < in.mNumFaces; ++f) {
+    const aiFace& face = in.mFaces[f];
+    if (face.mNumIndices != 3) continue;  // SortByPType leaves triangles only; be safe anyway
+    mesh.indices.insert(mesh.indices.end(), face.mIndices, face.mIndices + 3);
+  }
+  if (in.mMaterialIndex < ai.mNumMaterials) mesh.albedo = material_albedo(*ai.mMaterials[in.mMaterialIndex], format_has_materials);
+  return mesh;
+}
+
+/// The meshes of a node tree that uses some mesh several times: a mesh used once is moved to
+/// world space (normals through the cofactor matrix, so they stay on the side the transformed
+/// winding faces); a mesh used more often is kept once in object space, and each use becomes an
+/// Instance named after its node. Meshes no node uses are left out (as pre-transforming does).
+void convert_instanced(const aiScene& ai, unsigned uv_set, bool format_has_materials, Scene& scene) {
+  const std::vector<MeshUse> uses = mesh_uses(ai);
+  std::vector<unsigned> refs(ai.mNumMeshes, 0);
+  for (const MeshUse& u : uses) ++refs[u.mesh];
+  std::vector<std::uint32_t> index(ai.mNumMeshes, SceneObject::kNoInstance);
+  for (const MeshUse& u : uses) {
+    const aiMesh& in = *ai.mMeshes[u.mesh];
+    if ((in.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+    const Affine3 t = to_affine(u.world);
+    if (refs[u.mesh] == 1) {
+      Mesh mesh = convert_mesh(ai, in, uv_set, format_has_materials);
+      const Affine3 n = cofactor(t);
+      for (Vec3& p : mesh.positions) p = t.point(p);
+      for (Vec3& v : mesh.normals) v = normalize(n.vector(v));
+      scene.meshes.push_back(std::move(mesh));
+      continue;
+    }
+    if (index[u.mesh] == SceneObject::kNoInstance) {
+      index[u.mesh] = static_cast<std::uint32_t>(scene.meshes.size());
+      scene.meshes.push_back(convert_mesh(ai, in, uv_set, format_has_materials));
+    }
+    scene.instances.push_back({index[u.mesh], t, u.node->mName.C_Str()});
+  }
+}
+
+Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOptions& options, bool is_gltf) {
   const std::string ext = lower(path.extension().string());
   const bool is_stl = ext == ".stl" || data.starts_with("solid");
   // STL, PLY and OFF carry no materials; assimp's stand-in colour for them is white.
@@ -389,10 +479,15 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
     fail(path, explain_assimp_error(error));
   }
   check_raw_meshes(path, *raw, static_cast<unsigned>(options.uv_set));
+  // A glTF whose node tree uses a mesh several times keeps the mesh once, with instances
+  // (convert_instanced); everything else is pre-transformed into world space by assimp, which
+  // also joins the meshes that share a material and vertex format into one.
+  const bool instanced = is_gltf && !options.flatten_instances && uses_a_mesh_twice(*raw);
 
   // No GenNormals / GenSmoothNormals (validate_and_prepare makes normals), and no FindInvalidData or
   // FixInfacingNormals, which would change the data without telling anyone.
-  unsigned steps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices | aiProcess_SortByPType;
+  unsigned steps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
+  if (!instanced) steps |= aiProcess_PreTransformVertices;
   if (is_stl) steps |= aiProcess_RemoveComponent;
   const aiScene* ai = nullptr;
   try {
@@ -423,29 +518,14 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
 
   Scene scene;
   scene.name = path.filename().string();
-  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
-    const aiMesh& in = *ai->mMeshes[m];
-    if ((in.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
-    Mesh mesh;
-    mesh.name = in.mName.C_Str();
-    mesh.positions.reserve(in.mNumVertices + kVertexPadding);  // see kVertexPadding
-    for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.positions.push_back({in.mVertices[v].x, in.mVertices[v].y, in.mVertices[v].z});
-    if (in.HasNormals()) {
-      mesh.normals.reserve(in.mNumVertices);
-      for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.normals.push_back({in.mNormals[v].x, in.mNormals[v].y, in.mNormals[v].z});
+  if (instanced) {
+    convert_instanced(*ai, uv_set, format_has_materials, scene);
+  } else {
+    for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+      const aiMesh& in = *ai->mMeshes[m];
+      if ((in.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+      scene.meshes.push_back(convert_mesh(*ai, in, uv_set, format_has_materials));
     }
-    if (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && in.HasTextureCoords(uv_set)) {
-      mesh.uvs.reserve(in.mNumVertices);
-      for (unsigned v = 0; v < in.mNumVertices; ++v) mesh.uvs.push_back({in.mTextureCoords[uv_set][v].x, in.mTextureCoords[uv_set][v].y});
-    }
-    mesh.indices.reserve(static_cast<std::size_t>(in.mNumFaces) * 3);
-    for (unsigned f = 0; f < in.mNumFaces; ++f) {
-      const aiFace& face = in.mFaces[f];
-      if (face.mNumIndices != 3) continue;  // SortByPType leaves triangles only; be safe anyway
-      mesh.indices.insert(mesh.indices.end(), face.mIndices, face.mIndices + 3);
-    }
-    if (in.mMaterialIndex < ai->mNumMaterials) mesh.albedo = material_albedo(*ai->mMaterials[in.mMaterialIndex], format_has_materials);
-    scene.meshes.push_back(std::move(mesh));
   }
   if (scene.meshes.empty()) fail(path, "the file has no triangles");
   validate_and_prepare(scene);
@@ -477,9 +557,10 @@ Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
       throw SystemError(path.string() + ": out of memory loading the mesh (" + std::to_string(data.size()) + " bytes of file)");
     }
   }
-  if (looks_like_gltf(path, data)) check_gltf(path, data);
+  const bool is_gltf = looks_like_gltf(path, data);
+  if (is_gltf) check_gltf(path, data);
   else if (ext == ".obj") check_obj(path, data);
-  return read_with_assimp(path, data, options);
+  return read_with_assimp(path, data, options, is_gltf);
 }
 
 }  // namespace ao

@@ -13,12 +13,19 @@ struct LoadOptions {
   /// default, is the first set; a mesh lacking the set loads without UVs. Asking for a set above 0
   /// that no mesh of the file has is an InputError "<file>: has K UV sets, --uv-set N asked for".
   int uv_set = 0;
+  /// glTF only: a mesh that the node tree uses several times is copied into world space once per
+  /// use (assimp's pre-transform, which also joins meshes sharing a material) instead of being
+  /// kept once with one Scene::instances entry per use. On for baking, whose maps and per-vertex
+  /// values belong to each placed copy; off (instances) by default.
+  bool flatten_instances = false;
 };
 
 /// Loads OBJ, PLY, OFF, STL, glTF/GLB (by content/extension; OBJ, STL and glTF via assimp) into a
 /// Scene: one Mesh per assimp mesh (so per material; one for OFF and PLY), triangulated, with normals when the file has them, the UV set
 /// `options.uv_set` (default the first), and the material's diffuse colour (or glTF baseColorFactor) as albedo. Node transforms are applied
-/// (pre-transform vertices). Calls validate_and_prepare. Throws InputError with one line naming the
+/// (pre-transform vertices), except that a glTF whose node tree uses a mesh more than once keeps
+/// that mesh once in object space with one Scene::instances entry per node using it (named after
+/// the node; see LoadOptions::flatten_instances); its other meshes are moved to world space one by one. Calls validate_and_prepare. Throws InputError with one line naming the
 /// file and problem: missing/unreadable file, unknown format, truncated/malformed content, bad counts,
 /// NaN/inf, coordinates beyond kMaxCoordinate, indices out of range, empty scene, and what
 /// check_gltf (gltf_check.h) and check_obj (obj_check.h) refuse. Throws SystemError when memory

@@ -23,7 +23,8 @@ namespace ao {
 namespace {
 
 constexpr int kTile = 16;
-// Below this transmittance the remaining spheres of a cone cannot change V by more than 1e-4.
+// A cone stops once its transmittance T <= kOpaque: its remaining spheres can lower T by at most
+// kOpaque, so V (the mean over cones) by at most kOpaque = 1e-4, far below an 8-bit step (1/255).
 constexpr float kOpaque = 1e-4f;
 
 // Length of [zlo, zhi) (voxel units along the column) covered by solid voxels, counting the two
@@ -52,12 +53,12 @@ struct WorldSampler {
   Vec3 inv;  // 1 / voxel size along (i, j, k)
   int np;    // prisms per sphere
   int lanes; // np rounded up to a multiple of 8
-  // Per sphere of the chain (they differ only in radius): radii in voxels along (i, j, k), the sum
-  // of the prisms' chords, how far its prisms reach along the column (voxels) and across the
-  // columns (coarse cells, -1: beyond the coarse masks' cap).
+  // The prisms stay within rho_max of the disk's centre and half_max of the equator (unit disk).
+  float rho_max = 0, half_max = 0;
+  // Per sphere of the chain (they differ only in radius): radii in voxels along (i, j, k) and the
+  // sum of the prisms' chords.
   struct Sphere {
-    float rx, ry, rz, chord, zreach;
-    int reach;
+    float rx, ry, rz, chord;
   };
   std::vector<Sphere> spheres;
   // Structure of arrays, padded to `lanes` with zeros: disk points, and per sphere each prism's
@@ -67,8 +68,6 @@ struct WorldSampler {
   WorldSampler(const VoxelGrid& grid, const ConeSetup& setup, float r_max)
       : g(grid), inv{1.0f / grid.voxel_size.x, 1.0f / grid.voxel_size.y, 1.0f / grid.voxel_size.z}, np(static_cast<int>(setup.disk.size())),
         lanes((np + 7) / 8 * 8), du(lanes, 0.0f), dv(lanes, 0.0f) {
-    // The prisms stay within rho_max of the disk's centre and half_max of the equator.
-    float rho_max = 0, half_max = 0;
     for (int s = 0; s < np; ++s) {
       const ConeSetup::Disk& d = setup.disk[s];
       du[s] = d.u, dv[s] = d.v;
@@ -78,17 +77,12 @@ struct WorldSampler {
     half.assign(setup.sphere_radius.size() * lanes, 0.0f);
     for (std::size_t k = 0; k < setup.sphere_radius.size(); ++k) {
       const float r = setup.sphere_radius[k] * r_max;
-      Sphere sp{r * inv.x, r * inv.y, r * inv.z, 0.0f, 0.0f, -1};
+      Sphere sp{r * inv.x, r * inv.y, r * inv.z, 0.0f};
       for (int s = 0; s < np; ++s) {
         const float h = setup.disk[s].half_chord * sp.rz;
         half[k * lanes + s] = h;
         sp.chord += 2.0f * h;
       }
-      // A prism reads columns within rho_max * r of the centre and voxels within half_max * r
-      // along the column; floor(a) - floor(a - b) <= ceil(b); margins cover rounding.
-      sp.zreach = half_max * sp.rz * 1.001f + 1e-3f;
-      const float e = std::ceil(std::max(rho_max * sp.rx, rho_max * sp.ry) / VoxelGrid::kCellXY * 1.001f + 1e-3f);
-      if (!g.dilated.empty() && e <= static_cast<float>(VoxelGrid::kReachCap)) sp.reach = static_cast<int>(e);
       spheres.push_back(sp);
     }
   }
@@ -96,51 +90,33 @@ struct WorldSampler {
   // Spheres that start nearer the apex than this (world units) are skipped: 1.5 voxels, within
   // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
   // voxel whose centre is inside) fills them.
-  float near_limit(Vec3) const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
+  float near_limit() const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
   // The voxel at world point p (false outside the grid).
   bool solid_at(Vec3 p) const {
     const float gx = (p.x - g.origin.x) * inv.x, gy = (p.z - g.origin.z) * inv.y, gz = (p.y - g.origin.y) * inv.z;
     if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
     return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
   }
-  static int clamp_index(float x, int n) {  // clamp(floor(x), 0, n - 1), branch-free; NaN -> 0
-    return static_cast<int>(std::min(std::max(0.0f, x), static_cast<float>(n - 1)));
-  }
 
-  // Conservative: false only when no prism of sphere k centred at (gx, gy, gz) can meet a solid voxel.
-  bool maybe_solid(const Sphere& sp, float gx, float gy, float gz) const {
-    if (sp.reach >= 0) {
-      // One 64-bit mask: the cells within `reach` of the centre's cell across the columns (the
-      // centre clamped into the grid, which only shrinks the set the prisms can read), tested
-      // over the cells of the prisms' z range.
-      constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
-      const std::uint64_t m = g.near_mask(sp.reach, clamp_index(gx * kInvC, g.dnx), clamp_index(gy * kInvC, g.dny));
-      const int cl = clamp_index(gz - sp.zreach, g.depth_bits) >> g.cell_shift, ch = clamp_index(gz + sp.zreach, g.depth_bits) >> g.cell_shift;
-      const std::uint64_t bits = m >> cl;
-      const int len = ch - cl + 1;
-      return (len >= 64 ? bits : bits & ((std::uint64_t{1} << len) - 1)) != 0;
-    }
-    // Too large for the masks: the OR of every block the sphere's bounding box touches.
+  // For spheres wider than the largest window: the OR of every block the sphere's box touches.
+  bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
     constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
-    const int bx0 = std::max(0, static_cast<int>(std::floor((gx - sp.rx) * kInvB)));
-    const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + sp.rx) * kInvB)));
-    const int by0 = std::max(0, static_cast<int>(std::floor((gy - sp.ry) * kInvB)));
-    const int by1 = std::min(g.bny - 1, static_cast<int>(std::floor((gy + sp.ry) * kInvB)));
-    const int k0 = static_cast<int>(std::floor(std::max(gz - sp.rz, -1.0f))), k1 = static_cast<int>(std::min(gz + sp.rz, 1e6f)) + 1;
+    const int bx0 = std::max(0, static_cast<int>(std::floor((gx - rx) * kInvB)));
+    const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + rx) * kInvB)));
+    const int by0 = std::max(0, static_cast<int>(std::floor((gy - ry) * kInvB)));
+    const int by1 = std::min(g.bny - 1, static_cast<int>(std::floor((gy + ry) * kInvB)));
+    const int k0 = static_cast<int>(std::floor(std::max(gz - rz, -1.0f))), k1 = static_cast<int>(std::min(gz + rz, 1e6f)) + 1;
     for (int by = by0; by <= by1; ++by)
       for (int bx = bx0; bx <= bx1; ++bx)
         if (any_bits(g.block(bx, by), g.words, k0, k1)) return true;
     return false;
   }
 
-  // centre in world space, sphere k of the chain with its radius times `scale` (in (0, 1]: the
-  // jittered chain and the filler sphere, never larger, so sphere k's skipping reach stays
-  // conservative); disk points are (u, v) in the world x-z plane.
-  float operator()(Vec3 c, int k, float scale, float rot_c, float rot_s) const {
-    const float gx = (c.x - g.origin.x) * inv.x, gy = (c.z - g.origin.z) * inv.y, gz = (c.y - g.origin.y) * inv.z;
+  // Obstructed fraction of sphere k of the chain centred at grid point (gx, gy, gz), its radius
+  // times `scale` (in (0, 1]: the jittered chain and the filler sphere); disk points are (u, v) in
+  // the world x-z plane, turned by (rot_c, rot_s).
+  float fraction(float gx, float gy, float gz, int k, float scale, float rot_c, float rot_s) const {
     const Sphere& sp = spheres[k];
-    // Empty-space skipping (not in the paper): an empty neighbourhood needs no prism lookups.
-    if (!maybe_solid(sp, gx, gy, gz)) return 0.0f;
     const float* h = half.data() + static_cast<std::size_t>(k) * lanes;
     float len[64];  // solid length per prism, summed in prism order below (same sum at any width)
     prisms(gx, gy, gz, sp.rx * scale, sp.ry * scale, h, scale, rot_c, rot_s, len);
@@ -157,7 +133,7 @@ struct WorldSampler {
     return solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - h, gz + h);
   }
 
-#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__)
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__) && !defined(AO_NO_GATHER)
   // 8 prisms at once: column indices, z ranges, two gathered words per prism (the words of the end
   // voxels), masks and VPOPCNTQ. Prisms whose range spans more than two words go the scalar way.
   void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, float rot_c, float rot_s, float* len) const {
@@ -270,99 +246,343 @@ struct EyeSampler {
   }
 };
 
+// The per-pixel jitter of deviation 5 (docs/methods/cone.md), tabulated once per call: pixel
+// (x, y) takes slot (x mod P, y mod P) of a P x P table whose entries come from
+// pixel_seed(seed, slot), so the image does not depend on the thread count and each pixel's cones
+// are as random as with a hash per pixel; only pixels P apart repeat a pattern. Per slot: the
+// prism pattern turns by beta, and each cone takes one random direction in its own cell of the
+// hemisphere (stratified sampling of the cell's measure: theta uniform in the band's sin^2 theta
+// or 1 - cos theta, phi uniform in its azimuth range) and one random scale of its sphere chain.
+// Fixed directions and distances make the error a fixed function of the distance to each
+// occluder, which shows as rings that no averaging over seeds removes. What is left per pixel and
+// cone is turning the tabulated axis into the normal's frame.
+struct ConePattern {
+  // 32: a multiple of the tile size, far beyond the 5-tap filter's reach, and 32 x 32 slots x 6
+  // cones of 16 bytes stay in the L2 cache (98 KB).
+  static constexpr int kPeriod = 32;
+  struct Cone {
+    float x, y, z;  ///< Axis in the normal's frame (z along the normal).
+    float scale;    ///< Chain scale s = q^-xi in (1/q, 1].
+  };
+  int period = 1;
+  int cones = 0;
+  std::vector<float> rot;  // per slot: cos and sin of the prism pattern's turn
+  std::vector<Cone> cone;  // per slot, `cones` in order
+  int slot(int x, int y) const { return (y & (period - 1)) * period + (x & (period - 1)); }
+};
+
+ConePattern make_pattern(const ConeSetup& setup, bool jitter, std::uint32_t seed) {
+  ConePattern pat;
+  pat.period = jitter ? ConePattern::kPeriod : 1;
+  pat.cones = static_cast<int>(setup.cones.size());
+  const int slots = pat.period * pat.period;
+  pat.rot.resize(2 * static_cast<std::size_t>(slots));
+  pat.cone.resize(static_cast<std::size_t>(slots) * pat.cones);
+  const float log_q = std::log(setup.chain_ratio);
+  for (int sy = 0; sy < pat.period; ++sy)
+    for (int sx = 0; sx < pat.period; ++sx) {
+      const int slot = pat.slot(sx, sy);
+      const std::uint32_t ps = pixel_seed(seed, sx, sy);
+      float rot_c = 1, rot_s = 0;
+      if (jitter) {
+        const float beta = 2.0f * kPi * to_unit_float(hash32(ps));
+        rot_c = std::cos(beta), rot_s = std::sin(beta);
+      }
+      pat.rot[2 * slot] = rot_c, pat.rot[2 * slot + 1] = rot_s;
+      for (int c = 0; c < pat.cones; ++c) {
+        const ConeSetup::Cone& cone = setup.cones[c];
+        float st = cone.sin_theta, ct = cone.cos_theta, cp = cone.cos_phi, sp = cone.sin_phi, scale = 1.0f;
+        if (jitter) {
+          const std::uint32_t hc = hash_combine(ps, 1u + static_cast<std::uint32_t>(c));
+          const float u = cone.band0 + to_unit_float(hc) * (cone.band1 - cone.band0);
+          st = setup.cosine ? std::sqrt(u) : std::sqrt(std::max(0.0f, u * (2.0f - u)));  // 1 - cos = u
+          st = std::min(st, setup.sin_theta_max);
+          ct = std::sqrt(1.0f - st * st);
+          // phi = the cell's centre + delta, delta uniform in +-dphi / 2.
+          const float delta = (to_unit_float(hash_combine(hc, 1u)) - 0.5f) * cone.dphi;
+          const float cd = std::cos(delta), sd = std::sin(delta);
+          cp = cone.cos_phi * cd - cone.sin_phi * sd, sp = cone.sin_phi * cd + cone.cos_phi * sd;
+          // Chain scale s = q^-xi in (1/q, 1]: one ratio step of random phase, the geometric
+          // analogue of jittering a uniform step.
+          scale = std::exp(-to_unit_float(hash_combine(hc, 2u)) * log_q);
+        }
+        pat.cone[static_cast<std::size_t>(slot) * pat.cones + c] = {st * cp, st * sp, ct, scale};
+      }
+    }
+  return pat;
+}
+
+// Per sphere of a cone: where along the axis it sits (world units), which sphere of the chain it
+// is (its prisms' half chords) and the scale of its radius. The chain of sphere k is scaled by the
+// cone's s: sphere k at s d_k with radius s r_k, starting at s (d_k - r_k). A scaled chain ends at
+// s R_max; the filler sphere, inscribed in [s R_max, R_max] along the axis, samples the rest: its
+// radius (1 - s) R_max / 2 is at most the last sphere's (equal at s = 1/q), and it fits in the
+// cone for s >= 1/q. `used` is false for spheres that start within near_limit of the apex and for
+// a filler of (almost) no size.
+struct ChainSphere {
+  float distance, scale;
+  int k;
+  bool used;
+};
+void chain_spheres(const ConeSetup& setup, float r_max, float near, float chain_scale, ChainSphere* out) {
+  const int ns = static_cast<int>(setup.sphere_distance.size());
+  for (int k = 0; k < ns; ++k) {
+    const float start = (setup.sphere_distance[k] - setup.sphere_radius[k]) * r_max * chain_scale;
+    out[k] = {setup.sphere_distance[k] * r_max * chain_scale, chain_scale, k, start >= near};
+  }
+  const float filler = 0.5f * (1.0f - chain_scale) / setup.sphere_radius.back();  // radius / the last sphere's
+  out[ns] = {0.5f * (1.0f + chain_scale) * r_max, std::min(filler, 1.0f), ns - 1, filler > 1e-3f};
+}
+
+// Front-to-back along one cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed fraction
+// f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
+// `inside`: a surface point facing into the winding-number solid counts the complement.
+template <class Fraction>
+float transmittance(const ChainSphere* chain, int n, bool inside, Fraction&& fraction) {
+  float t = 1.0f;
+  for (int k = 0; k < n && t > kOpaque; ++k) {
+    if (!chain[k].used) continue;
+    const float f = fraction(k);
+    t *= inside ? f : 1.0f - f;
+  }
+  return t;
+}
+
+// The inside of a holed mesh's shell, seen through a hole, faces into its winding-number solid
+// (voxelize.h); its occluders are the inside of the shell, so its cones count the complement of
+// the solid as occluded (1 - the obstructed fraction): a hollow inside.
 template <class Sampler>
-void trace(const GBuffer& gb, const Sampler& sample, bool world, float r_max, const ConeParams& p, const ConeSetup& setup, std::uint32_t seed,
-           ImageView<float> out, const ProgressFn& progress) {
+bool faces_inside(const GBuffer& gb, const Sampler& sample, int x, int y, Vec3 p, Vec3 n, float near) {
+  const std::uint32_t id = gb.object_id(x, y);
+  const std::vector<std::uint8_t>& capped = sample.g.capped;
+  return id > 0 && id <= capped.size() && capped[id - 1] && sample.solid_at(p + n * near);
+}
+
+// The spheres of one pixel's cones, slot i = c * per_cone + j: j < ns is sphere j of cone c's
+// chain, j = ns its filler. The chain of a cone with scale s has sphere j at s d_j with radius
+// s r_j, starting at s (d_j - r_j); a scaled chain ends at s R_max, and the filler sphere,
+// inscribed in [s R_max, R_max] along the axis, samples the rest: its radius (1 - s) R_max / 2
+// is at most the last sphere's (equal at s = 1/q), and it fits in the cone for s >= 1/q. So each
+// slot's distance along the axis, radius scale and "is sampled" test are affine in s:
+//   distance = dist_a s + dist_b, radius scale = min(rad_a s + rad_b, 1), sampled: use_a s + use_b >= 0,
+// sampled meaning: the sphere starts at least near_limit from the apex (the chain), the filler's
+// radius is more than 1e-3 of the last sphere's.
+struct SphereSlots {
+  int n = 0, per_cone = 0;
+  int padded = 0;  // n rounded up to a multiple of 16 with slots that are never sampled: whole vectors
+  std::vector<float> dist_a, dist_b, rad_a, rad_b, use_a, use_b;
+  std::vector<float> ex, ey, ez;  // half extents of the prisms' box at radius scale 1, voxels (PixelSpheres::place)
+  std::vector<int> k;             // sphere of the chain whose prisms it uses
+
+  SphereSlots(const ConeSetup& setup, const WorldSampler& sample, float r_max, int cones) {
+    const int ns = static_cast<int>(setup.sphere_distance.size());
+    per_cone = ns + 1;
+    n = cones * per_cone;
+    const float near = sample.near_limit();
+    const float inv_last_radius = 1.0f / setup.sphere_radius.back();  // relative to R_max
+    for (int c = 0; c < cones; ++c)
+      for (int j = 0; j <= ns; ++j) {
+        const int kj = std::min(j, ns - 1);
+        if (j < ns) {
+          dist_a.push_back(setup.sphere_distance[j] * r_max), dist_b.push_back(0.0f);
+          rad_a.push_back(1.0f), rad_b.push_back(0.0f);
+          use_a.push_back((setup.sphere_distance[j] - setup.sphere_radius[j]) * r_max), use_b.push_back(-near);
+        } else {
+          dist_a.push_back(0.5f * r_max), dist_b.push_back(0.5f * r_max);
+          rad_a.push_back(-0.5f * inv_last_radius), rad_b.push_back(0.5f * inv_last_radius);
+          use_a.push_back(-0.5f * inv_last_radius), use_b.push_back(0.5f * inv_last_radius - 1e-3f);
+        }
+        const WorldSampler::Sphere& sp = sample.spheres[kj];
+        ex.push_back(sample.rho_max * sp.rx), ey.push_back(sample.rho_max * sp.ry), ez.push_back(sample.half_max * sp.rz);
+        k.push_back(kj);
+      }
+    padded = (n + 15) / 16 * 16;
+    for (int i = n; i < padded; ++i) {
+      dist_a.push_back(0.0f), dist_b.push_back(0.0f), rad_a.push_back(0.0f), rad_b.push_back(0.0f), use_a.push_back(0.0f), use_b.push_back(-1.0f);
+      ex.push_back(0.0f), ey.push_back(0.0f), ez.push_back(0.0f), k.push_back(0);
+    }
+  }
+};
+
+// One pixel's spheres, placed and tested against the coarse masks: flat loops over the slots with
+// no branch, so the placement and the window arithmetic vectorise, and the mask loads of all
+// spheres are issued back to back (their cache misses overlap).
+struct PixelSpheres {
+  // In, per cone: chain scale and axis (voxels).
+  std::vector<float> scale, ax, ay, az;
+  std::vector<float> s_, ax_, ay_, az_;  // the same per slot
+  // Per slot: centre (voxels), radius scale, whether it is sampled, the coarse test's mask index,
+  // z cells and "wider than the largest window", and the verdict: sampled and the coarse masks
+  // say maybe (wide: maybe_solid_blocks decides).
+  std::vector<float> cx, cy, cz, rs;
+  std::vector<int> used, lo, span, wide;
+  std::vector<std::uint32_t> index;
+  std::vector<std::uint8_t> pass;
+  // The pixel.
+  int x = 0, y = 0;
+  bool inside = false;
+  float rot_c = 1, rot_s = 0;
+
+  PixelSpheres(int cones, int n)
+      : scale(cones), ax(cones), ay(cones), az(cones), s_(n), ax_(n), ay_(n), az_(n), cx(n), cy(n), cz(n), rs(n), used(n), lo(n), span(n), wide(n), index(n), pass(n) {}
+
+  void place(const SphereSlots& q, const WorldSampler& sample, float gx, float gy, float gz) {
+    const int n = q.padded, per_cone = q.per_cone, dnx = sample.g.dnx, dny = sample.g.dny, cap = VoxelGrid::kWindowCap, shift = sample.g.cell_shift;
+    const float fdnx = static_cast<float>(dnx - 1), fdny = static_cast<float>(dny - 1), fbits = static_cast<float>(sample.g.depth_bits - 1);
+    constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
+    const float *__restrict da = q.dist_a.data(), *__restrict db = q.dist_b.data(), *__restrict ra = q.rad_a.data(), *__restrict rb = q.rad_b.data();
+    const float *__restrict ua = q.use_a.data(), *__restrict ub = q.use_b.data();
+    const float *__restrict qex = q.ex.data(), *__restrict qey = q.ey.data(), *__restrict qez = q.ez.data();
+    float *__restrict ox = cx.data(), *__restrict oy = cy.data(), *__restrict oz = cz.data(), *__restrict orr = rs.data();
+    int *__restrict ou = used.data(), *__restrict olo = lo.data(), *__restrict osp = span.data(), *__restrict owi = wide.data();
+    std::uint32_t* __restrict oi = index.data();
+    // Each slot's cone: scale and axis, copied per slot so that the loop below is flat.
+    for (int c = 0; c < q.n / per_cone; ++c)
+      for (int i = c * per_cone; i < (c + 1) * per_cone; ++i) s_[i] = scale[c], ax_[i] = ax[c], ay_[i] = ay[c], az_[i] = az[c];
+    const float *__restrict ss = s_.data(), *__restrict sx = ax_.data(), *__restrict sy = ay_.data(), *__restrict sz = az_.data();
+#pragma GCC ivdep  // the arrays do not overlap (GCC does not apply __restrict to local pointers)
+    for (int i = 0; i < n; ++i) {
+      const float s = ss[i];
+      const float d = da[i] * s + db[i];
+      const float px = gx + sx[i] * d, py = gy + sy[i] * d, pz = gz + sz[i] * d;
+      const float r = std::min(ra[i] * s + rb[i], 1.0f);
+      ox[i] = px, oy[i] = py, oz[i] = pz, orr[i] = r;
+      ou[i] = ua[i] * s + ub[i] >= 0.0f ? 1 : 0;
+      // Empty-space skipping (not in the paper; exact: a skipped sphere's prisms read no solid
+      // voxel). The sphere's prisms read columns within (ex, ey) = rho_max * (rx, ry) of its
+      // centre and voxels within ez = half_max * rz along them (floor(a) - floor(a - b) <=
+      // ceil(b); the margins cover rounding). That box of columns lies in the window (voxelize.h)
+      // anchored at its lowest cell, w = its larger span in cells (clamped into the grid, which
+      // only drops columns no prism can read); test() checks the window's z cells cl..ch. A box
+      // wider than the largest window goes to maybe_solid_blocks. Indices are
+      // int(min(max(0, x), n - 1)): clamp(floor(x), 0, n - 1) for x >= 0, and 0 for NaN.
+      const float ex = qex[i] * r * 1.001f + 1e-3f, ey = qey[i] * r * 1.001f + 1e-3f, ez = qez[i] * r * 1.001f + 1e-3f;
+      const int x0 = static_cast<int>(std::min(std::max(0.0f, (px - ex) * kInvC), fdnx)), x1 = static_cast<int>(std::min(std::max(0.0f, (px + ex) * kInvC), fdnx));
+      const int y0 = static_cast<int>(std::min(std::max(0.0f, (py - ey) * kInvC), fdny)), y1 = static_cast<int>(std::min(std::max(0.0f, (py + ey) * kInvC), fdny));
+      const int w = std::max(x1 - x0, y1 - y0);
+      const int cl = static_cast<int>(std::min(std::max(0.0f, pz - ez), fbits)) >> shift, ch = static_cast<int>(std::min(std::max(0.0f, pz + ez), fbits)) >> shift;
+      oi[i] = static_cast<std::uint32_t>((y0 * dnx + x0) * (cap + 1) + std::min(w, cap));
+      olo[i] = cl, osp[i] = ch - cl, owi[i] = w > cap ? 1 : 0;
+    }
+  }
+
+  void test(const WorldSampler& sample, const SphereSlots& q) {
+    const std::uint64_t* __restrict win = sample.g.window.data();
+    const int *__restrict ou = used.data(), *__restrict olo = lo.data(), *__restrict osp = span.data(), *__restrict owi = wide.data();
+    const std::uint32_t* __restrict oi = index.data();
+    std::uint8_t* __restrict op = pass.data();
+    const int n = q.n;
+#pragma GCC ivdep
+    for (int i = 0; i < n; ++i) {
+      const bool any = ((win[oi[i]] >> olo[i]) & (~std::uint64_t{0} >> (63 - osp[i]))) != 0;  // z cells lo..lo + span
+      op[i] = static_cast<std::uint8_t>(ou[i] & (any | owi[i]));
+    }
+  }
+  // The verdicts of slots i0 .. i0 + count - 1 as bits (count <= 17: spheres per cone + 1).
+  std::uint32_t passed(int i0, int count) const {
+    std::uint32_t m = 0;
+    for (int j = 0; j < count; ++j) m |= static_cast<std::uint32_t>(pass[i0 + j]) << j;
+    return m;
+  }
+};
+
+// World grid: per pixel, every sphere is placed and passes the coarse test (PixelSpheres), then
+// each cone runs front to back, sampling the prisms of the spheres that passed.
+void trace_world(const GBuffer& gb, const WorldSampler& sample, float r_max, const ConeSetup& setup, const ConePattern& pat, ImageView<float> out,
+                 const ProgressFn& progress) {
   const int w = gb.width(), h = gb.height();
   const Frame basis = gb.camera.basis();
   const Vec3 eye = gb.camera.eye;
-  const int nc = static_cast<int>(setup.cones.size()), ns = static_cast<int>(setup.sphere_distance.size());
-  std::vector<float> distance(ns);
-  for (int k = 0; k < ns; ++k) distance[k] = setup.sphere_distance[k] * r_max;
+  const VoxelGrid& g = sample.g;
+  const Vec3 inv = sample.inv;
+  const int nc = pat.cones;
+  const SphereSlots slots(setup, sample, r_max, nc);
+  const int per_cone = slots.per_cone;
   const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
-  const float log_q = std::log(setup.chain_ratio);
-  const float inv_last_radius = 1.0f / setup.sphere_radius.back();  // both relative to R_max
-  const std::vector<std::uint8_t>& capped = sample.g.capped;
-  std::vector<float> start(ns);  // where each sphere begins along the axis, world units
-  for (int k = 0; k < ns; ++k) start[k] = (setup.sphere_distance[k] - setup.sphere_radius[k]) * r_max;
+  const float near = sample.near_limit();
+  // Front to back along each cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
+  // fraction f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
+  const auto finish = [&](PixelSpheres& ps) {
+    const auto fraction = [&](int i) {
+      const WorldSampler::Sphere& sp = sample.spheres[slots.k[i]];
+      const float r = ps.rs[i];
+      if (ps.wide[i] && !sample.maybe_solid_blocks(ps.cx[i], ps.cy[i], ps.cz[i], sp.rx * r, sp.ry * r, sp.rz * r)) return 0.0f;
+      return sample.fraction(ps.cx[i], ps.cy[i], ps.cz[i], slots.k[i], r, ps.rot_c, ps.rot_s);
+    };
+    float v = 0;
+    for (int c = 0; c < nc; ++c) {
+      float tr = 1.0f;
+      const int i0 = c * per_cone;
+      if (!ps.inside) {
+        // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
+        // ones, in order (bit j: sphere j of the cone).
+        for (std::uint32_t m = ps.passed(i0, per_cone); m && tr > kOpaque; m &= m - 1) tr *= 1.0f - fraction(i0 + std::countr_zero(m));
+      } else {
+        // The inside of a shell counts the complement (faces_inside): T *= f, and an empty sphere
+        // (f = 0) closes the cone.
+        for (int i = i0; i < i0 + per_cone && tr > kOpaque; ++i)
+          if (ps.used[i]) tr *= ps.pass[i] ? fraction(i) : 0.0f;
+      }
+      v += weight * tr;
+    }
+    out(ps.x, ps.y) = std::clamp(v, 0.0f, 1.0f);
+  };
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+    PixelSpheres ps(nc, slots.padded);
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         if (!gb.covered(x, y)) {
           out(x, y) = 1.0f;
           continue;
         }
-        Vec3 pos = gb.position(x, y), n = gb.normal(x, y);
-        if (world) {
-          pos = basis.to_world(pos) + eye;
-          n = normalize(basis.to_world(n));
-        }
+        const Vec3 pos = basis.to_world(gb.position(x, y)) + eye, n = normalize(basis.to_world(gb.normal(x, y)));
         const Frame frame = Frame::from_normal(n);
-        const float near = sample.near_limit(gb.position(x, y));
-        // The inside of a holed mesh's shell, seen through a hole, faces into its winding-number
-        // solid (voxelize.h); its occluders are the inside of the shell, so its cones count the
-        // complement of the solid as occluded (1 - the obstructed fraction): a hollow inside.
-        const std::uint32_t id = gb.object_id(x, y);
-        const bool inside = id > 0 && id <= capped.size() && capped[id - 1] && sample.solid_at(pos + n * near);
-        // Per-pixel jitter (deviation 5 of docs/methods/cone.md), all from hash(seed, pixel), so
-        // the image does not depend on the thread count: the prism pattern turns by beta, and each
-        // cone takes one random direction in its own cell of the hemisphere (stratified sampling
-        // of the cell's measure: theta uniform in the band's sin^2 theta or 1 - cos theta, phi
-        // uniform in its azimuth range) and one random scale of its sphere chain. Fixed
-        // directions and distances make the error a fixed function of the distance to each
-        // occluder, which shows as rings that no averaging over seeds removes.
-        const std::uint32_t ps = pixel_seed(seed, x, y);
-        float rot_c = 1, rot_s = 0;
-        if (p.jitter) {
-          const float beta = 2.0f * kPi * to_unit_float(hash32(ps));
-          rot_c = std::cos(beta), rot_s = std::sin(beta);
+        ps.x = x, ps.y = y;
+        ps.inside = faces_inside(gb, sample, x, y, pos, n, near);
+        const int slot = pat.slot(x, y);
+        ps.rot_c = pat.rot[2 * slot], ps.rot_s = pat.rot[2 * slot + 1];
+        const ConePattern::Cone* cones = pat.cone.data() + static_cast<std::size_t>(slot) * nc;
+        for (int c = 0; c < nc; ++c) {
+          const Vec3 a = frame.to_world({cones[c].x, cones[c].y, cones[c].z});
+          ps.scale[c] = cones[c].scale, ps.ax[c] = a.x * inv.x, ps.ay[c] = a.z * inv.y, ps.az[c] = a.y * inv.z;  // the axis in voxels
         }
+        ps.place(slots, sample, (pos.x - g.origin.x) * inv.x, (pos.z - g.origin.z) * inv.y, (pos.y - g.origin.y) * inv.z);
+        ps.test(sample, slots);
+        finish(ps);
+      }
+    counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
+  });
+}
+
+// Eye grid: cone by cone, sphere by sphere.
+void trace_eye(const GBuffer& gb, const EyeSampler& sample, float r_max, const ConeSetup& setup, const ConePattern& pat, ImageView<float> out,
+               const ProgressFn& progress) {
+  const int w = gb.width(), h = gb.height();
+  const int nc = pat.cones, per_cone = static_cast<int>(setup.sphere_distance.size()) + 1;
+  const float weight = 1.0f / static_cast<float>(nc);
+  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
+  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
+    std::vector<ChainSphere> chain(per_cone);
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        if (!gb.covered(x, y)) {
+          out(x, y) = 1.0f;
+          continue;
+        }
+        const Vec3 pos = gb.position(x, y), n = gb.normal(x, y);
+        const Frame frame = Frame::from_normal(n);
+        const float near = sample.near_limit(pos);
+        const bool inside = faces_inside(gb, sample, x, y, pos, n, near);
+        const int slot = pat.slot(x, y);
+        const float rot_c = pat.rot[2 * slot], rot_s = pat.rot[2 * slot + 1];
         float v = 0;
         for (int c = 0; c < nc; ++c) {
-          const ConeSetup::Cone& cone = setup.cones[c];
-          float st = cone.sin_theta, ct = cone.cos_theta, cp = cone.cos_phi, sp = cone.sin_phi, scale = 1.0f;
-          if (p.jitter) {
-            const std::uint32_t hc = hash_combine(ps, 1u + static_cast<std::uint32_t>(c));
-            const float u = cone.band0 + to_unit_float(hc) * (cone.band1 - cone.band0);
-            st = setup.cosine ? std::sqrt(u) : std::sqrt(std::max(0.0f, u * (2.0f - u)));  // 1 - cos = u
-            st = std::min(st, setup.sin_theta_max);
-            ct = std::sqrt(1.0f - st * st);
-            // phi = the cell's centre + delta, delta uniform in +-dphi / 2.
-            const float delta = (to_unit_float(hash_combine(hc, 1u)) - 0.5f) * cone.dphi;
-            float cd, sd;
-            if (cone.dphi <= 2.0f) {
-              // |delta| <= 1: Taylor series to delta^6 / delta^7, cheaper than sin and cos; the
-              // truncation error is at most delta^8 / 8! = 2.5e-5.
-              const float d2 = delta * delta;
-              cd = 1.0f - d2 * (0.5f - d2 * (1.0f / 24.0f - d2 * (1.0f / 720.0f)));
-              sd = delta * (1.0f - d2 * (1.0f / 6.0f - d2 * (1.0f / 120.0f - d2 * (1.0f / 5040.0f))));
-            } else {
-              cd = std::cos(delta), sd = std::sin(delta);  // a ring of one or two cones
-            }
-            cp = cone.cos_phi * cd - cone.sin_phi * sd, sp = cone.sin_phi * cd + cone.cos_phi * sd;
-            // Chain scale s = q^-xi in (1/q, 1]: one ratio step of random phase, the geometric
-            // analogue of jittering a uniform step.
-            scale = std::exp(-to_unit_float(hash_combine(hc, 2u)) * log_q);
-          }
-          const Vec3 axis = frame.to_world({st * cp, st * sp, ct});
-          // Front-to-back along the cone (sec. III-C2, Fig. 8): each sphere absorbs its
-          // obstructed fraction of the rays that reach it.
-          float transmittance = 1.0f;
-          for (int k = 0; k < ns && transmittance > kOpaque; ++k) {
-            if (start[k] * scale < near) continue;
-            const float f = sample(pos + axis * (distance[k] * scale), k, scale, rot_c, rot_s);
-            transmittance *= inside ? f : 1.0f - f;
-          }
-          // A scaled chain ends at s R_max; the filler sphere, inscribed in [s R_max, R_max] along
-          // the axis, samples the rest. Its radius (1 - s) R_max / 2 is at most the last sphere's
-          // (equal at s = 1/q), and it fits in the cone for s >= 1/q.
-          const float filler = 0.5f * (1.0f - scale) * inv_last_radius;  // radius / the last sphere's
-          if (filler > 1e-3f && transmittance > kOpaque) {
-            const float f = sample(pos + axis * (0.5f * (1.0f + scale) * r_max), ns - 1, std::min(filler, 1.0f), rot_c, rot_s);
-            transmittance *= inside ? f : 1.0f - f;
-          }
-          v += weight * transmittance;
+          const ConePattern::Cone& cone = pat.cone[static_cast<std::size_t>(slot) * nc + c];
+          chain_spheres(setup, r_max, near, cone.scale, chain.data());
+          const Vec3 axis = frame.to_world({cone.x, cone.y, cone.z});
+          v += weight * transmittance(chain.data(), per_cone, inside,
+                                      [&](int k) { return sample(pos + axis * chain[k].distance, chain[k].k, chain[k].scale, rot_c, rot_s); });
         }
         out(x, y) = std::clamp(v, 0.0f, 1.0f);
       }
@@ -543,17 +763,17 @@ void compute_cone(const GBuffer& gb, const VoxelGrid& g, float r_max, const Cone
   if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
   if (out.width != gb.width() || out.height != gb.height()) throw InputError("cone: output and G-buffer sizes differ");
   const ConeSetup setup = derive_cone_setup(params);
+  const ConePattern pattern = make_pattern(setup, params.jitter, seed);
   if (g.space == GridSpace::World) {
-    const WorldSampler s(g, setup, r_max);
-    trace(gb, s, true, r_max, params, setup, seed, out, progress);
+    trace_world(gb, WorldSampler(g, setup, r_max), r_max, setup, pattern, out, progress);
   } else {
     const Camera& cam = g.camera;
     const float t = cam.tan_half_fov();
     EyeSampler s{g, 0.5f * cam.width / (t * cam.aspect()) / g.pixels_per_column_x, -0.5f * cam.height / t / g.pixels_per_column_y,
-                       0.5f * cam.width / g.pixels_per_column_x, 0.5f * cam.height / g.pixels_per_column_y, setup.disk.data(),
-                       static_cast<int>(setup.disk.size()), {}};
+                 0.5f * cam.width / g.pixels_per_column_x, 0.5f * cam.height / g.pixels_per_column_y, setup.disk.data(),
+                 static_cast<int>(setup.disk.size()), {}};
     for (float rk : setup.sphere_radius) s.radius.push_back(rk * r_max);
-    trace(gb, s, false, r_max, params, setup, seed, out, progress);
+    trace_eye(gb, s, r_max, setup, pattern, out, progress);
   }
 }
 

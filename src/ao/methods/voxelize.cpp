@@ -7,7 +7,7 @@
 //     chunk); each band rasterises the triangles that overlap it at the column centres and toggles
 //     one bit per fragment (no atomics: bands are disjoint);
 //  3. one prefix-XOR scan per column turns toggles into "XOR from the fragment to the far end";
-//  4. coarse occupancy (blocks and dilated cell masks, voxelize.h) for empty-space skipping.
+//  4. coarse occupancy (blocks and windowed cell masks, voxelize.h) for empty-space skipping.
 #include "ao/methods/voxelize.h"
 
 #include <algorithm>
@@ -286,8 +286,8 @@ std::size_t scan_columns(VoxelGrid& g) {
 
 // Coarse occupancy for empty-space skipping, in one pass over the grid: the OR of each cell of
 // kCellXY x kCellXY columns (all words), from which the blocks (2 x 2 cells, all words) and the
-// cells' 64-bit masks along the column (one bit per cell_bits voxels), dilated by 0..kReachCap
-// cells across the columns (separable 3 x 3 OR, repeated). Returns the number of solid voxels.
+// cells' 64-bit masks along the column (one bit per cell_bits voxels), ORed over the square
+// windows of 1..kWindowCap + 1 cells anchored at each cell. Returns the number of solid voxels.
 std::size_t build_coarse(VoxelGrid& g) {
   constexpr int C = VoxelGrid::kCellXY, B = VoxelGrid::kBlock;
   static_assert(B == 2 * C);
@@ -303,8 +303,8 @@ std::size_t build_coarse(VoxelGrid& g) {
   const int dnx = g.dnx, dny = g.dny;
   const std::size_t cells = static_cast<std::size_t>(dnx) * dny;
   std::vector<std::uint64_t> cell_words(cells * words, 0);
-  constexpr int L = VoxelGrid::kReachCap + 1;
-  std::vector<std::uint64_t> level(cells * L);  // level t at [t * cells, (t + 1) * cells), then interleaved
+  constexpr int L = VoxelGrid::kWindowCap + 1;
+  std::vector<std::uint64_t> level(cells * L);  // window w at [w * cells, (w + 1) * cells), then interleaved
   std::uint64_t* m0 = level.data();
   std::vector<std::size_t> set_per_row(dny, 0);
   tbb::parallel_for(0, dny, [&](int cj) {
@@ -344,26 +344,26 @@ std::size_t build_coarse(VoxelGrid& g) {
       const std::uint64_t* cw = cell_words.data() + (static_cast<std::size_t>(cj) * dnx + ci) * words;
       for (int w = 0; w < words; ++w) blk[w] |= cw[w];
     }
-  std::vector<std::uint64_t> tmp(cells);
-  for (int t = 1; t <= VoxelGrid::kReachCap; ++t) {
-    const std::uint64_t* prev = level.data() + (t - 1) * cells;
-    std::uint64_t* next = level.data() + t * cells;
-    for (int cj = 0; cj < dny; ++cj) {
-      const std::uint64_t* __restrict p = prev + static_cast<std::size_t>(cj) * dnx;
-      std::uint64_t* __restrict q = tmp.data() + static_cast<std::size_t>(cj) * dnx;
-      for (int ci = 0; ci < dnx; ++ci) q[ci] = p[ci] | (ci > 0 ? p[ci - 1] : 0) | (ci + 1 < dnx ? p[ci + 1] : 0);
-    }
-    for (int cj = 0; cj < dny; ++cj) {
-      const std::uint64_t* p = tmp.data() + static_cast<std::size_t>(cj) * dnx;
-      const std::uint64_t* up = cj > 0 ? p - dnx : p;
-      const std::uint64_t* down = cj + 1 < dny ? p + dnx : p;
-      std::uint64_t* __restrict q = next + static_cast<std::size_t>(cj) * dnx;
-      for (int ci = 0; ci < dnx; ++ci) q[ci] = p[ci] | up[ci] | down[ci];
-    }
-  }
-  g.dilated.resize(cells * L);
+  // Windows of w + 1 cells: the OR along i of cells ci..ci + w (row w = row w - 1 | cell ci + w),
+  // then the OR of those over the rows cj..cj + w.
+  std::vector<std::uint64_t> rows(cells * L);
+  for (std::size_t c = 0; c < cells; ++c) rows[c] = m0[c];
+  for (int w = 1; w < L; ++w)
+    for (int cj = 0; cj < dny; ++cj)
+      for (int ci = 0; ci < dnx; ++ci) {
+        const std::size_t c = static_cast<std::size_t>(cj) * dnx + ci;
+        rows[w * cells + c] = rows[(w - 1) * cells + c] | (ci + w < dnx ? m0[c + w] : 0);
+      }
+  for (int w = 1; w < L; ++w)
+    for (int cj = 0; cj < dny; ++cj)
+      for (int ci = 0; ci < dnx; ++ci) {
+        std::uint64_t m = 0;
+        for (int j = cj; j <= std::min(cj + w, dny - 1); ++j) m |= rows[w * cells + static_cast<std::size_t>(j) * dnx + ci];
+        level[w * cells + static_cast<std::size_t>(cj) * dnx + ci] = m;
+      }
+  g.window.resize(cells * L);
   for (std::size_t c = 0; c < cells; ++c)
-    for (int t = 0; t < L; ++t) g.dilated[c * L + t] = level[t * cells + c];
+    for (int w = 0; w < L; ++w) g.window[c * L + w] = level[w * cells + c];
   std::size_t set = 0;
   for (std::size_t n : set_per_row) set += n;
   return set;
@@ -394,14 +394,22 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // A holed mesh voxelized by winding number (voxelize.h) gets one fan triangle per boundary
   // edge after its own triangles: (b, a, centroid) for the boundary edge a -> b, so that every
   // edge of the mesh and its fans is used twice and the parity pass sees a closed surface.
+  // The triangles are those of every object (Scene::objects(): a world-space mesh, or an instance
+  // whose mesh's triangles go through its transform); closure and hole centroids are per mesh, as
+  // an affine map keeps both (it maps centroids to centroids).
+  const std::vector<SceneObject> objects = scene.objects();
   std::vector<std::vector<Vec3>> centre(scene.meshes.size());
-  std::vector<std::size_t> first{0};
+  std::vector<std::uint8_t> mesh_capped(scene.meshes.size(), 0);
   std::size_t capped = 0;
   for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const bool cap = o.open_meshes == OpenMeshes::Winding && closure[mi].holed();
     if (cap) centre[mi] = hole_centroids(scene.meshes[mi], closure[mi]), ++capped;
-    g.capped.push_back(cap ? 1 : 0);
-    first.push_back(first.back() + scene.meshes[mi].triangle_count() + (cap ? closure[mi].boundary.size() : 0));
+    mesh_capped[mi] = cap ? 1 : 0;
+  }
+  std::vector<std::size_t> first{0};
+  for (const SceneObject& ob : objects) {
+    g.capped.push_back(mesh_capped[ob.mesh]);
+    first.push_back(first.back() + scene.meshes[ob.mesh].triangle_count() + (mesh_capped[ob.mesh] ? closure[ob.mesh].boundary.size() : 0));
   }
   const std::size_t total = first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
@@ -409,21 +417,29 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   std::vector<Buckets> buckets(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
     const std::size_t t0 = c * kChunk, t1 = std::min(total, t0 + kChunk);
-    std::size_t mi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
+    std::size_t oi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
     auto& out = tris[c];
     out.reserve(t1 - t0);
     for (std::size_t t = t0; t < t1; ++t) {
-      while (t >= first[mi + 1]) ++mi;
+      while (t >= first[oi + 1]) ++oi;
+      const std::size_t mi = objects[oi].mesh;
+      const Affine3* tf = objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[oi].instance].object_to_world;
       const bool open = o.open_meshes != OpenMeshes::Parity && closure[mi].open_surface();
       const Mesh& m = scene.meshes[mi];
-      const std::size_t local = t - first[mi];
+      const std::size_t local = t - first[oi];
+      Tri3 tri;
       if (local < m.triangle_count()) {
-        emit(out, source_triangle(m, local, open));
+        tri = source_triangle(m, local, open);
       } else {
         const std::size_t e = local - m.triangle_count();
         const auto [a, b] = closure[mi].boundary[e];
-        emit(out, Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}});
+        tri = Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}};
       }
+      if (tf) {
+        for (Vec3& v : tri.v) v = tf->point(v);
+        if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+      }
+      emit(out, tri);
     }
     Buckets& bk = buckets[c];
     bk.start.assign(3 * static_cast<std::size_t>(bands) + 1, 0);

@@ -136,19 +136,22 @@ struct VoxelGrid {
   std::vector<std::uint64_t> block_bits;
   const std::uint64_t* block(int bi, int bj) const { return block_bits.data() + (static_cast<std::size_t>(bj) * bnx + bi) * words; }
 
-  // Dilated coarse occupancy for O(1) empty-space skipping. Cells are kCellXY x kCellXY columns x
+  // Windowed coarse occupancy for O(1) empty-space skipping. Cells are kCellXY x kCellXY columns x
   // cell_bits voxels (cell_bits: the smallest power of two that gives at most 64 cells per column).
-  // dilated[(cj * dnx + ci) * (kReachCap + 1) + t], t in [0, kReachCap] (one cache line per cell),
+  // window[(cj * dnx + ci) * (kWindowCap + 1) + w], w in [0, kWindowCap] (one cache line per cell),
   // is a 64-bit mask over the cells along the column: bit ck is set when a cell (ci', cj', ck) with
-  // max(|ci' - ci|, |cj' - cj|) <= t holds a solid voxel. Blocks (above) are 2 x 2 cells.
+  // ci <= ci' <= ci + w and cj <= cj' <= cj + w (the square window of w + 1 cells anchored at
+  // (ci, cj), clipped to the grid) holds a solid voxel. A box of columns [x0, x1] x [y0, y1] lies in
+  // the window anchored at its lowest cell with w = the larger of its spans in cells. Blocks
+  // (above) are 2 x 2 cells.
   static constexpr int kCellXY = 4;
-  static constexpr int kReachCap = 7;
+  static constexpr int kWindowCap = 7;
   int dnx = 0, dny = 0;
   int cell_bits = 0, cell_shift = 0;  ///< cell_bits = 1 << cell_shift.
-  std::vector<std::uint64_t> dilated;
-  std::uint64_t near_mask(int t, int ci, int cj) const { return dilated[(static_cast<std::size_t>(cj) * dnx + ci) * (kReachCap + 1) + t]; }
+  std::vector<std::uint64_t> window;
+  std::uint64_t window_mask(int w, int ci, int cj) const { return window[(static_cast<std::size_t>(cj) * dnx + ci) * (kWindowCap + 1) + w]; }
 
-  /// Per mesh of the scene (G-buffer object id - 1): 1 when the mesh had holes and was voxelized as
+  /// Per object of the scene (Scene::objects(), G-buffer object id - 1): 1 when its mesh had holes and was voxelized as
   /// its winding-number solid (OpenMeshes::Winding), so that a surface point of it whose front is
   /// solid is the inside of its shell, seen through a hole.
   std::vector<std::uint8_t> capped;

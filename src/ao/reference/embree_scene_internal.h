@@ -1,6 +1,10 @@
 // Internal: the Embree objects behind a RayScene, for the ray kernels of reference/, gbuffer/ and
-// bake/. Not installed; programs using the library never see an Embree type.
+// bake/, and the one place a hit is mapped back to the scene (resolve). Not installed; programs
+// using the library never see an Embree type.
 #pragma once
+
+#include <cstdint>
+#include <vector>
 
 #include <embree3/rtcore.h>
 
@@ -10,10 +14,52 @@ namespace ao {
 
 struct RayScene::Handles {
   RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
+  RTCScene scene = nullptr;                 ///< Top level: geometry i is object i (Scene::objects()).
+  std::vector<RTCScene> mesh_scenes;        ///< Per mesh: its own scene when it is instanced, else null.
+  std::vector<SceneObject> objects;         ///< rs.scene().objects(), by geometry ID of the top level.
+  std::vector<Affine3> normal_to_world;     ///< Per instance: cofactor of its transform (face normals; normalise).
 };
 
-/// The committed Embree scene of `rs`: mesh i is geometry i.
+/// The committed top-level Embree scene of `rs`: object i (Scene::objects()) is geometry i, a
+/// triangle geometry for a mesh drawn in world space, an instance geometry for an instance.
 inline RTCScene embree_scene(const RayScene& rs) { return rs.handles().scene; }
+
+/// The object a hit belongs to (its top-level geometry ID): an instance hit has geomID = the
+/// triangle geometry inside the instanced scene and instID[0] = the instance's top-level ID.
+inline unsigned hit_object(unsigned geom_id, unsigned inst_id) { return inst_id != RTC_INVALID_GEOMETRY_ID ? inst_id : geom_id; }
+
+/// What a hit is on: the mesh and its triangle, and the transform from the mesh's coordinates to
+/// the world (null: the mesh is in world space).
+struct HitRef {
+  std::uint32_t object;              ///< Index into Scene::objects() (object id - 1).
+  std::uint32_t mesh;                ///< Index into Scene::meshes.
+  std::uint32_t triangle;            ///< Triangle within that mesh (Embree's primID).
+  const Affine3* to_world = nullptr; ///< Instance transform, or null.
+  const Affine3* normal_to_world = nullptr;  ///< Its cofactor matrix (face and vertex normals; normalise), or null.
+};
+
+/// Maps a hit (geomID, instID[0], primID; geomID valid) to the scene. Every kernel that needs more
+/// than "hit or not" and the distance goes through this.
+inline HitRef resolve(const RayScene& rs, unsigned geom_id, unsigned inst_id, unsigned prim_id) {
+  const RayScene::Handles& h = rs.handles();
+  HitRef r;
+  r.object = hit_object(geom_id, inst_id);
+  const SceneObject& o = h.objects[r.object];
+  r.mesh = o.mesh;
+  r.triangle = prim_id;
+  if (o.instance != SceneObject::kNoInstance) {
+    r.to_world = &rs.scene().instances[o.instance].object_to_world;
+    r.normal_to_world = &h.normal_to_world[o.instance];
+  }
+  return r;
+}
+
+/// The world-space vertices of a resolved hit's triangle.
+inline void world_triangle(const RayScene& rs, const HitRef& h, Vec3& p0, Vec3& p1, Vec3& p2) {
+  const Mesh& m = rs.scene().meshes[h.mesh];
+  const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(h.triangle)];
+  p0 = m.positions[i[0]], p1 = m.positions[i[1]], p2 = m.positions[i[2]];
+  if (h.to_world) p0 = h.to_world->point(p0), p1 = h.to_world->point(p1), p2 = h.to_world->point(p2);
+}
 
 }  // namespace ao

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <vector>
 
 #include "ao/core/gbuffer.h"
 #include "ao/reference/ray_offset.h"
@@ -22,6 +23,7 @@ struct PixelSurface {
 struct PixelSurfaceContext {
   const GBuffer& g;
   const Scene& scene;
+  std::vector<SceneObject> objects;  // scene.objects(): object id - 1 -> mesh and instance
   Frame basis;
   Vec3 eye;
   float eye_magnitude;    // largest coordinate of the eye
@@ -32,6 +34,7 @@ struct PixelSurfaceContext {
   PixelSurfaceContext(const GBuffer& gb, const Scene& s, const Bounds3& bounds, float fixed)
       : g(gb),
         scene(s),
+        objects(s.objects()),
         basis(gb.camera.basis()),
         eye(gb.camera.eye),
         eye_magnitude(max_abs_coordinate(gb.camera.eye)),
@@ -51,12 +54,17 @@ struct PixelSurfaceContext {
     float magnitude = eye_magnitude + max_abs_coordinate(pc);
     const std::uint32_t id = g.object_id(x, y);
     const std::size_t tri = has_triangles ? g.primitive_id(x, y) : 0;
-    if (has_triangles && id >= 1 && id <= scene.meshes.size() && tri < scene.meshes[id - 1].triangle_count()) {
-      const Mesh& m = scene.meshes[id - 1];
+    if (has_triangles && id >= 1 && id <= objects.size() && tri < scene.meshes[objects[id - 1].mesh].triangle_count()) {
+      // The triangle in world space (an instance's moved vertex by vertex, as the G-buffer did).
+      const SceneObject& o = objects[id - 1];
+      const Mesh& m = scene.meshes[o.mesh];
       const std::uint32_t* i = &m.indices[3 * tri];
-      const Vec3 ng = normalize(cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]));
+      Vec3 p[3] = {m.positions[i[0]], m.positions[i[1]], m.positions[i[2]]};
+      if (o.instance != SceneObject::kNoInstance)
+        for (Vec3& q : p) q = scene.instances[o.instance].object_to_world.point(q);
+      const Vec3 ng = normalize(cross(p[1] - p[0], p[2] - p[0]));
       s.geometric = dot(ng, s.normal) < 0 ? -ng : ng;
-      magnitude = std::max(magnitude, triangle_magnitude(m, tri));
+      magnitude = std::max({magnitude, max_abs_coordinate(p[0]), max_abs_coordinate(p[1]), max_abs_coordinate(p[2])});
     } else {
       magnitude = std::max(magnitude, scene_magnitude);
     }

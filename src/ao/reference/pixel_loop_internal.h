@@ -67,7 +67,8 @@ void for_each_covered_pixel(const RayScene& rs, const GBuffer& g, float fixed_of
 }
 
 /// Traces `count` <= max(N, 16) rays from `origin` in directions dir(i) for i in [0, count), each
-/// up to tfar(i), and calls hit(i, distance, geom_id) with distance = +infinity and geom_id =
+/// up to tfar(i), and calls hit(i, distance, object) with `object` the index into
+/// Scene::objects() of what was hit (hit_object), or distance = +infinity and object =
 /// RTC_INVALID_GEOMETRY_ID where nothing was hit within tfar(i).
 template <int N, class Dir, class Far, class Hit>
 void trace_closest(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, int count, Dir&& dir, Far&& tfar, Hit&& hit) {
@@ -79,7 +80,7 @@ void trace_closest(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, in
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(embree_scene(rs), &ctx, &rh);
       const bool missed = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
-      hit(i, missed ? kInfinity : rh.ray.tfar, rh.hit.geomID);
+      hit(i, missed ? kInfinity : rh.ray.tfar, missed ? RTC_INVALID_GEOMETRY_ID : hit_object(rh.hit.geomID, rh.hit.instID[0]));
     }
   } else {
     for (int first = 0; first < count; first += N) {
@@ -94,7 +95,7 @@ void trace_closest(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, in
       Packet<N>::intersect(valid, embree_scene(rs), &ctx, &rh);
       for (int k = 0; k < lanes; ++k) {
         const bool missed = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID;
-        hit(first + k, missed ? kInfinity : rh.ray.tfar[k], rh.hit.geomID[k]);
+        hit(first + k, missed ? kInfinity : rh.ray.tfar[k], missed ? RTC_INVALID_GEOMETRY_ID : hit_object(rh.hit.geomID[k], rh.hit.instID[0][k]));
       }
     }
   }

@@ -23,6 +23,29 @@ void check(RTCDevice device, const char* what) {
   if (e != RTC_ERROR_NONE) throw SystemError(std::string("embree: ") + what + " failed (error " + std::to_string(static_cast<int>(e)) + ")");
 }
 
+RTCBuildQuality embree_quality(BvhQuality q) {
+  return q == BvhQuality::High ? RTC_BUILD_QUALITY_HIGH : q == BvhQuality::Medium ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_LOW;
+}
+
+// A committed triangle geometry for mesh m. Embree's SIMD loads read 16 bytes from the last
+// vertex, 4 past its end: the mesh's own array is shared when its spare capacity covers that
+// (validate_and_prepare reserves it), else copied into a buffer Embree pads itself.
+RTCGeometry triangle_geometry(RTCDevice device, const Mesh& m) {
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  if (m.positions.capacity() >= m.positions.size() + kVertexPadding) {
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0, sizeof(Vec3), m.positions.size());
+  } else {
+    auto* v = static_cast<Vec3*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), m.positions.size()));
+    check(device, "allocating a vertex buffer");
+    std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(Vec3));
+  }
+  // Indices are read one triangle (12 bytes) at a time: no padding needed.
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0, 3 * sizeof(std::uint32_t), m.triangle_count());
+  check(device, "setting geometry buffers");
+  rtcCommitGeometry(geom);
+  return geom;
+}
+
 }  // namespace
 
 RayScene::RayScene(const Scene& scene, const BvhOptions& options)
@@ -36,41 +59,63 @@ RayScene::RayScene(const Scene& scene, const BvhOptions& options)
   else if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) packet_width_ = 8;
   else if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED)) packet_width_ = 4;
 
-  // The size rule of kCompactBvhTriangles (measured in BENCHMARKS.md, "Loading big meshes").
-  const bool big = scene.triangle_count() > kCompactBvhTriangles;
+  // Object i (Scene::objects()) is geometry i of the top-level scene: a mesh drawn in world space
+  // is a triangle geometry there; an instanced mesh gets a committed scene of its own, built once,
+  // and each of its instances is an instance geometry pointing at it.
+  Handles& h = *handles_;
+  h.objects = scene.objects();
+  h.mesh_scenes.assign(scene.meshes.size(), nullptr);
+  std::size_t top_triangles = 0;
+  for (const SceneObject& o : h.objects)
+    if (o.instance == SceneObject::kNoInstance) top_triangles += scene.meshes[o.mesh].triangle_count();
+  // The size rule of kCompactBvhTriangles (measured in BENCHMARKS.md, "Loading big meshes"),
+  // applied to each BVH's own triangles: the top level's world-space meshes, each instanced mesh's.
+  const auto is_big = [](std::size_t triangles) { return triangles > kCompactBvhTriangles; };
+  const bool big = is_big(top_triangles);
   quality_ = options.quality.value_or(big ? BvhQuality::Medium : BvhQuality::High);
   compact_ = options.compact.value_or(big);
   bvh = rtcNewScene(device);
-  rtcSetSceneBuildQuality(bvh, quality_ == BvhQuality::High ? RTC_BUILD_QUALITY_HIGH
-                               : quality_ == BvhQuality::Medium ? RTC_BUILD_QUALITY_MEDIUM
-                                                                : RTC_BUILD_QUALITY_LOW);
+  rtcSetSceneBuildQuality(bvh, embree_quality(quality_));
   if (compact_) rtcSetSceneFlags(bvh, RTC_SCENE_FLAG_COMPACT);
-  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-    const Mesh& m = scene.meshes[i];
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Embree's SIMD loads read 16 bytes from the last vertex, 4 past its end: the mesh's own array
-    // is shared when its spare capacity covers that (validate_and_prepare reserves it), else copied
-    // into a buffer Embree pads itself.
-    if (m.positions.capacity() >= m.positions.size() + kVertexPadding) {
-      rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0, sizeof(Vec3), m.positions.size());
+  for (std::size_t i = 0; i < h.objects.size(); ++i) {
+    const SceneObject& o = h.objects[i];
+    RTCGeometry geom = nullptr;
+    if (o.instance == SceneObject::kNoInstance) {
+      geom = triangle_geometry(device, scene.meshes[o.mesh]);
     } else {
-      auto* v = static_cast<Vec3*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), m.positions.size()));
-      check(device, "allocating a vertex buffer");
-      std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(Vec3));
+      RTCScene& sub = h.mesh_scenes[o.mesh];
+      if (!sub) {
+        const Mesh& m = scene.meshes[o.mesh];
+        const bool sub_big = is_big(m.triangle_count());
+        sub = rtcNewScene(device);
+        rtcSetSceneBuildQuality(sub, embree_quality(options.quality.value_or(sub_big ? BvhQuality::Medium : BvhQuality::High)));
+        if (options.compact.value_or(sub_big)) rtcSetSceneFlags(sub, RTC_SCENE_FLAG_COMPACT);
+        RTCGeometry mesh_geom = triangle_geometry(device, m);
+        rtcAttachGeometryByID(sub, mesh_geom, 0);
+        rtcReleaseGeometry(mesh_geom);
+        rtcCommitScene(sub);
+        check(device, "building the BVH of an instanced mesh");
+      }
+      const Instance& in = scene.instances[o.instance];
+      geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(geom, sub);
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, &in.object_to_world);
+      check(device, "setting an instance");
+      rtcCommitGeometry(geom);
     }
-    // Indices are read one triangle (12 bytes) at a time: no padding needed.
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0, 3 * sizeof(std::uint32_t), m.triangle_count());
-    check(device, "setting geometry buffers");
-    rtcCommitGeometry(geom);
     rtcAttachGeometryByID(bvh, geom, static_cast<unsigned>(i));
     rtcReleaseGeometry(geom);
   }
+  h.normal_to_world.reserve(scene.instances.size());
+  for (const Instance& in : scene.instances) h.normal_to_world.push_back(cofactor(in.object_to_world));
   rtcCommitScene(bvh);
   check(device, "building the BVH");
 }
 
 RayScene::~RayScene() {
   if (handles_->scene) rtcReleaseScene(handles_->scene);
+  for (RTCScene sub : handles_->mesh_scenes)
+    if (sub) rtcReleaseScene(sub);
   if (handles_->device) rtcReleaseDevice(handles_->device);
 }
 

@@ -24,7 +24,8 @@ enum class BvhQuality {
 /// ratio given in BENCHMARKS.md ("Loading big meshes", where the rule is measured).
 inline constexpr std::size_t kCompactBvhTriangles = 4'000'000;
 
-/// BVH build settings; every field left empty is chosen from the triangle count.
+/// BVH build settings; every field left empty is chosen from the triangle count (of each BVH: the
+/// world-space meshes together, and each instanced mesh on its own).
 struct BvhOptions {
   std::optional<BvhQuality> quality;  ///< Empty: High up to kCompactBvhTriangles, Medium above.
   std::optional<bool> compact;        ///< Leaves that index the mesh's vertices instead of copying them. Empty: above kCompactBvhTriangles.
@@ -33,10 +34,12 @@ struct BvhOptions {
 class RayScene {
  public:
   /// Builds the BVH for `scene`, which must outlive this object, stay unmodified while it lives,
-  /// and have passed validate_and_prepare. Mesh i becomes geometry i. Embree reads the meshes'
-  /// positions and indices in place (no copy) when the positions have the spare capacity
-  /// validate_and_prepare reserves (kVertexPadding); otherwise it copies them. Throws SystemError
-  /// when Embree fails.
+  /// and have passed validate_and_prepare. Object i of Scene::objects() becomes geometry i (without
+  /// instances: mesh i); an instanced mesh gets one BVH of its own, which each of its instances
+  /// references through its transform (one BVH over the instances on top, not a copy per
+  /// instance). Embree reads the meshes' positions and indices in place (no copy) when the
+  /// positions have the spare capacity validate_and_prepare reserves (kVertexPadding); otherwise it
+  /// copies them. Throws SystemError when Embree fails.
   explicit RayScene(const Scene& scene, const BvhOptions& options = {});
   ~RayScene();
   RayScene(const RayScene&) = delete;
@@ -48,7 +51,7 @@ class RayScene {
   /// Widest ray packet (16, 8, 4 or 1) this Embree build supports natively on this CPU.
   int native_packet_width() const { return packet_width_; }
 
-  /// The build settings used, with the automatic choices resolved.
+  /// The build settings used for the top-level BVH, with the automatic choices resolved.
   BvhQuality quality() const { return quality_; }
   bool compact() const { return compact_; }
 

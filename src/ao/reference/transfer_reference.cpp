@@ -62,11 +62,11 @@ TransferEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 ori
         rs, ctx, origin, count,
         [&](int i) { return frame.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + i), seed))); },
         [&](int) { return reach; },
-        [&](int, float d, unsigned geom) {
+        [&](int, float d, unsigned object) {
           // Eq. 4's two integrands over cosine-weighted directions: mu(d) of the sky, and the
           // occluder's albedo weighted by 1 - mu(d); nothing hit within the reach is open sky.
-          const double mu = geom == RTC_INVALID_GEOMETRY_ID ? 1.0 : falloff.mu(d);
-          const Vec3 a = geom == RTC_INVALID_GEOMETRY_ID ? Vec3{} : albedo[geom];
+          const double mu = object == RTC_INVALID_GEOMETRY_ID ? 1.0 : falloff.mu(d);
+          const Vec3 a = object == RTC_INVALID_GEOMETRY_ID ? Vec3{} : albedo[object];
           const double q[3] = {1.0 - (1.0 - mu) * a.x, 1.0 - (1.0 - mu) * a.y, 1.0 - (1.0 - mu) * a.z};
           acc.add(mu, q);
         });
@@ -81,11 +81,11 @@ TransferEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 ori
   return e;
 }
 
-// Albedo by Embree geometry id (mesh i is geometry i), scaled.
+// Albedo by object (Scene::objects(), the ids trace_closest reports), scaled.
 std::vector<Vec3> scaled_albedos(const RayScene& rs, float scale) {
   if (!(scale >= 0.0f && scale <= 1.0f)) throw InputError("transfer reference: albedo scale must be in [0, 1], got " + std::to_string(scale));
   std::vector<Vec3> a;
-  for (const Mesh& m : rs.scene().meshes) a.push_back(m.albedo * scale);
+  for (const SceneObject& o : rs.scene().objects()) a.push_back(rs.scene().meshes[o.mesh].albedo * scale);
   return a;
 }
 

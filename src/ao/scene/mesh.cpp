@@ -1,6 +1,7 @@
 #include "ao/scene/mesh.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -25,16 +26,71 @@ Bounds3 Mesh::bounds() const {
   return b;
 }
 
+namespace {
+
+/// Per mesh: does some instance name it (then it is drawn only through its instances)?
+std::vector<char> instanced_meshes(const Scene& s) {
+  std::vector<char> used(s.meshes.size(), 0);
+  for (const Instance& in : s.instances)
+    if (in.mesh < used.size()) used[in.mesh] = 1;
+  return used;
+}
+
+}  // namespace
+
 Bounds3 Scene::bounds() const {
   Bounds3 b;
-  for (const Mesh& m : meshes) b.extend(m.bounds());
+  const std::vector<char> instanced = instanced_meshes(*this);
+  std::vector<Bounds3> mesh_bounds(meshes.size());
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    mesh_bounds[i] = meshes[i].bounds();
+    if (!instanced[i]) b.extend(mesh_bounds[i]);
+  }
+  for (const Instance& in : instances)
+    if (in.mesh < meshes.size()) b.extend(transform_bounds(in.object_to_world, mesh_bounds[in.mesh]));
   return b;
 }
 
 std::size_t Scene::triangle_count() const {
   std::size_t n = 0;
+  for (const SceneObject& o : objects()) n += meshes[o.mesh].triangle_count();
+  return n;
+}
+
+std::size_t Scene::stored_triangle_count() const {
+  std::size_t n = 0;
   for (const Mesh& m : meshes) n += m.triangle_count();
   return n;
+}
+
+std::vector<SceneObject> Scene::objects() const {
+  std::vector<SceneObject> out;
+  const std::vector<char> instanced = instanced_meshes(*this);
+  for (std::size_t i = 0; i < meshes.size(); ++i)
+    if (!instanced[i]) out.push_back({static_cast<std::uint32_t>(i), SceneObject::kNoInstance});
+  for (std::size_t k = 0; k < instances.size(); ++k)
+    if (instances[k].mesh < meshes.size()) out.push_back({instances[k].mesh, static_cast<std::uint32_t>(k)});
+  return out;
+}
+
+Scene flatten_instances(const Scene& scene) {
+  Scene out;
+  out.name = scene.name;
+  out.preferred_view = scene.preferred_view;
+  out.analytic = scene.analytic;
+  out.warnings = scene.warnings;
+  for (const SceneObject& o : scene.objects()) {
+    Mesh m = scene.meshes[o.mesh];
+    if (o.instance != SceneObject::kNoInstance) {
+      const Affine3& t = scene.instances[o.instance].object_to_world;
+      const Affine3 n = cofactor(t);
+      for (Vec3& p : m.positions) p = t.point(p);
+      for (Vec3& v : m.normals) v = normalize(n.vector(v));
+    }
+    m.positions.reserve(m.positions.size() + kVertexPadding);  // see kVertexPadding
+    out.meshes.push_back(std::move(m));
+  }
+  return out;
 }
 
 std::size_t Scene::vertex_count() const {
@@ -203,8 +259,54 @@ void validate_mesh(const Scene& scene, Mesh& mesh) {
 
 }  // namespace
 
+namespace {
+
+// Node names come from the file: kept printable, one line and short in messages.
+std::string instance_label(const Scene& scene, std::size_t k) {
+  const Instance& in = scene.instances[k];
+  if (in.name.empty()) return "instance " + std::to_string(k);
+  std::string name;
+  for (char c : in.name.substr(0, 64)) name += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+  return "node '" + name + (in.name.size() > 64 ? "...'" : "'");
+}
+
+// Transforms: finite, invertible, and keeping their mesh inside +-kMaxCoordinate. The box test
+// first (8 corners); only a transform whose box leaves the range has its vertices checked one by
+// one, since a rotated box can stick out where no vertex does.
+void validate_instances(const Scene& scene) {
+  std::vector<Bounds3> mesh_bounds(scene.meshes.size());
+  std::vector<char> have(scene.meshes.size(), 0);
+  for (std::size_t k = 0; k < scene.instances.size(); ++k) {
+    const Instance& in = scene.instances[k];
+    const std::string w = scene.name + ": " + instance_label(scene, k);
+    const Affine3& t = in.object_to_world;
+    if (!t.is_finite()) throw InputError(w + " has a non-finite transform");
+    // A zero determinant flattens the mesh onto a plane or a line: every triangle would be
+    // degenerate, and the ray tracer needs the inverse.
+    const double det = t.determinant();
+    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) throw InputError(w + " has a transform with determinant 0 (it flattens the mesh)");
+    if (!have[in.mesh]) mesh_bounds[in.mesh] = scene.meshes[in.mesh].bounds(), have[in.mesh] = 1;
+    const Bounds3 b = transform_bounds(t, mesh_bounds[in.mesh]);
+    const auto too_far = [](Vec3 p) { return !is_finite(p) || std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > kMaxCoordinate; };
+    if (!too_far(b.lo) && !too_far(b.hi)) continue;
+    for (const Vec3& p : scene.meshes[in.mesh].positions) {
+      const Vec3 q = t.point(p);
+      if (!too_far(q)) continue;
+      const float m = is_finite(q) ? std::max({std::abs(q.x), std::abs(q.y), std::abs(q.z)}) : kInfinity;
+      throw InputError(w + " moves its mesh to coordinate " + format_magnitude(m) + ", beyond the +-" + format_magnitude(kMaxCoordinate) +
+                       " ao traces correctly (scale the scene down)");
+    }
+  }
+}
+
+}  // namespace
+
 void validate_and_prepare(Scene& scene) {
   if (scene.meshes.empty()) throw InputError(scene.name + ": the scene has no meshes");
+  for (std::size_t k = 0; k < scene.instances.size(); ++k)
+    if (scene.instances[k].mesh >= scene.meshes.size())
+      throw InputError(scene.name + ": " + instance_label(scene, k) + " uses mesh " + std::to_string(scene.instances[k].mesh) + ", the scene has " +
+                       std::to_string(scene.meshes.size()));
   for (Mesh& mesh : scene.meshes) {
     const std::size_t before = mesh.triangle_count();
     validate_mesh(scene, mesh);
@@ -213,7 +315,17 @@ void validate_and_prepare(Scene& scene) {
       scene.warnings.push_back(where(scene, mesh) + ": dropped " + std::to_string(dropped) + " degenerate (zero-area) triangle" +
                                (dropped == 1 ? "" : "s"));
   }
+  // Meshes left without triangles go, and instances follow their mesh's new index.
+  std::vector<std::uint32_t> new_index(scene.meshes.size(), SceneObject::kNoInstance);
+  std::uint32_t next = 0;
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i)
+    if (scene.meshes[i].triangle_count() > 0) new_index[i] = next++;
   std::erase_if(scene.meshes, [](const Mesh& m) { return m.triangle_count() == 0; });
+  if (!scene.instances.empty()) {
+    for (Instance& in : scene.instances) in.mesh = new_index[in.mesh];
+    std::erase_if(scene.instances, [](const Instance& in) { return in.mesh == SceneObject::kNoInstance; });
+    validate_instances(scene);
+  }
   if (scene.triangle_count() == 0) throw InputError(scene.name + ": the scene has no triangles with nonzero area");
 }
 

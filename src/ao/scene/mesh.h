@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "ao/core/affine.h"
 #include "ao/core/camera.h"
 #include "ao/core/math.h"
 #include "ao/scene/analytic.h"
@@ -37,19 +38,56 @@ struct Mesh {
   Bounds3 bounds() const;
 };
 
+/// One more placement of a mesh in the world: a glTF node that uses a mesh which other nodes use
+/// too. The mesh is stored once, in its own (object) space, and traced through the transform.
+struct Instance {
+  std::uint32_t mesh = 0;   ///< Index into Scene::meshes.
+  Affine3 object_to_world;  ///< Finite, invertible (checked by validate_and_prepare).
+  std::string name;         ///< The node's name, for messages; may be empty.
+};
+
+/// One thing the scene shows, as the G-buffer's object ids count them (object id = index + 1):
+/// a mesh drawn once in world space, or one instance of a mesh.
+struct SceneObject {
+  static constexpr std::uint32_t kNoInstance = 0xffffffffu;
+  std::uint32_t mesh = 0;                 ///< Index into Scene::meshes.
+  std::uint32_t instance = kNoInstance;   ///< Index into Scene::instances, or kNoInstance (world space).
+};
+
 /// A scene: meshes, plus an optional camera the scene was designed to be seen from, and (for
 /// built-in scenes that are exactly such surfaces) analytic descriptions of what the meshes show.
+///
+/// Instances: a mesh that some entry of `instances` names is in object space and is drawn only
+/// through its instances (each one its own object); every other mesh is in world space and drawn
+/// once. With `instances` empty (built-in scenes, OBJ/PLY/OFF/STL, glTF files that use no mesh
+/// twice, or any file loaded with LoadOptions::flatten_instances) every mesh is drawn once.
 struct Scene {
   std::string name;                     ///< File name or built-in scene name, used in messages.
   std::vector<Mesh> meshes;
+  std::vector<Instance> instances;      ///< Further placements of meshes; see above.
   std::optional<Camera> preferred_view; ///< Eye/target/up/fov only; size comes from the caller.
   AnalyticSurfaces analytic;            ///< World space; empty for scenes from files. The meshes are authoritative, these describe them.
   std::vector<std::string> warnings;    ///< Things fixed while loading (dropped triangles, ...).
 
+  /// World-space bounds of everything drawn (instances through their transforms).
   Bounds3 bounds() const;
+  /// Triangles drawn: an instanced mesh counts once per instance.
   std::size_t triangle_count() const;
+  /// Triangles held in memory: every mesh once (what the BVHs and memory estimates scale with).
+  std::size_t stored_triangle_count() const;
+  /// Vertices held in memory (every mesh once).
   std::size_t vertex_count() const;
+  /// What is drawn, in object-id order: the meshes no instance names, in mesh order, then the
+  /// instances in order. Without instances, object i is mesh i.
+  std::vector<SceneObject> objects() const;
 };
+
+/// The same scene with every instance copied into a world-space mesh of its own (positions through
+/// the transform, normals through its cofactor matrix, renormalised), in object order, so object
+/// i of the result is object i of `scene`; `instances` of the result is empty. For consumers that
+/// need world-space triangles of every object (and as the reference instanced tracing is tested
+/// against). `scene` must have passed validate_and_prepare.
+Scene flatten_instances(const Scene& scene);
 
 /// Smooth per-vertex normals, weighting each face normal by its angle at the vertex, for a mesh
 /// whose `normals` is empty and whose indices are in range. Vertices used by no triangle get +z.
@@ -59,7 +97,11 @@ void generate_normals(Mesh& mesh);
 /// Checks and repairs a scene in place before it is used; `source` names it in messages.
 /// Throws InputError for non-finite coordinates or normals, coordinates beyond +-kMaxCoordinate,
 /// non-finite UVs, indices out of range, an index count
-/// not divisible by 3, per-vertex arrays of the wrong length, and a scene with no triangle left.
+/// not divisible by 3, per-vertex arrays of the wrong length, and a scene with no triangle left;
+/// and, for instances, a mesh index out of range, a non-finite or non-invertible (zero
+/// determinant) transform, or a transform that moves a vertex of its mesh beyond +-kMaxCoordinate
+/// (the message names the instance's node). Instances of a mesh that lost all its triangles go
+/// with it.
 /// Drops degenerate (zero-area) triangles, since real meshes carry a few of them, adds a warning
 /// with their count, and generates normals where missing (unit length is restored where loaded
 /// normals are not).

@@ -1,0 +1,50 @@
+// Affine maps of 3D space (3x4 matrices), as glTF nodes place instanced meshes in the world.
+#pragma once
+
+#include <cmath>
+
+#include "ao/core/math.h"
+
+namespace ao {
+
+/// x' = c0 x + c1 y + c2 z + c3: a 3x3 linear part (columns c0, c1, c2) and a translation c3.
+/// The memory layout (12 floats, column by column) is Embree's RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR.
+/// The default is the identity.
+struct Affine3 {
+  Vec3 c0{1, 0, 0}, c1{0, 1, 0}, c2{0, 0, 1}, c3{0, 0, 0};
+
+  /// The linear part applied to a direction (no translation).
+  Vec3 vector(Vec3 v) const { return c0 * v.x + c1 * v.y + c2 * v.z; }
+  /// The whole map applied to a point.
+  Vec3 point(Vec3 p) const { return vector(p) + c3; }
+  /// Determinant of the linear part, in double: its sign says whether the map mirrors, and a
+  /// zero means the map flattens space (no inverse).
+  double determinant() const {
+    const auto d = [](float v) { return static_cast<double>(v); };
+    return d(c0.x) * (d(c1.y) * d(c2.z) - d(c2.y) * d(c1.z)) - d(c1.x) * (d(c0.y) * d(c2.z) - d(c2.y) * d(c0.z)) +
+           d(c2.x) * (d(c0.y) * d(c1.z) - d(c1.y) * d(c0.z));
+  }
+  bool is_finite() const { return ao::is_finite(c0) && ao::is_finite(c1) && ao::is_finite(c2) && ao::is_finite(c3); }
+};
+
+static_assert(sizeof(Affine3) == 12 * sizeof(float), "Affine3 is passed to Embree as 12 packed floats");
+
+/// a after b: (a * b)(p) = a(b(p)).
+inline Affine3 operator*(const Affine3& a, const Affine3& b) { return {a.vector(b.c0), a.vector(b.c1), a.vector(b.c2), a.point(b.c3)}; }
+
+/// The cofactor matrix of m's linear part (det(L) times its inverse transpose), as the linear part
+/// of the result (translation zero). It maps the cross product of two vectors to the cross product
+/// of their images, L a x L b = cof(L) (a x b), so a face normal transformed by it points where
+/// the normal of the transformed triangle points, mirrors included; unlike the inverse transpose it
+/// exists for every matrix. Normalise after applying it.
+inline Affine3 cofactor(const Affine3& m) { return {cross(m.c1, m.c2), cross(m.c2, m.c0), cross(m.c0, m.c1), {0, 0, 0}}; }
+
+/// The axis-aligned box of m applied to the corners of b (an empty box stays empty).
+inline Bounds3 transform_bounds(const Affine3& m, const Bounds3& b) {
+  Bounds3 out;
+  if (b.empty()) return out;
+  for (int k = 0; k < 8; ++k) out.extend(m.point({k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z}));
+  return out;
+}
+
+}  // namespace ao

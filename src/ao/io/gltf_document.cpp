@@ -1,0 +1,726 @@
+// glTF load-modify-save with tinygltf (see gltf_document.h). The structure is checked by
+// check_gltf before tinygltf parses anything (tinygltf trusts counts, offsets and nesting), and
+// every accessor read here is bounds-checked again, so a hostile file ends in one InputError.
+// tinygltf's file system is replaced: it may read files of the input's own folder and nothing
+// else, and it cannot write at all (the GLB is serialised to memory and written atomically here).
+#include "ao/io/gltf_document.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "ao/core/error.h"
+#include "ao/io/atomic_file.h"
+#include "ao/io/gltf_check.h"
+
+namespace ao {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
+
+/// tinygltf's messages are several lines: one line, printable, short.
+std::string one_line(const std::string& s) {
+  std::string out;
+  for (char c : s.substr(0, 240)) out += std::isspace(static_cast<unsigned char>(c)) ? ' ' : std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+  while (!out.empty() && (out.back() == ' ' || out.back() == '.')) out.pop_back();
+  return s.size() > 240 ? out + "..." : out;
+}
+
+// --- tinygltf's file system: the input's folder, read only ------------------------------------
+
+struct Folder {
+  fs::path dir;  ///< weakly_canonical folder of the input
+};
+
+/// True when `file` is a regular file in the input's folder or below it (after resolving "..",
+/// "." and symbolic links).
+bool in_folder(const std::string& file, const Folder& f) {
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(fs::path(file), ec);
+  if (ec || f.dir.empty() || !fs::is_regular_file(p, ec)) return false;
+  const fs::path rel = p.lexically_relative(f.dir);
+  return !rel.empty() && *rel.begin() != "..";
+}
+
+bool fs_exists(const std::string& file, void* user) { return in_folder(file, *static_cast<Folder*>(user)); }
+std::string fs_expand(const std::string& file, void*) { return file; }  // no ~ or $VAR expansion
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
+  if (!in_folder(file, *static_cast<Folder*>(user))) {
+    if (err) *err = "not a file in the glTF's folder";
+    return false;
+  }
+  std::ifstream in(file, std::ios::binary);
+  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (in.bad()) {
+    if (err) *err = "cannot be read";
+    return false;
+  }
+  return true;
+}
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "ao does not write through tinygltf";
+  return false;
+}
+
+/// Image "loader": images in a bufferView stay there; bytes of a data: URI or a file are kept
+/// encoded in Image::image (moved into the binary chunk after the load).
+bool keep_encoded(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes, int size, void*) {
+  if (image->bufferView >= 0) return true;
+  image->image.assign(bytes, bytes + size);
+  image->as_is = true;
+  return true;
+}
+
+std::string sniff_mime(const std::vector<unsigned char>& b) {
+  if (b.size() >= 8 && std::memcmp(b.data(), "\x89PNG\r\n\x1a\n", 8) == 0) return "image/png";
+  if (b.size() >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return "image/jpeg";
+  return {};
+}
+
+// --- matrices (column-major, as glTF) ----------------------------------------------------------
+
+using Mat4 = std::array<double, 16>;
+constexpr Mat4 kIdentity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+Mat4 mul(const Mat4& a, const Mat4& b) {
+  Mat4 r{};
+  for (int c = 0; c < 4; ++c)
+    for (int row = 0; row < 4; ++row) {
+      double s = 0;
+      for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
+      r[c * 4 + row] = s;
+    }
+  return r;
+}
+
+/// The node's local matrix: `matrix`, or T * R * S (glTF 2.0 spec, "Transformations").
+Mat4 local_matrix(const tinygltf::Node& n) {
+  if (n.matrix.size() == 16) {
+    Mat4 m;
+    std::copy(n.matrix.begin(), n.matrix.end(), m.begin());
+    return m;
+  }
+  Mat4 t = kIdentity, r = kIdentity, s = kIdentity;
+  if (n.translation.size() == 3) t[12] = n.translation[0], t[13] = n.translation[1], t[14] = n.translation[2];
+  if (n.scale.size() == 3) s[0] = n.scale[0], s[5] = n.scale[1], s[10] = n.scale[2];
+  if (n.rotation.size() == 4) {
+    double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+    const double len = std::sqrt(x * x + y * y + z * z + w * w);
+    if (len > 0) x /= len, y /= len, z /= len, w /= len;  // the spec asks for unit quaternions; exporters round
+    r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
+         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
+         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
+         0,                       0,                       0,                       1};
+  }
+  return mul(t, mul(r, s));
+}
+
+/// Cofactor matrix of the upper 3x3 (the inverse transpose times the determinant): maps normals;
+/// its scale does not matter, normals are normalised after.
+std::array<double, 9> normal_matrix(const Mat4& m, double& det) {
+  auto a = [&](int row, int col) { return m[col * 4 + row]; };
+  std::array<double, 9> c{};  // row-major
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) {
+      const int r1 = (row + 1) % 3, r2 = (row + 2) % 3, c1 = (col + 1) % 3, c2 = (col + 2) % 3;
+      c[row * 3 + col] = a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1);
+    }
+  det = a(0, 0) * c[0] + a(0, 1) * c[1] + a(0, 2) * c[2];
+  return c;
+}
+
+}  // namespace
+
+// --- the document -------------------------------------------------------------------------------
+
+struct GltfDocument::Impl {
+  fs::path path;
+  int uv_set = 0;
+  tinygltf::Model model;
+  std::vector<std::string> warnings;
+  /// Instances of the displayed scene: (node, mesh, world matrix), depth first.
+  struct Instance {
+    int node, mesh;
+    Mat4 world;
+  };
+  std::vector<Instance> instances;
+  std::map<int, int> map_texture;  ///< mesh -> texture index of its AO map
+  bool materials_done = false;
+  std::vector<std::string> save_warnings;
+
+  std::string uv_attribute() const { return "TEXCOORD_" + std::to_string(uv_set); }
+  static bool is_triangles(const tinygltf::Primitive& p) { return p.mode == -1 || (p.mode >= TINYGLTF_MODE_TRIANGLES && p.mode <= TINYGLTF_MODE_TRIANGLE_FAN); }
+  bool bakes(const tinygltf::Primitive& p) const { return is_triangles(p) && p.attributes.count("POSITION") && p.attributes.count(uv_attribute()); }
+
+  std::string label(int mesh) const {
+    const std::string& n = model.meshes[static_cast<std::size_t>(mesh)].name;
+    return n.empty() ? "mesh " + std::to_string(mesh) : "'" + n + "'";
+  }
+  /// The mesh's name, or "mesh N", for names of what is added for it.
+  std::string plain_name(int mesh) const {
+    const std::string& n = model.meshes[static_cast<std::size_t>(mesh)].name;
+    return n.empty() ? "mesh " + std::to_string(mesh) : n;
+  }
+  int map_sampler = -1;  ///< The sampler of the AO maps, added with the first.
+
+  // Reads accessor `index` as `comps` floats per element. Integer components count as glTF
+  // specifies: normalized ones scaled to [0, 1] or [-1, 1], others as their value. Sparse values
+  // are applied; an accessor without a bufferView starts as zeros.
+  std::vector<float> read_floats(int index, int comps, const std::string& what) const {
+    const tinygltf::Accessor& a = accessor(index, what);
+    if (tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type)) != comps)
+      fail(path, what + ": accessor " + std::to_string(index) + " has " + std::to_string(tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type))) +
+                     " components, " + std::to_string(comps) + " expected");
+    std::vector<float> out(a.count * static_cast<std::size_t>(comps), 0.0f);
+    auto convert = [&](const unsigned char* src, int type, float* dst, int n) {
+      for (int k = 0; k < n; ++k) {
+        float v = 0;
+        switch (type) {
+          case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&v, src + 4 * k, 4); break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = src[k]; if (a.normalized) v /= 255.0f; break;
+          case TINYGLTF_COMPONENT_TYPE_BYTE: v = static_cast<float>(static_cast<std::int8_t>(src[k])); if (a.normalized) v = std::max(v / 127.0f, -1.0f); break;
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, src + 2 * k, 2); v = u; if (a.normalized) v /= 65535.0f; break; }
+          case TINYGLTF_COMPONENT_TYPE_SHORT: { std::int16_t s; std::memcpy(&s, src + 2 * k, 2); v = s; if (a.normalized) v = std::max(v / 32767.0f, -1.0f); break; }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, src + 4 * k, 4); v = static_cast<float>(u); break; }
+          default: fail(path, what + ": accessor " + std::to_string(index) + " has component type " + std::to_string(type) + ", not a vertex attribute type");
+        }
+        dst[k] = v;
+      }
+    };
+    const std::size_t elem = static_cast<std::size_t>(comps) * component_size(a.componentType, index, what);
+    if (a.bufferView >= 0) {
+      const auto [data, stride] = view_range(a, index, elem, what);
+      for (std::size_t i = 0; i < a.count; ++i) convert(data + i * stride, a.componentType, &out[i * static_cast<std::size_t>(comps)], comps);
+    }
+    if (a.sparse.isSparse && a.sparse.count > 0) {
+      const std::size_t n = static_cast<std::size_t>(a.sparse.count);
+      const std::vector<std::uint32_t> at = read_indices_raw(a.sparse.indices.bufferView, static_cast<std::size_t>(a.sparse.indices.byteOffset), a.sparse.indices.componentType, n, index, what);
+      const unsigned char* values = raw_view(a.sparse.values.bufferView, static_cast<std::size_t>(a.sparse.values.byteOffset), n * elem, index, what);
+      for (std::size_t k = 0; k < n; ++k) {
+        if (at[k] >= a.count) fail(path, what + ": sparse index " + std::to_string(at[k]) + " of accessor " + std::to_string(index) + " is past its " + std::to_string(a.count) + " elements");
+        convert(values + k * elem, a.componentType, &out[at[k] * static_cast<std::size_t>(comps)], comps);
+      }
+    }
+    return out;
+  }
+
+  std::vector<std::uint32_t> read_indices(int index, const std::string& what) const {
+    const tinygltf::Accessor& a = accessor(index, what);
+    if (a.type != TINYGLTF_TYPE_SCALAR) fail(path, what + ": index accessor " + std::to_string(index) + " is not SCALAR");
+    if (a.sparse.isSparse) fail(path, what + ": sparse index accessor " + std::to_string(index) + " is not supported");
+    if (a.bufferView < 0) return std::vector<std::uint32_t>(a.count, 0);
+    const std::size_t elem = component_size(a.componentType, index, what);
+    const auto [data, stride] = view_range(a, index, elem, what);
+    std::vector<std::uint32_t> out(a.count);
+    for (std::size_t i = 0; i < a.count; ++i) out[i] = load_index(data + i * stride, a.componentType, index, what);
+    return out;
+  }
+
+  const tinygltf::Accessor& accessor(int index, const std::string& what) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size()) fail(path, what + " uses accessor " + std::to_string(index) + ", the file has " + std::to_string(model.accessors.size()));
+    return model.accessors[static_cast<std::size_t>(index)];
+  }
+  std::size_t component_size(int type, int index, const std::string& what) const {
+    const int s = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(type));
+    if (s <= 0 || s > 4) fail(path, what + ": accessor " + std::to_string(index) + " has an unsupported component type " + std::to_string(type));
+    return static_cast<std::size_t>(s);
+  }
+  std::uint32_t load_index(const unsigned char* p, int type, int index, const std::string& what) const {
+    switch (type) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); return u; }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); return u; }
+      default: fail(path, what + ": index accessor " + std::to_string(index) + " is not unsigned byte, short or int");
+    }
+  }
+  /// `bytes` bytes at `offset` in buffer view `view`, checked against the view and its buffer.
+  const unsigned char* raw_view(int view, std::size_t offset, std::size_t bytes, int index, const std::string& what) const {
+    if (view < 0 || static_cast<std::size_t>(view) >= model.bufferViews.size()) fail(path, what + ": accessor " + std::to_string(index) + " uses a missing bufferView");
+    const tinygltf::BufferView& v = model.bufferViews[static_cast<std::size_t>(view)];
+    if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= model.buffers.size()) fail(path, what + ": bufferView " + std::to_string(view) + " uses a missing buffer");
+    const std::size_t size = model.buffers[static_cast<std::size_t>(v.buffer)].data.size();
+    if (v.byteOffset > size || v.byteLength > size - v.byteOffset || offset > v.byteLength || bytes > v.byteLength - offset)
+      fail(path, what + ": accessor " + std::to_string(index) + " reads past the end of bufferView " + std::to_string(view));
+    return model.buffers[static_cast<std::size_t>(v.buffer)].data.data() + v.byteOffset + offset;
+  }
+  std::pair<const unsigned char*, std::size_t> view_range(const tinygltf::Accessor& a, int index, std::size_t elem, const std::string& what) const {
+    if (static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size()) fail(path, what + ": accessor " + std::to_string(index) + " uses a missing bufferView");
+    const std::size_t stride = model.bufferViews[static_cast<std::size_t>(a.bufferView)].byteStride ? model.bufferViews[static_cast<std::size_t>(a.bufferView)].byteStride : elem;
+    if (stride < elem) fail(path, what + ": accessor " + std::to_string(index) + " has a byteStride smaller than its elements");
+    if (a.count == 0) return {nullptr, stride};
+    if (a.count - 1 > (std::numeric_limits<std::size_t>::max() - elem) / stride) fail(path, what + ": accessor " + std::to_string(index) + " is too long");
+    return {raw_view(a.bufferView, a.byteOffset, (a.count - 1) * stride + elem, index, what), stride};
+  }
+  std::vector<std::uint32_t> read_indices_raw(int view, std::size_t offset, int type, std::size_t n, int index, const std::string& what) const {
+    const std::size_t elem = component_size(type, index, what);
+    const unsigned char* p = raw_view(view, offset, n * elem, index, what);
+    std::vector<std::uint32_t> out(n);
+    for (std::size_t i = 0; i < n; ++i) out[i] = load_index(p + i * elem, type, index, what);
+    return out;
+  }
+
+  /// One primitive as a Mesh in the mesh's own space: positions, normals (when given), the UV
+  /// set (when `with_uv` and given; v flipped to the loader's v-up convention), triangle indices
+  /// (strips and fans triangulated as the spec orders them).
+  Mesh primitive_mesh(int mesh, int prim, bool with_uv) const {
+    const tinygltf::Primitive& p = model.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
+    const std::string what = "mesh " + label(mesh) + " primitive " + std::to_string(prim);
+    Mesh m;
+    m.name = model.meshes[static_cast<std::size_t>(mesh)].name;
+    const std::vector<float> pos = read_floats(p.attributes.at("POSITION"), 3, what + " POSITION");
+    const std::size_t n = pos.size() / 3;
+    m.positions.reserve(n + kVertexPadding);  // see kVertexPadding
+    for (std::size_t v = 0; v < n; ++v) m.positions.push_back({pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]});
+    if (const auto it = p.attributes.find("NORMAL"); it != p.attributes.end()) {
+      const std::vector<float> nor = read_floats(it->second, 3, what + " NORMAL");
+      if (nor.size() != pos.size()) fail(path, what + ": NORMAL and POSITION have different counts");
+      m.normals.reserve(n);
+      for (std::size_t v = 0; v < n; ++v) m.normals.push_back({nor[3 * v], nor[3 * v + 1], nor[3 * v + 2]});
+    }
+    if (const auto it = p.attributes.find(uv_attribute()); with_uv && it != p.attributes.end()) {
+      const std::vector<float> uv = read_floats(it->second, 2, what + " " + uv_attribute());
+      if (uv.size() / 2 != n) fail(path, what + ": " + uv_attribute() + " and POSITION have different counts");
+      m.uvs.reserve(n);
+      for (std::size_t v = 0; v < n; ++v) m.uvs.push_back({uv[2 * v], 1.0f - uv[2 * v + 1]});  // glTF's v runs down the image
+    }
+    std::vector<std::uint32_t> idx;
+    if (p.indices >= 0) {
+      idx = read_indices(p.indices, what + " indices");
+    } else {
+      idx.resize(n);
+      for (std::size_t v = 0; v < n; ++v) idx[v] = static_cast<std::uint32_t>(v);
+    }
+    for (std::uint32_t i : idx)
+      if (i >= n) fail(path, what + " uses vertex " + std::to_string(i) + ", it has " + std::to_string(n));
+    if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (std::size_t k = 0; k + 2 < idx.size(); ++k) {
+        const bool odd = k % 2;  // every other strip triangle is listed clockwise
+        m.indices.insert(m.indices.end(), {idx[k + (odd ? 1 : 0)], idx[k + (odd ? 0 : 1)], idx[k + 2]});
+      }
+    } else if (p.mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+      for (std::size_t k = 1; k + 1 < idx.size(); ++k) m.indices.insert(m.indices.end(), {idx[k], idx[k + 1], idx[0]});
+    } else {
+      idx.resize(idx.size() / 3 * 3);
+      m.indices = std::move(idx);
+    }
+    return m;
+  }
+
+  void collect_instances() {
+    std::vector<int> roots;
+    const int scene = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
+    if (scene >= 0 && static_cast<std::size_t>(scene) < model.scenes.size()) {
+      roots = model.scenes[static_cast<std::size_t>(scene)].nodes;
+    } else {
+      // No scene: every node that is nobody's child (check_gltf made the graph a forest).
+      std::vector<bool> child(model.nodes.size(), false);
+      for (const tinygltf::Node& n : model.nodes)
+        for (int c : n.children)
+          if (c >= 0 && static_cast<std::size_t>(c) < child.size()) child[static_cast<std::size_t>(c)] = true;
+      for (std::size_t i = 0; i < child.size(); ++i)
+        if (!child[i]) roots.push_back(static_cast<int>(i));
+    }
+    // Explicit stack: check_gltf bounds the depth, but nothing here needs recursion.
+    std::vector<std::pair<int, Mat4>> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, kIdentity});
+    while (!stack.empty()) {
+      const auto [node, parent] = stack.back();
+      stack.pop_back();
+      if (node < 0 || static_cast<std::size_t>(node) >= model.nodes.size()) fail(path, "scene uses node " + std::to_string(node) + ", the file has " + std::to_string(model.nodes.size()));
+      const tinygltf::Node& n = model.nodes[static_cast<std::size_t>(node)];
+      const Mat4 world = mul(parent, local_matrix(n));
+      if (n.mesh >= 0) {
+        if (static_cast<std::size_t>(n.mesh) >= model.meshes.size()) fail(path, "node " + std::to_string(node) + " uses mesh " + std::to_string(n.mesh) + ", the file has " + std::to_string(model.meshes.size()));
+        instances.push_back({node, n.mesh, world});
+      }
+      for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, world});
+    }
+  }
+
+  /// All buffers into buffer 0 (GLB has one binary chunk), each at a multiple of 16 bytes so every
+  /// accessor keeps its alignment; images given by URI are appended as bufferViews.
+  void merge_buffers() {
+    if (model.buffers.size() == 1) {
+      model.buffers[0].uri.clear();  // a lone buffer becomes the binary chunk as it is, without a copy
+    } else {
+      merge_several_buffers();
+    }
+    embed_images();
+  }
+  void merge_several_buffers() {
+    std::vector<unsigned char> bin;
+    std::vector<std::size_t> base;
+    for (const tinygltf::Buffer& b : model.buffers) {
+      bin.resize((bin.size() + 15) / 16 * 16, 0);
+      base.push_back(bin.size());
+      bin.insert(bin.end(), b.data.begin(), b.data.end());
+    }
+    for (tinygltf::BufferView& v : model.bufferViews) {
+      if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= base.size()) fail(path, "a bufferView uses a missing buffer");
+      v.byteOffset += base[static_cast<std::size_t>(v.buffer)];
+      v.buffer = 0;
+    }
+    tinygltf::Buffer merged;
+    if (!model.buffers.empty()) {
+      merged.name = model.buffers.front().name;
+      merged.extras = model.buffers.front().extras;
+      merged.extensions = model.buffers.front().extensions;
+    }
+    merged.data = std::move(bin);
+    model.buffers.assign(1, std::move(merged));
+  }
+  void embed_images() {
+    if (model.buffers.empty()) model.buffers.emplace_back();
+    for (std::size_t i = 0; i < model.images.size(); ++i) {
+      tinygltf::Image& im = model.images[i];
+      if (im.bufferView >= 0) continue;
+      if (im.image.empty()) {
+        warnings.push_back("image " + std::to_string(i) + " ('" + one_line(im.uri.substr(0, 60)) + "') could not be read beside the input; its URI is kept as is");
+        continue;
+      }
+      if (im.mimeType.empty()) im.mimeType = sniff_mime(im.image);
+      if (im.mimeType.empty()) im.mimeType = "image/png";
+      im.bufferView = append_view(im.image.data(), im.image.size(), 0);
+      im.image.clear();
+      im.uri.clear();
+      im.as_is = false;
+    }
+  }
+
+  int append_view(const unsigned char* data, std::size_t size, int target) {
+    std::vector<unsigned char>& bin = model.buffers.at(0).data;
+    bin.resize((bin.size() + 15) / 16 * 16, 0);
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = bin.size();
+    v.byteLength = size;
+    v.target = target;
+    bin.insert(bin.end(), data, data + size);
+    model.bufferViews.push_back(std::move(v));
+    return static_cast<int>(model.bufferViews.size() - 1);
+  }
+
+  /// Occlusion textures onto the materials of baked primitives (gltf_document.h, add_occlusion_map).
+  void assign_materials() {
+    if (materials_done || map_texture.empty()) return;
+    materials_done = true;
+    // What each material is asked to carry: the map of a mesh (>= 0) or no change (-1), per primitive.
+    std::map<int, std::set<int>> uses;  // material -> the maps (or -1) its primitives need
+    auto map_of = [&](int mesh, const tinygltf::Primitive& p) {
+      const auto it = map_texture.find(mesh);
+      return it != map_texture.end() && bakes(p) ? it->first : -1;
+    };
+    for (std::size_t m = 0; m < model.meshes.size(); ++m)
+      for (const tinygltf::Primitive& p : model.meshes[m].primitives)
+        if (p.material >= 0) uses[p.material].insert(map_of(static_cast<int>(m), p));
+    std::map<std::pair<int, int>, int> material_for;  // (material or -1, map mesh) -> material index
+    std::set<int> replaced;
+    for (std::size_t m = 0; m < model.meshes.size(); ++m)
+      for (tinygltf::Primitive& p : model.meshes[m].primitives) {
+        const int map_mesh = map_of(static_cast<int>(m), p);
+        if (map_mesh < 0) continue;
+        const auto key = std::make_pair(p.material, map_mesh);
+        auto it = material_for.find(key);
+        if (it == material_for.end()) {
+          int target = -1;
+          if (p.material < 0) {
+            // glTF's default material (white, metallic 1, roughness 1), named for the map.
+            tinygltf::Material fresh;
+            fresh.name = "ao " + plain_name(static_cast<int>(m));
+            model.materials.push_back(fresh);
+            target = static_cast<int>(model.materials.size() - 1);
+          } else {
+            const std::set<int>& u = uses[p.material];
+            // In place when this map is its only use, or the first map of a material that every
+            // user needs changed; otherwise a clone for this mesh's primitives.
+            const bool first_taker = !u.count(-1) && std::none_of(material_for.begin(), material_for.end(), [&](const auto& e) { return e.first.first == p.material; });
+            if (u.size() == 1 || first_taker) {
+              target = p.material;
+            } else {
+              tinygltf::Material clone = model.materials[static_cast<std::size_t>(p.material)];
+              clone.name += (clone.name.empty() ? "" : " ") + std::string("(ao ") + plain_name(map_mesh) + ")";
+              model.materials.push_back(std::move(clone));
+              target = static_cast<int>(model.materials.size() - 1);
+            }
+            if (model.materials[static_cast<std::size_t>(target)].occlusionTexture.index >= 0) replaced.insert(p.material);
+          }
+          tinygltf::OcclusionTextureInfo& o = model.materials[static_cast<std::size_t>(target)].occlusionTexture;
+          o = tinygltf::OcclusionTextureInfo();
+          o.index = map_texture.at(map_mesh);
+          o.texCoord = uv_set;
+          o.strength = 1.0;
+          it = material_for.emplace(key, target).first;
+        }
+        p.material = it->second;
+      }
+    for (int m : replaced) {
+      const std::string& n = model.materials[static_cast<std::size_t>(m)].name;
+      save_warnings.push_back("material " + (n.empty() ? std::to_string(m) : "'" + n + "'") + ": its occlusion texture is replaced by the baked map");
+    }
+  }
+};
+
+GltfDocument::GltfDocument(const fs::path& path, int uv_set) : impl_(std::make_unique<Impl>()) {
+  Impl& d = *impl_;
+  d.path = path;
+  d.uv_set = uv_set;
+  if (uv_set < 0) fail(path, "--uv-set " + std::to_string(uv_set) + " asked for, UV sets count from 0");
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) fail(path, fs::exists(path, ec) ? "is not a regular file" : "no such file");
+  std::string err, warn;
+  bool ok = false;
+  Folder folder;
+  folder.dir = fs::weakly_canonical(fs::absolute(path, ec).parent_path(), ec);
+  {
+    // The file's bytes live only for the parse: tinygltf copies the buffers out of them.
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, "cannot be opened for reading");
+    const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) fail(path, "cannot be read");
+    if (data.empty()) fail(path, "the file is empty");
+    if (data.size() > std::numeric_limits<std::uint32_t>::max()) fail(path, "larger than 4 GB, more than glTF and GLB can address");
+    check_gltf(path, data);  // structure, sizes and nesting first: tinygltf trusts them
+
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &folder});
+    loader.SetImageLoader(&keep_encoded, nullptr);
+    const std::string base = folder.dir.string();
+    try {
+      if (data.size() >= 4 && data.compare(0, 4, "glTF") == 0)
+        ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn, reinterpret_cast<const unsigned char*>(data.data()), static_cast<unsigned>(data.size()), base);
+      else
+        ok = loader.LoadASCIIFromString(&d.model, &err, &warn, data.data(), static_cast<unsigned>(data.size()), base);
+    } catch (const std::bad_alloc&) {
+      throw SystemError(path.string() + ": out of memory while reading the glTF document");
+    } catch (const std::exception& e) {
+      fail(path, "malformed glTF (" + one_line(e.what()) + ")");
+    }
+  }
+  if (!ok) fail(path, "malformed glTF (" + one_line(err.empty() ? warn : err) + ")");
+  // Compressed geometry lives in the extension, not in the accessors this reads.
+  for (const std::string& e : d.model.extensionsRequired)
+    if (e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression")
+      fail(path, "its geometry is compressed with " + e + ", which ao cannot decode; export it uncompressed to bake it");
+  // Indices this code follows (check_gltf covers the node graph, buffers, views and accessors).
+  for (std::size_t m = 0; m < d.model.meshes.size(); ++m)
+    for (std::size_t p = 0; p < d.model.meshes[m].primitives.size(); ++p) {
+      const int mat = d.model.meshes[m].primitives[p].material;
+      if (mat < -1 || mat >= static_cast<int>(d.model.materials.size()))
+        fail(path, "mesh " + d.label(static_cast<int>(m)) + " primitive " + std::to_string(p) + " uses material " + std::to_string(mat) + ", the file has " +
+                       std::to_string(d.model.materials.size()));
+    }
+  d.merge_buffers();
+  d.collect_instances();
+
+  // The UV set: a set above 0 that no primitive has is a mistake worth stopping on, as in load_scene_file.
+  if (uv_set > 0) {
+    int sets = 0;
+    bool found = false;
+    for (const tinygltf::Mesh& m : d.model.meshes)
+      for (const tinygltf::Primitive& p : m.primitives) {
+        while (p.attributes.count("TEXCOORD_" + std::to_string(sets))) ++sets;
+        found = found || p.attributes.count(d.uv_attribute());
+      }
+    if (!found) fail(path, "has " + std::to_string(sets) + " UV set" + (sets == 1 ? "" : "s") + ", --uv-set " + std::to_string(uv_set) + " asked for");
+  }
+  if (instanced_meshes(false).empty()) fail(path, "the file has no triangles in its scene");
+}
+
+GltfDocument::~GltfDocument() = default;
+GltfDocument::GltfDocument(GltfDocument&&) noexcept = default;
+GltfDocument& GltfDocument::operator=(GltfDocument&&) noexcept = default;
+
+const std::vector<std::string>& GltfDocument::warnings() const { return impl_->warnings; }
+
+std::vector<int> GltfDocument::instanced_meshes(bool with_uv_set) const {
+  const Impl& d = *impl_;
+  std::set<int> used;
+  for (const Impl::Instance& i : d.instances) used.insert(i.mesh);
+  std::vector<int> out;
+  for (int m : used) {
+    const auto& prims = d.model.meshes[static_cast<std::size_t>(m)].primitives;
+    if (std::any_of(prims.begin(), prims.end(), [&](const tinygltf::Primitive& p) {
+          return with_uv_set ? d.bakes(p) : Impl::is_triangles(p) && p.attributes.count("POSITION");
+        }))
+      out.push_back(m);
+  }
+  return out;
+}
+
+std::string GltfDocument::mesh_label(int mesh) const { return impl_->label(mesh); }
+
+int GltfDocument::instance_count(int mesh) const {
+  return static_cast<int>(std::count_if(impl_->instances.begin(), impl_->instances.end(), [&](const Impl::Instance& i) { return i.mesh == mesh; }));
+}
+
+std::size_t GltfDocument::world_triangle_count() const {
+  const Impl& d = *impl_;
+  std::size_t n = 0;
+  for (const Impl::Instance& i : d.instances)
+    for (const tinygltf::Primitive& p : d.model.meshes[static_cast<std::size_t>(i.mesh)].primitives) {
+      if (!Impl::is_triangles(p) || !p.attributes.count("POSITION")) continue;
+      const int a = p.indices >= 0 ? p.indices : p.attributes.at("POSITION");
+      if (a < 0 || static_cast<std::size_t>(a) >= d.model.accessors.size()) continue;
+      const std::size_t count = d.model.accessors[static_cast<std::size_t>(a)].count;
+      n += p.mode == TINYGLTF_MODE_TRIANGLE_STRIP || p.mode == TINYGLTF_MODE_TRIANGLE_FAN ? (count > 2 ? count - 2 : 0) : count / 3;
+    }
+  return n;
+}
+
+std::size_t GltfDocument::world_vertex_count() const {
+  const Impl& d = *impl_;
+  std::size_t n = 0;
+  for (const Impl::Instance& i : d.instances)
+    for (const tinygltf::Primitive& p : d.model.meshes[static_cast<std::size_t>(i.mesh)].primitives) {
+      if (!Impl::is_triangles(p) || !p.attributes.count("POSITION")) continue;
+      const int a = p.attributes.at("POSITION");
+      if (a >= 0 && static_cast<std::size_t>(a) < d.model.accessors.size()) n += d.model.accessors[static_cast<std::size_t>(a)].count;
+    }
+  return n;
+}
+
+GltfWorldScene GltfDocument::world_scene(int baked_mesh) const {
+  const Impl& d = *impl_;
+  GltfWorldScene out;
+  out.scene.name = d.path.filename().string();
+  std::set<int> seen;
+  // Each primitive is read once per world scene, then transformed per instance.
+  std::map<std::pair<int, int>, Mesh> local;
+  for (const Impl::Instance& inst : d.instances) {
+    const bool first = seen.insert(inst.mesh).second;
+    const auto& prims = d.model.meshes[static_cast<std::size_t>(inst.mesh)].primitives;
+    double det = 0;
+    const std::array<double, 9> nm = normal_matrix(inst.world, det);
+    const Mat4& w = inst.world;
+    for (std::size_t pi = 0; pi < prims.size(); ++pi) {
+      const tinygltf::Primitive& p = prims[pi];
+      if (!Impl::is_triangles(p) || !p.attributes.count("POSITION")) continue;
+      const auto key = std::make_pair(inst.mesh, static_cast<int>(pi));
+      auto it = local.find(key);
+      if (it == local.end()) it = local.emplace(key, d.primitive_mesh(inst.mesh, static_cast<int>(pi), inst.mesh == baked_mesh)).first;
+      Mesh m;
+      m.name = it->second.name;
+      m.positions.reserve(it->second.positions.size() + kVertexPadding);
+      for (const Vec3& v : it->second.positions) {
+        const double x = v.x, y = v.y, z = v.z;
+        m.positions.push_back({static_cast<float>(w[0] * x + w[4] * y + w[8] * z + w[12]), static_cast<float>(w[1] * x + w[5] * y + w[9] * z + w[13]),
+                               static_cast<float>(w[2] * x + w[6] * y + w[10] * z + w[14])});
+      }
+      m.normals.reserve(it->second.normals.size());
+      for (const Vec3& n : it->second.normals) {
+        const double x = n.x, y = n.y, z = n.z;
+        Vec3 t{static_cast<float>(nm[0] * x + nm[1] * y + nm[2] * z), static_cast<float>(nm[3] * x + nm[4] * y + nm[5] * z),
+               static_cast<float>(nm[6] * x + nm[7] * y + nm[8] * z)};
+        if (det < 0) t = t * -1.0f;  // the cofactor matrix carries the determinant's sign
+        m.normals.push_back(t);
+      }
+      m.indices = it->second.indices;
+      if (det < 0)  // a mirroring transform reverses the winding (glTF 2.0 spec, "Transformations")
+        for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) std::swap(m.indices[k + 1], m.indices[k + 2]);
+      if (first && inst.mesh == baked_mesh) m.uvs = it->second.uvs;
+      out.scene.meshes.push_back(std::move(m));
+      out.sources.push_back({inst.mesh, static_cast<int>(pi), inst.node, first});
+    }
+  }
+  // validate_and_prepare drops meshes left without triangles: names that tell the instances apart
+  // (also in its warnings) keep track of the sources.
+  std::vector<std::string> names;
+  std::map<std::string, std::size_t> index_of;
+  for (std::size_t i = 0; i < out.scene.meshes.size(); ++i) {
+    names.push_back(out.scene.meshes[i].name);
+    const GltfWorldScene::Source& s = out.sources[i];
+    const std::string& node = d.model.nodes[static_cast<std::size_t>(s.node)].name;
+    out.scene.meshes[i].name = names[i] + (names[i].empty() ? "" : " ") + "[mesh " + std::to_string(s.mesh) + ", primitive " + std::to_string(s.primitive) + ", node " +
+                               std::to_string(s.node) + (node.empty() ? "" : " " + node) + "]";
+    index_of[out.scene.meshes[i].name] = i;
+  }
+  validate_and_prepare(out.scene);
+  std::vector<GltfWorldScene::Source> kept;
+  for (Mesh& m : out.scene.meshes) {
+    const std::size_t i = index_of.at(m.name);
+    kept.push_back(out.sources[i]);
+    m.name = names[i];
+  }
+  out.sources = std::move(kept);
+  return out;
+}
+
+void GltfDocument::add_occlusion_map(int mesh, const std::string& png) {
+  Impl& d = *impl_;
+  if (d.materials_done) throw std::logic_error("add_occlusion_map after save_glb");
+  tinygltf::Image im;
+  im.name = "ao " + d.plain_name(mesh);
+  im.mimeType = "image/png";
+  im.bufferView = d.append_view(reinterpret_cast<const unsigned char*>(png.data()), png.size(), 0);
+  d.model.images.push_back(std::move(im));
+  if (d.map_sampler < 0) {
+    tinygltf::Sampler s;  // linear, mipmapped: the map is smooth data
+    s.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    s.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    s.wrapS = s.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
+    d.model.samplers.push_back(s);
+    d.map_sampler = static_cast<int>(d.model.samplers.size() - 1);
+  }
+  tinygltf::Texture t;
+  t.source = static_cast<int>(d.model.images.size() - 1);
+  t.sampler = d.map_sampler;
+  d.model.textures.push_back(std::move(t));
+  d.map_texture[mesh] = static_cast<int>(d.model.textures.size() - 1);
+}
+
+void GltfDocument::set_vertex_ao(int mesh, int primitive, const std::vector<float>& ao) {
+  Impl& d = *impl_;
+  tinygltf::Primitive& p = d.model.meshes.at(static_cast<std::size_t>(mesh)).primitives.at(static_cast<std::size_t>(primitive));
+  std::vector<float> rgb;
+  rgb.reserve(ao.size() * 3);
+  for (float v : ao) rgb.insert(rgb.end(), {v, v, v});  // linear: glTF multiplies the base colour by COLOR_0
+  tinygltf::Accessor a;
+  a.bufferView = d.append_view(reinterpret_cast<const unsigned char*>(rgb.data()), rgb.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+  a.byteOffset = 0;
+  a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  a.count = ao.size();
+  a.type = TINYGLTF_TYPE_VEC3;
+  d.model.accessors.push_back(std::move(a));
+  if (p.attributes.count("COLOR_0"))
+    d.save_warnings.push_back("mesh " + d.label(mesh) + " primitive " + std::to_string(primitive) + ": its COLOR_0 is replaced by the per-vertex AO");
+  p.attributes["COLOR_0"] = static_cast<int>(d.model.accessors.size() - 1);
+}
+
+std::vector<std::string> GltfDocument::save_glb(const fs::path& path) {
+  Impl& d = *impl_;
+  d.assign_materials();
+  if (d.model.buffers.at(0).data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)
+    fail(path, "the binary chunk would be " + std::to_string(d.model.buffers[0].data.size()) + " bytes, more than GLB's 4 GB");
+  if (d.model.asset.generator.empty()) d.model.asset.generator = "ao bake";
+  std::ostringstream glb;
+  tinygltf::TinyGLTF writer;
+  Folder nowhere;  // an empty folder: the writer may read nothing either
+  writer.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &nowhere});
+  if (!writer.WriteGltfSceneToStream(&d.model, glb, false, true)) throw SystemError(path.string() + ": cannot serialise the glTF document");
+  const std::string bytes = glb.str();
+  write_file_atomically(path, [&](const fs::path& temp) {
+    std::ofstream f(temp, std::ios::binary);
+    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    f.close();
+    if (!f) throw SystemError(path.string() + ": cannot write");
+  });
+  std::vector<std::string> w = std::move(d.save_warnings);
+  d.save_warnings.clear();
+  return w;
+}
+
+}  // namespace ao

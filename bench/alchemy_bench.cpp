@@ -28,7 +28,7 @@ struct AlchemyFixture {
     const RayScene rays(scene);
     gbuffer = render_gbuffer(rays, framed(scene, kWidth, kHeight));
     radius = 0.1f * scene.bounds().diagonal();  // the CLI's default R
-    for (std::size_t i = 0; i < gbuffer.coverage.size(); ++i) covered += gbuffer.coverage[i];
+    for (std::size_t i = 0; i < gbuffer.object_id.size(); ++i) covered += gbuffer.covered(i);
   }
 };
 

@@ -68,7 +68,7 @@ void cone_trace(benchmark::State& state, const std::string& file) {
   Image<float> v(g.width(), g.height());
   for (auto _ : state) compute_cone(g, grid, f->r_max, p, 1, v.view());
   std::size_t covered = 0;
-  for (std::uint8_t c : g.coverage.pixels()) covered += c;
+  for (std::size_t i = 0; i < g.object_id.size(); ++i) covered += g.covered(i) ? 1 : 0;
   state.counters["Mpix/s"] = benchmark::Counter(static_cast<double>(covered) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
   state.counters["covered"] = static_cast<double>(covered);
 }
@@ -128,7 +128,7 @@ void cone_rmse(benchmark::State& state, const std::string& file) {
   ErrorMetrics m;
   for (auto _ : state) {
     const ConeResult r = render_cone(f->scene, f->closure, g, f->r_max, p, 1);
-    m = compare_images(r.visibility, references[file], g.coverage);
+    m = compare_images(r.visibility, references[file], coverage_mask(g));
   }
   state.counters["rmse"] = m.rmse;
   state.counters["mean_signed"] = m.mean_signed;

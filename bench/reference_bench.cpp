@@ -74,7 +74,7 @@ void gbuffer_ao(benchmark::State& state, const char* mesh, bool full) {
   render_gbuffer(f->rays, cam, options, g);
   for (auto _ : state) {
     render_gbuffer(f->rays, cam, options, g);
-    benchmark::DoNotOptimize(g.depth.data());
+    benchmark::DoNotOptimize(g.position.data());
   }
   set_rate(state, static_cast<double>(cam.width) * cam.height);
 }
@@ -101,7 +101,7 @@ void reference_ao(benchmark::State& state, const char* mesh) {
     const RaytracedImage img = render_raytraced(f->rays, f->gbuffer, f->falloff, {.samples = kSamples}, 1);
     rays = img.rays;
     sum_v = 0;
-    for (std::size_t i = 0; i < img.visibility.size(); ++i) sum_v += f->gbuffer.coverage[i] ? img.visibility[i] : 0.0;
+    for (std::size_t i = 0; i < img.visibility.size(); ++i) sum_v += f->gbuffer.covered(i) ? img.visibility[i] : 0.0;
   }
   set_rate(state, static_cast<double>(rays));
   state.counters["mean_V"] = sum_v * kSamples / static_cast<double>(rays);
@@ -123,7 +123,7 @@ void direct_light(benchmark::State& state, const char* mesh) {
   const Sun sun{normalize(Vec3{-1.0f, 0.6f, 0.5f}), kPi};
   const Vec3 l = f->gbuffer.camera.basis().to_local(sun.direction);  // camera space, as the G-buffer's normals
   double rays = 0;
-  for (std::size_t i = 0; i < f->gbuffer.coverage.size(); ++i) rays += f->gbuffer.coverage[i] && dot(f->gbuffer.normal[i], l) > 0;
+  for (std::size_t i = 0; i < f->gbuffer.object_id.size(); ++i) rays += f->gbuffer.covered(i) && dot(f->gbuffer.normal[i], l) > 0;
   for (auto _ : state) benchmark::DoNotOptimize(render_direct_light(f->rays, f->gbuffer, sun).data());
   set_rate(state, rays);
 }
@@ -139,10 +139,10 @@ void sampling_error(benchmark::State& state, const char* mesh) {
   cam.width = 640;
   cam.height = 360;
   const GBuffer g = render_gbuffer(f->rays, cam, GBufferOptions{.normal = SurfaceNormal::Geometric});
-  std::vector<bare::Hit> hits(g.coverage.size());
+  std::vector<bare::Hit> hits(g.object_id.size());
   const Frame basis = cam.basis();
   for (std::size_t i = 0; i < hits.size(); ++i) {
-    hits[i].valid = g.coverage[i] != 0;
+    hits[i].valid = g.covered(i);
     const Vec3 p = basis.to_world(g.position[i]) + cam.eye, n = basis.to_world(g.normal[i]);
     hits[i].p = {p.x, p.y, p.z};
     hits[i].n = {n.x, n.y, n.z};

@@ -12,15 +12,16 @@ int main() {
   ao::Camera camera;
   camera.vertical_fov_deg = 60.0f, camera.width = 320, camera.height = 240;
   ao::GBuffer g(camera);
-  // 2. Fill the buffers: per pixel the camera-space position, linear depth, unit normal, coverage.
+  // 2. Fill the buffers: per pixel the camera-space position (its -z is the linear depth), unit
+  //    normal, and an object id >= 1 (0 marks background).
   //    The view looks straight down at a floor 2 units away; a 0.5-unit-high box stands in the middle.
   for (int y = 0; y < camera.height; ++y)
     for (int x = 0; x < camera.width; ++x) {
       const bool box = x > 130 && x < 190 && y > 90 && y < 150;
       const float depth = box ? 1.5f : 2.0f;
       const ao::Vec3 ray = camera.camera_direction(x + 0.5f, y + 0.5f);  // z = -1
-      g.position(x, y) = ray * depth, g.depth(x, y) = depth;
-      g.normal(x, y) = {0, 0, 1}, g.albedo(x, y) = {0.8f, 0.8f, 0.8f}, g.coverage(x, y) = 1;
+      g.position(x, y) = ray * depth;
+      g.normal(x, y) = {0, 0, 1}, g.albedo(x, y) = {0.8f, 0.8f, 0.8f}, g.object_id(x, y) = 1;
     }
   // 3. Volumetric AO (tangent sphere of radius R/2) with R = 0.4 world units and default parameters.
   const ao::Image<float> v = ao::volumetric_ao(g, 0.4f, ao::VolumetricParams{}, /*seed=*/1);

@@ -176,7 +176,7 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
     timings["load_gbuffer_ms"] = clock.lap_ms();
     Bounds3 b;
     for (std::size_t i = 0; i < g.position.size(); ++i)
-      if (g.coverage[i]) b.extend(g.position[i]);
+      if (g.covered(i)) b.extend(g.position[i]);
     diagonal = b.diagonal();
   } else {
     scene = load_scene_arguments(o.scene);
@@ -238,8 +238,8 @@ int run_render(const RenderOptions& o, const GlobalOptions& global) {
 
   double sum_v = 0;
   std::size_t covered = 0;
-  for (std::size_t i = 0; i < g.coverage.size(); ++i)
-    if (g.coverage[i]) {
+  for (std::size_t i = 0; i < g.object_id.size(); ++i)
+    if (g.covered(i)) {
       sum_v += result.visibility[i];
       ++covered;
     }

@@ -90,8 +90,8 @@ void ProgressiveReference::run() {
     if (s.visibility.empty()) s.visibility = Image<float>(g.width(), g.height(), 1.0f);
     double sum_se = 0;
     std::size_t covered = 0;
-    for (std::size_t i = 0; i < g.coverage.size(); ++i) {
-      if (!g.coverage[i]) continue;
+    for (std::size_t i = 0; i < g.object_id.size(); ++i) {
+      if (!g.covered(i)) continue;
       const double v = out.scalar.visibility[i];
       sum_[i] += v;
       sum_sq_[i] += v * v;

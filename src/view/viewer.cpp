@@ -504,8 +504,8 @@ class Viewer {
     if (ref_.visibility.size() != result_.visibility.size()) return;
     double sum = 0;
     std::size_t n = 0;
-    for (std::size_t i = 0; i < gbuffer_->coverage.size(); ++i) {
-      if (!gbuffer_->coverage[i]) continue;
+    for (std::size_t i = 0; i < gbuffer_->object_id.size(); ++i) {
+      if (!gbuffer_->covered(i)) continue;
       const double d = static_cast<double>(result_.visibility[i]) - ref_.visibility[i];
       sum += d * d;
       ++n;
@@ -522,7 +522,7 @@ class Viewer {
     try {
       if (view_ == ViewMode::Shaded) {
         const Image<float>& v = method_ == "raytraced" && !ref_.visibility.empty() ? ref_.visibility : result_.visibility;
-        shaded_ = v.size() == g.coverage.size() ? shade_for_display(g, v, result_.color) : Image<Vec3>();
+        shaded_ = v.size() == g.object_id.size() ? shade_for_display(g, v, result_.color) : Image<Vec3>();
       }
       if (view_ == ViewMode::Map && !s_.ao_map.empty()) map_v_ = visibility_from_ao_map(g, s_.scene, s_.ao_map, "--ao-map");
     } catch (const InputError& e) {
@@ -565,7 +565,7 @@ class Viewer {
           const std::size_t i = row + x;
           Vec3 c{1, 1, 1};
           if (view == ViewMode::Error) {
-            if (!g.coverage[i]) {
+            if (!g.covered(i)) {
               c = {0.5f, 0.5f, 0.5f};
             } else if (have_ref && !method_v.empty()) {
               c = signed_error_colour(method_v[i] - ref_.visibility[i], kHeatRange);

@@ -12,6 +12,11 @@
 #include <limits>
 #include <string>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+
 #include "ao/core/error.h"
 #include "support/errors.h"
 #include "support/run.h"
@@ -51,11 +56,9 @@ GBuffer sphere_gbuffer(const Camera& camera) {
       const float t = (-b - std::sqrt(disc)) / (2 * a);
       const Vec3 p = d * t;
       g.position(x, y) = p;
-      g.depth(x, y) = -p.z;
       g.normal(x, y) = normalize(p - centre);
       g.albedo(x, y) = {0.1f + 0.01f * x, 0.2f + 0.01f * y, 0.7f};
       g.object_id(x, y) = 1u + static_cast<unsigned>(x % 3);
-      g.coverage(x, y) = 1;
     }
   }
   return g;
@@ -63,7 +66,7 @@ GBuffer sphere_gbuffer(const Camera& camera) {
 
 int covered_count(const GBuffer& g) {
   int n = 0;
-  for (const auto c : g.coverage.pixels()) n += c;
+  for (std::size_t i = 0; i < g.object_id.size(); ++i) n += g.covered(i) ? 1 : 0;
   return n;
 }
 
@@ -82,12 +85,12 @@ TEST(GBufferExr, RoundTripKeepsEveryChannelExactly) {
   const GBuffer back = read_gbuffer_exr(dir / "g.exr");
   ASSERT_EQ(back.width(), g.width());
   ASSERT_EQ(back.height(), g.height());
-  for (std::size_t i = 0; i < g.depth.size(); ++i) {
+  for (std::size_t i = 0; i < g.position.size(); ++i) {
     EXPECT_EQ(back.position[i], g.position[i]) << i;
-    EXPECT_EQ(back.depth[i], g.depth[i]) << i;  // +inf background included
+    EXPECT_EQ(back.depth(i), g.depth(i)) << i;  // +inf background included
     EXPECT_EQ(back.albedo[i], g.albedo[i]) << i;
     EXPECT_EQ(back.object_id[i], g.object_id[i]) << i;
-    EXPECT_EQ(back.coverage[i], g.coverage[i]) << i;
+    EXPECT_EQ(back.covered(i), g.covered(i)) << i;
     // Renormalising an already unit normal may move it by an ulp.
     expect_near(back.normal[i], g.normal[i], 1e-6f);
   }
@@ -103,7 +106,7 @@ TEST(GBufferExr, DirectLightPassRoundTripsExactlyAndIsOptional) {
 
   g.direct = Image<Vec3>(g.width(), g.height());
   for (std::size_t i = 0; i < g.direct.size(); ++i)
-    if (g.coverage[i]) g.direct[i] = {0.01f * static_cast<float>(i % 97), 2.5f, 1e-8f * static_cast<float>(i)};  // > 1 is allowed
+    if (g.covered(i)) g.direct[i] = {0.01f * static_cast<float>(i % 97), 2.5f, 1e-8f * static_cast<float>(i)};  // > 1 is allowed
   write_gbuffer_exr(dir / "g.exr", g);
   const GBuffer back = read_gbuffer_exr(dir / "g.exr");
   ASSERT_EQ(back.direct.width(), g.width());
@@ -124,7 +127,7 @@ TEST(GBufferExr, PrimitiveIdsRoundTripExactlyAndAreOptional) {
 
   g.primitive_id = Image<std::uint32_t>(g.width(), g.height(), 0u);
   for (std::size_t i = 0; i < g.primitive_id.size(); ++i)
-    if (g.coverage[i]) g.primitive_id[i] = static_cast<std::uint32_t>(i * 2654435761u % 4000000000u);
+    if (g.covered(i)) g.primitive_id[i] = static_cast<std::uint32_t>(i * 2654435761u % 4000000000u);
   write_gbuffer_exr(dir / "g.exr", g);
   const GBuffer back = read_gbuffer_exr(dir / "g.exr");
   ASSERT_EQ(back.primitive_id.width(), g.width());
@@ -228,31 +231,28 @@ TEST(GBufferExr, FieldOfViewOverrideWinsOverTheFile) {
 TEST(GBufferExr, WorldSpacePassesAreMovedIntoCameraSpace) {
   TempDir dir;
   const GBuffer g = sphere_gbuffer(test_camera());
-  GBuffer world = g;
-  for (std::size_t i = 0; i < g.depth.size(); ++i) {
-    if (!g.coverage[i]) continue;
-    world.position[i] = g.camera.camera_to_world_point(g.position[i]);
-    world.normal[i] = g.camera.camera_to_world_vector(g.normal[i]);
-  }
-  write_gbuffer_exr(dir / "world.exr", world);
+  write_gbuffer_exr(dir / "world.exr", g, {.world_space = true});
   const GBuffer back = read_gbuffer_exr(dir / "world.exr", {.world_space = true});
-  for (std::size_t i = 0; i < g.depth.size(); ++i) {
-    if (!g.coverage[i]) continue;
+  for (std::size_t i = 0; i < g.position.size(); ++i) {
+    if (!g.covered(i)) continue;
     expect_near(back.position[i], g.position[i], 1e-4f * length(g.position[i]));
     expect_near(back.normal[i], g.normal[i], 1e-5f);
   }
-  write_gbuffer_exr(dir / "nocam.exr", world, {.camera = false});
+  write_gbuffer_exr(dir / "nocam.exr", g, {.camera = false, .world_space = true});
   test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "nocam.exr", {.vertical_fov_deg = 50.0f, .world_space = true}); },
                               dir / "nocam.exr", "camera placement");
 }
 
 TEST(GBufferExr, BlenderStyleHugeBackgroundDepthIsNotCovered) {
   TempDir dir;
-  GBuffer g = sphere_gbuffer(test_camera());
-  for (auto& d : g.depth.pixels())
-    if (!std::isfinite(d)) d = 1e10f;
+  const GBuffer sphere = sphere_gbuffer(test_camera());
+  // The background as a far surface at depth 1e10, written without A: Z = 1e10 there.
+  GBuffer g = sphere;
+  for (int y = 0; y < g.height(); ++y)
+    for (int x = 0; x < g.width(); ++x)
+      if (!g.covered(x, y)) g.position(x, y) = g.camera.camera_direction(x + 0.5f, y + 0.5f) * 1e10f, g.object_id(x, y) = 1;
   write_gbuffer_exr(dir / "g.exr", g, {.coverage = false});
-  EXPECT_EQ(covered_count(read_gbuffer_exr(dir / "g.exr")), covered_count(g));
+  EXPECT_EQ(covered_count(read_gbuffer_exr(dir / "g.exr")), covered_count(sphere));
 }
 
 TEST(GBufferExr, NonFiniteNormalAtACoveredPixelIsAnErrorNamingThePixel) {
@@ -272,16 +272,55 @@ TEST(GBufferExr, NonFinitePositionOrDepthAtACoveredPixelIsAnError) {
   test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "p.exr"); }, dir / "p.exr", "pixel (24, 16)");
 
   g = sphere_gbuffer(test_camera());
-  g.depth(20, 15) = std::numeric_limits<float>::quiet_NaN();
+  g.position(20, 15).z = std::numeric_limits<float>::quiet_NaN();  // Z = -P.z is NaN too
   write_gbuffer_exr(dir / "z.exr", g);  // A says covered, so the NaN depth is an error
   test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "z.exr"); }, dir / "z.exr", "pixel (20, 15)");
+}
+
+// A kW x kH EXR of FLOAT channels (and `id` as UINT when given), written by hand: files ao itself
+// would never write.
+constexpr int kRawW = 4, kRawH = 3;
+void write_raw_exr(const fs::path& path, std::vector<std::pair<const char*, std::vector<float>>> floats, std::vector<unsigned> id = {}) {
+  Imf::Header header(kRawW, kRawH);
+  Imf::FrameBuffer frame;
+  const auto add = [&](const char* name, Imf::PixelType type, void* base, std::size_t size) {
+    header.channels().insert(name, Imf::Channel(type));
+    frame.insert(name, Imf::Slice(type, static_cast<char*>(base), size, size * kRawW));
+  };
+  for (auto& [name, plane] : floats) add(name, Imf::FLOAT, plane.data(), sizeof(float));
+  if (!id.empty()) add("id", Imf::UINT, id.data(), sizeof(unsigned));
+  Imf::OutputFile file(path.c_str(), header);
+  file.setFrameBuffer(frame);
+  file.writePixels(kRawH);
+}
+
+// Coverage is object_id != 0 and depth is -P.z (GBuffer), so a covered pixel needs an id >= 1 and
+// a position in front of the camera; anything else is an error naming the pixel.
+TEST(GBufferExr, CoveredPixelWithIdZeroOrPositionBehindTheCameraIsAnError) {
+  TempDir dir;
+  constexpr std::size_t n = kRawW * kRawH, at = 2 * kRawW + 1;  // pixel (1, 2)
+  const std::vector<float> zero(n, 0.0f), one(n, 1.0f), two(n, 2.0f), minus_two(n, -2.0f);
+  std::vector<unsigned> id(n, 1u);
+  id[at] = 0;
+  write_raw_exr(dir / "id0.exr", {{"Z", two}, {"N.X", zero}, {"N.Y", zero}, {"N.Z", one}, {"A", one}}, id);
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "id0.exr", {.vertical_fov_deg = 40.0f}); }, dir / "id0.exr",
+                                          "pixel (1, 2)");
+
+  std::vector<float> pz = minus_two;
+  pz[at] = 2.0f;  // Z says 2 in front, P says behind
+  write_raw_exr(dir / "behind.exr", {{"Z", two}, {"N.X", zero}, {"N.Y", zero}, {"N.Z", one}, {"P.X", zero}, {"P.Y", zero}, {"P.Z", pz}});
+  test::expect_one_line_error<InputError>([&] { read_gbuffer_exr(dir / "behind.exr", {.vertical_fov_deg = 40.0f}); }, dir / "behind.exr",
+                                          "pixel (1, 2)");
+  // Consistent channels read fine, and the depth is -P.z.
+  write_raw_exr(dir / "ok.exr", {{"Z", two}, {"N.X", zero}, {"N.Y", zero}, {"N.Z", one}, {"P.X", zero}, {"P.Y", zero}, {"P.Z", minus_two}});
+  EXPECT_EQ(read_gbuffer_exr(dir / "ok.exr", {.vertical_fov_deg = 40.0f}).depth(1, 2), 2.0f);
 }
 
 TEST(GBufferExr, NanDepthWithoutCoverageChannelIsBackground) {
   TempDir dir;
   GBuffer g = sphere_gbuffer(test_camera());
   ASSERT_TRUE(g.covered(20, 15));
-  g.depth(20, 15) = std::numeric_limits<float>::quiet_NaN();
+  g.position(20, 15).z = std::numeric_limits<float>::quiet_NaN();  // Z = -P.z is NaN too
   write_gbuffer_exr(dir / "z.exr", g, {.coverage = false});
   const GBuffer back = read_gbuffer_exr(dir / "z.exr");
   EXPECT_FALSE(back.covered(20, 15));

@@ -203,18 +203,18 @@ struct Agreement {
 
 Agreement compare_gbuffers(const GBuffer& a, const GBuffer& b, bool same_ids) {
   Agreement r;
-  for (std::size_t i = 0; i < a.coverage.size(); ++i) {
-    if (!a.coverage[i] && !b.coverage[i]) continue;
+  for (std::size_t i = 0; i < a.object_id.size(); ++i) {
+    if (!a.covered(i) && !b.covered(i)) continue;
     // With the same objects, the same triangle; else (assimp's copies joined into one mesh
     // renumber the triangles) the same face, told by its normal.
-    const bool match = a.coverage[i] && b.coverage[i] &&
+    const bool match = a.covered(i) && b.covered(i) &&
                        (same_ids ? a.primitive_id[i] == b.primitive_id[i] && a.object_id[i] == b.object_id[i] : length(a.normal[i] - b.normal[i]) < 1e-2f);
     if (!match) {
       ++r.differ;
       continue;
     }
     ++r.same;
-    r.max_depth_rel = std::max(r.max_depth_rel, std::abs(static_cast<double>(a.depth[i]) - b.depth[i]) / b.depth[i]);
+    r.max_depth_rel = std::max(r.max_depth_rel, std::abs(static_cast<double>(a.depth(i)) - b.depth(i)) / b.depth(i));
     r.max_normal = std::max(r.max_normal, static_cast<double>(length(a.normal[i] - b.normal[i])));
     r.max_position_rel = std::max(r.max_position_rel, static_cast<double>(length(a.position[i] - b.position[i]) / length(b.position[i])));
   }
@@ -247,8 +247,8 @@ TEST(GltfInstances, GBufferMatchesTheFlattenedScene) {
   // Every instance is an object of its own, ids 1 (floor) to 4, and primitive ids are triangles of
   // the cube (0..11) or of the floor (0..1).
   std::set<std::uint32_t> ids;
-  for (std::size_t i = 0; i < a.g.coverage.size(); ++i) {
-    if (!a.g.coverage[i]) continue;
+  for (std::size_t i = 0; i < a.g.object_id.size(); ++i) {
+    if (!a.g.covered(i)) continue;
     ids.insert(a.g.object_id[i]);
     EXPECT_LT(a.g.primitive_id[i], a.g.object_id[i] == 1 ? 2u : 12u) << "pixel " << i;
   }
@@ -271,7 +271,7 @@ TEST(GltfInstances, RaytracedAoMatchesTheFlattenedScene) {
   std::size_t differ = 0, covered = 0;
   double sum = 0;
   for (std::size_t i = 0; i < va.visibility.size(); ++i) {
-    if (!a.g.coverage[i] || !b.g.coverage[i]) continue;
+    if (!a.g.covered(i) || !b.g.covered(i)) continue;
     ++covered;
     const double d = std::abs(static_cast<double>(va.visibility[i]) - vb.visibility[i]);
     sum += d;

@@ -114,7 +114,7 @@ TEST(Alchemy, StaysWithinBoundOfItsReferenceOnDefaultScene) {
   for (const AlchemyParams& p : {paper, AlchemyParams{}}) {
     const AlchemyImage img = render_alchemy(g, p, R, 1);
     const auto ref = render_raytraced(rs, g, alchemy_reference_falloff(p, R), {.samples = 64}, 2);
-    const ErrorMetrics e = compare_images(img.visibility, ref.visibility, g.coverage);
+    const ErrorMetrics e = compare_images(img.visibility, ref.visibility, coverage_mask(g));
     if (p.preset == AlchemyPreset::Paper) {
       // Not a convergence test: with the paper's sigma the screen-space estimator weights occluders
       // by the visible area on the disk (~ t^2 d omega), not by solid angle, and clamps the sum rather

@@ -25,10 +25,8 @@ GBuffer facing_planes(int w, int h, DepthFn depth_of) {
     for (int x = 0; x < w; ++x) {
       const float d = depth_of(x, y);
       if (!std::isfinite(d)) continue;
-      g.depth(x, y) = d;
       g.position(x, y) = cam.camera_direction(x + 0.5f, y + 0.5f) * d;
       g.normal(x, y) = {0, 0, 1};
-      g.coverage(x, y) = 1;
       g.object_id(x, y) = 1;
     }
   return g;

@@ -30,11 +30,9 @@ GBuffer one_pixel(Vec3 p, Vec3 n) {
   cam.width = cam.height = 1;
   GBuffer g(cam);
   g.position(0, 0) = cam.world_to_camera_point(p);
-  g.depth(0, 0) = -g.position(0, 0).z;
   g.normal(0, 0) = normalize(cam.world_to_camera_vector(n));
   g.albedo(0, 0) = {0.8f, 0.8f, 0.8f};
   g.object_id(0, 0) = 1;
-  g.coverage(0, 0) = 1;
   return g;
 }
 
@@ -128,7 +126,7 @@ TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
     const float R = 0.1f * s.bounds().diagonal();
     const auto ref = render_raytraced(rs, g, {Membership::Step, R}, {.samples = 256}, 9);
     const ConeResult r = render_cone(s, analyze_closure(s), g, R, cone_preset(ConeQuality::Medium), 1);
-    const ErrorMetrics m = compare_images(r.visibility, ref.visibility, g.coverage);
+    const ErrorMetrics m = compare_images(r.visibility, ref.visibility, coverage_mask(g));
     EXPECT_LT(m.rmse, bound) << name << ": mean signed error " << m.mean_signed;
   }
 }
@@ -189,7 +187,7 @@ OpenError cone_error(const Mesh& object, int columns = 256) {
   ConeParams p;
   p.columns = columns;
   const ConeResult r = render_cone(s, analyze_closure(s), g, R, p, 1);
-  const ErrorMetrics m = compare_images(r.visibility, ref.visibility, g.coverage);
+  const ErrorMetrics m = compare_images(r.visibility, ref.visibility, coverage_mask(g));
   return {m.rmse, m.mean_signed, cone_stats(r)};
 }
 

@@ -79,7 +79,7 @@ TEST(Containment, SilhouetteEliminationRemovesFalseShadowOfDistantObject) {
   const Image<float> v_on = containment_ao(s.g, f, on, 1), v_off = containment_ao(s.g, f, off, 1);
   double min_on = 1, min_off = 1;
   for (std::size_t i = 0; i < v_on.size(); ++i)
-    if (s.g.coverage[i] && s.g.object_id[i] == 1) {  // wall pixels
+    if (s.g.covered(i) && s.g.object_id[i] == 1) {  // wall pixels
       min_on = std::min(min_on, static_cast<double>(v_on[i]));
       min_off = std::min(min_off, static_cast<double>(v_off[i]));
     }

@@ -50,7 +50,7 @@ TEST(Gtao, WedgeCreaseIsHalfVisibleAndProfileMatchesAnalytic) {
     int n_crease = 0, n = 0;
     for (int y = 0; y < s.g.height(); ++y)
       for (int x = 0; x < s.g.width(); ++x) {
-        if (!s.g.coverage(x, y)) continue;
+        if (!s.g.covered(x, y)) continue;
         const Vec3 w = s.g.camera.camera_to_world_point(s.g.position(x, y));
         if (w.y > 1e-3f || w.z > R || std::abs(w.x) > 2.0f) continue;  // floor, within R of the wall
         const double exact = wedge_visibility(w.z, R), e = v(x, y) - exact;

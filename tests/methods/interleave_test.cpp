@@ -14,8 +14,8 @@ GBuffer two_depths(int w, int h) {
   GBuffer g(c);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      g.coverage(x, y) = 1;
-      g.depth(x, y) = x < w / 2 ? 1.0f : 5.0f;
+      g.object_id(x, y) = 1;
+      g.position(x, y) = {0, 0, x < w / 2 ? -1.0f : -5.0f};  // depth 1 or 5
     }
   return g;
 }
@@ -33,8 +33,7 @@ TEST(Interleave, FilterAveragesTheSixteenPatternPositions) {
 
 TEST(Interleave, FilterSkipsNeighboursAcrossADepthEdgeAndBackground) {
   GBuffer g = two_depths(16, 8);
-  g.coverage(2, 2) = 0;
-  g.depth(2, 2) = kInfinity;
+  g.object_id(2, 2) = 0;  // background
   Image<float> v(16, 8);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 16; ++x) v(x, y) = x < 8 ? 0.25f : 1.0f;

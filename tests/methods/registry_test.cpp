@@ -50,7 +50,7 @@ double covered_mean(const Image<float>& v, const GBuffer& g) {
   double sum = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < v.size(); ++i)
-    if (g.coverage[i]) sum += v[i], ++n;
+    if (g.covered(i)) sum += v[i], ++n;
   return n ? sum / static_cast<double>(n) : 1.0;
 }
 

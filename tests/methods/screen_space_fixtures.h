@@ -39,17 +39,15 @@ inline GBuffer one_pixel(Vec3 p, Vec3 n, Vec3 albedo = {0.5f, 0.5f, 0.5f}) {
   c.width = c.height = 1;
   GBuffer g(c);
   g.position(0, 0) = p;
-  g.depth(0, 0) = -p.z;
   g.normal(0, 0) = normalize(n);
   g.albedo(0, 0) = albedo;
-  g.coverage(0, 0) = 1;
   g.object_id(0, 0) = 1;
   return g;
 }
 
 /// RMSE of `v` against the ray-traced reference over covered pixels.
 inline double rmse_against(const Image<float>& v, const Image<float>& reference, const GBuffer& g) {
-  return compare_images(v, reference, g.coverage).rmse;
+  return compare_images(v, reference, coverage_mask(g)).rmse;
 }
 
 }  // namespace ao::test

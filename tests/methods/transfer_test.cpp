@@ -61,7 +61,7 @@ TEST(Transfer, WhiteRoomCornersAreNoDarkerThanWalls) {
   const TransferImage t = transfer_ao(s.g, {Membership::Step, 1.0f}, {}, 3);
   double min_o = 1;
   for (std::size_t i = 0; i < t.luminance.size(); ++i) {
-    if (!s.g.coverage[i] || t.obscurance[i] == 0) continue;
+    if (!s.g.covered(i) || t.obscurance[i] == 0) continue;
     min_o = std::min(min_o, static_cast<double>(t.obscurance[i]));
     ASSERT_NEAR(t.luminance[i], 1.0f, 1e-5f) << "pixel " << i;
   }
@@ -134,7 +134,7 @@ TEST(Transfer, MoreTestsPerRayNeverOpenMoreRays) {
 // and both silhouette settings, m = 1 and 2; exact equality on a real scene's million tests.
 TEST(Transfer, PackedDepthAndPaletteChangeNothing) {
   const auto s = test::builtin_gbuffer("default");
-  const Image<float> depth_copy = s.g.depth;
+  const Image<float> depth_copy = depth_plane(s.g);
   DepthBufferCharacteristic plain(s.g);
   plain.depth = depth_copy.data();
   int cases = 0;
@@ -178,27 +178,28 @@ TEST(Transfer, HeightFieldTimesDepthBufferShowsDisplacementDetail) {
   hf.map = bumps.view();
   hf.period = 2.0f;  // 4 bumps per 2 world units
   hf.amplitude = 0.2f;
-  // The displacement renderer's G-buffer: positions and normals on the displaced surface, depth
-  // left flat (VAO: "even if the depth value isn't modified").
+  // The displacement renderer's G-buffer: positions and normals on the displaced surface, its depth
+  // buffer left flat (VAO: "even if the depth value isn't modified"): the undisplaced G-buffer's.
   GBuffer g = s.g;
   for (std::size_t i = 0; i < g.position.size(); ++i) {
-    if (!g.coverage[i]) continue;
+    if (!g.covered(i)) continue;
     const Vec3 l = hf.frame.to_local(g.position[i] - hf.origin);
     Vec3 gradient;
     hf.value(g.position[i], &gradient);
     g.position[i] += hf.frame.n * hf.height(l.x, l.y);
     g.normal[i] = normalize(gradient);
   }
-  const DepthTimesHeightField both{DepthBufferCharacteristic(g), hf};
+  const DepthBufferCharacteristic flat(s.g);
+  const DepthTimesHeightField both{flat, hf};
   const Falloff f{Membership::Step, 0.4f};
   TransferParams p;
   p.silhouette_elimination = false;
-  const Image<float> o_depth = transfer_ao(g, f, p, 1).obscurance;
+  const Image<float> o_depth = transfer_ao(g, flat, g.albedo, f, p, 1).obscurance;
   const Image<float> o_both = transfer_ao(g, both, g.albedo, f, p, 1).obscurance;
   double mean_depth = 0, mean_both = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < o_depth.size(); ++i)
-    if (s.g.coverage[i]) mean_depth += o_depth[i], mean_both += o_both[i], ++n;
+    if (s.g.covered(i)) mean_depth += o_depth[i], mean_both += o_both[i], ++n;
   EXPECT_GT(mean_depth / n, 0.99) << "the flat depth buffer alone sees (almost) no occlusion";
   EXPECT_LT(mean_both / n, mean_depth / n - 0.01) << "the height field adds the bumps' self-occlusion";
 }
@@ -273,7 +274,7 @@ TEST(Transfer, RadianceModeGrowsWithTheSunWhereOccludersAreLit) {
     ASSERT_GE(b.x, a.x) << "pixel " << i;
     ASSERT_GE(b.y, a.y) << "pixel " << i;
     ASSERT_GE(b.z, a.z) << "pixel " << i;
-    if (s.g.coverage[i] && dim.obscurance[i] == 1.0f) {
+    if (s.g.covered(i) && dim.obscurance[i] == 1.0f) {
       ++open;
       ASSERT_EQ(a, (Vec3{1, 1, 1})) << "pixel " << i;
       ASSERT_EQ(b, (Vec3{1, 1, 1})) << "pixel " << i;

@@ -41,7 +41,7 @@ TEST(DirectLight, OpenPlaneFacingTheSunHasAlbedoTimesEOverPiTimesCosine) {
     const Image<Vec3> ld = render_direct_light(*s.rays, s.g, c.sun);
     int covered = 0;
     for (std::size_t i = 0; i < ld.size(); ++i) {
-      if (!s.g.coverage[i]) {
+      if (!s.g.covered(i)) {
         ASSERT_EQ(ld[i], (Vec3{0, 0, 0}));
         continue;
       }

@@ -38,11 +38,11 @@ void expect_open_everywhere(const RayScene& rs, const GBuffer& g, float radius, 
   const auto img = render_raytraced(rs, g, {Membership::Step, radius}, {.samples = 64}, 11);
   std::size_t covered = 0, acne = 0;
   for (std::size_t i = 0; i < img.visibility.size(); ++i) {
-    if (!g.coverage[i]) continue;
+    if (!g.covered(i)) continue;
     ++covered;
     acne += img.visibility[i] < 1.0f;
   }
-  EXPECT_GT(covered, g.coverage.size() / 10) << what;
+  EXPECT_GT(covered, g.object_id.size() / 10) << what;
   EXPECT_EQ(acne, 0u) << what << ": pixels whose rays hit the surface they start on";
 }
 
@@ -61,7 +61,7 @@ TEST(RayOffset, NoAcneOnTiltedPlaneFarFromOrigin) {
   // The sun pass starts its shadow rays the same way: a sun on the visible side lights every pixel.
   const Image<Vec3> ld = render_direct_light(rs, g, Sun{normalize(side + u * 0.3f), kPi});
   for (std::size_t i = 0; i < ld.size(); ++i)
-    if (g.coverage[i]) {
+    if (g.covered(i)) {
       ASSERT_GT(ld[i].x, 0.0f) << "pixel " << i << " shadowed by its own plane";
     }
 }
@@ -93,7 +93,7 @@ TEST(RayOffset, GeometricAndShadingNormalsAgreeOnFlatShadedCube) {
   double max_diff = 0, sum_v = 0;
   std::size_t covered = 0;
   for (std::size_t i = 0; i < a.visibility.size(); ++i) {
-    if (!shading.coverage[i]) continue;
+    if (!shading.covered(i)) continue;
     ++covered;
     sum_v += a.visibility[i];
     // Same sample sets; the normals differ by float rounding at most, which can flip a ray that
@@ -115,7 +115,7 @@ MeanV mean_v_of_object(const RayScene& rs, const GBuffer& g, std::uint32_t objec
   double sum = 0, var = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < img.visibility.size(); ++i) {
-    if (!g.coverage[i] || g.object_id[i] != object) continue;
+    if (!g.covered(i) || g.object_id[i] != object) continue;
     sum += img.visibility[i];
     var += static_cast<double>(img.std_error[i]) * img.std_error[i];
     ++n;
@@ -199,7 +199,7 @@ TEST(RayOffset, ReferencesOffsetPerTriangleNotByTheScene) {
     double sum = 0, var = 0;
     std::size_t n = 0;
     for (std::size_t i = 0; i < img.visibility.size(); ++i) {
-      if (!g.coverage[i]) continue;
+      if (!g.covered(i)) continue;
       sum += img.visibility[i];
       var += static_cast<double>(img.std_error[i]) * img.std_error[i];
       ++n;

@@ -34,8 +34,8 @@ TEST(RayScene, EveryBuildSettingHitsTheSameSurfaces) {
     int covered = 0;
     for (int y = 0; y < cam.height; ++y)
       for (int x = 0; x < cam.width; ++x) {
-        ASSERT_EQ(got.coverage(x, y), want.coverage(x, y)) << x << "," << y;
-        if (!want.coverage(x, y)) continue;
+        ASSERT_EQ(got.covered(x, y), want.covered(x, y)) << x << "," << y;
+        if (!want.covered(x, y)) continue;
         ++covered;
         // The same triangle intersected the same way; the BVH only changes the order of tests.
         EXPECT_NEAR(got.depth(x, y), want.depth(x, y), 1e-5f * want.depth(x, y)) << x << "," << y;

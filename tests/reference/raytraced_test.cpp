@@ -122,7 +122,7 @@ TEST(Raytraced, InsideClosedRoomIsFullyOccludedWithLargeRadius) {
   const GBuffer g = render_gbuffer(rs, cam);
   const auto img = render_raytraced(rs, g, {Membership::Step, 100.0f}, {.samples = 64}, 1);
   for (std::size_t i = 0; i < img.visibility.size(); ++i) {
-    ASSERT_TRUE(g.coverage[i]) << "the room encloses the camera, every pixel sees a wall";
+    ASSERT_TRUE(g.covered(i)) << "the room encloses the camera, every pixel sees a wall";
     EXPECT_EQ(img.visibility[i], 0.0f) << "pixel " << i;
   }
 }

@@ -73,7 +73,7 @@ TEST(TransferReference, WhiteRoomIsUniformlyLit) {
   const auto sg = test::scene_gbuffer(std::move(s));
   const TransferReferenceImage img = render_transfer_reference(*sg.rays, sg.g, {Membership::Linear, 20.0f}, 1.0f, {.samples = 64}, 3);
   for (std::size_t i = 0; i < img.transfer.size(); ++i) {
-    if (!sg.g.coverage[i]) continue;
+    if (!sg.g.covered(i)) continue;
     ASSERT_LT(img.obscurance[i], 0.5f) << "pixel " << i;
     ASSERT_NEAR(img.scalar.visibility[i], 1.0f, 1e-5f) << "pixel " << i;  // float rounding of the ratio
   }
@@ -110,7 +110,7 @@ TEST(TransferReference, BlackOccludersGiveTheObscuranceReference) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < o.visibility.size(); ++i) {
     ASSERT_EQ(t.scalar.visibility[i], t.obscurance[i]) << "pixel " << i;
-    if (!s.g.coverage[i]) continue;
+    if (!s.g.covered(i)) continue;
     sum_t += t.obscurance[i];
     sum_o += o.visibility[i];
     var += static_cast<double>(o.std_error[i]) * o.std_error[i];

@@ -1,5 +1,8 @@
 // GBuffer: what every screen-space method reads. One entry per pixel, all in camera space
-// (right-handed, looking down -z; see camera.h).
+// (right-handed, looking down -z; see camera.h). Linear depth and coverage are not stored: they
+// follow from the position and the object id (GBuffer::depth, GBuffer::covered), so rendering a
+// G-buffer writes fewer bytes a pixel; kernels that gather depths build a contiguous plane with
+// depth_plane().
 #pragma once
 
 #include <cstdint>
@@ -18,12 +21,13 @@ enum class SurfaceNormal {
 
 struct GBuffer {
   Camera camera;              ///< Intrinsics (fov, size) and, when known, the world placement.
-  Image<Vec3> position;       ///< Camera-space position of the visible surface; (0,0,0) where not covered.
-  Image<float> depth;         ///< Linear depth = -position.z (> 0); +infinity where not covered.
+  Image<Vec3> position;       ///< Camera-space position of the visible surface, z < 0; (0,0,0) where not covered.
   Image<Vec3> normal;         ///< Unit camera-space normal facing the camera (the shading normal unless rendered with SurfaceNormal::Geometric); (0,0,0) where not covered.
   Image<Vec3> albedo;         ///< Diffuse albedo in [0,1] per channel, linear; 0 where not covered. Empty when rendered without it (GBufferOptions::albedo).
-  Image<std::uint32_t> object_id;  ///< 1 + index of the mesh in its scene; 0 where not covered.
-  Image<std::uint8_t> coverage;    ///< 1 where a surface is visible, 0 for background.
+  /// 1 + index of the object in its scene (Scene::objects(): the mesh, or a glTF instance of it)
+  /// where a surface is visible; 0 where not covered (the background): this is the coverage
+  /// (covered()).
+  Image<std::uint32_t> object_id;
   Image<Vec2> uv;                  ///< First UV set of the visible surface; (0,0) where not covered or the mesh has none. Empty when rendered without it (GBufferOptions::uv).
   /// Optional direct-light pass: the radiance Ld the visible surface reflects of direct lights
   /// (sun, point lights; not the ambient light), per channel, in units of the ambient radiance La
@@ -40,16 +44,30 @@ struct GBuffer {
   explicit GBuffer(const Camera& cam)
       : camera(cam),
         position(cam.width, cam.height),
-        depth(cam.width, cam.height, kInfinity),
         normal(cam.width, cam.height),
         albedo(cam.width, cam.height),
         object_id(cam.width, cam.height, 0u),
-        coverage(cam.width, cam.height, std::uint8_t{0}),
         uv(cam.width, cam.height) {}
 
   int width() const { return camera.width; }
   int height() const { return camera.height; }
-  bool covered(int x, int y) const { return coverage(x, y) != 0; }
+  /// True where a surface is visible (object_id != 0).
+  bool covered(int x, int y) const { return object_id(x, y) != 0; }
+  /// The same for pixel index i = y * width + x.
+  bool covered(std::size_t i) const { return object_id[i] != 0; }
+  /// Linear depth -position.z (> 0) where covered; +infinity where not.
+  float depth(int x, int y) const { return covered(x, y) ? -position(x, y).z : kInfinity; }
+  /// The same for pixel index i = y * width + x.
+  float depth(std::size_t i) const { return covered(i) ? -position[i].z : kInfinity; }
 };
+
+/// GBuffer::depth of every pixel as one contiguous image (width x height, reusing `out`'s storage),
+/// for kernels that gather depths (the screen-space methods, their filters). Computed in parallel.
+void depth_plane(const GBuffer& g, Image<float>& out);
+/// The same as a new image.
+Image<float> depth_plane(const GBuffer& g);
+
+/// 1 where covered, 0 elsewhere: the mask the metrics (eval/metrics.h) take.
+Image<std::uint8_t> coverage_mask(const GBuffer& g);
 
 }  // namespace ao

@@ -14,9 +14,10 @@ namespace ao {
 namespace {
 
 // --- render, bytes per pixel --------------------------------------------------------------------
-// G-buffer (core/gbuffer.h): position 12 + depth 4 + normal 12 + albedo 12 + object id 4 +
-// coverage 1 + uv 8.
-constexpr std::uint64_t kGBufferBytes = 53;
+// G-buffer (core/gbuffer.h): position 12 + normal 12 + albedo 12 + object id 4 + triangle index 4
+// + uv 8 (depth and coverage are derived; the depth plane a screen-space pass builds, 4, is its
+// scratch, within kMethodBytes).
+constexpr std::uint64_t kGBufferBytes = 52;
 constexpr std::uint64_t kDirectBytes = 12;  // GBuffer::direct, RGB float
 // The method's result and scratch, the largest over the registry: ambient transfer keeps V (4),
 // W (RGB, 12), obscurance (4) and its per-row buffers. Measured peak resident size per pixel at

@@ -134,6 +134,7 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
     return out;
   };
 
+  const Image<std::uint8_t> covered = coverage_mask(g);
   for (const std::string& name : s.methods) {
     const MethodInfo& m = find_method(name);
     const nlohmann::json& p = s.params.at(name);
@@ -144,8 +145,8 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
     row.reference = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
     MethodOutput out = run_method(m, p, row.ms);
     const Image<float>& ref = result.references[row.reference].visibility;
-    row.metrics = compare_images(out.visibility, ref, g.coverage);
-    row.heat = signed_error_heat_map(out.visibility, ref, g.coverage, kCompareHeatRange);
+    row.metrics = compare_images(out.visibility, ref, covered);
+    row.heat = signed_error_heat_map(out.visibility, ref, covered, kCompareHeatRange);
     row.stats = out.stats;
     row.visibility = std::move(out.visibility);
     result.rows.push_back(std::move(row));
@@ -161,7 +162,7 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
         const std::size_t r = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
         double ms = 0;
         const MethodOutput out = run_method(m, p, ms);
-        const ErrorMetrics e = compare_images(out.visibility, result.references[r].visibility, g.coverage);
+        const ErrorMetrics e = compare_images(out.visibility, result.references[r].visibility, covered);
         result.sweep.push_back({name, v, e.rmse, ms});
       }
     }

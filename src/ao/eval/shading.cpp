@@ -13,7 +13,7 @@ Image<Vec3> shade_for_display(const GBuffer& g, const Image<float>& v, const Ima
   constexpr float kSkyWithSun = 0.5f;  // La in display units with a direct-light pass
   Image<Vec3> out(g.width(), g.height(), Vec3{1, 1, 1});
   for (std::size_t i = 0; i < out.size(); ++i) {
-    if (!g.coverage[i]) continue;
+    if (!g.covered(i)) continue;
     if (!g.direct.empty()) {
       const Vec3 ambient = color.empty() ? g.albedo[i] * v[i] : g.albedo[i] * color[i];  // a V or a W
       out[i] = (ambient + g.direct[i]) * kSkyWithSun;
@@ -29,8 +29,8 @@ Image<Vec3> shade_for_display(const GBuffer& g, const Image<float>& v, const Ima
 Image<float> visibility_from_ao_map(const GBuffer& g, const Scene& scene, const Image<float>& map, const std::string& map_name) {
   Image<float> v(g.width(), g.height(), 1.0f);
   const std::vector<SceneObject> objects = scene.objects();  // object id - 1 -> mesh
-  for (std::size_t i = 0; i < g.coverage.size(); ++i) {
-    if (!g.coverage[i]) continue;
+  for (std::size_t i = 0; i < g.object_id.size(); ++i) {
+    if (!g.covered(i)) continue;
     const Mesh& mesh = scene.meshes[objects[g.object_id[i] - 1].mesh];
     if (mesh.uvs.empty())
       throw InputError(scene.name + ": mesh '" + mesh.name + "' is visible but has no UVs, so the AO map " + map_name + " cannot be shown on it");

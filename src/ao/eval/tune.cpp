@@ -32,17 +32,20 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
 
   TuneResult r;
   // Mean RMSE over the views; a parameter value the method refuses counts as infinitely bad.
+  std::vector<Image<std::uint8_t>> covered;
+  for (const TuneView& v : views) covered.push_back(coverage_mask(*v.gbuffer));
   auto evaluate = [&](const nlohmann::json& params) {
     ++r.evaluations;
     double sum = 0;
-    for (const TuneView& v : views) {
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const TuneView& v = views[i];
       MethodOutput out;
       try {
         out = m.run(MethodInput{*v.gbuffer, v.scene, v.falloff, s.seed, {}, v.surfaces}, params);
       } catch (const InputError&) {
         return std::numeric_limits<double>::infinity();
       }
-      sum += compare_images(out.visibility, v.reference, v.gbuffer->coverage).rmse;
+      sum += compare_images(out.visibility, v.reference, covered[i]).rmse;
     }
     return sum / static_cast<double>(views.size());
   };

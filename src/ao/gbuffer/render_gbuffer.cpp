@@ -90,7 +90,7 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
 }
 
 // Copies `bytes` bytes from src to dst with non-temporal (streaming) stores where dst is 16-byte
-// aligned, plain stores at the unaligned ends. The G-buffer (57 bytes a pixel, tens of MB) is
+// aligned, plain stores at the unaligned ends. The G-buffer (32-52 bytes a pixel, tens of MB) is
 // written once and read later by another pass, so streaming it skips reading every destination
 // cache line into the cache before overwriting it: half the memory traffic of plain stores.
 // Callers issue _mm_sfence() before other threads may read what was written.
@@ -108,9 +108,7 @@ void stream_copy(void* dst, const void* src, std::size_t bytes) {
 // One tile row of every G-buffer channel, assembled in cache and then streamed to the images.
 struct RowBuffer {
   Vec3 position[kTileWidth], normal[kTileWidth], albedo[kTileWidth];
-  float depth[kTileWidth];
   std::uint32_t object_id[kTileWidth], primitive_id[kTileWidth];
-  std::uint8_t coverage[kTileWidth];
   Vec2 uv[kTileWidth];
 
   // Channels a G-buffer rendered without albedo or UVs leaves empty are not written.
@@ -118,83 +116,93 @@ struct RowBuffer {
     stream_copy(&g.position(x0, y), position, n * sizeof(Vec3));
     stream_copy(&g.normal(x0, y), normal, n * sizeof(Vec3));
     if (!g.albedo.empty()) stream_copy(&g.albedo(x0, y), albedo, n * sizeof(Vec3));
-    stream_copy(&g.depth(x0, y), depth, n * sizeof(float));
     stream_copy(&g.object_id(x0, y), object_id, n * sizeof(std::uint32_t));
     stream_copy(&g.primitive_id(x0, y), primitive_id, n * sizeof(std::uint32_t));
-    stream_copy(&g.coverage(x0, y), coverage, n * sizeof(std::uint8_t));
     if (!g.uv.empty()) stream_copy(&g.uv(x0, y), uv, n * sizeof(Vec2));
   }
 };
 
+// The visible triangle in camera space: what every pixel that sees it interpolates. Consecutive
+// pixels mostly see the same triangle, so it is built once per run of such pixels instead of
+// once per pixel (the vertex fetches, the cross product and the transforms to camera space).
+struct CameraTriangle {
+  unsigned geom = RTC_INVALID_GEOMETRY_ID, inst = RTC_INVALID_GEOMETRY_ID, prim = 0;  ///< Embree's ids of the hit.
+  std::uint32_t object = 0;    ///< Index into Scene::objects() (object id - 1).
+  std::uint32_t triangle = 0;  ///< Triangle within its mesh.
+  Vec3 albedo;
+  Vec3 q0, q1, q2;  ///< Vertices, camera space (relative to the eye).
+  Vec3 ng;          ///< Unit geometric normal, camera space, as wound (not yet turned to the camera).
+  Vec3 n0, n1, n2;  ///< Vertex normals, camera space (SurfaceNormal::Shading only).
+  Vec2 t0, t1, t2;  ///< Vertex UVs; zero when the mesh has none or UVs are not wanted.
+
+  template <SurfaceNormal kWhich>
+  void load(const RayScene& rs, const Camera& cam, const Frame& basis, unsigned g, unsigned i, unsigned p, bool want_uv) {
+    geom = g, inst = i, prim = p;
+    // An instance's triangle is moved to the world vertex by vertex, so the point, the normal and
+    // their rounding are those of the same triangle stored in world space.
+    const HitRef hit = resolve(rs, g, i, p);
+    const Mesh& m = rs.scene().meshes[hit.mesh];
+    object = hit.object, triangle = hit.triangle, albedo = m.albedo;
+    const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(hit.triangle)];
+    Vec3 p0, p1, p2;
+    world_triangle(rs, hit, p0, p1, p2);
+    // Moving the vertices to camera space and interpolating there puts each point on the triangle
+    // to a few float spacings of the coordinates and the eye, which the ray offsets rely on
+    // (reference/ray_offset.h); eye + t * direction would be off by the error of t.
+    q0 = basis.to_local(p0 - cam.eye), q1 = basis.to_local(p1 - cam.eye), q2 = basis.to_local(p2 - cam.eye);
+    ng = basis.to_local(normalize(cross(p1 - p0, p2 - p0)));
+    if constexpr (kWhich == SurfaceNormal::Shading) {
+      Vec3 w0 = m.normals[tri[0]], w1 = m.normals[tri[1]], w2 = m.normals[tri[2]];
+      if (const Affine3* nt = hit.normal_to_world)  // vertex normals as flatten_instances stores them
+        w0 = normalize(nt->vector(w0)), w1 = normalize(nt->vector(w1)), w2 = normalize(nt->vector(w2));
+      n0 = basis.to_local(w0), n1 = basis.to_local(w1), n2 = basis.to_local(w2);
+    }
+    if (want_uv && !m.uvs.empty()) t0 = m.uvs[tri[0]], t1 = m.uvs[tri[1]], t2 = m.uvs[tri[2]];
+    else t0 = t1 = t2 = {};
+  }
+};
+
 // Writes the G-buffer rows of tile t from its hits: each row is assembled in a RowBuffer and
-// streamed out, one contiguous run per channel.
-template <SurfaceNormal kWhich>
+// streamed out, one contiguous run per channel. kExtras: albedo and UVs are wanted (else their
+// images are empty and nothing is computed for them).
+template <SurfaceNormal kWhich, bool kExtras>
 void shade_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const TileHits& hits, GBuffer& g, const Tile& t) {
-  const Scene& scene = rs.scene();
   const int tw = t.x1 - t.x0;
-  const bool want_uv = !g.uv.empty();
+  const bool want_uv = kExtras && !g.uv.empty();
   RowBuffer row;
-  Vec3* const position = row.position;
-  Vec3* const normal = row.normal;
-  Vec3* const albedo = row.albedo;
-  float* const depth = row.depth;
-  std::uint32_t* const object_id = row.object_id;
-  std::uint32_t* const primitive_id = row.primitive_id;
-  std::uint8_t* const coverage = row.coverage;
-  Vec2* const uv = row.uv;
+  CameraTriangle tri;
   for (int y = t.y0; y < t.y1; ++y) {
-    const TileHits* const h = &hits;
     const int r = (y - t.y0) * tw;
     for (int i = 0; i < tw; ++i) {
-      const unsigned geom = h->geom[r + i];
+      const unsigned geom = hits.geom[r + i];
       if (geom == RTC_INVALID_GEOMETRY_ID) {
-        position[i] = {};
-        depth[i] = kInfinity;
-        normal[i] = {};
-        albedo[i] = {};
-        object_id[i] = 0;
-        primitive_id[i] = 0;
-        coverage[i] = 0;
-        uv[i] = {};
+        row.position[i] = {};
+        row.normal[i] = {};
+        row.object_id[i] = 0;
+        row.primitive_id[i] = 0;
+        if constexpr (kExtras) row.albedo[i] = {}, row.uv[i] = {};
         continue;
       }
-      // An instance's triangle is moved to the world vertex by vertex, so the point, the normal and
-      // their rounding are those of the same triangle stored in world space.
-      const HitRef hit = resolve(rs, geom, h->inst[r + i], h->prim[r + i]);
-      const Mesh& m = scene.meshes[hit.mesh];
-      const unsigned prim = hit.triangle;
-      const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(prim)];
-      const float bu = h->u[r + i], bv = h->v[r + i], bw = 1.0f - bu - bv;
-      Vec3 p0, p1, p2;
-      world_triangle(rs, hit, p0, p1, p2);
-      // Interpolating the vertices puts the point on the triangle to float rounding, which is
-      // more accurate than eye + t * direction far from the camera (the ray offsets rely on it).
-      const Vec3 pc = basis.to_local(p0 * bw + p1 * bu + p2 * bv - cam.eye);
-      Vec3 ng = basis.to_local(normalize(cross(p1 - p0, p2 - p0)));
+      const unsigned inst = hits.inst[r + i], prim = hits.prim[r + i];
+      if (geom != tri.geom || prim != tri.prim || inst != tri.inst) tri.load<kWhich>(rs, cam, basis, geom, inst, prim, want_uv);
+      const float bu = hits.u[r + i], bv = hits.v[r + i], bw = 1.0f - bu - bv;
+      const Vec3 pc = tri.q0 * bw + tri.q1 * bu + tri.q2 * bv;
       // Both sides of a surface can be seen (open meshes, rooms): AO is for the side facing the
       // viewer, so turn the geometric normal towards the camera and the shading normal onto its side.
-      if (dot(ng, pc) > 0) ng = -ng;
-      position[i] = pc;
-      depth[i] = -pc.z;
-      albedo[i] = m.albedo;
-      object_id[i] = hit.object + 1;
-      primitive_id[i] = prim;
-      coverage[i] = 1;
+      const Vec3 ng = dot(tri.ng, pc) > 0 ? -tri.ng : tri.ng;
       Vec3 n = ng;
       if constexpr (kWhich == SurfaceNormal::Shading) {
-        Vec3 n0 = m.normals[tri[0]], n1 = m.normals[tri[1]], n2 = m.normals[tri[2]];
-        if (const Affine3* nt = hit.normal_to_world)  // vertex normals as flatten_instances stores them
-          n0 = normalize(nt->vector(n0)), n1 = normalize(nt->vector(n1)), n2 = normalize(nt->vector(n2));
-        n = basis.to_local(normalize(n0 * bw + n1 * bu + n2 * bv));
+        n = normalize(tri.n0 * bw + tri.n1 * bu + tri.n2 * bv);
         if (dot(n, ng) < 0) n = -n;
-        if (!(length(n) > 0.5f)) n = ng;
+        if (!(dot(n, n) > 0.25f)) n = ng;  // zero where the vertex normals cancel
       }
-      normal[i] = n;
-      if (want_uv && !m.uvs.empty()) {
-        const Vec2 t0 = m.uvs[tri[0]], t1 = m.uvs[tri[1]], t2 = m.uvs[tri[2]];
-        uv[i] = {t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv};
-      } else {
-        uv[i] = {};
+      row.position[i] = pc;
+      row.normal[i] = n;
+      row.object_id[i] = tri.object + 1;
+      row.primitive_id[i] = tri.triangle;
+      if constexpr (kExtras) {
+        row.albedo[i] = tri.albedo;
+        row.uv[i] = {tri.t0.x * bw + tri.t1.x * bu + tri.t2.x * bv, tri.t0.y * bw + tri.t1.y * bu + tri.t2.y * bv};
       }
     }
     row.stream_to(g, t.x0, y, tw);
@@ -213,8 +221,14 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
   for (int y = t.y0; y < t.y1; y += kStrip) {
     const Tile s{t.x0, y, t.x1, std::min(y + kStrip, t.y1)};
     trace_tile<N>(embree_scene(rs), cam, gen, s, hits);
-    if (which == SurfaceNormal::Shading) shade_tile<SurfaceNormal::Shading>(rs, cam, basis, hits, g, s);
-    else shade_tile<SurfaceNormal::Geometric>(rs, cam, basis, hits, g, s);
+    const bool extras = !g.albedo.empty() || !g.uv.empty();
+    if (which == SurfaceNormal::Shading) {
+      if (extras) shade_tile<SurfaceNormal::Shading, true>(rs, cam, basis, hits, g, s);
+      else shade_tile<SurfaceNormal::Shading, false>(rs, cam, basis, hits, g, s);
+    } else {
+      if (extras) shade_tile<SurfaceNormal::Geometric, true>(rs, cam, basis, hits, g, s);
+      else shade_tile<SurfaceNormal::Geometric, false>(rs, cam, basis, hits, g, s);
+    }
   }
   _mm_sfence();  // the streamed rows are visible to whichever thread reads the G-buffer next
 }
@@ -239,12 +253,10 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   // the right size is kept, and fresh pages are first touched by the parallel tiles.
   const int w = camera.width, h = camera.height;
   g.position.resize(w, h);
-  g.depth.resize(w, h);
   g.normal.resize(w, h);
   if (options.albedo) g.albedo.resize(w, h);
   else g.albedo = Image<Vec3>();
   g.object_id.resize(w, h);
-  g.coverage.resize(w, h);
   if (options.uv) g.uv.resize(w, h);
   else g.uv = Image<Vec2>();
   g.primitive_id.resize(w, h);

@@ -21,7 +21,8 @@ struct GBufferOptions {
 };
 
 /// Traces one primary ray through each pixel centre of `camera` (which must validate) and fills
-/// the G-buffer: camera-space position interpolated on the hit triangle, linear depth, the normal
+/// the G-buffer: camera-space position interpolated on the hit triangle (linear depth and coverage
+/// follow from it and the id: GBuffer::depth, ::covered), the normal
 /// chosen by `options` turned to face the camera (the shading normal onto the side of the
 /// geometric one), the mesh's id, the triangle's index (primitive_id), and the mesh's albedo and
 /// the UVs unless `options` leave them out (then those images are empty). The optional

@@ -228,6 +228,10 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
       }
       if (!is_finite(normal) || length(normal) <= 0.0f) bad_pixel(path, x, y, "normal N = " + format_vec(normal) + " is not a finite, non-zero vector");
       if (!is_finite(position)) bad_pixel(path, x, y, "position P = " + format_vec(position) + " is not finite");
+      // The G-buffer's depth is -P.z (GBuffer::depth): the point must be in front of the camera.
+      if (!(position.z < 0.0f)) bad_pixel(path, x, y, "position P = " + format_vec(position) + " is not in front of the camera (P.z must be < 0)");
+      const std::uint32_t object = has_id ? id[i] : 1u;
+      if (object == 0) bad_pixel(path, x, y, "covered but its id is 0, which marks background (surfaces have ids >= 1)");
       const Vec3 albedo = has_albedo ? Vec3{ar[i], ag[i], ab[i]} : Vec3{kDefaultAlbedo, kDefaultAlbedo, kDefaultAlbedo};
       if (!is_finite(albedo)) bad_pixel(path, x, y, "albedo = " + format_vec(albedo) + " is not finite");
       if (has_direct) {
@@ -238,12 +242,10 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
       }
 
       g.position(x, y) = position;
-      g.depth(x, y) = depth;
       g.normal(x, y) = normalize(normal);  // passes are often filtered or stored as half: renormalise
       g.albedo(x, y) = albedo;
-      g.object_id(x, y) = has_id ? id[i] : 1u;
+      g.object_id(x, y) = object;
       if (has_primitive) g.primitive_id(x, y) = primitive[i];
-      g.coverage(x, y) = 1;
     }
   }
   return g;
@@ -254,8 +256,8 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
 void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWriteOptions& opt) {
   const int width = g.width(), height = g.height();
   const auto same_size = [&](const auto& image) { return image.width() == width && image.height() == height; };
-  if (width < 1 || height < 1 || !same_size(g.position) || !same_size(g.depth) || !same_size(g.normal) || !same_size(g.albedo) ||
-      !same_size(g.object_id) || !same_size(g.coverage) || (!g.direct.empty() && !same_size(g.direct)) ||
+  if (width < 1 || height < 1 || !same_size(g.position) || !same_size(g.normal) || !same_size(g.albedo) || !same_size(g.object_id) ||
+      (!g.direct.empty() && !same_size(g.direct)) ||
       (!g.primitive_id.empty() && !same_size(g.primitive_id)))
     throw InputError(path.string() + ": G-buffer images do not all match the camera's " + std::to_string(width) + "x" +
                      std::to_string(height) + " pixels");
@@ -270,9 +272,11 @@ void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWrit
     header.insert(kUpAttribute, Imf::V3fAttribute(to_imath(g.camera.up)));
   }
 
-  // Coverage is stored as a float alpha (what compositors expect in A), so it needs its own plane.
-  std::vector<float> alpha(g.coverage.size());
-  for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = g.coverage[i] != 0 ? 1.0f : 0.0f;
+  // Depth and coverage are not stored in the G-buffer: Z is computed from the positions, and the
+  // coverage becomes a float alpha (what compositors expect in A).
+  const Image<float> depth = depth_plane(g);
+  std::vector<float> alpha(g.object_id.size());
+  for (std::size_t i = 0; i < alpha.size(); ++i) alpha[i] = g.covered(i) ? 1.0f : 0.0f;
 
   Imf::FrameBuffer frame;
   const std::size_t w = static_cast<std::size_t>(width);
@@ -287,9 +291,18 @@ void write_gbuffer_exr(const fs::path& path, const GBuffer& g, const GBufferWrit
     insert(y, Imf::FLOAT, base + 1, sizeof(Vec3));
     insert(z, Imf::FLOAT, base + 2, sizeof(Vec3));
   };
-  if (opt.positions) insert_vec3("P.X", "P.Y", "P.Z", g.position);
-  insert("Z", Imf::FLOAT, g.depth.data(), sizeof(float));
-  insert_vec3("N.X", "N.Y", "N.Z", g.normal);
+  Image<Vec3> world_position, world_normal;
+  if (opt.world_space) {
+    world_position = g.position, world_normal = g.normal;
+    for (std::size_t i = 0; i < g.object_id.size(); ++i)
+      if (g.covered(i))
+        world_position[i] = g.camera.camera_to_world_point(g.position[i]), world_normal[i] = g.camera.camera_to_world_vector(g.normal[i]);
+  }
+  const Image<Vec3>& position = opt.world_space ? world_position : g.position;
+  const Image<Vec3>& normal = opt.world_space ? world_normal : g.normal;
+  if (opt.positions) insert_vec3("P.X", "P.Y", "P.Z", position);
+  insert("Z", Imf::FLOAT, depth.data(), sizeof(float));
+  insert_vec3("N.X", "N.Y", "N.Z", normal);
   if (opt.albedo) insert_vec3("albedo.R", "albedo.G", "albedo.B", g.albedo);
   if (opt.object_ids) insert("id", Imf::UINT, g.object_id.data(), sizeof(std::uint32_t));
   if (opt.primitive_ids && !g.primitive_id.empty()) insert("primid", Imf::UINT, g.primitive_id.data(), sizeof(std::uint32_t));

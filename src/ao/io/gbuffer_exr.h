@@ -20,6 +20,9 @@ struct GBufferWriteOptions {
   bool coverage = true;    ///< A.
   bool camera = true;      ///< worldToCamera and the ao:* camera attributes (fov included).
   bool direct = true;      ///< direct.R direct.G direct.B, when the G-buffer has a direct-light pass.
+  /// P and N in world space (as Blender writes them; read them with GBufferReadOptions::world_space),
+  /// through the camera's placement; Z stays linear camera depth. Default false: camera space.
+  bool world_space = false;
 };
 
 /// Writes every G-buffer channel (P.X P.Y P.Z, Z, N.X N.Y N.Z, albedo.R albedo.G albedo.B as

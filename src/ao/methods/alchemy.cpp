@@ -132,7 +132,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
   // three from the 12-byte positions, which keeps a tile's sample footprint in L2 (the gathers' cache
   // misses were most of the time; docs/methods/alchemy.md). C is reconstructed the same way, so C and
   // its samples agree exactly on a plane.
-  const float* depth_buffer = g.depth.data();
+  const Image<float> depth_image = depth_plane(g);  // also the filter's
+  const float* depth_buffer = depth_image.data();
   const float t = g.camera.tan_half_fov();
   // camera_direction(px, py) = (ax * px + bx, ay * py + by, -1) for continuous pixel coordinates.
   const float ax = 2.0f * t * g.camera.aspect() / static_cast<float>(w), bx = -t * g.camera.aspect();
@@ -153,8 +154,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
           for (int y = range.rows().begin(); y < range.rows().end(); ++y) {
             const std::size_t base = static_cast<std::size_t>(y) * w + x0;
             const float* nn = &g.normal[base].x;
-            const float* depth = &g.depth[base];
-            const std::uint8_t* cov = &g.coverage[base];
+            const float* depth = &depth_image[base];
+            const std::uint32_t* cov = &g.object_id[base];
             // Per-pixel set-up in plain loops the compiler vectorises (component loads of the AoS
             // Vec3s, integer hashing, a table gather).
             for (int j = 0; j < n; ++j) {
@@ -229,7 +230,7 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
   if (params.filter) {
     const auto t1 = std::chrono::steady_clock::now();
     out.unfiltered = out.visibility;
-    bilateral_filter(g, out.visibility, params.bilateral);
+    bilateral_filter(g, depth_image, out.visibility, params.bilateral);
     out.filter_ms = ms_since(t1);
   }
   return out;

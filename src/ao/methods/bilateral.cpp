@@ -39,11 +39,12 @@ struct Centres {
   alignas(64) std::array<float, kTileWidth> a, b, c, cov;
 };
 
-void load_centres(const GBuffer& g, const Rays& rays, int y, int x0, int x1, float plane_sigma, bool vertical, Centres& ce) {
+void load_centres(const GBuffer& g, const float* depth_plane, const Rays& rays, int y, int x0, int x1, float plane_sigma, bool vertical,
+                  Centres& ce) {
   const std::size_t base = static_cast<std::size_t>(y) * g.width() + x0;
   const float* n = &g.normal[base].x;
-  const float* depth = &g.depth[base];
-  const std::uint8_t* cov = &g.coverage[base];
+  const float* depth = &depth_plane[base];
+  const std::uint32_t* cov = &g.object_id[base];
   const float ry = rays.y(static_cast<float>(y) + 0.5f);
   const int count = x1 - x0;
   for (int k = 0; k < count; ++k) {
@@ -146,13 +147,21 @@ void BilateralParams::validate() const {
 void to_json(nlohmann::json& j, const BilateralParams& p) { j = bilateral_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, BilateralParams& p) { bilateral_param_table().from_json(j, p); }
 
-void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralParams& params) {
+namespace {
+
+// Validates the call; false when there is nothing to filter.
+bool filter_wanted(const GBuffer& g, const Image<float>& values, const BilateralParams& params) {
   params.validate();
   const int w = g.width(), h = g.height();
   if (values.width() != w || values.height() != h)
     throw InputError("bilateral: the image is " + std::to_string(values.width()) + "x" + std::to_string(values.height()) +
                      " but the G-buffer is " + std::to_string(w) + "x" + std::to_string(h));
-  if (params.taps == 1 || values.empty()) return;
+  return params.taps != 1 && !values.empty();
+}
+
+// The filter, with `depth` the G-buffer's depth_plane().
+void filter(const GBuffer& g, const float* depth, Image<float>& values, const BilateralParams& params) {
+  const int w = g.width(), h = g.height();
   const int half = params.taps / 2;
   std::array<float, kMaxTaps> spatial{};
   const float ss = params.effective_spatial_sigma();
@@ -160,7 +169,6 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
 
   const float t = g.camera.tan_half_fov(), aspect = g.camera.aspect();
   const Rays rays{2.0f * t * aspect / static_cast<float>(w), -t * aspect, -2.0f * t / static_cast<float>(h), t};
-  const float* depth = g.depth.data();
 
   Image<float> tmp(w, h);
   // Horizontal pass: each row segment's depths and values are copied with `half` pixels of margin
@@ -173,7 +181,7 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
         alignas(64) std::array<float, kTileWidth + 2 * kMaxTaps> rx, rd, rv;
         for (int k = 0; k < n + 2 * half; ++k) rx[k] = rays.x(static_cast<float>(x0 - half + k) + 0.5f);
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-          load_centres(g, rays, y, x0, x1, params.plane_sigma, false, c);
+          load_centres(g, depth, rays, y, x0, x1, params.plane_sigma, false, c);
           const std::size_t row = static_cast<std::size_t>(y) * w;
           // Inside the image a plain copy (the per-element bounds test kept this loop scalar), margins apart.
           const int lo = std::max(0, half - x0), hi = std::min(n + 2 * half, w - x0 + half);
@@ -194,7 +202,7 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
         Centres c;
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
-          load_centres(g, rays, y, x0, x1, params.plane_sigma, true, c);
+          load_centres(g, depth, rays, y, x0, x1, params.plane_sigma, true, c);
           std::array<const float*, kMaxTaps> tt, td, tv;
           std::array<float, kMaxTaps> ry, sp;
           int taps = 0;
@@ -212,6 +220,20 @@ void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralPar
         }
       },
       tbb::simple_partitioner());
+}
+
+}  // namespace
+
+void bilateral_filter(const GBuffer& g, Image<float>& values, const BilateralParams& params) {
+  if (!filter_wanted(g, values, params)) return;
+  const Image<float> depth = depth_plane(g);
+  filter(g, depth.data(), values, params);
+}
+
+void bilateral_filter(const GBuffer& g, const Image<float>& depth, Image<float>& values, const BilateralParams& params) {
+  if (!filter_wanted(g, values, params)) return;
+  AO_ASSERT(depth.width() == g.width() && depth.height() == g.height());
+  filter(g, depth.data(), values, params);
 }
 
 }  // namespace ao

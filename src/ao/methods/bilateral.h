@@ -60,5 +60,8 @@ std::vector<Param<P>> bilateral_params(const std::string& prefix, Ref ref) {
 /// with a horizontal then a vertical pass. Tiles run in parallel; the result does not depend on the
 /// thread count.
 void bilateral_filter(const GBuffer& gbuffer, Image<float>& values, const BilateralParams& params);
+/// The same with the G-buffer's depth_plane() already at hand (`depth`, same size), for a caller
+/// that built it for its own pass.
+void bilateral_filter(const GBuffer& gbuffer, const Image<float>& depth, Image<float>& values, const BilateralParams& params);
 
 }  // namespace ao

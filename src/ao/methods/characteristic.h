@@ -30,6 +30,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <type_traits>
 
 #include "ao/core/camera.h"
 #include "ao/core/gbuffer.h"
@@ -73,9 +75,11 @@ struct ScreenProjection {
 /// (nearest pixel, clamped to the image); background pixels hold +infinity, so they are free.
 struct DepthBufferCharacteristic {
   ScreenProjection projection;
-  const float* depth = nullptr;  ///< The G-buffer's depth, width * height values; must outlive this.
+  std::shared_ptr<const Image<float>> plane;  ///< The G-buffer's depth_plane(), built once and shared by copies.
+  const float* depth = nullptr;               ///< The depth read, width * height values: plane's.
 
-  explicit DepthBufferCharacteristic(const GBuffer& g) : projection(ScreenProjection::from_camera(g.camera)), depth(g.depth.data()) {}
+  explicit DepthBufferCharacteristic(const GBuffer& g)
+      : projection(ScreenProjection::from_camera(g.camera)), plane(std::make_shared<const Image<float>>(depth_plane(g))), depth(plane->data()) {}
 
   float distance(float x, float y, float z) const {
     int i;
@@ -214,6 +218,14 @@ using DepthTimesHeightField = ProductCharacteristic<DepthBufferCharacteristic, H
 /// VAO fig. 12 with the depth buffer's silhouette shadows eliminated and the height field's kept
 /// (what `characteristic=depth*height-field` of the registry runs).
 using EliminatedDepthTimesHeightField = ProductCharacteristic<SilhouetteEliminated<DepthBufferCharacteristic>, HeightFieldCharacteristic>;
+
+/// The G-buffer depth plane a characteristic function carries (DepthBufferCharacteristic's), else
+/// null: the filter after a pass reuses it instead of building another.
+template <class C>
+const Image<float>* carried_depth_plane(const C& ch) {
+  if constexpr (std::is_same_v<C, DepthBufferCharacteristic>) return ch.plane.get();
+  else return nullptr;
+}
 
 /// The scene's implicit surface (world space) as a characteristic function in the camera space of
 /// `camera`. InputError when it has no primitive or more than ImplicitCharacteristic::kMaxPrimitives.

@@ -725,9 +725,12 @@ bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const Voxe
     return false;
   if (space == GridSpace::World) return true;
   const Camera& c = gb.camera;
-  return c.eye == camera_.eye && c.target == camera_.target && c.up == camera_.up && c.vertical_fov_deg == camera_.vertical_fov_deg &&
-         c.width == camera_.width && c.height == camera_.height && std::equal(gb.depth.data(), gb.depth.data() + gb.depth.size(), depth_.begin(), depth_.end()) &&
-         std::equal(gb.coverage.data(), gb.coverage.data() + gb.coverage.size(), coverage_.begin(), coverage_.end());
+  if (!(c.eye == camera_.eye && c.target == camera_.target && c.up == camera_.up && c.vertical_fov_deg == camera_.vertical_fov_deg &&
+        c.width == camera_.width && c.height == camera_.height && gb.object_id.size() == depth_.size() && depth_.size() == coverage_.size()))
+    return false;
+  for (std::size_t i = 0; i < depth_.size(); ++i)
+    if (gb.depth(i) != depth_[i] || (gb.covered(i) ? 1 : 0) != coverage_[i]) return false;
+  return true;
 }
 
 ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams& params, std::uint32_t seed, const ProgressFn& progress) {
@@ -742,8 +745,9 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
     options_ = options;
     if (p.grid == GridSpace::Eye) {
       camera_ = gb.camera;
-      depth_.assign(gb.depth.data(), gb.depth.data() + gb.depth.size());
-      coverage_.assign(gb.coverage.data(), gb.coverage.data() + gb.coverage.size());
+      depth_.resize(gb.object_id.size());
+      coverage_.resize(gb.object_id.size());
+      for (std::size_t i = 0; i < depth_.size(); ++i) depth_[i] = gb.depth(i), coverage_[i] = gb.covered(i) ? 1 : 0;
     }
     valid_ = true;
     ++builds_;

@@ -58,13 +58,13 @@ void load_pixel_row_simd(PixelRow& row, std::vector<int>& index, const GBuffer& 
   int* idx = index.data();
   const Vec3* pos = &g.position(first, y);
   const Vec3* nrm = &g.normal(first, y);
-  const std::uint8_t* cov = &g.coverage(first, y);
+  const std::uint32_t* id = &g.object_id(first, y);
   // Compaction: the covered pixels' offsets (scalar, branch-free), then their data gathered
   // across entries (vectorised). The row's rotations repeat every 4 pixels.
   int m = 0;
   for (int j = 0; j < last - first; ++j) {
     idx[m] = j;
-    m += cov[j] != 0 ? 1 : 0;
+    m += id[j] != 0 ? 1 : 0;
   }
   const Rotation* rot = rotations.data();
 #pragma GCC ivdep
@@ -184,7 +184,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
     }
   });
   if (params.interleave.interleave && params.interleave.filter)
-    v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, falloff.radius));
+    v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, falloff.radius), carried_depth_plane(ch));
   return v;
 }
 

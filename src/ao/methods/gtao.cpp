@@ -139,7 +139,8 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   const float r2 = radius * radius;
   // Continuous pixel coordinates stay below these (just inside the last pixel) along a slice.
   const float width_in = static_cast<float>(w) - 1e-3f, height_in = static_cast<float>(h) - 1e-3f;
-  const float* depth = g.depth.data();
+  const Image<float> depth_image = depth_plane(g);  // also the filter's
+  const float* depth = depth_image.data();
 
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& tile) {
@@ -149,11 +150,11 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
       int n = 0;
       for (int x = tile.x0; x < tile.x1; ++x) {
         row.index[static_cast<std::size_t>(n)] = x - tile.x0;
-        n += g.coverage(x, y) != 0 ? 1 : 0;
+        n += g.covered(x, y) ? 1 : 0;
       }
       for (int k = 0; k < n; ++k) {
         const int x = tile.x0 + row.index[static_cast<std::size_t>(k)];
-        const float d = g.depth(x, y);
+        const float d = depth[static_cast<std::size_t>(y) * w + x];
         const float fx = static_cast<float>(x) + 0.5f, fy = static_cast<float>(y) + 0.5f;
         row.fx[k] = fx, row.fy[k] = fy;
         row.px[k] = d * (ax * fx + bx), row.py[k] = d * (ay * fy + by), row.pz[k] = -d;
@@ -293,13 +294,13 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
       }
     }
   });
-  if (params.interleave.interleave && params.interleave.filter) v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius));
+  if (params.interleave.interleave && params.interleave.filter) v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius), &depth_image);
   GtaoImage out;
   if (params.multi_bounce) {
     out.color = Image<Vec3>(w, h, Vec3{1, 1, 1});
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
-        if (!g.coverage(x, y)) continue;
+        if (!g.covered(x, y)) continue;
         const Vec3 a = g.albedo(x, y);
         const float vis = v(x, y);
         out.color(x, y) = {gtao_multi_bounce(vis, a.x), gtao_multi_bounce(vis, a.y), gtao_multi_bounce(vis, a.z)};

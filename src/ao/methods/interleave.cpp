@@ -99,10 +99,13 @@ inline std::array<T, S> spread(T m) {
 }
 
 template <int N, int S>
-void box_filter_lanes(const std::array<const float*, N>& src, const std::array<float*, N>& dst, const GBuffer& g, float limit) {
+void box_filter_lanes(const std::array<const float*, N>& src, const std::array<float*, N>& dst, const GBuffer& g, float limit,
+                      const Image<float>* depth_image) {
   const int w = g.width(), h = g.height(), lanes = S * w;
-  const float* depth = g.depth.data();
-  const std::uint8_t* cov = g.coverage.data();
+  Image<float> own;
+  if (!depth_image) depth_plane(g, own);
+  const float* depth = depth_image ? depth_image->data() : own.data();
+  const std::uint32_t* cov = g.object_id.data();
   tbb::parallel_for(
       tbb::blocked_range<int>(0, h, 8),
       [&](const tbb::blocked_range<int>& r) {
@@ -191,37 +194,40 @@ void check_size(const GBuffer& g, int w, int h) {
 
 }  // namespace
 
-Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit) {
+Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit, const Image<float>* depth) {
   check_size(g, image.width(), image.height());
   Image<float> out(image.width(), image.height());
-  box_filter_lanes<1, 1>({image.data()}, {out.data()}, g, depth_limit);
+  box_filter_lanes<1, 1>({image.data()}, {out.data()}, g, depth_limit, depth);
   return out;
 }
 
-Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit) {
+Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit, const Image<float>* depth) {
   check_size(g, image.width(), image.height());
   // Interleaved RGB lanes directly (3 lanes per pixel, one depth test per lane), no planar copies.
   static_assert(sizeof(Vec3) == 3 * sizeof(float));
   Image<Vec3> out(image.width(), image.height());
-  box_filter_lanes<1, 3>({&image.data()->x}, {&out.data()->x}, g, depth_limit);
+  box_filter_lanes<1, 3>({&image.data()->x}, {&out.data()->x}, g, depth_limit, depth);
   return out;
 }
 
-void depth_aware_box_filter_planes(std::span<const float* const> src, std::span<float* const> dst, const GBuffer& g, float depth_limit) {
+void depth_aware_box_filter_planes(std::span<const float* const> src, std::span<float* const> dst, const GBuffer& g, float depth_limit,
+                                   const Image<float>* depth) {
   if (src.size() != dst.size() || src.size() > 4) throw InputError("depth_aware_box_filter_planes: 1 to 4 source planes, one destination each");
   auto in = [&](std::size_t c) { return src[c]; };
   auto out = [&](std::size_t c) { return dst[c]; };
   switch (src.size()) {  // up to 4 channels share one pass of depth tests
-    case 1: box_filter_lanes<1, 1>({in(0)}, {out(0)}, g, depth_limit); break;
-    case 2: box_filter_lanes<2, 1>({in(0), in(1)}, {out(0), out(1)}, g, depth_limit); break;
-    case 3: box_filter_lanes<3, 1>({in(0), in(1), in(2)}, {out(0), out(1), out(2)}, g, depth_limit); break;
-    case 4: box_filter_lanes<4, 1>({in(0), in(1), in(2), in(3)}, {out(0), out(1), out(2), out(3)}, g, depth_limit); break;
+    case 1: box_filter_lanes<1, 1>({in(0)}, {out(0)}, g, depth_limit, depth); break;
+    case 2: box_filter_lanes<2, 1>({in(0), in(1)}, {out(0), out(1)}, g, depth_limit, depth); break;
+    case 3: box_filter_lanes<3, 1>({in(0), in(1), in(2)}, {out(0), out(1), out(2)}, g, depth_limit, depth); break;
+    case 4: box_filter_lanes<4, 1>({in(0), in(1), in(2), in(3)}, {out(0), out(1), out(2), out(3)}, g, depth_limit, depth); break;
     default: break;
   }
 }
 
-void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit) {
+void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit, const Image<float>* depth) {
   for (const Image<float>* p : planes) check_size(g, p->width(), p->height());
+  Image<float> own;
+  if (!depth && planes.size() > 4) depth = &(own = depth_plane(g));  // built once for every group of 4
   for (std::size_t done = 0; done < planes.size();) {
     const std::size_t k = std::min<std::size_t>(4, planes.size() - done);
     std::array<Image<float>, 4> out;
@@ -231,7 +237,7 @@ void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const 
       out[c] = Image<float>(g.width(), g.height());
       src[c] = planes[done + c]->data(), dst[c] = out[c].data();
     }
-    depth_aware_box_filter_planes(std::span(src.data(), k), std::span(dst.data(), k), g, depth_limit);
+    depth_aware_box_filter_planes(std::span(src.data(), k), std::span(dst.data(), k), g, depth_limit, depth);
     for (std::size_t c = 0; c < k; ++c) *planes[done + c] = std::move(out[c]);
     done += k;
   }

@@ -42,15 +42,18 @@ float effective_depth_limit(const InterleaveOptions& o, float radius);
 /// 4x4 box filter of `image` over covered pixels, window offsets -2..+1 in x and y (so it holds each
 /// of the 16 pattern positions once), skipping uncovered neighbours and those whose depth differs
 /// from the centre pixel's by more than `depth_limit` (world units). Uncovered pixels keep their
-/// value. Works for float and Vec3 images.
-Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit);
-Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit);
+/// value. Works for float and Vec3 images. `depth`: the G-buffer's depth_plane() when the caller
+/// has built it for its own pass; null (the default): built here.
+Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit, const Image<float>* depth = nullptr);
+Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, float depth_limit, const Image<float>* depth = nullptr);
 /// The same filter over planar float channels of one image (e.g. W's R, G, B and O), in place: each
 /// tap's depth test is shared by up to 4 channels. Each plane gives what depth_aware_box_filter
 /// would give for it alone. Planes must have the G-buffer's size (InputError otherwise).
-void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit);
+void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const GBuffer& g, float depth_limit,
+                                   const Image<float>* depth = nullptr);
 /// The same over up to 4 planes from `src` into `dst` (each width * height floats of the
 /// G-buffer's size, dst[c] != src[c]): what a caller that keeps its own storage uses.
-void depth_aware_box_filter_planes(std::span<const float* const> src, std::span<float* const> dst, const GBuffer& g, float depth_limit);
+void depth_aware_box_filter_planes(std::span<const float* const> src, std::span<float* const> dst, const GBuffer& g, float depth_limit,
+                                   const Image<float>* depth = nullptr);
 
 }  // namespace ao

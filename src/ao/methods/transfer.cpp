@@ -441,8 +441,14 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
 #if defined(__AVX512F__)
   alignas(64) std::array<float, 96> palette_rgb{};
   // The radiance mode reads Ld~ at the occluder's pixel, which a palette index does not give.
-  const std::uint32_t* packed =
-      !radiance && make_palette(indirect, g.depth, buffers.depth_and_palette, palette_rgb) ? buffers.depth_and_palette.data() : nullptr;
+  // The palette is packed into the G-buffer's depth plane: the characteristic's own when it reads one.
+  const std::uint32_t* packed = nullptr;
+  if (!radiance) {
+    Image<float> own_depth;
+    const Image<float>* depth = carried_depth_plane(ch);
+    if (!depth) depth = &(own_depth = depth_plane(g));
+    if (make_palette(indirect, *depth, buffers.depth_and_palette, palette_rgb)) packed = buffers.depth_and_palette.data();
+  }
   const float* palette_rgb_ptr = palette_rgb.data();
 #else
   const std::uint32_t* packed = nullptr;
@@ -486,8 +492,8 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
 #if defined(__AVX512F__)
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {
         load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, true);
-        // The packed words hold the G-buffer's depth: used when that is the depth this reads.
-        const std::uint32_t* depth_packed = local_ch.depth == g.depth.data() ? packed : nullptr;
+        // The packed words hold the G-buffer's depth plane: used when that is the depth this reads.
+        const std::uint32_t* depth_packed = local_ch.depth == ch.plane->data() ? packed : nullptr;
         Vec3* row_rgb = final_rgb ? final_rgb + base : nullptr;
         if (radiance)
           transfer_row_depth_avx512<true>(local_projection, local_ch.depth, row, s, m, far_limit, albedo, nullptr, palette_rgb.data(), direct,
@@ -549,7 +555,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     fr = out.luminance.data(), fg = buffers.scratch[4].data(), fb = buffers.scratch[5].data();
     const std::array<const float*, 4> src{raw_r, raw_g, raw_b, raw_o};
     const std::array<float*, 4> dst{fr, fg, fb, out.obscurance.data()};
-    depth_aware_box_filter_planes(src, dst, g, effective_depth_limit(params.interleave, falloff.radius));
+    depth_aware_box_filter_planes(src, dst, g, effective_depth_limit(params.interleave, falloff.radius), carried_depth_plane(ch));
   }
   if (kernel_writes_final) return out;  // the kernel wrote the final images
   // Interleave W, and its luminance over the R plane in place (each pixel reads R before writing).

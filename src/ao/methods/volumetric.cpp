@@ -139,7 +139,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
     }
   });
   if (params.interleave.interleave && params.interleave.filter)
-    v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius));
+    v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius), carried_depth_plane(ch));
   return v;
 }
 

@@ -107,7 +107,7 @@ inline void summarise(RaytracedImage& out, const Image<int>& samples, const GBuf
   std::size_t covered = 0;
   double sum_se = 0;
   for (std::size_t i = 0; i < out.std_error.size(); ++i) {
-    if (!g.coverage[i]) continue;
+    if (!g.covered(i)) continue;
     ++covered;
     sum_se += out.std_error[i];
     out.max_std_error = std::max(out.max_std_error, static_cast<double>(out.std_error[i]));

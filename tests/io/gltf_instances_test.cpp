@@ -266,8 +266,11 @@ TEST(GltfInstances, RaytracedAoMatchesTheFlattenedScene) {
   const Falloff falloff{Membership::Step, 0.3f * inst.bounds().diagonal()};
   const RaytracedImage va = render_raytraced(*a.rays, a.g, falloff, params, 7);
   const RaytracedImage vb = render_raytraced(*b.rays, b.g, falloff, params, 7);
-  // Same seed, same pixels, same directions: a ray's fate can only differ where it grazes an edge,
-  // which changes that pixel by 1/64. Measured: identical images.
+  // Same seed, same pixels, same directions. The instanced G-buffer places its hit points through
+  // the instance transform, the flattened one from transformed vertices, so the points (and the
+  // rays' origins) differ by a few float roundings: a ray's fate can only change where it grazes an
+  // edge or a face, 1/64 of the pixel per ray. Near the cubes' corners on the floor a few rays of
+  // one pixel graze at once. Measured: 2 pixels differ, by 3/64.
   std::size_t differ = 0, covered = 0;
   double sum = 0;
   for (std::size_t i = 0; i < va.visibility.size(); ++i) {
@@ -276,7 +279,7 @@ TEST(GltfInstances, RaytracedAoMatchesTheFlattenedScene) {
     const double d = std::abs(static_cast<double>(va.visibility[i]) - vb.visibility[i]);
     sum += d;
     if (d > 1e-6) ++differ;
-    EXPECT_LE(d, 2.0 / 64 + 1e-6) << "pixel " << i;
+    EXPECT_LE(d, 4.0 / 64 + 1e-6) << "pixel " << i;
   }
   EXPECT_LE(differ, covered / 200);
   EXPECT_LT(sum / static_cast<double>(covered), 1e-4);

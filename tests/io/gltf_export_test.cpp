@@ -13,10 +13,13 @@
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
 #include "ao/scene/procedural.h"
+#include "support/bytes.h"
 #include "support/run.h"
 
 namespace ao {
 namespace {
+
+using test::base64;
 
 std::uint32_t u32(const std::string& s, std::size_t at) {
   std::uint32_t v = 0;
@@ -176,21 +179,6 @@ TEST(GltfExport, AssimpLoadsTheSameTrianglesAndUvs) {
 }
 
 // --- glTF input: its materials are kept -------------------------------------------------------
-
-std::string base64(const std::string& bytes) {
-  static const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    std::uint32_t n = static_cast<std::uint8_t>(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) n |= static_cast<std::uint8_t>(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) n |= static_cast<std::uint8_t>(bytes[i + 2]);
-    out += abc[(n >> 18) & 63];
-    out += abc[(n >> 12) & 63];
-    out += i + 1 < bytes.size() ? abc[(n >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? abc[n & 63] : '=';
-  }
-  return out;
-}
 
 // A unit quad (z = 0, facing +z) with TEXCOORD_0 over [0.1, 0.4]^2 and TEXCOORD_1 over [0.5, 0.9]^2
 // (glTF's v down), embedded base64 buffer, using `material` (JSON) and `images` (JSON array).

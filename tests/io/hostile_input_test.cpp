@@ -19,6 +19,7 @@
 #include "ao/io/gltf_check.h"
 #include "ao/io/mesh_io.h"
 #include "ao/reference/raytraced.h"
+#include "support/bytes.h"
 #include "support/load_error.h"
 #include "support/run.h"
 
@@ -28,25 +29,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using test::TempDir;
+using test::base64;
+using test::append;
 
 using test::load_error;
-
-std::string base64(const std::string& bytes) {
-  static const char* const kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
-    std::uint32_t v = 0;
-    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<std::uint8_t>(bytes[i + k]) : 0u);
-    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? kAlphabet[(v >> (18 - 6 * k)) & 63] : '=';
-  }
-  return out;
-}
-
-template <class T>
-void append(std::string& bytes, const std::vector<T>& values) {
-  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-}
 
 /// A one-triangle glTF 2.0 (positions (0,0,0) (1,0,0) (0,1,0), uint16 indices) with its buffer as
 /// a base64 data URI, as JSON the tests then damage. Accessor 0: POSITION, 1: indices.

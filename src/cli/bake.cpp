@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -326,6 +327,17 @@ bool is_gltf_round_trip(const fs::path& input, const BakeOptions& o) {
   return (!o.gltf.empty() || lower_extension(o.per_vertex) == ".glb") && is_gltf_file(input);
 }
 
+// Both bakers' parameters as the options set them (seed, distance, membership).
+std::pair<RaytracedBakeParams, HistogramParams> baker_params(const BakeOptions& o) {
+  RaytracedBakeParams rt = o.rt;
+  rt.seed = o.seed;
+  rt.max_distance = o.max_distance;
+  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
+  HistogramParams hist = o.hist;
+  hist.seed = o.seed;
+  return {rt, hist};
+}
+
 nlohmann::json bake_gltf_input(const fs::path& input, const BakeOptions& o, const MeshOutputs& outs, OutputSet& outputs, const GlobalOptions& global) {
   const std::pair<bool, const char*> unsupported[] = {{!o.high.empty(), "--high"},
                                                       {!o.groups.empty() || o.self_occlusion || o.match_by_name, "bake groups"},
@@ -339,12 +351,9 @@ nlohmann::json bake_gltf_input(const fs::path& input, const BakeOptions& o, cons
       throw InputError(input.string() + ": a glTF input baked to a .glb keeps its document, one map per glTF mesh; " + what +
                        " does not apply to it (bake without --gltf/--per-vertex .glb for the flattened scene)");
   const bool progress = !global.quiet && stderr_is_terminal();
-  RaytracedBakeParams rt = o.rt;
-  rt.seed = o.seed;
-  rt.max_distance = o.max_distance;
-  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
-  HistogramParams hist = o.hist;
-  hist.seed = o.seed;
+  const std::pair<RaytracedBakeParams, HistogramParams> params = baker_params(o);
+  const RaytracedBakeParams& rt = params.first;
+  const HistogramParams& hist = params.second;
   GltfRoundTrip job;
   job.input = input;
   job.gltf = outs.gltf;
@@ -391,12 +400,9 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
   for (const std::string& w : scene.warnings) std::cerr << "warning: " << input.string() << ": " << w << "\n";
   timings["load_ms"] = clock.lap_ms();
   nlohmann::json summary = {{"input", input.string()}, {"method", o.method}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
-  RaytracedBakeParams rt = o.rt;
-  rt.seed = o.seed;
-  rt.max_distance = o.max_distance;
-  if (o.max_distance) rt.membership = *parse_membership(o.membership);  // checked by run_bake
-  HistogramParams hist = o.hist;
-  hist.seed = o.seed;
+  const std::pair<RaytracedBakeParams, HistogramParams> params = baker_params(o);
+  const RaytracedBakeParams& rt = params.first;
+  const HistogramParams& hist = params.second;
   std::unique_ptr<RayScene> rays;
   auto ray_scene = [&]() -> RayScene& {
     if (!rays) {

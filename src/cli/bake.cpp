@@ -582,13 +582,13 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
         write_image(tmp.path(), r.visibility, {.png_bits = o.png_bits});
         png = read_bytes(tmp.path());
       }
-      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, nullptr, vertex_ao.empty() ? nullptr : &vertex_ao); });
+      outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, scene, png, vertex_ao.empty() ? nullptr : &vertex_ao); });
       summary["gltf_output"] = outs.gltf.string();
     }
   }
   if (!outs.per_vertex.empty()) {
     outputs.write(outs.per_vertex, [&] {
-      if (lower_extension(outs.per_vertex) == ".glb") write_ao_glb(outs.per_vertex, scene, "", nullptr, &vertex_ao);
+      if (lower_extension(outs.per_vertex) == ".glb") write_ao_glb(outs.per_vertex, scene, "", &vertex_ao);
       else write_vertex_ao_ply(outs.per_vertex, scene, vertex_ao);
     });
     summary["per_vertex_output"] = outs.per_vertex.string();

@@ -13,13 +13,10 @@
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
 #include "ao/scene/procedural.h"
-#include "support/bytes.h"
 #include "support/run.h"
 
 namespace ao {
 namespace {
-
-using test::base64;
 
 std::uint32_t u32(const std::string& s, std::size_t at) {
   std::uint32_t v = 0;
@@ -178,184 +175,23 @@ TEST(GltfExport, AssimpLoadsTheSameTrianglesAndUvs) {
   }
 }
 
-// --- glTF input: its materials are kept -------------------------------------------------------
-
-// A unit quad (z = 0, facing +z) with TEXCOORD_0 over [0.1, 0.4]^2 and TEXCOORD_1 over [0.5, 0.9]^2
-// (glTF's v down), embedded base64 buffer, using `material` (JSON) and `images` (JSON array).
-nlohmann::json quad_gltf(const nlohmann::json& material, const nlohmann::json& images = nlohmann::json::array()) {
-  nlohmann::json g = nlohmann::json::parse(R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],
-  "nodes":[{"mesh":0}],
-  "meshes":[{"name":"quad","primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1,"TEXCOORD_1":2},"indices":3,"material":0}]}],
-  "buffers":[{"byteLength":124,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAzczMPc3MzD3NzMw+zczMPc3MzD7NzMw+zczMPc3MzD4AAAA/AAAAP2ZmZj8AAAA/ZmZmP2ZmZj8AAAA/ZmZmPwAAAQACAAAAAgADAA=="}],
-  "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":32},
-                 {"buffer":0,"byteOffset":80,"byteLength":32},{"buffer":0,"byteOffset":112,"byteLength":12}],
-  "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
-               {"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"},
-               {"bufferView":2,"componentType":5126,"count":4,"type":"VEC2"},
-               {"bufferView":3,"componentType":5123,"count":6,"type":"SCALAR"}]})");
-  g["materials"] = {material};
-  if (!images.empty()) {
-    g["images"] = images;
-    g["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}, {"magFilter", 9728}}};
-    g["textures"] = nlohmann::json::array();
-    for (std::size_t i = 0; i < images.size(); ++i) g["textures"].push_back({{"source", i}, {"sampler", 0}});
-  }
-  return g;
+TEST(GltfExport, GltfFilesAreKnownByExtensionOrMagic) {
+  const test::TempDir dir;
+  test::write_text(dir / "a.GLTF", "{}");
+  EXPECT_TRUE(is_gltf_file(dir / "a.GLTF"));
+  test::write_text(dir / "renamed.bin", std::string("glTF\x02\0\0\0", 8));
+  EXPECT_TRUE(is_gltf_file(dir / "renamed.bin"));
+  test::write_text(dir / "mesh.obj", "v 0 0 0\n");
+  EXPECT_FALSE(is_gltf_file(dir / "mesh.obj"));
+  EXPECT_FALSE(is_gltf_file(dir / "missing.dat"));
 }
-
-// The floats of a VEC2 accessor of the output.
-std::vector<Vec2> read_vec2(const Glb& g, std::size_t accessor) {
-  const auto& a = g.json["accessors"][accessor];
-  EXPECT_EQ(a["type"], "VEC2");
-  const auto& v = g.json["bufferViews"][a["bufferView"].get<std::size_t>()];
-  std::vector<Vec2> out(a["count"].get<std::size_t>());
-  std::memcpy(out.data(), g.bin.data() + v.value("byteOffset", std::size_t{0}), out.size() * sizeof(Vec2));
-  return out;
-}
-
-// Bakes nothing: loads `gltf` like `ao bake` does, then exports it with `png` as the map.
-Glb export_gltf_input(const test::TempDir& dir, const nlohmann::json& gltf, const std::string& png, int uv_set, GltfSource* source_out = nullptr) {
-  test::write_text(dir / "in.gltf", gltf.dump());
-  const Scene scene = load_scene_file(dir / "in.gltf", {.uv_set = uv_set});
-  EXPECT_TRUE(is_gltf_file(dir / "in.gltf"));
-  const GltfSource source = load_gltf_materials(dir / "in.gltf", scene, uv_set);
-  if (source_out) *source_out = source;
-  write_ao_glb(dir / "out.glb", scene, png, &source);
-  return parse_glb(test::read_text(dir / "out.glb"));
-}
-
-TEST(GltfExport, GltfInputKeepsItsMaterialFactorsAndGetsTheOcclusionTexture) {
-  test::TempDir dir;
-  Image<float> img;
-  const std::string png = gradient_png(dir, img);
-  const nlohmann::json material = {{"name", "Painted metal"},
-                                   {"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.4, 0.6, 0.8}}, {"metallicFactor", 0.3}, {"roughnessFactor", 0.7}}},
-                                   {"emissiveFactor", {0.1, 0.2, 0.3}},
-                                   {"alphaMode", "MASK"},
-                                   {"alphaCutoff", 0.25},
-                                   {"doubleSided", true}};
-  GltfSource source;
-  const Glb g = export_gltf_input(dir, quad_gltf(material), png, 0, &source);
-  EXPECT_TRUE(source.warnings.empty()) << source.warnings.front();
-  ASSERT_EQ(g.json["materials"].size(), 1u);
-  const auto& m = g.json["materials"][0];
-  EXPECT_EQ(m["name"], "Painted metal");
-  const auto& pbr = m["pbrMetallicRoughness"];
-  const float base[4] = {0.2f, 0.4f, 0.6f, 0.8f};
-  ASSERT_EQ(pbr["baseColorFactor"].size(), 4u);
-  for (int k = 0; k < 4; ++k) EXPECT_FLOAT_EQ(pbr["baseColorFactor"][k].get<float>(), base[k]) << k;
-  EXPECT_FLOAT_EQ(pbr["metallicFactor"].get<float>(), 0.3f);
-  EXPECT_FLOAT_EQ(pbr["roughnessFactor"].get<float>(), 0.7f);
-  ASSERT_EQ(m["emissiveFactor"].size(), 3u);
-  EXPECT_FLOAT_EQ(m["emissiveFactor"][2].get<float>(), 0.3f);
-  EXPECT_EQ(m["alphaMode"], "MASK");
-  EXPECT_FLOAT_EQ(m["alphaCutoff"].get<float>(), 0.25f);
-  EXPECT_EQ(m["doubleSided"], true);
-  EXPECT_FALSE(m.contains("extensions"));  // not unlit, no emissive strength
-  // The map was added as the occlusion texture, on the baked set (TEXCOORD_0), and it is the PNG.
-  ASSERT_TRUE(m.contains("occlusionTexture"));
-  EXPECT_EQ(m["occlusionTexture"]["texCoord"], 0);
-  const std::size_t image = g.json["textures"][m["occlusionTexture"]["index"].get<std::size_t>()]["source"];
-  const auto& view = g.json["bufferViews"][g.json["images"][image]["bufferView"].get<std::size_t>()];
-  EXPECT_EQ(g.bin.substr(view["byteOffset"], view["byteLength"]), png);
-  // No textures of its own, and only the baked UV set is written.
-  EXPECT_FALSE(pbr.contains("baseColorTexture"));
-  const auto& attributes = g.json["meshes"][0]["primitives"][0]["attributes"];
-  EXPECT_TRUE(attributes.contains("TEXCOORD_0"));
-  EXPECT_FALSE(attributes.contains("TEXCOORD_1"));
-  // assimp reads the output back with the material's colour.
-  const Scene back = load_scene_file(dir / "out.glb");
-  ASSERT_EQ(back.meshes.size(), 1u);
-  EXPECT_NEAR(back.meshes[0].albedo.y, 0.4f, 1e-6f);
-}
-
-TEST(GltfExport, GltfInputBaseColorTextureIsCopiedWithItsUvSet) {
-  test::TempDir dir;
-  Image<float> img;
-  const std::string ao_png = gradient_png(dir, img);
-  // A distinct small PNG as the input's base-colour texture (embedded as a data URI).
-  Image<float> colour(2, 2, 0.25f);
-  write_image(dir / "colour.png", colour);
-  const std::string colour_png = test::read_text(dir / "colour.png");
-  ASSERT_NE(colour_png, ao_png);
-  const nlohmann::json images = {{{"uri", "data:image/png;base64," + base64(colour_png)}}};
-  const nlohmann::json material = {{"name", "textured"},
-                                   {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}, {"metallicFactor", 0.0}}}};
-  for (const int uv_set : {0, 1}) {
-    SCOPED_TRACE("uv_set " + std::to_string(uv_set));
-    GltfSource source;
-    const Glb g = export_gltf_input(dir, quad_gltf(material, images), ao_png, uv_set, &source);
-    EXPECT_TRUE(source.warnings.empty()) << source.warnings.front();
-    const auto& m = g.json["materials"][0];
-    EXPECT_EQ(m["name"], "textured");
-    EXPECT_FLOAT_EQ(m["pbrMetallicRoughness"]["metallicFactor"].get<float>(), 0.0f);
-    ASSERT_TRUE(m["pbrMetallicRoughness"].contains("baseColorTexture"));
-    ASSERT_TRUE(m.contains("occlusionTexture"));
-    EXPECT_EQ(m["occlusionTexture"]["texCoord"], 0);
-    const auto& bct = m["pbrMetallicRoughness"]["baseColorTexture"];
-    // The base-colour texture's image is the input's PNG, its sampler the input's.
-    const auto& texture = g.json["textures"][bct["index"].get<std::size_t>()];
-    const auto& image = g.json["images"][texture["source"].get<std::size_t>()];
-    EXPECT_EQ(image["mimeType"], "image/png");
-    const auto& view = g.json["bufferViews"][image["bufferView"].get<std::size_t>()];
-    EXPECT_EQ(g.bin.substr(view["byteOffset"], view["byteLength"]), colour_png);
-    const auto& sampler = g.json["samplers"][texture["sampler"].get<std::size_t>()];
-    EXPECT_EQ(sampler["wrapS"], 33071);
-    EXPECT_EQ(sampler["wrapT"], 33648);
-    EXPECT_EQ(sampler["magFilter"], 9728);
-    // TEXCOORD_0 is always the baked set; the texture's set (the input's TEXCOORD_1) is either the
-    // baked one (uv_set 1) or written after it.
-    const auto& attributes = g.json["meshes"][0]["primitives"][0]["attributes"];
-    const std::vector<Vec2> t0 = read_vec2(g, attributes["TEXCOORD_0"]);
-    ASSERT_EQ(t0.size(), 4u);
-    const float baked_lo = uv_set == 0 ? 0.1f : 0.5f;
-    for (const Vec2& t : t0) {
-      EXPECT_GE(t.x, baked_lo - 1e-6f);
-      EXPECT_LE(t.x, baked_lo + 0.4f + 1e-6f);
-      EXPECT_GE(t.y, baked_lo - 1e-6f);  // back in glTF's v-down convention
-      EXPECT_LE(t.y, baked_lo + 0.4f + 1e-6f);
-    }
-    if (uv_set == 1) {
-      EXPECT_EQ(bct["texCoord"], 0);
-      EXPECT_FALSE(attributes.contains("TEXCOORD_1"));
-    } else {
-      EXPECT_EQ(bct["texCoord"], 1);
-      ASSERT_TRUE(attributes.contains("TEXCOORD_1"));
-      for (const Vec2& t : read_vec2(g, attributes["TEXCOORD_1"])) {
-        EXPECT_GE(t.x, 0.5f - 1e-6f);
-        EXPECT_LE(t.x, 0.9f + 1e-6f);
-        EXPECT_GE(t.y, 0.5f - 1e-6f);
-        EXPECT_LE(t.y, 0.9f + 1e-6f);
-      }
-    }
-  }
-}
-
-TEST(GltfExport, GltfPrimitiveWithoutMaterialGetsAFreshOne) {
-  test::TempDir dir;
-  Image<float> img;
-  const std::string png = gradient_png(dir, img);
-  nlohmann::json gltf = quad_gltf({{"name", "unused"}});
-  gltf["meshes"][0]["primitives"][0].erase("material");
-  const Glb g = export_gltf_input(dir, gltf, png, 0);
-  const auto& m = g.json["materials"][0];
-  EXPECT_EQ(m["name"], "quad");
-  EXPECT_FLOAT_EQ(m["pbrMetallicRoughness"]["metallicFactor"].get<float>(), 0.0f);
-  EXPECT_TRUE(m.contains("occlusionTexture"));
-}
-
-}  // namespace
-}  // namespace ao
-
-namespace ao {
-namespace {
 
 TEST(GltfExport, PerVertexAoIsColor0OfEveryPrimitive) {
   const test::TempDir dir;
   const Scene s = textured_and_untextured();
   std::vector<float> ao(s.vertex_count());
   for (std::size_t i = 0; i < ao.size(); ++i) ao[i] = static_cast<float>(i) / static_cast<float>(ao.size());
-  write_ao_glb(dir / "out.glb", s, "", nullptr, &ao);
+  write_ao_glb(dir / "out.glb", s, "", &ao);
   const Glb g = parse_glb(test::read_text(dir / "out.glb"));
   EXPECT_FALSE(g.json.contains("textures"));  // no map given: no occlusion texture
   std::size_t first = 0;
@@ -376,7 +212,7 @@ TEST(GltfExport, PerVertexAoIsColor0OfEveryPrimitive) {
     first += c.size();
   }
   std::vector<float> wrong(3, 1.0f);
-  EXPECT_THROW(write_ao_glb(dir / "bad.glb", s, "", nullptr, &wrong), InputError);
+  EXPECT_THROW(write_ao_glb(dir / "bad.glb", s, "", &wrong), InputError);
 }
 
 }  // namespace

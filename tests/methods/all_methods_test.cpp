@@ -1,7 +1,8 @@
 // Every method of the registry through the same checks, so that a new row is tested without a
 // line here: the open plane is fully visible, V stays in [0, 1], results are identical at 1 and 2
-// threads, parameters round trip through JSON (floats at the precision they were given), and bad
-// parameter values are refused with one line that names the parameter and its valid range.
+// threads, the mean V falls as R grows, parameters round trip through JSON (floats at the
+// precision they were given), and bad parameter values are refused with one line that names the
+// parameter and its valid range.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,6 +82,22 @@ TEST_P(AllMethods, VisibilityInUnitIntervalAndIdenticalAtOneAndTwoThreads) {
   for (std::size_t i = 0; i < a.color.size(); ++i) ASSERT_TRUE(a.color[i] == b.color[i]) << "colour, pixel " << i;
   for (const auto& [name, image] : a.extras)
     for (std::size_t i = 0; i < image.size(); ++i) ASSERT_EQ(image[i], b.extras.at(name)[i]) << name << ", pixel " << i;
+}
+
+// Every method estimates the obscurance integral, which with step membership can only fall as R
+// grows (more of each ray's path counts as occluding): the mean over the image must fall strictly
+// from R = 0.25 to 0.5 to 1 on a unit sphere resting on a plane (contact shadow grows with R).
+TEST_P(AllMethods, MeanVisibilityFallsAsRadiusGrows) {
+  const Fixture f = fixture("sphere-on-plane");
+  double previous = 2.0;
+  for (float R : {0.25f, 0.5f, 1.0f}) {
+    const MethodOutput out = run(method(), f, {Membership::Step, R}, 5);
+    double sum = 0;
+    for (std::size_t i = 0; i < out.visibility.size(); ++i) sum += out.visibility[i];
+    const double mean = sum / static_cast<double>(out.visibility.size());
+    EXPECT_LT(mean, previous) << "R = " << R;
+    previous = mean;
+  }
 }
 
 TEST_P(AllMethods, DefaultsAreTheTablesDefaults) {

@@ -87,22 +87,6 @@ TEST(Containment, SilhouetteEliminationRemovesFalseShadowOfDistantObject) {
   EXPECT_EQ(min_on, 1.0) << "and is gone with it";
 }
 
-TEST(Containment, VisibilityInUnitRangeAndMonotoneInRadius) {
-  const auto s = test::builtin_gbuffer("sphere-on-plane");
-  double previous = 1e30;
-  for (float R : {0.1f, 0.3f, 1.0f}) {
-    const Image<float> v = containment_ao(s.g, {Membership::Step, R}, {}, 5);
-    double sum = 0;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      ASSERT_GE(v[i], 0.0f);
-      ASSERT_LE(v[i], 1.0f);
-      sum += v[i];
-    }
-    EXPECT_LT(sum, previous) << "R = " << R;
-    previous = sum;
-  }
-}
-
 // AT sec. 4: with m tests along each ray a ray is free only if all are, and the end point (eq. 5's
 // one test) is among them, so every pixel is at most as open as with m = 1.
 TEST(Containment, MoreRayStepsNeverOpenAPixel) {

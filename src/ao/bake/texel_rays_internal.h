@@ -82,6 +82,27 @@ inline PatchSample sample_patch(const std::vector<PatchPiece>& patch, Vec2 u) {
   return {&patch[pi], {1.0f - r, r * (1.0f - u.y), r * u.y}};
 }
 
+/// Up to 16 rays of one texel, laid out as an RTCRay16's origins and directions (structure of
+/// arrays, one lane per ray).
+struct TexelRayBatch {
+  static constexpr int kWidth = 16;
+  alignas(64) float ox[kWidth], oy[kWidth], oz[kWidth];
+  alignas(64) float dx[kWidth], dy[kWidth], dz[kWidth];
+  alignas(64) int valid[kWidth];  ///< -1: a ray to trace; 0: no ray (a direction below the face, mu = 0, or a lane past the count).
+};
+
+/// The rays of samples first .. first + count - 1 (count in [1, 16]) of a texel with non-empty
+/// patch `patch` and key `key`: sample i is point i of the 4-D Owen-scrambled Sobol set keyed by
+/// `key` (sobol_owen_4d; dimensions 0-1 make a cosine-weighted direction about the unit normal at
+/// the point, 2-3 pick the point with sample_patch), as bake_texels samples. The normal is the
+/// interpolated one, or the face normal when `geometric`; the origin is the point pushed off along
+/// the face normal by `fixed_offset`, or by the piece's scale-free offset when `fixed_offset` is 0;
+/// a direction with d . ng <= 0 is no ray. The same rays as sample_patch, Frame and
+/// cosine_hemisphere make, computed lane-parallel: the arithmetic runs in SIMD registers across the
+/// 16 lanes and the concentric map's sine and cosine are polynomials (error under 1e-7).
+void make_texel_rays(const std::vector<PatchPiece>& patch, std::uint32_t key, std::uint32_t first, int count, bool geometric, float fixed_offset,
+                     TexelRayBatch& out);
+
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {
   const RayScene& rs;
@@ -149,6 +170,10 @@ struct Tracer {
   }
 };
 
+/// Texels per tile side of the inside-out bakers' tile loops: neighbouring texels lie close on the
+/// surface, so a tile's rays share BVH nodes in cache.
+inline constexpr int kTexelTile = 16;
+
 /// One sample of a texel: its point on the patch and the two uniforms its direction is made from.
 struct TexelSample {
   PatchSample point;
@@ -179,12 +204,11 @@ struct TexelSums {
 template <class MakeRay, class Finish>
 std::size_t bake_texels(const Scene& surface, const TexelCoverage& cov, const Tracer& tracer, int samples, std::uint32_t seed,
                         const ProgressFn& progress, MakeRay&& make_ray, Finish&& finish) {
-  constexpr int kTile = 16;  // texels per tile side: neighbouring texels lie close on the surface, so a tile's rays share BVH nodes in cache
   const TriangleNormals fn = face_normals(surface);
   std::atomic<std::size_t> finished{0};
   ProgressCounter counter(progress, cov.texel_count());
   dispatch_packet_width(tracer.rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(cov.width, cov.height, kTile, [&](const Tile& t) {
+    parallel_for_tiles(cov.width, cov.height, kTexelTile, [&](const Tile& t) {
       flush_denormals_to_zero();
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);

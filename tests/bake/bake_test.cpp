@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include <tbb/global_control.h>
 
@@ -252,7 +253,9 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
         for (std::uint32_t first = 0; first < 48; first += 16) {
           const int count = first == 32 ? 11 : 16;
           detail::TexelRayBatch b;
-          detail::make_texel_rays(patch, key, first, count, geometric, fixed, b);
+          float lanes[4][16];
+          sobol_owen_4d_batch(first, count, key, lanes);
+          detail::make_texel_rays(patch, lanes, count, geometric, fixed, b);
           for (int k = 0; k < 16; ++k) {
             if (k >= count) {
               EXPECT_EQ(b.valid[k], 0);
@@ -274,6 +277,34 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
         }
       }
   EXPECT_GT(multi, 0);  // the multi-piece path was exercised
+}
+
+TEST(Bake, TexelPointsAreTheSobolSetInDirectionCells) {
+  // The order holds the same points as index order (so the texel's mean is unchanged), and at a
+  // power-of-two count every packet of 16 lies in one cell of the direction grid (the net
+  // property); at other counts the order is still a permutation.
+  detail::TexelPoints pts;
+  for (int samples : {64, 256, 128, 37}) {
+    pts.generate(12345u, samples);
+    std::vector<std::array<float, 4>> want, got;
+    for (int i = 0; i < samples; ++i) {
+      want.push_back(sobol_owen_4d(static_cast<std::uint32_t>(i), 12345u));
+      got.push_back({pts.u[0][static_cast<std::size_t>(i)], pts.u[1][static_cast<std::size_t>(i)], pts.u[2][static_cast<std::size_t>(i)],
+                     pts.u[3][static_cast<std::size_t>(i)]});
+    }
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want) << samples;
+    if ((samples & (samples - 1)) != 0) continue;
+    const int cells = samples / 16;
+    const int cols = samples == 128 ? 4 : static_cast<int>(std::lround(std::sqrt(cells))), rows = cells / cols;
+    for (int first = 0; first < samples; first += 16) {
+      std::set<int> cell;
+      for (int k = first; k < first + 16; ++k)
+        cell.insert(static_cast<int>(pts.u[0][static_cast<std::size_t>(k)] * cols) * rows + static_cast<int>(pts.u[1][static_cast<std::size_t>(k)] * rows));
+      EXPECT_EQ(cell.size(), 1u) << samples << " samples, packet at " << first;
+    }
+  }
 }
 
 TEST(Bake, RaytracedDistanceLimitMatchesWallFormula) {

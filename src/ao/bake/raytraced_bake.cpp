@@ -127,6 +127,8 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
       std::vector<PatchPiece> patch;
+      detail::TexelPoints points;
+      alignas(64) float u[4][16];
       alignas(64) detail::TexelRayBatch batch;
       alignas(64) RTCRay16 packet;  // the 16-wide occlusion packet; lanes' fixed fields set once
       for (int k = 0; k < 16; ++k) detail::set_ray(packet, k, {0, 0, 0}, {0, 0, 1}, reach);
@@ -138,12 +140,13 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
           if (!cov.mask[texel]) continue;
           detail::build_patch(scene, cov, surface_normals, texel, patch);
           if (patch.empty()) continue;
-          const std::uint32_t key = pixel_seed(params.seed, x, y);
+          points.generate(pixel_seed(params.seed, x, y), params.samples);
           double sum = 0;
           Vec3 bent{0, 0, 0};
           for (int first = 0; first < params.samples; first += 16) {
             const int count = std::min(16, params.samples - first);
-            detail::make_texel_rays(patch, key, static_cast<std::uint32_t>(first), count, geometric, fixed_offset, batch);
+            points.lanes(first, count, u);
+            detail::make_texel_rays(patch, u, count, geometric, fixed_offset, batch);
             if constexpr (N == 16) {
               if (occlusion_only && !params.bent_normals) {
                 // The default bake: the batch is the packet (tfar is reset, as Embree sets it to

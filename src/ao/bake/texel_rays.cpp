@@ -80,11 +80,46 @@ inline void sincos_quarter(float t, float& s, float& c) {
 
 }  // namespace
 
-void make_texel_rays(const std::vector<PatchPiece>& patch, std::uint32_t key, std::uint32_t first, int count, bool geometric, float fixed_offset,
-                     TexelRayBatch& out) {
+void TexelPoints::generate(std::uint32_t key, int samples) {
+  const auto n = static_cast<std::size_t>(samples);
+  for (int d = 0; d < 4; ++d) {
+    u[d].resize(n);
+    scratch[d].resize(n);
+  }
+  alignas(64) float batch[4][16];
+  for (int first = 0; first < samples; first += 16) {
+    const int count = std::min(16, samples - first);
+    sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, batch);
+    for (int d = 0; d < 4; ++d) std::copy_n(batch[d], count, scratch[d].begin() + first);
+  }
+  // Grid of 2^c cells, 2^c the largest power of two <= samples / 16, as square as it goes.
+  int c = 0;
+  while ((32 << c) <= samples) ++c;
+  const int cols = 1 << ((c + 1) / 2), rows = 1 << (c / 2);
+  const auto cell = [&](std::size_t i) {
+    const int a = std::min(static_cast<int>(scratch[0][i] * static_cast<float>(cols)), cols - 1);
+    const int b = std::min(static_cast<int>(scratch[1][i] * static_cast<float>(rows)), rows - 1);
+    return static_cast<std::size_t>(a * rows + b);
+  };
+  // Counting sort by cell, stable.
+  cell_count.assign(static_cast<std::size_t>(cols * rows) + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++cell_count[cell(i) + 1];
+  for (std::size_t k = 1; k < cell_count.size(); ++k) cell_count[k] += cell_count[k - 1];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t to = cell_count[cell(i)]++;
+    for (int d = 0; d < 4; ++d) u[d][to] = scratch[d][i];
+  }
+}
+
+void TexelPoints::lanes(int first, int count, float (&out)[4][16]) const {
+  for (int d = 0; d < 4; ++d) {
+    std::copy_n(u[d].begin() + first, count, out[d]);
+    std::fill(out[d] + count, out[d] + 16, 0.5f);  // unused lanes: any point
+  }
+}
+
+void make_texel_rays(const std::vector<PatchPiece>& patch, const float (&u)[4][16], int count, bool geometric, float fixed_offset, TexelRayBatch& out) {
   constexpr int W = TexelRayBatch::kWidth;
-  alignas(64) float u[4][W];
-  sobol_owen_4d_batch(first, count, key, u);
   // Per lane, the piece and its data (corner positions p, corner normals n, face normal ng, ray
   // offset), so that the arithmetic below reads only lane arrays and vectorises. Each field is
   // written for the lanes whose piece is j, one piece at a time (selects across the lanes, no

@@ -91,17 +91,32 @@ struct TexelRayBatch {
   alignas(64) int valid[kWidth];  ///< -1: a ray to trace; 0: no ray (a direction below the face, mu = 0, or a lane past the count).
 };
 
-/// The rays of samples first .. first + count - 1 (count in [1, 16]) of a texel with non-empty
-/// patch `patch` and key `key`: sample i is point i of the 4-D Owen-scrambled Sobol set keyed by
-/// `key` (sobol_owen_4d; dimensions 0-1 make a cosine-weighted direction about the unit normal at
-/// the point, 2-3 pick the point with sample_patch), as bake_texels samples. The normal is the
+/// A texel's sample points, points 0 .. samples - 1 of the 4-D Owen-scrambled Sobol set keyed by
+/// the texel's key (sobol_owen_4d; dimensions 0-1 make the direction, 2-3 the point on the
+/// patch), in direction order: sorted (stably) into the cells of a grid over dimensions 0-1 with
+/// about 16 points per cell (2 x 2 cells at 64 samples). The concentric map takes a cell to one
+/// compact region of the hemisphere, so the 16 rays of a packet leave one texel in similar
+/// directions and traverse much the same BVH nodes. Dimensions 0-1 of each aligned block of 2^m
+/// points are a (0, m, 2)-net, so a power-of-two count of samples puts exactly 16 in every cell.
+/// The set of samples, and so the texel's mean, is the one sobol_owen_4d gives in index order.
+struct TexelPoints {
+  std::vector<float> u[4];  ///< Dimension d of the j-th point in direction order.
+  std::vector<std::uint32_t> cell_count;
+  std::vector<float> scratch[4];
+  void generate(std::uint32_t key, int samples);
+  /// Points first .. first + count - 1 (count in [1, 16]) of the order into lanes 0 .. count - 1.
+  void lanes(int first, int count, float (&out)[4][16]) const;
+};
+
+/// The rays of `count` (in [1, 16]) samples of a texel with non-empty patch `patch`, sample k
+/// from the point u[0..3][k] (as TexelPoints: dimensions 0-1 make a cosine-weighted direction
+/// about the unit normal at the point, 2-3 pick the point with sample_patch). The normal is the
 /// interpolated one, or the face normal when `geometric`; the origin is the point pushed off along
 /// the face normal by `fixed_offset`, or by the piece's scale-free offset when `fixed_offset` is 0;
 /// a direction with d . ng <= 0 is no ray. The same rays as sample_patch, Frame and
 /// cosine_hemisphere make, computed lane-parallel: the arithmetic runs in SIMD registers across the
 /// 16 lanes and the concentric map's sine and cosine are polynomials (error under 1e-7).
-void make_texel_rays(const std::vector<PatchPiece>& patch, std::uint32_t key, std::uint32_t first, int count, bool geometric, float fixed_offset,
-                     TexelRayBatch& out);
+void make_texel_rays(const std::vector<PatchPiece>& patch, const float (&u)[4][16], int count, bool geometric, float fixed_offset, TexelRayBatch& out);
 
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {

@@ -8,9 +8,10 @@
 // 1/pi), so V is the plain mean of mu over the samples. A point per ray, rather than one point at
 // the texel centre, is what keeps thin charts and texels that straddle several triangles from
 // aliasing. The patch (its pieces with world-space corners, built once per texel), the sample set
-// and the tile loop with its ray packets (reference/raytraced.cpp's tracing, with an origin per
-// lane, unlimited distance and back-face skipping) are in texel_rays_internal.h, shared with
-// high_to_low.cpp.
+// in direction order (TexelPoints), the lane-parallel ray maker and the tracer (reference/
+// raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) are
+// in texel_rays_internal.h, shared with high_to_low.cpp; the tile loop here hands the default bake's
+// 16 rays to Embree as one occlusion packet.
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>
@@ -128,6 +129,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
       rtcInitIntersectContext(&ctx);
       std::vector<PatchPiece> patch;
       detail::TexelPoints points;
+      alignas(64) detail::PatchTable table;
       alignas(64) float u[4][16];
       alignas(64) detail::TexelRayBatch batch;
       alignas(64) RTCRay16 packet;  // the 16-wide occlusion packet; lanes' fixed fields set once
@@ -140,13 +142,14 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
           if (!cov.mask[texel]) continue;
           detail::build_patch(scene, cov, surface_normals, texel, patch);
           if (patch.empty()) continue;
+          table.build(patch, fixed_offset);
           points.generate(pixel_seed(params.seed, x, y), params.samples);
           double sum = 0;
           Vec3 bent{0, 0, 0};
           for (int first = 0; first < params.samples; first += 16) {
             const int count = std::min(16, params.samples - first);
             points.lanes(first, count, u);
-            detail::make_texel_rays(patch, u, count, geometric, fixed_offset, batch);
+            detail::make_texel_rays(patch, table, u, count, geometric, batch);
             if constexpr (N == 16) {
               if (occlusion_only && !params.bent_normals) {
                 // The default bake: the batch is the packet (tfar is reset, as Embree sets it to

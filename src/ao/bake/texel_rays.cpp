@@ -118,52 +118,57 @@ void TexelPoints::lanes(int first, int count, float (&out)[4][16]) const {
   }
 }
 
-void make_texel_rays(const std::vector<PatchPiece>& patch, const float (&u)[4][16], int count, bool geometric, float fixed_offset, TexelRayBatch& out) {
+void PatchTable::piece_fields(const std::vector<PatchPiece>& patch, std::size_t j, float (&v)[kFields]) const {
+  const PatchPiece& pc = patch[j];
+  for (int c = 0; c < 3; ++c) {
+    v[kP + 3 * c] = pc.p[c].x, v[kP + 3 * c + 1] = pc.p[c].y, v[kP + 3 * c + 2] = pc.p[c].z;
+    v[kN + 3 * c] = pc.n[c].x, v[kN + 3 * c + 1] = pc.n[c].y, v[kN + 3 * c + 2] = pc.n[c].z;
+  }
+  v[kNg] = pc.ng.x, v[kNg + 1] = pc.ng.y, v[kNg + 2] = pc.ng.z;
+  v[kOff] = fixed_offset > 0 ? fixed_offset : pc.offset;
+  v[kLo] = j == 0 ? 0.0f : patch[j - 1].cdf;
+  const float span = pc.cdf - v[kLo];
+  v[kInvSpan] = span > 0 ? 1.0f / span : 0.0f;  // an empty piece: its first corner (r = 0)
+}
+
+void PatchTable::build(const std::vector<PatchPiece>& patch, float offset) {
+  fixed_offset = offset;
+  if (patch.size() > kMaxPieces) return;
+  for (std::size_t j = 0; j < patch.size(); ++j) {
+    float v[kFields];
+    piece_fields(patch, j, v);
+    for (int q = 0; q < kFields; ++q) f[q][j] = v[q];
+  }
+}
+
+void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& table, const float (&u)[4][16], int count, bool geometric,
+                     TexelRayBatch& out) {
   constexpr int W = TexelRayBatch::kWidth;
-  // Per lane, the piece and its data (corner positions p, corner normals n, face normal ng, ray
-  // offset), so that the arithmetic below reads only lane arrays and vectorises. Each field is
-  // written for the lanes whose piece is j, one piece at a time (selects across the lanes, no
-  // gather: texels have a few pieces). The piece is sample_patch's: the first whose cumulative area
-  // exceeds u2 * total (the cumulative areas are non-decreasing).
-  enum : int { kP = 0, kN = 9, kNg = 18, kOff = 21, kLo = 22, kInvSpan = 23, kFields = 24 };
-  constexpr int kTable = 16;  // pieces held in the lane table; a texel with more takes the scalar gather
-  alignas(64) float table[kFields][kTable];
-  alignas(64) float lane[kFields][W];
+  using T = PatchTable;
+  // Per lane, the piece (sample_patch's: the first whose cumulative area exceeds u2 * total; the
+  // cumulative areas are non-decreasing) and its fields, looked up from the texel's table (a
+  // permute across a register for each field), so that the arithmetic below reads only lane
+  // arrays and vectorises.
+  alignas(64) float lane[T::kFields][W];
   alignas(64) float su[W], target[W];
   alignas(64) int piece[W];
   const float total = patch.back().cdf;
-  const auto piece_fields = [&](std::size_t j, float* v) {
-    const PatchPiece& pc = patch[j];
-    for (int c = 0; c < 3; ++c) {
-      v[kP + 3 * c] = pc.p[c].x, v[kP + 3 * c + 1] = pc.p[c].y, v[kP + 3 * c + 2] = pc.p[c].z;
-      v[kN + 3 * c] = pc.n[c].x, v[kN + 3 * c + 1] = pc.n[c].y, v[kN + 3 * c + 2] = pc.n[c].z;
-    }
-    v[kNg] = pc.ng.x, v[kNg + 1] = pc.ng.y, v[kNg + 2] = pc.ng.z;
-    v[kOff] = fixed_offset > 0 ? fixed_offset : pc.offset;
-    v[kLo] = j == 0 ? 0.0f : patch[j - 1].cdf;
-    const float span = pc.cdf - v[kLo];
-    v[kInvSpan] = span > 0 ? 1.0f / span : 0.0f;  // an empty piece: its first corner (r = 0)
-  };
   for (int k = 0; k < W; ++k) target[k] = u[2][k] * total, piece[k] = 0;
   for (std::size_t j = 0; j + 1 < patch.size(); ++j) {
     const float cj = patch[j].cdf;
     for (int k = 0; k < W; ++k) piece[k] += cj <= target[k] ? 1 : 0;
   }
-  if (patch.size() <= kTable) {
-    for (std::size_t j = 0; j < patch.size(); ++j) {
-      float v[kFields];
-      piece_fields(j, v);
-      for (int q = 0; q < kFields; ++q) table[q][j] = v[q];
-    }
-    for (int q = 0; q < kFields; ++q)
-      for (int k = 0; k < W; ++k) lane[q][k] = table[q][piece[k]];
+  if (patch.size() <= T::kMaxPieces) {
+    for (int q = 0; q < T::kFields; ++q)
+      for (int k = 0; k < W; ++k) lane[q][k] = table.f[q][piece[k]];
   } else {
     for (int k = 0; k < W; ++k) {
-      float v[kFields];
-      piece_fields(static_cast<std::size_t>(piece[k]), v);
-      for (int q = 0; q < kFields; ++q) lane[q][k] = v[q];
+      float v[T::kFields];
+      table.piece_fields(patch, static_cast<std::size_t>(piece[k]), v);
+      for (int q = 0; q < T::kFields; ++q) lane[q][k] = v[q];
     }
   }
+  constexpr int kP = T::kP, kN = T::kN, kNg = T::kNg, kOff = T::kOff, kLo = T::kLo, kInvSpan = T::kInvSpan;
   for (int k = 0; k < W; ++k) su[k] = std::min(std::max((target[k] - lane[kLo][k]) * lane[kInvSpan][k], 0.0f), 1.0f);
   for (int k = 0; k < W; ++k) {
     // The point: corner weights (1 - r, r (1 - t), r t), r = sqrt(s), as sample_patch.

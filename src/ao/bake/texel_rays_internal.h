@@ -108,15 +108,30 @@ struct TexelPoints {
   void lanes(int first, int count, float (&out)[4][16]) const;
 };
 
-/// The rays of `count` (in [1, 16]) samples of a texel with non-empty patch `patch`, sample k
-/// from the point u[0..3][k] (as TexelPoints: dimensions 0-1 make a cosine-weighted direction
-/// about the unit normal at the point, 2-3 pick the point with sample_patch). The normal is the
-/// interpolated one, or the face normal when `geometric`; the origin is the point pushed off along
-/// the face normal by `fixed_offset`, or by the piece's scale-free offset when `fixed_offset` is 0;
-/// a direction with d . ng <= 0 is no ray. The same rays as sample_patch, Frame and
-/// cosine_hemisphere make, computed lane-parallel: the arithmetic runs in SIMD registers across the
-/// 16 lanes and the concentric map's sine and cosine are polynomials (error under 1e-7).
-void make_texel_rays(const std::vector<PatchPiece>& patch, const float (&u)[4][16], int count, bool geometric, float fixed_offset, TexelRayBatch& out);
+/// A patch's pieces as columns of per-field rows (corner positions, corner normals, face normal,
+/// ray offset, and where the piece starts in the cumulative area with 1 / its area), built once
+/// per texel for make_texel_rays, which looks a lane's piece up in each row.
+struct PatchTable {
+  enum : int { kP = 0, kN = 9, kNg = 18, kOff = 21, kLo = 22, kInvSpan = 23, kFields = 24 };
+  static constexpr int kMaxPieces = 16;  ///< Pieces the table holds; a patch with more is read piece by piece.
+  alignas(64) float f[kFields][kMaxPieces];
+  float fixed_offset = 0;
+  /// `fixed_offset`: the user's ray offset, or 0 for each piece's scale-free one.
+  void build(const std::vector<PatchPiece>& patch, float fixed_offset);
+  /// The fields of piece j of `patch`.
+  void piece_fields(const std::vector<PatchPiece>& patch, std::size_t j, float (&v)[kFields]) const;
+};
+
+/// The rays of `count` (in [1, 16]) samples of a texel with non-empty patch `patch` (and its
+/// table), sample k from the point u[0..3][k] (as TexelPoints: dimensions 0-1 make a
+/// cosine-weighted direction about the unit normal at the point, 2-3 pick the point with
+/// sample_patch). The normal is the interpolated one, or the face normal when `geometric`; the
+/// origin is the point pushed off along the face normal by the table's offset; a direction with
+/// d . ng <= 0 is no ray. The same rays as sample_patch, Frame and cosine_hemisphere make,
+/// computed lane-parallel: the arithmetic runs in SIMD registers across the 16 lanes and the
+/// concentric map's sine and cosine are polynomials (error under 1e-7).
+void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& table, const float (&u)[4][16], int count, bool geometric,
+                     TexelRayBatch& out);
 
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {

@@ -292,7 +292,7 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
                              [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
                                if (!high) {
                                  if (o.method == "histogram") return bake_histogram(gs, cov, hist, progress);
-                                 const RayScene rays(gs);
+                                 const RayScene rays(gs, bake_bvh_options(gs.triangle_count()));
                                  return bake_raytraced(rays, cov, rt, progress);
                                }
                                Scene targets;
@@ -371,7 +371,7 @@ nlohmann::json bake_gltf_input(const fs::path& input, const BakeOptions& o, cons
     for (const std::string& w : cov.warnings()) std::cerr << "warning: " << input.string() << ": mesh " << label << ": " << w << "\n";
     ProgressBar bar("bake " + input.filename().string() + " " + label, progress);
     if (o.method == "histogram") return bake_histogram(scene, cov, hist, bar.callback());
-    const RayScene rays(scene);
+    const RayScene rays(scene, bake_bvh_options(scene.triangle_count()));
     return bake_raytraced(rays, cov, rt, bar.callback());
   };
   job.bake_vertices = [&](const Scene& scene, std::uint64_t* nrays) {
@@ -408,7 +408,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
     if (!rays) {
       check_memory(estimate_ray_scene_memory(scene.triangle_count(), scene.vertex_count()),
                    input.string() + ": the BVH of " + std::to_string(scene.triangle_count()) + " triangles");
-      rays = std::make_unique<RayScene>(scene);
+      rays = std::make_unique<RayScene>(scene, bake_bvh_options(scene.triangle_count()));
       timings["bvh_ms"] = clock.lap_ms();
     }
     return *rays;
@@ -448,7 +448,7 @@ nlohmann::json bake_one(const fs::path& input, const BakeOptions& o, bool batch,
           if (o.method == "histogram") {
             tr = bake_histogram(ts, cov, hist, bar.callback());
           } else {
-            const RayScene tile_rays(ts);  // the UVs differ per tile, and the baker reads them from its scene
+            const RayScene tile_rays(ts, bake_bvh_options(ts.triangle_count()));  // the UVs differ per tile, and the baker reads them from its scene
             tr = bake_raytraced(tile_rays, cov, rt, bar.callback());
           }
         }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include <tbb/global_control.h>
 
@@ -13,6 +14,7 @@
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/raytraced_bake.h"
 #include "ao/bake/texel_coverage.h"
+#include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
 #include "ao/scene/procedural.h"
 
@@ -226,6 +228,106 @@ TEST(Bake, QuadInsideClosedBoxIsFullyOccluded) {
 
 // With a distance limit, the ray-traced baker matches the foundation's step-membership wall formula
 // V = 1 - (acos(a) - a sqrt(1-a^2))/pi for a = d/R <= 1 (infinite wall).
+TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
+  // make_texel_rays (lane-parallel, polynomial sine and cosine) against sample_patch, Frame and
+  // cosine_hemisphere one sample at a time, on a quad with bent vertex normals whose texels
+  // straddle its diagonal (patches of one and several pieces, from PatchTable), and on a 4 x 4
+  // grid of bumpy quads baked into one texel (32 pieces: more than PatchTable holds, so read piece
+  // by piece). Tolerance 1e-5: float rounding of unit vectors and unit-sized positions, plus the
+  // polynomials' error (< 1e-7).
+  Mesh grid;
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) {
+      const float x = i / 4.0f, y = j / 4.0f;
+      grid.positions.push_back({x, y, 0.1f * std::sin(6 * x) * std::cos(5 * y)});
+      grid.normals.push_back(normalize(Vec3{-0.6f * std::cos(6 * x) * std::cos(5 * y), 0.5f * std::sin(6 * x) * std::sin(5 * y), 1}));
+      grid.uvs.push_back({x, y});
+    }
+  for (std::uint32_t j = 0; j < 4; ++j)
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t a = j * 5 + i;
+      grid.indices.insert(grid.indices.end(), {a, a + 1, a + 6, a, a + 6, a + 5});
+    }
+  Mesh m = uv_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0.3f}, {0, 1, 0}, {0, 0}, {1, 1});
+  m.normals = {normalize(Vec3{0.3f, 0, 1}), normalize(Vec3{-0.2f, 0.4f, 1}), normalize(Vec3{0, -0.6f, 1}), {0, 0, 1}};
+  int multi = 0, many = 0;
+  for (const auto& [mesh, size] : {std::pair{m, 5}, std::pair{grid, 1}}) {
+    Scene s;
+    s.meshes.push_back(mesh);
+    s = prepared(std::move(s));
+    const TexelCoverage cov = compute_texel_coverage(s, size);
+    const detail::TriangleNormals fn = detail::face_normals(s);
+    std::vector<detail::PatchPiece> patch;
+    for (bool geometric : {false, true})
+      for (float fixed : {0.0f, 0.01f})
+        for (std::size_t texel = 0; texel < cov.texel_count(); ++texel) {
+          if (!cov.mask[texel]) continue;
+          detail::build_patch(s, cov, fn, texel, patch);
+          if (patch.empty()) continue;
+          multi += patch.size() > 1;
+          many += patch.size() > static_cast<std::size_t>(detail::PatchTable::kMaxPieces);
+          const std::uint32_t key = pixel_seed(3, static_cast<int>(texel), 0);
+          for (std::uint32_t first = 0; first < 48; first += 16) {
+            const int count = first == 32 ? 11 : 16;
+            detail::TexelRayBatch b;
+            float lanes[4][16];
+            sobol_owen_4d_batch(first, count, key, lanes);
+            detail::PatchTable table;
+            table.build(patch, fixed);
+            detail::make_texel_rays(patch, table, lanes, count, geometric, b);
+            for (int k = 0; k < 16; ++k) {
+              if (k >= count) {
+                EXPECT_EQ(b.valid[k], 0);
+                continue;
+              }
+              const std::array<float, 4> u = sobol_owen_4d(first + static_cast<std::uint32_t>(k), key);
+              const detail::PatchSample ps = detail::sample_patch(patch, {u[2], u[3]});
+              const Vec3 ng = ps.piece->ng;
+              const Vec3 d = Frame::from_normal(geometric ? ng : ps.normal()).to_world(cosine_hemisphere({u[0], u[1]}));
+              const Vec3 o = ps.position() + ng * (fixed > 0 ? fixed : ps.piece->offset);
+              if (std::abs(dot(d, ng)) > 1e-5f) EXPECT_EQ(b.valid[k] != 0, dot(d, ng) > 0) << "texel " << texel << " sample " << first + k;
+              EXPECT_NEAR(b.dx[k], d.x, 1e-5f);
+              EXPECT_NEAR(b.dy[k], d.y, 1e-5f);
+              EXPECT_NEAR(b.dz[k], d.z, 1e-5f);
+              EXPECT_NEAR(b.ox[k], o.x, 1e-5f);
+              EXPECT_NEAR(b.oy[k], o.y, 1e-5f);
+              EXPECT_NEAR(b.oz[k], o.z, 1e-5f);
+            }
+          }
+        }
+  }
+  EXPECT_GT(multi, 0);  // both lookups were exercised
+  EXPECT_GT(many, 0);
+}
+
+TEST(Bake, TexelPointsAreTheSobolSetInDirectionCells) {
+  // The order holds the same points as index order (so the texel's mean is unchanged), and at a
+  // power-of-two count every packet of 16 lies in one cell of the direction grid (the net
+  // property); at other counts the order is still a permutation.
+  detail::TexelPoints pts;
+  for (int samples : {64, 256, 128, 37}) {
+    pts.generate(12345u, samples);
+    std::vector<std::array<float, 4>> want, got;
+    for (int i = 0; i < samples; ++i) {
+      want.push_back(sobol_owen_4d(static_cast<std::uint32_t>(i), 12345u));
+      got.push_back({pts.u[0][static_cast<std::size_t>(i)], pts.u[1][static_cast<std::size_t>(i)], pts.u[2][static_cast<std::size_t>(i)],
+                     pts.u[3][static_cast<std::size_t>(i)]});
+    }
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want) << samples;
+    if ((samples & (samples - 1)) != 0) continue;
+    const int cells = samples / 16;
+    const int cols = samples == 128 ? 4 : static_cast<int>(std::lround(std::sqrt(cells))), rows = cells / cols;
+    for (int first = 0; first < samples; first += 16) {
+      std::set<int> cell;
+      for (int k = first; k < first + 16; ++k)
+        cell.insert(static_cast<int>(pts.u[0][static_cast<std::size_t>(k)] * cols) * rows + static_cast<int>(pts.u[1][static_cast<std::size_t>(k)] * rows));
+      EXPECT_EQ(cell.size(), 1u) << samples << " samples, packet at " << first;
+    }
+  }
+}
+
 TEST(Bake, RaytracedDistanceLimitMatchesWallFormula) {
   const Scene s = floor_and_wall(40.0f);
   const int n = 8;

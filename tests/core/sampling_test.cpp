@@ -104,6 +104,21 @@ TEST(Sampling, Sobol4dIntegratesAProductOfAllFourDimensions) {
   }
 }
 
+TEST(Sampling, Sobol4dBatchIsBitIdenticalToOnePointAtATime) {
+  // Both batch paths: a first index that is a multiple of 16 (the XOR of two table points) and one
+  // that is not (each point on its own), with a full and a partial batch.
+  for (std::uint32_t seed : {0u, 7u, 0xdeadbeefu})
+    for (std::uint32_t first : {0u, 16u, 48u, 4080u, 65520u, 3u, 1000001u})
+      for (int count : {16, 5}) {
+        float out[4][16];
+        sobol_owen_4d_batch(first, count, seed, out);
+        for (int k = 0; k < count; ++k) {
+          const std::array<float, 4> u = sobol_owen_4d(first + static_cast<std::uint32_t>(k), seed);
+          for (int d = 0; d < 4; ++d) EXPECT_EQ(out[d][k], u[static_cast<std::size_t>(d)]) << "seed " << seed << " point " << first + k << " dim " << d;
+        }
+      }
+}
+
 TEST(Sampling, DifferentSeedsGiveDifferentPoints) {
   EXPECT_NE(sobol_owen_2d(3, 1).x, sobol_owen_2d(3, 2).x);
   EXPECT_EQ(sobol_owen_2d(3, 1).x, sobol_owen_2d(3, 1).x);

@@ -8,9 +8,10 @@
 // 1/pi), so V is the plain mean of mu over the samples. A point per ray, rather than one point at
 // the texel centre, is what keeps thin charts and texels that straddle several triangles from
 // aliasing. The patch (its pieces with world-space corners, built once per texel), the sample set
-// and the tile loop with its ray packets (reference/raytraced.cpp's tracing, with an origin per
-// lane, unlimited distance and back-face skipping) are in texel_rays_internal.h, shared with
-// high_to_low.cpp.
+// in direction order (TexelPoints), the lane-parallel ray maker and the tracer (reference/
+// raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) are
+// in texel_rays_internal.h, shared with high_to_low.cpp; the tile loop here hands the default bake's
+// 16 rays to Embree as one occlusion packet.
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>
@@ -114,20 +115,78 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
   if (params.bent_normals) out.bent_normal = Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0});
-  const auto make_ray = [&](RTCIntersectContext&, const detail::TexelSample& s, Vec3& org, Vec3& dir) {
-    const PatchPiece& pc = *s.point.piece;
-    const Vec3 d = Frame::from_normal(geometric ? pc.ng : s.point.normal()).to_world(cosine_hemisphere(s.u_direction));
-    if (dot(d, pc.ng) <= 0) return detail::SampleRay::Occluded;  // below the face: occluded by the surface itself (mu = 0)
-    // Off the triangle by the scale-free offset of ray_offset.h, or the user's fixed one.
-    org = s.point.position() + pc.ng * (params.offset > 0 ? params.offset : pc.offset);
-    dir = d;
-    return detail::SampleRay::Trace;
-  };
-  const auto finish = [&](std::size_t texel, const detail::TexelSums& sums) {
-    out.visibility[texel] = static_cast<float>(sums.mu / params.samples);
-    if (params.bent_normals) out.bent_normal[texel] = normalize(sums.bent);
-  };
-  detail::bake_texels(scene, cov, tracer, params.samples, params.seed, progress, make_ray, finish);
+  const float fixed_offset = params.offset;
+  // A step membership (unlimited distance is a step at infinity) needs only whether something lies
+  // within reach: Embree's any-hit occlusion query.
+  const bool occlusion_only = falloff.membership == Membership::Step && !params.ignore_back_faces;
+  const float reach = falloff.reach();
+  const TriangleNormals& surface_normals = fn;
+  ProgressCounter counter(progress, cov.texel_count());
+  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
+    parallel_for_tiles(cov.width, cov.height, detail::kTexelTile, [&](const Tile& t) {
+      detail::flush_denormals_to_zero();
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::vector<PatchPiece> patch;
+      detail::TexelPoints points;
+      alignas(64) detail::PatchTable table;
+      alignas(64) float u[4][16];
+      alignas(64) detail::TexelRayBatch batch;
+      alignas(64) RTCRay16 packet;  // the 16-wide occlusion packet; lanes' fixed fields set once
+      for (int k = 0; k < 16; ++k) detail::set_ray(packet, k, {0, 0, 0}, {0, 0, 1}, reach);
+      std::array<Vec3, 16> org, dir;
+      std::array<float, 16> mu;
+      for (int y = t.y0; y < t.y1; ++y)
+        for (int x = t.x0; x < t.x1; ++x) {
+          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+          if (!cov.mask[texel]) continue;
+          detail::build_patch(scene, cov, surface_normals, texel, patch);
+          if (patch.empty()) continue;
+          table.build(patch, fixed_offset);
+          points.generate(pixel_seed(params.seed, x, y), params.samples);
+          double sum = 0;
+          Vec3 bent{0, 0, 0};
+          for (int first = 0; first < params.samples; first += 16) {
+            const int count = std::min(16, params.samples - first);
+            points.lanes(first, count, u);
+            detail::make_texel_rays(patch, table, u, count, geometric, batch);
+            if constexpr (N == 16) {
+              if (occlusion_only && !params.bent_normals) {
+                // The default bake: the batch is the packet (tfar is reset, as Embree sets it to
+                // -infinity for an occluded lane); mu is 1 for a lane with nothing within reach.
+                for (int k = 0; k < 16; ++k) {
+                  packet.org_x[k] = batch.ox[k], packet.org_y[k] = batch.oy[k], packet.org_z[k] = batch.oz[k];
+                  packet.dir_x[k] = batch.dx[k], packet.dir_y[k] = batch.dy[k], packet.dir_z[k] = batch.dz[k];
+                  packet.tfar[k] = reach;
+                }
+                rtcOccluded16(batch.valid, embree_scene(rs), &ctx, &packet);
+                int unoccluded = 0;
+                for (int k = 0; k < 16; ++k) unoccluded += batch.valid[k] != 0 && packet.tfar[k] >= 0;
+                sum += unoccluded;
+                continue;
+              }
+            }
+            // Everything else: the traced lanes, compacted, through the general tracer.
+            int live = 0;
+            for (int k = 0; k < count; ++k)
+              if (batch.valid[k]) {
+                org[static_cast<std::size_t>(live)] = {batch.ox[k], batch.oy[k], batch.oz[k]};
+                dir[static_cast<std::size_t>(live)] = {batch.dx[k], batch.dy[k], batch.dz[k]};
+                ++live;
+              }
+            constexpr int step = N == 1 ? 16 : N;
+            for (int at = 0; at < live; at += step) tracer.template trace<N>(ctx, org.data() + at, dir.data() + at, std::min(step, live - at), mu.data() + at);
+            for (int k = 0; k < live; ++k) {
+              sum += mu[static_cast<std::size_t>(k)];
+              bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
+            }
+          }
+          out.visibility[texel] = static_cast<float>(sum / params.samples);
+          if (params.bent_normals) out.bent_normal[texel] = normalize(bent);
+        }
+      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0));
+    });
+  });
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
   out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;

@@ -3,6 +3,7 @@
 // only count within a distance R (the histogram baker's distance is unlimited).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -38,6 +39,21 @@ struct RaytracedBakeParams {
   Falloff falloff() const;
 };
 void to_json(nlohmann::json& j, const RaytracedBakeParams& p);
+
+/// Triangles above which a ray-traced bake builds a Medium BVH (binned SAH) instead of a High one
+/// (SAH with spatial splits). The spatial splits pay off on long thin triangles, the stuff of
+/// low-poly meshes, whose High build is quick; on a dense mesh they cost build time and gain no
+/// speed: on refined_elephant_uv (88,928 triangles) the High build took 0.2 s of a 1.5 s bake at
+/// 1024^2 and 64 rays, and the rays traced no faster than through the Medium BVH (BENCHMARKS.md,
+/// "bake").
+inline constexpr std::size_t kBakeMediumBvhTriangles = 50'000;
+/// The BVH settings for ray-traced bakes of a scene of `triangles` triangles (the rest chosen as
+/// RayScene does).
+inline BvhOptions bake_bvh_options(std::size_t triangles) {
+  BvhOptions o;
+  if (triangles > kBakeMediumBvhTriangles) o.quality = BvhQuality::Medium;
+  return o;
+}
 
 /// V per covered texel, the area-weighted mean of the obscurance integral over the texel's patch
 /// (eq. 2 of the per-texel AO paper, with mu(D) in place of V when R is set). Sample i of texel

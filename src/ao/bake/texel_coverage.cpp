@@ -34,7 +34,7 @@ ClipPolygon clip_half_plane(const ClipPolygon& in, int axis, float bound, bool k
     return keep_greater ? c >= bound : c <= bound;
   };
   for (int i = 0; i < in.n; ++i) {
-    const Vec2 a = in.p[i], b = in.p[(i + 1) % in.n];
+    const Vec2 a = in.p[i], b = in.p[i + 1 == in.n ? 0 : i + 1];
     const bool ia = inside(a), ib = inside(b);
     if (ia) out.p[out.n++] = a;
     if (ia != ib) {

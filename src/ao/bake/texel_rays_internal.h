@@ -82,6 +82,57 @@ inline PatchSample sample_patch(const std::vector<PatchPiece>& patch, Vec2 u) {
   return {&patch[pi], {1.0f - r, r * (1.0f - u.y), r * u.y}};
 }
 
+/// Up to 16 rays of one texel, laid out as an RTCRay16's origins and directions (structure of
+/// arrays, one lane per ray).
+struct TexelRayBatch {
+  static constexpr int kWidth = 16;
+  alignas(64) float ox[kWidth], oy[kWidth], oz[kWidth];
+  alignas(64) float dx[kWidth], dy[kWidth], dz[kWidth];
+  alignas(64) int valid[kWidth];  ///< -1: a ray to trace; 0: no ray (a direction below the face, mu = 0, or a lane past the count).
+};
+
+/// A texel's sample points, points 0 .. samples - 1 of the 4-D Owen-scrambled Sobol set keyed by
+/// the texel's key (sobol_owen_4d; dimensions 0-1 make the direction, 2-3 the point on the
+/// patch), in direction order: sorted (stably) into the cells of a grid over dimensions 0-1 with
+/// about 16 points per cell (2 x 2 cells at 64 samples). The concentric map takes a cell to one
+/// compact region of the hemisphere, so the 16 rays of a packet leave one texel in similar
+/// directions and traverse much the same BVH nodes. Dimensions 0-1 of each aligned block of 2^m
+/// points are a (0, m, 2)-net, so a power-of-two count of samples puts exactly 16 in every cell.
+/// The set of samples, and so the texel's mean, is the one sobol_owen_4d gives in index order.
+struct TexelPoints {
+  std::vector<float> u[4];  ///< Dimension d of the j-th point in direction order.
+  std::vector<std::uint32_t> cell_count;
+  std::vector<float> scratch[4];
+  void generate(std::uint32_t key, int samples);
+  /// Points first .. first + count - 1 (count in [1, 16]) of the order into lanes 0 .. count - 1.
+  void lanes(int first, int count, float (&out)[4][16]) const;
+};
+
+/// A patch's pieces as columns of per-field rows (corner positions, corner normals, face normal,
+/// ray offset, and where the piece starts in the cumulative area with 1 / its area), built once
+/// per texel for make_texel_rays, which looks a lane's piece up in each row.
+struct PatchTable {
+  enum : int { kP = 0, kN = 9, kNg = 18, kOff = 21, kLo = 22, kInvSpan = 23, kFields = 24 };
+  static constexpr int kMaxPieces = 16;  ///< Pieces the table holds; a patch with more is read piece by piece.
+  alignas(64) float f[kFields][kMaxPieces];
+  float fixed_offset = 0;
+  /// `fixed_offset`: the user's ray offset, or 0 for each piece's scale-free one.
+  void build(const std::vector<PatchPiece>& patch, float fixed_offset);
+  /// The fields of piece j of `patch`.
+  void piece_fields(const std::vector<PatchPiece>& patch, std::size_t j, float (&v)[kFields]) const;
+};
+
+/// The rays of `count` (in [1, 16]) samples of a texel with non-empty patch `patch` (and its
+/// table), sample k from the point u[0..3][k] (as TexelPoints: dimensions 0-1 make a
+/// cosine-weighted direction about the unit normal at the point, 2-3 pick the point with
+/// sample_patch). The normal is the interpolated one, or the face normal when `geometric`; the
+/// origin is the point pushed off along the face normal by the table's offset; a direction with
+/// d . ng <= 0 is no ray. The same rays as sample_patch, Frame and cosine_hemisphere make,
+/// computed lane-parallel: the arithmetic runs in SIMD registers across the 16 lanes and the
+/// concentric map's sine and cosine are polynomials (error under 1e-7).
+void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& table, const float (&u)[4][16], int count, bool geometric,
+                     TexelRayBatch& out);
+
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {
   const RayScene& rs;
@@ -149,6 +200,10 @@ struct Tracer {
   }
 };
 
+/// Texels per tile side of the inside-out bakers' tile loops: neighbouring texels lie close on the
+/// surface, so a tile's rays share BVH nodes in cache.
+inline constexpr int kTexelTile = 16;
+
 /// One sample of a texel: its point on the patch and the two uniforms its direction is made from.
 struct TexelSample {
   PatchSample point;
@@ -179,12 +234,11 @@ struct TexelSums {
 template <class MakeRay, class Finish>
 std::size_t bake_texels(const Scene& surface, const TexelCoverage& cov, const Tracer& tracer, int samples, std::uint32_t seed,
                         const ProgressFn& progress, MakeRay&& make_ray, Finish&& finish) {
-  constexpr int kTile = 16;  // texels per tile side: neighbouring texels lie close on the surface, so a tile's rays share BVH nodes in cache
   const TriangleNormals fn = face_normals(surface);
   std::atomic<std::size_t> finished{0};
   ProgressCounter counter(progress, cov.texel_count());
   dispatch_packet_width(tracer.rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(cov.width, cov.height, kTile, [&](const Tile& t) {
+    parallel_for_tiles(cov.width, cov.height, kTexelTile, [&](const Tile& t) {
       flush_denormals_to_zero();
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);

@@ -1,5 +1,6 @@
 #include "ao/core/sampling.h"
 
+#include <array>
 #include <cmath>
 #include <initializer_list>
 
@@ -7,7 +8,7 @@ namespace ao {
 
 namespace {
 
-std::uint32_t reverse_bits(std::uint32_t x) {
+constexpr std::uint32_t reverse_bits(std::uint32_t x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
   x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
@@ -93,6 +94,42 @@ std::array<float, 4> sobol_owen_4d(std::uint32_t index, std::uint32_t seed) {
   const std::uint32_t d2 = reverse_bits(laine_karras(reverse_bits(kSobolDim2(index)), hash_combine(seed, 0x50b03u)));
   const std::uint32_t d3 = reverse_bits(laine_karras(reverse_bits(kSobolDim3(index)), hash_combine(seed, 0x50b04u)));
   return {to_unit_float(d0), to_unit_float(d1), to_unit_float(d2), to_unit_float(d3)};
+}
+
+void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, float (&out)[4][16]) {
+  const std::uint32_t key[4] = {hash_combine(seed, 0x50b01u), hash_combine(seed, 0x50b02u), hash_combine(seed, 0x50b03u), hash_combine(seed, 0x50b04u)};
+  // The unscrambled points, bit-reversed (the scramble's inner reversal); dimension 0's reversal
+  // is the index itself. A Sobol dimension is linear over GF(2), and so is the reversal: for first
+  // a multiple of 16 and k < 16 (disjoint bits), point first + k is point first XOR point k, so
+  // one table lookup per dimension serves all 16 lanes.
+  static constexpr auto kLow = [] {
+    std::array<std::array<std::uint32_t, 16>, 3> t{};
+    for (std::uint32_t k = 0; k < 16; ++k) {
+      t[0][k] = reverse_bits(kSobolDim1(k));
+      t[1][k] = reverse_bits(kSobolDim2(k));
+      t[2][k] = reverse_bits(kSobolDim3(k));
+    }
+    return t;
+  }();
+  alignas(64) std::uint32_t r[4][16] = {};
+  if (first % 16 == 0) {
+    const std::uint32_t high[3] = {reverse_bits(kSobolDim1(first)), reverse_bits(kSobolDim2(first)), reverse_bits(kSobolDim3(first))};
+    for (int k = 0; k < 16; ++k) {
+      r[0][k] = first + static_cast<std::uint32_t>(k);
+      for (int d = 0; d < 3; ++d) r[d + 1][k] = high[d] ^ kLow[static_cast<std::size_t>(d)][static_cast<std::size_t>(k)];
+    }
+  } else {
+    for (int k = 0; k < count; ++k) {
+      const std::uint32_t i = first + static_cast<std::uint32_t>(k);
+      r[0][k] = i;
+      r[1][k] = reverse_bits(kSobolDim1(i));
+      r[2][k] = reverse_bits(kSobolDim2(i));
+      r[3][k] = reverse_bits(kSobolDim3(i));
+    }
+  }
+  // Hash and outer reversal: shifts, masks and multiplies, all 16 lanes at once.
+  for (int d = 0; d < 4; ++d)
+    for (int k = 0; k < 16; ++k) out[d][k] = to_unit_float(reverse_bits(laine_karras(r[d][k], key[d])));
 }
 
 Vec3 cosine_hemisphere(Vec2 u) {

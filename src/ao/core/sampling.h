@@ -41,6 +41,12 @@ Vec2 sobol_owen_2d(std::uint32_t index, std::uint32_t seed);
 /// 0 and 1 and is a net of the four dimensions jointly; different seeds give independent sets.
 std::array<float, 4> sobol_owen_4d(std::uint32_t index, std::uint32_t seed);
 
+/// Points first .. first + count - 1 of sobol_owen_4d(., seed), count in [0, 16]: dimension d of
+/// point first + k in out[d][k], bit-identical to sobol_owen_4d. The per-dimension keys are
+/// hashed once and the scramble runs over the 16 lanes in SIMD registers (the inside-out baker's
+/// rays of one packet).
+void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, float (&out)[4][16]);
+
 /// Cosine-weighted direction on the hemisphere about +z from u in [0,1)^2: Shirley-Chiu concentric
 /// disk mapping, lifted to the hemisphere (Malley's method). pdf = cos(theta) / pi.
 Vec3 cosine_hemisphere(Vec2 u);

@@ -561,6 +561,18 @@ void trace_world(const GBuffer& gb, const WorldSampler& sample, float r_max, con
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)
   const FlatSlots flat(lanes, nc);
   const int stride = per_cone;
+  // The pattern's cone axes and chain scales per slot, cones padded to 8 (zeros).
+  const int cones_padded = (nc + 7) / 8 * 8;
+  struct {
+    std::vector<float> x, y, z, s;
+  } soa;
+  for (auto* a : {&soa.x, &soa.y, &soa.z, &soa.s}) a->assign(pat.cone.size() / nc * cones_padded, 0.0f);
+  for (std::size_t slot = 0; slot < pat.cone.size() / nc; ++slot)
+    for (int c = 0; c < nc; ++c) {
+      const ConePattern::Cone& k = pat.cone[slot * nc + c];
+      const std::size_t o = slot * cones_padded + c;
+      soa.x[o] = k.x, soa.y[o] = k.y, soa.z[o] = k.z, soa.s[o] = k.scale;
+    }
 #else
   const int stride = lanes.padded;
 #endif
@@ -612,11 +624,31 @@ void trace_world(const GBuffer& gb, const WorldSampler& sample, float r_max, con
         ps.inside = faces_inside(gb, sample, x, y, pos, n, near);
         const int slot = pat.slot(x, y);
         sample.turn(pat.rot[2 * slot], pat.rot[2 * slot + 1], ps.u.data(), ps.v.data());
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)
+        // The cones' axes turned into the normal's frame and into voxels, 8 cones at a time.
+        {
+          const std::size_t o = static_cast<std::size_t>(slot) * cones_padded;
+          const __m256 tx = _mm256_set1_ps(frame.t.x), ty = _mm256_set1_ps(frame.t.y), tz = _mm256_set1_ps(frame.t.z);
+          const __m256 bx = _mm256_set1_ps(frame.b.x), by = _mm256_set1_ps(frame.b.y), bz = _mm256_set1_ps(frame.b.z);
+          const __m256 nx = _mm256_set1_ps(frame.n.x), ny = _mm256_set1_ps(frame.n.y), nz = _mm256_set1_ps(frame.n.z);
+          for (int c = 0; c < nc; c += 8) {
+            const __m256 lx = _mm256_loadu_ps(soa.x.data() + o + c), ly = _mm256_loadu_ps(soa.y.data() + o + c), lz = _mm256_loadu_ps(soa.z.data() + o + c);
+            const __m256 wx = _mm256_fmadd_ps(nx, lz, _mm256_fmadd_ps(bx, ly, _mm256_mul_ps(tx, lx)));
+            const __m256 wy = _mm256_fmadd_ps(ny, lz, _mm256_fmadd_ps(by, ly, _mm256_mul_ps(ty, lx)));
+            const __m256 wz = _mm256_fmadd_ps(nz, lz, _mm256_fmadd_ps(bz, ly, _mm256_mul_ps(tz, lx)));
+            _mm256_storeu_ps(ps.scale.data() + c, _mm256_loadu_ps(soa.s.data() + o + c));
+            _mm256_storeu_ps(ps.ax.data() + c, _mm256_mul_ps(wx, _mm256_set1_ps(inv.x)));
+            _mm256_storeu_ps(ps.ay.data() + c, _mm256_mul_ps(wz, _mm256_set1_ps(inv.y)));
+            _mm256_storeu_ps(ps.az.data() + c, _mm256_mul_ps(wy, _mm256_set1_ps(inv.z)));
+          }
+        }
+#else
         const ConePattern::Cone* cones = pat.cone.data() + static_cast<std::size_t>(slot) * nc;
         for (int c = 0; c < nc; ++c) {
           const Vec3 a = frame.to_world({cones[c].x, cones[c].y, cones[c].z});
           ps.scale[c] = cones[c].scale, ps.ax[c] = a.x * inv.x, ps.ay[c] = a.z * inv.y, ps.az[c] = a.y * inv.z;  // the axis in voxels
         }
+#endif
         const float gx = (pos.x - g.origin.x) * inv.x, gy = (pos.z - g.origin.z) * inv.y, gz = (pos.y - g.origin.y) * inv.z;
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)
         ps.place_flat(flat, sample, nc, gx, gy, gz);

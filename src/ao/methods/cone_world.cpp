@@ -291,7 +291,7 @@ struct FlatSlots {
       const int j = real ? i % q.per_cone : q.padded - 1;  // a padding lane: never sampled
       cone.push_back(real ? i / q.per_cone : 0);
       dist_a.push_back(q.dist_a[j]), dist_b.push_back(q.dist_b[j]), rad_a.push_back(q.rad_a[j]), rad_b.push_back(q.rad_b[j]);
-      use_a.push_back(q.use_a[j]), use_b.push_back(real ? q.use_b[j] : -1.0f);
+      use_a.push_back(real ? q.use_a[j] : 0.0f), use_b.push_back(real ? q.use_b[j] : -1.0f);  // padding: 0 s - 1 < 0
       ex.push_back(q.ex[j] * 1.001f * kInvC), ey.push_back(q.ey[j] * 1.001f * kInvC), ez.push_back(q.ez[j] * 1.001f);
     }
   }

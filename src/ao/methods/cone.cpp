@@ -6,193 +6,25 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <mutex>
-
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/methods/bilateral.h"
+#include "ao/methods/cone_kernel_internal.h"
 #include "ao/methods/cone_pattern_internal.h"
 
 namespace ao {
 
 namespace {
 
-constexpr int kTile = 16;
-// A cone stops once its transmittance T <= kOpaque: its remaining spheres can lower T by at most
-// kOpaque, so V (the mean over cones) by at most kOpaque = 1e-4, far below an 8-bit step (1/255).
-constexpr float kOpaque = 1e-4f;
-
-// Length of [zlo, zhi) (voxel units along the column) covered by solid voxels, counting the two
-// end voxels by the part of them inside the range. The paper counts whole bits (Fig. 7); the
-// fractional ends remove a bias of up to a voxel per prism, which matters for the small spheres
-// near the apex whose chords are a few voxels long.
-inline float solid_length(const std::uint64_t* col, int words, int nbits, float zlo, float zhi) {
-  zlo = std::max(zlo, 0.0f);
-  zhi = std::min(zhi, static_cast<float>(nbits));
-  if (!(zhi > zlo)) return 0.0f;
-  const int k0 = static_cast<int>(zlo);
-  const int k1 = std::min(static_cast<int>(zhi), nbits - 1);
-  const auto bit = [&](int k) { return static_cast<float>((col[k >> 6] >> (k & 63)) & 1u); };
-  if (k0 >= k1) return bit(k0) * (zhi - zlo);
-  // Whole voxels strictly between the end voxels: bitfieldExtract + bitCount of Fig. 7.
-  return bit(k0) * (static_cast<float>(k0 + 1) - zlo) + static_cast<float>(count_bits(col, words, k0 + 1, k1)) +
-         bit(k1) * (zhi - static_cast<float>(k1));
-}
-
-// Obstructed fraction of one sphere (sec. III-C1): prisms along the grid's z through the great
-// disk's samples; each prism spans the sphere's chord [z_in, z_out] at its sample. Monte Carlo
-// over the disk: volume ~ sum of chords, obstructed volume ~ sum of solid lengths, so the
-// fraction is their ratio (as volumetric AO's pipes, the paper's [4]).
-struct WorldSampler {
-  const VoxelGrid& g;
-  Vec3 inv;  // 1 / voxel size along (i, j, k)
-  int np;    // prisms per sphere
-  int lanes; // np rounded up to a multiple of 8
-  // The prisms stay within rho_max of the disk's centre and half_max of the equator (unit disk).
-  float rho_max = 0, half_max = 0;
-  // Per sphere of the chain (they differ only in radius): radii in voxels along (i, j, k) and the
-  // sum of the prisms' chords.
-  struct Sphere {
-    float rx, ry, rz, chord;
-  };
-  std::vector<Sphere> spheres;
-  // Structure of arrays, padded to `lanes` with zeros: disk points, and per sphere each prism's
-  // half chord in voxels ([k * lanes + s]).
-  std::vector<float> du, dv, half;
-
-  WorldSampler(const VoxelGrid& grid, const ConeSetup& setup, float r_max)
-      : g(grid), inv{1.0f / grid.voxel_size.x, 1.0f / grid.voxel_size.y, 1.0f / grid.voxel_size.z}, np(static_cast<int>(setup.disk.size())),
-        lanes((np + 7) / 8 * 8), du(lanes, 0.0f), dv(lanes, 0.0f) {
-    for (int s = 0; s < np; ++s) {
-      const ConeSetup::Disk& d = setup.disk[s];
-      du[s] = d.u, dv[s] = d.v;
-      rho_max = std::max(rho_max, std::sqrt(d.u * d.u + d.v * d.v));
-      half_max = std::max(half_max, d.half_chord);
-    }
-    half.assign(setup.sphere_radius.size() * lanes, 0.0f);
-    for (std::size_t k = 0; k < setup.sphere_radius.size(); ++k) {
-      const float r = setup.sphere_radius[k] * r_max;
-      Sphere sp{r * inv.x, r * inv.y, r * inv.z, 0.0f};
-      for (int s = 0; s < np; ++s) {
-        const float h = setup.disk[s].half_chord * sp.rz;
-        half[k * lanes + s] = h;
-        sp.chord += 2.0f * h;
-      }
-      spheres.push_back(sp);
-    }
-  }
-
-  // Spheres that start nearer the apex than this (world units) are skipped: 1.5 voxels, within
-  // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
-  // voxel whose centre is inside) fills them.
-  float near_limit() const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
-  // The voxel at world point p (false outside the grid).
-  bool solid_at(Vec3 p) const {
-    const float gx = (p.x - g.origin.x) * inv.x, gy = (p.z - g.origin.z) * inv.y, gz = (p.y - g.origin.y) * inv.z;
-    if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
-    return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
-  }
-
-  // For spheres wider than the largest window: the OR of every block the sphere's box touches.
-  bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
-    constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
-    const int bx0 = std::max(0, static_cast<int>(std::floor((gx - rx) * kInvB)));
-    const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + rx) * kInvB)));
-    const int by0 = std::max(0, static_cast<int>(std::floor((gy - ry) * kInvB)));
-    const int by1 = std::min(g.bny - 1, static_cast<int>(std::floor((gy + ry) * kInvB)));
-    const int k0 = static_cast<int>(std::floor(std::max(gz - rz, -1.0f))), k1 = static_cast<int>(std::min(gz + rz, 1e6f)) + 1;
-    for (int by = by0; by <= by1; ++by)
-      for (int bx = bx0; bx <= bx1; ++bx)
-        if (any_bits(g.block(bx, by), g.words, k0, k1)) return true;
-    return false;
-  }
-
-  // Obstructed fraction of sphere k of the chain centred at grid point (gx, gy, gz), its radius
-  // times `scale` (in (0, 1]: the jittered chain and the filler sphere); disk points are (u, v) in
-  // the world x-z plane, turned by (rot_c, rot_s).
-  float fraction(float gx, float gy, float gz, int k, float scale, float rot_c, float rot_s) const {
-    const Sphere& sp = spheres[k];
-    const float* h = half.data() + static_cast<std::size_t>(k) * lanes;
-    float len[64];  // solid length per prism, summed in prism order below (same sum at any width)
-    prisms(gx, gy, gz, sp.rx * scale, sp.ry * scale, h, scale, rot_c, rot_s, len);
-    float solid = 0;
-    for (int s = 0; s < np; ++s) solid += len[s];
-    const float chord = sp.chord * scale;
-    return chord > 0 ? std::min(1.0f, solid / chord) : 0.0f;
-  }
-
-  float scalar_prism(int s, float gx, float gy, float gz, float rx, float ry, float h, float rot_c, float rot_s) const {
-    const float u = du[s] * rot_c - dv[s] * rot_s, v = du[s] * rot_s + dv[s] * rot_c;
-    const float fx = gx + u * rx, fy = gy + v * ry;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return 0.0f;
-    return solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - h, gz + h);
-  }
-
-#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__) && !defined(AO_NO_GATHER)
-  // 8 prisms at once: column indices, z ranges, two gathered words per prism (the words of the end
-  // voxels), masks and VPOPCNTQ. Prisms whose range spans more than two words go the scalar way.
-  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, float rot_c, float rot_s, float* len) const {
-    const __m256 vscale = _mm256_set1_ps(scale);
-    const __m256 vrc = _mm256_set1_ps(rot_c), vrs = _mm256_set1_ps(rot_s);
-    const __m256 zero = _mm256_setzero_ps(), fnx = _mm256_set1_ps(static_cast<float>(g.nx)), fny = _mm256_set1_ps(static_cast<float>(g.ny));
-    const __m256 fbits = _mm256_set1_ps(static_cast<float>(g.depth_bits));
-    const __m256i last_bit = _mm256_set1_epi32(g.depth_bits - 1), nx = _mm256_set1_epi32(g.nx), words = _mm256_set1_epi32(g.words);
-    const __m512i one = _mm512_set1_epi64(1), ones = _mm512_set1_epi64(-1), c63 = _mm512_set1_epi64(63);
-    const long long* base = reinterpret_cast<const long long*>(g.bits.data());
-    for (int s0 = 0; s0 < np; s0 += 8) {
-      const __mmask8 lane = static_cast<__mmask8>(np - s0 >= 8 ? 0xff : (1u << (np - s0)) - 1);
-      const __m256 u0 = _mm256_loadu_ps(du.data() + s0), v0 = _mm256_loadu_ps(dv.data() + s0), hh = _mm256_mul_ps(_mm256_loadu_ps(h + s0), vscale);
-      const __m256 u = _mm256_fmsub_ps(u0, vrc, _mm256_mul_ps(v0, vrs)), v = _mm256_fmadd_ps(u0, vrs, _mm256_mul_ps(v0, vrc));
-      const __m256 fx = _mm256_fmadd_ps(u, _mm256_set1_ps(rx), _mm256_set1_ps(gx)), fy = _mm256_fmadd_ps(v, _mm256_set1_ps(ry), _mm256_set1_ps(gy));
-      __m256 zlo = _mm256_sub_ps(_mm256_set1_ps(gz), hh), zhi = _mm256_add_ps(_mm256_set1_ps(gz), hh);
-      zlo = _mm256_max_ps(zlo, zero);
-      zhi = _mm256_min_ps(zhi, fbits);
-      __mmask8 ok = lane & _mm256_cmp_ps_mask(fx, zero, _CMP_GE_OQ) & _mm256_cmp_ps_mask(fy, zero, _CMP_GE_OQ) &
-                    _mm256_cmp_ps_mask(fx, fnx, _CMP_LT_OQ) & _mm256_cmp_ps_mask(fy, fny, _CMP_LT_OQ) & _mm256_cmp_ps_mask(zhi, zlo, _CMP_GT_OQ);
-      const __m256i ix = _mm256_cvttps_epi32(fx), iy = _mm256_cvttps_epi32(fy);
-      const __m256i k0 = _mm256_cvttps_epi32(zlo), k1 = _mm256_min_epi32(_mm256_cvttps_epi32(zhi), last_bit);
-      const __m256i w0 = _mm256_srli_epi32(k0, 6), w1 = _mm256_srli_epi32(k1, 6);
-      // Lanes spanning more than two words: scalar.
-      const __mmask8 wide = ok & _mm256_cmp_epi32_mask(_mm256_sub_epi32(w1, w0), _mm256_set1_epi32(1), _MM_CMPINT_GT);
-      ok &= static_cast<__mmask8>(~wide);
-      const __m256i col = _mm256_mullo_epi32(_mm256_add_epi32(_mm256_mullo_epi32(iy, nx), ix), words);
-      const __m512i a = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), ok, _mm256_add_epi32(col, w0), base, 8);
-      const __m512i b = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), ok, _mm256_add_epi32(col, w1), base, 8);
-      const __m512i s0b = _mm512_and_si512(_mm512_cvtepi32_epi64(k0), c63), s1b = _mm512_and_si512(_mm512_cvtepi32_epi64(k1), c63);
-      const __m512i bit0 = _mm512_and_si512(_mm512_srlv_epi64(a, s0b), one), bit1 = _mm512_and_si512(_mm512_srlv_epi64(b, s1b), one);
-      // Bits strictly between the end voxels: [k0 + 1, k1) = [k0, k1) minus bit k0.
-      const __m512i lo = _mm512_sllv_epi64(ones, s0b), hi = _mm512_sub_epi64(_mm512_sllv_epi64(one, s1b), one);
-      const __mmask8 same = _mm256_cmp_epi32_mask(w0, w1, _MM_CMPINT_EQ);
-      const __m512i pa = _mm512_and_si512(a, _mm512_and_si512(lo, _mm512_mask_blend_epi64(same, ones, hi)));
-      const __m512i pb = _mm512_maskz_and_epi64(static_cast<__mmask8>(~same), b, hi);
-      const __m512i mid = _mm512_sub_epi64(_mm512_add_epi64(_mm512_popcnt_epi64(pa), _mm512_popcnt_epi64(pb)), bit0);
-      const __m256 fb0 = _mm512_cvtepi64_ps(bit0), fb1 = _mm512_cvtepi64_ps(bit1), fmid = _mm512_cvtepi64_ps(mid);
-      const __m256 fk0 = _mm256_cvtepi32_ps(k0), fk1 = _mm256_cvtepi32_ps(k1);
-      // k0 == k1: bit(k0) * (zhi - zlo); else bit(k0) (k0 + 1 - zlo) + between + bit(k1) (zhi - k1).
-      const __m256 multi = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(fb0, _mm256_sub_ps(_mm256_add_ps(fk0, _mm256_set1_ps(1.0f)), zlo)), fmid),
-                                         _mm256_mul_ps(fb1, _mm256_sub_ps(zhi, fk1)));
-      const __m256 single = _mm256_mul_ps(fb0, _mm256_sub_ps(zhi, zlo));
-      const __mmask8 one_voxel = _mm256_cmp_epi32_mask(k0, k1, _MM_CMPINT_GE);
-      const __m256 r = _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single));
-      _mm256_storeu_ps(len + s0, r);
-      for (unsigned m = wide; m; m &= m - 1) {
-        const int s = s0 + std::countr_zero(m);
-        len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s] * scale, rot_c, rot_s);
-      }
-    }
-  }
-#else
-  void prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, float rot_c, float rot_s, float* len) const {
-    for (int s = 0; s < np; ++s) len[s] = scalar_prism(s, gx, gy, gz, rx, ry, h[s] * scale, rot_c, rot_s);
-  }
-#endif
-};
+using cone_internal::faces_inside;
+using cone_internal::kOpaque;
+using cone_internal::kTile;
+using cone_internal::solid_length;
 
 struct EyeSampler {
   const VoxelGrid& g;
@@ -201,7 +33,7 @@ struct EyeSampler {
   int np;
   std::vector<float> radius;  // world units, per sphere of the chain
 
-  // As WorldSampler::near_limit, with the voxel of the column the point projects to: its depth
+  // As the world grid's near_limit (cone_world.cpp), with the voxel of the column the point projects to: its depth
   // 1 / voxels_per_unit and its width at the point's depth.
   float near_limit(Vec3 c) const {
     const float depth = -c.z;
@@ -281,213 +113,6 @@ float transmittance(const ChainSphere* chain, int n, bool inside, Fraction&& fra
     t *= inside ? f : 1.0f - f;
   }
   return t;
-}
-
-// The inside of a holed mesh's shell, seen through a hole, faces into its winding-number solid
-// (voxelize.h); its occluders are the inside of the shell, so its cones count the complement of
-// the solid as occluded (1 - the obstructed fraction): a hollow inside.
-template <class Sampler>
-bool faces_inside(const GBuffer& gb, const Sampler& sample, int x, int y, Vec3 p, Vec3 n, float near) {
-  const std::uint32_t id = gb.object_id(x, y);
-  const std::vector<std::uint8_t>& capped = sample.g.capped;
-  return id > 0 && id <= capped.size() && capped[id - 1] && sample.solid_at(p + n * near);
-}
-
-// The spheres of one pixel's cones, slot i = c * per_cone + j: j < ns is sphere j of cone c's
-// chain, j = ns its filler. The chain of a cone with scale s has sphere j at s d_j with radius
-// s r_j, starting at s (d_j - r_j); a scaled chain ends at s R_max, and the filler sphere,
-// inscribed in [s R_max, R_max] along the axis, samples the rest: its radius (1 - s) R_max / 2
-// is at most the last sphere's (equal at s = 1/q), and it fits in the cone for s >= 1/q. So each
-// slot's distance along the axis, radius scale and "is sampled" test are affine in s:
-//   distance = dist_a s + dist_b, radius scale = min(rad_a s + rad_b, 1), sampled: use_a s + use_b >= 0,
-// sampled meaning: the sphere starts at least near_limit from the apex (the chain), the filler's
-// radius is more than 1e-3 of the last sphere's.
-struct SphereSlots {
-  int n = 0, per_cone = 0;
-  int padded = 0;  // n rounded up to a multiple of 16 with slots that are never sampled: whole vectors
-  std::vector<float> dist_a, dist_b, rad_a, rad_b, use_a, use_b;
-  std::vector<float> ex, ey, ez;  // half extents of the prisms' box at radius scale 1, voxels (PixelSpheres::place)
-  std::vector<int> k;             // sphere of the chain whose prisms it uses
-
-  SphereSlots(const ConeSetup& setup, const WorldSampler& sample, float r_max, int cones) {
-    const int ns = static_cast<int>(setup.sphere_distance.size());
-    per_cone = ns + 1;
-    n = cones * per_cone;
-    const float near = sample.near_limit();
-    const float inv_last_radius = 1.0f / setup.sphere_radius.back();  // relative to R_max
-    for (int c = 0; c < cones; ++c)
-      for (int j = 0; j <= ns; ++j) {
-        const int kj = std::min(j, ns - 1);
-        if (j < ns) {
-          dist_a.push_back(setup.sphere_distance[j] * r_max), dist_b.push_back(0.0f);
-          rad_a.push_back(1.0f), rad_b.push_back(0.0f);
-          use_a.push_back((setup.sphere_distance[j] - setup.sphere_radius[j]) * r_max), use_b.push_back(-near);
-        } else {
-          dist_a.push_back(0.5f * r_max), dist_b.push_back(0.5f * r_max);
-          rad_a.push_back(-0.5f * inv_last_radius), rad_b.push_back(0.5f * inv_last_radius);
-          use_a.push_back(-0.5f * inv_last_radius), use_b.push_back(0.5f * inv_last_radius - 1e-3f);
-        }
-        const WorldSampler::Sphere& sp = sample.spheres[kj];
-        ex.push_back(sample.rho_max * sp.rx), ey.push_back(sample.rho_max * sp.ry), ez.push_back(sample.half_max * sp.rz);
-        k.push_back(kj);
-      }
-    padded = (n + 15) / 16 * 16;
-    for (int i = n; i < padded; ++i) {
-      dist_a.push_back(0.0f), dist_b.push_back(0.0f), rad_a.push_back(0.0f), rad_b.push_back(0.0f), use_a.push_back(0.0f), use_b.push_back(-1.0f);
-      ex.push_back(0.0f), ey.push_back(0.0f), ez.push_back(0.0f), k.push_back(0);
-    }
-  }
-};
-
-// One pixel's spheres, placed and tested against the coarse masks: flat loops over the slots with
-// no branch, so the placement and the window arithmetic vectorise, and the mask loads of all
-// spheres are issued back to back (their cache misses overlap).
-struct PixelSpheres {
-  // In, per cone: chain scale and axis (voxels).
-  std::vector<float> scale, ax, ay, az;
-  std::vector<float> s_, ax_, ay_, az_;  // the same per slot
-  // Per slot: centre (voxels), radius scale, whether it is sampled, the coarse test's mask index,
-  // z cells and "wider than the largest window", and the verdict: sampled and the coarse masks
-  // say maybe (wide: maybe_solid_blocks decides).
-  std::vector<float> cx, cy, cz, rs;
-  std::vector<int> used, lo, span, wide;
-  std::vector<std::uint32_t> index;
-  std::vector<std::uint8_t> pass;
-  // The pixel.
-  int x = 0, y = 0;
-  bool inside = false;
-  float rot_c = 1, rot_s = 0;
-
-  PixelSpheres(int cones, int n)
-      : scale(cones), ax(cones), ay(cones), az(cones), s_(n), ax_(n), ay_(n), az_(n), cx(n), cy(n), cz(n), rs(n), used(n), lo(n), span(n), wide(n), index(n), pass(n) {}
-
-  void place(const SphereSlots& q, const WorldSampler& sample, float gx, float gy, float gz) {
-    const int n = q.padded, per_cone = q.per_cone, dnx = sample.g.dnx, dny = sample.g.dny, cap = VoxelGrid::kWindowCap, shift = sample.g.cell_shift;
-    const float fdnx = static_cast<float>(dnx - 1), fdny = static_cast<float>(dny - 1), fbits = static_cast<float>(sample.g.depth_bits - 1);
-    constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
-    const float *__restrict da = q.dist_a.data(), *__restrict db = q.dist_b.data(), *__restrict ra = q.rad_a.data(), *__restrict rb = q.rad_b.data();
-    const float *__restrict ua = q.use_a.data(), *__restrict ub = q.use_b.data();
-    const float *__restrict qex = q.ex.data(), *__restrict qey = q.ey.data(), *__restrict qez = q.ez.data();
-    float *__restrict ox = cx.data(), *__restrict oy = cy.data(), *__restrict oz = cz.data(), *__restrict orr = rs.data();
-    int *__restrict ou = used.data(), *__restrict olo = lo.data(), *__restrict osp = span.data(), *__restrict owi = wide.data();
-    std::uint32_t* __restrict oi = index.data();
-    // Each slot's cone: scale and axis, copied per slot so that the loop below is flat.
-    for (int c = 0; c < q.n / per_cone; ++c)
-      for (int i = c * per_cone; i < (c + 1) * per_cone; ++i) s_[i] = scale[c], ax_[i] = ax[c], ay_[i] = ay[c], az_[i] = az[c];
-    const float *__restrict ss = s_.data(), *__restrict sx = ax_.data(), *__restrict sy = ay_.data(), *__restrict sz = az_.data();
-#pragma GCC ivdep  // the arrays do not overlap (GCC does not apply __restrict to local pointers)
-    for (int i = 0; i < n; ++i) {
-      const float s = ss[i];
-      const float d = da[i] * s + db[i];
-      const float px = gx + sx[i] * d, py = gy + sy[i] * d, pz = gz + sz[i] * d;
-      const float r = std::min(ra[i] * s + rb[i], 1.0f);
-      ox[i] = px, oy[i] = py, oz[i] = pz, orr[i] = r;
-      ou[i] = ua[i] * s + ub[i] >= 0.0f ? 1 : 0;
-      // Empty-space skipping (not in the paper; exact: a skipped sphere's prisms read no solid
-      // voxel). The sphere's prisms read columns within (ex, ey) = rho_max * (rx, ry) of its
-      // centre and voxels within ez = half_max * rz along them (floor(a) - floor(a - b) <=
-      // ceil(b); the margins cover rounding). That box of columns lies in the window (voxelize.h)
-      // anchored at its lowest cell, w = its larger span in cells (clamped into the grid, which
-      // only drops columns no prism can read); test() checks the window's z cells cl..ch. A box
-      // wider than the largest window goes to maybe_solid_blocks. Indices are
-      // int(min(max(0, x), n - 1)): clamp(floor(x), 0, n - 1) for x >= 0, and 0 for NaN.
-      const float ex = qex[i] * r * 1.001f + 1e-3f, ey = qey[i] * r * 1.001f + 1e-3f, ez = qez[i] * r * 1.001f + 1e-3f;
-      const int x0 = static_cast<int>(std::min(std::max(0.0f, (px - ex) * kInvC), fdnx)), x1 = static_cast<int>(std::min(std::max(0.0f, (px + ex) * kInvC), fdnx));
-      const int y0 = static_cast<int>(std::min(std::max(0.0f, (py - ey) * kInvC), fdny)), y1 = static_cast<int>(std::min(std::max(0.0f, (py + ey) * kInvC), fdny));
-      const int w = std::max(x1 - x0, y1 - y0);
-      const int cl = static_cast<int>(std::min(std::max(0.0f, pz - ez), fbits)) >> shift, ch = static_cast<int>(std::min(std::max(0.0f, pz + ez), fbits)) >> shift;
-      oi[i] = static_cast<std::uint32_t>((y0 * dnx + x0) * (cap + 1) + std::min(w, cap));
-      olo[i] = cl, osp[i] = ch - cl, owi[i] = w > cap ? 1 : 0;
-    }
-  }
-
-  void test(const WorldSampler& sample, const SphereSlots& q) {
-    const std::uint64_t* __restrict win = sample.g.window.data();
-    const int *__restrict ou = used.data(), *__restrict olo = lo.data(), *__restrict osp = span.data(), *__restrict owi = wide.data();
-    const std::uint32_t* __restrict oi = index.data();
-    std::uint8_t* __restrict op = pass.data();
-    const int n = q.n;
-#pragma GCC ivdep
-    for (int i = 0; i < n; ++i) {
-      const bool any = ((win[oi[i]] >> olo[i]) & (~std::uint64_t{0} >> (63 - osp[i]))) != 0;  // z cells lo..lo + span
-      op[i] = static_cast<std::uint8_t>(ou[i] & (any | owi[i]));
-    }
-  }
-  // The verdicts of slots i0 .. i0 + count - 1 as bits (count <= 17: spheres per cone + 1).
-  std::uint32_t passed(int i0, int count) const {
-    std::uint32_t m = 0;
-    for (int j = 0; j < count; ++j) m |= static_cast<std::uint32_t>(pass[i0 + j]) << j;
-    return m;
-  }
-};
-
-// World grid: per pixel, every sphere is placed and passes the coarse test (PixelSpheres), then
-// each cone runs front to back, sampling the prisms of the spheres that passed.
-void trace_world(const GBuffer& gb, const WorldSampler& sample, float r_max, const ConeSetup& setup, const ConePattern& pat, ImageView<float> out,
-                 const ProgressFn& progress) {
-  const int w = gb.width(), h = gb.height();
-  const Frame basis = gb.camera.basis();
-  const Vec3 eye = gb.camera.eye;
-  const VoxelGrid& g = sample.g;
-  const Vec3 inv = sample.inv;
-  const int nc = pat.cones;
-  const SphereSlots slots(setup, sample, r_max, nc);
-  const int per_cone = slots.per_cone;
-  const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
-  const float near = sample.near_limit();
-  // Front to back along each cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
-  // fraction f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
-  const auto finish = [&](PixelSpheres& ps) {
-    const auto fraction = [&](int i) {
-      const WorldSampler::Sphere& sp = sample.spheres[slots.k[i]];
-      const float r = ps.rs[i];
-      if (ps.wide[i] && !sample.maybe_solid_blocks(ps.cx[i], ps.cy[i], ps.cz[i], sp.rx * r, sp.ry * r, sp.rz * r)) return 0.0f;
-      return sample.fraction(ps.cx[i], ps.cy[i], ps.cz[i], slots.k[i], r, ps.rot_c, ps.rot_s);
-    };
-    float v = 0;
-    for (int c = 0; c < nc; ++c) {
-      float tr = 1.0f;
-      const int i0 = c * per_cone;
-      if (!ps.inside) {
-        // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
-        // ones, in order (bit j: sphere j of the cone).
-        for (std::uint32_t m = ps.passed(i0, per_cone); m && tr > kOpaque; m &= m - 1) tr *= 1.0f - fraction(i0 + std::countr_zero(m));
-      } else {
-        // The inside of a shell counts the complement (faces_inside): T *= f, and an empty sphere
-        // (f = 0) closes the cone.
-        for (int i = i0; i < i0 + per_cone && tr > kOpaque; ++i)
-          if (ps.used[i]) tr *= ps.pass[i] ? fraction(i) : 0.0f;
-      }
-      v += weight * tr;
-    }
-    out(ps.x, ps.y) = std::clamp(v, 0.0f, 1.0f);
-  };
-  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
-  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-    PixelSpheres ps(nc, slots.padded);
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        if (!gb.covered(x, y)) {
-          out(x, y) = 1.0f;
-          continue;
-        }
-        const Vec3 pos = basis.to_world(gb.position(x, y)) + eye, n = normalize(basis.to_world(gb.normal(x, y)));
-        const Frame frame = Frame::from_normal(n);
-        ps.x = x, ps.y = y;
-        ps.inside = faces_inside(gb, sample, x, y, pos, n, near);
-        const int slot = pat.slot(x, y);
-        ps.rot_c = pat.rot[2 * slot], ps.rot_s = pat.rot[2 * slot + 1];
-        const ConePattern::Cone* cones = pat.cone.data() + static_cast<std::size_t>(slot) * nc;
-        for (int c = 0; c < nc; ++c) {
-          const Vec3 a = frame.to_world({cones[c].x, cones[c].y, cones[c].z});
-          ps.scale[c] = cones[c].scale, ps.ax[c] = a.x * inv.x, ps.ay[c] = a.z * inv.y, ps.az[c] = a.y * inv.z;  // the axis in voxels
-        }
-        ps.place(slots, sample, (pos.x - g.origin.x) * inv.x, (pos.z - g.origin.z) * inv.y, (pos.y - g.origin.y) * inv.z);
-        ps.test(sample, slots);
-        finish(ps);
-      }
-    counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-  });
 }
 
 // Eye grid: cone by cone, sphere by sphere.
@@ -655,7 +280,7 @@ void compute_cone(const GBuffer& gb, const VoxelGrid& g, float r_max, const Cone
   const ConeSetup setup = derive_cone_setup(params);
   const ConePattern pattern = make_cone_pattern(setup, params.jitter, seed);
   if (g.space == GridSpace::World) {
-    trace_world(gb, WorldSampler(g, setup, r_max), r_max, setup, pattern, out, progress);
+    cone_internal::trace_world(gb, g, r_max, setup, pattern, out, progress);
   } else {
     const Camera& cam = g.camera;
     const float t = cam.tan_half_fov();

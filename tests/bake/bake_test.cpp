@@ -285,7 +285,9 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
               const Vec3 ng = ps.piece->ng;
               const Vec3 d = Frame::from_normal(geometric ? ng : ps.normal()).to_world(cosine_hemisphere({u[0], u[1]}));
               const Vec3 o = ps.position() + ng * (fixed > 0 ? fixed : ps.piece->offset);
-              if (std::abs(dot(d, ng)) > 1e-5f) EXPECT_EQ(b.valid[k] != 0, dot(d, ng) > 0) << "texel " << texel << " sample " << first + k;
+              if (std::abs(dot(d, ng)) > 1e-5f) {
+                EXPECT_EQ(b.valid[k] != 0, dot(d, ng) > 0) << "texel " << texel << " sample " << first + k;
+              }
               EXPECT_NEAR(b.dx[k], d.x, 1e-5f);
               EXPECT_NEAR(b.dy[k], d.y, 1e-5f);
               EXPECT_NEAR(b.dz[k], d.z, 1e-5f);

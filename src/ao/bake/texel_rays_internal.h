@@ -1,7 +1,8 @@
 // Pieces shared by the inside-out bakers (raytraced_bake.cpp, high_to_low.cpp): a texel's patch of
 // surface as sub-triangles for sampling points by area, the ray tracer that turns a batch of rays
-// into mu(D), and the tile loop both bakers run (bake_texels). Internal to src/ao/bake (namespace
-// detail).
+// into mu(D), the lane-parallel ray maker (make_texel_rays, TexelPoints) the ray-traced baker's own
+// tile loop uses, and the general tile loop high-to-low runs (bake_texels). Internal to src/ao/bake
+// (namespace detail).
 #pragma once
 
 #include <algorithm>
@@ -223,7 +224,7 @@ struct TexelSums {
   Vec3 bent{0, 0, 0}; ///< Sum of direction x mu over the traced rays.
 };
 
-/// The tile loop of the inside-out bakers. For each covered texel of `cov` (computed on
+/// The tile loop of the high-to-low baker. For each covered texel of `cov` (computed on
 /// `surface`) with a non-empty patch: `samples` samples, sample i the point i of a 4-D
 /// Owen-scrambled Sobol set keyed by pixel_seed(seed, x, y) (dimensions 0-1 make the direction,
 /// 2-3 pick the point on the patch: one jointly stratified set), `make_ray(ctx, sample, origin, direction)` turns each into a

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <new>
 #include <span>
 #include <type_traits>
 #include <utility>
@@ -39,6 +40,12 @@ struct DefaultInitAllocator : std::allocator<T> {
   DefaultInitAllocator() = default;
   template <class U>
   DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  // Pixels start on a cache line (64 bytes; malloc gives 16): rows whose size is a multiple of
+  // 64 bytes then cover whole lines, which streamed (non-temporal) stores write without reading
+  // and without two threads sharing a line at a tile seam.
+  static constexpr std::align_val_t kAlignment{64};
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlignment)); }
+  void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, kAlignment); }
   // Pixel types (float, Vec3, ...) are trivially copyable aggregates: implicit-lifetime types,
   // whose objects exist in the allocated storage without a constructor call (C++20 [intro.object]),
   // so even their default member initialisers are skipped. Others are default-initialised.

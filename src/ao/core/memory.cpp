@@ -1,13 +1,16 @@
 #include "ao/core/memory.h"
 
+#include <sys/mman.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <new>
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/core/image.h"
 
 namespace ao {
 
@@ -150,5 +153,28 @@ void check_memory(std::uint64_t bytes, const std::string& what) {
   throw SystemError(what + " needs about " + format_bytes(bytes) + " of memory, more than the " + format_bytes(avail->bytes) + " available (" +
                     avail->source + ")");
 }
+
+namespace detail {
+
+namespace {
+constexpr std::size_t kCacheLine = 64, kHugePage = std::size_t{2} << 20, kPage = 4096;
+}  // namespace
+
+void* allocate_pixels(std::size_t bytes) {
+  if (bytes < kHugePage) return ::operator new(bytes, std::align_val_t{kCacheLine});
+  void* p = ::operator new(bytes, std::align_val_t{kHugePage});
+#ifdef MADV_HUGEPAGE
+  // Advice only (the kernel may have THP off or no huge page free): the result is not checked.
+  // The range ends at the last whole 4 KiB page of the block, which is all madvise may be given.
+  madvise(p, bytes / kPage * kPage, MADV_HUGEPAGE);
+#endif
+  return p;
+}
+
+void free_pixels(void* p, std::size_t bytes) noexcept {
+  ::operator delete(p, std::align_val_t{bytes < kHugePage ? kCacheLine : kHugePage});
+}
+
+}  // namespace detail
 
 }  // namespace ao

@@ -7,6 +7,9 @@
 
 #include <emmintrin.h>
 
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
 #include "ao/core/parallel.h"
 #include "ao/reference/packets_internal.h"
 
@@ -14,8 +17,9 @@ namespace ao {
 
 namespace {
 
-// A tile (one TBB task) is kTileWidth x kTileHeight pixels, traced and written in strips one
-// packet block high (at most kStripHeight rows): long rows make long streamed runs per channel.
+// A tile is kTileWidth x kTileHeight pixels (TBB hands each thread blocks of tiles), traced and
+// written in strips one packet block high (at most kStripHeight rows): long rows make long
+// streamed runs per channel.
 constexpr int kTileWidth = 64, kTileHeight = 16, kStripHeight = 4;
 
 // World-space direction through pixel centre (x + 0.5, y + 0.5) as origin + x * dx + y * dy: the
@@ -266,9 +270,17 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   const RayGenerator gen(camera, basis);
   ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(camera.width, camera.height, kTileWidth, kTileHeight, [&](const Tile& t) {
-      render_tile<N>(rs, camera, basis, gen, options.normal, g, t);
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
+    // The range is of tile indices, so the tiles are the same however TBB splits it. TBB's auto
+    // partitioner hands each thread a few blocks of tiles (splitting further only when a thread
+    // runs dry) instead of one task per tile: fewer task switches.
+    const int columns = (camera.width + kTileWidth - 1) / kTileWidth, rows = (camera.height + kTileHeight - 1) / kTileHeight;
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, rows, 0, columns), [&](const tbb::blocked_range2d<int>& r) {
+      for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
+        for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
+          const Tile t{tx * kTileWidth, ty * kTileHeight, std::min((tx + 1) * kTileWidth, camera.width), std::min((ty + 1) * kTileHeight, camera.height)};
+          render_tile<N>(rs, camera, basis, gen, options.normal, g, t);
+          counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
+        }
     });
   });
 }

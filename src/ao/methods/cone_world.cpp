@@ -129,7 +129,7 @@ struct WorldSampler {
     const __m256 fbits = _mm256_set1_ps(static_cast<float>(g.depth_bits));
     const __m256i last_bit = _mm256_set1_epi32(g.depth_bits - 1), nx = _mm256_set1_epi32(g.nx), words = _mm256_set1_epi32(g.words);
     const __m256i last_byte = _mm256_set1_epi32(8 * g.words - 8);  // the last 8-byte load that stays in the column
-    const __m512i one = _mm512_set1_epi64(1);
+    const __m512i one = _mm512_set1_epi64(1), two = _mm512_set1_epi64(2);
     const char* base = reinterpret_cast<const char*>(g.bits.data());
     float solid = 0;
     for (int s0 = 0; s0 < np; s0 += 8) {
@@ -151,38 +151,26 @@ struct WorldSampler {
       const __m256i col = _mm256_mullo_epi32(_mm256_add_epi32(_mm256_mullo_epi32(iy, nx), ix), words);
       const __m512i at = _mm512_add_epi64(_mm512_slli_epi64(_mm512_cvtepi32_epi64(col), 3), _mm512_cvtepi32_epi64(byte));
       const __m512i word = _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), ok, at, base, 1);
-      const __m512i n64 = _mm512_cvtepi32_epi64(n);
       const __m512i x = _mm512_srlv_epi64(word, _mm512_cvtepi32_epi64(sh));  // bit 0 = voxel k0, bit n = voxel k1
-      const __m512i bit0 = _mm512_and_si512(x, one), bit1 = _mm512_and_si512(_mm512_srlv_epi64(x, n64), one);
-      // Voxels strictly between the end voxels: bits 1 .. n - 1 of x.
-      const __m512i mid = _mm512_sub_epi64(_mm512_popcnt_epi64(_mm512_and_si512(x, _mm512_sub_epi64(_mm512_sllv_epi64(one, n64), one))), bit0);
-      const __m256 fb0 = _mm512_cvtepi64_ps(bit0), fb1 = _mm512_cvtepi64_ps(bit1), fmid = _mm512_cvtepi64_ps(mid);
+      const __m512i top = _mm512_sllv_epi64(one, _mm512_cvtepi32_epi64(n));
+      const __mmask8 b0 = _mm512_test_epi64_mask(x, one), b1 = _mm512_test_epi64_mask(x, top);
+      // Voxels strictly between the end voxels: bits 1 .. n - 1 of x (n >= 1; n = 0 takes `single`).
+      const __m256 fmid = _mm512_cvtepi64_ps(_mm512_popcnt_epi64(_mm512_and_si512(x, _mm512_sub_epi64(top, two))));
       const __m256 fk0 = _mm256_cvtepi32_ps(k0), fk1 = _mm256_cvtepi32_ps(k1);
       // k0 == k1: bit(k0) * (zhi - zlo); else bit(k0) (k0 + 1 - zlo) + between + bit(k1) (zhi - k1).
-      const __m256 multi = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(fb0, _mm256_sub_ps(_mm256_add_ps(fk0, _mm256_set1_ps(1.0f)), zlo)), fmid),
-                                         _mm256_mul_ps(fb1, _mm256_sub_ps(zhi, fk1)));
-      const __m256 single = _mm256_mul_ps(fb0, _mm256_sub_ps(zhi, zlo));
+      const __m256 multi = _mm256_add_ps(_mm256_add_ps(_mm256_maskz_sub_ps(b0, _mm256_add_ps(fk0, _mm256_set1_ps(1.0f)), zlo), fmid),
+                                         _mm256_maskz_sub_ps(b1, zhi, fk1));
+      const __m256 single = _mm256_maskz_sub_ps(b0, zhi, zlo);
       const __mmask8 one_voxel = _mm256_cmp_epi32_mask(k0, k1, _MM_CMPINT_GE);
-      __m256 r = _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single));
-      if (wide) {
-        alignas(32) float len[8];
-        _mm256_store_ps(len, r);
-        for (unsigned m = wide; m; m &= m - 1) {
-          const int s = s0 + std::countr_zero(m);
-          len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * scale, pu[s], pv[s]);
-        }
-        r = _mm256_load_ps(len);
+      alignas(32) float len[8];
+      _mm256_store_ps(len, _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single)));
+      for (unsigned m = wide; m; m &= m - 1) {
+        const int s = s0 + std::countr_zero(m);
+        len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * scale, pu[s], pv[s]);
       }
-      // Summed lane by lane in prism order (lanes past np hold 0), the order of the scalar path.
-      const __m128 lo = _mm256_castps256_ps128(r), hi = _mm256_extractf128_ps(r, 1);
-      solid += _mm_cvtss_f32(lo);
-      solid += _mm_cvtss_f32(_mm_movehdup_ps(lo));
-      solid += _mm_cvtss_f32(_mm_movehl_ps(lo, lo));
-      solid += _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, 3));
-      solid += _mm_cvtss_f32(hi);
-      solid += _mm_cvtss_f32(_mm_movehdup_ps(hi));
-      solid += _mm_cvtss_f32(_mm_movehl_ps(hi, hi));
-      solid += _mm_cvtss_f32(_mm_shuffle_ps(hi, hi, 3));
+      // Summed lane by lane in prism order, the order of the scalar path (lanes past np hold 0).
+      const int count = std::min(8, np - s0);
+      for (int l = 0; l < count; ++l) solid += len[l];
     }
     return solid;
   }

@@ -129,7 +129,7 @@ struct WorldSampler {
     const __m256 fbits = _mm256_set1_ps(static_cast<float>(g.depth_bits));
     const __m256i last_bit = _mm256_set1_epi32(g.depth_bits - 1), nx = _mm256_set1_epi32(g.nx), words = _mm256_set1_epi32(g.words);
     const __m256i last_byte = _mm256_set1_epi32(8 * g.words - 8);  // the last 8-byte load that stays in the column
-    const __m512i one = _mm512_set1_epi64(1);
+    const __m512i one = _mm512_set1_epi64(1), two = _mm512_set1_epi64(2);
     const char* base = reinterpret_cast<const char*>(g.bits.data());
     float solid = 0;
     for (int s0 = 0; s0 < np; s0 += 8) {
@@ -151,38 +151,26 @@ struct WorldSampler {
       const __m256i col = _mm256_mullo_epi32(_mm256_add_epi32(_mm256_mullo_epi32(iy, nx), ix), words);
       const __m512i at = _mm512_add_epi64(_mm512_slli_epi64(_mm512_cvtepi32_epi64(col), 3), _mm512_cvtepi32_epi64(byte));
       const __m512i word = _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), ok, at, base, 1);
-      const __m512i n64 = _mm512_cvtepi32_epi64(n);
       const __m512i x = _mm512_srlv_epi64(word, _mm512_cvtepi32_epi64(sh));  // bit 0 = voxel k0, bit n = voxel k1
-      const __m512i bit0 = _mm512_and_si512(x, one), bit1 = _mm512_and_si512(_mm512_srlv_epi64(x, n64), one);
-      // Voxels strictly between the end voxels: bits 1 .. n - 1 of x.
-      const __m512i mid = _mm512_sub_epi64(_mm512_popcnt_epi64(_mm512_and_si512(x, _mm512_sub_epi64(_mm512_sllv_epi64(one, n64), one))), bit0);
-      const __m256 fb0 = _mm512_cvtepi64_ps(bit0), fb1 = _mm512_cvtepi64_ps(bit1), fmid = _mm512_cvtepi64_ps(mid);
+      const __m512i top = _mm512_sllv_epi64(one, _mm512_cvtepi32_epi64(n));
+      const __mmask8 b0 = _mm512_test_epi64_mask(x, one), b1 = _mm512_test_epi64_mask(x, top);
+      // Voxels strictly between the end voxels: bits 1 .. n - 1 of x (n >= 1; n = 0 takes `single`).
+      const __m256 fmid = _mm512_cvtepi64_ps(_mm512_popcnt_epi64(_mm512_and_si512(x, _mm512_sub_epi64(top, two))));
       const __m256 fk0 = _mm256_cvtepi32_ps(k0), fk1 = _mm256_cvtepi32_ps(k1);
       // k0 == k1: bit(k0) * (zhi - zlo); else bit(k0) (k0 + 1 - zlo) + between + bit(k1) (zhi - k1).
-      const __m256 multi = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(fb0, _mm256_sub_ps(_mm256_add_ps(fk0, _mm256_set1_ps(1.0f)), zlo)), fmid),
-                                         _mm256_mul_ps(fb1, _mm256_sub_ps(zhi, fk1)));
-      const __m256 single = _mm256_mul_ps(fb0, _mm256_sub_ps(zhi, zlo));
+      const __m256 multi = _mm256_add_ps(_mm256_add_ps(_mm256_maskz_sub_ps(b0, _mm256_add_ps(fk0, _mm256_set1_ps(1.0f)), zlo), fmid),
+                                         _mm256_maskz_sub_ps(b1, zhi, fk1));
+      const __m256 single = _mm256_maskz_sub_ps(b0, zhi, zlo);
       const __mmask8 one_voxel = _mm256_cmp_epi32_mask(k0, k1, _MM_CMPINT_GE);
-      __m256 r = _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single));
-      if (wide) {
-        alignas(32) float len[8];
-        _mm256_store_ps(len, r);
-        for (unsigned m = wide; m; m &= m - 1) {
-          const int s = s0 + std::countr_zero(m);
-          len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * scale, pu[s], pv[s]);
-        }
-        r = _mm256_load_ps(len);
+      alignas(32) float len[8];
+      _mm256_store_ps(len, _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single)));
+      for (unsigned m = wide; m; m &= m - 1) {
+        const int s = s0 + std::countr_zero(m);
+        len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * scale, pu[s], pv[s]);
       }
-      // Summed lane by lane in prism order (lanes past np hold 0), the order of the scalar path.
-      const __m128 lo = _mm256_castps256_ps128(r), hi = _mm256_extractf128_ps(r, 1);
-      solid += _mm_cvtss_f32(lo);
-      solid += _mm_cvtss_f32(_mm_movehdup_ps(lo));
-      solid += _mm_cvtss_f32(_mm_movehl_ps(lo, lo));
-      solid += _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, 3));
-      solid += _mm_cvtss_f32(hi);
-      solid += _mm_cvtss_f32(_mm_movehdup_ps(hi));
-      solid += _mm_cvtss_f32(_mm_movehl_ps(hi, hi));
-      solid += _mm_cvtss_f32(_mm_shuffle_ps(hi, hi, 3));
+      // Summed lane by lane in prism order, the order of the scalar path (lanes past np hold 0).
+      const int count = std::min(8, np - s0);
+      for (int l = 0; l < count; ++l) solid += len[l];
     }
     return solid;
   }
@@ -309,6 +297,7 @@ struct PixelSpheres {
   std::vector<std::uint8_t> used, wide, pass;
   // The pixel, and its prism pattern turned (WorldSampler::turn).
   int x = 0, y = 0;
+  float at_x = 0, at_y = 0, at_z = 0;  // the pixel's point in voxels
   bool inside = false;
   std::vector<float> u, v;
   // Per cone (padded to a multiple of 8): chain scale and axis in voxels.
@@ -372,7 +361,8 @@ struct PixelSpheres {
 
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)
   // Every slot of `q` (stride = per_cone): the same placement and test as place_cone, 8 slots at a
-  // time, each slot taking its cone's scale and axis by a permutation (a gather past 8 cones).
+  // time, each slot taking its cone's scale and axis by a permutation (a gather past 8 cones). The
+  // centres and radii are not stored: centre() computes them for the few slots that pass.
   void place_flat(const FlatSlots& q, const WorldSampler& sample, int cones, float gx, float gy, float gz) {
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), quarter = _mm256_set1_ps(1.0f / VoxelGrid::kCellXY);
     const __m256 fdnx = _mm256_set1_ps(static_cast<float>(sample.g.dnx - 1)), fdny = _mm256_set1_ps(static_cast<float>(sample.g.dny - 1));
@@ -396,7 +386,6 @@ struct PixelSpheres {
       const __m256 d = _mm256_fmadd_ps(_mm256_loadu_ps(q.dist_a.data() + i), s, _mm256_loadu_ps(q.dist_b.data() + i));
       const __m256 px = _mm256_fmadd_ps(cax, d, vgx), py = _mm256_fmadd_ps(cay, d, vgy), pz = _mm256_fmadd_ps(caz, d, vgz);
       const __m256 r = _mm256_min_ps(_mm256_fmadd_ps(_mm256_loadu_ps(q.rad_a.data() + i), s, _mm256_loadu_ps(q.rad_b.data() + i)), one);
-      _mm256_storeu_ps(cx.data() + i, px), _mm256_storeu_ps(cy.data() + i, py), _mm256_storeu_ps(cz.data() + i, pz), _mm256_storeu_ps(rs.data() + i, r);
       const __mmask8 use = _mm256_cmp_ps_mask(_mm256_fmadd_ps(_mm256_loadu_ps(q.use_a.data() + i), s, _mm256_loadu_ps(q.use_b.data() + i)), zero, _CMP_GE_OQ);
       // The box of place_cone in cells (x, y) and voxels (z); max(v, 0) gives 0 for NaN.
       const __m256 ex = _mm256_fmadd_ps(_mm256_loadu_ps(q.ex.data() + i), r, margin_c), ey = _mm256_fmadd_ps(_mm256_loadu_ps(q.ey.data() + i), r, margin_c);
@@ -409,11 +398,20 @@ struct PixelSpheres {
       const __m256i w = _mm256_max_epi32(_mm256_sub_epi32(x1, x0), _mm256_sub_epi32(y1, y0));
       const __mmask8 wid = _mm256_cmp_epi32_mask(w, cap, _MM_CMPINT_GT);
       const __m256i idx = _mm256_add_epi32(_mm256_slli_epi32(_mm256_add_epi32(_mm256_mullo_epi32(y0, dnx), x0), 3), _mm256_min_epi32(w, cap));
-      const __m512i wm = _mm512_i32gather_epi64(idx, win, 8);
+      const __m512i wm = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), use, idx, win, 8);
       const __m512i sh = _mm512_cvtepi32_epi64(_mm256_sub_epi32(c63, _mm256_sub_epi32(ch, cl)));
       const __mmask8 any = _mm512_test_epi64_mask(_mm512_srlv_epi64(wm, _mm512_cvtepi32_epi64(cl)), _mm512_srlv_epi64(ones, sh));
       used[i >> 3] = use, wide[i >> 3] = wid, pass[i >> 3] = use & (any | wid);
     }
+  }
+
+  // Slot i's centre (voxels) and radius scale as place_flat computes them (the same fused
+  // multiply-adds), from the pixel's grid point (gx, gy, gz).
+  void centre(const FlatSlots& q, int i, float gx, float gy, float gz, float& px, float& py, float& pz, float& r) const {
+    const int c = q.cone[i];
+    const float s = scale[c], d = std::fma(q.dist_a[i], s, q.dist_b[i]);
+    px = std::fma(ax[c], d, gx), py = std::fma(ay[c], d, gy), pz = std::fma(az[c], d, gz);
+    r = std::min(std::fma(q.rad_a[i], s, q.rad_b[i]), 1.0f);
   }
 #endif
 };
@@ -456,9 +454,14 @@ void trace_with(const GBuffer& gb, const WorldSampler& sample, float r_max, cons
     const auto fraction = [&](int i, int j) {
       const int k = lanes.k[j];
       const WorldSampler::Sphere& sp = sample.spheres[k];
-      const float r = ps.rs[i];
-      if (PixelSpheres::bit(ps.wide, i) && !sample.maybe_solid_blocks(ps.cx[i], ps.cy[i], ps.cz[i], sp.rx * r, sp.ry * r, sp.rz * r)) return 0.0f;
-      return sample.fraction(ps.cx[i], ps.cy[i], ps.cz[i], k, r, ps.u.data(), ps.v.data());
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)
+      float px, py, pz, r;
+      ps.centre(flat, i, ps.at_x, ps.at_y, ps.at_z, px, py, pz, r);
+#else
+      const float px = ps.cx[i], py = ps.cy[i], pz = ps.cz[i], r = ps.rs[i];
+#endif
+      if (PixelSpheres::bit(ps.wide, i) && !sample.maybe_solid_blocks(px, py, pz, sp.rx * r, sp.ry * r, sp.rz * r)) return 0.0f;
+      return sample.fraction(px, py, pz, k, r, ps.u.data(), ps.v.data());
     };
     float v = 0;
     for (int c = 0; c < nc; ++c) {
@@ -523,6 +526,7 @@ void trace_with(const GBuffer& gb, const WorldSampler& sample, float r_max, cons
 #endif
         const float gx = (pos.x - g.origin.x) * inv.x, gy = (pos.z - g.origin.z) * inv.y, gz = (pos.y - g.origin.y) * inv.z;
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)
+        ps.at_x = gx, ps.at_y = gy, ps.at_z = gz;
         ps.place_flat(flat, sample, nc, gx, gy, gz);
 #else
         for (int c = 0; c < nc; ++c) ps.place_cone(lanes, sample, c, gx, gy, gz);

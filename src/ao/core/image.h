@@ -52,6 +52,9 @@ struct DefaultInitAllocator : std::allocator<T> {
   DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
   T* allocate(std::size_t n) { return static_cast<T*>(allocate_pixels(n * sizeof(T))); }
   void deallocate(T* p, std::size_t n) noexcept { free_pixels(p, n * sizeof(T)); }
+  // Pixel types (float, Vec3, ...) are trivially copyable aggregates: implicit-lifetime types,
+  // whose objects exist in the allocated storage without a constructor call (C++20 [intro.object]),
+  // so even their default member initialisers are skipped. Others are default-initialised.
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
     if constexpr (!(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>)) ::new (static_cast<void*>(p)) U;

@@ -118,6 +118,15 @@ struct WorldSampler {
   }
 
 #if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512VPOPCNTDQ__) && !defined(AO_NO_GATHER)
+  // The grid's constants in vectors, made once per call of the kernel (not rebuilt per sphere).
+  struct VecConst {
+    __m256 fnx, fny, fbits;
+    __m256i last_bit, nx, words, last_byte;  // last_byte: the last 8-byte load that stays in the column
+    __m512i one, two;
+  };
+  VecConst vk{_mm256_set1_ps(static_cast<float>(g.nx)), _mm256_set1_ps(static_cast<float>(g.ny)), _mm256_set1_ps(static_cast<float>(g.depth_bits)),
+              _mm256_set1_epi32(g.depth_bits - 1), _mm256_set1_epi32(g.nx), _mm256_set1_epi32(g.words), _mm256_set1_epi32(8 * g.words - 8),
+              _mm512_set1_epi64(1), _mm512_set1_epi64(2)};
   // The solid length of the np prisms summed in prism order, 8 at a time: column indices, z ranges,
   // one gathered 64-bit load per prism starting at the byte that holds its first voxel (bits
   // k0 .. k1 of the column are then bits sh .. sh + k1 - k0 of the load, sh = k0 mod 8, or
@@ -125,11 +134,9 @@ struct WorldSampler {
   // (k1 - k0 + sh > 63) go the scalar way.
   float prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float scale, const float* pu, const float* pv) const {
     const __m256 vscale = _mm256_set1_ps(scale);
-    const __m256 zero = _mm256_setzero_ps(), fnx = _mm256_set1_ps(static_cast<float>(g.nx)), fny = _mm256_set1_ps(static_cast<float>(g.ny));
-    const __m256 fbits = _mm256_set1_ps(static_cast<float>(g.depth_bits));
-    const __m256i last_bit = _mm256_set1_epi32(g.depth_bits - 1), nx = _mm256_set1_epi32(g.nx), words = _mm256_set1_epi32(g.words);
-    const __m256i last_byte = _mm256_set1_epi32(8 * g.words - 8);  // the last 8-byte load that stays in the column
-    const __m512i one = _mm512_set1_epi64(1), two = _mm512_set1_epi64(2);
+    const __m256 zero = _mm256_setzero_ps(), fnx = vk.fnx, fny = vk.fny, fbits = vk.fbits;
+    const __m256i last_bit = vk.last_bit, nx = vk.nx, words = vk.words, last_byte = vk.last_byte;
+    const __m512i one = vk.one, two = vk.two;
     const char* base = reinterpret_cast<const char*>(g.bits.data());
     float solid = 0;
     for (int s0 = 0; s0 < np; s0 += 8) {
@@ -162,15 +169,23 @@ struct WorldSampler {
                                          _mm256_maskz_sub_ps(b1, zhi, fk1));
       const __m256 single = _mm256_maskz_sub_ps(b0, zhi, zlo);
       const __mmask8 one_voxel = _mm256_cmp_epi32_mask(k0, k1, _MM_CMPINT_GE);
-      alignas(32) float len[8];
-      _mm256_store_ps(len, _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single)));
-      for (unsigned m = wide; m; m &= m - 1) {
-        const int s = s0 + std::countr_zero(m);
-        len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * scale, pu[s], pv[s]);
+      __m256 len = _mm256_maskz_mov_ps(ok, _mm256_mask_blend_ps(one_voxel, multi, single));
+      if (wide) {
+        alignas(32) float w[8];
+        _mm256_store_ps(w, len);
+        for (unsigned m = wide; m; m &= m - 1) {
+          const int s = s0 + std::countr_zero(m);
+          w[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * scale, pu[s], pv[s]);
+        }
+        len = _mm256_load_ps(w);
       }
-      // Summed lane by lane in prism order, the order of the scalar path (lanes past np hold 0).
-      const int count = std::min(8, np - s0);
-      for (int l = 0; l < count; ++l) solid += len[l];
+      // Summed lane by lane in prism order, the order of the scalar path, in registers. Lanes past
+      // np hold +0, and adding +0 to a sum >= +0 leaves it as it is, so all 8 lanes are added.
+      const __m128 a = _mm256_castps256_ps128(len), b = _mm256_extractf128_ps(len, 1);
+      __m128 t = _mm_set_ss(solid);
+      t = _mm_add_ss(t, a), t = _mm_add_ss(t, _mm_movehdup_ps(a)), t = _mm_add_ss(t, _mm_movehl_ps(a, a)), t = _mm_add_ss(t, _mm_shuffle_ps(a, a, 3));
+      t = _mm_add_ss(t, b), t = _mm_add_ss(t, _mm_movehdup_ps(b)), t = _mm_add_ss(t, _mm_movehl_ps(b, b)), t = _mm_add_ss(t, _mm_shuffle_ps(b, b, 3));
+      solid = _mm_cvtss_f32(t);
     }
     return solid;
   }

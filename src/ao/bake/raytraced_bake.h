@@ -52,6 +52,7 @@ inline constexpr std::size_t kBakeMediumBvhTriangles = 50'000;
 inline BvhOptions bake_bvh_options(std::size_t triangles) {
   BvhOptions o;
   if (triangles > kBakeMediumBvhTriangles) o.quality = BvhQuality::Medium;
+  o.quads = true;
   return o;
 }
 

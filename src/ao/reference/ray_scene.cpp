@@ -1,5 +1,6 @@
 #include "ao/reference/ray_scene.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -78,7 +79,9 @@ RayScene::RayScene(const Scene& scene, const BvhOptions& options)
   const bool big = is_big(top_triangles);
   quality_ = options.quality.value_or(big ? BvhQuality::Medium : BvhQuality::High);
   compact_ = options.compact.value_or(big);
-  quads_ = options.quads;
+  // Pairing numbers a triangle's edges 4 t + corner in 32 bits: meshes of 2^30 triangles or more
+  // (12 GB of indices) stay triangles.
+  quads_ = options.quads && std::all_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.triangle_count() < detail::kMaxPairedTriangles; });
   // The quads of each mesh, built before any geometry shares them.
   if (quads_) {
     h.pairs.resize(scene.meshes.size());

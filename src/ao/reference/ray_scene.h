@@ -33,7 +33,8 @@ struct BvhOptions {
   /// with its last vertex repeated): the same surfaces in about half the primitives, a smaller
   /// BVH that occlusion rays traverse faster (the ray-traced bake's, bake_bvh_options). A hit's
   /// triangle is then found from the quad and the hit's (u, v) (embree_scene_internal.h's resolve
-  /// with u and v). Off: one primitive per triangle.
+  /// with u and v). Off: one primitive per triangle. A scene with a mesh of 2^30 triangles or more
+  /// stays triangles.
   bool quads = false;
 };
 

@@ -5,6 +5,7 @@
 // primitives.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -19,7 +20,10 @@ struct TrianglePairs {
   std::size_t paired_triangles = 0;      ///< Triangles that share their quad with another.
 };
 
-/// Pairs the triangles of `m` into quads. Two triangles pair across an edge they share with
+/// Meshes pair_triangles takes have fewer triangles than this (it numbers edges in 32 bits).
+inline constexpr std::size_t kMaxPairedTriangles = std::size_t{1} << 30;
+
+/// Pairs the triangles of `m` (fewer than kMaxPairedTriangles) into quads. Two triangles pair across an edge they share with
 /// opposite directions (both wound the same way seen from one side), the edge's ends compared by
 /// position, so the two sides of a UV seam, whose vertices are split, still pair; an edge of more
 /// than two triangles pairs any two of them with opposite directions. Among the candidate pairs, those whose

@@ -49,7 +49,7 @@ void raytraced(benchmark::State& state, const std::string& file) {
   BakeFixture* f = uv_mesh(file, size);
   if (!f) return state.SkipWithError("../shared/data/meshes not found");
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
-  const RayScene rs(f->scene);
+  const RayScene rs(f->scene, bake_bvh_options(f->scene.triangle_count()));  // the BVH `ao bake` builds
   for (auto _ : state) benchmark::DoNotOptimize(bake_raytraced(rs, f->coverage, {.samples = spp}));
   const double texels = static_cast<double>(f->coverage.covered_texels) * state.iterations();
   state.counters["texels/s"] = benchmark::Counter(texels, benchmark::Counter::kIsRate);

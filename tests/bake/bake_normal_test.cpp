@@ -50,7 +50,7 @@ RaytracedBakeParams with_normal(SurfaceNormal n) { return {.samples = 64, .norma
 
 TEST(BakeNormal, FlatShadedCubeGivesTheSameMapAndVerticesWithEitherNormal) {
   const Scene s = cube_on_floor();
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const TexelCoverage cov = compute_texel_coverage(s, 48);
   const BakeResult a = bake_raytraced(rs, cov, with_normal(SurfaceNormal::Shading));
   const BakeResult b = bake_raytraced(rs, cov, with_normal(SurfaceNormal::Geometric));
@@ -75,7 +75,7 @@ TEST(BakeNormal, FlatShadedCubeGivesTheSameMapAndVerticesWithEitherNormal) {
 
 TEST(BakeNormal, CoarseSmoothSphereDiffersBetweenNormals) {
   const Scene s = coarse_sphere();
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const TexelCoverage cov = compute_texel_coverage(s, 64);
   const BakeResult shading = bake_raytraced(rs, cov, with_normal(SurfaceNormal::Shading));
   const BakeResult geometric = bake_raytraced(rs, cov, with_normal(SurfaceNormal::Geometric));
@@ -119,7 +119,7 @@ TEST(BakeNormal, SmoothCreaseVertexDiffersBetweenNormals) {
   s.name = "crease";
   validate_and_prepare(s);
   ASSERT_NEAR(s.meshes[0].normals[4].y, std::sqrt(0.5f), 1e-5f);
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   RaytracedBakeParams p{.samples = 4096, .seed = 3};
   const float shading = bake_vertices_raytraced(rs, p)[4];
   p.normal = SurfaceNormal::Geometric;

@@ -83,7 +83,7 @@ TEST(Bake, SingleQuadIsFullyVisibleBothMethods) {
   const TexelCoverage cov = compute_texel_coverage(s, 16);
   EXPECT_EQ(cov.covered_texels, 256u);
   const BakeResult h = bake_histogram(s, cov, {.directions = 256, .pixels_per_texel = 2.0f});
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const BakeResult r = bake_raytraced(rs, cov, {.samples = 64});
   double hmin = 1, hsum = 0;
   for (std::size_t i = 0; i < h.visibility.size(); ++i) {
@@ -129,7 +129,7 @@ TEST(Bake, FloorNextToWallMatchesViewFactorBothMethods) {
   const int n = 16;
   const TexelCoverage cov = compute_texel_coverage(s, n);
   const BakeResult h = bake_histogram(s, cov, {.directions = 1024, .pixels_per_texel = 2.0f});
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const BakeResult r = bake_raytraced(rs, cov, {.samples = 1024});
   for (int band = 0; band < 4; ++band) {
     const double d0 = band * 0.25, d1 = d0 + 0.25;
@@ -177,7 +177,7 @@ TEST(Bake, NonSquareMapMatchesViewFactorBothMethods) {
   const TexelCoverage cov = compute_texel_coverage(s, w, h);
   EXPECT_EQ(cov.covered_texels, static_cast<std::size_t>(w * h));
   const BakeResult hist = bake_histogram(s, cov, {.directions = 1024, .pixels_per_texel = 2.0f});
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const BakeResult ray = bake_raytraced(rs, cov, {.samples = 1024});
   for (const BakeResult* r : {&hist, &ray}) {
     ASSERT_EQ(r->visibility.width(), w);
@@ -215,7 +215,7 @@ TEST(Bake, QuadInsideClosedBoxIsFullyOccluded) {
   s = prepared(std::move(s));
   const TexelCoverage cov = compute_texel_coverage(s, 8);
   const BakeResult h = bake_histogram(s, cov, {.directions = 128});
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const BakeResult r = bake_raytraced(rs, cov, {.samples = 64});
   for (std::size_t i = 0; i < h.visibility.size(); ++i) {
     EXPECT_EQ(h.visibility[i], 0.0f);
@@ -334,7 +334,7 @@ TEST(Bake, RaytracedDistanceLimitMatchesWallFormula) {
   const Scene s = floor_and_wall(40.0f);
   const int n = 8;
   const TexelCoverage cov = compute_texel_coverage(s, n);
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const float R = 2.0f;
   const BakeResult r = bake_raytraced(rs, cov, {.samples = 2048, .max_distance = R});
   for (int y = 0; y < n; ++y) {
@@ -397,9 +397,46 @@ TEST(Bake, HistogramIsIdenticalAtOneAndTwoThreads) {
 TEST(Bake, RaytracedIsIdenticalAtOneAndTwoThreads) {
   const Scene s = floor_and_wall(1.0f);
   const TexelCoverage cov = compute_texel_coverage(s, 16);
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const RaytracedBakeParams p{.samples = 48, .bent_normals = true, .seed = 5};
   expect_identical_at_one_and_two_threads([&] { return bake_raytraced(rs, cov, p); });
+}
+
+// The bake's quad BVH (bake_bvh_options pairs triangles into quads) traces the same rays to the
+// same answers as a BVH of the triangles: occlusion packets (the default), closest hits through
+// back faces (ignore_back_faces maps each hit back to its triangle for the face normal) and
+// distances (a linear membership). Occluders: a sphere and a torus, curved, so a quad's two
+// halves face different ways.
+TEST(Bake, QuadBvhBakesTheTriangleBvhsMap) {
+  Scene s;
+  s.meshes.push_back(uv_quad({-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}, {0, 0}, {1, 1}));
+  s.meshes.push_back(make_sphere({0.5f, 0.6f, 0.3f}, 0.5f, 20, 9));
+  s.meshes.push_back(make_torus({-0.8f, 0.3f, -0.5f}, 0.6f, 0.2f, 17, 7));
+  s = prepared(std::move(s));
+  const TexelCoverage cov = compute_texel_coverage(s, 24);
+  const RayScene quads(s, bake_bvh_options(s.triangle_count()));
+  ASSERT_TRUE(quads.quads());
+  const RayScene tris(s, {});
+  ASSERT_FALSE(tris.quads());
+  const RaytracedBakeParams cases[] = {{.samples = 64},
+                                       {.samples = 32, .ignore_back_faces = true},
+                                       {.samples = 32, .max_distance = 1.0f, .membership = Membership::Linear}};
+  for (const RaytracedBakeParams& p : cases) {
+    const BakeResult want = bake_raytraced(tris, cov, p);
+    const BakeResult got = bake_raytraced(quads, cov, p);
+    double darkened = 0;  // how much the occluders take off the map, to show the case tests something
+    int differ = 0;
+    for (std::size_t i = 0; i < want.visibility.size(); ++i) {
+      if (!want.mask[i]) continue;
+      darkened += 1.0 - want.visibility[i];
+      // A ray that grazes an edge two triangles share may be answered differently (the order of
+      // the two intersection tests changes): at most a sample or two of a texel.
+      EXPECT_NEAR(got.visibility[i], want.visibility[i], 2.0 / p.samples) << "texel " << i;
+      differ += got.visibility[i] != want.visibility[i];
+    }
+    EXPECT_GT(darkened, 10.0);
+    EXPECT_LT(differ, static_cast<int>(want.covered_texels / 50)) << "texels not bit-identical";
+  }
 }
 
 // The texel error against the analytic texel average falls faster than Monte Carlo's N^-1/2:
@@ -410,7 +447,7 @@ TEST(Bake, RaytracedErrorFallsFasterThanMonteCarlo) {
   const Scene s = floor_and_wall(1.0f);
   const int n = 16;
   const TexelCoverage cov = compute_texel_coverage(s, n);
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   auto rmse = [&](int samples) {
     double se = 0;
     int count = 0;
@@ -446,7 +483,7 @@ TEST(Bake, PaddingLeavesNoBlackTexelWithinTheMargin) {
   s = prepared(std::move(s));
   const int n = 64, margin = 6;
   const TexelCoverage cov = compute_texel_coverage(s, n);
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   BakeResult r = bake_raytraced(rs, cov, {.samples = 16});  // open quad: exactly 1 on the charts
   pad(r.visibility, nearest_valid_texel(r.mask, margin));
   for (int y = 0; y < n; ++y)
@@ -463,7 +500,7 @@ TEST(Bake, PaddingLeavesNoBlackTexelWithinTheMargin) {
 TEST(Bake, PerVertexBothMethodsOnOpenQuadAndWall) {
   const Scene s = floor_and_wall(1.0f);
   const std::vector<float> h = bake_vertices_histogram(s, {.directions = 512, .resolution = 512});
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const std::vector<float> r = bake_vertices_raytraced(rs, {.samples = 1024});
   ASSERT_EQ(h.size(), s.vertex_count());
   ASSERT_EQ(r.size(), s.vertex_count());
@@ -479,7 +516,7 @@ TEST(Bake, PerVertexRaytracedIsTheSameAtAnyThreadCount) {
   // Vertices are traced in Morton order, in tiles spread over the threads; each vertex's samples
   // are keyed by its index, so neither the order nor the thread count may change a value.
   const Scene s = make_builtin_scene("default");
-  const RayScene rs(s);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
   const RaytracedBakeParams params{.samples = 4, .max_distance = 0.5f};
   const std::vector<float> many = bake_vertices_raytraced(rs, params);
   std::vector<float> one;

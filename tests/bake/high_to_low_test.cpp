@@ -3,10 +3,12 @@
 // finely tessellated sphere with bumps (radius 1 + A sin(K phi) sin(K theta)).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
 #include "ao/bake/high_to_low.h"
+#include "ao/bake/raytraced_bake.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/error.h"
 #include "ao/reference/embree_scene_internal.h"
@@ -183,6 +185,27 @@ TEST(HighToLow, CageOfAnotherTopologyIsAOneLineError) {
     EXPECT_NE(msg.find("topology"), std::string::npos) << msg;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }
+}
+
+// The cage ray's hit is interpolated with triangle barycentrics, so a quad BVH of the high mesh
+// (the ray-traced bake's) is refused; as occluders it is fine.
+TEST(HighToLow, QuadTargetsAreRejectedQuadOccludersAreNot) {
+  const Scene low = prepared(lat_long_sphere(12, 6, round_unit, true), "low");
+  const Scene high = prepared(lat_long_sphere(24, 12, round_unit, false), "high");
+  const RayScene tris(high);
+  const RayScene quads(high, bake_bvh_options(high.triangle_count()));
+  ASSERT_TRUE(quads.quads());
+  const TexelCoverage cov = compute_texel_coverage(low, 16);
+  HighToLowParams p;
+  p.ao.samples = 16;
+  p.cage_extrusion = 0.05f;
+  const CagePositions cage = extrude_cage(low, *p.cage_extrusion);
+  EXPECT_THROW(bake_high_to_low(low, cov, cage, quads, quads, p), InputError);
+  const BakeResult want = bake_high_to_low(low, cov, cage, tris, tris, p);
+  const BakeResult got = bake_high_to_low(low, cov, cage, tris, quads, p);
+  double diff = 0;
+  for (std::size_t i = 0; i < want.visibility.size(); ++i) diff = std::max(diff, std::abs(static_cast<double>(got.visibility[i]) - want.visibility[i]));
+  EXPECT_LE(diff, 2.0 / 16);  // the same rays; one grazing an edge two triangles share may differ
 }
 
 TEST(HighToLow, BadDistancesAreRejected) {

@@ -51,7 +51,7 @@ HighHit trace_cage_ray(const RayScene& targets, const TriangleNormals& fn, RTCIn
     RTCRayHit rh{};
     rh.ray = {o.x, o.y, o.z, tnear, d.x, d.y, d.z, 0.0f, tfar, 0xffffffffu, 0, 0};
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(embree_scene(targets), &ctx, &rh);
+    rtcIntersect1(embree_scene(targets), &ctx, &rh);  // targets are triangles (high_to_low.h): (u, v) are barycentrics
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
     const HitRef hit = resolve(targets, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID);
     const Affine3* nt = hit.normal_to_world;  // null: the mesh is in world space
@@ -145,6 +145,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
                             const HighToLowParams& params, const ProgressFn& progress) {
   params.validate();
   if (cage.size() != low.meshes.size()) throw InputError("high-to-low: the cage has a different number of meshes than the low scene");
+  if (targets.quads()) throw InputError("high-to-low: the high meshes' BVH must hold triangles (built without BvhOptions::quads)");
   const Falloff falloff = params.ao.falloff();
   const TriangleNormals target_fn = detail::face_normals(targets.scene());
   const TriangleNormals occluder_fn = detail::face_normals(occluders.scene());

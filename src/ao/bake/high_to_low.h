@@ -48,8 +48,10 @@ CagePositions cage_from_mesh(const Scene& low, const Scene& cage);
 
 /// V per covered texel of `coverage` (computed on `low`): the mean over `params.ao.samples`
 /// samples per texel, each a uniform point of the texel's patch, its cage ray to `targets` (the high
-/// meshes) and one cosine-weighted AO ray at the hit, traced in `occluders` (the high meshes and
-/// any extra occluders; may be the same RayScene as `targets`). Samples whose cage ray misses are
+/// meshes, a RayScene of triangles: built without BvhOptions::quads, since the cage ray's hit is
+/// interpolated with Embree's triangle barycentrics) and one cosine-weighted AO ray at the hit,
+/// traced in `occluders` (the high meshes and any extra occluders; may be the same RayScene as
+/// `targets`; either kind). Samples whose cage ray misses are
 /// left out of the mean; a texel where all miss is marked in BakeResult::missed, counted in
 /// missed_texels, and takes the value of the nearest texel that hit (fill_missed_texels).
 /// Deterministic at any thread count (per-texel scrambled Sobol sets, as bake_raytraced).

@@ -29,9 +29,10 @@ struct TriangleNormals {
   std::vector<std::vector<Vec3>> per_mesh;
 };
 
-/// World-space face normal (not unit for an instance) of the triangle a ray hit.
-inline Vec3 hit_face_normal(const RayScene& rs, const TriangleNormals& fn, unsigned geom_id, unsigned inst_id, unsigned prim_id) {
-  const HitRef h = resolve(rs, geom_id, inst_id, prim_id);
+/// World-space face normal (not unit for an instance) of the triangle a ray hit (Embree's hit
+/// fields; u and v find the triangle in a quad BVH).
+inline Vec3 hit_face_normal(const RayScene& rs, const TriangleNormals& fn, unsigned geom_id, unsigned inst_id, unsigned prim_id, float u, float v) {
+  const HitRef h = resolve(rs, geom_id, inst_id, prim_id, u, v);
   const Vec3 n = fn.per_mesh[h.mesh][h.triangle];
   return h.normal_to_world ? h.normal_to_world->vector(n) : n;
 }
@@ -152,7 +153,7 @@ struct Tracer {
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(embree_scene(rs), &ctx, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 1.0f;
-      if (!ignore_back || dot(hit_face_normal(rs, normals, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID), d) <= 0) return falloff.mu(rh.ray.tfar);
+      if (!ignore_back || dot(hit_face_normal(rs, normals, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v), d) <= 0) return falloff.mu(rh.ray.tfar);
       tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: look beyond it
     }
     return 0.0f;
@@ -190,7 +191,7 @@ struct Tracer {
         for (int k = 0; k < count; ++k) {
           if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
             mu[k] = 1.0f;
-          } else if (ignore_back && dot(hit_face_normal(rs, normals, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k]), dir[k]) > 0) {
+          } else if (ignore_back && dot(hit_face_normal(rs, normals, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]), dir[k]) > 0) {
             mu[k] = trace1(ctx, org[k], dir[k], std::nextafter(rh.ray.tfar[k], kInfinity));
           } else {
             mu[k] = falloff.mu(rh.ray.tfar[k]);

@@ -9,6 +9,7 @@
 #include <embree3/rtcore.h>
 
 #include "ao/reference/ray_scene.h"
+#include "ao/reference/triangle_pairs_internal.h"
 
 namespace ao {
 
@@ -18,6 +19,7 @@ struct RayScene::Handles {
   std::vector<RTCScene> mesh_scenes;        ///< Per mesh: its own scene when it is instanced, else null.
   std::vector<SceneObject> objects;         ///< rs.scene().objects(), by geometry ID of the top level.
   std::vector<Affine3> normal_to_world;     ///< Per instance: cofactor of its transform (face normals; normalise).
+  std::vector<detail::TrianglePairs> pairs; ///< Per mesh: its quads when built with BvhOptions::quads, else empty.
 };
 
 /// The committed top-level Embree scene of `rs`: object i (Scene::objects()) is geometry i, a
@@ -38,8 +40,9 @@ struct HitRef {
   const Affine3* normal_to_world = nullptr;  ///< Its cofactor matrix (face and vertex normals; normalise), or null.
 };
 
-/// Maps a hit (geomID, instID[0], primID; geomID valid) to the scene. Every kernel that needs more
-/// than "hit or not" and the distance goes through this.
+/// Maps a hit (geomID, instID[0], primID; geomID valid) to the scene, in a scene of triangles
+/// (built without BvhOptions::quads; the overload below takes any). Every kernel that needs more
+/// than "hit or not" and the distance goes through one of the two.
 inline HitRef resolve(const RayScene& rs, unsigned geom_id, unsigned inst_id, unsigned prim_id) {
   const RayScene::Handles& h = rs.handles();
   HitRef r;
@@ -51,6 +54,14 @@ inline HitRef resolve(const RayScene& rs, unsigned geom_id, unsigned inst_id, un
     r.to_world = &rs.scene().instances[o.instance].object_to_world;
     r.normal_to_world = &h.normal_to_world[o.instance];
   }
+  return r;
+}
+
+/// Maps a hit (geomID, instID[0], primID and Embree's hit coordinates u, v) to the scene, whether
+/// its primitives are triangles or quads (BvhOptions::quads: the quad's half that (u, v) lies in).
+inline HitRef resolve(const RayScene& rs, unsigned geom_id, unsigned inst_id, unsigned prim_id, float u, float v) {
+  HitRef r = resolve(rs, geom_id, inst_id, prim_id);
+  if (rs.quads()) r.triangle = detail::quad_hit_triangle(rs.handles().pairs[r.mesh], prim_id, u, v);
   return r;
 }
 

@@ -1,5 +1,6 @@
 #include "ao/reference/ray_scene.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -27,11 +28,12 @@ RTCBuildQuality embree_quality(BvhQuality q) {
   return q == BvhQuality::High ? RTC_BUILD_QUALITY_HIGH : q == BvhQuality::Medium ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_LOW;
 }
 
-// A committed triangle geometry for mesh m. Embree's SIMD loads read 16 bytes from the last
-// vertex, 4 past its end: the mesh's own array is shared when its spare capacity covers that
-// (validate_and_prepare reserves it), else copied into a buffer Embree pads itself.
-RTCGeometry triangle_geometry(RTCDevice device, const Mesh& m) {
-  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+// A committed geometry for mesh m: its triangles, or (`pairs` not null) the quads of its paired
+// triangles. Embree's SIMD loads read 16 bytes from the last vertex, 4 past its end: the mesh's own
+// array is shared when its spare capacity covers that (validate_and_prepare reserves it), else
+// copied into a buffer Embree pads itself.
+RTCGeometry mesh_geometry(RTCDevice device, const Mesh& m, const detail::TrianglePairs* pairs) {
+  RTCGeometry geom = rtcNewGeometry(device, pairs ? RTC_GEOMETRY_TYPE_QUAD : RTC_GEOMETRY_TYPE_TRIANGLE);
   if (m.positions.capacity() >= m.positions.size() + kVertexPadding) {
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0, sizeof(Vec3), m.positions.size());
   } else {
@@ -39,8 +41,11 @@ RTCGeometry triangle_geometry(RTCDevice device, const Mesh& m) {
     check(device, "allocating a vertex buffer");
     std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(Vec3));
   }
-  // Indices are read one triangle (12 bytes) at a time: no padding needed.
-  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0, 3 * sizeof(std::uint32_t), m.triangle_count());
+  // Indices are read one primitive (12 or 16 bytes) at a time: no padding needed.
+  if (pairs)
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, pairs->quads.data(), 0, 4 * sizeof(std::uint32_t), pairs->quad_count());
+  else
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices.data(), 0, 3 * sizeof(std::uint32_t), m.triangle_count());
   check(device, "setting geometry buffers");
   rtcCommitGeometry(geom);
   return geom;
@@ -60,7 +65,7 @@ RayScene::RayScene(const Scene& scene, const BvhOptions& options)
   else if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED)) packet_width_ = 4;
 
   // Object i (Scene::objects()) is geometry i of the top-level scene: a mesh drawn in world space
-  // is a triangle geometry there; an instanced mesh gets a committed scene of its own, built once,
+  // is a triangle (or quad) geometry there; an instanced mesh gets a committed scene of its own, built once,
   // and each of its instances is an instance geometry pointing at it.
   Handles& h = *handles_;
   h.objects = scene.objects();
@@ -74,6 +79,16 @@ RayScene::RayScene(const Scene& scene, const BvhOptions& options)
   const bool big = is_big(top_triangles);
   quality_ = options.quality.value_or(big ? BvhQuality::Medium : BvhQuality::High);
   compact_ = options.compact.value_or(big);
+  // Pairing numbers a triangle's edges 4 t + corner in 32 bits: meshes of 2^30 triangles or more
+  // (12 GB of indices) stay triangles.
+  quads_ = options.quads && std::all_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.triangle_count() < detail::kMaxPairedTriangles; });
+  // The quads of each mesh, built before any geometry shares them.
+  if (quads_) {
+    h.pairs.resize(scene.meshes.size());
+    for (const SceneObject& o : h.objects)
+      if (h.pairs[o.mesh].quads.empty()) h.pairs[o.mesh] = detail::pair_triangles(scene.meshes[o.mesh]);
+  }
+  const auto pairs_of = [&](std::uint32_t mesh) { return quads_ ? &h.pairs[mesh] : nullptr; };
   bvh = rtcNewScene(device);
   rtcSetSceneBuildQuality(bvh, embree_quality(quality_));
   if (compact_) rtcSetSceneFlags(bvh, RTC_SCENE_FLAG_COMPACT);
@@ -81,7 +96,7 @@ RayScene::RayScene(const Scene& scene, const BvhOptions& options)
     const SceneObject& o = h.objects[i];
     RTCGeometry geom = nullptr;
     if (o.instance == SceneObject::kNoInstance) {
-      geom = triangle_geometry(device, scene.meshes[o.mesh]);
+      geom = mesh_geometry(device, scene.meshes[o.mesh], pairs_of(o.mesh));
     } else {
       RTCScene& sub = h.mesh_scenes[o.mesh];
       if (!sub) {
@@ -90,7 +105,7 @@ RayScene::RayScene(const Scene& scene, const BvhOptions& options)
         sub = rtcNewScene(device);
         rtcSetSceneBuildQuality(sub, embree_quality(options.quality.value_or(sub_big ? BvhQuality::Medium : BvhQuality::High)));
         if (options.compact.value_or(sub_big)) rtcSetSceneFlags(sub, RTC_SCENE_FLAG_COMPACT);
-        RTCGeometry mesh_geom = triangle_geometry(device, m);
+        RTCGeometry mesh_geom = mesh_geometry(device, m, pairs_of(o.mesh));
         rtcAttachGeometryByID(sub, mesh_geom, 0);
         rtcReleaseGeometry(mesh_geom);
         rtcCommitScene(sub);

@@ -29,6 +29,13 @@ inline constexpr std::size_t kCompactBvhTriangles = 4'000'000;
 struct BvhOptions {
   std::optional<BvhQuality> quality;  ///< Empty: High up to kCompactBvhTriangles, Medium above.
   std::optional<bool> compact;        ///< Leaves that index the mesh's vertices instead of copying them. Empty: above kCompactBvhTriangles.
+  /// Triangles that share an edge are paired into one quad primitive (a lone triangle is a quad
+  /// with its last vertex repeated): the same surfaces in about half the primitives, a smaller
+  /// BVH that occlusion rays traverse faster (the ray-traced bake's, bake_bvh_options). A hit's
+  /// triangle is then found from the quad and the hit's (u, v) (embree_scene_internal.h's resolve
+  /// with u and v). Off: one primitive per triangle. A scene with a mesh of 2^30 triangles or more
+  /// stays triangles.
+  bool quads = false;
 };
 
 class RayScene {
@@ -54,6 +61,8 @@ class RayScene {
   /// The build settings used for the top-level BVH, with the automatic choices resolved.
   BvhQuality quality() const { return quality_; }
   bool compact() const { return compact_; }
+  /// Whether the BVH's primitives are quads of paired triangles (BvhOptions::quads).
+  bool quads() const { return quads_; }
 
   /// Embree's device and scene; defined in ao/reference/embree_scene_internal.h (internal).
   struct Handles;
@@ -66,6 +75,7 @@ class RayScene {
   int packet_width_ = 1;
   BvhQuality quality_ = BvhQuality::High;
   bool compact_ = false;
+  bool quads_ = false;
 };
 
 }  // namespace ao

@@ -189,7 +189,8 @@ class Viewer {
   // started by the previous frame is collected and its image becomes the shown one; if the state
   // changed, the compute of the new state starts on the compute thread; the shown image is drawn
   // meanwhile. So the window shows the state of one frame earlier while a change is in flight, and
-  // a frame costs about the larger of compute and drawing, not their sum.
+  // a frame costs about the larger of compute and drawing, not their sum. `--set pipeline=off`
+  // collects each compute in the frame that starts it (compute, then drawing), to measure the gain.
   int run() {
     open_window();
     Clock::time_point last_input = Clock::now();
@@ -223,6 +224,7 @@ class Viewer {
       if (s_.benchmark) dirty_gbuffer_ = true;
       collect(times);
       start_compute();
+      if (!pipeline_) collect(times);  // compute, then draw its image: one after the other
       poll_reference();
       const Clock::time_point display_start = Clock::now();
       const auto [fbw, fbh] = draw_frame();
@@ -431,13 +433,13 @@ class Viewer {
       if (value != "y" && value != "z") throw InputError("--set up: y or z, got '" + value + "'");
       orbit_.set_up_axis(value == "y" ? UpAxis::Y : UpAxis::Z);
       camera_moved();
-    } else if (key == "panel" || key == "hud") {
+    } else if (key == "panel" || key == "hud" || key == "pipeline") {
       if (value != "on" && value != "off") throw InputError("--set " + key + ": on or off, got '" + value + "'");
-      (key == "panel" ? show_panel_ : show_hud_) = value == "on";
+      (key == "panel" ? show_panel_ : key == "hud" ? show_hud_ : pipeline_) = value == "on";
     } else {
       nlohmann::json& params = current_params();
       if (!params.contains(key)) {
-        std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud";
+        std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud, pipeline";
         for (const auto& [k, v] : params.items()) known += ", " + k;
         throw InputError("--set: unknown key '" + key + "' (viewer settings and parameters of " + method_ + ": " + known + ")");
       }
@@ -533,15 +535,15 @@ class Viewer {
     }
   }
 
-  // Waits for the compute in flight, if any, and makes its image the shown one; its stage times go
-  // into `times`. A scripted run fails on its error; an interactive one shows it in the panel.
+  // Waits for the compute in flight, if any, and makes its image the shown one; its stage times are
+  // added to `times`. A scripted run fails on its error; an interactive one shows it in the panel.
   void collect(StageTimes& times) {
     if (!compute_.busy()) return;
     const Clock::time_point t = Clock::now();
     try {
       compute_.wait();
     } catch (const InputError& e) {
-      times.wait = ms_since(t);
+      times.wait += ms_since(t);
       if (s_.frames > 0) throw;  // a scripted run must fail loudly
       error_ = e.what();
       // A G-buffer that was rendered is the current camera's: shown, with no method image on it.
@@ -552,8 +554,8 @@ class Viewer {
       dirty_display_ = true;
       return;
     }
-    times.wait = ms_since(t);
-    times.gbuffer = job_.times.gbuffer, times.method = job_.times.method, times.filter = job_.times.filter;
+    times.wait += ms_since(t);
+    times.gbuffer += job_.times.gbuffer, times.method += job_.times.method, times.filter += job_.times.filter;
     if (job_.rendered) adopt_gbuffer();
     job_.gbuffer.reset();
     result_ = std::move(job_.output);
@@ -1024,6 +1026,7 @@ class Viewer {
   ViewMode view_ = ViewMode::AO;
   float wipe_ = 1.0f;
   bool moved_ = false, show_panel_ = true, show_hud_ = true;
+  bool pipeline_ = true;  // --set pipeline=off: each compute is collected in the frame that starts it
   bool dirty_gbuffer_ = true, dirty_method_ = true, dirty_display_ = true;
   bool dirty_reference_side_ = false;  // only the reference (right of the wipe) changed
   bool screenshot_pending_ = false;

@@ -33,7 +33,6 @@
 #include "ao/io/image_io.h"
 #include "ao/methods/registry.h"
 #include "ao/reference/ray_scene.h"
-#include "view/background_task.h"
 #include "view/orbit.h"
 #include "view/progressive.h"
 
@@ -55,13 +54,10 @@ constexpr int kPanelWidth = 340;
 constexpr int kReferenceBatch = 4;
 constexpr int kReferenceMax = 4096;
 
-// Per-stage wall times, ms; a stage that did not run is 0. G-buffer, method and filter run on the
-// compute thread (BackgroundTask) and are reported in the frame that collects them; display, wait
-// and frame are the main thread's, and overlap the compute of the next image.
+// Per-stage wall times of one frame, ms; a stage that did not run this frame is 0.
 struct StageTimes {
   double gbuffer = 0, method = 0, filter = 0, display = 0, frame = 0;
   double image = 0;  // the part of display that builds and uploads the 8-bit image (0: unchanged)
-  double wait = 0;   // the main thread waiting for the compute it collects (0: none collected)
 };
 
 // Averages over the frames of the last second (the HUD) and over the whole run (--json).
@@ -78,15 +74,7 @@ class StageStats {
     if (t.filter > 0) last_.filter = t.filter;
     if (t.display > 0) last_.display = t.display;
     total_.image += t.image, runs_.image += t.image > 0;
-    total_.wait += t.wait, runs_.wait += t.gbuffer > 0 || t.method > 0;
     ++frames_;
-  }
-  /// A compute collected after the last frame (a scripted run's end): its stages count in the
-  /// stage means, and the wait for it in the frame time (N frames then cost the wall time of N
-  /// computes and N drawings), but it is not a frame of its own.
-  void add_compute(const StageTimes& t) {
-    total_.gbuffer += t.gbuffer, total_.method += t.method, total_.filter += t.filter, total_.frame += t.wait;
-    runs_.gbuffer += t.gbuffer > 0, runs_.method += t.method > 0, runs_.filter += t.filter > 0;
   }
   /// The time of each stage the last time it ran.
   const StageTimes& last_run() const { return last_; }
@@ -111,7 +99,6 @@ class StageStats {
             {"filter_ms", mean(total_.filter, runs_.filter)},
             {"display_ms", mean(total_.display, runs_.display)},
             {"image_ms", mean(total_.image, runs_.image)},
-            {"wait_ms", mean(total_.wait, runs_.wait)},
             {"gbuffer_runs", runs_.gbuffer},
             {"method_runs", runs_.method}};
   }
@@ -158,21 +145,6 @@ std::pair<float, float> parse_xy(const std::string& text, const std::string& wha
   throw InputError("--event: " + what + " takes dx,dy in pixels, got '" + text + "'");
 }
 
-// One image's compute on the compute thread: its inputs, copied from the viewer's state when it
-// starts, then its outputs.
-struct ComputeJob {
-  bool render = false;  // render the G-buffer first (else: the method on `gbuffer` as it is)
-  Camera camera;
-  std::shared_ptr<GBuffer> gbuffer;  // rendered into (null: a new one), or read
-  std::string method;
-  nlohmann::json params;
-  Falloff falloff;
-  std::uint32_t seed = 0;
-  bool rendered = false;  // the G-buffer was rendered (the method may still have failed)
-  MethodOutput output;
-  StageTimes times;
-};
-
 class Viewer {
  public:
   explicit Viewer(ViewSetup setup) : s_(std::move(setup)), rays_(s_.scene), orbit_(s_.camera), progressive_(kReferenceBatch, s_.frames > 0 && s_.wait_reference_spp > 0 ? s_.wait_reference_spp : kReferenceMax) {
@@ -185,30 +157,16 @@ class Viewer {
     for (const std::string& kv : s_.sets) apply_set(kv);
   }
 
-  // One frame: input (window events, scripted events, the panel) changes the state; the compute
-  // started by the previous frame is collected and its image becomes the shown one; if the state
-  // changed, the compute of the new state starts on the compute thread; the shown image is drawn
-  // meanwhile. So the window shows the state of one frame earlier while a change is in flight, and
-  // a frame costs about the larger of compute and drawing, not their sum. `--set pipeline=off`
-  // collects each compute in the frame that starts it (compute, then drawing), to measure the gain.
   int run() {
     open_window();
     Clock::time_point last_input = Clock::now();
     for (frame_ = 0;; ++frame_) {
       if (glfwWindowShouldClose(window_)) break;
-      if (s_.frames > 0 && frame_ >= s_.frames) {
-        // A scripted run ends on the state of its last frame: its compute is collected first.
-        StageTimes last;
-        collect(last);
-        stats_.add_compute(last);
-        poll_reference();
-        if (reference_ready()) break;
-      }
+      if (s_.frames > 0 && frame_ >= s_.frames && reference_ready()) break;
       const Clock::time_point frame_start = Clock::now();
       StageTimes times;
       // Interactive and idle: sleep until input or the reference's next batch, instead of spinning.
-      const bool idle = s_.frames == 0 && !s_.benchmark && !dirty_gbuffer_ && !dirty_method_ && !compute_.busy() &&
-                        Clock::now() - last_input > std::chrono::milliseconds(200);
+      const bool idle = s_.frames == 0 && !s_.benchmark && !dirty_gbuffer_ && !dirty_method_ && Clock::now() - last_input > std::chrono::milliseconds(200);
       if (idle)
         glfwWaitEventsTimeout(0.05);
       else
@@ -222,10 +180,7 @@ class Viewer {
       if (handle_input()) last_input = Clock::now();
       if (show_panel_) draw_panel();
       if (s_.benchmark) dirty_gbuffer_ = true;
-      collect(times);
-      start_compute();
-      if (!pipeline_) collect(times);  // compute, then draw its image: one after the other
-      poll_reference();
+      update(times);
       const Clock::time_point display_start = Clock::now();
       const auto [fbw, fbh] = draw_frame();
       times.display = ms_since(display_start);
@@ -234,11 +189,6 @@ class Viewer {
       glfwSwapBuffers(window_);
       times.frame = ms_since(frame_start);
       stats_.add(times);
-    }
-    if (compute_.busy()) {  // the window was closed with a compute in flight
-      StageTimes last;
-      collect(last);
-      stats_.add_compute(last);
     }
     if (!s_.screenshot.empty()) {
       // The last frame is still in the back buffer's twin: draw it once more and read it back.
@@ -433,13 +383,13 @@ class Viewer {
       if (value != "y" && value != "z") throw InputError("--set up: y or z, got '" + value + "'");
       orbit_.set_up_axis(value == "y" ? UpAxis::Y : UpAxis::Z);
       camera_moved();
-    } else if (key == "panel" || key == "hud" || key == "pipeline") {
+    } else if (key == "panel" || key == "hud") {
       if (value != "on" && value != "off") throw InputError("--set " + key + ": on or off, got '" + value + "'");
-      (key == "panel" ? show_panel_ : key == "hud" ? show_hud_ : pipeline_) = value == "on";
+      (key == "panel" ? show_panel_ : show_hud_) = value == "on";
     } else {
       nlohmann::json& params = current_params();
       if (!params.contains(key)) {
-        std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud, pipeline";
+        std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud";
         for (const auto& [k, v] : params.items()) known += ", " + k;
         throw InputError("--set: unknown key '" + key + "' (viewer settings and parameters of " + method_ + ": " + known + ")");
       }
@@ -482,127 +432,70 @@ class Viewer {
     return c;
   }
 
-  // Starts the compute of the current state on the compute thread if the state changed since the
-  // last one: the G-buffer (if the camera or the scale changed) and the method. What it needs is
-  // copied into job_ here, so input and the panel can change the state while it runs.
-  void start_compute() {
-    if (!dirty_gbuffer_ && !dirty_method_) return;
-    if (!dirty_gbuffer_ && !gbuffer_) {  // no G-buffer to run the method on: the next render runs it
-      dirty_method_ = false;
-      return;
-    }
-    job_.render = dirty_gbuffer_;
-    job_.camera = current_camera();
-    // Render into a G-buffer that nothing shows or holds (the one shown before the current one,
-    // once the reference has let go of it): a moving camera then touches no fresh pages (half of a
-    // cold G-buffer is page faults). The shown G-buffer is never written while it is drawn.
-    job_.gbuffer = !job_.render ? gbuffer_ : spare_gbuffer_.use_count() == 1 ? std::move(spare_gbuffer_) : nullptr;
-    spare_gbuffer_.reset();
-    job_.method = method_;
-    job_.params = current_params();
-    job_.falloff = falloff_;
-    job_.seed = s_.seed;
-    job_.rendered = false;
-    dirty_gbuffer_ = dirty_method_ = false;
-    compute_.start([this] { run_compute(job_); });
-  }
-
-  // On the compute thread: reads job (and the scene, the ray scene and the method cache, which only
-  // this thread uses while a compute is in flight), writes job's outputs.
-  void run_compute(ComputeJob& job) {
-    job.times = {};
-    if (job.render) {
-      const Clock::time_point t = Clock::now();
-      job.camera.validate();
-      if (job.gbuffer)
-        render_gbuffer(rays_, job.camera, *job.gbuffer);
-      else
-        job.gbuffer = std::make_shared<GBuffer>(render_gbuffer(rays_, job.camera));
-      job.rendered = true;
-      job.times.gbuffer = ms_since(t);
-    }
-    const Clock::time_point t = Clock::now();
-    if (job.method == "raytraced") {
-      job.output = MethodOutput{};  // the view shows the progressive reference itself
-    } else {
-      const MethodInfo& m = find_method(job.method);
-      job.output = m.run(MethodInput{*job.gbuffer, &rays_, job.falloff, job.seed, {}, &s_.scene.analytic, &method_cache_}, job.params);
-    }
-    job.times.method = ms_since(t);
-    if (job.output.stats.contains("filter_ms")) {
-      job.times.filter = job.output.stats["filter_ms"].get<double>();
-      job.times.method = std::max(0.0, job.times.method - job.times.filter);
-    }
-  }
-
-  // Waits for the compute in flight, if any, and makes its image the shown one; its stage times are
-  // added to `times`. A scripted run fails on its error; an interactive one shows it in the panel.
-  void collect(StageTimes& times) {
-    if (!compute_.busy()) return;
-    const Clock::time_point t = Clock::now();
+  void update(StageTimes& times) {
     try {
-      compute_.wait();
+      if (dirty_gbuffer_) {
+        const Clock::time_point t = Clock::now();
+        Camera cam = current_camera();
+        cam.validate();
+        // Render into the G-buffer of the previous frame when the reference no longer holds it: a
+        // moving camera then touches no fresh pages (half of a cold G-buffer is page faults).
+        if (gbuffer_ && gbuffer_.use_count() == 1)
+          render_gbuffer(rays_, cam, *gbuffer_);
+        else
+          gbuffer_ = std::make_shared<GBuffer>(render_gbuffer(rays_, cam));
+        times.gbuffer = ms_since(t);
+        dirty_gbuffer_ = false;
+        dirty_method_ = true;
+      }
+      if (dirty_method_) {
+        const Clock::time_point t = Clock::now();
+        const MethodInfo& m = find_method(method_);
+        nlohmann::json params = current_params();
+        if (method_ == "raytraced") {
+          result_ = MethodOutput{};  // the view shows the progressive reference itself
+        } else {
+          result_ = m.run(MethodInput{*gbuffer_, &rays_, falloff_, s_.seed, {}, &s_.scene.analytic, &method_cache_}, params);
+        }
+        times.method = ms_since(t);
+        if (result_.stats.contains("filter_ms")) {
+          times.filter = result_.stats["filter_ms"].get<double>();
+          times.method = std::max(0.0, times.method - times.filter);
+        }
+        dirty_method_ = false;
+        dirty_display_ = true;
+        restart_reference(m, params);
+        error_.clear();
+      }
     } catch (const InputError& e) {
-      times.wait += ms_since(t);
       if (s_.frames > 0) throw;  // a scripted run must fail loudly
       error_ = e.what();
-      // A G-buffer that was rendered is the current camera's: shown, with no method image on it.
-      if (job_.rendered) adopt_gbuffer();
-      result_ = MethodOutput{};
-      shown_method_ = job_.method;
-      job_.gbuffer.reset();
-      dirty_display_ = true;
-      return;
+      dirty_gbuffer_ = dirty_method_ = false;
     }
-    times.wait += ms_since(t);
-    times.gbuffer += job_.times.gbuffer, times.method += job_.times.method, times.filter += job_.times.filter;
-    if (job_.rendered) adopt_gbuffer();
-    job_.gbuffer.reset();
-    result_ = std::move(job_.output);
-    shown_method_ = job_.method;
-    dirty_display_ = true;
-    error_.clear();
-    try {
-      restart_reference(job_);
-    } catch (const InputError& e) {
-      if (s_.frames > 0) throw;
-      error_ = e.what();
-    }
-  }
-
-  void adopt_gbuffer() {
-    spare_gbuffer_ = std::move(gbuffer_);
-    gbuffer_ = job_.gbuffer;
-    shown_camera_ = job_.camera;
-  }
-
-  // Takes the reference's newest estimate when it has one.
-  void poll_reference() {
     const std::uint64_t v = progressive_.version();
     if (v != reference_version_) {
       reference_version_ = v;
       ref_ = progressive_.snapshot();
       if (const std::string e = progressive_.error(); !e.empty()) error_ = "reference: " + e;
       update_rmse();
-      if (view_ == ViewMode::Error || shown_method_ == "raytraced")
+      if (view_ == ViewMode::Error || method_ == "raytraced")
         dirty_display_ = true;
       else if (wipe_ < 1)
         dirty_reference_side_ = true;
     }
   }
 
-  // The reference of what the shown image was computed with.
-  void restart_reference(const ComputeJob& job) {
+  void restart_reference(const MethodInfo& m, const nlohmann::json& params) {
     if (s_.benchmark) {  // a moving camera: nothing to accumulate
       progressive_.stop();
       return;
     }
-    ReferenceJob ref;
-    ref.gbuffer = gbuffer_;
-    ref.scene = &rays_;
-    ref.spec = find_method(job.method).reference(job.falloff, job.params);
-    ref.seed = job.seed;
-    progressive_.restart(std::move(ref));
+    ReferenceJob job;
+    job.gbuffer = gbuffer_;
+    job.scene = &rays_;
+    job.spec = m.reference(falloff_, params);
+    job.seed = s_.seed;
+    progressive_.restart(std::move(job));
   }
 
   void update_rmse() {
@@ -628,7 +521,7 @@ class Viewer {
     const GBuffer& g = *gbuffer_;
     try {
       if (view_ == ViewMode::Shaded) {
-        const Image<float>& v = shown_method_ == "raytraced" && !ref_.visibility.empty() ? ref_.visibility : result_.visibility;
+        const Image<float>& v = method_ == "raytraced" && !ref_.visibility.empty() ? ref_.visibility : result_.visibility;
         shaded_ = v.size() == g.object_id.size() ? shade_for_display(g, v, result_.color) : Image<Vec3>();
       }
       if (view_ == ViewMode::Map && !s_.ao_map.empty()) map_v_ = visibility_from_ao_map(g, s_.scene, s_.ao_map, "--ao-map");
@@ -651,7 +544,7 @@ class Viewer {
     const int channels = grey ? 1 : 4;
     pixels_.resize(static_cast<std::size_t>(w) * h * channels);
     const bool have_ref = !ref_.visibility.empty() && ref_.visibility.width() == w && ref_.visibility.height() == h;
-    const Image<float>& method_v = shown_method_ == "raytraced" && have_ref ? ref_.visibility : result_.visibility;
+    const Image<float>& method_v = method_ == "raytraced" && have_ref ? ref_.visibility : result_.visibility;
     const int split = have_ref ? static_cast<int>(std::lround(wipe_ * w)) : w;
     const ViewMode view = view_;
     const bool transfer = view == ViewMode::Transfer && !result_.color.empty();
@@ -937,7 +830,7 @@ class Viewer {
       }
     write_rgb_image(screenshot_path_, image);
     if (!camera_path_.empty()) {
-      Camera cam = shown_camera_;  // the camera of the image on screen
+      Camera cam = current_camera();
       cam.width = width_, cam.height = height_;
       write_camera_file(camera_path_, cam);
     }
@@ -1011,14 +904,9 @@ class Viewer {
   std::string method_;
   std::map<std::string, nlohmann::json> params_by_method_;
   Falloff falloff_;
-  // The shown image: its G-buffer, the camera and method it was computed with, the method's output.
   std::shared_ptr<GBuffer> gbuffer_;
-  Camera shown_camera_;
-  std::string shown_method_;
   MethodOutput result_;
-  std::shared_ptr<GBuffer> spare_gbuffer_;  // the one shown before, for the next render to reuse
-  ComputeJob job_;  // between start_compute() and collect() only the compute thread touches it
-  MethodCache method_cache_;  // cone's voxel grid, transfer's scratch images: kept from frame to frame; the compute thread's
+  MethodCache method_cache_;  // cone's voxel grid, transfer's scratch images: kept from frame to frame
   Image<Vec3> shaded_;
   Image<float> map_v_;
   double rmse_ = -1;
@@ -1026,7 +914,6 @@ class Viewer {
   ViewMode view_ = ViewMode::AO;
   float wipe_ = 1.0f;
   bool moved_ = false, show_panel_ = true, show_hud_ = true;
-  bool pipeline_ = true;  // --set pipeline=off: each compute is collected in the frame that starts it
   bool dirty_gbuffer_ = true, dirty_method_ = true, dirty_display_ = true;
   bool dirty_reference_side_ = false;  // only the reference (right of the wipe) changed
   bool screenshot_pending_ = false;
@@ -1034,9 +921,6 @@ class Viewer {
   std::unique_ptr<tbb::global_control> limit_;
   StageStats stats_;
   double image_ms_ = 0;  // building and uploading the image in the last draw_frame
-  // Last, so it is destroyed first: its destructor waits for a compute in flight, which uses the
-  // members above.
-  BackgroundTask compute_;
 };
 
 }  // namespace

@@ -96,17 +96,18 @@ void TexelPoints::generate(std::uint32_t key, int samples) {
   int c = 0;
   while ((32 << c) <= samples) ++c;
   const int cols = 1 << ((c + 1) / 2), rows = 1 << (c / 2);
-  const auto cell = [&](std::size_t i) {
+  cell_of.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const int a = std::min(static_cast<int>(scratch[0][i] * static_cast<float>(cols)), cols - 1);
     const int b = std::min(static_cast<int>(scratch[1][i] * static_cast<float>(rows)), rows - 1);
-    return static_cast<std::size_t>(a * rows + b);
-  };
+    cell_of[i] = static_cast<std::uint32_t>(a * rows + b);
+  }
   // Counting sort by cell, stable.
   cell_count.assign(static_cast<std::size_t>(cols * rows) + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++cell_count[cell(i) + 1];
+  for (std::size_t i = 0; i < n; ++i) ++cell_count[cell_of[i] + 1];
   for (std::size_t k = 1; k < cell_count.size(); ++k) cell_count[k] += cell_count[k - 1];
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t to = cell_count[cell(i)]++;
+    const std::size_t to = cell_count[cell_of[i]]++;
     for (int d = 0; d < 4; ++d) u[d][to] = scratch[d][i];
   }
 }

@@ -104,6 +104,7 @@ struct TexelRayBatch {
 struct TexelPoints {
   std::vector<float> u[4];  ///< Dimension d of the j-th point in direction order.
   std::vector<std::uint32_t> cell_count;
+  std::vector<std::uint32_t> cell_of;  ///< Grid cell of each point in index order.
   std::vector<float> scratch[4];
   void generate(std::uint32_t key, int samples);
   /// Points first .. first + count - 1 (count in [1, 16]) of the order into lanes 0 .. count - 1.

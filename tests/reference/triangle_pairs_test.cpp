@@ -113,6 +113,23 @@ TEST(TrianglePairs, LoneFlippedAndNonManifoldTriangles) {
   EXPECT_EQ(pair_triangles(Mesh{}).quad_count(), 0u);
 }
 
+// A "book" of 20,000 pages on one edge (each page a triangle 0 -> 1 -> its own corner, every
+// other one wound the other way): the edge offers no pairs (a fan of more than 8), so every page
+// stays alone and pairing stays linear in the page count instead of building 10^8 candidates.
+TEST(TrianglePairs, AFanOfManyTrianglesOnOneEdgeStaysAlone) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {0, 0, 1}};
+  constexpr int kPages = 20000;
+  for (int i = 0; i < kPages; ++i) {
+    const float a = 6.2831853f * static_cast<float>(i) / kPages;
+    m.positions.push_back({std::cos(a), std::sin(a), 0.5f});
+    const auto c = static_cast<std::uint32_t>(i + 2);
+    m.indices.insert(m.indices.end(), i % 2 ? std::initializer_list<std::uint32_t>{1, 0, c} : std::initializer_list<std::uint32_t>{0, 1, c});
+  }
+  const TrianglePairs p = pair_triangles(m);
+  EXPECT_EQ(check_pairs(m, p), kPages);
+}
+
 // Closest hits of random rays through the quad BVH and the triangle BVH of `s`: the same distance
 // and (resolve with u, v) the same triangle, but for rays that land on an edge two triangles share.
 void expect_same_hits(const Scene& s) {

@@ -76,24 +76,28 @@ TrianglePairs pair_triangles(const Mesh& m) {
     }
   tbb::parallel_sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.key != y.key ? x.key < y.key : x.at < y.at; });
 
-  // Candidates: two different triangles on one edge, running it in opposite directions.
+  // Candidates: two different triangles on one edge, running it in opposite directions. An edge
+  // of more than kMaxFan triangles (non-manifold fans, stacked copies) offers none: its candidates
+  // grow with the square of its triangles, and they still pair across their other edges.
+  constexpr std::size_t kMaxFan = 8;
   std::vector<Candidate> candidates;
   for (std::size_t first = 0; first < edges.size();) {
     std::size_t last = first + 1;
     while (last < edges.size() && edges[last].key == edges[first].key) ++last;
-    for (std::size_t i = first; i < last; ++i)
-      for (std::size_t j = i + 1; j < last; ++j) {
-        const Edge& x = edges[i];
-        const Edge& y = edges[j];
-        if (x.tri() == y.tri() || x.forward == y.forward) continue;
-        const Vec3 pa = m.positions[vertex(x.tri(), x.corner())], pb = m.positions[vertex(x.tri(), x.corner() + 1)];
-        const Vec3 pc = m.positions[vertex(x.tri(), x.corner() + 2)], pd = m.positions[vertex(y.tri(), y.corner() + 2)];
-        const float separate = box_area({pa, pb, pc}) + box_area({pa, pb, pd});
-        const float cost = separate > 0 ? box_area({pa, pb, pc, pd}) / separate : 0.0f;
-        const auto cx = static_cast<std::uint8_t>(x.corner()), cy = static_cast<std::uint8_t>(y.corner());
-        if (x.tri() < y.tri()) candidates.push_back({cost, x.tri(), y.tri(), cx, cy});
-        else candidates.push_back({cost, y.tri(), x.tri(), cy, cx});
-      }
+    if (last - first <= kMaxFan)
+      for (std::size_t i = first; i < last; ++i)
+        for (std::size_t j = i + 1; j < last; ++j) {
+          const Edge& x = edges[i];
+          const Edge& y = edges[j];
+          if (x.tri() == y.tri() || x.forward == y.forward) continue;
+          const Vec3 pa = m.positions[vertex(x.tri(), x.corner())], pb = m.positions[vertex(x.tri(), x.corner() + 1)];
+          const Vec3 pc = m.positions[vertex(x.tri(), x.corner() + 2)], pd = m.positions[vertex(y.tri(), y.corner() + 2)];
+          const float separate = box_area({pa, pb, pc}) + box_area({pa, pb, pd});
+          const float cost = separate > 0 ? box_area({pa, pb, pc, pd}) / separate : 0.0f;
+          const auto cx = static_cast<std::uint8_t>(x.corner()), cy = static_cast<std::uint8_t>(y.corner());
+          if (x.tri() < y.tri()) candidates.push_back({cost, x.tri(), y.tri(), cx, cy});
+          else candidates.push_back({cost, y.tri(), x.tri(), cy, cx});
+        }
     first = last;
   }
   tbb::parallel_sort(candidates.begin(), candidates.end(),

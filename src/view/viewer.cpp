@@ -785,7 +785,7 @@ class Viewer {
       if (ImGui::Button("screenshot (S)")) on_key(GLFW_KEY_S);
     }
     if (ImGui::CollapsingHeader("reference", ImGuiTreeNodeFlags_DefaultOpen)) {
-      ImGui::Text("%d rays/pixel, std error %.4f", ref_.samples_per_pixel, ref_.mean_std_error);
+      ImGui::Text("%d rays/pixel, std error %s", ref_.samples_per_pixel, std_error_text().c_str());
       if (rmse_ >= 0) ImGui::Text("RMSE of %s: %.4f", method_.c_str(), rmse_);
     }
     if (!error_.empty()) ImGui::TextWrapped("%s", error_.c_str());
@@ -810,7 +810,7 @@ class Viewer {
     ImGui::Text("method   %6.1f ms", t.method);
     ImGui::Text("filter   %6.1f ms", t.filter);
     ImGui::Text("display  %6.1f ms", t.display);
-    ImGui::Text("ref %d spp, se %.4f", ref_.samples_per_pixel, ref_.mean_std_error);
+    ImGui::Text("ref %d spp, se %s", ref_.samples_per_pixel, std_error_text().c_str());
     if (rmse_ >= 0) ImGui::Text("RMSE %.4f", rmse_);
     ImGui::End();
   }
@@ -866,6 +866,14 @@ class Viewer {
     return {fbw, fbh};
   }
 
+  // The reference's standard error as shown: it needs two batches to be estimated, "-" before.
+  std::string std_error_text() const {
+    if (ref_.batches < 2) return "-";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4f", ref_.mean_std_error);
+    return text;
+  }
+
   nlohmann::json summary() const {
     nlohmann::json j = stats_.json();
     j["method"] = method_;
@@ -880,7 +888,7 @@ class Viewer {
     j["camera"] = camera_to_json(current_camera());
     j["reference"] = {{"samples_per_pixel", ref_.samples_per_pixel},
                       {"batches", ref_.batches},
-                      {"mean_std_error", ref_.mean_std_error},
+                      {"mean_std_error", ref_.batches >= 2 ? nlohmann::json(ref_.mean_std_error) : nlohmann::json()},
                       {"rmse", rmse_ >= 0 ? nlohmann::json(rmse_) : nlohmann::json()}};
     return j;
   }

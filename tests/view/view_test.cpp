@@ -211,6 +211,10 @@ TEST(ViewCli, ReferenceStandardErrorFallsAsItAccumulates) {
   // few step-membership rays are far from normal), so ask only for a fall below 0.6x.
   EXPECT_LT(many["mean_std_error"].get<double>(), 0.6 * few["mean_std_error"].get<double>());
   EXPECT_GT(few["rmse"].get<double>(), 0.0);
+  // One batch (4 rays) allows no estimate: null, not 0 (which would read as converged).
+  const nlohmann::json one = state(4);
+  EXPECT_EQ(one["batches"].get<int>(), 1);
+  EXPECT_TRUE(one["mean_std_error"].is_null());
 }
 
 TEST(ViewCli, BadSettingsAreOneLineErrors) {

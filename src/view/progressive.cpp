@@ -104,7 +104,7 @@ void ProgressiveReference::run() {
     }
     s.batches = n;
     s.samples_per_pixel = n * batch_samples_;
-    s.mean_std_error = covered > 0 ? sum_se / static_cast<double>(covered) : 0.0;
+    if (n >= 2) s.mean_std_error = covered > 0 ? sum_se / static_cast<double>(covered) : 0.0;
     s.version = version_.load() + 1;
     version_.store(s.version, std::memory_order_release);
   }

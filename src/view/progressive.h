@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "ao/core/gbuffer.h"
@@ -33,7 +34,7 @@ struct ReferenceSnapshot {
   Image<float> visibility;      ///< Mean over batches; empty before the first batch.
   int samples_per_pixel = 0;    ///< Rays per covered pixel so far.
   int batches = 0;
-  double mean_std_error = 0;    ///< Over covered pixels; 0 before the second batch (the viewer shows "-").
+  std::optional<double> mean_std_error;  ///< Over covered pixels; empty until two batches allow an estimate.
   std::uint64_t version = 0;    ///< Grows with every completed batch and every restart.
 };
 

@@ -866,11 +866,11 @@ class Viewer {
     return {fbw, fbh};
   }
 
-  // The reference's standard error as shown: it needs two batches to be estimated, "-" before.
+  // The reference's standard error as shown: "-" until two batches allow an estimate.
   std::string std_error_text() const {
-    if (ref_.batches < 2) return "-";
+    if (!ref_.mean_std_error) return "-";
     char text[32];
-    std::snprintf(text, sizeof text, "%.4f", ref_.mean_std_error);
+    std::snprintf(text, sizeof text, "%.4f", *ref_.mean_std_error);
     return text;
   }
 
@@ -888,7 +888,7 @@ class Viewer {
     j["camera"] = camera_to_json(current_camera());
     j["reference"] = {{"samples_per_pixel", ref_.samples_per_pixel},
                       {"batches", ref_.batches},
-                      {"mean_std_error", ref_.batches >= 2 ? nlohmann::json(ref_.mean_std_error) : nlohmann::json()},
+                      {"mean_std_error", ref_.mean_std_error ? nlohmann::json(*ref_.mean_std_error) : nlohmann::json()},
                       {"rmse", rmse_ >= 0 ? nlohmann::json(rmse_) : nlohmann::json()}};
     return j;
   }

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "ao/bake/bake_groups.h"
+#include "ao/bake/denoise.h"
 #include "ao/bake/high_to_low.h"
 #include "ao/bake/histogram.h"
 #include "ao/bake/padding.h"
@@ -68,6 +69,8 @@ struct BakeOptions {
   std::string direction_set = "fibonacci", normalization = "area";
   std::string normal = "shading";  // --normal, parsed into rt.normal
   RaytracedBakeParams rt;
+  float denoise = kDefaultBakeDenoise;  // --denoise, into rt.denoise for maps of the ray-traced baker
+  bool denoise_given = false;
   std::optional<float> max_distance;
   std::string membership = "step";
   int vertex_resolution = 1024;
@@ -679,6 +682,12 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   o.hist.normalization = *norm;
   o.hist.bent_normals = o.rt.bent_normals = !o.bent.empty();
   o.rt.normal = parse_surface_normal(o.normal);
+  if (o.denoise_given && !o.high.empty())
+    throw InputError("--denoise with --high: the high-to-low baker does not filter its map (yet); drop --denoise");
+  if (o.denoise_given && !wants_map(o)) throw InputError("--denoise filters maps; per-vertex AO is not filtered, so drop --denoise");
+  // The default filter applies where it can: ray-traced maps baked from the mesh itself.
+  o.rt.denoise = o.high.empty() ? o.denoise : 0.0f;
+  if (!(o.rt.denoise >= 0.0f && o.rt.denoise <= kMaxDenoiseSigma)) throw InputError("--denoise must be a filter sigma in [0, 4] texels (0 = off)");
   o.hist.validate();
   const auto size = parse_map_size(o.size_text);
   if (!size) throw InputError("--size: expected N or WIDTHxHEIGHT (2048x1024), each in [1, 16384] texels, got '" + o.size_text + "'");
@@ -709,7 +718,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (wants_map(o)) {
     const int threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     check_memory(estimate_bake_memory({.size = o.width, .height = o.height, .histogram = o.method == "histogram", .bent_normals = !o.bent.empty(),
-                                       .pixels_per_texel = o.hist.pixels_per_texel, .threads = threads}),
+                                       .pixels_per_texel = o.hist.pixels_per_texel, .threads = threads, .denoise = o.rt.denoise > 0}),
                  "ao bake: a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " map");
   }
   if (!batch) {
@@ -768,6 +777,10 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
       ->capture_default_str();
   cmd->add_flag("--seam-fix,!--no-seam-fix", o->hist.seam_fix, "histogram: refill poorly covered chart-border texels from their neighbours (paper sec. 3.3; default on)");
   cmd->add_option("--samples,--spp", o->rt.samples, "raytraced: rays per texel (per vertex with --per-vertex)")->capture_default_str();
+  auto* denoise_opt = cmd->add_option("--denoise", o->denoise,
+                                      "raytraced maps: sigma in texels of the texture-space filter that averages the noise of texels that are "
+                                      "neighbours on the surface (not across charts or creases); 0 = off, the plain ray-traced estimate [0, 4]")
+                          ->capture_default_str();
   cmd->add_option("--max-distance", o->max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");
   cmd->add_option("--membership", o->membership, "raytraced with --max-distance: falloff step, linear, sqrt or cubic")->capture_default_str();
   cmd->add_option("--offset", o->rt.offset, "raytraced: ray origin offset along the face normal, world units (0: scale-free, a few float spacings of the coordinates; docs/methods/raytraced.md)")->capture_default_str();
@@ -810,10 +823,11 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   for (const char* name : {"--directions", "--direction-set", "--pixels-per-texel", "--point-size", "--normalization", "--min-samples", "--seam-fix",
                            "--vertex-resolution"})
     histogram_only.push_back(cmd->get_option(name));
-  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal"})
+  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal", "--denoise"})
     raytraced_only.push_back(cmd->get_option(name));
-  cmd->callback([o, method, size_opt, png_bits_opt, histogram_only, raytraced_only, &global, &action] {
+  cmd->callback([o, method, size_opt, png_bits_opt, denoise_opt, histogram_only, raytraced_only, &global, &action] {
     o->method_given = method->count() > 0;
+    o->denoise_given = denoise_opt->count() > 0;
     o->size_given = size_opt->count() > 0;
     o->png_bits_given = png_bits_opt->count() > 0;
     for (const CLI::Option* opt : histogram_only)

@@ -9,6 +9,7 @@
 
 #include <tbb/global_control.h>
 
+#include "ao/bake/denoise.h"
 #include "ao/bake/histogram.h"
 #include "ao/bake/padding.h"
 #include "ao/bake/per_vertex.h"
@@ -402,6 +403,82 @@ TEST(Bake, RaytracedIsIdenticalAtOneAndTwoThreads) {
   expect_identical_at_one_and_two_threads([&] { return bake_raytraced(rs, cov, p); });
 }
 
+TEST(Bake, DenoisedRaytracedIsIdenticalAtOneAndTwoThreads) {
+  const Scene s = floor_and_wall(1.0f);
+  const TexelCoverage cov = compute_texel_coverage(s, 16);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  const RaytracedBakeParams p{.samples = 16, .bent_normals = true, .seed = 5, .denoise = 1.0f};
+  expect_identical_at_one_and_two_threads([&] { return bake_raytraced(rs, cov, p); });
+}
+
+// A floor under a ceiling at height d, occluders counted within R (a step): a direction at angle t
+// from the normal meets the ceiling within R when d / cos t <= R, and the cosine-weighted share of
+// cos t >= d / R is 1 - (d / R)^2, so V = (d / R)^2 at every floor point whose ceiling reaches
+// sqrt(R^2 - d^2) beyond it. Floor: x, z in [-2, 2], facing up, UVs u in [u0, u1] over the whole
+// height of the map; ceiling: a slab whose underside is at y = d over x, z in [-8, 8].
+constexpr float kCeilingHeight = 0.5f, kCeilingReach = 1.0f;
+constexpr double kUnderCeiling = 0.25;  // (d / R)^2
+
+Mesh floor_chart(float x0, float u0, float u1) {
+  return uv_quad({x0, 0, 2}, {x0 + 4, 0, 2}, {x0 + 4, 0, -2}, {x0, 0, -2}, {u0, 1}, {u1, 0});
+}
+Mesh ceiling() { return make_box({-8, kCeilingHeight, -8}, {8, kCeilingHeight + 0.2f, 8}); }
+
+struct MapError {
+  double rmse = 0, mean = 0;
+};
+// RMSE against `truth` and mean over the covered texels of columns [x0, x1).
+MapError map_error(const BakeResult& r, int x0, int x1, double truth) {
+  double se = 0, sum = 0;
+  int n = 0;
+  for (int y = 0; y < r.visibility.height(); ++y)
+    for (int x = x0; x < x1; ++x)
+      if (r.mask(x, y)) {
+        se += (r.visibility(x, y) - truth) * (r.visibility(x, y) - truth);
+        sum += r.visibility(x, y);
+        ++n;
+      }
+  return {std::sqrt(se / n), sum / n};
+}
+
+// The filter averages the noise of neighbouring texels of one surface and keeps the mean: on a
+// surface of constant V, 16 rays per texel, its error against the exact V must fall by more than
+// half (a Gaussian of sigma 1 texel weighs about 12 texels' worth: about a third of the noise in
+// the interior), and both means stay at V (16 x 32 x 32 samples: standard error ~0.002).
+TEST(Bake, DenoisingAveragesNoiseAndKeepsTheExactMean) {
+  Scene s;
+  s.meshes = {floor_chart(-2, 0, 1), ceiling()};
+  s = prepared(std::move(s));
+  const TexelCoverage cov = compute_texel_coverage(s, 32);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  const RaytracedBakeParams plain{.samples = 16, .max_distance = kCeilingReach};
+  RaytracedBakeParams filtered = plain;
+  filtered.denoise = 1.0f;
+  const MapError e0 = map_error(bake_raytraced(rs, cov, plain), 0, 32, kUnderCeiling);
+  const MapError e1 = map_error(bake_raytraced(rs, cov, filtered), 0, 32, kUnderCeiling);
+  EXPECT_GT(e0.rmse, 0.02);  // there is noise to remove
+  EXPECT_LT(e1.rmse, 0.5 * e0.rmse);
+  EXPECT_NEAR(e0.mean, kUnderCeiling, 0.01);
+  EXPECT_NEAR(e1.mean, kUnderCeiling, 0.01);
+}
+
+// Two charts side by side in UV, far apart on the surface: the floor under the ceiling (V = 1/4)
+// on the left half of the map and a floor in the open (V = 1, every ray misses) on the right, in
+// the same plane with the same normal, so only the distance on the surface tells them apart. The
+// filter must not mix them: the open chart stays exactly 1 and the column of the covered chart
+// next to the UV border keeps its mean.
+TEST(Bake, DenoisingDoesNotMixChartsThatAreOnlyNeighboursInUv) {
+  Scene s;
+  s.meshes = {floor_chart(-2, 0, 0.5f), floor_chart(50, 0.5f, 1), ceiling()};
+  s = prepared(std::move(s));
+  const TexelCoverage cov = compute_texel_coverage(s, 32);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  const BakeResult r = bake_raytraced(rs, cov, {.samples = 64, .max_distance = kCeilingReach, .denoise = 2.0f});
+  for (int y = 0; y < 32; ++y)
+    for (int x = 16; x < 32; ++x) EXPECT_EQ(r.visibility(x, y), 1.0f) << x << ", " << y;
+  EXPECT_NEAR(map_error(r, 15, 16, kUnderCeiling).mean, kUnderCeiling, 0.02);  // 32 texels x 64 rays; leaking 1s would give ~0.4
+}
+
 // The bake's quad BVH (bake_bvh_options pairs triangles into quads) traces the same rays to the
 // same answers as a BVH of the triangles: occlusion packets (the default), closest hits through
 // back faces (ignore_back_faces maps each hit back to its triangle for the face normal) and
@@ -559,6 +636,9 @@ TEST(Bake, BadParametersAreRejected) {
   EXPECT_THROW((RaytracedBakeParams{.max_distance = -1.0f}.validate()), InputError);
   EXPECT_THROW((RaytracedBakeParams{.max_distance = kInfinity}.validate()), InputError);
   EXPECT_THROW((RaytracedBakeParams{.samples = 0}.validate()), InputError);
+  EXPECT_THROW((RaytracedBakeParams{.denoise = -1.0f}.validate()), InputError);
+  EXPECT_THROW((RaytracedBakeParams{.denoise = kMaxDenoiseSigma * 1.01f}.validate()), InputError);
+  EXPECT_THROW((RaytracedBakeParams{.denoise = std::nanf("")}.validate()), InputError);
   const Scene s = make_builtin_scene("plane");
   EXPECT_THROW(compute_texel_coverage(s, 0), InputError);
 }

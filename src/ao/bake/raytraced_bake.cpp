@@ -24,6 +24,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "ao/bake/denoise.h"
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -80,6 +81,7 @@ void RaytracedBakeParams::validate() const {
   if (max_distance && !(*max_distance > 0 && std::isfinite(*max_distance)))
     throw InputError("bake raytraced: max distance must be a finite number > 0 (omit it for unlimited distance)");
   if (!(offset >= 0.0f && offset <= kMaxCoordinate)) throw InputError("bake raytraced: --offset must be a number in [0, 1e9] world units (kMaxCoordinate)");
+  if (!(denoise >= 0.0f && denoise <= kMaxDenoiseSigma)) throw InputError("bake raytraced: --denoise must be a filter sigma in [0, 4] texels (0 = off)");
   if (max_distance) falloff().validate();
 }
 
@@ -99,7 +101,8 @@ void to_json(nlohmann::json& j, const RaytracedBakeParams& p) {
        {"ignore_back_faces", p.ignore_back_faces},
        {"bent_normals", p.bent_normals},
        {"normal", p.normal == SurfaceNormal::Geometric ? "geometric" : "shading"},
-       {"seed", p.seed}};
+       {"seed", p.seed},
+       {"denoise", p.denoise}};
 }
 
 BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const RaytracedBakeParams& params, const ProgressFn& progress) {
@@ -121,6 +124,10 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   const bool occlusion_only = falloff.membership == Membership::Step && !params.ignore_back_faces;
   const float reach = falloff.reach();
   const TriangleNormals& surface_normals = fn;
+  // The filter's guides, filled in the tile loop from the patches it builds anyway.
+  const bool denoise = params.denoise > 0;
+  TexelGuides guides;
+  if (denoise) guides = {Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}), Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 1})};
   ProgressCounter counter(progress, cov.texel_count());
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(cov.width, cov.height, detail::kTexelTile, [&](const Tile& t) {
@@ -143,6 +150,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
           detail::build_patch(scene, cov, surface_normals, texel, patch);
           if (patch.empty()) continue;
           table.build(patch, fixed_offset);
+          if (denoise) detail::patch_guide(patch, geometric, guides.position[texel], guides.normal[texel]);
           points.generate(pixel_seed(params.seed, x, y), params.samples);
           double sum = 0;
           Vec3 bent{0, 0, 0};
@@ -187,6 +195,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0));
     });
   });
+  if (denoise) denoise_map(out.visibility, cov, guides, params.denoise);
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
   out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;

@@ -32,6 +32,10 @@ struct RaytracedBakeParams {
   SurfaceNormal normal = SurfaceNormal::Shading;
   bool bent_normals = false;             ///< Also average the unoccluded directions per texel.
   std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
+  /// Maps only: sigma, in texels, of the texture-space filter that averages the noise of texels
+  /// that are neighbours on the surface (denoise.h); 0 = off, the plain estimate of eq. 2.
+  /// [0, kMaxDenoiseSigma]. Bent normals are not filtered.
+  float denoise = 0.0f;
 
   /// Throws InputError naming the bad field.
   void validate() const;

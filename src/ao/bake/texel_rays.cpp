@@ -68,6 +68,20 @@ void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals
   }
 }
 
+void patch_guide(const std::vector<PatchPiece>& patch, bool geometric, Vec3& position, Vec3& normal) {
+  Vec3 c{0, 0, 0}, n{0, 0, 0};
+  float lo = 0;
+  for (const PatchPiece& pc : patch) {
+    const float area = pc.cdf - lo;
+    lo = pc.cdf;
+    c += (pc.p[0] + pc.p[1] + pc.p[2]) * (area / 3.0f);
+    n += geometric ? pc.ng * area : (pc.n[0] + pc.n[1] + pc.n[2]) * area;
+  }
+  position = lo > 0 ? c / lo : patch[0].p[0];
+  const float len = length(n);
+  normal = len > 0 ? n / len : patch[0].ng;
+}
+
 namespace {
 
 // sin t and cos t for t in [-pi/4, pi/4], from their Taylor series to degree 9 and 10: the

@@ -54,6 +54,11 @@ struct PatchPiece {
 /// The pieces of texel `texel` of `cov` (computed on `s`), in fragment order. `fn` = face_normals(s).
 void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::size_t texel, std::vector<PatchPiece>& out);
 
+/// The area-weighted centroid and unit mean normal of a non-empty patch (of the face normals when
+/// `geometric`, else of the interpolated normals; the first piece's face normal where they cancel):
+/// where denoise_map finds the texel on the surface.
+void patch_guide(const std::vector<PatchPiece>& patch, bool geometric, Vec3& position, Vec3& normal);
+
 /// A point of a patch: its piece and the weights of the piece's corners (summing to 1).
 struct PatchSample {
   const PatchPiece* piece;

@@ -11,6 +11,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/image.h"
+#include "ao/core/math.h"
 
 namespace ao {
 
@@ -111,6 +112,8 @@ std::uint64_t estimate_bake_memory(const BakeMemoryInput& in) {
   const std::uint64_t texels = static_cast<std::uint64_t>(std::max(in.size, 0)) * static_cast<std::uint64_t>(std::max(height, 0));
   const std::uint64_t threads = static_cast<std::uint64_t>(std::max(in.threads, 1));
   std::uint64_t bytes = kBaseBytes + texels * (kCoverageBytes + kResultBytes + (in.bent_normals ? kBentResultBytes : 0));
+  // The filter's guides (a position and a normal per texel) and its copy of the map.
+  if (in.denoise && !in.histogram) bytes += texels * (2 * sizeof(Vec3) + sizeof(float));
   // Measured (grid of 20,000 triangles, 2 threads, 2048^2 minus 256^2, /usr/bin/time -v): histogram
   // 90 B per texel (estimate 116), raytraced 60 (estimate 60).
   if (in.histogram) {

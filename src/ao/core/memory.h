@@ -43,6 +43,7 @@ struct BakeMemoryInput {
   bool bent_normals = false;  ///< Bent normals are accumulated and written too.
   float pixels_per_texel = 1; ///< Histogram view resolution (HistogramParams::pixels_per_texel).
   int threads = 1;            ///< Worker threads (each histogram worker has its own accumulators and view).
+  bool denoise = false;       ///< The ray-traced map is filtered (RaytracedBakeParams::denoise > 0): its guides and a copy of the map.
 };
 /// Peak bytes of a map bake: coverage, accumulators, result, padding and the encoded output.
 std::uint64_t estimate_bake_memory(const BakeMemoryInput& in);

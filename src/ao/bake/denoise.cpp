@@ -1,0 +1,64 @@
+// Texture-space denoising of an AO map: see denoise.h.
+#include "ao/bake/denoise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace ao {
+
+namespace {
+
+constexpr float kPlaneTolerance = 0.5f;  // tau, texels
+constexpr float kGateSlope = 2.0f, kGateSlack = 1.5f;
+
+}  // namespace
+
+void denoise_map(Image<float>& visibility, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
+  const int w = cov.width, h = cov.height;
+  const int r = static_cast<int>(std::ceil(2.0f * sigma));
+  const int side = 2 * r + 1;
+  std::vector<float> gauss(static_cast<std::size_t>(side * side)), gate(gauss.size());
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      const auto k = static_cast<std::size_t>((dy + r) * side + dx + r);
+      const float d2 = static_cast<float>(dx * dx + dy * dy);
+      gauss[k] = std::exp(-d2 / (2.0f * sigma * sigma));
+      const float g = kGateSlope * std::sqrt(d2) + kGateSlack;
+      gate[k] = g * g;
+    }
+  const Image<float> in = visibility;
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t c = at(x, y);
+        if (!cov.mask[c]) continue;
+        const float texel_area = cov.uv_area[c] > 0 ? cov.world_area[c] / cov.uv_area[c] : 0.0f;  // h_c^2
+        if (!(texel_area > 0)) continue;
+        const Vec3 pc = guides.position[c], nc = guides.normal[c];
+        const float plane_scale = 1.0f / (kPlaneTolerance * kPlaneTolerance * texel_area);
+        float sum = 0, wsum = 0;
+        for (int dy = std::max(-r, -y); dy <= std::min(r, h - 1 - y); ++dy)
+          for (int dx = std::max(-r, -x); dx <= std::min(r, w - 1 - x); ++dx) {
+            const std::size_t q = at(x + dx, y + dy);
+            if (!cov.mask[q]) continue;
+            const auto k = static_cast<std::size_t>((dy + r) * side + dx + r);
+            const Vec3 d = guides.position[q] - pc;
+            if (dot(d, d) > gate[k] * texel_area) continue;  // far on the surface: another chart
+            const float off_plane = dot(d, nc);
+            float cn = std::max(0.0f, dot(nc, guides.normal[q]));
+            cn *= cn, cn *= cn, cn *= cn;
+            const float wq = gauss[k] * std::exp(-0.5f * off_plane * off_plane * plane_scale) * cn;
+            sum += wq * in[q];
+            wsum += wq;
+          }
+        if (wsum > 0) visibility[c] = sum / wsum;
+      }
+  });
+}
+
+}  // namespace ao

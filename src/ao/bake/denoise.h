@@ -1,0 +1,44 @@
+// Texture-space denoising of a ray-traced AO map: a cross-bilateral filter (a Gaussian over each
+// texel's neighbours in the map) guided by where the texels lie on the surface, so that it
+// averages the Monte Carlo noise of texels that are neighbours on the surface and leaves alone
+// texels that are only neighbours in the UV layout (another chart, the far side of a seam) or that
+// lie across a crease. What lightmap bakers do for their AO (Unity's progressive lightmapper filters
+// its AO in texture space); the measured trade of rays for filter width is in docs/methods/bake.md,
+// "Denoising".
+//
+// A texel q near texel c gets the weight
+//   w(q) = exp(-|uv_q - uv_c|^2 / (2 sigma^2))          the Gaussian, sigma in texels
+//        * exp(-((p_q - p_c) . n_c / (tau h_c))^2 / 2)  off c's tangent plane (curvature, a crease, another layer)
+//        * max(0, n_c . n_q)^8                          normals apart (a crease of 30 degrees: 0.32, 45: 0.06)
+// and none when |p_q - p_c| > (2 |uv_q - uv_c| + 1.5) h_c: a UV neighbour that is far away on the
+// surface is another chart or the other side of a seam. p and n are the texel's area-weighted patch
+// centroid and mean normal (TexelGuides), h_c the world size of one texel at c (sqrt of world area
+// over UV area) and tau = 1/2 texel. The filtered value is the weighted mean over the window of
+// radius ceil(2 sigma); uncovered texels neither take part nor change.
+#pragma once
+
+#include "ao/bake/texel_coverage.h"
+#include "ao/core/image.h"
+#include "ao/core/math.h"
+
+namespace ao {
+
+/// Largest filter sigma, texels: a wider filter is a lower-resolution map, which -s asks for directly.
+inline constexpr float kMaxDenoiseSigma = 4.0f;
+
+/// `ao bake`'s sigma for ray-traced maps (docs/methods/bake.md, "Denoising"). The library's
+/// RaytracedBakeParams::denoise stays 0: the library's estimate is the paper's integral.
+inline constexpr float kDefaultBakeDenoise = 0.75f;
+
+/// Where each covered texel lies on the surface: its patch's area-weighted centroid and unit mean
+/// normal (world space). Uncovered texels are not read.
+struct TexelGuides {
+  Image<Vec3> position;
+  Image<Vec3> normal;
+};
+
+/// Filters `visibility` (width x height of `cov`) in place over the covered texels of `cov` with
+/// the weights above; `sigma` in (0, kMaxDenoiseSigma]. Deterministic at any thread count.
+void denoise_map(Image<float>& visibility, const TexelCoverage& cov, const TexelGuides& guides, float sigma);
+
+}  // namespace ao

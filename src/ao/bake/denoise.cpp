@@ -17,7 +17,7 @@ constexpr float kGateSlope = 2.0f, kGateSlack = 1.5f;
 
 }  // namespace
 
-void denoise_map(Image<float>& visibility, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
+void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
   const int w = cov.width, h = cov.height;
   const int r = static_cast<int>(std::ceil(2.0f * sigma));
   const int side = 2 * r + 1;
@@ -36,7 +36,7 @@ void denoise_map(Image<float>& visibility, const TexelCoverage& cov, const Texel
     for (int y = rows.begin(); y < rows.end(); ++y)
       for (int x = 0; x < w; ++x) {
         const std::size_t c = at(x, y);
-        if (!cov.mask[c]) continue;
+        if (!valid[c]) continue;
         const float texel_area = cov.uv_area[c] > 0 ? cov.world_area[c] / cov.uv_area[c] : 0.0f;  // h_c^2
         if (!(texel_area > 0)) continue;
         const Vec3 pc = guides.position[c], nc = guides.normal[c];
@@ -45,7 +45,7 @@ void denoise_map(Image<float>& visibility, const TexelCoverage& cov, const Texel
         for (int dy = std::max(-r, -y); dy <= std::min(r, h - 1 - y); ++dy)
           for (int dx = std::max(-r, -x); dx <= std::min(r, w - 1 - x); ++dx) {
             const std::size_t q = at(x + dx, y + dy);
-            if (!cov.mask[q]) continue;
+            if (!valid[q]) continue;
             const auto k = static_cast<std::size_t>((dy + r) * side + dx + r);
             const Vec3 d = guides.position[q] - pc;
             if (dot(d, d) > gate[k] * texel_area) continue;  // far on the surface: another chart

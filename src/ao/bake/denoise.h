@@ -17,6 +17,8 @@
 // radius ceil(2 sigma); uncovered texels neither take part nor change.
 #pragma once
 
+#include <cstdint>
+
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/image.h"
 #include "ao/core/math.h"
@@ -37,8 +39,9 @@ struct TexelGuides {
   Image<Vec3> normal;
 };
 
-/// Filters `visibility` (width x height of `cov`) in place over the covered texels of `cov` with
-/// the weights above; `sigma` in (0, kMaxDenoiseSigma]. Deterministic at any thread count.
-void denoise_map(Image<float>& visibility, const TexelCoverage& cov, const TexelGuides& guides, float sigma);
+/// Filters `visibility` (width x height of `cov`) in place over the texels set in `valid` (the
+/// covered texels of `cov` that have a value) with the weights above; `sigma` in (0,
+/// kMaxDenoiseSigma]. Deterministic at any thread count.
+void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma);
 
 }  // namespace ao

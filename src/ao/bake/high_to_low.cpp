@@ -194,9 +194,19 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
     out.visibility[texel] = static_cast<float>(sums.mu / sums.counted);
     if (params.ao.bent_normals) out.bent_normal[texel] = normalize(sums.bent);
   };
-  const std::size_t texels = detail::bake_texels(low, cov, tracer, params.ao.samples, params.ao.seed, progress, make_ray, finish);
+  // The filter's guides are the low mesh's patches: the map lives in its UV charts.
+  const bool denoise = params.ao.denoise > 0;
+  TexelGuides guides;
+  if (denoise) guides = {Image<Vec3>(width, height, Vec3{0, 0, 0}), Image<Vec3>(width, height, Vec3{0, 0, 1})};
+  const std::size_t texels =
+      detail::bake_texels(low, cov, tracer, params.ao.samples, params.ao.seed, progress, denoise ? &guides : nullptr, make_ray, finish);
   out.rays = static_cast<std::uint64_t>(texels) * static_cast<std::uint64_t>(params.ao.samples) + traced.load();  // a cage ray per sample, plus the AO rays
   for (std::size_t i = 0; i < out.missed.size(); ++i) out.missed_texels += out.missed[i];
+  if (denoise) {  // over the texels that have a value; the missed ones are filled after, from filtered neighbours
+    Image<std::uint8_t> valid = out.mask;
+    for (std::size_t i = 0; i < valid.size(); ++i) valid[i] = valid[i] && !out.missed[i];
+    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise);
+  }
   fill_missed_texels(out);
   out.stats = {{"rays", out.rays}, {"offset", offset}, {"missed_texels", out.missed_texels}};
   return out;

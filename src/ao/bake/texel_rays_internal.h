@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "ao/bake/denoise.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/membership.h"
 #include "ao/core/parallel.h"
@@ -237,11 +238,12 @@ struct TexelSums {
 /// 2-3 pick the point on the patch: one jointly stratified set), `make_ray(ctx, sample, origin, direction)` turns each into a
 /// SampleRay, the rays are traced by `tracer` in packets of its scene's native width, and
 /// `finish(texel, sums)` receives the texel's totals. Each texel's work depends only on its
-/// coordinates and the seed, so the result is the same at any thread count. Returns the number of
-/// texels finished.
+/// coordinates and the seed, so the result is the same at any thread count. With `guides`, each
+/// texel's patch_guide (shading normals of `surface`) is stored there for denoise_map. Returns the
+/// number of texels finished.
 template <class MakeRay, class Finish>
 std::size_t bake_texels(const Scene& surface, const TexelCoverage& cov, const Tracer& tracer, int samples, std::uint32_t seed,
-                        const ProgressFn& progress, MakeRay&& make_ray, Finish&& finish) {
+                        const ProgressFn& progress, TexelGuides* guides, MakeRay&& make_ray, Finish&& finish) {
   const TriangleNormals fn = face_normals(surface);
   std::atomic<std::size_t> finished{0};
   ProgressCounter counter(progress, cov.texel_count());
@@ -261,6 +263,7 @@ std::size_t bake_texels(const Scene& surface, const TexelCoverage& cov, const Tr
           if (!cov.mask[texel]) continue;
           build_patch(surface, cov, fn, texel, patch);
           if (patch.empty()) continue;
+          if (guides) patch_guide(patch, false, guides->position[texel], guides->normal[texel]);
           const std::uint32_t key = pixel_seed(seed, x, y);
           TexelSums sums;
           for (int first = 0; first < samples; first += batch) {

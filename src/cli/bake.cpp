@@ -778,7 +778,8 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--samples,--spp", o->rt.samples, "raytraced: rays per texel (per vertex with --per-vertex)")->capture_default_str();
   auto* denoise_opt = cmd->add_option("--denoise", o->denoise,
                                       "raytraced maps: sigma in texels of the texture-space filter that averages the noise of texels that are "
-                                      "neighbours on the surface (not across charts or creases); 0 = off, the plain ray-traced estimate [0, 4]")
+                                      "neighbours on the surface (not across charts or creases); 0 = off, the plain ray-traced estimate; --high maps: off "
+                                      "unless given [0, 4]")
                           ->capture_default_str();
   cmd->add_option("--max-distance", o->max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");
   cmd->add_option("--membership", o->membership, "raytraced with --max-distance: falloff step, linear, sqrt or cubic")->capture_default_str();

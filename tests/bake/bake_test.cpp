@@ -462,6 +462,32 @@ TEST(Bake, DenoisingAveragesNoiseAndKeepsTheExactMean) {
   EXPECT_NEAR(e1.mean, kUnderCeiling, 0.01);
 }
 
+// A contact shadow's edge on one flat chart: the floor of floor_and_wall extended under the wall
+// (a closed box standing on it), so the floor is 0 under the wall (every ray meets the box's inside)
+// and, just outside, the wall's view factor, about 1/2: a step of one texel. Rows are 1/16 apart
+// and the wall's face lies on a row boundary. The value term keeps the filter from averaging across
+// the step (a Gaussian alone would pull both rows next to it about 0.1 towards each other); each row
+// must stay within 0.03 of its exact texel average (32 texels x 64 rays: standard error ~0.005).
+TEST(Bake, DenoisingKeepsTheEdgeOfAContactShadow) {
+  Scene s;
+  s.meshes = {uv_quad({-0.5f, 0, 1}, {0.5f, 0, 1}, {0.5f, 0, -1}, {-0.5f, 0, -1}, {0, 1}, {1, 0}), make_box({-20, 0, -1.5f}, {20, 1, 0})};
+  s = prepared(std::move(s));
+  const int n = 32;
+  const TexelCoverage cov = compute_texel_coverage(s, n);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  const BakeResult r = bake_raytraced(rs, cov, {.samples = 64, .denoise = kDefaultBakeDenoise});
+  auto row_mean = [&](int y) {
+    double sum = 0;
+    for (int x = 0; x < n; ++x) sum += r.visibility(x, y);
+    return sum / n;
+  };
+  // Row y covers z in [1 - (y + 1) / 16, 1 - y / 16]: row 15 is the first outside the wall, row 16 the first under it.
+  double outside = 0;
+  for (int k = 0; k < 64; ++k) outside += wall_visibility((k + 0.5) / 64 / 16, 1.0) / 64;
+  EXPECT_NEAR(row_mean(15), outside, 0.03);
+  EXPECT_NEAR(row_mean(16), 0.0, 0.03);
+}
+
 // Two charts side by side in UV, far apart on the surface: the floor under the ceiling (V = 1/4)
 // on the left half of the map and a floor in the open (V = 1, every ray misses) on the right, in
 // the same plane with the same normal, so only the distance on the surface tells them apart. The

@@ -14,10 +14,13 @@ namespace {
 
 constexpr float kPlaneTolerance = 0.5f;  // tau, texels
 constexpr float kGateSlope = 2.0f, kGateSlack = 1.5f;
+constexpr float kRangeTolerance = 3.0f;     // k, standard deviations of the difference
+constexpr float kVarianceFloor = 1e-4f;     // a standard deviation of 0.01
 
 }  // namespace
 
-void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
+void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma,
+                 int samples) {
   const int w = cov.width, h = cov.height;
   const int r = static_cast<int>(std::ceil(2.0f * sigma));
   const int side = 2 * r + 1;
@@ -31,6 +34,8 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
       gate[k] = g * g;
     }
   const Image<float> in = visibility;
+  const float range_scale = 1.0f / (kRangeTolerance * kRangeTolerance);
+  const float inv_samples = 1.0f / static_cast<float>(std::max(samples, 1));
   const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y)
@@ -40,6 +45,7 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
         const float texel_area = cov.uv_area[c] > 0 ? cov.world_area[c] / cov.uv_area[c] : 0.0f;  // h_c^2
         if (!(texel_area > 0)) continue;
         const Vec3 pc = guides.position[c], nc = guides.normal[c];
+        const float vc = in[c], var_c = vc * (1.0f - vc) * inv_samples;
         const float plane_scale = 1.0f / (kPlaneTolerance * kPlaneTolerance * texel_area);
         float sum = 0, wsum = 0;
         for (int dy = std::max(-r, -y); dy <= std::min(r, h - 1 - y); ++dy)
@@ -52,8 +58,10 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
             const float off_plane = dot(d, nc);
             float cn = std::max(0.0f, dot(nc, guides.normal[q]));
             cn *= cn, cn *= cn, cn *= cn;
-            const float wq = gauss[k] * std::exp(-0.5f * off_plane * off_plane * plane_scale) * cn;
-            sum += wq * in[q];
+            const float vq = in[q], dv = vq - vc;
+            const float var = var_c + vq * (1.0f - vq) * inv_samples + kVarianceFloor;
+            const float wq = gauss[k] * std::exp(-0.5f * (off_plane * off_plane * plane_scale + dv * dv * range_scale / var)) * cn;
+            sum += wq * vq;
             wsum += wq;
           }
         if (wsum > 0) visibility[c] = sum / wsum;

@@ -9,12 +9,16 @@
 // A texel q near texel c gets the weight
 //   w(q) = exp(-|uv_q - uv_c|^2 / (2 sigma^2))          the Gaussian, sigma in texels
 //        * exp(-((p_q - p_c) . n_c / (tau h_c))^2 / 2)  off c's tangent plane (curvature, a crease, another layer)
+//        * exp(-(V_q - V_c)^2 / (2 k^2 s^2))            values further apart than the noise explains (a contact shadow's edge)
 //        * max(0, n_c . n_q)^8                          normals apart (a crease of 30 degrees: 0.32, 45: 0.06)
 // and none when |p_q - p_c| > (2 |uv_q - uv_c| + 1.5) h_c: a UV neighbour that is far away on the
 // surface is another chart or the other side of a seam. p and n are the texel's area-weighted patch
 // centroid and mean normal (TexelGuides), h_c the world size of one texel at c (sqrt of world area
-// over UV area) and tau = 1/2 texel. The filtered value is the weighted mean over the window of
-// radius ceil(2 sigma); uncovered texels neither take part nor change.
+// over UV area) and tau = 1/2 texel. s^2 = (V_c (1 - V_c) + V_q (1 - V_q)) / N + 0.01^2 bounds the
+// variance of the difference of two texels' means of N samples: a sample's mu lies in [0, 1], so its
+// variance is at most V (1 - V) (Bhatia-Davis), and stratified samples only lower it; k = 3. The
+// filtered value is the weighted mean over the window of radius ceil(2 sigma); texels not valid
+// neither take part nor change.
 #pragma once
 
 #include <cstdint>
@@ -41,7 +45,9 @@ struct TexelGuides {
 
 /// Filters `visibility` (width x height of `cov`) in place over the texels set in `valid` (the
 /// covered texels of `cov` that have a value) with the weights above; `sigma` in (0,
-/// kMaxDenoiseSigma]. Deterministic at any thread count.
-void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma);
+/// kMaxDenoiseSigma]; `samples`, N above, the samples per texel the values are means of.
+/// Deterministic at any thread count.
+void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma,
+                 int samples);
 
 }  // namespace ao

@@ -205,7 +205,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   if (denoise) {  // over the texels that have a value; the missed ones are filled after, from filtered neighbours
     Image<std::uint8_t> valid = out.mask;
     for (std::size_t i = 0; i < valid.size(); ++i) valid[i] = valid[i] && !out.missed[i];
-    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise);
+    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise, params.ao.samples);
   }
   fill_missed_texels(out);
   out.stats = {{"rays", out.rays}, {"offset", offset}, {"missed_texels", out.missed_texels}};

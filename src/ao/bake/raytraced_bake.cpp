@@ -195,7 +195,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
       counter.add(static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0));
     });
   });
-  if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise);
+  if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise, params.samples);
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
   out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;

@@ -685,7 +685,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.denoise_given && !wants_map(o)) throw InputError("--denoise filters maps; per-vertex AO is not filtered, so drop --denoise");
   // High to low bakes the high mesh's detail, often a few texels wide, which the filter would
   // soften: filtered only when asked (docs/methods/bake.md, "Denoising").
-  o.rt.denoise = o.high.empty() || o.denoise_given ? o.denoise : 0.0f;
+  o.rt.denoise = wants_map(o) && (o.high.empty() || o.denoise_given) ? o.denoise : 0.0f;
   if (!(o.rt.denoise >= 0.0f && o.rt.denoise <= kMaxDenoiseSigma)) throw InputError("--denoise must be a filter sigma in [0, 4] texels (0 = off)");
   o.hist.validate();
   const auto size = parse_map_size(o.size_text);

@@ -686,7 +686,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   // High to low bakes the high mesh's detail, often a few texels wide, which the filter would
   // soften: filtered only when asked (docs/methods/bake.md, "Denoising").
   o.rt.denoise = wants_map(o) && (o.high.empty() || o.denoise_given) ? o.denoise : 0.0f;
-  if (!(o.rt.denoise >= 0.0f && o.rt.denoise <= kMaxDenoiseSigma)) throw InputError("--denoise must be a filter sigma in [0, 4] texels (0 = off)");
+  o.rt.validate();  // before any mesh is loaded: --samples, --offset, --denoise
   o.hist.validate();
   const auto size = parse_map_size(o.size_text);
   if (!size) throw InputError("--size: expected N or WIDTHxHEIGHT (2048x1024), each in [1, 16384] texels, got '" + o.size_text + "'");

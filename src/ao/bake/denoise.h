@@ -39,6 +39,9 @@ inline constexpr float kDefaultBakeDenoise = 0.75f;
 /// Where each covered texel lies on the surface: its patch's area-weighted centroid and unit mean
 /// normal (world space). Uncovered texels are not read.
 struct TexelGuides {
+  TexelGuides() = default;
+  /// Guides for a width x height map, to be filled texel by texel.
+  TexelGuides(int width, int height) : position(width, height, Vec3{0, 0, 0}), normal(width, height, Vec3{0, 0, 1}) {}
   Image<Vec3> position;
   Image<Vec3> normal;
 };

@@ -197,7 +197,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   // The filter's guides are the low mesh's patches: the map lives in its UV charts.
   const bool denoise = params.ao.denoise > 0;
   TexelGuides guides;
-  if (denoise) guides = {Image<Vec3>(width, height, Vec3{0, 0, 0}), Image<Vec3>(width, height, Vec3{0, 0, 1})};
+  if (denoise) guides = TexelGuides(width, height);
   const std::size_t texels =
       detail::bake_texels(low, cov, tracer, params.ao.samples, params.ao.seed, progress, denoise ? &guides : nullptr, make_ray, finish);
   out.rays = static_cast<std::uint64_t>(texels) * static_cast<std::uint64_t>(params.ao.samples) + traced.load();  // a cage ray per sample, plus the AO rays

@@ -127,7 +127,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   // The filter's guides, filled in the tile loop from the patches it builds anyway.
   const bool denoise = params.denoise > 0;
   TexelGuides guides;
-  if (denoise) guides = {Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}), Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 1})};
+  if (denoise) guides = TexelGuides(cov.width, cov.height);
   ProgressCounter counter(progress, cov.texel_count());
   detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     parallel_for_tiles(cov.width, cov.height, detail::kTexelTile, [&](const Tile& t) {

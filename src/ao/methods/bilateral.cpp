@@ -11,6 +11,7 @@
 #include "ao/core/error.h"
 #include "ao/core/math.h"
 #include "ao/core/parallel.h"
+#include "ao/simd/filters_internal.h"
 
 namespace ao {
 
@@ -28,109 +29,19 @@ struct Rays {
   float y(float py) const { return ay * py + by; }
 };
 
-// The centre pixels of one row segment, folded into three coefficients per pass so that a tap
-// costs two FMAs before the kernel. With C = d0 (rx, ry, -1) (positions are depth * ray, as in
-// alchemy.cpp: taps read one float of depth, not a 12-byte position) and a tap at depth d on the
-// ray (tx, ty, -1), the tangent-plane distance over the scale, halved (K(x) = max(0, 1 - (x/2)^2)^2), is
+// The centre pixels of one row segment are folded into three coefficients per pass so that a tap
+// costs two multiply-adds before the kernel (simd::bilateral_centres). With C = d0 (rx, ry, -1)
+// (positions are depth * ray, as in alchemy.cpp: taps read one float of depth, not a 12-byte
+// position) and a tap at depth d on the ray (tx, ty, -1), the tangent-plane distance over the
+// scale, halved (K(x) = max(0, 1 - (x/2)^2)^2), is
 //   x/2 = |d (n . (tx, ty, -1)) - n . C| * s/2 = |d (a t + b) - c|,  s = 1 / (plane_sigma d0),
 // where t is the coordinate that varies along the pass (tx horizontally, ty vertically):
 //   horizontal: a = nx s/2, b = (ny ry - nz) s/2;  vertical: a = ny s/2, b = (nx rx - nz) s/2;  c = (n . C) s/2.
-struct Centres {
-  alignas(64) std::array<float, kTileWidth> a, b, c, cov;
-};
-
 void load_centres(const GBuffer& g, const float* depth_plane, const Rays& rays, int y, int x0, int x1, float plane_sigma, bool vertical,
-                  Centres& ce) {
+                  simd::BilateralCentres& ce) {
   const std::size_t base = static_cast<std::size_t>(y) * g.width() + x0;
-  const float* n = &g.normal[base].x;
-  const float* depth = &depth_plane[base];
-  const std::uint32_t* cov = &g.object_id[base];
-  const float ry = rays.y(static_cast<float>(y) + 0.5f);
-  const int count = x1 - x0;
-  for (int k = 0; k < count; ++k) {
-    const float nx = n[3 * k], ny = n[3 * k + 1], nz = n[3 * k + 2];
-    const bool covered = cov[k] != 0;
-    const float d = covered ? depth[k] : 0.0f;
-    const float rx = rays.x(static_cast<float>(x0 + k) + 0.5f);
-    // Background: scale 0 (and cov 0), so its result is never used.
-    const float half_s = covered ? 0.5f / (plane_sigma * d) : 0.0f;
-    ce.a[k] = (vertical ? ny : nx) * half_s;
-    ce.b[k] = (vertical ? nx * rx - nz : ny * ry - nz) * half_s;
-    ce.c[k] = d * (nx * rx + ny * ry - nz) * half_s;
-    ce.cov[k] = covered ? 1.0f : 0.0f;
-  }
-}
-
-// All taps of a row segment, in blocks of kBlock pixels whose two sums stay in registers across the
-// taps (one pass over the segment instead of one per tap). Tap j reads depths td[j][k] and values
-// tv[j][k] (aligned with the segment's first pixel) with spatial weight sp[j]; its varying ray
-// coordinate is tt[j][k] (horizontal: per pixel) or tt[j][0] (vertical: one value for the whole
-// row). Per pixel the taps are summed in order, so the result does not depend on the blocking.
-// 16-wide vectors (one AVX-512 register; two AVX ones elsewhere), two per block for independent sums.
-constexpr int kLanes = 16, kBlock = 2 * kLanes;
-using VecF = float __attribute__((vector_size(4 * kLanes)));
-using VecI = std::int32_t __attribute__((vector_size(4 * kLanes)));
-
-inline VecF loadv(const float* p) {
-  VecF v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline VecF splatv(float f) { return VecF{} + f; }
-inline VecF selectv(VecI m, VecF a, VecF b) { return (VecF)((m & (VecI)a) | (~m & (VecI)b)); }
-
-// Blocks of kBlock pixels: two vectors per sum, the same arithmetic as the 1-pixel path below.
-template <bool kPerPixel>
-inline void filter_block(const Centres& ce, int k0, int taps, const float* sp, const float* const* tt, const float* const* td,
-                           const float* const* tv, const float* __restrict in, float* __restrict out) {
-  VecF a[2], b[2], c[2], sum_w[2] = {}, sum_v[2] = {};
-  for (int h = 0; h < 2; ++h) a[h] = loadv(&ce.a[k0 + kLanes * h]), b[h] = loadv(&ce.b[k0 + kLanes * h]), c[h] = loadv(&ce.c[k0 + kLanes * h]);
-  const VecF zero{}, one = splatv(1.0f);
-  for (int j = 0; j < taps; ++j) {
-    const VecF spatial = splatv(sp[j]);
-    for (int h = 0; h < 2; ++h) {
-      const VecF t = kPerPixel ? loadv(tt[j] + k0 + kLanes * h) : splatv(tt[j][0]);
-      const VecF d = loadv(td[j] + k0 + kLanes * h);
-      const VecF half_x = d * (a[h] * t + b[h]) - c[h];
-      VecF u = one - half_x * half_x;
-      u = selectv(u > zero, u, zero);  // max(0, u), NaN -> 0 as std::max(0.0f, NaN)
-      // Background taps (d = +inf): half_x is +-inf or NaN, so u = 0 and w = 0 as in filter_pixel.
-      const VecF w = spatial * (u * u);
-      sum_w[h] += w;
-      sum_v[h] += w * loadv(tv[j] + k0 + kLanes * h);
-    }
-  }
-  for (int h = 0; h < 2; ++h) {
-    const VecI covered = loadv(&ce.cov[k0 + kLanes * h]) > zero;
-    const VecF r = selectv(covered, sum_v[h] / sum_w[h], loadv(in + k0 + kLanes * h));
-    std::memcpy(out + k0 + kLanes * h, &r, sizeof r);
-  }
-}
-
-template <bool kPerPixel>
-inline void filter_pixel(const Centres& ce, int k, int taps, const float* sp, const float* const* tt, const float* const* td,
-                         const float* const* tv, const float* __restrict in, float* __restrict out) {
-  float sum_w = 0.0f, sum_v = 0.0f;
-  for (int j = 0; j < taps; ++j) {
-    const float d = td[j][k];
-    const float half_x = d * (ce.a[k] * tt[j][kPerPixel ? k : 0] + ce.b[k]) - ce.c[k];
-    // K = max(0, 1 - (x/2)^2)^2. Background taps have depth +inf: x is inf or NaN, and the select
-    // gives them weight 0.
-    const float u = std::max(0.0f, 1.0f - half_x * half_x);
-    const float w = d < kInfinity ? sp[j] * (u * u) : 0.0f;
-    sum_w += w;
-    sum_v += w * tv[j][k];
-  }
-  // The centre tap has weight spatial(0) * 1 > 0 on covered pixels, so sum_w > 0 there.
-  out[k] = ce.cov[k] > 0 ? sum_v / sum_w : in[k];
-}
-
-template <bool kPerPixel>
-void filter_segment(const Centres& ce, int count, int taps, const float* sp, const float* const* tt, const float* const* td, const float* const* tv,
-                    const float* in, float* out) {
-  int k0 = 0;
-  for (; k0 + kBlock <= count; k0 += kBlock) filter_block<kPerPixel>(ce, k0, taps, sp, tt, td, tv, in, out);
-  for (; k0 < count; ++k0) filter_pixel<kPerPixel>(ce, k0, taps, sp, tt, td, tv, in, out);
+  simd::bilateral_centres(ce, &g.normal[base].x, &depth_plane[base], &g.object_id[base], x0, x1 - x0, rays.ax, rays.bx,
+                          rays.y(static_cast<float>(y) + 0.5f), plane_sigma, vertical);
 }
 
 }  // namespace
@@ -177,7 +88,7 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
       tbb::blocked_range2d<int>(0, h, kTileHeight, 0, w, kTileWidth),
       [&](const tbb::blocked_range2d<int>& r) {
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
-        Centres c;
+        simd::BilateralCentres c;
         alignas(64) std::array<float, kTileWidth + 2 * kMaxTaps> rx, rd, rv;
         for (int k = 0; k < n + 2 * half; ++k) rx[k] = rays.x(static_cast<float>(x0 - half + k) + 0.5f);
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
@@ -191,7 +102,7 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
           std::fill(rd.begin() + hi, rd.begin() + n + 2 * half, kInfinity), std::fill(rv.begin() + hi, rv.begin() + n + 2 * half, 0.0f);
           std::array<const float*, kMaxTaps> tt, td, tv;
           for (int j = 0; j < params.taps; ++j) tt[j] = &rx[j], td[j] = &rd[j], tv[j] = &rv[j];
-          filter_segment<true>(c, n, params.taps, spatial.data(), tt.data(), td.data(), tv.data(), &values[row + x0], &tmp[row + x0]);
+          simd::bilateral_taps(c, n, params.taps, spatial.data(), tt.data(), true, td.data(), tv.data(), &values[row + x0], &tmp[row + x0]);
         }
       },
       tbb::simple_partitioner());
@@ -200,7 +111,7 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
       tbb::blocked_range2d<int>(0, h, kTileHeight, 0, w, kTileWidth),
       [&](const tbb::blocked_range2d<int>& r) {
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
-        Centres c;
+        simd::BilateralCentres c;
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
           load_centres(g, depth, rays, y, x0, x1, params.plane_sigma, true, c);
           std::array<const float*, kMaxTaps> tt, td, tv;
@@ -216,7 +127,7 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
             ++taps;
           }
           const std::size_t row = static_cast<std::size_t>(y) * w + x0;
-          filter_segment<false>(c, n, taps, sp.data(), tt.data(), td.data(), tv.data(), &tmp[row], &values[row]);
+          simd::bilateral_taps(c, n, taps, sp.data(), tt.data(), false, td.data(), tv.data(), &tmp[row], &values[row]);
         }
       },
       tbb::simple_partitioner());

@@ -37,6 +37,39 @@ void VolumetricParams::validate() const { volumetric_param_table().validate(*thi
 void to_json(nlohmann::json& j, const VolumetricParams& p) { j = volumetric_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, VolumetricParams& p) { volumetric_param_table().from_json(j, p); }
 
+namespace {
+
+// VAO eq. 6-7 with an analytic characteristic function: simd::sum_free_pipes one pixel at a time
+// (the analytic scenes are small test scenes). free[k] = sum over the pipes of entry k of their
+// free length inside the tangent sphere.
+template <class Characteristic>
+void sum_free_pipes(const simd::CoveredPixels& row, const Characteristic& ch, float half_r, const DiskSamples& s, float far_limit, float* free) {
+  for (int k = 0; k < row.count; ++k) {
+    const auto e = static_cast<std::size_t>(k);
+    // Fig. 4: the tangent sphere's centre x + N R/2.
+    const float cx = row.px[e] + half_r * row.nx[e], cy = row.py[e] + half_r * row.ny[e], cz = row.pz[e] + half_r * row.nz[e];
+    float acc = 0.0f;
+    for (int i = 0; i < s.size(); ++i) {
+      const auto si = static_cast<std::size_t>(i);
+      // Disk sample i scaled to the sphere, rotated by the pixel's interleaving angle about the view axis, at depth z_c.
+      const float xi = half_r * s.x[si], yi = half_r * s.y[si];
+      const float half_chord = half_r * s.h[si];  // (R/2) h_i = z_c - z_entry
+      const float chord = 2.0f * half_chord;       // z_exit - z_entry
+      const float ox = row.rc[e] * xi - row.rs[e] * yi, oy = row.rs[e] * xi + row.rc[e] * yi;
+      // distance = z* - z_c, so z* - z_entry = distance + (R/2) h_i.
+      const float to_surface = ch.distance(cx + ox, cy + oy, cz) + half_chord + row.bias[e];
+      // Fig. 7: dz = clamp(z* - z_entry, 0, chord): (a) surface inside: z* - z_entry; (b) behind:
+      // the chord; (c) in front: 0. AT 4.3 for pipes: a distant foreground surface leaves it free.
+      const float dz = std::min(std::max(to_surface, 0.0f), chord);
+      const bool distant = to_surface < far_limit && to_surface > -1e30f;  // -inf: inner all along, not distant
+      acc += distant ? chord : dz;
+    }
+    free[k] = acc;
+  }
+}
+
+}  // namespace
+
 template <class Characteristic>
 Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float radius, const VolumetricParams& params, std::uint32_t seed) {
   Falloff{Membership::Cubic, radius}.validate();
@@ -54,88 +87,19 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
   // AT 4.3 for pipes: a surface more than R in front of the pipe's entry is a distant foreground
   // object and does not occlude (z_entry - z* > R).
   const float far_limit = params.silhouette_elimination ? -R : -kInfinity;
+  const simd::Rotations16 rot = simd_rotations(rotations);
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-    // A local copy: its members are then known not to alias the accumulators, so the loop vectorises.
-    // Locals, not the closure's references: loads through the closure may alias the accumulators,
-    // which kept them in the loop and stopped if-conversion (GCC 12: "control flow in loop").
-    const Characteristic local_ch = ch;
-    const float hr = half_r, lim = far_limit;
-    PixelRow row;
-    std::vector<int> index;  // entry k of the row is pixel t.x0 + index[k] (covered pixels only)
-    std::vector<float> cx, cy, cz, free_len;
-    alignas(64) float fx0[kTile], fy0[kTile], cax[kTile], cbx[kTile], cay[kTile], cby[kTile];  // depth-buffer path
+    simd::CoveredPixels row;
+    simd::AlignedVector<float> free_len(static_cast<std::size_t>(simd::padded(t.x1 - t.x0)));
     for (int y = t.y0; y < t.y1; ++y) {
-      load_pixel_row_simd(row, index, g, y, t.x0, t.x1, rotations, params.bias, false);  // no tangent frame: pipes run along the view axis
-      const int count = row.count;
-      cx.resize(static_cast<std::size_t>(count));
-      cy.resize(static_cast<std::size_t>(count));
-      cz.resize(static_cast<std::size_t>(count));
-      free_len.assign(static_cast<std::size_t>(count), 0.0f);
-      // Fig. 4: the tangent sphere's centre x + N R/2.
-      for (int k = 0; k < count; ++k) {
-        const auto i = static_cast<std::size_t>(k);
-        cx[i] = row.px[i] + half_r * row.nx[i];
-        cy[i] = row.py[i] + half_r * row.ny[i];
-        cz[i] = row.pz[i] + half_r * row.nz[i];
-      }
-      float* __restrict acc = free_len.data();
-      const float *pcx = cx.data(), *pcy = cy.data(), *pcz = cz.data(), *rc = row.rc.data(), *rs = row.rs.data(), *bias = row.bias.data();
-      if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>) {
-        // The depth-buffer lookup with the projection hoisted out of the sample loop: a pipe's point
-        // (c_x + o_x, c_y + o_y, c_z) has the same depth c_z for every sample, so the divide by -c_z
-        // and the rotation fold into per-pixel affine coefficients of the pixel position:
-        //   f_x = f_x0 + x_i a_x - y_i b_x,  f_y = f_y0 - x_i a_y - y_i b_y.
-        const ScreenProjection pr = local_ch.projection;
-        const float* __restrict depth = local_ch.depth;
-        const float max_x = static_cast<float>(pr.width - 1), max_y = static_cast<float>(pr.height - 1);
-        for (int k = 0; k < count; ++k) {
-          const float inv = -1.0f / pcz[k], kx = inv * pr.scale_x, ky = inv * pr.scale_y;
-          fx0[k] = pcx[k] * kx + pr.centre_x, fy0[k] = pr.centre_y - pcy[k] * ky;
-          cax[k] = rc[k] * kx, cbx[k] = rs[k] * kx, cay[k] = rs[k] * ky, cby[k] = rc[k] * ky;
-        }
-        for (int i = 0; i < s.size(); ++i) {
-          const float xi = hr * s.x[static_cast<std::size_t>(i)], yi = hr * s.y[static_cast<std::size_t>(i)];
-          const float half_chord = hr * s.h[static_cast<std::size_t>(i)];  // (R/2) h_i = z_c - z_entry
-          const float chord = 2.0f * half_chord;                              // z_exit - z_entry
-#pragma GCC ivdep
-          for (int k = 0; k < count; ++k) {
-            const float fx = fx0[k] + xi * cax[k] - yi * cbx[k], fy = fy0[k] - xi * cay[k] - yi * cby[k];
-            const float z = pcz[k];
-            // As ScreenProjection::locate: clamp-to-edge, free only behind the camera.
-            const bool valid = z < 0.0f;
-            const int ix = static_cast<int>(std::min(std::max(valid ? fx : 0.0f, 0.0f), max_x));
-            const int iy = static_cast<int>(std::min(std::max(valid ? fy : 0.0f, 0.0f), max_y));
-            const float zs = depth[iy * pr.width + ix];
-            // As DepthBufferCharacteristic::distance, then z* - z_entry = (z* - z_c) + (R/2) h_i.
-            const float to_surface = (valid ? zs + z : kInfinity) + half_chord + bias[k];
-            const float dz = std::min(std::max(to_surface, 0.0f), chord);  // fig. 7 a-c
-            const bool distant = (to_surface < lim) & (to_surface > -1e30f);
-            acc[k] += distant ? chord : dz;
-          }
-        }
-      } else {
-        for (int i = 0; i < s.size(); ++i) {
-          // Disk sample i scaled to the sphere, rotated per pixel below by (rc, rs) about the view axis.
-          const float xi = hr * s.x[static_cast<std::size_t>(i)], yi = hr * s.y[static_cast<std::size_t>(i)];
-          const float half_chord = hr * s.h[static_cast<std::size_t>(i)];  // (R/2) h_i = z_c - z_entry
-          const float chord = 2.0f * half_chord;                              // z_exit - z_entry
-// Lane k writes only its own accumulator; the gathers read the (read-only) G-buffer.
-#pragma GCC ivdep
-          for (int k = 0; k < count; ++k) {
-            // Disk sample rotated by the pixel's interleaving angle about the view axis, at depth z_c.
-            const float ox = rc[k] * xi - rs[k] * yi, oy = rs[k] * xi + rc[k] * yi;
-            // distance = z* - z_c, so z* - z_entry = distance + (R/2) h_i.
-            const float to_surface = local_ch.distance(pcx[k] + ox, pcy[k] + oy, pcz[k]) + half_chord + bias[k];
-            // Fig. 7: dz = clamp(z* - z_entry, 0, chord): (a) surface inside: z* - z_entry; (b) behind:
-            // the chord; (c) in front: 0. Branch-free (max/min, & not &&) so the loop if-converts.
-            const float dz = std::min(std::max(to_surface, 0.0f), chord);
-            const bool distant = (to_surface < lim) & (to_surface > -1e30f);  // -inf: inner all along, not distant
-            acc[k] += distant ? chord : dz;
-          }
-        }
-      }
-      for (int k = 0; k < count; ++k) v(t.x0 + index[static_cast<std::size_t>(k)], y) = std::min(acc[k] * inv_f, 1.0f);  // eq. 7; analytic F can overshoot 1
+      simd::load_covered_pixels(row, g, y, t.x0, t.x1, rot, params.bias, false);  // no tangent frame: pipes run along the view axis
+      if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>)
+        simd::sum_free_pipes(row, simd_depth_plane(ch), half_r, simd_points(s), far_limit, free_len.data());
+      else
+        sum_free_pipes(row, ch, half_r, s, far_limit, free_len.data());
+      for (int k = 0; k < row.count; ++k)
+        v(t.x0 + row.index[static_cast<std::size_t>(k)], y) = std::min(free_len[static_cast<std::size_t>(k)] * inv_f, 1.0f);  // eq. 7; analytic F can overshoot 1
     }
   });
   if (params.interleave.interleave && params.interleave.filter)

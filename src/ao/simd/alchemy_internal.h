@@ -1,0 +1,40 @@
+// Kernel of Alchemy AO's estimator (McGuire, Osman, Bukowski, Hennessy, "The Alchemy Screen-Space
+// Ambient Obscurance Algorithm", HPG 2011, eq. 10), written once for every SIMD target
+// (alchemy.cpp). methods/alchemy.cpp turns the paper's constants into world units and builds the
+// sample pattern; this kernel runs it for a row of pixels in the lanes of vectors.
+#pragma once
+
+#include <cstdint>
+
+namespace ao::simd {
+
+/// What the estimator reads: the G-buffer's depth plane, normals and ids, its constants and the
+/// sample pattern.
+struct AlchemyInputs {
+  const float* depth = nullptr;             ///< width * height linear depths, +infinity on background.
+  const float* normal = nullptr;            ///< width * height unit normals, xyz triples, camera space.
+  const std::uint32_t* object_id = nullptr; ///< width * height; 0: uncovered.
+  int width = 0, height = 0;
+  /// Camera rays through pixel centres: ray(x, y) = (ray_ax (x + 1/2) + ray_bx, ray_ay (y + 1/2) + ray_by, -1).
+  float ray_ax = 0, ray_bx = 0, ray_ay = 0, ray_by = 0;
+  float radius = 1;       ///< r of eq. 9-10, world units.
+  float px_per_unit = 1;  ///< Pixels per unit of x/(-z) on both axes.
+  float max_pixel_radius = 16384;  ///< Cap on the disk's screen radius, pixels.
+  float epsilon = 0;      ///< epsilon of eq. 10, world units squared.
+  float beta = 0;         ///< beta of eq. 10 (multiplies z_C).
+  float scale = 0;        ///< 2 sigma / s: the factor of eq. 10's sum.
+  int samples = 1;        ///< s of eq. 10.
+  const float* ux = nullptr;  ///< s unit directions of the pattern (cos of sample i's angle).
+  const float* uy = nullptr;  ///< (sin of sample i's angle).
+  const float* rot_c = nullptr;  ///< Per-pixel rotations of the pattern: a table of 1024 (cos, sin).
+  const float* rot_s = nullptr;
+  std::uint32_t seed = 0;  ///< Picks each pixel's rotation and jitter: pixel_seed(seed, x, y).
+};
+
+/// Eq. 10 before the power k for the pixels [x0, x1) of row y into v[x - x0]: on covered pixels
+/// max(0, 1 - scale sum_i max(0, v_i . n + z_C beta) / (v_i . v_i + epsilon)) over the s samples
+/// P_i of the disk of radius r about C (stratified in s equal-area annuli, rotated and jittered per
+/// pixel, read from the depth buffer, clamp-to-edge) with |v_i| < r, v_i = P_i - C; 1 elsewhere.
+void alchemy_row(const AlchemyInputs& in, int y, int x0, int x1, float* v);
+
+}  // namespace ao::simd

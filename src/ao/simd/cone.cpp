@@ -1,0 +1,344 @@
+// Kernel of voxel cone traced AO on the world grid (cone_internal.h; methods/cone_world.cpp for the
+// tables, docs/methods/cone.md for the method and its speed), compiled once per SIMD target. Per
+// pixel: the prism pattern turned and the cones' axes taken into the grid (vectors over prisms and
+// cones), every sphere of every cone placed and tested against the window masks with no branch
+// between spheres (vectors over slots, 64-bit mask gathers), then each cone front to back over the
+// spheres that passed, a sphere's prisms counted a vector at a time (one 64-bit load per prism,
+// masks and popcount). Sums over prisms run in prism order and multiply-adds are written out
+// (MulAdd), compiled without contraction: targets with FMA agree bit for bit.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "ao/simd/cone.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include <hwy/highway.h>
+
+#include "ao/methods/cone_kernel_internal.h"
+#include "ao/simd/aligned_internal.h"
+#include "ao/simd/cone_internal.h"
+#include "ao/simd/vec_internal.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace ao::simd::HWY_NAMESPACE {
+
+namespace {
+
+using D64 = hn::ScalableTag<std::uint64_t>;  // 64-bit words: column and window loads
+using DI64 = hn::RebindToSigned<D64>;
+using DH = hn::Rebind<float, D64>;           // floats alongside the words (half a vector)
+using DHI = hn::Rebind<std::int32_t, D64>;
+using DHU = hn::Rebind<std::uint32_t, D64>;
+using V64 = hn::Vec<D64>;
+using VH = hn::Vec<DH>;
+using VHI = hn::Vec<DHI>;
+
+// Bits of a mask of (at most 8) lanes, lane 0 in bit 0.
+template <class D>
+HWY_INLINE unsigned mask_bits(D d, hn::Mask<D> m) {
+  std::uint8_t b[8] = {};
+  hn::StoreMaskBits(d, m, b);
+  return b[0];
+}
+
+// A 64-bit word per lane from base + offset bytes (unaligned) where bit l of `bits` is set, 0 in
+// the other lanes, whose offsets must then still be readable except on AVX-512 (masked gathers).
+HWY_INLINE V64 gather_words(unsigned bits, const std::uint64_t* base, hn::Vec<DI64> offset_bytes) {
+#if HWY_TARGET <= HWY_AVX3
+  return V64{_mm512_mask_i64gather_epi64(_mm512_setzero_si512(), static_cast<__mmask8>(bits), offset_bytes.raw, base, 1)};
+#else
+  (void)bits;
+  return hn::GatherOffset(D64(), base, offset_bytes);
+#endif
+}
+
+// 64-bit lanes (small non-negative integers) as floats alongside.
+HWY_INLINE VH to_float(V64 v) { return hn::ConvertTo(DH(), hn::BitCast(DHI(), hn::TruncateTo(DHU(), v))); }
+
+// Everything of one call that does not change from pixel to pixel, and one pixel's scratch.
+struct Kernel {
+  const VoxelGrid& g;
+  const ConeTables& tb;
+  float weight;  // every cone stands for a cell of equal measure
+  // The pixel's turned prism pattern, the cones' axes in voxels and chain scales, and per slot the
+  // sphere's centre (voxels) and radius scale and the bit arrays "sampled", "wider than the
+  // largest window" and "passed" (sampled and the window masks say maybe; wide: the blocks decide).
+  // One allocation per call, carved into the arrays (each a whole number of the widest vectors).
+  AlignedVector<float> scratch;
+  float *u, *v, *ax, *ay, *az, *scale, *cx, *cy, *cz, *rs;
+  std::vector<std::uint8_t> used, wide, pass;
+
+  Kernel(const VoxelGrid& grid, const ConeTables& tables)
+      : g(grid), tb(tables), weight(1.0f / static_cast<float>(tables.cones)),
+        scratch(2 * static_cast<std::size_t>(tables.prism_lanes) + 4 * static_cast<std::size_t>(tables.cones_padded) +
+                4 * static_cast<std::size_t>(padded(tables.slots))),
+        used(static_cast<std::size_t>(padded(tables.slots)) / 8 + 8), wide(used.size()), pass(used.size()) {
+    float* p = scratch.data();
+    const auto take = [&](std::size_t n) { return std::exchange(p, p + n); };
+    const auto np = static_cast<std::size_t>(tables.prism_lanes), nc = static_cast<std::size_t>(tables.cones_padded),
+               ns = static_cast<std::size_t>(padded(tables.slots));
+    u = take(np), v = take(np), ax = take(nc), ay = take(nc), az = take(nc), scale = take(nc);
+    cx = take(ns), cy = take(ns), cz = take(ns), rs = take(ns);
+  }
+
+  static bool bit(const std::vector<std::uint8_t>& b, int i) { return (b[static_cast<std::size_t>(i) >> 3] >> (i & 7)) & 1u; }
+  // `count` (<= 25) bits of a bit array from bit `first`.
+  static std::uint32_t bits(const std::vector<std::uint8_t>& b, int first, int count) {
+    std::uint32_t word;
+    std::memcpy(&word, b.data() + (first >> 3), sizeof word);
+    return (word >> (first & 7)) & ((1u << count) - 1);
+  }
+
+  // The disk points turned by the pixel's (rot_c, rot_s).
+  void turn(float rot_c, float rot_s) {
+    const DF d;
+    const VF c = hn::Set(d, rot_c), s = hn::Set(d, rot_s);
+    for (int k = 0; k < tb.prism_lanes; k += static_cast<int>(hn::Lanes(d))) {
+      const VF du = hn::Load(d, tb.disk_u + k), dv = hn::Load(d, tb.disk_v + k);
+      hn::Store(hn::MulSub(du, c, hn::Mul(dv, s)), d, u + k);
+      hn::Store(hn::MulAdd(du, s, hn::Mul(dv, c)), d, v + k);
+    }
+  }
+
+  // The pattern's cone axes turned into the pixel's frame and into voxels.
+  void axes(const ConePixel& p) {
+    const DF d;
+    const std::size_t o = static_cast<std::size_t>(p.pattern) * tb.cones_padded;
+    const VF tx = hn::Set(d, p.t.x), ty = hn::Set(d, p.t.y), tz = hn::Set(d, p.t.z), bx = hn::Set(d, p.b.x), by = hn::Set(d, p.b.y),
+             bz = hn::Set(d, p.b.z), nx = hn::Set(d, p.n.x), ny = hn::Set(d, p.n.y), nz = hn::Set(d, p.n.z);
+    const VF ix = hn::Set(d, tb.inv_voxel.x), iy = hn::Set(d, tb.inv_voxel.y), iz = hn::Set(d, tb.inv_voxel.z);
+    for (int c = 0; c < tb.cones; c += static_cast<int>(hn::Lanes(d))) {
+      const VF lx = hn::Load(d, tb.axis_x + o + c), ly = hn::Load(d, tb.axis_y + o + c), lz = hn::Load(d, tb.axis_z + o + c);
+      const VF wx = hn::MulAdd(nx, lz, hn::MulAdd(bx, ly, hn::Mul(tx, lx)));
+      const VF wy = hn::MulAdd(ny, lz, hn::MulAdd(by, ly, hn::Mul(ty, lx)));
+      const VF wz = hn::MulAdd(nz, lz, hn::MulAdd(bz, ly, hn::Mul(tz, lx)));
+      hn::Store(hn::Load(d, tb.axis_scale + o + c), d, scale + c);
+      // World (x, y, z) is the grid's (i, k, j).
+      hn::Store(hn::Mul(wx, ix), d, ax + c), hn::Store(hn::Mul(wz, iy), d, ay + c), hn::Store(hn::Mul(wy, iz), d, az + c);
+    }
+  }
+
+  // Every slot's sphere placed from the pixel's grid point and tested against the window masks
+  // (deviation 6 of docs/methods/cone.md; exact: a skipped sphere's prisms read no solid voxel).
+  void place(float gx, float gy, float gz) {
+    const DH dh;
+    const DHI dhi;
+    const DI64 di64;
+    const int lanes = static_cast<int>(hn::Lanes(dh));
+    constexpr float kInvC = 1.0f / VoxelGrid::kCellXY;
+    const VH zero = hn::Zero(dh), one = hn::Set(dh, 1.0f), quarter = hn::Set(dh, kInvC);
+    const VH fdnx = hn::Set(dh, static_cast<float>(g.dnx - 1)), fdny = hn::Set(dh, static_cast<float>(g.dny - 1)),
+             fbits = hn::Set(dh, static_cast<float>(g.depth_bits - 1));
+    // Margins for rounding: 1e-3 voxels, in cells along x and y.
+    const VH margin_c = hn::Set(dh, 1e-3f * kInvC), margin_z = hn::Set(dh, 1e-3f);
+    const VH vgx = hn::Set(dh, gx), vgy = hn::Set(dh, gy), vgz = hn::Set(dh, gz);
+    const VHI dnx = hn::Set(dhi, g.dnx), cap = hn::Set(dhi, VoxelGrid::kWindowCap), c63 = hn::Set(dhi, 63);
+    const V64 ones = hn::Set(D64(), ~std::uint64_t{0});
+    const bool permute = tb.cones <= lanes;  // the cones' values fit one vector: a permute per slot, else a gather
+    const VH ps = hn::LoadU(dh, scale), pax = hn::LoadU(dh, ax), pay = hn::LoadU(dh, ay), paz = hn::LoadU(dh, az);
+    std::fill(used.begin(), used.end(), 0), std::fill(wide.begin(), wide.end(), 0), std::fill(pass.begin(), pass.end(), 0);
+    for (int i = 0; i < tb.slots; i += lanes) {
+      const VHI c = hn::LoadU(dhi, tb.slot_cone + i);
+      VH s, cax, cay, caz;
+      if (permute) {
+        const auto idx = hn::IndicesFromVec(dh, c);
+        s = hn::TableLookupLanes(ps, idx), cax = hn::TableLookupLanes(pax, idx), cay = hn::TableLookupLanes(pay, idx), caz = hn::TableLookupLanes(paz, idx);
+      } else {
+        s = hn::GatherIndex(dh, scale, c), cax = hn::GatherIndex(dh, ax, c), cay = hn::GatherIndex(dh, ay, c),
+        caz = hn::GatherIndex(dh, az, c);
+      }
+      // The chain, affine in the cone's scale s (cone_internal.h).
+      const VH d = hn::MulAdd(hn::LoadU(dh, tb.dist_a + i), s, hn::LoadU(dh, tb.dist_b + i));
+      const VH px = hn::MulAdd(cax, d, vgx), py = hn::MulAdd(cay, d, vgy), pz = hn::MulAdd(caz, d, vgz);
+      const VH r = hn::Min(hn::MulAdd(hn::LoadU(dh, tb.rad_a + i), s, hn::LoadU(dh, tb.rad_b + i)), one);
+      const unsigned use = mask_bits(dh, hn::Ge(hn::MulAdd(hn::LoadU(dh, tb.use_a + i), s, hn::LoadU(dh, tb.use_b + i)), zero));
+      hn::Store(px, dh, cx + i), hn::Store(py, dh, cy + i), hn::Store(pz, dh, cz + i), hn::Store(r, dh, rs + i);
+      // The sphere's prisms read columns within (ex, ey) of its centre and voxels within ez along
+      // them; that box of columns lies in the window anchored at its lowest cell, w = its larger
+      // span in cells (clamped into the grid, which only drops columns no prism can read), whose
+      // mask is checked over the box's z cells cl..ch. A box wider than the largest window goes to
+      // the blocks. Indices are int(min(max(x, 0), n - 1)): clamp(floor(x), 0, n - 1) for x >= 0, 0 for NaN.
+      const VH ex = hn::MulAdd(hn::LoadU(dh, tb.box_x + i), r, margin_c), ey = hn::MulAdd(hn::LoadU(dh, tb.box_y + i), r, margin_c);
+      const VH ez = hn::MulAdd(hn::LoadU(dh, tb.box_z + i), r, margin_z);
+      const VH pxc = hn::Mul(px, quarter), pyc = hn::Mul(py, quarter);
+      const auto cell = [&](VH a, VH hi) { return truncate_in_range_h(hn::Min(hn::Max(a, zero), hi)); };
+      const VHI x0 = cell(hn::Sub(pxc, ex), fdnx), x1 = cell(hn::Add(pxc, ex), fdnx);
+      const VHI y0 = cell(hn::Sub(pyc, ey), fdny), y1 = cell(hn::Add(pyc, ey), fdny);
+      const VHI cl = hn::ShiftRightSame(cell(hn::Sub(pz, ez), fbits), g.cell_shift), ch = hn::ShiftRightSame(cell(hn::Add(pz, ez), fbits), g.cell_shift);
+      const VHI w = hn::Max(hn::Sub(x1, x0), hn::Sub(y1, y0));
+      const unsigned wid = mask_bits(dhi, hn::Gt(w, cap));
+      const VHI idx = hn::Add(hn::ShiftLeft<3>(hn::Add(hn::Mul(y0, dnx), x0)), hn::Min(w, cap));  // kWindowCap + 1 = 8 masks per cell
+      const V64 wm = gather_words(use, g.window.data(), hn::ShiftLeft<3>(hn::PromoteTo(di64, idx)));
+      const V64 sh = hn::BitCast(D64(), hn::PromoteTo(di64, hn::Sub(c63, hn::Sub(ch, cl))));
+      const V64 lo = hn::BitCast(D64(), hn::PromoteTo(di64, cl));
+      const unsigned any = mask_bits(D64(), hn::Not(hn::Eq(hn::And((wm >> lo), (ones >> sh)), hn::Zero(D64()))));
+      const int at = i >> 3, shift = i & 7;  // `lanes` divides 8: a step's bits never straddle a byte
+      used[static_cast<std::size_t>(at)] |= static_cast<std::uint8_t>(use << shift);
+      wide[static_cast<std::size_t>(at)] |= static_cast<std::uint8_t>(wid << shift);
+      pass[static_cast<std::size_t>(at)] |= static_cast<std::uint8_t>((use & (any | wid)) << shift);
+    }
+  }
+
+  static VHI truncate_in_range_h(VH v) {
+#if HWY_TARGET <= HWY_AVX3
+    return VHI{_mm256_cvttps_epi32(v.raw)};
+#elif HWY_TARGET <= HWY_AVX2
+    return VHI{_mm_cvttps_epi32(v.raw)};
+#else
+    return hn::ConvertTo(DHI(), v);
+#endif
+  }
+
+  float scalar_prism(float gx, float gy, float gz, float rx, float ry, float h, float pu, float pv) const {
+    const float fx = gx + pu * rx, fy = gy + pv * ry;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return 0.0f;
+    return cone_internal::solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - h, gz + h);
+  }
+
+  // The solid length of the sphere's prisms (centred at grid point (gx, gy, gz), radii rx, ry in
+  // voxels, half chords h times `hs`), a vector of prisms at a time: column indices, z ranges, one
+  // 64-bit load per prism starting at the byte that holds its first voxel (bits k0 .. k1 of the
+  // column are then bits sh .. sh + k1 - k0 of the load, sh = k0 mod 8, or further in at the
+  // column's last 8 bytes), masks and popcount. Prisms longer than the load (k1 - k0 + sh > 63) go
+  // the scalar way. The ends count by the part of their voxel inside the range (solid_length).
+  // Summed in prism order.
+  float prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float hs) const {
+    const DH dh;
+    const DHI dhi;
+    const DI64 di64;
+    const D64 d64;
+    const int lanes = static_cast<int>(hn::Lanes(dh));
+    const VH zero = hn::Zero(dh), one = hn::Set(dh, 1.0f), fnx = hn::Set(dh, static_cast<float>(g.nx)), fny = hn::Set(dh, static_cast<float>(g.ny)),
+             fbits = hn::Set(dh, static_cast<float>(g.depth_bits));
+    const VHI last_bit = hn::Set(dhi, g.depth_bits - 1), nx = hn::Set(dhi, g.nx), words = hn::Set(dhi, g.words),
+              last_byte = hn::Set(dhi, 8 * g.words - 8), c63 = hn::Set(dhi, 63);
+    const V64 one64 = hn::Set(d64, 1), two64 = hn::Set(d64, 2);
+    const VH vs = hn::Set(dh, hs), vrx = hn::Set(dh, rx), vry = hn::Set(dh, ry), vgx = hn::Set(dh, gx), vgy = hn::Set(dh, gy), vgz = hn::Set(dh, gz);
+    HWY_ALIGN float len[8];
+    float solid = 0;
+    for (int s0 = 0; s0 < tb.prisms; s0 += lanes) {
+      const VH pu = hn::Load(dh, u + s0), pv = hn::Load(dh, v + s0), hh = hn::Mul(hn::Load(dh, h + s0), vs);
+      const VH fx = hn::MulAdd(pu, vrx, vgx), fy = hn::MulAdd(pv, vry, vgy);
+      const VH zlo = hn::Max(hn::Sub(vgz, hh), zero), zhi = hn::Min(hn::Add(vgz, hh), fbits);
+      const auto live = hn::FirstN(dh, static_cast<std::size_t>(tb.prisms - s0));
+      const auto inside = hn::And(hn::And(hn::Ge(fx, zero), hn::Ge(fy, zero)), hn::And(hn::Lt(fx, fnx), hn::Lt(fy, fny)));
+      const auto in_range = hn::And(live, hn::And(inside, hn::Gt(zhi, zlo)));
+      // Lanes out of range read column 0 (their length is 0).
+      const auto ok_i = hn::RebindMask(dhi, in_range);
+      const VHI ix = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, fx)));
+      const VHI iy = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, fy)));
+      const VHI k0 = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, zlo)));
+      const VHI k1 = hn::IfThenElseZero(ok_i, hn::Min(truncate_in_range_h(hn::IfThenElseZero(in_range, zhi)), last_bit));
+      const VHI byte = hn::Min(hn::ShiftRight<3>(k0), last_byte);
+      const VHI sh = hn::Sub(k0, hn::ShiftLeft<3>(byte)), n = hn::Sub(k1, k0);
+      const auto wide_i = hn::And(ok_i, hn::Gt(hn::Add(sh, n), c63));
+      const unsigned wide_bits = mask_bits(dhi, wide_i);
+      const auto ok = hn::RebindMask(dh, hn::AndNot(wide_i, ok_i));
+      // Byte offsets in 64 bits: a grid of 4096 x 4096 columns of 1024 bits has 2^31 bytes.
+      const VHI col = hn::Mul(hn::Add(hn::Mul(iy, nx), ix), words);
+      const hn::Vec<DI64> at = hn::Add(hn::ShiftLeft<3>(hn::PromoteTo(di64, col)), hn::PromoteTo(di64, byte));
+      const V64 word = gather_words(mask_bits(dh, ok), g.bits.data(), at);
+      const V64 x = (word >> hn::BitCast(d64, hn::PromoteTo(di64, sh)));  // bit 0 = voxel k0, bit n = voxel k1
+      const V64 n64 = hn::BitCast(d64, hn::PromoteTo(di64, n));
+      const VH b0 = to_float(hn::And(x, one64)), b1 = to_float(hn::And((x >> n64), one64));
+      // Voxels strictly between the end voxels: bits 1 .. n - 1 of x (n >= 1; n = 0 takes `single`).
+      const VH mid = to_float(hn::PopulationCount(hn::And(x, hn::Sub((one64 << n64), two64))));
+      const VH fk0 = hn::ConvertTo(dh, k0), fk1 = hn::ConvertTo(dh, k1);
+      // k0 == k1: bit(k0) (zhi - zlo); else bit(k0) (k0 + 1 - zlo) + between + bit(k1) (zhi - k1).
+      const VH multi = hn::Add(hn::Add(hn::Mul(b0, hn::Sub(hn::Add(fk0, one), zlo)), mid), hn::Mul(b1, hn::Sub(zhi, fk1)));
+      const VH single = hn::Mul(b0, hn::Sub(zhi, zlo));
+      const auto one_voxel = hn::RebindMask(dh, hn::Not(hn::Lt(k0, k1)));
+      hn::Store(hn::IfThenElseZero(ok, hn::IfThenElse(one_voxel, single, multi)), dh, len);
+      for (unsigned m = wide_bits; m; m &= m - 1) {
+        const int s = s0 + std::countr_zero(m);
+        len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * hs, u[s], v[s]);
+      }
+      // Lanes past the prisms hold +0, and adding +0 to a sum >= +0 leaves it as it is.
+      for (int k = 0; k < lanes; ++k) solid += len[k];
+    }
+    return solid;
+  }
+
+  // For spheres wider than the largest window: the OR of every block the sphere's box touches.
+  bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
+    constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
+    const int bx0 = std::max(0, static_cast<int>(std::floor((gx - rx) * kInvB)));
+    const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + rx) * kInvB)));
+    const int by0 = std::max(0, static_cast<int>(std::floor((gy - ry) * kInvB)));
+    const int by1 = std::min(g.bny - 1, static_cast<int>(std::floor((gy + ry) * kInvB)));
+    const int k0 = static_cast<int>(std::floor(std::max(gz - rz, -1.0f))), k1 = static_cast<int>(std::min(gz + rz, 1e6f)) + 1;
+    for (int by = by0; by <= by1; ++by)
+      for (int bx = bx0; bx <= bx1; ++bx)
+        if (any_bits(g.block(bx, by), g.words, k0, k1)) return true;
+    return false;
+  }
+
+  // Obstructed fraction of slot i's sphere (sec. III-C1): prisms through its great disk's samples,
+  // each spanning the sphere's chord; Monte Carlo over the disk: its volume ~ the sum of the chords,
+  // its obstructed volume ~ the sum of their solid lengths.
+  float fraction(int i) const {
+    const auto si = static_cast<std::size_t>(i);
+    const int k = tb.slot_sphere[i];
+    const float px = cx[si], py = cy[si], pz = cz[si], r = rs[si];
+    const float rx = tb.sphere_rx[k] * r, ry = tb.sphere_ry[k] * r;
+    if (bit(wide, i) && !maybe_solid_blocks(px, py, pz, rx, ry, tb.sphere_rz[k] * r)) return 0.0f;
+    const float solid = prisms(px, py, pz, rx, ry, tb.half_chord + static_cast<std::size_t>(k) * tb.prism_lanes, r);
+    const float chord = tb.sphere_chord[k] * r;
+    return chord > 0 ? std::min(1.0f, solid / chord) : 0.0f;
+  }
+
+  // Front to back along each cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
+  // fraction f of the rays that reach it, T *= 1 - f, until T <= kOpaque; V = the cones' mean T.
+  float visibility(bool inside) const {
+    float vis = 0;
+    for (int c = 0; c < tb.cones; ++c) {
+      float tr = 1.0f;
+      const int i0 = c * tb.per_cone;
+      if (!inside) {
+        // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
+        // ones, in order (bit j: sphere j of the cone).
+        for (std::uint32_t m = bits(pass, i0, tb.per_cone); m && tr > cone_internal::kOpaque; m &= m - 1)
+          tr *= 1.0f - fraction(i0 + std::countr_zero(m));
+      } else {
+        // The inside of a shell counts the complement (faces_inside): T *= f, and an empty sphere
+        // (f = 0) closes the cone.
+        for (int j = 0; j < tb.per_cone && tr > cone_internal::kOpaque; ++j)
+          if (bit(used, i0 + j)) tr *= bit(pass, i0 + j) ? fraction(i0 + j) : 0.0f;
+      }
+      vis += weight * tr;
+    }
+    return std::clamp(vis, 0.0f, 1.0f);
+  }
+};
+
+}  // namespace
+
+void TraceCones(const VoxelGrid& grid, const ConeTables& tables, const ConePixel* pixels, int count, float* v) {
+  Kernel k(grid, tables);
+  for (int i = 0; i < count; ++i) {
+    const ConePixel& p = pixels[i];
+    k.turn(tables.turn[2 * p.pattern], tables.turn[2 * p.pattern + 1]);
+    k.axes(p);
+    k.place(p.gx, p.gy, p.gz);
+    v[i] = k.visibility(p.inside);
+  }
+}
+
+}  // namespace ao::simd::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace ao::simd {
+
+HWY_EXPORT(TraceCones);
+
+void trace_cones(const VoxelGrid& grid, const ConeTables& tables, const ConePixel* pixels, int count, float* v) {
+  HWY_DYNAMIC_DISPATCH(TraceCones)(grid, tables, pixels, count, v);
+}
+
+}  // namespace ao::simd
+#endif

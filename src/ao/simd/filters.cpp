@@ -1,0 +1,264 @@
+// Kernels of the 4x4 depth-aware box filter and the cross-bilateral filter (filters_internal.h
+// states what they compute), compiled once per SIMD target. The box filter only adds and divides,
+// so every target gives the same bits; the bilateral filter's multiply-adds are written out
+// (MulAdd) and this file is compiled without contraction, so targets with FMA agree bit for bit.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "ao/simd/filters.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <hwy/highway.h>
+
+#include "ao/core/math.h"
+#include "ao/simd/filters_internal.h"
+#include "ao/simd/vec_internal.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace ao::simd::HWY_NAMESPACE {
+
+namespace {
+
+constexpr int kMaxChannels = 4;
+constexpr int kMaxTaps = 63;  // kMaxBilateralTaps
+
+// Lane l of an RGB vector k (k = 0, 1, 2) of a block of Lanes() pixels belongs to pixel (k Lanes() + l) / 3.
+constexpr std::array<std::int32_t, 3 * kMaxLanes> kRgbPixel = [] {
+  std::array<std::int32_t, 3 * kMaxLanes> t{};
+  for (int l = 0; l < 3 * kMaxLanes; ++l) t[static_cast<std::size_t>(l)] = l / 3;
+  return t;
+}();
+
+// A value per pixel of a block spread to the pixel's S lanes: S vectors.
+template <int S>
+HWY_INLINE std::array<VF, S> spread(VF v) {
+  if constexpr (S == 1) {
+    return {v};
+  } else {
+    static_assert(S == 3);
+    const DF d;
+    const DI di;
+    const int n = static_cast<int>(hn::Lanes(d));
+    std::array<VF, 3> out;
+    for (int k = 0; k < 3; ++k)
+      out[static_cast<std::size_t>(k)] = hn::TableLookupLanes(v, hn::IndicesFromVec(d, hn::LoadU(di, kRgbPixel.data() + k * n)));
+    return out;
+  }
+}
+
+template <int S>
+void BoxRows(const BoxFilterImage& im, float limit, int y0, int y1) {
+  const DF d;
+  const int n = static_cast<int>(hn::Lanes(d));
+  const int w = im.width, h = im.height, lanes = S * w, channels = im.channels;
+  const float* depth = im.depth;
+  auto depth_row = [&](int yy) { return depth + static_cast<std::size_t>(yy) * w; };
+  // Centre depths, NaN on uncovered pixels: no tap passes, the count stays 0 and the value is kept.
+  AlignedVector<float> centre(static_cast<std::size_t>(w));
+  const VF lim = hn::Set(d, limit), one = hn::Set(d, 1.0f), zero = hn::Zero(d);
+  for (int y = y0; y < y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * lanes;
+    const float* dcy = depth_row(y);
+    const std::uint32_t* cov = im.object_id + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) centre[static_cast<std::size_t>(x)] = cov[x] ? dcy[x] : std::numeric_limits<float>::quiet_NaN();
+    const int dy_lo = std::max(-2, -y), dy_hi = std::min(1, h - 1 - y);
+    // Pixels whose taps dx = -2..+1 all lie inside the row, a vector of them at a time: the depth
+    // test is made once per pixel; for RGB its mask is spread to the pixel's 3 lanes.
+    int p = 2;
+    for (; p + n <= w - 1; p += n) {
+      const VF dc = hn::LoadU(d, centre.data() + p);
+      VF count = zero;
+      std::array<VF, kMaxChannels * S> sum;
+      sum.fill(zero);
+      for (int dy = dy_lo; dy <= dy_hi; ++dy) {
+        const float* dn = depth_row(y + dy) + p;
+        const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes + static_cast<std::size_t>(S) * p;
+        for (int dx = -2; dx <= 1; ++dx) {
+          const MF m = hn::Le(hn::Abs(hn::Sub(hn::LoadU(d, dn + dx), dc)), lim);
+          const VF taken = hn::IfThenElseZero(m, one);
+          count = hn::Add(count, taken);
+          std::array<MF, S> e;
+          if constexpr (S == 1) {
+            e[0] = m;
+          } else {
+            const std::array<VF, S> spread_taken = spread<S>(taken);
+            for (int k = 0; k < S; ++k) e[static_cast<std::size_t>(k)] = hn::Gt(spread_taken[static_cast<std::size_t>(k)], zero);
+          }
+          for (int c = 0; c < channels; ++c) {
+            const float* v = im.src[c] + nrow + S * dx;
+            for (int k = 0; k < S; ++k) {
+              VF& s = sum[static_cast<std::size_t>(c * S + k)];
+              s = hn::Add(s, hn::IfThenElseZero(e[static_cast<std::size_t>(k)], hn::LoadU(d, v + n * k)));
+            }
+          }
+        }
+      }
+      const std::array<VF, S> q = spread<S>(count);
+      for (int k = 0; k < S; ++k) {
+        const VF qk = q[static_cast<std::size_t>(k)];
+        const MF some = hn::Gt(qk, zero);  // else keep the value (uncovered, or no tap)
+        for (int c = 0; c < channels; ++c) {
+          const std::size_t at = row + static_cast<std::size_t>(S) * p + static_cast<std::size_t>(n * k);
+          hn::StoreU(hn::IfThenElse(some, hn::Div(sum[static_cast<std::size_t>(c * S + k)], qk), hn::LoadU(d, im.src[c] + at)), d, im.dst[c] + at);
+        }
+      }
+    }
+    // The rest one lane at a time, same tap order.
+    const int l = S * p, vlo = 2 * S;
+    auto scalar = [&](int l0, int l1) {
+      for (int q = l0; q < l1; ++q) {
+        const int x = q / S;
+        const float dc = centre[static_cast<std::size_t>(x)];
+        float count = 0;
+        std::array<float, kMaxChannels> s{};
+        for (int dy = dy_lo; dy <= dy_hi; ++dy) {
+          const float* dn = depth_row(y + dy);
+          const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes;
+          for (int dx = std::max(-2, -x); dx <= std::min(1, w - 1 - x); ++dx) {
+            const int t = q + S * dx;
+            const bool use = std::abs(dn[x + dx] - dc) <= limit;
+            count += use ? 1.0f : 0.0f;
+            for (int c = 0; c < channels; ++c) s[static_cast<std::size_t>(c)] += use ? im.src[c][nrow + t] : 0.0f;
+          }
+        }
+        for (int c = 0; c < channels; ++c) {
+          const float in = im.src[c][row + q];
+          im.dst[c][row + q] = count > 0 ? s[static_cast<std::size_t>(c)] / count : in;
+        }
+      }
+    };
+    scalar(0, std::min(vlo, lanes));
+    scalar(std::max(l, std::min(vlo, lanes)), lanes);
+  }
+}
+
+// One vector of pixels: the centres from entry k0, tap j's data from tt[j] + kt (tt[j][0] without
+// per_pixel_t), td[j] + kt, tv[j] + kt, the input from `in`. The taps' sums stay in registers, in tap order.
+HWY_INLINE VF bilateral_vector(const BilateralCentres& ce, int k0, int taps, const float* sp, const float* const* tt, bool per_pixel_t,
+                               const float* const* td, const float* const* tv, int kt, const float* in) {
+  const DF d;
+  const VF a = hn::Load(d, ce.a.data() + k0), b = hn::Load(d, ce.b.data() + k0), c = hn::Load(d, ce.c.data() + k0);
+  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  VF sum_w = zero, sum_v = zero;
+  for (int j = 0; j < taps; ++j) {
+    const VF t = per_pixel_t ? hn::LoadU(d, tt[j] + kt) : hn::Set(d, tt[j][0]);
+    const VF depth = hn::LoadU(d, td[j] + kt);
+    // x/2 = d (a t + b) - c; K = max(0, 1 - (x/2)^2)^2. Background taps (d = +inf): x/2 is +-inf or
+    // NaN, so u = 0 and w = 0 (the comparison is false for NaN).
+    const VF half_x = hn::MulSub(depth, hn::MulAdd(a, t, b), c);
+    const VF u = hn::NegMulAdd(half_x, half_x, one);
+    const VF uc = hn::IfThenElseZero(hn::Gt(u, zero), u);
+    const VF w = hn::Mul(hn::Set(d, sp[j]), hn::Mul(uc, uc));
+    sum_w = hn::Add(sum_w, w);
+    sum_v = hn::MulAdd(w, hn::LoadU(d, tv[j] + kt), sum_v);
+  }
+  // The centre tap has weight spatial(0) * 1 > 0 on covered pixels, so sum_w > 0 there.
+  return hn::IfThenElse(hn::Gt(hn::Load(d, ce.cov.data() + k0), zero), hn::Div(sum_v, sum_w), hn::LoadU(d, in));
+}
+
+}  // namespace
+
+void BoxFilterRows(const BoxFilterImage& image, float depth_limit, int y0, int y1) {
+  if (image.stride == 3)
+    BoxRows<3>(image, depth_limit, y0, y1);
+  else
+    BoxRows<1>(image, depth_limit, y0, y1);
+}
+
+void BilateralCentresRow(BilateralCentres& ce, const float* normal, const float* depth, const std::uint32_t* object_id, int x0, int count,
+                         float ray_ax, float ray_bx, float ry, float plane_sigma, bool vertical) {
+  const DF d;
+  const DU du;
+  const int n = static_cast<int>(hn::Lanes(d));
+  const std::size_t cap = static_cast<std::size_t>(padded(count));
+  for (AlignedVector<float>* v : {&ce.a, &ce.b, &ce.c, &ce.cov}) v->resize(cap);
+  const VF half = hn::Set(d, 0.5f), sigma = hn::Set(d, plane_sigma), ax = hn::Set(d, ray_ax), bx = hn::Set(d, ray_bx),
+           vry = hn::Set(d, ry);
+  // The last partial vector reads copies padded with uncovered pixels, so no read passes the image.
+  HWY_ALIGN float tail_n[3 * kMaxLanes], tail_d[kMaxLanes];
+  HWY_ALIGN std::uint32_t tail_id[kMaxLanes];
+  for (int k0 = 0; k0 < count; k0 += n) {
+    const float* nn = normal + 3 * static_cast<std::size_t>(k0);
+    const float* dd = depth + k0;
+    const std::uint32_t* id = object_id + k0;
+    if (k0 + n > count) {
+      const int rest = count - k0;
+      for (int k = 0; k < n; ++k) {
+        const bool real = k < rest;
+        for (int c = 0; c < 3; ++c) tail_n[3 * k + c] = real ? nn[3 * k + c] : 0.0f;
+        tail_d[k] = real ? dd[k] : 1.0f, tail_id[k] = real ? id[k] : 0u;
+      }
+      nn = tail_n, dd = tail_d, id = tail_id;
+    }
+    VF nx, ny, nz;
+    hn::LoadInterleaved3(d, nn, nx, ny, nz);
+    const MF covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::LoadU(du, id), hn::Zero(du))));
+    const VF depth_v = hn::IfThenElseZero(covered, hn::LoadU(d, dd));
+    const VF px = hn::Add(hn::ConvertTo(d, hn::Iota(DI(), x0 + k0)), half);
+    const VF rx = hn::MulAdd(ax, px, bx);
+    // Background: scale 0 (and cov 0), so its result is never used.
+    const VF half_s = hn::IfThenElseZero(covered, hn::Div(half, hn::Mul(sigma, depth_v)));
+    hn::Store(hn::Mul(vertical ? ny : nx, half_s), d, ce.a.data() + k0);
+    hn::Store(hn::Mul(vertical ? hn::MulSub(nx, rx, nz) : hn::MulSub(ny, vry, nz), half_s), d, ce.b.data() + k0);
+    hn::Store(hn::Mul(hn::Mul(depth_v, hn::Sub(hn::MulAdd(ny, vry, hn::Mul(nx, rx)), nz)), half_s), d, ce.c.data() + k0);
+    hn::Store(hn::IfThenElseZero(covered, hn::Set(d, 1.0f)), d, ce.cov.data() + k0);
+  }
+}
+
+void BilateralTaps(const BilateralCentres& ce, int count, int taps, const float* spatial, const float* const* tt, bool per_pixel_t,
+                   const float* const* td, const float* const* tv, const float* in, float* out) {
+  const DF d;
+  const int n = static_cast<int>(hn::Lanes(d));
+  int k0 = 0;
+  for (; k0 + n <= count; k0 += n) hn::StoreU(bilateral_vector(ce, k0, taps, spatial, tt, per_pixel_t, td, tv, k0, in + k0), d, out + k0);
+  if (k0 == count) return;
+  // The last partial vector: its taps' rows copied into buffers padded with background (depth
+  // +inf: weight 0), so no read passes the image and the arithmetic is the vector's.
+  const int rest = count - k0;  // in [1, n)
+  HWY_ALIGN float bt[kMaxTaps][kMaxLanes], bd[kMaxTaps][kMaxLanes], bv[kMaxTaps][kMaxLanes], bin[kMaxLanes], bout[kMaxLanes];
+  std::array<const float*, kMaxTaps> ptt, ptd, ptv;
+  for (int j = 0; j < taps; ++j) {
+    for (int k = 0; k < n; ++k) {
+      const bool real = k < rest;
+      bt[j][k] = per_pixel_t ? (real ? tt[j][k0 + k] : 0.0f) : tt[j][0];
+      bd[j][k] = real ? td[j][k0 + k] : kInfinity;
+      bv[j][k] = real ? tv[j][k0 + k] : 0.0f;
+    }
+    ptt[static_cast<std::size_t>(j)] = bt[j], ptd[static_cast<std::size_t>(j)] = bd[j], ptv[static_cast<std::size_t>(j)] = bv[j];
+  }
+  for (int k = 0; k < n; ++k) bin[k] = k < rest ? in[k0 + k] : 0.0f;
+  // The centres are padded: their arrays hold whole vectors, the part past `count` unused.
+  const VF r = bilateral_vector(ce, k0, taps, spatial, ptt.data(), per_pixel_t, ptd.data(), ptv.data(), 0, bin);
+  hn::Store(r, d, bout);
+  for (int k = 0; k < rest; ++k) out[k0 + k] = bout[k];
+}
+
+}  // namespace ao::simd::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace ao::simd {
+
+HWY_EXPORT(BoxFilterRows);
+HWY_EXPORT(BilateralCentresRow);
+HWY_EXPORT(BilateralTaps);
+
+void box_filter_rows(const BoxFilterImage& image, float depth_limit, int y0, int y1) {
+  HWY_DYNAMIC_DISPATCH(BoxFilterRows)(image, depth_limit, y0, y1);
+}
+
+void bilateral_centres(BilateralCentres& centres, const float* normal, const float* depth, const std::uint32_t* object_id, int x0, int count,
+                       float ray_ax, float ray_bx, float ry, float plane_sigma, bool vertical) {
+  HWY_DYNAMIC_DISPATCH(BilateralCentresRow)(centres, normal, depth, object_id, x0, count, ray_ax, ray_bx, ry, plane_sigma, vertical);
+}
+
+void bilateral_taps(const BilateralCentres& centres, int count, int taps, const float* spatial, const float* const* tt, bool per_pixel_t,
+                    const float* const* td, const float* const* tv, const float* in, float* out) {
+  HWY_DYNAMIC_DISPATCH(BilateralTaps)(centres, count, taps, spatial, tt, per_pixel_t, td, tv, in, out);
+}
+
+}  // namespace ao::simd
+#endif

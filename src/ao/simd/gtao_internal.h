@@ -1,0 +1,38 @@
+// Kernel of GTAO (Jimenez, Wu, Pesce, Jarabo, "Practical Realtime Strategies for Accurate Indirect
+// Occlusion", 2016: the horizon search in screen-space slices and the cosine-weighted inner
+// integral of its eq. 10), written once for every SIMD target (gtao.cpp). methods/gtao.cpp derives
+// the slices' directions and the samples' distances from its parameters and states the method's
+// deviations; this kernel runs them for a row of pixels, covered pixels in the lanes of vectors.
+#pragma once
+
+#include <cstdint>
+
+namespace ao::simd {
+
+/// What GTAO's kernel reads: the G-buffer's depth plane, normals and ids, and the tables of the 4x4
+/// pattern (entry (y % 4) * 4 + x % 4 of each).
+struct GtaoInputs {
+  const float* depth = nullptr;            ///< width * height linear depths, +infinity on background.
+  const float* normal = nullptr;           ///< width * height unit normals, xyz triples, camera space.
+  const std::uint32_t* object_id = nullptr;///< width * height; 0: uncovered.
+  int width = 0, height = 0;
+  /// Camera rays through pixel centres: ray(x, y) = (ray_ax (x + 1/2) + ray_bx, ray_ay (y + 1/2) + ray_by, -1).
+  float ray_ax = 0, ray_bx = 0, ray_ay = 0, ray_by = 0;
+  float radius = 1;                         ///< R, world units.
+  float px_per_unit = 1;                    ///< Pixels per unit of x/(-z) on both axes.
+  int slices = 1, steps = 1;
+  const float* dir_c = nullptr;             ///< slices x 16: cos phi of slice k for pattern entry p, [k * 16 + p].
+  const float* dir_s = nullptr;             ///< slices x 16: sin phi (screen y down).
+  const float* step_t = nullptr;            ///< steps x 16: step j's fraction of the screen radius, [j * 16 + p].
+};
+
+/// The widest row segment gtao_row takes, pixels.
+inline constexpr int kMaxGtaoSegment = 512;
+
+/// V of the covered pixels among [x0, x1) (x1 - x0 <= kMaxGtaoSegment) of row y into v[x - x0] (the others untouched):
+/// sum over slices of |n_p| a(h1, h2) / sum of |n_p| a for the open hemisphere, clamped to [0, 1],
+/// with the horizons h1, h2 of each slice found among its `steps` depth samples on either side
+/// within R above the tangent plane.
+void gtao_row(const GtaoInputs& in, int y, int x0, int x1, float* v);
+
+}  // namespace ao::simd

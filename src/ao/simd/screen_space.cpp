@@ -1,0 +1,396 @@
+// Kernels of the depth-buffer screen-space methods (screen_space_internal.h states what each
+// computes, in the papers' terms): containment AO (VAO eq. 5, AT sec. 4), volumetric AO's pipes
+// (VAO eq. 6-7) and ambient transfer (AT eq. 8-9), compiled once per SIMD target. Lanes are a row's
+// covered pixels; a kernel keeps a vector of pixels' values and sums in registers through all of
+// their samples, so the gathers of successive test points are independent and several are in
+// flight at once. Multiply-adds are written out (MulAdd) in the order the scalar reading of each
+// equation gives; this file is compiled without contraction, so targets with FMA agree bit for bit.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "ao/simd/screen_space.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <algorithm>
+#include <cstring>
+
+#include <hwy/highway.h>
+
+#include "ao/simd/screen_space_internal.h"
+#include "ao/simd/vec_internal.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace ao::simd::HWY_NAMESPACE {
+
+namespace {
+
+constexpr int kMaxSteps = 8;            // m: test points per ray (the methods' parameter range)
+constexpr int kMaxSamples = 256;        // n: rays per pixel (kMaxScreenSpaceSamples)
+constexpr std::uint32_t kPaletteMask = 0x1F;  // a palette index's bits in a packed depth word
+
+// Rec. 709 luminance of W: the method's scalar visibility.
+inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+
+// The depth plane's constants in vectors, made once per call.
+struct Plane {
+  VF scale_x, scale_y, centre_x, centre_y, max_x, max_y;
+  VI width;
+  const float* depth;
+  explicit Plane(const DepthPlane& p)
+      : scale_x(hn::Set(DF(), p.scale_x)), scale_y(hn::Set(DF(), p.scale_y)), centre_x(hn::Set(DF(), p.centre_x)),
+        centre_y(hn::Set(DF(), p.centre_y)), max_x(hn::Set(DF(), static_cast<float>(p.width - 1))),
+        max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), width(hn::Set(DI(), p.width)), depth(p.depth) {}
+
+  // ScreenProjection::locate, lane-wise: the pixel of camera-space point q (clamp-to-edge: f clamped
+  // to [0, size - 1] as floats before the conversion; Max returns its second operand, 0, for a NaN
+  // first one on every target). `valid`: q is in front of the camera (else the pixel is meaningless).
+  VI pixel(VF qx, VF qy, VF qz) const {
+    const VF zero = hn::Zero(DF());
+    const VF inv = hn::Div(hn::Set(DF(), -1.0f), qz);
+    const VF fx = hn::MulAdd(hn::Mul(qx, inv), scale_x, centre_x);
+    const VF fy = hn::NegMulAdd(hn::Mul(qy, inv), scale_y, centre_y);
+    const VI ix = truncate_in_range(hn::Min(hn::Max(fx, zero), max_x));
+    const VI iy = truncate_in_range(hn::Min(hn::Max(fy, zero), max_y));
+    return hn::Add(hn::Mul(iy, width), ix);
+  }
+};
+
+// A vector of CoveredPixels entries from k0: position, rotated frame, normal, bias.
+struct Entries {
+  VF px, py, pz, tx, ty, tz, bx, by, bz, nx, ny, nz, bias;
+  Entries(const CoveredPixels& row, int k0) {
+    const DF d;
+    px = hn::Load(d, row.px.data() + k0), py = hn::Load(d, row.py.data() + k0), pz = hn::Load(d, row.pz.data() + k0);
+    tx = hn::Load(d, row.tx.data() + k0), ty = hn::Load(d, row.ty.data() + k0), tz = hn::Load(d, row.tz.data() + k0);
+    bx = hn::Load(d, row.bx.data() + k0), by = hn::Load(d, row.by.data() + k0), bz = hn::Load(d, row.bz.data() + k0);
+    nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
+    bias = hn::Load(d, row.bias.data() + k0);
+  }
+  // VAO eq. 5 / AT eq. 8: the test point x + X T + Y B + Z N for the offset (X, Y, Z).
+  void point(float X, float Y, float Z, VF& qx, VF& qy, VF& qz) const {
+    const DF d;
+    const VF vx = hn::Set(d, X), vy = hn::Set(d, Y), vz = hn::Set(d, Z);
+    qx = hn::MulAdd(vz, nx, hn::MulAdd(vy, bx, hn::MulAdd(vx, tx, px)));
+    qy = hn::MulAdd(vz, ny, hn::MulAdd(vy, by, hn::MulAdd(vx, ty, py)));
+    qz = hn::MulAdd(vz, nz, hn::MulAdd(vy, bz, hn::MulAdd(vx, tz, pz)));
+  }
+};
+
+// The offsets of every test point, (j/m)(X_i, Y_i, Z_i) for step j of ray i, scaled once per call.
+struct StepOffsets {
+  float xyz[3 * kMaxSamples * kMaxSteps];
+  StepOffsets(const TestPoints& s, int m) {
+    const float inv_m = 1.0f / static_cast<float>(m);
+    for (int i = 0; i < s.n; ++i)
+      for (int j = 1; j <= m; ++j) {
+        const float f = static_cast<float>(j) * inv_m;
+        float* o = at(i, j);
+        o[0] = f * s.x[i], o[1] = f * s.y[i], o[2] = f * s.z[i];
+      }
+  }
+  float* at(int i, int j) { return &xyz[3 * (i * kMaxSteps + j - 1)]; }
+  const float* at(int i, int j) const { return &xyz[3 * (i * kMaxSteps + j - 1)]; }
+};
+
+}  // namespace
+
+void LoadCoveredPixels(CoveredPixels& row, const GBuffer& g, int y, int first, int last, const Rotations16& rotations, float bias_world,
+                       bool frame) {
+  const DF d;
+  const DI di;
+  const int n = last - first, cap = padded(n);
+  row.y = y, row.x0 = first;
+  for (AlignedVector<float>* v : {&row.px, &row.py, &row.pz, &row.nx, &row.ny, &row.nz, &row.rc, &row.rs, &row.bias})
+    v->resize(static_cast<std::size_t>(cap));
+  if (frame)
+    for (AlignedVector<float>* v : {&row.tx, &row.ty, &row.tz, &row.bx, &row.by, &row.bz}) v->resize(static_cast<std::size_t>(cap));
+  row.index.resize(static_cast<std::size_t>(cap));
+  // Compaction: the covered pixels' offsets (branch-free); the padding entries read pixel 0 of the
+  // segment and are replaced by the dummy point below.
+  int* idx = row.index.data();
+  const std::uint32_t* id = &g.object_id(first, y);
+  int m = 0;
+  for (int j = 0; j < n; ++j) {
+    idx[m] = j;
+    m += id[j] != 0 ? 1 : 0;
+  }
+  row.count = m;
+  const int end = padded(m);
+  std::fill(idx + m, idx + end, 0);
+  // Their data gathered across entries (positions and normals are 12-byte AoS records); the row's
+  // rotations repeat every 4 pixels.
+  const float* pos = &g.position(first, y).x;
+  const float* nrm = &g.normal(first, y).x;
+  const VI three = hn::Set(di, 3), rot_row = hn::Set(di, (y & 3) * 4), x_first = hn::Set(di, first);
+  for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
+    const VI j = hn::Load(di, idx + k0), j3 = hn::Mul(j, three);
+    hn::Store(hn::GatherIndex(d, pos, j3), d, row.px.data() + k0);
+    hn::Store(hn::GatherIndex(d, pos + 1, j3), d, row.py.data() + k0);
+    hn::Store(hn::GatherIndex(d, pos + 2, j3), d, row.pz.data() + k0);
+    hn::Store(hn::GatherIndex(d, nrm, j3), d, row.nx.data() + k0);
+    hn::Store(hn::GatherIndex(d, nrm + 1, j3), d, row.ny.data() + k0);
+    hn::Store(hn::GatherIndex(d, nrm + 2, j3), d, row.nz.data() + k0);
+    const VI r = hn::Add(rot_row, hn::And(hn::Add(x_first, j), three));
+    hn::Store(hn::GatherIndex(d, rotations.c, r), d, row.rc.data() + k0);
+    hn::Store(hn::GatherIndex(d, rotations.s, r), d, row.rs.data() + k0);
+  }
+  for (int k = m; k < end; ++k) {  // the harmless point: one unit in front of the camera, facing it
+    row.px[k] = row.py[k] = 0.0f, row.pz[k] = -1.0f;
+    row.nx[k] = row.ny[k] = 0.0f, row.nz[k] = 1.0f;
+    row.rc[k] = 1.0f, row.rs[k] = 0.0f;
+  }
+  if (bias_world > 0) {
+    std::fill(row.bias.begin(), row.bias.begin() + end, bias_world);
+  } else {
+    // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
+    const VF footprint = hn::Set(d, 2.0f * g.camera.tan_half_fov() / static_cast<float>(g.height()));
+    const VF one = hn::Set(d, 1.0f), zero = hn::Zero(d), min_cos = hn::Set(d, 0.124f);  // cos 82.9 deg: tan <= 8
+    for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
+      const VF px = hn::Load(d, row.px.data() + k0), py = hn::Load(d, row.py.data() + k0), pz = hn::Load(d, row.pz.data() + k0);
+      const VF nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
+      // tan theta_v from N and the unit view direction u = p / |p| (p itself when |p| = 0).
+      const VF len = hn::Sqrt(hn::MulAdd(pz, pz, hn::MulAdd(py, py, hn::Mul(px, px))));
+      const MF positive = hn::Gt(len, zero);
+      const VF ux = hn::IfThenElse(positive, hn::Div(px, len), px), uy = hn::IfThenElse(positive, hn::Div(py, len), py);
+      const VF uz = hn::IfThenElse(positive, hn::Div(pz, len), pz);
+      const VF cos_v = hn::Max(hn::Abs(hn::MulAdd(nz, uz, hn::MulAdd(ny, uy, hn::Mul(nx, ux)))), min_cos);
+      const VF tan_v = hn::Div(hn::Sqrt(hn::NegMulAdd(cos_v, cos_v, one)), cos_v);
+      hn::Store(hn::Mul(hn::Mul(footprint, hn::Neg(pz)), hn::Add(one, tan_v)), d, row.bias.data() + k0);
+    }
+  }
+  if (!frame) return;
+  const VF one = hn::Set(d, 1.0f), minus_one = hn::Set(d, -1.0f);
+  for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
+    const VF nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
+    // Frame::from_normal (Duff et al. 2017): T = (1 + s nx^2 a, s c, -s nx), B = (c, s + ny^2 a, -ny)
+    // with s = sign(nz), a = -1 / (s + nz), c = nx ny a.
+    const VF sign = hn::CopySign(one, nz);
+    const VF a = hn::Div(minus_one, hn::Add(sign, nz));
+    const VF c = hn::Mul(hn::Mul(nx, ny), a);
+    const VF ftx = hn::MulAdd(hn::Mul(hn::Mul(sign, nx), nx), a, one), fty = hn::Mul(sign, c), ftz = hn::Neg(hn::Mul(sign, nx));
+    const VF fbx = c, fby = hn::MulAdd(hn::Mul(ny, ny), a, sign), fbz = hn::Neg(ny);
+    // Rotation by alpha about N (sec. 4.2): T' = cos a T + sin a B, B' = -sin a T + cos a B.
+    const VF rc = hn::Load(d, row.rc.data() + k0), rs = hn::Load(d, row.rs.data() + k0);
+    hn::Store(hn::MulAdd(fbx, rs, hn::Mul(ftx, rc)), d, row.tx.data() + k0);
+    hn::Store(hn::MulAdd(fby, rs, hn::Mul(fty, rc)), d, row.ty.data() + k0);
+    hn::Store(hn::MulAdd(fbz, rs, hn::Mul(ftz, rc)), d, row.tz.data() + k0);
+    hn::Store(hn::NegMulAdd(ftx, rs, hn::Mul(fbx, rc)), d, row.bx.data() + k0);
+    hn::Store(hn::NegMulAdd(fty, rs, hn::Mul(fby, rc)), d, row.by.data() + k0);
+    hn::Store(hn::NegMulAdd(ftz, rs, hn::Mul(fbz, rc)), d, row.bz.data() + k0);
+  }
+}
+
+void CountOpenRays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, float* open) {
+  const DF d;
+  const Plane pl(plane);
+  const StepOffsets offsets(s, m);
+  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), far = hn::Set(d, far_limit), inf = hn::Set(d, kInfinity);
+  for (int k0 = 0; k0 < row.count; k0 += static_cast<int>(hn::Lanes(d))) {
+    const Entries e(row, k0);
+    const VF minus_bias = hn::Neg(e.bias);
+    VF count = zero;
+    for (int i = 0; i < s.n; ++i) {
+      // AT sec. 4: I = prod_j I0(x + w r j/m), the ray is free only if all m test points are.
+      MF blocked = hn::MaskFromVec(zero);
+      for (int j = 1; j <= m; ++j) {
+        const float* o = offsets.at(i, j);
+        VF qx, qy, qz;
+        e.point(o[0], o[1], o[2], qx, qy, qz);
+        // DepthBufferCharacteristic::distance: z* - depth(p), +infinity behind the camera.
+        const VF zs = hn::GatherIndex(d, pl.depth, pl.pixel(qx, qy, qz));
+        const VF dist = hn::IfThenElse(hn::Lt(qz, zero), hn::Add(zs, qz), inf);
+        // Occluded: behind the surface by more than the bias, and (AT 4.3) less than R behind it.
+        blocked = hn::Or(blocked, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+      }
+      count = hn::Add(count, hn::IfThenZeroElse(blocked, one));
+    }
+    hn::Store(count, d, open + k0);
+  }
+}
+
+void SumFreePipes(const CoveredPixels& row, const DepthPlane& plane, float half_radius, const TestPoints& disk, float far_limit,
+                  float* free) {
+  const DF d;
+  const Plane pl(plane);
+  const VF zero = hn::Zero(d), hr = hn::Set(d, half_radius), lim = hn::Set(d, far_limit), inf = hn::Set(d, kInfinity);
+  const VF minus_huge = hn::Set(d, -1e30f);  // below this a distance stands for -infinity (never distant)
+  for (int k0 = 0; k0 < row.count; k0 += static_cast<int>(hn::Lanes(d))) {
+    // Fig. 4: the tangent sphere's centre c = x + N R/2. Its pipes run along the view axis at depth
+    // c_z, so the divide by -c_z and the pixel's rotation fold into affine coefficients of the
+    // disk sample (x_i, y_i):  f_x = f_x0 + x_i a_x - y_i b_x,  f_y = f_y0 - x_i a_y - y_i b_y.
+    const VF cx = hn::MulAdd(hr, hn::Load(d, row.nx.data() + k0), hn::Load(d, row.px.data() + k0));
+    const VF cy = hn::MulAdd(hr, hn::Load(d, row.ny.data() + k0), hn::Load(d, row.py.data() + k0));
+    const VF cz = hn::MulAdd(hr, hn::Load(d, row.nz.data() + k0), hn::Load(d, row.pz.data() + k0));
+    const VF rc = hn::Load(d, row.rc.data() + k0), rs = hn::Load(d, row.rs.data() + k0), bias = hn::Load(d, row.bias.data() + k0);
+    const VF inv = hn::Div(hn::Set(d, -1.0f), cz), kx = hn::Mul(inv, pl.scale_x), ky = hn::Mul(inv, pl.scale_y);
+    const VF fx0 = hn::MulAdd(cx, kx, pl.centre_x), fy0 = hn::NegMulAdd(cy, ky, pl.centre_y);
+    const VF ax = hn::Mul(rc, kx), bx = hn::Mul(rs, kx), ay = hn::Mul(rs, ky), by = hn::Mul(rc, ky);
+    // As ScreenProjection::locate: clamp-to-edge, free only behind the camera.
+    const MF valid = hn::Lt(cz, zero);
+    VF acc = zero;
+    for (int i = 0; i < disk.n; ++i) {
+      const float xi = half_radius * disk.x[i], yi = half_radius * disk.y[i];
+      const float half_chord = half_radius * disk.z[i];  // (R/2) h_i = z_c - z_entry
+      const VF hc = hn::Set(d, half_chord), chord = hn::Set(d, 2.0f * half_chord);  // z_exit - z_entry
+      const VF vxi = hn::Set(d, xi), vyi = hn::Set(d, yi);
+      const VF fx = hn::NegMulAdd(vyi, bx, hn::MulAdd(vxi, ax, fx0)), fy = hn::NegMulAdd(vyi, by, hn::NegMulAdd(vxi, ay, fy0));
+      // Clamp-to-edge as Plane::pixel (behind the camera the pixel is any one: the pipe is free).
+      const VI ix = truncate_in_range(hn::Min(hn::Max(fx, zero), pl.max_x));
+      const VI iy = truncate_in_range(hn::Min(hn::Max(fy, zero), pl.max_y));
+      const VF zs = hn::GatherIndex(d, pl.depth, hn::Add(hn::Mul(iy, pl.width), ix));
+      // DepthBufferCharacteristic::distance z* - z_c, then z* - z_entry = (z* - z_c) + (R/2) h_i.
+      const VF to_surface = hn::Add(hn::Add(hn::IfThenElse(valid, hn::Add(zs, cz), inf), hc), bias);
+      // Fig. 7: dz = clamp(z* - z_entry, 0, chord): (a) surface inside: z* - z_entry; (b) behind:
+      // the chord; (c) in front: 0. A distant foreground surface (AT 4.3) leaves the pipe free.
+      const VF dz = hn::Min(hn::Max(to_surface, zero), chord);
+      const MF distant = hn::And(hn::Lt(to_surface, lim), hn::Gt(to_surface, minus_huge));
+      acc = hn::Add(acc, hn::IfThenElse(distant, chord, dz));
+    }
+    hn::Store(acc, d, free + k0);
+  }
+}
+
+template <bool kDirect>
+void TransferRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, const TransferInputs& in,
+                      std::size_t row_base, const TransferOutputs& out) {
+  const DF d;
+  const DI di;
+  const DU du;
+  const Plane pl(plane);
+  const StepOffsets offsets(s, m);
+  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), far = hn::Set(d, far_limit);
+  const VU palette_mask = hn::Set(du, kPaletteMask);
+  const VF exactness = hn::Set(d, 0x1p-16f);
+  const VI three = hn::Set(di, 3);
+  const std::uint32_t* packed = in.packed;
+  const float n = static_cast<float>(s.n);
+  // An RGB value per blocked lane (a~, or Ld~): with a palette `id` holds palette indices and the
+  // exact R, G, B planes of its 32 entries are looked up; else `id` holds pixels and the RGB image
+  // is read at them (free rays read nothing where the target has masked gathers).
+  const auto blocked_rgb = [&](bool by_palette, VI id, MF blocked, const float* image, VF& r, VF& g, VF& b) {
+    if (by_palette) {
+      r = lookup32(in.palette, id), g = lookup32(in.palette + 32, id), b = lookup32(in.palette + 64, id);
+    } else {
+      const VI a = hn::Mul(id, three);
+      r = gather_where(blocked, image, a), g = gather_where(blocked, image + 1, a), b = gather_where(blocked, image + 2, a);
+    }
+  };
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  HWY_ALIGN float wr[kMaxLanes], wg[kMaxLanes], wb[kMaxLanes], wo[kMaxLanes];
+  for (int k0 = 0; k0 < row.count; k0 += lanes) {
+    const Entries e(row, k0);
+    const VF minus_bias = hn::Neg(e.bias);
+    VF open = zero, lr = zero, lg = zero, lb = zero;
+    VF gr = zero, gg = zero, gb = zero;  // sum (1 - I) Ld~ (kDirect)
+    for (int i = 0; i < s.n; ++i) {
+      // Sec. 4: the nearest occluded test wins; steps run from the far end inwards, each occluded
+      // one overwriting `at`: the palette index with `packed`, else the occluder's pixel.
+      VI at = hn::Zero(di);
+      MF blocked = hn::MaskFromVec(zero);
+      for (int j = m; j >= 1; --j) {
+        const float* o = offsets.at(i, j);
+        VF qx, qy, qz;
+        e.point(o[0], o[1], o[2], qx, qy, qz);
+        const VI pixel = pl.pixel(qx, qy, qz);
+        const MF valid = hn::Lt(qz, zero);  // only points behind the camera are free
+        VF dist;  // z* - depth(p)
+        VI id = pixel;
+        if (packed) {
+          // One gather brings z* and the pixel's palette index. z* with its low mantissa bits
+          // cleared is within 2^-18 of the true depth (relative); only when a comparison below is
+          // closer than 2^-16 of the magnitudes involved can it differ, and then the true depth is
+          // gathered for those lanes: the tests stay exact.
+          const VU bits = gather_where(hn::RebindMask(du, valid), packed, pixel);
+          const VF z_near = hn::BitCast(d, hn::AndNot(palette_mask, bits));
+          dist = hn::Add(z_near, qz);
+          const VF margin = hn::Mul(hn::Add(z_near, hn::Abs(qz)), exactness);
+          const MF close = hn::And(valid, hn::Or(hn::Lt(hn::Abs(hn::Sub(dist, minus_bias)), margin), hn::Lt(hn::Abs(hn::Sub(dist, far)), margin)));
+          if (!hn::AllFalse(d, close)) dist = hn::IfThenElse(close, hn::Add(gather_where(close, pl.depth, pixel), qz), dist);
+          id = hn::BitCast(di, hn::And(bits, palette_mask));
+        } else {
+          dist = hn::Add(gather_where(valid, pl.depth, pixel), qz);
+        }
+        // AT 4.3: occluded only when the surface in front is less than R in front.
+        const MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+        at = hn::IfThenElse(hn::RebindMask(di, occluded), id, at);
+        blocked = hn::Or(blocked, occluded);
+      }
+      open = hn::IfThenElse(blocked, open, hn::Add(open, one));
+      VF ar, ag, ab;
+      blocked_rgb(packed != nullptr, at, blocked, in.albedo, ar, ag, ab);
+      // (1 - I) a~ of eq. 9's denominator.
+      lr = add_where(blocked, lr, ar), lg = add_where(blocked, lg, ag), lb = add_where(blocked, lb, ab);
+      if constexpr (kDirect) {
+        // (1 - I) Ld~ in the numerator of eq. 9' (docs/methods/transfer.md), at the same occluder pixel.
+        VF dr, dg, db;
+        blocked_rgb(false, at, blocked, in.direct, dr, dg, db);
+        gr = add_where(blocked, gr, dr), gg = add_where(blocked, gg, dg), gb = add_where(blocked, gb, db);
+      }
+    }
+    // Eq. 9, and O = sum I / n (eq. 5), stored and copied out to the entries' pixels (cheaper than
+    // a scatter, which is microcoded on current cores).
+    const VF nv = hn::Set(d, n), scale = hn::Set(d, in.albedo_scale);
+    if constexpr (kDirect) {
+      // (sum I + scale sum (1 - I) Ld~) / (n - scale sum (1 - I) a~), 0 unless both are > 0, not
+      // clamped: lit occluders can send more than the sky would.
+      const auto ratio = [&](VF lost, VF gain) {
+        const VF num = hn::MulAdd(scale, gain, open), den = hn::NegMulAdd(scale, lost, nv);
+        return hn::IfThenElseZero(hn::And(hn::Gt(num, zero), hn::Gt(den, zero)), hn::Div(num, den));
+      };
+      hn::Store(ratio(lr, gr), d, wr), hn::Store(ratio(lg, gg), d, wg), hn::Store(ratio(lb, gb), d, wb);
+    } else {
+      // The denominator is >= sum I since a~ <= 1; with no open ray at all W = 0.
+      const MF lit = hn::Gt(open, zero);
+      const auto ratio = [&](VF lost) { return hn::IfThenElseZero(lit, hn::Min(hn::Div(open, hn::NegMulAdd(scale, lost, nv)), one)); };
+      hn::Store(ratio(lr), d, wr), hn::Store(ratio(lg), d, wg), hn::Store(ratio(lb), d, wb);
+    }
+    hn::Store(hn::Div(open, nv), d, wo);
+    for (int k = 0; k < std::min(lanes, row.count - k0); ++k) {
+      const std::size_t at_pixel = row_base + static_cast<std::size_t>(row.index[static_cast<std::size_t>(k0 + k)]);
+      if (out.rgb) {  // the final images directly: W interleaved, its luminance in out.r
+        out.rgb[at_pixel] = Vec3{wr[k], wg[k], wb[k]}, out.r[at_pixel] = luminance(wr[k], wg[k], wb[k]), out.o[at_pixel] = wo[k];
+      } else {
+        out.r[at_pixel] = wr[k], out.g[at_pixel] = wg[k], out.b[at_pixel] = wb[k], out.o[at_pixel] = wo[k];
+      }
+    }
+  }
+}
+
+void TransferRays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, const TransferInputs& in,
+                  std::size_t row_base, const TransferOutputs& out) {
+  if (in.direct)
+    TransferRaysImpl<true>(row, plane, s, m, far_limit, in, row_base, out);
+  else
+    TransferRaysImpl<false>(row, plane, s, m, far_limit, in, row_base, out);
+}
+
+}  // namespace ao::simd::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace ao::simd {
+
+HWY_EXPORT(LoadCoveredPixels);
+HWY_EXPORT(CountOpenRays);
+HWY_EXPORT(SumFreePipes);
+HWY_EXPORT(TransferRays);
+
+void load_covered_pixels(CoveredPixels& row, const GBuffer& g, int y, int x0, int x1, const Rotations16& rotations, float bias_world,
+                         bool frame) {
+  HWY_DYNAMIC_DISPATCH(LoadCoveredPixels)(row, g, y, x0, x1, rotations, bias_world, frame);
+}
+
+void count_open_rays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& samples, int m, float far_limit, float* open) {
+  HWY_DYNAMIC_DISPATCH(CountOpenRays)(row, plane, samples, m, far_limit, open);
+}
+
+void sum_free_pipes(const CoveredPixels& row, const DepthPlane& plane, float half_radius, const TestPoints& disk, float far_limit,
+                    float* free) {
+  HWY_DYNAMIC_DISPATCH(SumFreePipes)(row, plane, half_radius, disk, far_limit, free);
+}
+
+void transfer_rays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& samples, int m, float far_limit,
+                   const TransferInputs& in, std::size_t row_base, const TransferOutputs& out) {
+  HWY_DYNAMIC_DISPATCH(TransferRays)(row, plane, samples, m, far_limit, in, row_base, out);
+}
+
+}  // namespace ao::simd
+#endif

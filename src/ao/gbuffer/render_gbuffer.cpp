@@ -5,13 +5,12 @@
 #include <cstdint>
 #include <cstring>
 
-#include <emmintrin.h>
-
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
 #include "ao/core/parallel.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/simd/stream_internal.h"
 
 namespace ao {
 
@@ -93,22 +92,6 @@ void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const 
   }
 }
 
-// Copies `bytes` bytes from src to dst with non-temporal (streaming) stores where dst is 16-byte
-// aligned, plain stores at the unaligned ends. The G-buffer (32-52 bytes a pixel, tens of MB) is
-// written once and read later by another pass, so streaming it skips reading every destination
-// cache line into the cache before overwriting it: half the memory traffic of plain stores.
-// Callers issue _mm_sfence() before other threads may read what was written.
-void stream_copy(void* dst, const void* src, std::size_t bytes) {
-  auto* d = static_cast<unsigned char*>(dst);
-  const auto* s = static_cast<const unsigned char*>(src);
-  const std::size_t head = std::min(bytes, (16 - reinterpret_cast<std::uintptr_t>(d) % 16) % 16);
-  std::memcpy(d, s, head);
-  d += head, s += head, bytes -= head;
-  for (; bytes >= 16; d += 16, s += 16, bytes -= 16)
-    _mm_stream_si128(reinterpret_cast<__m128i*>(d), _mm_loadu_si128(reinterpret_cast<const __m128i*>(s)));
-  std::memcpy(d, s, bytes);
-}
-
 // One tile row of every G-buffer channel, assembled in cache and then streamed to the images.
 struct RowBuffer {
   Vec3 position[kTileWidth], normal[kTileWidth], albedo[kTileWidth];
@@ -117,12 +100,12 @@ struct RowBuffer {
 
   // Channels a G-buffer rendered without albedo or UVs leaves empty are not written.
   void stream_to(GBuffer& g, int x0, int y, int n) const {
-    stream_copy(&g.position(x0, y), position, n * sizeof(Vec3));
-    stream_copy(&g.normal(x0, y), normal, n * sizeof(Vec3));
-    if (!g.albedo.empty()) stream_copy(&g.albedo(x0, y), albedo, n * sizeof(Vec3));
-    stream_copy(&g.object_id(x0, y), object_id, n * sizeof(std::uint32_t));
-    stream_copy(&g.primitive_id(x0, y), primitive_id, n * sizeof(std::uint32_t));
-    if (!g.uv.empty()) stream_copy(&g.uv(x0, y), uv, n * sizeof(Vec2));
+    simd::stream_copy(&g.position(x0, y), position, n * sizeof(Vec3));
+    simd::stream_copy(&g.normal(x0, y), normal, n * sizeof(Vec3));
+    if (!g.albedo.empty()) simd::stream_copy(&g.albedo(x0, y), albedo, n * sizeof(Vec3));
+    simd::stream_copy(&g.object_id(x0, y), object_id, n * sizeof(std::uint32_t));
+    simd::stream_copy(&g.primitive_id(x0, y), primitive_id, n * sizeof(std::uint32_t));
+    if (!g.uv.empty()) simd::stream_copy(&g.uv(x0, y), uv, n * sizeof(Vec2));
   }
 };
 
@@ -234,7 +217,7 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
       else shade_tile<SurfaceNormal::Geometric, false>(rs, cam, basis, hits, g, s);
     }
   }
-  _mm_sfence();  // the streamed rows are visible to whichever thread reads the G-buffer next
+  simd::stream_fence();  // the streamed rows are visible to whichever thread reads the G-buffer next
 }
 
 }  // namespace

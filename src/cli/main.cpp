@@ -13,12 +13,13 @@
 
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
+#include "ao/simd/target.h"
 #include "ao/version.h"
 #include "subcommands.h"
 
 int main(int argc, char** argv) {
   CLI::App app("ao: ambient occlusion on the CPU. Ray-traced ground truth and published AO methods.", "ao");
-  app.set_version_flag("--version", "ao " AO_VERSION_STRING);
+  app.set_version_flag("--version", [] { return "ao " AO_VERSION_STRING " (SIMD: " + ao::simd_target() + ")"; });
   app.require_subcommand(1);
   app.fallthrough();  // --threads and --quiet may also follow the subcommand
   ao::cli::GlobalOptions global;

@@ -12,10 +12,6 @@
 #include <cstdlib>
 #include <vector>
 
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -24,6 +20,7 @@
 #include "ao/methods/containment.h"
 #include "ao/methods/gtao.h"
 #include "ao/methods/interleave.h"
+#include "ao/methods/screen_space_internal.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/transfer_internal.h"
 #include "ao/methods/volumetric.h"
@@ -145,67 +142,52 @@ void box_filter_planes4(benchmark::State& state) {
   rate(state);
 }
 
-#if defined(__AVX512F__)
-// The floor under the depth-buffer methods on this machine: N depth tests per covered pixel and
-// nothing else (a point at distance R in one of N fixed directions, projected, one 16-lane depth
-// gather, one compare, a count), over the same G-buffer and threads. At their defaults transfer
-// (m = 2) makes 24 such tests per pixel and containment (m = 3) 36, plus their per-pixel setup, sample frames and
-// accumulation; this says how much of their time the tests alone need. Counter: ns per 16-lane
-// test (CPU time of all threads / tests).
+// The floor under the depth-buffer methods: N depth tests per covered pixel and nothing else (a
+// point at distance R in one of N fixed directions of the pixel's tangent frame, projected, one
+// depth gather, one compare, a count: simd::count_open_rays with m = 1 on rows of covered pixels
+// prepared outside the timed loop), over the same G-buffer and threads. At their defaults transfer
+// (m = 2) makes 24 such tests per pixel and containment (m = 3) 36, plus their per-pixel setup,
+// sample offsets and accumulation; this says how much of their time the tests alone need.
+// Counter: ns per test of one pixel (CPU time of all threads / tests).
 void depth_test_floor(benchmark::State& state) {
   Fixture& f = demo();
   const int tests = static_cast<int>(state.range(0));
-  std::vector<float> px, py, pz;
-  for (std::size_t i = 0; i < f.g.position.size(); ++i)
-    if (f.g.covered(i)) px.push_back(f.g.position[i].x), py.push_back(f.g.position[i].y), pz.push_back(f.g.position[i].z);
-  const std::size_t n = px.size(), vectors = n / 16;
   std::vector<float> dx(static_cast<std::size_t>(tests)), dy(dx.size()), dz(dx.size());
-  for (int t = 0; t < tests; ++t) {  // a spiral over the sphere, radius R
-    const float zc = 1.0f - (2.0f * static_cast<float>(t) + 1.0f) / static_cast<float>(tests), rc = std::sqrt(1.0f - zc * zc);
+  for (int t = 0; t < tests; ++t) {  // a spiral over the upper hemisphere, radius R
+    const float zc = 1.0f - (static_cast<float>(t) + 0.5f) / static_cast<float>(tests), rc = std::sqrt(1.0f - zc * zc);
     const float a = 2.39996f * static_cast<float>(t);
     dx[static_cast<std::size_t>(t)] = f.radius * rc * std::cos(a), dy[static_cast<std::size_t>(t)] = f.radius * rc * std::sin(a);
     dz[static_cast<std::size_t>(t)] = f.radius * zc;
   }
-  const ScreenProjection pr = ScreenProjection::from_camera(f.g.camera);
-  const Image<float> depth_image = depth_plane(f.g);
-  const float* depth = depth_image.data();
+  const DepthBufferCharacteristic ch(f.g);
+  const simd::DepthPlane plane = simd_depth_plane(ch);
+  const simd::TestPoints points{dx.data(), dy.data(), dz.data(), tests};
+  const simd::Rotations16 rot = simd_rotations(interleave_rotations(1, true));
+  std::vector<simd::CoveredPixels> rows(static_cast<std::size_t>(kHeight));
+  std::size_t covered = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    simd::load_covered_pixels(rows[static_cast<std::size_t>(y)], f.g, y, 0, kWidth, rot, 0.0f, true);
+    covered += static_cast<std::size_t>(rows[static_cast<std::size_t>(y)].count);
+  }
   std::atomic<long long> total{0};
   for (auto _ : state) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vectors, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-      const __m512 zero = _mm512_setzero_ps(), minus_one = _mm512_set1_ps(-1.0f);
-      const __m512 sx = _mm512_set1_ps(pr.scale_x), sy = _mm512_set1_ps(pr.scale_y), cx = _mm512_set1_ps(pr.centre_x),
-                   cy = _mm512_set1_ps(pr.centre_y), wf = _mm512_set1_ps(static_cast<float>(pr.width)),
-                   hf = _mm512_set1_ps(static_cast<float>(pr.height));
-      const __m512i stride = _mm512_set1_epi32(pr.width);
-      __m512i count = _mm512_setzero_si512();
-      for (std::size_t v = r.begin(); v < r.end(); ++v) {
-        const __m512 x = _mm512_loadu_ps(&px[16 * v]), y = _mm512_loadu_ps(&py[16 * v]), z = _mm512_loadu_ps(&pz[16 * v]);
-        for (int t = 0; t < tests; ++t) {
-          const auto ts = static_cast<std::size_t>(t);
-          const __m512 qx = _mm512_add_ps(x, _mm512_set1_ps(dx[ts])), qy = _mm512_add_ps(y, _mm512_set1_ps(dy[ts]));
-          const __m512 qz = _mm512_add_ps(z, _mm512_set1_ps(dz[ts]));
-          const __m512 inv = _mm512_div_ps(minus_one, qz);
-          const __m512 fx = _mm512_fmadd_ps(_mm512_mul_ps(qx, inv), sx, cx), fy = _mm512_fnmadd_ps(_mm512_mul_ps(qy, inv), sy, cy);
-          __mmask16 valid = _mm512_cmp_ps_mask(qz, zero, _CMP_LT_OQ);
-          valid = _mm512_mask_cmp_ps_mask(valid, fx, zero, _CMP_GE_OQ);
-          valid = _mm512_mask_cmp_ps_mask(valid, fy, zero, _CMP_GE_OQ);
-          valid = _mm512_mask_cmp_ps_mask(valid, fx, wf, _CMP_LT_OQ);
-          valid = _mm512_mask_cmp_ps_mask(valid, fy, hf, _CMP_LT_OQ);
-          const __m512i pixel = _mm512_add_epi32(_mm512_mullo_epi32(_mm512_maskz_cvttps_epi32(0xFFFF, fy), stride), _mm512_maskz_cvttps_epi32(0xFFFF, fx));
-          const __m512 d = _mm512_add_ps(_mm512_mask_i32gather_ps(zero, valid, pixel, depth, 4), qz);
-          count = _mm512_mask_add_epi32(count, _mm512_mask_cmp_ps_mask(valid, d, zero, _CMP_LT_OQ), count, _mm512_set1_epi32(1));
-        }
+    tbb::parallel_for(tbb::blocked_range<int>(0, kHeight, 8), [&](const tbb::blocked_range<int>& r) {
+      simd::AlignedVector<float> open(static_cast<std::size_t>(simd::padded(kWidth)));
+      long long sum = 0;
+      for (int y = r.begin(); y < r.end(); ++y) {
+        const simd::CoveredPixels& row = rows[static_cast<std::size_t>(y)];
+        simd::count_open_rays(row, plane, points, 1, -kInfinity, open.data());
+        for (int k = 0; k < row.count; ++k) sum += static_cast<long long>(open[static_cast<std::size_t>(k)]);
       }
-      total += _mm512_reduce_add_epi32(count);
+      total += sum;
     });
   }
   benchmark::DoNotOptimize(total.load());
-  state.counters["ns/test"] = benchmark::Counter(static_cast<double>(state.iterations()) * static_cast<double>(vectors) * tests,
+  state.counters["ns/test"] = benchmark::Counter(static_cast<double>(state.iterations()) * static_cast<double>(covered) * tests,
                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["Mpix/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * state.iterations() / 1e6, benchmark::Counter::kIsRate);
 }
 BENCHMARK(depth_test_floor)->Arg(12)->Arg(24)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-#endif
 
 // Arg: filter on (1) / off (0); transfer's second arg is m (tests per ray).
 BENCHMARK(containment)->Args({0, 1})->Args({1, 1})->Args({0, 3})->Args({1, 3})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

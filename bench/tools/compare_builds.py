@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Side-by-side speed of two builds' ao_bench, alternating runs so both see the same machine load.
 
-    bench/tools/compare_builds.py A/bench/ao_bench B/bench/ao_bench --pairs 5 --filter REGEX [-- ao_bench args]
+    bench/tools/compare_builds.py A/bench/ao_bench B/bench/ao_bench --pairs 5 --filter REGEX [-- more ao_bench arguments]
 
 Runs A, B, A, B, ... (`--pairs` of each), every run with the same benchmark filter and arguments,
 and reports per benchmark the ratio A / B of its time (real time, and the CPU time Google Benchmark
@@ -40,9 +40,10 @@ def main():
     p.add_argument("--pairs", type=int, default=5)
     p.add_argument("--filter", default=".")
     p.add_argument("--keep", help="directory for every run's JSON")
-    p.add_argument("rest", nargs="*", help="more ao_bench arguments (after --)")
-    o = p.parse_args()
-    args = ["--benchmark_filter=" + o.filter] + o.rest
+    argv = sys.argv[1:]
+    rest = argv[argv.index("--") + 1:] if "--" in argv else []
+    o = p.parse_args(argv[:argv.index("--")] if "--" in argv else argv)
+    args = ["--benchmark_filter=" + o.filter] + rest
     if o.keep:
         os.makedirs(o.keep, exist_ok=True)
     ratios = {}

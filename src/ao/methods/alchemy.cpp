@@ -20,6 +20,7 @@ constexpr int kMaxSamples = 1024;
 // Tiles of 128 x 8 pixels: rows long enough to vectorise over pixels, and a tile's sample footprint
 // (the tile grown by the disk's pixel radius) small enough to stay in L2 for typical radii.
 constexpr int kTileWidth = 128, kTileHeight = 8;
+static_assert(kTileWidth <= simd::kMaxAlchemySegment);
 // The disk's screen radius is capped (a pixel whose disk covers the whole image gains nothing from a
 // larger one) so that pixel coordinates stay below the kernel's offset (65536) and truncation acts as floor.
 constexpr float kMaxPixelRadius = 16384.0f;

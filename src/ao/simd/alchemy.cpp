@@ -12,6 +12,7 @@
 
 #include <hwy/highway.h>
 
+#include "ao/core/error.h"
 #include "ao/core/math.h"
 #include "ao/core/sampling.h"
 #include "ao/simd/aligned_internal.h"
@@ -116,57 +117,85 @@ void AlchemyRow(const AlchemyInputs& in, int y, int x0, int x1, float* out) {
   // Per pixel of the whole image the seed's hash is the same: pixel_seed = hash_combine(hash_combine(hash32(seed), x), y).
   const VU seed_hash = hn::Set(du, ao::hash32(in.seed)), row_y = hn::Set(du, static_cast<std::uint32_t>(y));
   const VF fy = hn::Set(d, static_cast<float>(y) + 0.5f);
-  HWY_ALIGN float v[kMaxLanes];
-  for (int j0 = 0; j0 < n; j0 += lanes) {
-    // Lanes past the segment repeat its last pixel (valid reads); their results are not written.
-    const VI j = hn::Min(hn::Iota(di, j0), hn::Set(di, n - 1));
+  // The row's per-pixel values, structure of arrays: the sample loop below runs sample by sample
+  // across the row (the gathers of a sample's pixel vectors are independent and close in the image).
+  AO_ASSERT(n <= kMaxAlchemySegment);
+  HWY_ALIGN float cx[kMaxAlchemySegment], cy[kMaxAlchemySegment], cz[kMaxAlchemySegment], nx[kMaxAlchemySegment], ny[kMaxAlchemySegment],
+      nz[kMaxAlchemySegment], bias[kMaxAlchemySegment], radius_px[kMaxAlchemySegment], jitter[kMaxAlchemySegment], rc[kMaxAlchemySegment],
+      rs[kMaxAlchemySegment], fx0[kMaxAlchemySegment], sum[kMaxAlchemySegment], cov[kMaxAlchemySegment];
+  const VI lane = hn::Iota(di, 0);  // made once: Highway builds it through memory
+  const int end = (n + lanes - 1) / lanes * lanes;
+  const std::size_t row = static_cast<std::size_t>(y) * w + x0;
+  for (int j0 = 0; j0 < end; j0 += lanes) {
+    const VI j = hn::Add(lane, hn::Set(di, j0));
     const VI x = hn::Add(hn::Set(di, x0), j);
-    const VI pixel = hn::Add(hn::Set(di, y * w), x);
-    const MF covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::GatherIndex(du, in.object_id, pixel), hn::Zero(du))));
-    const VF depth = hn::GatherIndex(d, in.depth, pixel);
+    // The row's depths, ids and normals: contiguous loads; the last vector, past the segment,
+    // gathers its last pixel again (valid reads; those lanes' results are not written).
+    VF depth, nx_v, ny_v, nz_v;
+    MF covered;
+    if (j0 + lanes <= n) {
+      depth = hn::LoadU(d, in.depth + row + j0);
+      covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::LoadU(du, in.object_id + row + j0), hn::Zero(du))));
+      hn::LoadInterleaved3(d, in.normal + 3 * (row + j0), nx_v, ny_v, nz_v);
+    } else {
+      const VI pixel = hn::Add(hn::Set(di, static_cast<int>(row)), hn::Min(j, hn::Set(di, n - 1)));
+      depth = hn::GatherIndex(d, in.depth, pixel);
+      covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::GatherIndex(du, in.object_id, pixel), hn::Zero(du))));
+      const VI p3 = hn::Mul(pixel, hn::Set(di, 3));
+      nx_v = hn::GatherIndex(d, in.normal, p3), ny_v = hn::GatherIndex(d, in.normal + 1, p3), nz_v = hn::GatherIndex(d, in.normal + 2, p3);
+    }
     // C from the depth buffer, as its samples (so C and its samples agree exactly on a plane);
     // background: C = 0, its result is overwritten.
     const VF dc = hn::IfThenElseZero(covered, depth);
     const VF fx = hn::Add(hn::ConvertTo(d, x), half);
-    const VF cx = hn::Mul(dc, hn::MulAdd(ax, fx, bx)), cy = hn::Mul(dc, hn::MulAdd(ay, fy, by)), cz = hn::Neg(dc);
-    const VI p3 = hn::Mul(pixel, hn::Set(di, 3));
-    const VF nx = hn::GatherIndex(d, in.normal, p3), ny = hn::GatherIndex(d, in.normal + 1, p3), nz = hn::GatherIndex(d, in.normal + 2, p3);
+    const VF vcz = hn::Neg(dc);
+    hn::Store(hn::Mul(dc, hn::MulAdd(ax, fx, bx)), d, cx + j0), hn::Store(hn::Mul(dc, hn::MulAdd(ay, fy, by)), d, cy + j0), hn::Store(vcz, d, cz + j0);
+    hn::Store(nx_v, d, nx + j0), hn::Store(ny_v, d, ny + j0), hn::Store(nz_v, d, nz + j0);
     // Eq. 10's z_C beta: z_C < 0, so this lowers v.n and drops samples nearly in the tangent plane
     // (self-occlusion from imprecise normals and positions), more so far away.
-    const VF bias = hn::Mul(cz, beta);
+    hn::Store(hn::Mul(vcz, beta), d, bias + j0);
     // Screen radius of the world disk; background has depth +inf, so radius 0.
-    const VF radius_px = hn::Min(hn::Set(d, in.max_pixel_radius), hn::Div(hn::Set(d, in.radius * in.px_per_unit), depth));
+    hn::Store(hn::Min(hn::Set(d, in.max_pixel_radius), hn::Div(hn::Set(d, in.radius * in.px_per_unit), depth)), d, radius_px + j0);
     // The pixel's jitter and rotation of the pattern, from its seed.
     const VU hs = hash_combine(hash_combine(seed_hash, hn::BitCast(du, x)), row_y);
-    const VF jitter = hn::Mul(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<8>(hs))), hn::Set(d, 0x1.0p-24f));
+    hn::Store(hn::Mul(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<8>(hs))), hn::Set(d, 0x1.0p-24f)), d, jitter + j0);
     const VI ri = hn::BitCast(di, hn::And(hash32(hs), hn::Set(du, kRotationMask)));
-    const VF rc = hn::GatherIndex(d, in.rot_c, ri), rs = hn::GatherIndex(d, in.rot_s, ri);
-    const VF fx0 = hn::Add(fx, offset), fy0 = hn::Add(fy, offset);
-    VF sum = zero;
-    for (int i = 0; i < in.samples; ++i) {
-      // Sample i lies in the i-th of s equal-area annuli (radius sqrt((i + jitter) / s)) at angle
-      // i * golden angle + the pixel's rotation: stratified, and uniform on the disk.
-      const VF pux = hn::Set(d, in.ux[i]), puy = hn::Set(d, in.uy[i]);
-      const VF rho = hn::Mul(radius_px, sqrt_unit(hn::Mul(hn::Add(hn::Set(d, static_cast<float>(i)), jitter), inv_s)));
-      const VF dx = hn::Mul(rho, hn::NegMulAdd(rs, puy, hn::Mul(rc, pux))), dy = hn::Mul(rho, hn::MulAdd(rc, puy, hn::Mul(rs, pux)));
+    hn::Store(hn::GatherIndex(d, in.rot_c, ri), d, rc + j0), hn::Store(hn::GatherIndex(d, in.rot_s, ri), d, rs + j0);
+    hn::Store(hn::Add(fx, offset), d, fx0 + j0);
+    hn::Store(zero, d, sum + j0);
+    hn::Store(hn::IfThenElseZero(covered, one), d, cov + j0);
+  }
+  const VF fy0 = hn::Add(fy, offset);
+  for (int i = 0; i < in.samples; ++i) {
+    // Sample i lies in the i-th of s equal-area annuli (radius sqrt((i + jitter) / s)) at angle
+    // i * golden angle + the pixel's rotation: stratified, and uniform on the disk.
+    const VF pux = hn::Set(d, in.ux[i]), puy = hn::Set(d, in.uy[i]), stratum = hn::Set(d, static_cast<float>(i));
+    for (int j0 = 0; j0 < end; j0 += lanes) {
+      const VF vrc = hn::Load(d, rc + j0), vrs = hn::Load(d, rs + j0);
+      const VF rho = hn::Mul(hn::Load(d, radius_px + j0), sqrt_unit(hn::Mul(hn::Add(stratum, hn::Load(d, jitter + j0)), inv_s)));
+      const VF dx = hn::Mul(rho, hn::NegMulAdd(vrs, puy, hn::Mul(vrc, pux))), dy = hn::Mul(rho, hn::MulAdd(vrc, puy, hn::Mul(vrs, pux)));
       // +kCoordOffset keeps the coordinate positive, so truncation is floor. Clamp-to-edge: a
       // sample beyond the frame reads the nearest border pixel (the surfaces at the edge go on
       // beyond it) rather than counting as empty space.
-      const VI ix = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(fx0, dx)), ioffset), izero), max_ix);
+      const VI ix = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(hn::Load(d, fx0 + j0), dx)), ioffset), izero), max_ix);
       const VI iy = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(fy0, dy)), ioffset), izero), max_iy);
       const VF dp = hn::GatherIndex(d, in.depth, hn::Add(hn::Mul(iy, width), ix));
-      const VF vx = hn::Sub(hn::Mul(dp, hn::MulAdd(ax, hn::Add(hn::ConvertTo(d, ix), half), bx)), cx);
-      const VF vy = hn::Sub(hn::Mul(dp, hn::MulAdd(ay, hn::Add(hn::ConvertTo(d, iy), half), by)), cy);
-      const VF vz = hn::Sub(hn::Neg(dp), cz);
+      const VF vx = hn::Sub(hn::Mul(dp, hn::MulAdd(ax, hn::Add(hn::ConvertTo(d, ix), half), bx)), hn::Load(d, cx + j0));
+      const VF vy = hn::Sub(hn::Mul(dp, hn::MulAdd(ay, hn::Add(hn::ConvertTo(d, iy), half), by)), hn::Load(d, cy + j0));
+      const VF vz = hn::Sub(hn::Neg(dp), hn::Load(d, cz + j0));
       const VF vv = hn::MulAdd(vz, vz, hn::MulAdd(vy, vy, hn::Mul(vx, vx)));
-      const VF vn = hn::Add(hn::MulAdd(vz, nz, hn::MulAdd(vy, ny, hn::Mul(vx, nx))), bias);
+      const VF vn = hn::Add(hn::MulAdd(vz, hn::Load(d, nz + j0), hn::MulAdd(vy, hn::Load(d, ny + j0), hn::Mul(vx, hn::Load(d, nx + j0)))),
+                            hn::Load(d, bias + j0));
       // Background samples (depth +inf, so vv is inf or NaN and fails vv < r^2) contribute
       // nothing: the paper's assumption that unseen space is empty. vv < r^2 is eq. 9's H.
       const MF use = hn::And(hn::Lt(vv, r2), hn::Gt(vn, zero));
-      sum = hn::Add(sum, hn::IfThenElseZero(use, hn::Div(vn, hn::Add(vv, eps))));
+      hn::Store(hn::Add(hn::Load(d, sum + j0), hn::IfThenElseZero(use, hn::Div(vn, hn::Add(vv, eps)))), d, sum + j0);
     }
-    const VF a = hn::Max(hn::NegMulAdd(scale, sum, one), zero);  // eq. 10 before ^k
-    hn::Store(hn::IfThenElse(covered, a, one), d, v);
+  }
+  HWY_ALIGN float v[kMaxLanes];
+  for (int j0 = 0; j0 < n; j0 += lanes) {
+    const VF a = hn::Max(hn::NegMulAdd(scale, hn::Load(d, sum + j0), one), zero);  // eq. 10 before ^k
+    hn::Store(hn::IfThenElse(hn::Gt(hn::Load(d, cov + j0), zero), a, one), d, v);
     for (int k = 0; k < std::min(lanes, n - j0); ++k) out[j0 + k] = v[k];
   }
 }

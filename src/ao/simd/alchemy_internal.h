@@ -31,7 +31,10 @@ struct AlchemyInputs {
   std::uint32_t seed = 0;  ///< Picks each pixel's rotation and jitter: pixel_seed(seed, x, y).
 };
 
-/// Eq. 10 before the power k for the pixels [x0, x1) of row y into v[x - x0]: on covered pixels
+/// The widest row segment alchemy_row takes, pixels.
+inline constexpr int kMaxAlchemySegment = 512;
+
+/// Eq. 10 before the power k for the pixels [x0, x1) (x1 - x0 <= kMaxAlchemySegment) of row y into v[x - x0]: on covered pixels
 /// max(0, 1 - scale sum_i max(0, v_i . n + z_C beta) / (v_i . v_i + epsilon)) over the s samples
 /// P_i of the disk of radius r about C (stratified in s equal-area annuli, rotated and jittered per
 /// pixel, read from the depth buffer, clamp-to-edge) with |v_i| < r, v_i = P_i - C; 1 elsewhere.

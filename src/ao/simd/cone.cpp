@@ -18,6 +18,7 @@
 
 #include <hwy/highway.h>
 
+#include "ao/core/error.h"
 #include "ao/methods/cone_kernel_internal.h"
 #include "ao/simd/aligned_internal.h"
 #include "ao/simd/cone_internal.h"
@@ -37,12 +38,40 @@ using V64 = hn::Vec<D64>;
 using VH = hn::Vec<DH>;
 using VHI = hn::Vec<DHI>;
 
-// Bits of a mask of (at most 8) lanes, lane 0 in bit 0.
+// Bits of a mask of (at most 8) lanes, lane 0 in bit 0: AVX-512's mask register itself, else
+// through StoreMaskBits.
 template <class D>
 HWY_INLINE unsigned mask_bits(D d, hn::Mask<D> m) {
+#if HWY_TARGET <= HWY_AVX3
+  (void)d;
+  return static_cast<unsigned>(m.raw) & 0xFFu;
+#else
   std::uint8_t b[8] = {};
   hn::StoreMaskBits(d, m, b);
   return b[0];
+#endif
+}
+
+// solid + the lanes of `len` added one by one in lane order (the order of the scalar sum, so every
+// target gives the same bits): in registers where the vector is one of SSE's or AVX's.
+HWY_INLINE float add_in_order(float solid, VH len) {
+#if HWY_TARGET <= HWY_AVX3
+  const __m128 a = _mm256_castps256_ps128(len.raw), b = _mm256_extractf128_ps(len.raw, 1);
+  __m128 t = _mm_set_ss(solid);
+  t = _mm_add_ss(t, a), t = _mm_add_ss(t, _mm_movehdup_ps(a)), t = _mm_add_ss(t, _mm_movehl_ps(a, a)), t = _mm_add_ss(t, _mm_shuffle_ps(a, a, 3));
+  t = _mm_add_ss(t, b), t = _mm_add_ss(t, _mm_movehdup_ps(b)), t = _mm_add_ss(t, _mm_movehl_ps(b, b)), t = _mm_add_ss(t, _mm_shuffle_ps(b, b, 3));
+  return _mm_cvtss_f32(t);
+#elif HWY_TARGET <= HWY_AVX2
+  const __m128 a = len.raw;
+  __m128 t = _mm_set_ss(solid);
+  t = _mm_add_ss(t, a), t = _mm_add_ss(t, _mm_movehdup_ps(a)), t = _mm_add_ss(t, _mm_movehl_ps(a, a)), t = _mm_add_ss(t, _mm_shuffle_ps(a, a, 3));
+  return _mm_cvtss_f32(t);
+#else
+  HWY_ALIGN float l[8];
+  hn::Store(len, DH(), l);
+  for (std::size_t k = 0; k < hn::Lanes(DH()); ++k) solid += l[k];
+  return solid;
+#endif
 }
 
 // A 64-bit word per lane from base + offset bytes (unaligned) where bit l of `bits` is set, 0 in
@@ -67,29 +96,20 @@ struct Kernel {
   // The pixel's turned prism pattern, the cones' axes in voxels and chain scales, and per slot the
   // sphere's centre (voxels) and radius scale and the bit arrays "sampled", "wider than the
   // largest window" and "passed" (sampled and the window masks say maybe; wide: the blocks decide).
-  // One allocation per call, carved into the arrays (each a whole number of the widest vectors).
-  AlignedVector<float> scratch;
-  float *u, *v, *ax, *ay, *az, *scale, *cx, *cy, *cz, *rs;
-  std::vector<std::uint8_t> used, wide, pass;
+  // On the stack, at the largest sizes the parameters allow (about 18 KB).
+  HWY_ALIGN float u[kMaxConePrisms], v[kMaxConePrisms], ax[kMaxCones], ay[kMaxCones], az[kMaxCones], scale[kMaxCones];
+  HWY_ALIGN float cx[kMaxConeSlots], cy[kMaxConeSlots], cz[kMaxConeSlots], rs[kMaxConeSlots];
+  std::uint8_t used[kMaxConeSlots / 8 + 8], wide[kMaxConeSlots / 8 + 8], pass[kMaxConeSlots / 8 + 8];
 
-  Kernel(const VoxelGrid& grid, const ConeTables& tables)
-      : g(grid), tb(tables), weight(1.0f / static_cast<float>(tables.cones)),
-        scratch(2 * static_cast<std::size_t>(tables.prism_lanes) + 4 * static_cast<std::size_t>(tables.cones_padded) +
-                4 * static_cast<std::size_t>(padded(tables.slots))),
-        used(static_cast<std::size_t>(padded(tables.slots)) / 8 + 8), wide(used.size()), pass(used.size()) {
-    float* p = scratch.data();
-    const auto take = [&](std::size_t n) { return std::exchange(p, p + n); };
-    const auto np = static_cast<std::size_t>(tables.prism_lanes), nc = static_cast<std::size_t>(tables.cones_padded),
-               ns = static_cast<std::size_t>(padded(tables.slots));
-    u = take(np), v = take(np), ax = take(nc), ay = take(nc), az = take(nc), scale = take(nc);
-    cx = take(ns), cy = take(ns), cz = take(ns), rs = take(ns);
+  Kernel(const VoxelGrid& grid, const ConeTables& tables) : g(grid), tb(tables), weight(1.0f / static_cast<float>(tables.cones)) {
+    AO_ASSERT(tables.prism_lanes <= kMaxConePrisms && tables.cones_padded <= kMaxCones && tables.slots <= kMaxConeSlots);
   }
 
-  static bool bit(const std::vector<std::uint8_t>& b, int i) { return (b[static_cast<std::size_t>(i) >> 3] >> (i & 7)) & 1u; }
+  static bool bit(const std::uint8_t* b, int i) { return (b[static_cast<std::size_t>(i) >> 3] >> (i & 7)) & 1u; }
   // `count` (<= 25) bits of a bit array from bit `first`.
-  static std::uint32_t bits(const std::vector<std::uint8_t>& b, int first, int count) {
+  static std::uint32_t bits(const std::uint8_t* b, int first, int count) {
     std::uint32_t word;
-    std::memcpy(&word, b.data() + (first >> 3), sizeof word);
+    std::memcpy(&word, b + (first >> 3), sizeof word);
     return (word >> (first & 7)) & ((1u << count) - 1);
   }
 
@@ -140,7 +160,8 @@ struct Kernel {
     const V64 ones = hn::Set(D64(), ~std::uint64_t{0});
     const bool permute = tb.cones <= lanes;  // the cones' values fit one vector: a permute per slot, else a gather
     const VH ps = hn::LoadU(dh, scale), pax = hn::LoadU(dh, ax), pay = hn::LoadU(dh, ay), paz = hn::LoadU(dh, az);
-    std::fill(used.begin(), used.end(), 0), std::fill(wide.begin(), wide.end(), 0), std::fill(pass.begin(), pass.end(), 0);
+    const std::size_t bytes = static_cast<std::size_t>(tb.slots) / 8 + 8;
+    std::fill(used, used + bytes, 0), std::fill(wide, wide + bytes, 0), std::fill(pass, pass + bytes, 0);
     for (int i = 0; i < tb.slots; i += lanes) {
       const VHI c = hn::LoadU(dhi, tb.slot_cone + i);
       VH s, cax, cay, caz;
@@ -218,15 +239,14 @@ struct Kernel {
               last_byte = hn::Set(dhi, 8 * g.words - 8), c63 = hn::Set(dhi, 63);
     const V64 one64 = hn::Set(d64, 1), two64 = hn::Set(d64, 2);
     const VH vs = hn::Set(dh, hs), vrx = hn::Set(dh, rx), vry = hn::Set(dh, ry), vgx = hn::Set(dh, gx), vgy = hn::Set(dh, gy), vgz = hn::Set(dh, gz);
-    HWY_ALIGN float len[8];
     float solid = 0;
     for (int s0 = 0; s0 < tb.prisms; s0 += lanes) {
       const VH pu = hn::Load(dh, u + s0), pv = hn::Load(dh, v + s0), hh = hn::Mul(hn::Load(dh, h + s0), vs);
       const VH fx = hn::MulAdd(pu, vrx, vgx), fy = hn::MulAdd(pv, vry, vgy);
       const VH zlo = hn::Max(hn::Sub(vgz, hh), zero), zhi = hn::Min(hn::Add(vgz, hh), fbits);
-      const auto live = hn::FirstN(dh, static_cast<std::size_t>(tb.prisms - s0));
+      // Lanes past the prisms have a half chord of 0, so zhi > zlo fails for them.
       const auto inside = hn::And(hn::And(hn::Ge(fx, zero), hn::Ge(fy, zero)), hn::And(hn::Lt(fx, fnx), hn::Lt(fy, fny)));
-      const auto in_range = hn::And(live, hn::And(inside, hn::Gt(zhi, zlo)));
+      const auto in_range = hn::And(inside, hn::Gt(zhi, zlo));
       // Lanes out of range read column 0 (their length is 0).
       const auto ok_i = hn::RebindMask(dhi, in_range);
       const VHI ix = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, fx)));
@@ -252,13 +272,18 @@ struct Kernel {
       const VH multi = hn::Add(hn::Add(hn::Mul(b0, hn::Sub(hn::Add(fk0, one), zlo)), mid), hn::Mul(b1, hn::Sub(zhi, fk1)));
       const VH single = hn::Mul(b0, hn::Sub(zhi, zlo));
       const auto one_voxel = hn::RebindMask(dh, hn::Not(hn::Lt(k0, k1)));
-      hn::Store(hn::IfThenElseZero(ok, hn::IfThenElse(one_voxel, single, multi)), dh, len);
-      for (unsigned m = wide_bits; m; m &= m - 1) {
-        const int s = s0 + std::countr_zero(m);
-        len[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * hs, u[s], v[s]);
+      VH len = hn::IfThenElseZero(ok, hn::IfThenElse(one_voxel, single, multi));
+      if (wide_bits) {
+        HWY_ALIGN float l[8];
+        hn::Store(len, dh, l);
+        for (unsigned m = wide_bits; m; m &= m - 1) {
+          const int s = s0 + std::countr_zero(m);
+          l[s - s0] = scalar_prism(gx, gy, gz, rx, ry, h[s] * hs, u[s], v[s]);
+        }
+        len = hn::Load(dh, l);
       }
       // Lanes past the prisms hold +0, and adding +0 to a sum >= +0 leaves it as it is.
-      for (int k = 0; k < lanes; ++k) solid += len[k];
+      solid = add_in_order(solid, len);
     }
     return solid;
   }
@@ -318,6 +343,7 @@ struct Kernel {
 }  // namespace
 
 void TraceCones(const VoxelGrid& grid, const ConeTables& tables, const ConePixel* pixels, int count, float* v) {
+  if (count == 0) return;
   Kernel k(grid, tables);
   for (int i = 0; i < count; ++i) {
     const ConePixel& p = pixels[i];

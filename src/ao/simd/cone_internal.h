@@ -15,6 +15,10 @@
 
 namespace ao::simd {
 
+/// The largest tables the kernel takes (ConeParams' ranges: 64 cones of 16 spheres and the filler,
+/// 64 prisms per sphere), in whole vectors.
+inline constexpr int kMaxCones = 64, kMaxConePrisms = 64, kMaxConeSlots = 64 * 17;
+
 /// The tables of one call, built once (methods/cone_world.cpp says what each one is).
 struct ConeTables {
   // Prisms (sec. III-C1): `prisms` points (u, v) of the unit great disk, arrays padded to

@@ -32,7 +32,7 @@ constexpr std::array<std::int32_t, 3 * kMaxLanes> kRgbPixel = [] {
   return t;
 }();
 
-// A value per pixel of a block spread to the pixel's S lanes: S vectors.
+// A pixel's value or mask (as all-ones bits) spread to its S lanes: S vectors.
 template <int S>
 HWY_INLINE std::array<VF, S> spread(VF v) {
   if constexpr (S == 1) {
@@ -49,63 +49,68 @@ HWY_INLINE std::array<VF, S> spread(VF v) {
   }
 }
 
-template <int S>
+// V vectors of pixels from p of row y (taps dx = -2..+1 all inside the row): the depth test is
+// made once per pixel and shared by the N channels; for RGB (S = 3) its mask is spread to the
+// pixel's 3 lanes. The count and sums stay in registers through the 16 taps (V blocks give V
+// independent chains of additions).
+template <int S, int N, int V>
+HWY_INLINE void box_block(const BoxFilterImage& im, const float* centre, int y, int p, int dy_lo, int dy_hi, float limit) {
+  const DF d;
+  const int n = static_cast<int>(hn::Lanes(d));
+  const std::size_t lanes = static_cast<std::size_t>(S) * static_cast<std::size_t>(im.width);
+  const VF lim = hn::Set(d, limit), one = hn::Set(d, 1.0f), zero = hn::Zero(d);
+  VF dc[V], count[V], sum[V][N * S];
+  for (int u = 0; u < V; ++u) {
+    dc[u] = hn::LoadU(d, centre + p + n * u), count[u] = zero;
+    for (int k = 0; k < N * S; ++k) sum[u][k] = zero;
+  }
+  for (int dy = dy_lo; dy <= dy_hi; ++dy) {
+    const float* dn = im.depth + static_cast<std::size_t>(y + dy) * im.width + p;
+    const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes + static_cast<std::size_t>(S) * p;
+    for (int dx = -2; dx <= 1; ++dx)
+      for (int u = 0; u < V; ++u) {
+        const MF m = hn::Le(hn::Abs(hn::Sub(hn::LoadU(d, dn + dx + n * u), dc[u])), lim);
+        count[u] = hn::Add(count[u], hn::IfThenElseZero(m, one));
+        const std::array<VF, S> e = spread<S>(hn::VecFromMask(d, m));
+        for (int c = 0; c < N; ++c) {
+          const float* v = im.src[c] + nrow + S * (dx + n * u);
+          for (int k = 0; k < S; ++k) sum[u][c * S + k] = hn::Add(sum[u][c * S + k], hn::And(e[static_cast<std::size_t>(k)], hn::LoadU(d, v + n * k)));
+        }
+      }
+  }
+  const std::size_t row = static_cast<std::size_t>(y) * lanes;
+  for (int u = 0; u < V; ++u) {
+    const std::array<VF, S> q = spread<S>(count[u]);
+    for (int k = 0; k < S; ++k) {
+      const VF qk = q[static_cast<std::size_t>(k)];
+      const MF some = hn::Gt(qk, zero);  // else keep the value (uncovered, or no tap)
+      for (int c = 0; c < N; ++c) {
+        const std::size_t at = row + static_cast<std::size_t>(S) * (p + n * u) + static_cast<std::size_t>(n * k);
+        hn::StoreU(hn::IfThenElse(some, hn::Div(sum[u][c * S + k], qk), hn::LoadU(d, im.src[c] + at)), d, im.dst[c] + at);
+      }
+    }
+  }
+}
+
+template <int S, int N>
 void BoxRows(const BoxFilterImage& im, float limit, int y0, int y1) {
   const DF d;
   const int n = static_cast<int>(hn::Lanes(d));
-  const int w = im.width, h = im.height, lanes = S * w, channels = im.channels;
+  const int w = im.width, h = im.height, lanes = S * w, channels = N;
   const float* depth = im.depth;
   auto depth_row = [&](int yy) { return depth + static_cast<std::size_t>(yy) * w; };
   // Centre depths, NaN on uncovered pixels: no tap passes, the count stays 0 and the value is kept.
   AlignedVector<float> centre(static_cast<std::size_t>(w));
-  const VF lim = hn::Set(d, limit), one = hn::Set(d, 1.0f), zero = hn::Zero(d);
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * lanes;
     const float* dcy = depth_row(y);
     const std::uint32_t* cov = im.object_id + static_cast<std::size_t>(y) * w;
     for (int x = 0; x < w; ++x) centre[static_cast<std::size_t>(x)] = cov[x] ? dcy[x] : std::numeric_limits<float>::quiet_NaN();
     const int dy_lo = std::max(-2, -y), dy_hi = std::min(1, h - 1 - y);
-    // Pixels whose taps dx = -2..+1 all lie inside the row, a vector of them at a time: the depth
-    // test is made once per pixel; for RGB its mask is spread to the pixel's 3 lanes.
+    // Pixels whose taps dx = -2..+1 all lie inside the row: two vectors at a time, then one.
     int p = 2;
-    for (; p + n <= w - 1; p += n) {
-      const VF dc = hn::LoadU(d, centre.data() + p);
-      VF count = zero;
-      std::array<VF, kMaxChannels * S> sum;
-      sum.fill(zero);
-      for (int dy = dy_lo; dy <= dy_hi; ++dy) {
-        const float* dn = depth_row(y + dy) + p;
-        const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes + static_cast<std::size_t>(S) * p;
-        for (int dx = -2; dx <= 1; ++dx) {
-          const MF m = hn::Le(hn::Abs(hn::Sub(hn::LoadU(d, dn + dx), dc)), lim);
-          const VF taken = hn::IfThenElseZero(m, one);
-          count = hn::Add(count, taken);
-          std::array<MF, S> e;
-          if constexpr (S == 1) {
-            e[0] = m;
-          } else {
-            const std::array<VF, S> spread_taken = spread<S>(taken);
-            for (int k = 0; k < S; ++k) e[static_cast<std::size_t>(k)] = hn::Gt(spread_taken[static_cast<std::size_t>(k)], zero);
-          }
-          for (int c = 0; c < channels; ++c) {
-            const float* v = im.src[c] + nrow + S * dx;
-            for (int k = 0; k < S; ++k) {
-              VF& s = sum[static_cast<std::size_t>(c * S + k)];
-              s = hn::Add(s, hn::IfThenElseZero(e[static_cast<std::size_t>(k)], hn::LoadU(d, v + n * k)));
-            }
-          }
-        }
-      }
-      const std::array<VF, S> q = spread<S>(count);
-      for (int k = 0; k < S; ++k) {
-        const VF qk = q[static_cast<std::size_t>(k)];
-        const MF some = hn::Gt(qk, zero);  // else keep the value (uncovered, or no tap)
-        for (int c = 0; c < channels; ++c) {
-          const std::size_t at = row + static_cast<std::size_t>(S) * p + static_cast<std::size_t>(n * k);
-          hn::StoreU(hn::IfThenElse(some, hn::Div(sum[static_cast<std::size_t>(c * S + k)], qk), hn::LoadU(d, im.src[c] + at)), d, im.dst[c] + at);
-        }
-      }
-    }
+    for (; p + 2 * n <= w - 1; p += 2 * n) box_block<S, N, 2>(im, centre.data(), y, p, dy_lo, dy_hi, limit);
+    for (; p + n <= w - 1; p += n) box_block<S, N, 1>(im, centre.data(), y, p, dy_lo, dy_hi, limit);
     // The rest one lane at a time, same tap order.
     const int l = S * p, vlo = 2 * S;
     auto scalar = [&](int l0, int l1) {
@@ -135,37 +140,51 @@ void BoxRows(const BoxFilterImage& im, float limit, int y0, int y1) {
   }
 }
 
-// One vector of pixels: the centres from entry k0, tap j's data from tt[j] + kt (tt[j][0] without
-// per_pixel_t), td[j] + kt, tv[j] + kt, the input from `in`. The taps' sums stay in registers, in tap order.
-HWY_INLINE VF bilateral_vector(const BilateralCentres& ce, int k0, int taps, const float* sp, const float* const* tt, bool per_pixel_t,
-                               const float* const* td, const float* const* tv, int kt, const float* in) {
+// V vectors of pixels: the centres from entry k0, tap j's data from tt[j] + kt (tt[j][0] without
+// per_pixel_t), td[j] + kt, tv[j] + kt, the input from `in`; the results to `out`. The taps' sums
+// stay in registers, in tap order (V vectors: 2V independent chains of additions).
+template <int V>
+HWY_INLINE void bilateral_vectors(const BilateralCentres& ce, int k0, int taps, const float* sp, const float* const* tt, bool per_pixel_t,
+                                  const float* const* td, const float* const* tv, int kt, const float* in, float* out) {
   const DF d;
-  const VF a = hn::Load(d, ce.a.data() + k0), b = hn::Load(d, ce.b.data() + k0), c = hn::Load(d, ce.c.data() + k0);
+  const int n = static_cast<int>(hn::Lanes(d));
   const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f);
-  VF sum_w = zero, sum_v = zero;
+  VF a[V], b[V], c[V], sum_w[V], sum_v[V];
+  for (int u = 0; u < V; ++u) {
+    a[u] = hn::Load(d, ce.a.data() + k0 + n * u), b[u] = hn::Load(d, ce.b.data() + k0 + n * u), c[u] = hn::Load(d, ce.c.data() + k0 + n * u);
+    sum_w[u] = zero, sum_v[u] = zero;
+  }
   for (int j = 0; j < taps; ++j) {
-    const VF t = per_pixel_t ? hn::LoadU(d, tt[j] + kt) : hn::Set(d, tt[j][0]);
-    const VF depth = hn::LoadU(d, td[j] + kt);
-    // x/2 = d (a t + b) - c; K = max(0, 1 - (x/2)^2)^2. Background taps (d = +inf): x/2 is +-inf or
-    // NaN, so u = 0 and w = 0 (the comparison is false for NaN).
-    const VF half_x = hn::MulSub(depth, hn::MulAdd(a, t, b), c);
-    const VF u = hn::NegMulAdd(half_x, half_x, one);
-    const VF uc = hn::IfThenElseZero(hn::Gt(u, zero), u);
-    const VF w = hn::Mul(hn::Set(d, sp[j]), hn::Mul(uc, uc));
-    sum_w = hn::Add(sum_w, w);
-    sum_v = hn::MulAdd(w, hn::LoadU(d, tv[j] + kt), sum_v);
+    const VF spatial = hn::Set(d, sp[j]);
+    for (int u = 0; u < V; ++u) {
+      const VF t = per_pixel_t ? hn::LoadU(d, tt[j] + kt + n * u) : hn::Set(d, tt[j][0]);
+      const VF depth = hn::LoadU(d, td[j] + kt + n * u);
+      // x/2 = d (a t + b) - c; K = max(0, 1 - (x/2)^2)^2. Background taps (d = +inf): x/2 is +-inf
+      // or NaN, so u = 0 and w = 0 (the comparison is false for NaN).
+      const VF half_x = hn::MulSub(depth, hn::MulAdd(a[u], t, b[u]), c[u]);
+      const VF k = hn::NegMulAdd(half_x, half_x, one);
+      const VF kc = hn::IfThenElseZero(hn::Gt(k, zero), k);
+      const VF w = hn::Mul(spatial, hn::Mul(kc, kc));
+      sum_w[u] = hn::Add(sum_w[u], w);
+      sum_v[u] = hn::MulAdd(w, hn::LoadU(d, tv[j] + kt + n * u), sum_v[u]);
+    }
   }
   // The centre tap has weight spatial(0) * 1 > 0 on covered pixels, so sum_w > 0 there.
-  return hn::IfThenElse(hn::Gt(hn::Load(d, ce.cov.data() + k0), zero), hn::Div(sum_v, sum_w), hn::LoadU(d, in));
+  for (int u = 0; u < V; ++u)
+    hn::StoreU(hn::IfThenElse(hn::Gt(hn::Load(d, ce.cov.data() + k0 + n * u), zero), hn::Div(sum_v[u], sum_w[u]), hn::LoadU(d, in + n * u)), d,
+               out + n * u);
 }
 
 }  // namespace
 
 void BoxFilterRows(const BoxFilterImage& image, float depth_limit, int y0, int y1) {
-  if (image.stride == 3)
-    BoxRows<3>(image, depth_limit, y0, y1);
-  else
-    BoxRows<1>(image, depth_limit, y0, y1);
+  if (image.stride == 3) return BoxRows<3, 1>(image, depth_limit, y0, y1);  // RGB: one image
+  switch (image.channels) {
+    case 1: return BoxRows<1, 1>(image, depth_limit, y0, y1);
+    case 2: return BoxRows<1, 2>(image, depth_limit, y0, y1);
+    case 3: return BoxRows<1, 3>(image, depth_limit, y0, y1);
+    default: return BoxRows<1, 4>(image, depth_limit, y0, y1);
+  }
 }
 
 void BilateralCentresRow(BilateralCentres& ce, const float* normal, const float* depth, const std::uint32_t* object_id, int x0, int count,
@@ -180,6 +199,7 @@ void BilateralCentresRow(BilateralCentres& ce, const float* normal, const float*
   // The last partial vector reads copies padded with uncovered pixels, so no read passes the image.
   HWY_ALIGN float tail_n[3 * kMaxLanes], tail_d[kMaxLanes];
   HWY_ALIGN std::uint32_t tail_id[kMaxLanes];
+  const VI lane = hn::Iota(DI(), 0);  // made once: Highway builds it through memory
   for (int k0 = 0; k0 < count; k0 += n) {
     const float* nn = normal + 3 * static_cast<std::size_t>(k0);
     const float* dd = depth + k0;
@@ -197,7 +217,7 @@ void BilateralCentresRow(BilateralCentres& ce, const float* normal, const float*
     hn::LoadInterleaved3(d, nn, nx, ny, nz);
     const MF covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::LoadU(du, id), hn::Zero(du))));
     const VF depth_v = hn::IfThenElseZero(covered, hn::LoadU(d, dd));
-    const VF px = hn::Add(hn::ConvertTo(d, hn::Iota(DI(), x0 + k0)), half);
+    const VF px = hn::Add(hn::ConvertTo(d, hn::Add(lane, hn::Set(DI(), x0 + k0))), half);
     const VF rx = hn::MulAdd(ax, px, bx);
     // Background: scale 0 (and cov 0), so its result is never used.
     const VF half_s = hn::IfThenElseZero(covered, hn::Div(half, hn::Mul(sigma, depth_v)));
@@ -213,7 +233,8 @@ void BilateralTaps(const BilateralCentres& ce, int count, int taps, const float*
   const DF d;
   const int n = static_cast<int>(hn::Lanes(d));
   int k0 = 0;
-  for (; k0 + n <= count; k0 += n) hn::StoreU(bilateral_vector(ce, k0, taps, spatial, tt, per_pixel_t, td, tv, k0, in + k0), d, out + k0);
+  for (; k0 + 2 * n <= count; k0 += 2 * n) bilateral_vectors<2>(ce, k0, taps, spatial, tt, per_pixel_t, td, tv, k0, in + k0, out + k0);
+  for (; k0 + n <= count; k0 += n) bilateral_vectors<1>(ce, k0, taps, spatial, tt, per_pixel_t, td, tv, k0, in + k0, out + k0);
   if (k0 == count) return;
   // The last partial vector: its taps' rows copied into buffers padded with background (depth
   // +inf: weight 0), so no read passes the image and the arithmetic is the vector's.
@@ -231,8 +252,7 @@ void BilateralTaps(const BilateralCentres& ce, int count, int taps, const float*
   }
   for (int k = 0; k < n; ++k) bin[k] = k < rest ? in[k0 + k] : 0.0f;
   // The centres are padded: their arrays hold whole vectors, the part past `count` unused.
-  const VF r = bilateral_vector(ce, k0, taps, spatial, ptt.data(), per_pixel_t, ptd.data(), ptv.data(), 0, bin);
-  hn::Store(r, d, bout);
+  bilateral_vectors<1>(ce, k0, taps, spatial, ptt.data(), per_pixel_t, ptd.data(), ptv.data(), 0, bin, bout);
   for (int k = 0; k < rest; ++k) out[k0 + k] = bout[k];
 }
 

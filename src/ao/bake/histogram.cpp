@@ -3,9 +3,10 @@
 // The paper's pipeline, stage by stage, and where it lives here:
 //  - Directions w_d uniform on the sphere (sec. 3, after eq. 6): sphere_directions.cpp.
 //  - Stage 1, "render from light direction w": an orthographic z-buffered rasterisation with back-face
-//    culling (ortho_raster.cpp). For each visible pixel the fragment program outputs (u, v) and
-//    (w . n)|J|, with n the interpolated normal and |J| = |det d(u,v)/d(x_w,y_w)| (eq. 9). We
-//    recompute (u, v) and (w . n) from the pixel's barycentrics in the scatter loop below; |J| of an
+//    culling (ortho_raster.cpp, simd::rasterize_front_faces). For each visible pixel the fragment
+//    program outputs (u, v) and (w . n)|J|, with n the interpolated normal and |J| =
+//    |det d(u,v)/d(x_w,y_w)| (eq. 9). We recompute (u, v) and (w . n) from the pixel's barycentrics
+//    in the scatter (simd::scatter_histogram, src/ao/simd/histogram.cpp); |J| of an
 //    affine map is the ratio of the triangle's UV area to its image area, exactly what the paper's
 //    dFdx/dFdy estimate (they are exact for linear interpolation).
 //  - Stage 2, "sum over pixels": the histogram scatter of eq. 7-8, each pixel adding (w . n)|J| to
@@ -40,6 +41,7 @@
 #include "ao/bake/padding.h"
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
+#include "ao/simd/histogram_internal.h"
 
 namespace ao {
 
@@ -150,52 +152,15 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
       const OrthoView view = make_ortho_view(mesh, w, pixel_size, jitter);
       rasterize(mesh, view, acc.target);  // stage 1
       for (std::size_t i = 0; i < mesh.normals.size(); ++i) acc.cos_v[i] = dot(w, mesh.normals[i]);
-      const std::int64_t bx = std::llround(w.x * 1024.0), by = std::llround(w.y * 1024.0), bz = std::llround(w.z * 1024.0);
-
-      // Stage 2: the histogram scatter, eq. 8.
-      const std::uint32_t* ids = acc.target.id.data();
-      const float* px = acc.target.px.data();
-      const float* py = acc.target.py.data();
-      for (int y = 0; y < view.height; ++y) {
-        const float fy = static_cast<float>(y) + 0.5f;
-        for (int x = 0; x < view.width; ++x) {
-          const std::uint32_t id = ids[static_cast<std::size_t>(y) * view.width + x];
-          if (id == 0) continue;  // background: V = 0 (sec. 3)
-          const std::size_t t = id - 1;
-          if (!mesh.has_uv[t]) continue;
-          const std::uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
-          const float fx = static_cast<float>(x) + 0.5f;
-          const float ax = px[i0], ay = py[i0];
-          const float area2 = (px[i1] - ax) * (py[i2] - ay) - (px[i2] - ax) * (py[i1] - ay);
-          const float l1 = ((ax - px[i2]) * (fy - py[i2]) - (ay - py[i2]) * (fx - px[i2])) / area2;
-          const float l2 = ((px[i1] - ax) * (fy - ay) - (py[i1] - ay) * (fx - ax)) / area2;
-          const Vec2 ua = mesh.uvs[i0], ub = mesh.uvs[i1], uc = mesh.uvs[i2];
-          const float u = ua.x + l1 * (ub.x - ua.x) + l2 * (uc.x - ua.x);
-          const float v = ua.y + l1 * (ub.y - ua.y) + l2 * (uc.y - ua.y);
-          const int tx = static_cast<int>(std::floor(u)), ty = static_cast<int>(std::floor(v));
-          if (tx < 0 || ty < 0 || tx >= width || ty >= height) continue;
-          // (w . n) with the interpolated normal, as the paper's fragment program computes it;
-          // directions below the shading normal's horizon contribute nothing.
-          const float cos_s = std::max(0.0f, acc.cos_v[i0] + l1 * (acc.cos_v[i1] - acc.cos_v[i0]) + l2 * (acc.cos_v[i2] - acc.cos_v[i0]));
-          // |J| (eq. 9) in texels^2 per pixel: UV area over image area, both of this triangle.
-          const float uv_area2 = std::abs((ub.x - ua.x) * (uc.y - ua.y) - (uc.x - ua.x) * (ub.y - ua.y));
-          const float jac = uv_area2 / area2;
-          // Area: times s / p^2 (surface per texel^2, in pixels), see the header comment: weight
-          // = (w . n)/(w . n_g), 1 on flat geometry. Max: the paper's (w . n)|J|.
-          float weight = cos_s * jac * (area_norm ? mesh.stretch[t] / (pixel_size * pixel_size) : 1.0f);
-          weight = std::min(weight, kMaxWeight);
-          const auto q = static_cast<std::uint64_t>(static_cast<double>(weight) * kFixedScale + 0.5);
-          const std::size_t texel = static_cast<std::size_t>(ty) * width + tx;
-          acc.sum[texel] += q;
-          ++acc.fragments;
-          if (bent) {
-            const auto sq = static_cast<std::int64_t>(q >> 10);
-            acc.bent[3 * texel] += sq * bx;
-            acc.bent[3 * texel + 1] += sq * by;
-            acc.bent[3 * texel + 2] += sq * bz;
-          }
-        }
-      }
+      // Stage 2: the histogram scatter, eq. 8, in the SIMD kernel layer (compiled for every x86-64 target).
+      simd::ScatterInput in;
+      in.ids = acc.target.id.data(), in.px = acc.target.px.data(), in.py = acc.target.py.data();
+      in.view_width = view.width, in.view_height = view.height;
+      in.indices = mesh.indices.data(), in.has_uv = mesh.has_uv.data(), in.stretch = mesh.stretch.data(), in.uvs = mesh.uvs.data();
+      in.cos_v = acc.cos_v.data(), in.map_width = width, in.map_height = height, in.pixel_size = pixel_size, in.area_norm = area_norm;
+      in.max_weight = kMaxWeight, in.fixed_scale = kFixedScale, in.bent = bent;
+      in.bx = std::llround(w.x * 1024.0), in.by = std::llround(w.y * 1024.0), in.bz = std::llround(w.z * 1024.0);
+      acc.fragments += simd::scatter_histogram(in, acc.sum.data(), bent ? acc.bent.data() : nullptr);
       counter.add(1);
     }
   });

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <initializer_list>
 
+#include "ao/simd/sampling_internal.h"
+
 namespace ao {
 
 namespace {
@@ -127,9 +129,8 @@ void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, flo
       r[3][k] = reverse_bits(kSobolDim3(i));
     }
   }
-  // Hash and outer reversal: shifts, masks and multiplies, all 16 lanes at once.
-  for (int d = 0; d < 4; ++d)
-    for (int k = 0; k < 16; ++k) out[d][k] = to_unit_float(reverse_bits(laine_karras(r[d][k], key[d])));
+  // Hash and outer reversal: shifts, masks and multiplies, 16 lanes at once in the SIMD kernel layer.
+  simd::owen_scramble_4x16(r, key, out);
 }
 
 Vec3 cosine_hemisphere(Vec2 u) {

@@ -1,6 +1,7 @@
 #include "ao/core/gbuffer.h"
 
 #include "ao/core/parallel.h"
+#include "ao/simd/depth_internal.h"
 
 namespace ao {
 
@@ -9,10 +10,7 @@ void depth_plane(const GBuffer& g, Image<float>& out) {
   out.resize(w, h);
   // Rows of 64 x 16 pixels: each task streams 768 bytes of positions and 256 of ids per row.
   parallel_for_tiles(w, h, 64, 16, [&](const Tile& t) {
-    for (int y = t.y0; y < t.y1; ++y) {
-      const std::size_t row = static_cast<std::size_t>(y) * w;
-      for (int x = t.x0; x < t.x1; ++x) out[row + x] = g.object_id[row + x] != 0 ? -g.position[row + x].z : kInfinity;
-    }
+    simd::depth_plane_tile(g.position.data(), g.object_id.data(), w, t.x0, t.x1, t.y0, t.y1, out.data());  // the SIMD kernel layer
   });
 }
 

@@ -11,6 +11,7 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <algorithm>
+#include <iterator>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -103,6 +104,8 @@ struct Kernel {
 
   Kernel(const VoxelGrid& grid, const ConeTables& tables) : g(grid), tb(tables), weight(1.0f / static_cast<float>(tables.cones)) {
     AO_ASSERT(tables.prism_lanes <= kMaxConePrisms && tables.cones_padded <= kMaxCones && tables.slots <= kMaxConeSlots);
+    // The bytes past the slots stay 0 (bits() reads up to 4 bytes from any slot's byte).
+    std::fill(std::begin(used), std::end(used), 0), std::fill(std::begin(wide), std::end(wide), 0), std::fill(std::begin(pass), std::end(pass), 0);
   }
 
   static bool bit(const std::uint8_t* b, int i) { return (b[static_cast<std::size_t>(i) >> 3] >> (i & 7)) & 1u; }
@@ -160,8 +163,6 @@ struct Kernel {
     const V64 ones = hn::Set(D64(), ~std::uint64_t{0});
     const bool permute = tb.cones <= lanes;  // the cones' values fit one vector: a permute per slot, else a gather
     const VH ps = hn::LoadU(dh, scale), pax = hn::LoadU(dh, ax), pay = hn::LoadU(dh, ay), paz = hn::LoadU(dh, az);
-    const std::size_t bytes = static_cast<std::size_t>(tb.slots) / 8 + 8;
-    std::fill(used, used + bytes, 0), std::fill(wide, wide + bytes, 0), std::fill(pass, pass + bytes, 0);
     for (int i = 0; i < tb.slots; i += lanes) {
       const VHI c = hn::LoadU(dhi, tb.slot_cone + i);
       VH s, cax, cay, caz;
@@ -197,10 +198,11 @@ struct Kernel {
       const V64 sh = hn::BitCast(D64(), hn::PromoteTo(di64, hn::Sub(c63, hn::Sub(ch, cl))));
       const V64 lo = hn::BitCast(D64(), hn::PromoteTo(di64, cl));
       const unsigned any = mask_bits(D64(), hn::Not(hn::Eq(hn::And((wm >> lo), (ones >> sh)), hn::Zero(D64()))));
-      const int at = i >> 3, shift = i & 7;  // `lanes` divides 8: a step's bits never straddle a byte
-      used[static_cast<std::size_t>(at)] |= static_cast<std::uint8_t>(use << shift);
-      wide[static_cast<std::size_t>(at)] |= static_cast<std::uint8_t>(wid << shift);
-      pass[static_cast<std::size_t>(at)] |= static_cast<std::uint8_t>((use & (any | wid)) << shift);
+      // `lanes` divides 8: a step's bits never straddle a byte, and the first step of a byte sets it.
+      const auto at = static_cast<std::size_t>(i >> 3);
+      const int shift = i & 7;
+      const auto put = [&](std::uint8_t* b, unsigned m) { b[at] = static_cast<std::uint8_t>((shift ? b[at] : 0u) | (m << shift)); };
+      put(used, use), put(wide, wid), put(pass, use & (any | wid));
     }
   }
 

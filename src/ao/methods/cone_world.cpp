@@ -1,7 +1,7 @@
 // Voxel cone traced AO on the world grid (Dalla Favera & Celes 2012, sec. III-C): the quantities
-// of the paper the kernel (simd::trace_cones, src/ao/simd/cone.cpp) runs with, and each pixel's
-// point and frame. See cone.h for the convention (V = 1 - the paper's blocked fraction),
-// docs/methods/cone.md (Speed) for how the kernel is laid out.
+// of the paper the kernel (simd::trace_cones, src/ao/simd/cone.cpp) runs with for every pixel. See
+// cone.h for the convention (V = 1 - the paper's blocked fraction), docs/methods/cone.md (Speed)
+// for how the kernel is laid out.
 #include <algorithm>
 #include <cmath>
 
@@ -58,12 +58,6 @@ struct WorldSampler {
   // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
   // voxel whose centre is inside) fills them.
   float near_limit() const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
-  // The voxel at world point p (false outside the grid).
-  bool solid_at(Vec3 p) const {
-    const float gx = (p.x - g.origin.x) * inv.x, gy = (p.z - g.origin.z) * inv.y, gz = (p.y - g.origin.y) * inv.z;
-    if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
-    return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
-  }
 };
 
 // The spheres of one cone, j < ns being sphere j of its chain and j = ns its filler. The chain of a
@@ -110,9 +104,10 @@ struct ConeChain {
 };
 
 // The spheres of all of a pixel's cones in one flat run of slots, i = c * per_cone + j (cone c,
-// sphere j of its chain), padded to whole vectors with slots that are never sampled: with 6 cones
-// of 6 spheres, 3 vectors of 16 instead of 6 half-empty ones per cone. Per slot: its cone and the
-// constants of its sphere in the chain.
+// sphere j of its chain), padded to a multiple of 8 with slots that are never sampled (the kernel
+// places them in vectors of 8 at most, beside 64-bit mask loads): with 6 cones of 6 spheres, 5
+// vectors of 8 instead of 6 half-empty ones per cone. Per slot: its cone and the constants of its
+// sphere in the chain.
 struct FlatSlots {
   int n = 0, padded = 0;
   simd::AlignedVector<std::int32_t> cone, sphere;
@@ -120,7 +115,7 @@ struct FlatSlots {
 
   FlatSlots(const ConeChain& q, int cones) {
     n = cones * q.per_cone;
-    padded = simd::padded(n);
+    padded = (n + simd::kConeSlotGroup - 1) / simd::kConeSlotGroup * simd::kConeSlotGroup;
     for (int i = 0; i < padded; ++i) {
       const bool real = i < n;
       const auto j = static_cast<std::size_t>(real ? i % q.per_cone : 0);  // padding: never sampled
@@ -170,37 +165,10 @@ void trace_world(const GBuffer& gb, const VoxelGrid& g, float r_max, const ConeS
   tb.axis_x = axes.x.data(), tb.axis_y = axes.y.data(), tb.axis_z = axes.z.data(), tb.axis_scale = axes.s.data();
   tb.inv_voxel = sample.inv;
 
-  const int w = gb.width(), h = gb.height();
-  const Frame basis = gb.camera.basis();
-  const Vec3 eye = gb.camera.eye;
-  const float near = sample.near_limit();
-  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
-  parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-    // The tile's covered pixels: their point in the grid's voxels, frame, pattern slot and whether
-    // they face the inside of a shell; then their V from the kernel.
-    std::array<simd::ConePixel, kTile * kTile> pixels;
-    std::array<float, kTile * kTile> v;
-    int count = 0;
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        if (!gb.covered(x, y)) {
-          out(x, y) = 1.0f;
-          continue;
-        }
-        const Vec3 pos = basis.to_world(gb.position(x, y)) + eye, n = normalize(basis.to_world(gb.normal(x, y)));
-        const Frame frame = Frame::from_normal(n);
-        simd::ConePixel& p = pixels[static_cast<std::size_t>(count++)];
-        // World (x, y, z) is the grid's (i, k, j).
-        p.gx = (pos.x - g.origin.x) * sample.inv.x, p.gy = (pos.z - g.origin.z) * sample.inv.y, p.gz = (pos.y - g.origin.y) * sample.inv.z;
-        p.t = frame.t, p.b = frame.b, p.n = frame.n;
-        p.pattern = pat.slot(x, y);
-        p.inside = faces_inside(gb, sample, x, y, pos, n, near);
-      }
-    simd::trace_cones(g, tb, pixels.data(), count, v.data());
-    int i = 0;
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x)
-        if (gb.covered(x, y)) out(x, y) = v[static_cast<std::size_t>(i++)];
+  const simd::ConeView view{gb.camera.basis(), gb.camera.eye, g.origin, sample.near_limit(), pat.period};
+  ProgressCounter counter(progress, static_cast<std::size_t>(gb.width()) * gb.height());
+  parallel_for_tiles(gb.width(), gb.height(), kTile, [&](const Tile& t) {
+    simd::trace_cones(gb, g, tb, view, t.x0, t.x1, t.y0, t.y1, out);
     counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
   });
 }

@@ -127,12 +127,12 @@ struct Kernel {
     }
   }
 
-  // The pattern's cone axes turned into the pixel's frame and into voxels.
-  void axes(const ConePixel& p) {
+  // The pattern's cone axes turned into the pixel's frame (world space) and into voxels.
+  void axes(const Frame& f, int pattern) {
     const DF d;
-    const std::size_t o = static_cast<std::size_t>(p.pattern) * tb.cones_padded;
-    const VF tx = hn::Set(d, p.t.x), ty = hn::Set(d, p.t.y), tz = hn::Set(d, p.t.z), bx = hn::Set(d, p.b.x), by = hn::Set(d, p.b.y),
-             bz = hn::Set(d, p.b.z), nx = hn::Set(d, p.n.x), ny = hn::Set(d, p.n.y), nz = hn::Set(d, p.n.z);
+    const std::size_t o = static_cast<std::size_t>(pattern) * tb.cones_padded;
+    const VF tx = hn::Set(d, f.t.x), ty = hn::Set(d, f.t.y), tz = hn::Set(d, f.t.z), bx = hn::Set(d, f.b.x), by = hn::Set(d, f.b.y),
+             bz = hn::Set(d, f.b.z), nx = hn::Set(d, f.n.x), ny = hn::Set(d, f.n.y), nz = hn::Set(d, f.n.z);
     const VF ix = hn::Set(d, tb.inv_voxel.x), iy = hn::Set(d, tb.inv_voxel.y), iz = hn::Set(d, tb.inv_voxel.z);
     for (int c = 0; c < tb.cones; c += static_cast<int>(hn::Lanes(d))) {
       const VF lx = hn::Load(d, tb.axis_x + o + c), ly = hn::Load(d, tb.axis_y + o + c), lz = hn::Load(d, tb.axis_z + o + c);
@@ -216,7 +216,7 @@ struct Kernel {
 #endif
   }
 
-  float scalar_prism(float gx, float gy, float gz, float rx, float ry, float h, float pu, float pv) const {
+  HWY_NOINLINE float scalar_prism(float gx, float gy, float gz, float rx, float ry, float h, float pu, float pv) const {
     const float fx = gx + pu * rx, fy = gy + pv * ry;
     if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return 0.0f;
     return cone_internal::solid_length(g.column(static_cast<int>(fx), static_cast<int>(fy)), g.words, g.depth_bits, gz - h, gz + h);
@@ -229,7 +229,7 @@ struct Kernel {
   // column's last 8 bytes), masks and popcount. Prisms longer than the load (k1 - k0 + sh > 63) go
   // the scalar way. The ends count by the part of their voxel inside the range (solid_length).
   // Summed in prism order.
-  float prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float hs) const {
+  HWY_INLINE float prisms(float gx, float gy, float gz, float rx, float ry, const float* h, float hs) const {
     const DH dh;
     const DHI dhi;
     const DI64 di64;
@@ -291,7 +291,7 @@ struct Kernel {
   }
 
   // For spheres wider than the largest window: the OR of every block the sphere's box touches.
-  bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
+  HWY_NOINLINE bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
     constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
     const int bx0 = std::max(0, static_cast<int>(std::floor((gx - rx) * kInvB)));
     const int bx1 = std::min(g.bnx - 1, static_cast<int>(std::floor((gx + rx) * kInvB)));
@@ -307,7 +307,7 @@ struct Kernel {
   // Obstructed fraction of slot i's sphere (sec. III-C1): prisms through its great disk's samples,
   // each spanning the sphere's chord; Monte Carlo over the disk: its volume ~ the sum of the chords,
   // its obstructed volume ~ the sum of their solid lengths.
-  float fraction(int i) const {
+  HWY_INLINE float fraction(int i) const {
     const auto si = static_cast<std::size_t>(i);
     const int k = tb.slot_sphere[i];
     const float px = cx[si], py = cy[si], pz = cz[si], r = rs[si];
@@ -344,16 +344,37 @@ struct Kernel {
 
 }  // namespace
 
-void TraceCones(const VoxelGrid& grid, const ConeTables& tables, const ConePixel* pixels, int count, float* v) {
-  if (count == 0) return;
+void TraceCones(const GBuffer& gb, const VoxelGrid& grid, const ConeTables& tables, const ConeView& view, int x0, int x1, int y0, int y1,
+                ImageView<float> out) {
+  // The voxel at a world point (false outside the grid), for the test of a shell's inside.
+  struct Solid {
+    const VoxelGrid& g;
+    const ConeView& view;
+    Vec3 inv;
+    bool solid_at(Vec3 p) const {
+      const float gx = (p.x - view.grid_origin.x) * inv.x, gy = (p.z - view.grid_origin.z) * inv.y, gz = (p.y - view.grid_origin.y) * inv.z;
+      if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
+      return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
+    }
+  } const solid{grid, view, tables.inv_voxel};
   Kernel k(grid, tables);
-  for (int i = 0; i < count; ++i) {
-    const ConePixel& p = pixels[i];
-    k.turn(tables.turn[2 * p.pattern], tables.turn[2 * p.pattern + 1]);
-    k.axes(p);
-    k.place(p.gx, p.gy, p.gz);
-    v[i] = k.visibility(p.inside);
-  }
+  const Vec3 inv = tables.inv_voxel;
+  const int period = view.pattern_period;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      if (!gb.covered(x, y)) {
+        out(x, y) = 1.0f;
+        continue;
+      }
+      const Vec3 pos = view.basis.to_world(gb.position(x, y)) + view.eye, n = normalize(view.basis.to_world(gb.normal(x, y)));
+      const Frame frame = Frame::from_normal(n);
+      const int pattern = (y & (period - 1)) * period + (x & (period - 1));
+      k.turn(tables.turn[2 * pattern], tables.turn[2 * pattern + 1]);
+      k.axes(frame, pattern);
+      // World (x, y, z) is the grid's (i, k, j).
+      k.place((pos.x - view.grid_origin.x) * inv.x, (pos.z - view.grid_origin.z) * inv.y, (pos.y - view.grid_origin.y) * inv.z);
+      out(x, y) = k.visibility(cone_internal::faces_inside(gb, solid, x, y, pos, n, view.near));
+    }
 }
 
 }  // namespace ao::simd::HWY_NAMESPACE
@@ -364,8 +385,9 @@ namespace ao::simd {
 
 HWY_EXPORT(TraceCones);
 
-void trace_cones(const VoxelGrid& grid, const ConeTables& tables, const ConePixel* pixels, int count, float* v) {
-  HWY_DYNAMIC_DISPATCH(TraceCones)(grid, tables, pixels, count, v);
+void trace_cones(const GBuffer& gb, const VoxelGrid& grid, const ConeTables& tables, const ConeView& view, int x0, int x1, int y0, int y1,
+                 ImageView<float> out) {
+  HWY_DYNAMIC_DISPATCH(TraceCones)(gb, grid, tables, view, x0, x1, y0, y1, out);
 }
 
 }  // namespace ao::simd

@@ -10,6 +10,8 @@
 
 #include <cstdint>
 
+#include "ao/core/gbuffer.h"
+#include "ao/core/image.h"
 #include "ao/core/math.h"
 #include "ao/methods/voxelize.h"
 
@@ -18,6 +20,8 @@ namespace ao::simd {
 /// The largest tables the kernel takes (ConeParams' ranges: 64 cones of 16 spheres and the filler,
 /// 64 prisms per sphere), in whole vectors.
 inline constexpr int kMaxCones = 64, kMaxConePrisms = 64, kMaxConeSlots = 64 * 17;
+/// The slots are placed in groups of this many (vectors of 64-bit lanes: 8 on AVX-512, fewer elsewhere).
+inline constexpr int kConeSlotGroup = 8;
 
 /// The tables of one call, built once (methods/cone_world.cpp says what each one is).
 struct ConeTables {
@@ -33,7 +37,8 @@ struct ConeTables {
   const float* sphere_chord = nullptr;
   const float* half_chord = nullptr;
   // Slots: the spheres of all cones of a pixel in one flat run, slot i = c * per_cone + j (cone c,
-  // lane j of the chain: spheres, then the filler), `slots` of them padded with never-sampled ones.
+  // lane j of the chain: spheres, then the filler), `slots` of them, a multiple of kConeSlotGroup,
+  // padded with never-sampled ones.
   // Per slot, affine in the cone's chain scale s: distance along the axis dist_a s + dist_b
   // (voxels along the axis' unit), radius scale min(rad_a s + rad_b, 1), sampled when
   // use_a s + use_b >= 0; the half extents of its prisms' box at radius scale 1 (x, y in window
@@ -62,21 +67,25 @@ struct ConeTables {
   Vec3 inv_voxel;  ///< 1 / voxel size along the grid's (i, j, k) = world (x, z, y).
 };
 
-/// One pixel's input: its point in voxel coordinates, its frame (world space; z along the normal),
-/// its pattern slot, and whether it faces the inside of a holed mesh's shell (cone_kernel_internal.h:
-/// its cones then count the complement of the solid).
-struct ConePixel {
-  float gx = 0, gy = 0, gz = 0;
-  Vec3 t, b, n;
-  int pattern = 0;
-  bool inside = false;
+/// How the G-buffer's pixels meet the grid: camera space to world, the grid's origin, and the
+/// per-pixel pattern.
+struct ConeView {
+  Frame basis;           ///< Camera axes in world space (Camera::basis()).
+  Vec3 eye;              ///< Camera position, world.
+  Vec3 grid_origin;      ///< World point of voxel coordinate (0, 0, 0) (VoxelGrid::origin).
+  float near = 0;        ///< World distance in front of a pixel where a shell's inside is tested (cone_kernel_internal.h: faces_inside).
+  int pattern_period = 1;  ///< ConePattern::period: pixel (x, y) takes pattern slot (y mod P) P + x mod P.
 };
 
-/// V of `count` pixels: the mean over the cones of the transmittance T after the cone's spheres,
-/// front to back, T *= 1 - f (f: a sphere's obstructed fraction, the solid length of its prisms
-/// over their chords; spheres the window masks show empty have f = 0; a cone stops at T <= 1e-4);
-/// inside a shell T *= f, and a sphere that is not sampled or shows empty closes the cone.
-/// Clamped to [0, 1].
-void trace_cones(const VoxelGrid& grid, const ConeTables& tables, const ConePixel* pixels, int count, float* v);
+/// V of the covered pixels of the tile [x0, x1) x [y0, y1) of `gb` into `out` (1 on the others):
+/// per pixel, its point in the grid and its frame from the G-buffer (world: x, y, z are the grid's
+/// i, k, j), whether it faces the inside of a holed mesh's shell (its cones then count the
+/// complement of the solid: T *= f, and a sphere that is not sampled or shows empty closes the
+/// cone), then the mean over the cones of the transmittance T after the cone's spheres, front to
+/// back, T *= 1 - f (f: a sphere's obstructed fraction, the solid length of its prisms over their
+/// chords; spheres the window masks show empty have f = 0; a cone stops at T <= 1e-4), clamped to
+/// [0, 1].
+void trace_cones(const GBuffer& gb, const VoxelGrid& grid, const ConeTables& tables, const ConeView& view, int x0, int x1, int y0, int y1,
+                 ImageView<float> out);
 
 }  // namespace ao::simd

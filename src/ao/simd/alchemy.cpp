@@ -98,104 +98,135 @@ void alchemy_row_wide(const AlchemyInputs& in, int y, int x0, int x1, float* out
   }
 }
 
+// A row segment's per-pixel values, structure of arrays: the sample loop runs sample by sample
+// across the row (the gathers of a sample's pixel vectors are independent and close in the image).
+struct Row {
+  static constexpr int kN = kMaxAlchemySegment;
+  HWY_ALIGN float cx[kN], cy[kN], cz[kN], nx[kN], ny[kN], nz[kN], bias[kN], radius_px[kN], jitter[kN], rc[kN], rs[kN], fx0[kN], sum[kN],
+      cov[kN];
+};
+
+// The row's depths, ids and normals at pixels row_start + j0 + lane: contiguous loads; the last
+// vector, past the segment of n pixels, gathers its last pixel again (valid reads; those lanes'
+// results are not written).
+HWY_INLINE void load_pixels(const AlchemyInputs& in, std::size_t row_start, int j0, int n, VI j, VF& depth, MF& covered, VF& nx, VF& ny,
+                            VF& nz) {
+  const DF d;
+  const DI di;
+  const DU du;
+  if (j0 + static_cast<int>(hn::Lanes(d)) <= n) {
+    depth = hn::LoadU(d, in.depth + row_start + j0);
+    covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::LoadU(du, in.object_id + row_start + j0), hn::Zero(du))));
+    hn::LoadInterleaved3(d, in.normal + 3 * (row_start + j0), nx, ny, nz);
+  } else {
+    const VI pixel = hn::Add(hn::Set(di, static_cast<int>(row_start)), hn::Min(j, hn::Set(di, n - 1)));
+    depth = hn::GatherIndex(d, in.depth, pixel);
+    covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::GatherIndex(du, in.object_id, pixel), hn::Zero(du))));
+    const VI p3 = hn::Mul(pixel, hn::Set(di, 3));
+    nx = hn::GatherIndex(d, in.normal, p3), ny = hn::GatherIndex(d, in.normal + 1, p3), nz = hn::GatherIndex(d, in.normal + 2, p3);
+  }
+}
+
+// Each pixel's C, normal, bias, screen radius, jitter and rotation for the segment [x0, x0 + n)
+// of row y, whole vectors up to `end`.
+HWY_INLINE void prepare_row(const AlchemyInputs& in, int y, int x0, int n, int end, Row& r) {
+  const DF d;
+  const DI di;
+  const DU du;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), half = hn::Set(d, 0.5f), offset = hn::Set(d, kCoordOffset);
+  const VF ax = hn::Set(d, in.ray_ax), bx = hn::Set(d, in.ray_bx), ay = hn::Set(d, in.ray_ay), by = hn::Set(d, in.ray_by);
+  const VF beta = hn::Set(d, in.beta), fy = hn::Set(d, static_cast<float>(y) + 0.5f);
+  // Per pixel of the whole image the seed's hash is the same: pixel_seed = hash_combine(hash_combine(hash32(seed), x), y).
+  const VU seed_hash = hn::Set(du, ao::hash32(in.seed)), row_y = hn::Set(du, static_cast<std::uint32_t>(y));
+  const VI lane = hn::Iota(di, 0);  // made once: Highway builds it through memory
+  const std::size_t row_start = static_cast<std::size_t>(y) * in.width + x0;
+  for (int j0 = 0; j0 < end; j0 += lanes) {
+    const VI j = hn::Add(lane, hn::Set(di, j0));
+    const VI x = hn::Add(hn::Set(di, x0), j);
+    VF depth, nx, ny, nz;
+    MF covered;
+    load_pixels(in, row_start, j0, n, j, depth, covered, nx, ny, nz);
+    // C from the depth buffer, as its samples (so C and its samples agree exactly on a plane);
+    // background: C = 0, its result is overwritten.
+    const VF dc = hn::IfThenElseZero(covered, depth);
+    const VF fx = hn::Add(hn::ConvertTo(d, x), half);
+    const VF vcz = hn::Neg(dc);
+    hn::Store(hn::Mul(dc, hn::MulAdd(ax, fx, bx)), d, r.cx + j0), hn::Store(hn::Mul(dc, hn::MulAdd(ay, fy, by)), d, r.cy + j0);
+    hn::Store(vcz, d, r.cz + j0);
+    hn::Store(nx, d, r.nx + j0), hn::Store(ny, d, r.ny + j0), hn::Store(nz, d, r.nz + j0);
+    // Eq. 10's z_C beta: z_C < 0, so this lowers v.n and drops samples nearly in the tangent plane
+    // (self-occlusion from imprecise normals and positions), more so far away.
+    hn::Store(hn::Mul(vcz, beta), d, r.bias + j0);
+    // Screen radius of the world disk; background has depth +inf, so radius 0.
+    hn::Store(hn::Min(hn::Set(d, in.max_pixel_radius), hn::Div(hn::Set(d, in.radius * in.px_per_unit), depth)), d, r.radius_px + j0);
+    // The pixel's jitter and rotation of the pattern, from its seed.
+    const VU hs = hash_combine(hash_combine(seed_hash, hn::BitCast(du, x)), row_y);
+    hn::Store(hn::Mul(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<8>(hs))), hn::Set(d, 0x1.0p-24f)), d, r.jitter + j0);
+    const VI ri = hn::BitCast(di, hn::And(hash32(hs), hn::Set(du, kRotationMask)));
+    hn::Store(hn::GatherIndex(d, in.rot_c, ri), d, r.rc + j0), hn::Store(hn::GatherIndex(d, in.rot_s, ri), d, r.rs + j0);
+    hn::Store(hn::Add(fx, offset), d, r.fx0 + j0);
+    hn::Store(zero, d, r.sum + j0);
+    hn::Store(hn::IfThenElseZero(covered, one), d, r.cov + j0);
+  }
+}
+
+// Eq. 10's sum over the s samples for every pixel of the prepared row (whole vectors up to `end`).
+HWY_INLINE void add_samples(const AlchemyInputs& in, int y, int end, Row& r) {
+  const DF d;
+  const DI di;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const VF zero = hn::Zero(d), half = hn::Set(d, 0.5f);
+  const VF ax = hn::Set(d, in.ray_ax), bx = hn::Set(d, in.ray_bx), ay = hn::Set(d, in.ray_ay), by = hn::Set(d, in.ray_by);
+  const VF r2 = hn::Set(d, in.radius * in.radius), eps = hn::Set(d, in.epsilon), inv_s = hn::Set(d, 1.0f / static_cast<float>(in.samples));
+  const VI ioffset = hn::Set(di, static_cast<int>(kCoordOffset)), izero = hn::Zero(di), max_ix = hn::Set(di, in.width - 1),
+           max_iy = hn::Set(di, in.height - 1), width = hn::Set(di, in.width);
+  const VF fy0 = hn::Add(hn::Set(d, static_cast<float>(y) + 0.5f), hn::Set(d, kCoordOffset));
+  for (int i = 0; i < in.samples; ++i) {
+    // Sample i lies in the i-th of s equal-area annuli (radius sqrt((i + jitter) / s)) at angle
+    // i * golden angle + the pixel's rotation: stratified, and uniform on the disk.
+    const VF pux = hn::Set(d, in.ux[i]), puy = hn::Set(d, in.uy[i]), stratum = hn::Set(d, static_cast<float>(i));
+    for (int j0 = 0; j0 < end; j0 += lanes) {
+      const VF vrc = hn::Load(d, r.rc + j0), vrs = hn::Load(d, r.rs + j0);
+      const VF rho = hn::Mul(hn::Load(d, r.radius_px + j0), sqrt_unit(hn::Mul(hn::Add(stratum, hn::Load(d, r.jitter + j0)), inv_s)));
+      const VF dx = hn::Mul(rho, hn::NegMulAdd(vrs, puy, hn::Mul(vrc, pux))), dy = hn::Mul(rho, hn::MulAdd(vrc, puy, hn::Mul(vrs, pux)));
+      // +kCoordOffset keeps the coordinate positive, so truncation is floor. Clamp-to-edge: a
+      // sample beyond the frame reads the nearest border pixel (the surfaces at the edge go on
+      // beyond it) rather than counting as empty space.
+      const VI ix = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(hn::Load(d, r.fx0 + j0), dx)), ioffset), izero), max_ix);
+      const VI iy = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(fy0, dy)), ioffset), izero), max_iy);
+      const VF dp = hn::GatherIndex(d, in.depth, hn::Add(hn::Mul(iy, width), ix));
+      const VF vx = hn::Sub(hn::Mul(dp, hn::MulAdd(ax, hn::Add(hn::ConvertTo(d, ix), half), bx)), hn::Load(d, r.cx + j0));
+      const VF vy = hn::Sub(hn::Mul(dp, hn::MulAdd(ay, hn::Add(hn::ConvertTo(d, iy), half), by)), hn::Load(d, r.cy + j0));
+      const VF vz = hn::Sub(hn::Neg(dp), hn::Load(d, r.cz + j0));
+      const VF vv = hn::MulAdd(vz, vz, hn::MulAdd(vy, vy, hn::Mul(vx, vx)));
+      const VF vn = hn::Add(hn::MulAdd(vz, hn::Load(d, r.nz + j0), hn::MulAdd(vy, hn::Load(d, r.ny + j0), hn::Mul(vx, hn::Load(d, r.nx + j0)))),
+                            hn::Load(d, r.bias + j0));
+      // Background samples (depth +inf, so vv is inf or NaN and fails vv < r^2) contribute
+      // nothing: the paper's assumption that unseen space is empty. vv < r^2 is eq. 9's H.
+      const MF use = hn::And(hn::Lt(vv, r2), hn::Gt(vn, zero));
+      hn::Store(hn::Add(hn::Load(d, r.sum + j0), hn::IfThenElseZero(use, hn::Div(vn, hn::Add(vv, eps)))), d, r.sum + j0);
+    }
+  }
+}
+
 }  // namespace
 
 void AlchemyRow(const AlchemyInputs& in, int y, int x0, int x1, float* out) {
   if (static_cast<std::size_t>(in.width) * static_cast<std::size_t>(in.height) >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     return alchemy_row_wide(in, y, x0, x1, out);
   const DF d;
-  const DI di;
-  const DU du;
-  const int lanes = static_cast<int>(hn::Lanes(d)), n = x1 - x0, w = in.width;
-  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), half = hn::Set(d, 0.5f);
-  const VF ax = hn::Set(d, in.ray_ax), bx = hn::Set(d, in.ray_bx), ay = hn::Set(d, in.ray_ay), by = hn::Set(d, in.ray_by);
-  const VF r2 = hn::Set(d, in.radius * in.radius), eps = hn::Set(d, in.epsilon), beta = hn::Set(d, in.beta), scale = hn::Set(d, in.scale);
-  const VF inv_s = hn::Set(d, 1.0f / static_cast<float>(in.samples));
-  const VF offset = hn::Set(d, kCoordOffset);
-  const VI ioffset = hn::Set(di, static_cast<int>(kCoordOffset)), izero = hn::Zero(di), max_ix = hn::Set(di, w - 1),
-           max_iy = hn::Set(di, in.height - 1), width = hn::Set(di, w);
-  // Per pixel of the whole image the seed's hash is the same: pixel_seed = hash_combine(hash_combine(hash32(seed), x), y).
-  const VU seed_hash = hn::Set(du, ao::hash32(in.seed)), row_y = hn::Set(du, static_cast<std::uint32_t>(y));
-  const VF fy = hn::Set(d, static_cast<float>(y) + 0.5f);
-  // The row's per-pixel values, structure of arrays: the sample loop below runs sample by sample
-  // across the row (the gathers of a sample's pixel vectors are independent and close in the image).
+  const int lanes = static_cast<int>(hn::Lanes(d)), n = x1 - x0;
   AO_ASSERT(n <= kMaxAlchemySegment);
-  HWY_ALIGN float cx[kMaxAlchemySegment], cy[kMaxAlchemySegment], cz[kMaxAlchemySegment], nx[kMaxAlchemySegment], ny[kMaxAlchemySegment],
-      nz[kMaxAlchemySegment], bias[kMaxAlchemySegment], radius_px[kMaxAlchemySegment], jitter[kMaxAlchemySegment], rc[kMaxAlchemySegment],
-      rs[kMaxAlchemySegment], fx0[kMaxAlchemySegment], sum[kMaxAlchemySegment], cov[kMaxAlchemySegment];
-  const VI lane = hn::Iota(di, 0);  // made once: Highway builds it through memory
   const int end = (n + lanes - 1) / lanes * lanes;
-  const std::size_t row = static_cast<std::size_t>(y) * w + x0;
-  for (int j0 = 0; j0 < end; j0 += lanes) {
-    const VI j = hn::Add(lane, hn::Set(di, j0));
-    const VI x = hn::Add(hn::Set(di, x0), j);
-    // The row's depths, ids and normals: contiguous loads; the last vector, past the segment,
-    // gathers its last pixel again (valid reads; those lanes' results are not written).
-    VF depth, nx_v, ny_v, nz_v;
-    MF covered;
-    if (j0 + lanes <= n) {
-      depth = hn::LoadU(d, in.depth + row + j0);
-      covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::LoadU(du, in.object_id + row + j0), hn::Zero(du))));
-      hn::LoadInterleaved3(d, in.normal + 3 * (row + j0), nx_v, ny_v, nz_v);
-    } else {
-      const VI pixel = hn::Add(hn::Set(di, static_cast<int>(row)), hn::Min(j, hn::Set(di, n - 1)));
-      depth = hn::GatherIndex(d, in.depth, pixel);
-      covered = hn::RebindMask(d, hn::Not(hn::Eq(hn::GatherIndex(du, in.object_id, pixel), hn::Zero(du))));
-      const VI p3 = hn::Mul(pixel, hn::Set(di, 3));
-      nx_v = hn::GatherIndex(d, in.normal, p3), ny_v = hn::GatherIndex(d, in.normal + 1, p3), nz_v = hn::GatherIndex(d, in.normal + 2, p3);
-    }
-    // C from the depth buffer, as its samples (so C and its samples agree exactly on a plane);
-    // background: C = 0, its result is overwritten.
-    const VF dc = hn::IfThenElseZero(covered, depth);
-    const VF fx = hn::Add(hn::ConvertTo(d, x), half);
-    const VF vcz = hn::Neg(dc);
-    hn::Store(hn::Mul(dc, hn::MulAdd(ax, fx, bx)), d, cx + j0), hn::Store(hn::Mul(dc, hn::MulAdd(ay, fy, by)), d, cy + j0), hn::Store(vcz, d, cz + j0);
-    hn::Store(nx_v, d, nx + j0), hn::Store(ny_v, d, ny + j0), hn::Store(nz_v, d, nz + j0);
-    // Eq. 10's z_C beta: z_C < 0, so this lowers v.n and drops samples nearly in the tangent plane
-    // (self-occlusion from imprecise normals and positions), more so far away.
-    hn::Store(hn::Mul(vcz, beta), d, bias + j0);
-    // Screen radius of the world disk; background has depth +inf, so radius 0.
-    hn::Store(hn::Min(hn::Set(d, in.max_pixel_radius), hn::Div(hn::Set(d, in.radius * in.px_per_unit), depth)), d, radius_px + j0);
-    // The pixel's jitter and rotation of the pattern, from its seed.
-    const VU hs = hash_combine(hash_combine(seed_hash, hn::BitCast(du, x)), row_y);
-    hn::Store(hn::Mul(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<8>(hs))), hn::Set(d, 0x1.0p-24f)), d, jitter + j0);
-    const VI ri = hn::BitCast(di, hn::And(hash32(hs), hn::Set(du, kRotationMask)));
-    hn::Store(hn::GatherIndex(d, in.rot_c, ri), d, rc + j0), hn::Store(hn::GatherIndex(d, in.rot_s, ri), d, rs + j0);
-    hn::Store(hn::Add(fx, offset), d, fx0 + j0);
-    hn::Store(zero, d, sum + j0);
-    hn::Store(hn::IfThenElseZero(covered, one), d, cov + j0);
-  }
-  const VF fy0 = hn::Add(fy, offset);
-  for (int i = 0; i < in.samples; ++i) {
-    // Sample i lies in the i-th of s equal-area annuli (radius sqrt((i + jitter) / s)) at angle
-    // i * golden angle + the pixel's rotation: stratified, and uniform on the disk.
-    const VF pux = hn::Set(d, in.ux[i]), puy = hn::Set(d, in.uy[i]), stratum = hn::Set(d, static_cast<float>(i));
-    for (int j0 = 0; j0 < end; j0 += lanes) {
-      const VF vrc = hn::Load(d, rc + j0), vrs = hn::Load(d, rs + j0);
-      const VF rho = hn::Mul(hn::Load(d, radius_px + j0), sqrt_unit(hn::Mul(hn::Add(stratum, hn::Load(d, jitter + j0)), inv_s)));
-      const VF dx = hn::Mul(rho, hn::NegMulAdd(vrs, puy, hn::Mul(vrc, pux))), dy = hn::Mul(rho, hn::MulAdd(vrc, puy, hn::Mul(vrs, pux)));
-      // +kCoordOffset keeps the coordinate positive, so truncation is floor. Clamp-to-edge: a
-      // sample beyond the frame reads the nearest border pixel (the surfaces at the edge go on
-      // beyond it) rather than counting as empty space.
-      const VI ix = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(hn::Load(d, fx0 + j0), dx)), ioffset), izero), max_ix);
-      const VI iy = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(fy0, dy)), ioffset), izero), max_iy);
-      const VF dp = hn::GatherIndex(d, in.depth, hn::Add(hn::Mul(iy, width), ix));
-      const VF vx = hn::Sub(hn::Mul(dp, hn::MulAdd(ax, hn::Add(hn::ConvertTo(d, ix), half), bx)), hn::Load(d, cx + j0));
-      const VF vy = hn::Sub(hn::Mul(dp, hn::MulAdd(ay, hn::Add(hn::ConvertTo(d, iy), half), by)), hn::Load(d, cy + j0));
-      const VF vz = hn::Sub(hn::Neg(dp), hn::Load(d, cz + j0));
-      const VF vv = hn::MulAdd(vz, vz, hn::MulAdd(vy, vy, hn::Mul(vx, vx)));
-      const VF vn = hn::Add(hn::MulAdd(vz, hn::Load(d, nz + j0), hn::MulAdd(vy, hn::Load(d, ny + j0), hn::Mul(vx, hn::Load(d, nx + j0)))),
-                            hn::Load(d, bias + j0));
-      // Background samples (depth +inf, so vv is inf or NaN and fails vv < r^2) contribute
-      // nothing: the paper's assumption that unseen space is empty. vv < r^2 is eq. 9's H.
-      const MF use = hn::And(hn::Lt(vv, r2), hn::Gt(vn, zero));
-      hn::Store(hn::Add(hn::Load(d, sum + j0), hn::IfThenElseZero(use, hn::Div(vn, hn::Add(vv, eps)))), d, sum + j0);
-    }
-  }
+  Row r;
+  prepare_row(in, y, x0, n, end, r);
+  add_samples(in, y, end, r);
+  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), scale = hn::Set(d, in.scale);
   HWY_ALIGN float v[kMaxLanes];
   for (int j0 = 0; j0 < n; j0 += lanes) {
-    const VF a = hn::Max(hn::NegMulAdd(scale, hn::Load(d, sum + j0), one), zero);  // eq. 10 before ^k
-    hn::Store(hn::IfThenElse(hn::Gt(hn::Load(d, cov + j0), zero), a, one), d, v);
+    const VF a = hn::Max(hn::NegMulAdd(scale, hn::Load(d, r.sum + j0), one), zero);  // eq. 10 before ^k
+    hn::Store(hn::IfThenElse(hn::Gt(hn::Load(d, r.cov + j0), zero), a, one), d, v);
     for (int k = 0; k < std::min(lanes, n - j0); ++k) out[j0 + k] = v[k];
   }
 }

@@ -187,7 +187,7 @@ struct Kernel {
       const VH ex = hn::MulAdd(hn::LoadU(dh, tb.box_x + i), r, margin_c), ey = hn::MulAdd(hn::LoadU(dh, tb.box_y + i), r, margin_c);
       const VH ez = hn::MulAdd(hn::LoadU(dh, tb.box_z + i), r, margin_z);
       const VH pxc = hn::Mul(px, quarter), pyc = hn::Mul(py, quarter);
-      const auto cell = [&](VH a, VH hi) { return truncate_in_range_h(hn::Min(hn::Max(a, zero), hi)); };
+      const auto cell = [&](VH a, VH hi) { return truncate_in_range(hn::Min(hn::Max(a, zero), hi)); };
       const VHI x0 = cell(hn::Sub(pxc, ex), fdnx), x1 = cell(hn::Add(pxc, ex), fdnx);
       const VHI y0 = cell(hn::Sub(pyc, ey), fdny), y1 = cell(hn::Add(pyc, ey), fdny);
       const VHI cl = hn::ShiftRightSame(cell(hn::Sub(pz, ez), fbits), g.cell_shift), ch = hn::ShiftRightSame(cell(hn::Add(pz, ez), fbits), g.cell_shift);
@@ -204,16 +204,6 @@ struct Kernel {
       const auto put = [&](std::uint8_t* b, unsigned m) { b[at] = static_cast<std::uint8_t>((shift ? b[at] : 0u) | (m << shift)); };
       put(used, use), put(wide, wid), put(pass, use & (any | wid));
     }
-  }
-
-  static VHI truncate_in_range_h(VH v) {
-#if HWY_TARGET <= HWY_AVX3
-    return VHI{_mm256_cvttps_epi32(v.raw)};
-#elif HWY_TARGET <= HWY_AVX2
-    return VHI{_mm_cvttps_epi32(v.raw)};
-#else
-    return hn::ConvertTo(DHI(), v);
-#endif
   }
 
   HWY_NOINLINE float scalar_prism(float gx, float gy, float gz, float rx, float ry, float h, float pu, float pv) const {
@@ -251,10 +241,10 @@ struct Kernel {
       const auto in_range = hn::And(inside, hn::Gt(zhi, zlo));
       // Lanes out of range read column 0 (their length is 0).
       const auto ok_i = hn::RebindMask(dhi, in_range);
-      const VHI ix = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, fx)));
-      const VHI iy = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, fy)));
-      const VHI k0 = hn::IfThenElseZero(ok_i, truncate_in_range_h(hn::IfThenElseZero(in_range, zlo)));
-      const VHI k1 = hn::IfThenElseZero(ok_i, hn::Min(truncate_in_range_h(hn::IfThenElseZero(in_range, zhi)), last_bit));
+      const VHI ix = hn::IfThenElseZero(ok_i, truncate_in_range(hn::IfThenElseZero(in_range, fx)));
+      const VHI iy = hn::IfThenElseZero(ok_i, truncate_in_range(hn::IfThenElseZero(in_range, fy)));
+      const VHI k0 = hn::IfThenElseZero(ok_i, truncate_in_range(hn::IfThenElseZero(in_range, zlo)));
+      const VHI k1 = hn::IfThenElseZero(ok_i, hn::Min(truncate_in_range(hn::IfThenElseZero(in_range, zhi)), last_bit));
       const VHI byte = hn::Min(hn::ShiftRight<3>(k0), last_byte);
       const VHI sh = hn::Sub(k0, hn::ShiftLeft<3>(byte)), n = hn::Sub(k1, k0);
       const auto wide_i = hn::And(ok_i, hn::Gt(hn::Add(sh, n), c63));

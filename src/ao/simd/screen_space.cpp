@@ -90,38 +90,33 @@ struct StepOffsets {
   const float* at(int i, int j) const { return &xyz[3 * (i * kMaxSteps + j - 1)]; }
 };
 
-}  // namespace
-
-void LoadCoveredPixels(CoveredPixels& row, const GBuffer& g, int y, int first, int last, const Rotations16& rotations, float bias_world,
-                       bool frame) {
-  const DF d;
-  const DI di;
-  const int n = last - first, cap = padded(n);
-  row.y = y, row.x0 = first;
-  for (AlignedVector<float>* v : {&row.px, &row.py, &row.pz, &row.nx, &row.ny, &row.nz, &row.rc, &row.rs, &row.bias})
-    v->resize(static_cast<std::size_t>(cap));
-  if (frame)
-    for (AlignedVector<float>* v : {&row.tx, &row.ty, &row.tz, &row.bx, &row.by, &row.bz}) v->resize(static_cast<std::size_t>(cap));
-  row.index.resize(static_cast<std::size_t>(cap));
-  // Compaction: the covered pixels' offsets (branch-free); the padding entries read pixel 0 of the
-  // segment and are replaced by the dummy point below.
+// Compaction of row y's segment [first, last) to its covered pixels (branch-free): their offsets
+// in row.index, the padding entries up to a whole vector 0. Returns the padded count.
+int compact_row(CoveredPixels& row, const GBuffer& g, int y, int first, int last) {
   int* idx = row.index.data();
   const std::uint32_t* id = &g.object_id(first, y);
   int m = 0;
-  for (int j = 0; j < n; ++j) {
+  for (int j = 0; j < last - first; ++j) {
     idx[m] = j;
     m += id[j] != 0 ? 1 : 0;
   }
   row.count = m;
   const int end = padded(m);
   std::fill(idx + m, idx + end, 0);
-  // Their data gathered across entries (positions and normals are 12-byte AoS records); the row's
-  // rotations repeat every 4 pixels.
-  const float* pos = &g.position(first, y).x;
-  const float* nrm = &g.normal(first, y).x;
-  const VI three = hn::Set(di, 3), rot_row = hn::Set(di, (y & 3) * 4), x_first = hn::Set(di, first);
+  return end;
+}
+
+// The entries' positions, normals and rotations gathered across entries (positions and normals are
+// 12-byte AoS records; the row's rotations repeat every 4 pixels). The padding entries read pixel 0
+// of the segment and are replaced by a harmless point: one unit in front of the camera, facing it.
+void gather_entries(CoveredPixels& row, const GBuffer& g, int end, const Rotations16& rotations) {
+  const DF d;
+  const DI di;
+  const float* pos = &g.position(row.x0, row.y).x;
+  const float* nrm = &g.normal(row.x0, row.y).x;
+  const VI three = hn::Set(di, 3), rot_row = hn::Set(di, (row.y & 3) * 4), x_first = hn::Set(di, row.x0);
   for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
-    const VI j = hn::Load(di, idx + k0), j3 = hn::Mul(j, three);
+    const VI j = hn::Load(di, row.index.data() + k0), j3 = hn::Mul(j, three);
     hn::Store(hn::GatherIndex(d, pos, j3), d, row.px.data() + k0);
     hn::Store(hn::GatherIndex(d, pos + 1, j3), d, row.py.data() + k0);
     hn::Store(hn::GatherIndex(d, pos + 2, j3), d, row.pz.data() + k0);
@@ -132,31 +127,41 @@ void LoadCoveredPixels(CoveredPixels& row, const GBuffer& g, int y, int first, i
     hn::Store(hn::GatherIndex(d, rotations.c, r), d, row.rc.data() + k0);
     hn::Store(hn::GatherIndex(d, rotations.s, r), d, row.rs.data() + k0);
   }
-  for (int k = m; k < end; ++k) {  // the harmless point: one unit in front of the camera, facing it
+  for (int k = row.count; k < end; ++k) {
     row.px[k] = row.py[k] = 0.0f, row.pz[k] = -1.0f;
     row.nx[k] = row.ny[k] = 0.0f, row.nz[k] = 1.0f;
     row.rc[k] = 1.0f, row.rs[k] = 0.0f;
   }
+}
+
+// The entries' depth bias: bias_world where it is > 0, else a pixel's footprint at the entry's
+// depth times (1 + tan theta_v).
+void set_bias(CoveredPixels& row, const GBuffer& g, int end, float bias_world) {
+  const DF d;
   if (bias_world > 0) {
     std::fill(row.bias.begin(), row.bias.begin() + end, bias_world);
-  } else {
-    // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
-    const VF footprint = hn::Set(d, 2.0f * g.camera.tan_half_fov() / static_cast<float>(g.height()));
-    const VF one = hn::Set(d, 1.0f), zero = hn::Zero(d), min_cos = hn::Set(d, 0.124f);  // cos 82.9 deg: tan <= 8
-    for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
-      const VF px = hn::Load(d, row.px.data() + k0), py = hn::Load(d, row.py.data() + k0), pz = hn::Load(d, row.pz.data() + k0);
-      const VF nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
-      // tan theta_v from N and the unit view direction u = p / |p| (p itself when |p| = 0).
-      const VF len = hn::Sqrt(hn::MulAdd(pz, pz, hn::MulAdd(py, py, hn::Mul(px, px))));
-      const MF positive = hn::Gt(len, zero);
-      const VF ux = hn::IfThenElse(positive, hn::Div(px, len), px), uy = hn::IfThenElse(positive, hn::Div(py, len), py);
-      const VF uz = hn::IfThenElse(positive, hn::Div(pz, len), pz);
-      const VF cos_v = hn::Max(hn::Abs(hn::MulAdd(nz, uz, hn::MulAdd(ny, uy, hn::Mul(nx, ux)))), min_cos);
-      const VF tan_v = hn::Div(hn::Sqrt(hn::NegMulAdd(cos_v, cos_v, one)), cos_v);
-      hn::Store(hn::Mul(hn::Mul(footprint, hn::Neg(pz)), hn::Add(one, tan_v)), d, row.bias.data() + k0);
-    }
+    return;
   }
-  if (!frame) return;
+  // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
+  const VF footprint = hn::Set(d, 2.0f * g.camera.tan_half_fov() / static_cast<float>(g.height()));
+  const VF one = hn::Set(d, 1.0f), zero = hn::Zero(d), min_cos = hn::Set(d, 0.124f);  // cos 82.9 deg: tan <= 8
+  for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
+    const VF px = hn::Load(d, row.px.data() + k0), py = hn::Load(d, row.py.data() + k0), pz = hn::Load(d, row.pz.data() + k0);
+    const VF nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
+    // tan theta_v from N and the unit view direction u = p / |p| (p itself when |p| = 0).
+    const VF len = hn::Sqrt(hn::MulAdd(pz, pz, hn::MulAdd(py, py, hn::Mul(px, px))));
+    const MF positive = hn::Gt(len, zero);
+    const VF ux = hn::IfThenElse(positive, hn::Div(px, len), px), uy = hn::IfThenElse(positive, hn::Div(py, len), py);
+    const VF uz = hn::IfThenElse(positive, hn::Div(pz, len), pz);
+    const VF cos_v = hn::Max(hn::Abs(hn::MulAdd(nz, uz, hn::MulAdd(ny, uy, hn::Mul(nx, ux)))), min_cos);
+    const VF tan_v = hn::Div(hn::Sqrt(hn::NegMulAdd(cos_v, cos_v, one)), cos_v);
+    hn::Store(hn::Mul(hn::Mul(footprint, hn::Neg(pz)), hn::Add(one, tan_v)), d, row.bias.data() + k0);
+  }
+}
+
+// The entries' rotated frames T', B' about their normals.
+void rotate_frames(CoveredPixels& row, int end) {
+  const DF d;
   const VF one = hn::Set(d, 1.0f), minus_one = hn::Set(d, -1.0f);
   for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
     const VF nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
@@ -176,6 +181,22 @@ void LoadCoveredPixels(CoveredPixels& row, const GBuffer& g, int y, int first, i
     hn::Store(hn::NegMulAdd(fty, rs, hn::Mul(fby, rc)), d, row.by.data() + k0);
     hn::Store(hn::NegMulAdd(ftz, rs, hn::Mul(fbz, rc)), d, row.bz.data() + k0);
   }
+}
+
+}  // namespace
+
+void LoadCoveredPixels(CoveredPixels& row, const GBuffer& g, int y, int first, int last, const Rotations16& rotations, float bias_world,
+                       bool frame) {
+  const auto cap = static_cast<std::size_t>(padded(last - first));
+  row.y = y, row.x0 = first;
+  for (AlignedVector<float>* v : {&row.px, &row.py, &row.pz, &row.nx, &row.ny, &row.nz, &row.rc, &row.rs, &row.bias}) v->resize(cap);
+  if (frame)
+    for (AlignedVector<float>* v : {&row.tx, &row.ty, &row.tz, &row.bx, &row.by, &row.bz}) v->resize(cap);
+  row.index.resize(cap);
+  const int end = compact_row(row, g, y, first, last);
+  gather_entries(row, g, end, rotations);
+  set_bias(row, g, end, bias_world);
+  if (frame) rotate_frames(row, end);
 }
 
 void CountOpenRays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, float* open) {
@@ -248,109 +269,130 @@ void SumFreePipes(const CoveredPixels& row, const DepthPlane& plane, float half_
   }
 }
 
+namespace {
+
+// An RGB value per blocked lane (a~, or Ld~): with a palette `id` holds palette indices and the
+// exact R, G, B planes of its 32 entries are looked up; else `id` holds pixels and the RGB image is
+// read at them (free rays read nothing where the target has masked gathers).
+HWY_INLINE void blocked_rgb(const float* palette, VI id, MF blocked, const float* image, VF& r, VF& g, VF& b) {
+  if (palette) {
+    r = lookup32(palette, id), g = lookup32(palette + 32, id), b = lookup32(palette + 64, id);
+  } else {
+    const VI a = hn::Mul(id, hn::Set(DI(), 3));
+    r = gather_where(blocked, image, a), g = gather_where(blocked, image + 1, a), b = gather_where(blocked, image + 2, a);
+  }
+}
+
+// Ray i of a vector of entries (sec. 4): whether any of its m test points is occluded (`blocked`),
+// and the nearest occluded one's palette index (with `in.packed`) or pixel (`at`). Steps run from
+// the far end inwards, each occluded one overwriting `at`.
+HWY_INLINE void nearest_occluder(const Entries& e, const Plane& pl, const StepOffsets& offsets, int i, int m, VF far, const TransferInputs& in,
+                                 VI& at, MF& blocked) {
+  const DF d;
+  const DI di;
+  const DU du;
+  const VF zero = hn::Zero(d), minus_bias = hn::Neg(e.bias), exactness = hn::Set(d, 0x1p-16f);
+  const VU palette_mask = hn::Set(du, kPaletteMask);
+  at = hn::Zero(di);
+  blocked = hn::MaskFromVec(zero);
+  for (int j = m; j >= 1; --j) {
+    const float* o = offsets.at(i, j);
+    VF qx, qy, qz;
+    e.point(o[0], o[1], o[2], qx, qy, qz);
+    const VI pixel = pl.pixel(qx, qy, qz);
+    const MF valid = hn::Lt(qz, zero);  // only points behind the camera are free
+    VF dist;  // z* - depth(p)
+    VI id = pixel;
+    if (in.packed) {
+      // One gather brings z* and the pixel's palette index. z* with its low mantissa bits cleared
+      // is within 2^-18 of the true depth (relative); only when a comparison below is closer than
+      // 2^-16 of the magnitudes involved can it differ, and then the true depth is gathered for
+      // those lanes: the tests stay exact.
+      const VU bits = gather_where(hn::RebindMask(du, valid), in.packed, pixel);
+      const VF z_near = hn::BitCast(d, hn::AndNot(palette_mask, bits));
+      dist = hn::Add(z_near, qz);
+      const VF margin = hn::Mul(hn::Add(z_near, hn::Abs(qz)), exactness);
+      const MF close = hn::And(valid, hn::Or(hn::Lt(hn::Abs(hn::Sub(dist, minus_bias)), margin), hn::Lt(hn::Abs(hn::Sub(dist, far)), margin)));
+      if (!hn::AllFalse(d, close)) dist = hn::IfThenElse(close, hn::Add(gather_where(close, pl.depth, pixel), qz), dist);
+      id = hn::BitCast(di, hn::And(bits, palette_mask));
+    } else {
+      dist = hn::Add(gather_where(valid, pl.depth, pixel), qz);
+    }
+    // AT 4.3: occluded only when the surface in front is less than R in front.
+    const MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+    at = hn::IfThenElse(hn::RebindMask(di, occluded), id, at);
+    blocked = hn::Or(blocked, occluded);
+  }
+}
+
+// A vector of entries' sums over their rays: sum I, sum (1 - I) a~ and (radiance mode) sum (1 - I) Ld~.
+struct TransferSums {
+  VF open, lr, lg, lb, gr, gg, gb;
+};
+
+// Eq. 9, and O = sum I / n (eq. 5), stored and copied out to the entries k0.. of `row` (cheaper
+// than a scatter, which is microcoded on current cores).
+template <bool kDirect>
+HWY_INLINE void store_transfer(const TransferSums& t, float n, const TransferInputs& in, const CoveredPixels& row, int k0, std::size_t row_base,
+                               const TransferOutputs& out) {
+  const DF d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), nv = hn::Set(d, n), scale = hn::Set(d, in.albedo_scale);
+  HWY_ALIGN float wr[kMaxLanes], wg[kMaxLanes], wb[kMaxLanes], wo[kMaxLanes];
+  if constexpr (kDirect) {
+    // (sum I + scale sum (1 - I) Ld~) / (n - scale sum (1 - I) a~), 0 unless both are > 0, not
+    // clamped: lit occluders can send more than the sky would.
+    const auto ratio = [&](VF lost, VF gain) {
+      const VF num = hn::MulAdd(scale, gain, t.open), den = hn::NegMulAdd(scale, lost, nv);
+      return hn::IfThenElseZero(hn::And(hn::Gt(num, zero), hn::Gt(den, zero)), hn::Div(num, den));
+    };
+    hn::Store(ratio(t.lr, t.gr), d, wr), hn::Store(ratio(t.lg, t.gg), d, wg), hn::Store(ratio(t.lb, t.gb), d, wb);
+  } else {
+    // The denominator is >= sum I since a~ <= 1; with no open ray at all W = 0.
+    const MF lit = hn::Gt(t.open, zero);
+    const auto ratio = [&](VF lost) { return hn::IfThenElseZero(lit, hn::Min(hn::Div(t.open, hn::NegMulAdd(scale, lost, nv)), one)); };
+    hn::Store(ratio(t.lr), d, wr), hn::Store(ratio(t.lg), d, wg), hn::Store(ratio(t.lb), d, wb);
+  }
+  hn::Store(hn::Div(t.open, nv), d, wo);
+  for (int k = 0; k < std::min(lanes, row.count - k0); ++k) {
+    const std::size_t at_pixel = row_base + static_cast<std::size_t>(row.index[static_cast<std::size_t>(k0 + k)]);
+    if (out.rgb) {  // the final images directly: W interleaved, its luminance in out.r
+      out.rgb[at_pixel] = Vec3{wr[k], wg[k], wb[k]}, out.r[at_pixel] = luminance(wr[k], wg[k], wb[k]), out.o[at_pixel] = wo[k];
+    } else {
+      out.r[at_pixel] = wr[k], out.g[at_pixel] = wg[k], out.b[at_pixel] = wb[k], out.o[at_pixel] = wo[k];
+    }
+  }
+}
+
+}  // namespace
+
 template <bool kDirect>
 void TransferRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, const TransferInputs& in,
                       std::size_t row_base, const TransferOutputs& out) {
   const DF d;
-  const DI di;
-  const DU du;
   const Plane pl(plane);
   const StepOffsets offsets(s, m);
   const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), far = hn::Set(d, far_limit);
-  const VU palette_mask = hn::Set(du, kPaletteMask);
-  const VF exactness = hn::Set(d, 0x1p-16f);
-  const VI three = hn::Set(di, 3);
-  const std::uint32_t* packed = in.packed;
-  const float n = static_cast<float>(s.n);
-  // An RGB value per blocked lane (a~, or Ld~): with a palette `id` holds palette indices and the
-  // exact R, G, B planes of its 32 entries are looked up; else `id` holds pixels and the RGB image
-  // is read at them (free rays read nothing where the target has masked gathers).
-  const auto blocked_rgb = [&](bool by_palette, VI id, MF blocked, const float* image, VF& r, VF& g, VF& b) {
-    if (by_palette) {
-      r = lookup32(in.palette, id), g = lookup32(in.palette + 32, id), b = lookup32(in.palette + 64, id);
-    } else {
-      const VI a = hn::Mul(id, three);
-      r = gather_where(blocked, image, a), g = gather_where(blocked, image + 1, a), b = gather_where(blocked, image + 2, a);
-    }
-  };
-  const int lanes = static_cast<int>(hn::Lanes(d));
-  HWY_ALIGN float wr[kMaxLanes], wg[kMaxLanes], wb[kMaxLanes], wo[kMaxLanes];
-  for (int k0 = 0; k0 < row.count; k0 += lanes) {
+  for (int k0 = 0; k0 < row.count; k0 += static_cast<int>(hn::Lanes(d))) {
     const Entries e(row, k0);
-    const VF minus_bias = hn::Neg(e.bias);
-    VF open = zero, lr = zero, lg = zero, lb = zero;
-    VF gr = zero, gg = zero, gb = zero;  // sum (1 - I) Ld~ (kDirect)
+    TransferSums t{zero, zero, zero, zero, zero, zero, zero};
     for (int i = 0; i < s.n; ++i) {
-      // Sec. 4: the nearest occluded test wins; steps run from the far end inwards, each occluded
-      // one overwriting `at`: the palette index with `packed`, else the occluder's pixel.
-      VI at = hn::Zero(di);
-      MF blocked = hn::MaskFromVec(zero);
-      for (int j = m; j >= 1; --j) {
-        const float* o = offsets.at(i, j);
-        VF qx, qy, qz;
-        e.point(o[0], o[1], o[2], qx, qy, qz);
-        const VI pixel = pl.pixel(qx, qy, qz);
-        const MF valid = hn::Lt(qz, zero);  // only points behind the camera are free
-        VF dist;  // z* - depth(p)
-        VI id = pixel;
-        if (packed) {
-          // One gather brings z* and the pixel's palette index. z* with its low mantissa bits
-          // cleared is within 2^-18 of the true depth (relative); only when a comparison below is
-          // closer than 2^-16 of the magnitudes involved can it differ, and then the true depth is
-          // gathered for those lanes: the tests stay exact.
-          const VU bits = gather_where(hn::RebindMask(du, valid), packed, pixel);
-          const VF z_near = hn::BitCast(d, hn::AndNot(palette_mask, bits));
-          dist = hn::Add(z_near, qz);
-          const VF margin = hn::Mul(hn::Add(z_near, hn::Abs(qz)), exactness);
-          const MF close = hn::And(valid, hn::Or(hn::Lt(hn::Abs(hn::Sub(dist, minus_bias)), margin), hn::Lt(hn::Abs(hn::Sub(dist, far)), margin)));
-          if (!hn::AllFalse(d, close)) dist = hn::IfThenElse(close, hn::Add(gather_where(close, pl.depth, pixel), qz), dist);
-          id = hn::BitCast(di, hn::And(bits, palette_mask));
-        } else {
-          dist = hn::Add(gather_where(valid, pl.depth, pixel), qz);
-        }
-        // AT 4.3: occluded only when the surface in front is less than R in front.
-        const MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
-        at = hn::IfThenElse(hn::RebindMask(di, occluded), id, at);
-        blocked = hn::Or(blocked, occluded);
-      }
-      open = hn::IfThenElse(blocked, open, hn::Add(open, one));
+      VI at;
+      MF blocked;
+      nearest_occluder(e, pl, offsets, i, m, far, in, at, blocked);
+      t.open = hn::IfThenElse(blocked, t.open, hn::Add(t.open, one));
       VF ar, ag, ab;
-      blocked_rgb(packed != nullptr, at, blocked, in.albedo, ar, ag, ab);
+      blocked_rgb(in.packed ? in.palette : nullptr, at, blocked, in.albedo, ar, ag, ab);
       // (1 - I) a~ of eq. 9's denominator.
-      lr = add_where(blocked, lr, ar), lg = add_where(blocked, lg, ag), lb = add_where(blocked, lb, ab);
+      t.lr = add_where(blocked, t.lr, ar), t.lg = add_where(blocked, t.lg, ag), t.lb = add_where(blocked, t.lb, ab);
       if constexpr (kDirect) {
         // (1 - I) Ld~ in the numerator of eq. 9' (docs/methods/transfer.md), at the same occluder pixel.
         VF dr, dg, db;
-        blocked_rgb(false, at, blocked, in.direct, dr, dg, db);
-        gr = add_where(blocked, gr, dr), gg = add_where(blocked, gg, dg), gb = add_where(blocked, gb, db);
+        blocked_rgb(nullptr, at, blocked, in.direct, dr, dg, db);
+        t.gr = add_where(blocked, t.gr, dr), t.gg = add_where(blocked, t.gg, dg), t.gb = add_where(blocked, t.gb, db);
       }
     }
-    // Eq. 9, and O = sum I / n (eq. 5), stored and copied out to the entries' pixels (cheaper than
-    // a scatter, which is microcoded on current cores).
-    const VF nv = hn::Set(d, n), scale = hn::Set(d, in.albedo_scale);
-    if constexpr (kDirect) {
-      // (sum I + scale sum (1 - I) Ld~) / (n - scale sum (1 - I) a~), 0 unless both are > 0, not
-      // clamped: lit occluders can send more than the sky would.
-      const auto ratio = [&](VF lost, VF gain) {
-        const VF num = hn::MulAdd(scale, gain, open), den = hn::NegMulAdd(scale, lost, nv);
-        return hn::IfThenElseZero(hn::And(hn::Gt(num, zero), hn::Gt(den, zero)), hn::Div(num, den));
-      };
-      hn::Store(ratio(lr, gr), d, wr), hn::Store(ratio(lg, gg), d, wg), hn::Store(ratio(lb, gb), d, wb);
-    } else {
-      // The denominator is >= sum I since a~ <= 1; with no open ray at all W = 0.
-      const MF lit = hn::Gt(open, zero);
-      const auto ratio = [&](VF lost) { return hn::IfThenElseZero(lit, hn::Min(hn::Div(open, hn::NegMulAdd(scale, lost, nv)), one)); };
-      hn::Store(ratio(lr), d, wr), hn::Store(ratio(lg), d, wg), hn::Store(ratio(lb), d, wb);
-    }
-    hn::Store(hn::Div(open, nv), d, wo);
-    for (int k = 0; k < std::min(lanes, row.count - k0); ++k) {
-      const std::size_t at_pixel = row_base + static_cast<std::size_t>(row.index[static_cast<std::size_t>(k0 + k)]);
-      if (out.rgb) {  // the final images directly: W interleaved, its luminance in out.r
-        out.rgb[at_pixel] = Vec3{wr[k], wg[k], wb[k]}, out.r[at_pixel] = luminance(wr[k], wg[k], wb[k]), out.o[at_pixel] = wo[k];
-      } else {
-        out.r[at_pixel] = wr[k], out.g[at_pixel] = wg[k], out.b[at_pixel] = wb[k], out.o[at_pixel] = wo[k];
-      }
-    }
+    store_transfer<kDirect>(t, static_cast<float>(s.n), in, row, k0, row_base, out);
   }
 }
 

@@ -27,17 +27,24 @@ using VU = hn::Vec<DU>;
 using MF = hn::Mask<DF>;
 
 /// float -> int32 by truncation for values known to lie in int32's range (clamped pixel and voxel
-/// coordinates): the instruction alone, without Highway's fix-up of out-of-range lanes.
-HWY_INLINE VI truncate_in_range(VF v) {
-#if HWY_TARGET <= HWY_AVX3
-  return VI{_mm512_cvttps_epi32(v.raw)};
-#elif HWY_TARGET <= HWY_AVX2
-  return VI{_mm256_cvttps_epi32(v.raw)};
-#elif HWY_TARGET <= HWY_SSSE3
-  return VI{_mm_cvttps_epi32(v.raw)};
-#else
-  return hn::ConvertTo(DI(), v);
+/// coordinates), for full or partial vectors of floats: the instruction alone, without Highway's
+/// fix-up of out-of-range lanes.
+template <class V>
+HWY_INLINE auto truncate_in_range(V v) {
+  using DS = hn::RebindToSigned<hn::DFromV<V>>;
+#if HWY_TARGET <= HWY_SSSE3
+  using R = hn::Vec<DS>;
 #endif
+#if HWY_TARGET <= HWY_AVX3
+  if constexpr (sizeof(v.raw) == 64) return R{_mm512_cvttps_epi32(v.raw)};
+#endif
+#if HWY_TARGET <= HWY_AVX2
+  if constexpr (sizeof(v.raw) == 32) return R{_mm256_cvttps_epi32(v.raw)};
+#endif
+#if HWY_TARGET <= HWY_SSSE3
+  if constexpr (sizeof(v.raw) == 16) return R{_mm_cvttps_epi32(v.raw)};
+#endif
+  return hn::ConvertTo(DS(), v);
 }
 
 /// table[index] for a table of 32 floats (index in [0, 32)): two in-register permutes where the

@@ -9,10 +9,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <string>
 
+#include "ao/bake/histogram.h"
+#include "ao/bake/texel_coverage.h"
 #include "ao/core/error.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/bilateral.h"
@@ -166,6 +169,39 @@ TEST(SimdTargets, FiltersAgreeBetweenTargets) {
         EXPECT_LE(d.max, kRounding) << name << " on " << targets[k];
       }
     }
+  }
+}
+
+// The G-buffer's and the outside-in baker's kernels are scalar code compiled once per target
+// without contraction (ao/simd/gbuffer.cpp, histogram.cpp): every target gives the same bits.
+TEST(SimdTargets, GBufferAndHistogramBakeAreTheSameBitsOnEveryTarget) {
+  const TargetGuard guard;
+  Scene scene = make_builtin_scene("default");
+  // Planar UVs from x and z over the scene's box (overlapping charts: the baker only warns).
+  const Bounds3 box = scene.bounds();
+  const Vec3 size = box.hi - box.lo;
+  for (Mesh& m : scene.meshes) {
+    m.uvs.clear();
+    for (const Vec3& p : m.positions) m.uvs.push_back(Vec2{(p.x - box.lo.x) / size.x, (p.z - box.lo.z) / size.z});
+  }
+  const RayScene rays(scene);
+  Camera c = *scene.preferred_view;
+  c.width = 123, c.height = 77;
+  const TexelCoverage coverage = compute_texel_coverage(scene, 48);
+  const std::vector<std::string> targets = simd_targets();
+  auto same = [](const auto& a, const auto& b) { return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(*a.data())) == 0; };
+  set_simd_target(targets.front());
+  const GBuffer best = render_gbuffer(rays, c);
+  const BakeResult best_bake = bake_histogram(scene, coverage, {.directions = 24});
+  ASSERT_GT(best_bake.fragments, 1000u) << "the bake sees the scene";
+  ASSERT_GT(std::count(best.object_id.data(), best.object_id.data() + best.object_id.size(), 0u), 0) << "background too";
+  for (std::size_t k = 1; k < targets.size(); ++k) {
+    set_simd_target(targets[k]);
+    const GBuffer g = render_gbuffer(rays, c);
+    EXPECT_TRUE(same(g.position, best.position) && same(g.normal, best.normal) && same(g.albedo, best.albedo) && same(g.uv, best.uv) &&
+                same(g.object_id, best.object_id) && same(g.primitive_id, best.primitive_id))
+        << "G-buffer on " << targets[k];
+    EXPECT_TRUE(same(bake_histogram(scene, coverage, {.directions = 24}).visibility, best_bake.visibility)) << "histogram bake on " << targets[k];
   }
 }
 

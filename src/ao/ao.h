@@ -44,7 +44,7 @@
 #include "ao/methods/cone.h"
 #include "ao/methods/containment.h"
 #include "ao/methods/interleave.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/methods/samples.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"

@@ -1,4 +1,4 @@
-// ao compare: the command-line shell of the comparison pipeline (ao/eval/compare.h): parses the
+// ao compare: the command-line shell of the comparison pipeline (ao/jobs/compare.h): parses the
 // options, renders the G-buffer, calls compare_methods, and writes its table (Markdown and JSON),
 // the contact sheet and optionally the sweep. docs/compare.md.
 #include <algorithm>
@@ -14,13 +14,13 @@
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
-#include "ao/eval/compare.h"
+#include "ao/jobs/compare.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/image_io.h"
 #include "ao/io/output_set.h"
 #include "ao/io/text.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
 #include "common.h"
 #include "contact_sheet.h"

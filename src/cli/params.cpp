@@ -4,7 +4,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/params.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "subcommands.h"
 
 namespace ao::cli {
@@ -16,8 +16,7 @@ void add_params_command(CLI::App& app, const GlobalOptions&, std::function<int()
   cmd->callback([&action, method] {
     action = [method] {
       const MethodInfo& m = find_method(*method);
-      if (!m.param_specs) throw InputError("method " + *method + " has no parameter table");
-      std::fputs(params_markdown(m.param_specs()).c_str(), stdout);
+      std::fputs(params_markdown(m.params().specs()).c_str(), stdout);
       return 0;
     };
   });

@@ -14,7 +14,7 @@
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
 #include "ao/io/output_set.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/direct_light.h"
 #include "ao/reference/ray_scene.h"
 #include "common.h"

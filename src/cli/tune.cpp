@@ -1,4 +1,4 @@
-// ao tune: the command-line shell of tune_method (ao/eval/tune.h): loads the views, renders each
+// ao tune: the command-line shell of tune_method (ao/jobs/tune.h): loads the views, renders each
 // one's G-buffer and matched reference, fits the chosen parameters and writes them as a parameter
 // file that `ao render -p @file.json` loads. docs/compare.md#ao-tune.
 #include <fstream>
@@ -9,11 +9,11 @@
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
-#include "ao/eval/compare.h"
-#include "ao/eval/tune.h"
+#include "ao/jobs/compare.h"
+#include "ao/jobs/tune.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
 #include "common.h"
 #include "subcommands.h"

@@ -4,7 +4,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/image_io.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "common.h"
 #include "subcommands.h"
 #include "view/viewer.h"

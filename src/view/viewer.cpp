@@ -31,7 +31,7 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
 #include "view/orbit.h"
 #include "view/progressive.h"
@@ -652,7 +652,7 @@ class Viewer {
   void draw_parameters() {
     const MethodInfo& m = find_method(method_);
     nlohmann::json& params = current_params();
-    const std::vector<ParamSpec> specs = m.param_specs ? m.param_specs() : std::vector<ParamSpec>{};
+    const std::vector<ParamSpec>& specs = m.params().specs();
     for (const ParamSpec& spec : specs) {
       if (!params.contains(spec.name)) continue;
       nlohmann::json& value = params[spec.name];

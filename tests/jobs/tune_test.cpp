@@ -1,12 +1,12 @@
 // Parameter fitting (eval/tune.h): a known optimum found, improvement over the start, and bad input.
-#include "ao/eval/tune.h"
+#include "ao/jobs/tune.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "ao/core/error.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "../methods/screen_space_fixtures.h"
 
 namespace ao {

@@ -3,7 +3,7 @@
 // field, fig. 12 depth x height field) on the built-in scenes that describe them, against known
 // answers and the ray-traced reference, and the bad inputs. The tests print what they measure:
 //   ./build/tests/ao_tests --gtest_filter='Registry.*'
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include "ao/methods/containment.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
-#include "screen_space_fixtures.h"
+#include "methods/screen_space_fixtures.h"
 
 namespace ao {
 namespace {

@@ -1,4 +1,4 @@
-#include "ao/eval/tune.h"
+#include "ao/jobs/tune.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "ao/core/error.h"
-#include "ao/eval/compare.h"
+#include "ao/jobs/compare.h"
 #include "ao/eval/metrics.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 
 namespace ao {
 

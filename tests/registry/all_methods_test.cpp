@@ -14,7 +14,7 @@
 #include "ao/core/error.h"
 #include "ao/core/params.h"
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/scene/procedural.h"
 
 namespace ao {
@@ -102,9 +102,8 @@ TEST_P(AllMethods, MeanVisibilityFallsAsRadiusGrows) {
 
 TEST_P(AllMethods, DefaultsAreTheTablesDefaults) {
   const MethodInfo& m = method();
-  ASSERT_NE(m.param_specs, nullptr) << m.name << " has no parameter table (core/params.h)";
   const nlohmann::json defaults = m.default_params();
-  const std::vector<ParamSpec> specs = m.param_specs();
+  const std::vector<ParamSpec>& specs = m.params().specs();
   EXPECT_EQ(defaults.size(), specs.size()) << defaults.dump();
   for (const ParamSpec& s : specs) {
     ASSERT_TRUE(defaults.contains(s.name)) << s.name;
@@ -133,11 +132,10 @@ nlohmann::json other_value(const ParamSpec& s) {
 
 TEST_P(AllMethods, ParametersRoundTripThroughJson) {
   const MethodInfo& m = method();
-  ASSERT_NE(m.canonical_params, nullptr) << m.name << " has no parameter table (core/params.h)";
   const nlohmann::json defaults = m.default_params();
   EXPECT_EQ(m.canonical_params(defaults), defaults);
   EXPECT_EQ(m.canonical_params(nlohmann::json::object()), defaults) << "absent keys take their defaults";
-  for (const ParamSpec& s : m.param_specs()) {
+  for (const ParamSpec& s : m.params().specs()) {
     nlohmann::json j = defaults;
     j[s.name] = other_value(s);
     ASSERT_FALSE(j[s.name].is_null()) << s.name;
@@ -164,13 +162,12 @@ void expect_refused(const MethodInfo& m, const nlohmann::json& j, const std::str
 
 TEST_P(AllMethods, BadParameterValuesAreRefused) {
   const MethodInfo& m = method();
-  ASSERT_NE(m.canonical_params, nullptr) << m.name << " has no parameter table (core/params.h)";
   const nlohmann::json defaults = m.default_params();
   nlohmann::json j = defaults;
   j["no_such_parameter"] = 1;
   expect_refused(m, j, "no_such_parameter");
   expect_refused(m, nlohmann::json::array(), "JSON object");
-  for (const ParamSpec& s : m.param_specs()) {
+  for (const ParamSpec& s : m.params().specs()) {
     auto refused = [&](const nlohmann::json& value) {
       nlohmann::json bad = defaults;
       bad[s.name] = value;

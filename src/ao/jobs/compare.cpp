@@ -1,4 +1,4 @@
-#include "ao/eval/compare.h"
+#include "ao/jobs/compare.h"
 
 #include <charconv>
 #include <chrono>
@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "ao/core/error.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao {

@@ -75,7 +75,7 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
   if (s.methods.empty()) {
     // Every approximate method (the reference itself is not compared with itself).
     for (const MethodInfo& m : all_methods())
-      if (m.name != "raytraced") s.methods.emplace_back(m.name);
+      if (!m.ground_truth) s.methods.emplace_back(m.name);
     if (s.methods.empty()) throw InputError("--methods: the registry has no approximate methods");
   }
   for (const auto& [name, p] : in.params) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <string>
@@ -17,6 +18,8 @@
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
 #include "ao/eval/metrics.h"
+#include "ao/jobs/inputs.h"
+#include "ao/jobs/reporter.h"
 #include "ao/reference/reference.h"
 #include "ao/scene/analytic.h"
 
@@ -107,6 +110,39 @@ std::string compare_sweep_markdown(const CompareResult& result);
 /// The parameters a reader needs to tell rows apart: the sample count and quality preset where a
 /// method has them, and whatever differs from the defaults; empty when longer than `max_chars`.
 std::string compare_key_params(const CompareRow& row, std::size_t max_chars = 40);
+
+// ---- `ao compare` as a library call: a scene in, the comparison and its files out.
+
+struct CompareRequest {
+  SceneSource scene;
+  CameraRequest camera{.default_width = 640, .default_height = 360};
+  FalloffRequest falloff;
+  SurfaceNormal normal = SurfaceNormal::Shading;  ///< The G-buffer's N, for every method and its reference.
+  CompareSettings settings;   ///< Methods, parameters, references, spp, seed, sweep (falloff and progress are set by the job).
+  /// Where table.json, table.md, sheet.png (and sweep.json, sweep.md) go; created when missing.
+  /// Empty: nothing is written.
+  std::filesystem::path out_dir;
+  std::filesystem::path font;  ///< The sheet's label font; empty: DejaVu Sans where Debian installs it.
+};
+
+struct CompareJobResult {
+  CompareResult result;
+  std::string scene;          ///< Its name.
+  Camera camera;
+  nlohmann::json table;       ///< table.json, with the scene, camera and setup time.
+  std::string markdown;       ///< table.md.
+  Image<Vec3> sheet;          ///< sheet.png: per row the method, its reference and the error heat map.
+  std::vector<std::filesystem::path> written;
+};
+
+/// compare-<scene stem>: where `ao compare` writes without --out-dir.
+std::filesystem::path default_compare_dir(const CompareRequest& request);
+
+/// Renders the G-buffer of `request`'s scene and camera, runs compare_methods, and writes the
+/// files into out_dir as one transaction (refused before any work when one names an input). The
+/// checks that need no scene (methods, parameters, references, camera, falloff) come first.
+/// Problems methods worked around (cone: open meshes) are reported as warnings.
+CompareJobResult run_compare(const CompareRequest& request, const JobReporter& reporter = {});
 
 /// `j` with every number that is exactly a float replaced by the double of its shortest decimal
 /// form (0.0001f, stored as 9.999999747378752e-05, becomes 0.0001), so JSON and tables print

@@ -20,6 +20,11 @@ struct JobReporter {
   std::function<void(const std::string& line)> warning;
   /// A line for people about what was done ("wrote ao.png: ..."): what `ao` prints without --json.
   std::function<void(const std::string& line)> note;
+  /// The one-line error of one item of a batch that goes on without it (a mesh that failed).
+  std::function<void(const std::string& line)> error;
+  /// A line about a batch's progress meant for logs ("mesh 2 of 5: cow.obj ... done in 1.2 s"); a
+  /// terminal shows the stages' progress instead.
+  std::function<void(const std::string& line)> log;
 
   /// stage(name), or an empty ProgressFn.
   ProgressFn start(const std::string& name) const { return stage ? stage(name) : ProgressFn{}; }
@@ -28,6 +33,12 @@ struct JobReporter {
   }
   void tell(const std::string& line) const {
     if (note) note(line);
+  }
+  void fail(const std::string& line) const {
+    if (error) error(line);
+  }
+  void trace(const std::string& line) const {
+    if (log) log(line);
   }
 };
 

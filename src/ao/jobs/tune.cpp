@@ -3,9 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/io/atomic_file.h"
+#include "ao/reference/ray_scene.h"
+#include "ao/reference/reference.h"
 #include "ao/jobs/compare.h"
 #include "ao/eval/metrics.h"
 #include "ao/registry/registry.h"
@@ -87,6 +93,93 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
   r.best_rmse = best;
   r.seconds = seconds();
   return r;
+}
+
+}  // namespace ao
+
+// ---- The tune job.
+
+namespace ao {
+
+namespace {
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<TuneParameter> tune_parameters(const MethodInfo& m, const std::vector<TuneFit>& fit) {
+  if (fit.empty()) throw InputError("--fit: name at least one parameter to fit (key or key=lo:hi)");
+  std::vector<TuneParameter> out;
+  for (const TuneFit& f : fit) {
+    const ParamSpec* spec = m.params().find(f.key);
+    if (!spec) throw InputError("--fit: method " + std::string(m.name) + " has no parameter '" + f.key + "'");
+    const bool integer = spec->type == ParamType::Int || spec->type == ParamType::OptionalInt;
+    if (!integer && spec->type != ParamType::Float && spec->type != ParamType::OptionalFloat)
+      throw InputError("--fit: '" + f.key + "' of " + std::string(m.name) + " is " + spec->valid_text() + ", not a number to fit");
+    const Range& valid = spec->range;
+    TuneParameter p{.key = f.key, .lo = f.lo.value_or(valid.min), .hi = f.hi.value_or(valid.max), .integer = integer};
+    if (!f.lo && (valid.min_open || !std::isfinite(valid.min)))
+      throw InputError("--fit: '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
+    if (!f.hi && (valid.max_open || !std::isfinite(valid.max)))
+      throw InputError("--fit: '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
+    if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
+      throw InputError("--fit: the range of '" + f.key + "' must be finite with lo < hi, got " + number(p.lo) + ":" + number(p.hi));
+    if (!valid.contains(p.lo) || !valid.contains(p.hi))
+      throw InputError("--fit: the range " + number(p.lo) + ":" + number(p.hi) + " of '" + f.key + "' leaves its valid values, " + spec->valid_text());
+    out.push_back(p);
+  }
+  return out;
+}
+
+TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
+  const MethodInfo& m = find_method(r.method);
+  nlohmann::json start = r.params;
+  start = m.canonical_params(start);
+  TuneSettings settings{.method = r.method, .start = start, .time_budget_s = r.budget_s, .seed = r.seed};
+  settings.parameters = tune_parameters(m, r.fit);
+  if (r.spp_reference < 1 || r.spp_reference > (1 << 20)) throw InputError("--spp-reference must be in [1, 1048576]");
+  if (r.scenes.empty()) throw InputError("--scenes: no scene named");
+  r.camera.validate();
+  r.falloff.validate();
+
+  // Each view keeps its scene, BVH and G-buffer alive while tuning runs.
+  struct Loaded {
+    std::unique_ptr<PreparedScene> scene;
+    GBuffer g;
+  };
+  std::vector<std::unique_ptr<Loaded>> loaded;
+  std::vector<TuneView> views;
+  for (const std::string& name : r.scenes) {
+    auto l = std::make_unique<Loaded>();
+    l->scene = std::make_unique<PreparedScene>(SceneSource{.args = {name}}.load(), "ao tune", BvhOptions{});
+    const Scene& scene = *l->scene->scene;
+    l->g = render_gbuffer(*l->scene->rays, choose_camera(scene, r.camera));
+    const Falloff f = choose_falloff(r.falloff, scene.bounds().diagonal());
+    Image<float> ref = render_reference(*l->scene->rays, l->g, m.reference(f, start), {.samples = r.spp_reference}, r.seed + 1,
+                                        reporter.start("reference (" + name + ")"))
+                           .scalar.visibility;
+    views.push_back({l->scene->rays.get(), &l->g, &scene.analytic, f, std::move(ref)});
+    loaded.push_back(std::move(l));
+  }
+  settings.log = reporter.note;
+  TuneJobResult out;
+  out.tune = tune_method(views, settings);
+  const int width = r.camera.width.value_or(r.camera.default_width), height = r.camera.height.value_or(r.camera.default_height);
+  out.file = {{"method", r.method},       {"parameters", out.tune.params}, {"start_rmse", out.tune.start_rmse}, {"best_rmse", out.tune.best_rmse},
+              {"evaluations", out.tune.evaluations}, {"seconds", out.tune.seconds}, {"scenes", r.scenes},
+              {"width", width},           {"height", height}};
+  if (!r.output.empty())
+    write_file_atomically(r.output, [&](const std::filesystem::path& temp) {
+      std::ofstream file(temp, std::ios::binary);
+      file << out.file.dump(2) << "\n";
+      file.close();
+      if (!file) throw SystemError(r.output.string() + ": cannot write");
+    });
+  return out;
 }
 
 }  // namespace ao

@@ -4,7 +4,9 @@
 // every view. `ao tune` is its command-line shell (docs/compare.md#ao-tune).
 #pragma once
 
+#include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,11 +14,14 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/jobs/inputs.h"
+#include "ao/jobs/reporter.h"
 #include "ao/scene/analytic.h"
 
 namespace ao {
 
 class RayScene;
+struct MethodInfo;
 
 /// One parameter to fit, within [lo, hi]; integer parameters take rounded values.
 struct TuneParameter {
@@ -60,5 +65,42 @@ struct TuneResult {
 /// else halve that parameter's step. Deterministic for a seed (the methods are). InputError for
 /// unknown methods or keys, non-numeric values, empty ranges or an empty view list.
 TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& settings);
+
+// ---- `ao tune` as a library call: scenes and a method in, fitted parameters (and their file) out.
+
+/// A parameter to fit: its name, and optionally its range (default: the parameter table's range,
+/// which must then be finite and closed). Integer-ness comes from the table.
+struct TuneFit {
+  std::string key;
+  std::optional<double> lo, hi;
+};
+
+struct TuneRequest {
+  std::vector<std::string> scenes = {"default"};  ///< One view each: built-in names or mesh files.
+  std::string method;
+  std::vector<TuneFit> fit;                        ///< At least one.
+  nlohmann::json params = nlohmann::json::object();  ///< Overrides of the defaults: the starting point.
+  double budget_s = 60;                            ///< Seconds, > 0.
+  int spp_reference = 256;                         ///< Rays per pixel of the references, [1, 1048576].
+  CameraRequest camera{.default_width = 320, .default_height = 180};
+  FalloffRequest falloff;
+  std::uint32_t seed = 1;
+  std::filesystem::path output;                    ///< The parameter file (JSON; `ao render -p @FILE`); empty: not written.
+};
+
+struct TuneJobResult {
+  TuneResult tune;
+  nlohmann::json file;  ///< What the parameter file holds.
+};
+
+/// The parameters to fit, each with its range and integer-ness from the method's table;
+/// InputError naming --fit for an unknown or non-numeric key or a range that is empty, infinite or
+/// outside the parameter's valid range.
+std::vector<TuneParameter> tune_parameters(const MethodInfo& method, const std::vector<TuneFit>& fit);
+
+/// Loads each scene, renders its G-buffer and its matched reference (for the starting
+/// parameters), runs tune_method and writes the parameter file. Each accepted improvement is told
+/// to the reporter as a note.
+TuneJobResult run_tune(const TuneRequest& request, const JobReporter& reporter = {});
 
 }  // namespace ao

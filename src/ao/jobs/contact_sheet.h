@@ -11,7 +11,7 @@
 #include "ao/core/math.h"
 #include "ao/io/text.h"
 
-namespace ao::cli {
+namespace ao {
 
 /// One row of the sheet. The three images have the same size, and every row the same size.
 struct SheetRow {
@@ -30,4 +30,4 @@ struct SheetRow {
 /// Without a font: the images only, in a 3 x rows grid.
 Image<Vec3> contact_sheet(std::span<const SheetRow> rows, float heat_range, const Font* font);
 
-}  // namespace ao::cli
+}  // namespace ao

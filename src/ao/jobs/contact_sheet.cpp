@@ -1,6 +1,6 @@
 // The contact sheet is built as horizontal bands (the header, then one per row: label above
 // images) that are stacked with gutters between them.
-#include "contact_sheet.h"
+#include "ao/jobs/contact_sheet.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -8,7 +8,7 @@
 #include "ao/core/error.h"
 #include "ao/eval/metrics.h"
 
-namespace ao::cli {
+namespace ao {
 
 namespace {
 
@@ -161,4 +161,4 @@ Image<Vec3> contact_sheet(std::span<const SheetRow> rows, float heat_range, cons
   return sheet;
 }
 
-}  // namespace ao::cli
+}  // namespace ao

@@ -45,10 +45,10 @@ int run_view_command(const ViewOptions& o, const GlobalOptions& global) {
   if (!o.ao_map.empty()) setup.ao_map = read_image(o.ao_map);
   const CameraRequest camera = camera_request(o.camera);
   const FalloffRequest falloff = falloff_request(o.falloff);
-  setup.scene = *SceneSource{.args = o.scene}.load();
-  for (const std::string& w : setup.scene.warnings) std::cerr << "warning: " << w << "\n";
-  setup.camera = choose_camera(setup.scene, camera);
-  setup.radius_basis = interest_diagonal(setup.scene);
+  setup.scene = SceneSource{.args = o.scene}.load();
+  for (const std::string& w : setup.scene->warnings) std::cerr << "warning: " << w << "\n";
+  setup.camera = choose_camera(*setup.scene, camera);
+  setup.radius_basis = interest_diagonal(*setup.scene);
   setup.falloff = choose_falloff(falloff, setup.radius_basis);
   setup.method = o.method;
   setup.params = params;

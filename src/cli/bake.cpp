@@ -40,15 +40,9 @@ BakeRequest make_request(BakeOptions& o) {
   }
   if (o.size_given) r.size = parse_map_size(o.size);
   for (const std::string& g : o.groups) r.groups.push_back(split(g, ','));
-  r.raytraced.seed = r.histogram.seed = o.seed;
-  r.raytraced.normal = surface_normal_from_name(o.normal);
-  r.raytraced.membership = membership_from_name(o.membership);
-  const auto ds = parse_direction_set(o.direction_set);
-  if (!ds) throw InputError("--direction-set: expected fibonacci or gaussian, got '" + o.direction_set + "'");
-  r.histogram.direction_set = *ds;
-  const auto norm = parse_normalization(o.normalization);
-  if (!norm) throw InputError("--normalization: expected area or max, got '" + o.normalization + "'");
-  r.histogram.normalization = *norm;
+  // The options given as names go through the bakers' tables, which name the valid values.
+  raytraced_bake_param_table().from_json({{"seed", o.seed}, {"normal", o.normal}, {"membership", o.membership}}, r.raytraced);
+  histogram_param_table().from_json({{"seed", o.seed}, {"direction_set", o.direction_set}, {"normalization", o.normalization}}, r.histogram);
   return r;
 }
 
@@ -68,49 +62,47 @@ int run(BakeOptions& o, const GlobalOptions& global) {
 
 void add_histogram_options(CLI::App& cmd, BakeOptions& o) {
   HistogramParams& h = o.request.histogram;
-  cmd.add_option("-d,--directions", h.directions, "histogram: directions on the sphere [1, 65536]")->capture_default_str();
-  cmd.add_option("--direction-set", o.direction_set, "histogram: fibonacci (stratified) or gaussian (the paper's)")->capture_default_str();
-  cmd.add_option("--pixels-per-texel", h.pixels_per_texel, "histogram: view resolution, pixels per texel edge (0, 8]")->capture_default_str();
-  cmd.add_option("--point-size", h.point_size, "histogram: splat size in texels, >1 smooths (paper sec. 3.2) [1, 16]")->capture_default_str();
-  cmd.add_option("--normalization", o.normalization, "histogram: area (exact, absolute V) or max (the paper's: max V = 1)")->capture_default_str();
-  cmd.add_option("--min-samples", h.min_samples,
-                 "histogram: texels expected to get fewer pixel samples than this (chart slivers) copy the nearest texel that gets enough; 0 = off")
-      ->capture_default_str();
-  cmd.add_flag("--seam-fix,!--no-seam-fix", h.seam_fix, "histogram: refill poorly covered chart-border texels from their neighbours (paper sec. 3.3; default on)");
+  const ParamSchema table(histogram_param_table());
+  const auto help = [&](std::string_view name) { return param_help(table, name, "histogram: "); };
+  cmd.add_option("-d,--directions", h.directions, help("directions"))->capture_default_str();
+  cmd.add_option("--direction-set", o.direction_set, help("direction_set"))->capture_default_str();
+  cmd.add_option("--pixels-per-texel", h.pixels_per_texel, help("pixels_per_texel"))->capture_default_str();
+  cmd.add_option("--point-size", h.point_size, help("point_size"))->capture_default_str();
+  cmd.add_option("--normalization", o.normalization, help("normalization"))->capture_default_str();
+  cmd.add_option("--min-samples", h.min_samples, help("min_samples"))->capture_default_str();
+  cmd.add_flag("--seam-fix,!--no-seam-fix", h.seam_fix, help("seam_fix") + " (default on)");
   cmd.add_option("--vertex-resolution", o.request.vertex_resolution, "histogram --per-vertex: view size in pixels [64, 8192]")->capture_default_str();
 }
 
 void add_raytraced_options(CLI::App& cmd, BakeOptions& o) {
   RaytracedBakeParams& rt = o.request.raytraced;
-  cmd.add_option("--samples,--spp", rt.samples, "raytraced: rays per texel (per vertex with --per-vertex)")->capture_default_str();
+  const ParamSchema table(raytraced_bake_param_table());
+  const auto help = [&](std::string_view name) { return param_help(table, name, "raytraced: "); };
+  cmd.add_option("--samples,--spp", rt.samples, help("samples"))->capture_default_str();
   cmd.add_option("--denoise", o.request.denoise,
-                 "raytraced maps: sigma in texels of the texture-space filter that averages the noise of texels that are "
-                 "neighbours on the surface (not across charts or creases); 0 = off, the plain ray-traced estimate; --high maps: off "
-                 "unless given [0, 4]")
+                 help("denoise") + ": averages the noise of texels that are neighbours on the surface (not across charts or creases); "
+                 "--high maps: off unless given")
       ->default_str(float_text(kDefaultBakeDenoise));
-  cmd.add_option("--max-distance", rt.max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");
-  cmd.add_option("--membership", o.membership, "raytraced with --max-distance: falloff step, linear, sqrt or cubic")->capture_default_str();
-  cmd.add_option("--offset", rt.offset,
-                 "raytraced: ray origin offset along the face normal, world units (0: scale-free, a few float spacings of the coordinates; "
-                 "docs/methods/raytraced.md)")
-      ->capture_default_str();
+  cmd.add_option("--max-distance", rt.max_distance, help("max_distance"));
+  cmd.add_option("--membership", o.membership, help("membership"))->capture_default_str();
+  cmd.add_option("--offset", rt.offset, help("offset"))->capture_default_str();
   cmd.add_option("--normal", o.normal,
-                 "raytraced: hemisphere about the interpolated shading normal (default: the smooth surface the mesh stands for) or the "
-                 "triangle's geometric normal (per vertex: the area-weighted mean over its triangles); the histogram baker integrates the "
-                 "whole sphere of views and takes no normal")
+                 help("normal") + " (per vertex: the area-weighted mean over its triangles); the histogram baker integrates the whole "
+                 "sphere of views and takes no normal")
       ->type_name("shading|geometric")
       ->capture_default_str();
-  cmd.add_flag("--ignore-back-faces", rt.ignore_back_faces, "raytraced: rays pass through back faces (xNormal/Substance 'ignore backface')");
+  cmd.add_flag("--ignore-back-faces", rt.ignore_back_faces, help("ignore_back_faces"));
 }
 
 void add_high_to_low_options(CLI::App& cmd, BakeOptions& o) {
   BakeRequest& r = o.request;
+  const ParamSchema table(high_to_low_param_table());
+  const auto help = [&](std::string_view name) { return param_help(table, name, "High to low: "); };
   cmd.add_option("--high", r.high, "High to low: bake the AO of this high-poly mesh into the low mesh's UVs (repeatable; ray-traced)")->type_name("MESH");
   cmd.add_option("--cage", r.cage, "High to low: cage mesh (the low mesh's topology, pushed out); rays start on it and travel inwards");
-  cmd.add_option("--cage-extrusion", r.high_to_low.cage_extrusion,
-                 "High to low: without --cage, push the low mesh out along its smoothed normals by this distance, world units (default 0.01 x diagonal)");
-  cmd.add_option("--max-front", r.high_to_low.max_front, "High to low: rays start this far outside the low surface, world units (default: at the cage)");
-  cmd.add_option("--max-back", r.high_to_low.max_back, "High to low: rays look this far inside the low surface, world units (default: the cage distance)");
+  cmd.add_option("--cage-extrusion", r.high_to_low.cage_extrusion, help("cage_extrusion"));
+  cmd.add_option("--max-front", r.high_to_low.max_front, help("max_front"));
+  cmd.add_option("--max-back", r.high_to_low.max_back, help("max_back"));
   cmd.add_option("--occluder", r.occluders, "Mesh that occludes but is not baked (repeatable)")->type_name("MESH");
   cmd.add_flag("--floor", r.floor, "Add a ground plane under the model (y up, at its lowest point) as an occluder");
   cmd.add_option("--group", o.groups, "Bake group: comma-separated mesh names that occlude each other and nothing else (repeatable; meshes not named form one more group)")

@@ -55,6 +55,12 @@ FalloffRequest falloff_request(const FalloffOptions& falloff) {
   return r;
 }
 
+std::string param_help(const ParamSchema& schema, std::string_view name, std::string_view prefix) {
+  const ParamSpec* spec = schema.find(name);
+  if (!spec) throw std::logic_error("no parameter " + std::string(name) + " in the table of " + schema.owner());
+  return std::string(prefix) + spec->help + " [" + spec->valid_text() + "]";
+}
+
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
   std::stringstream in(s);

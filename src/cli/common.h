@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/core/params.h"
 #include "ao/jobs/inputs.h"
 #include "ao/jobs/reporter.h"
 
@@ -53,6 +54,10 @@ struct FalloffOptions {
 /// Declares --membership, -R/--radius, --radius-fraction and --tau (unless `with_tau` is false).
 void add_falloff_options(CLI::App& cmd, FalloffOptions& falloff, const std::string& membership_help, bool with_tau = true);
 FalloffRequest falloff_request(const FalloffOptions& falloff);
+
+/// An option's help from a parameter table: `prefix`, the parameter's one-line help and its valid
+/// values ("raytraced: rays per texel ... [an integer in [1, 1048576]]"), so ranges are written once.
+std::string param_help(const ParamSchema& schema, std::string_view name, std::string_view prefix = "");
 
 /// "x,y,z" as three finite numbers; InputError naming `option` otherwise.
 Vec3 parse_vec3(const std::string& text, const char* option);

@@ -94,24 +94,29 @@ std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
   return out;
 }
 
-bool finite_nonnegative(const std::optional<float>& v) { return !v || (*v >= 0 && std::isfinite(*v)); }
-
 }  // namespace
 
-void HighToLowParams::validate() const {
-  ao.validate();
-  if (!finite_nonnegative(cage_extrusion)) throw InputError("high-to-low: cage extrusion must be a finite number >= 0 (world units)");
-  if (!finite_nonnegative(max_front)) throw InputError("high-to-low: max front distance must be a finite number >= 0 (world units)");
-  if (!finite_nonnegative(max_back)) throw InputError("high-to-low: max back distance must be a finite number >= 0 (world units)");
+const ParamTable<HighToLowParams>& high_to_low_param_table() {
+  using P = Param<HighToLowParams>;
+  using H = HighToLowParams;
+  static const ParamTable<H> table{
+      "bake high-to-low",
+      {nested_params<H>(raytraced_bake_param_table(), &H::ao),
+       {P::optional_real("cage_extrusion", &H::cage_extrusion, Range::closed(0, kMaxCoordinate), "world units",
+                         "D: cage = low vertex + D x smoothed normal; null = 0.01 x the low mesh's diagonal; not with an explicit cage"),
+        P::optional_real("max_front", &H::max_front, Range::closed(0, kMaxCoordinate), "world units",
+                         "how far outside the low surface a ray starts; null = at the cage"),
+        P::optional_real("max_back", &H::max_back, Range::closed(0, kMaxCoordinate), "world units",
+                         "how far inside the low surface a ray still looks for the high mesh; null = the cage distance at that point")}}};
+  return table;
 }
 
-void to_json(nlohmann::json& j, const HighToLowParams& p) {
-  auto opt = [](const std::optional<float>& v, const char* otherwise) { return v ? nlohmann::json(*v) : nlohmann::json(otherwise); };
-  j = {{"ao", p.ao},
-       {"cage_extrusion", opt(p.cage_extrusion, "0.01 x low diagonal")},
-       {"max_front", opt(p.max_front, "cage")},
-       {"max_back", opt(p.max_back, "cage distance")}};
+void HighToLowParams::validate() const {
+  high_to_low_param_table().validate(*this);
+  ao.validate();
 }
+void to_json(nlohmann::json& j, const HighToLowParams& p) { j = high_to_low_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, HighToLowParams& p) { high_to_low_param_table().from_json(j, p); }
 
 CagePositions extrude_cage(const Scene& low, float distance) {
   const auto normals = smoothed_normals(low);

@@ -33,6 +33,10 @@ struct HighToLowParams {
   void validate() const;
 };
 void to_json(nlohmann::json& j, const HighToLowParams& p);
+void from_json(const nlohmann::json& j, HighToLowParams& p);
+/// The high-to-low parameter table: the ray-traced baker's rows (for the AO at the high-poly hit),
+/// then the cage's.
+const ParamTable<HighToLowParams>& high_to_low_param_table();
 
 /// Per low mesh, the cage position of each vertex.
 using CagePositions = std::vector<std::vector<Vec3>>;

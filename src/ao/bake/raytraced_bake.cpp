@@ -76,12 +76,31 @@ using detail::TriangleNormals;
 
 }  // namespace
 
+const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table() {
+  using P = Param<RaytracedBakeParams>;
+  using R = RaytracedBakeParams;
+  static const ParamTable<R> table{
+      "bake raytraced",
+      {P::integer("samples", &R::samples, Range::closed(1, kMaxSamples), "", "rays per texel (per vertex for per-vertex AO), each from its own point of the patch"),
+       P::optional_real("max_distance", &R::max_distance, Range::above(0), "world units",
+                        "R: occluders count only within this distance; null = unlimited (the paper's eq. 1)"),
+       P::enumeration<Membership>("membership", &R::membership,
+                                  {{"step", Membership::Step}, {"linear", Membership::Linear}, {"sqrt", Membership::Sqrt}, {"cubic", Membership::Cubic}},
+                                  "falloff mu(d) within max_distance"),
+       P::real("offset", &R::offset, Range::closed(0, kMaxCoordinate), "world units",
+               "ray origin offset along the face normal; 0 = scale-free, a few float spacings of the coordinates (reference/ray_offset.h)"),
+       P::boolean("ignore_back_faces", &R::ignore_back_faces, "rays pass through back faces (xNormal's and Substance's 'ignore backface')"),
+       P::enumeration<SurfaceNormal>("normal", &R::normal, {{"shading", SurfaceNormal::Shading}, {"geometric", SurfaceNormal::Geometric}},
+                                     "the hemisphere: about the interpolated shading normal, or the triangle's own"),
+       P::boolean("bent_normals", &R::bent_normals, "also average the unoccluded directions per texel"),
+       P::seed("seed", &R::seed, "keys the per-texel sample sets"),
+       P::real("denoise", &R::denoise, Range::closed(0, kMaxDenoiseSigma), "texels",
+               "sigma of the texture-space filter of maps (denoise.h); 0 = off, the plain estimate of eq. 2")}};
+  return table;
+}
+
 void RaytracedBakeParams::validate() const {
-  if (samples < 1 || samples > kMaxSamples) throw InputError("bake raytraced: samples must be in [1, 1048576], got " + std::to_string(samples));
-  if (max_distance && !(*max_distance > 0 && std::isfinite(*max_distance)))
-    throw InputError("bake raytraced: max distance must be a finite number > 0 (omit it for unlimited distance)");
-  if (!(offset >= 0.0f && offset <= kMaxCoordinate)) throw InputError("bake raytraced: --offset must be a number in [0, 1e9] world units (kMaxCoordinate)");
-  if (!(denoise >= 0.0f && denoise <= kMaxDenoiseSigma)) throw InputError("bake raytraced: --denoise must be a filter sigma in [0, 4] texels (0 = off)");
+  raytraced_bake_param_table().validate(*this);
   if (max_distance) falloff().validate();
 }
 
@@ -93,17 +112,8 @@ Falloff RaytracedBakeParams::falloff() const {
   return Falloff{membership, *max_distance};
 }
 
-void to_json(nlohmann::json& j, const RaytracedBakeParams& p) {
-  j = {{"samples", p.samples},
-       {"max_distance", p.max_distance ? nlohmann::json(*p.max_distance) : nlohmann::json("unlimited")},
-       {"membership", to_string(p.membership)},
-       {"offset", p.offset},
-       {"ignore_back_faces", p.ignore_back_faces},
-       {"bent_normals", p.bent_normals},
-       {"normal", p.normal == SurfaceNormal::Geometric ? "geometric" : "shading"},
-       {"seed", p.seed},
-       {"denoise", p.denoise}};
-}
+void to_json(nlohmann::json& j, const RaytracedBakeParams& p) { j = raytraced_bake_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, RaytracedBakeParams& p) { raytraced_bake_param_table().from_json(j, p); }
 
 BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const RaytracedBakeParams& params, const ProgressFn& progress) {
   params.validate();

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <initializer_list>
 #include <limits>
@@ -98,6 +99,11 @@ struct Param {
   template <class Ref>
   static Param real(std::string name, Ref ref, Range range, std::string unit, std::string help) {
     return make<float>(std::move(name), ParamType::Float, ref, range, std::move(unit), std::move(help));
+  }
+  /// A std::uint32_t seed: any integer in [0, 2^32 - 1].
+  template <class Ref>
+  static Param seed(std::string name, Ref ref, std::string help) {
+    return make<std::uint32_t>(std::move(name), ParamType::Int, ref, Range::closed(0, 4294967295.0), "", std::move(help));
   }
   template <class Ref>
   static Param boolean(std::string name, Ref ref, std::string help) {

@@ -6,6 +6,9 @@
 #include <utility>
 #include <vector>
 
+#include "ao/bake/high_to_low.h"
+#include "ao/bake/histogram.h"
+#include "ao/bake/raytraced_bake.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/methods/alchemy.h"
@@ -369,7 +372,32 @@ const std::array kMethods{
                .obscurance_falloff = step_falloff},
 };
 
+constexpr std::array kBakerTables{
+    ParamTableInfo{"bake-raytraced", schema<raytraced_bake_param_table>},
+    ParamTableInfo{"bake-histogram", schema<histogram_param_table>},
+    ParamTableInfo{"bake-high-to-low", schema<high_to_low_param_table>},
+};
+
 }  // namespace
+
+std::span<const ParamTableInfo> all_param_tables() {
+  static const std::vector<ParamTableInfo> tables = [] {
+    std::vector<ParamTableInfo> t;
+    for (const MethodInfo& m : kMethods) t.push_back({m.name, m.params});
+    t.insert(t.end(), kBakerTables.begin(), kBakerTables.end());
+    return t;
+  }();
+  return tables;
+}
+
+const ParamSchema& find_param_table(std::string_view name) {
+  std::string names;
+  for (const ParamTableInfo& t : all_param_tables()) {
+    if (t.name == name) return t.schema();
+    names += (names.empty() ? "" : ", ") + std::string(t.name);
+  }
+  throw InputError("no parameter table '" + std::string(name) + "' (known: " + names + ")");
+}
 
 std::span<const MethodInfo> all_methods() { return kMethods; }
 

@@ -159,6 +159,17 @@ inline constexpr const char* kMatchedReference = "matched";
 /// names otherwise.
 ReferenceSpec choose_reference(const MethodInfo& m, std::string_view name, const Falloff& requested, const nlohmann::json& params);
 
+/// A parameter table by name: each method's (its name) and the bakers' ("bake-raytraced",
+/// "bake-histogram", "bake-high-to-low"): what `ao params`, the generated docs and the Python
+/// module list.
+struct ParamTableInfo {
+  std::string_view name;
+  const ParamSchema& (*schema)();
+};
+std::span<const ParamTableInfo> all_param_tables();
+/// The table called `name`; InputError listing the valid names otherwise.
+const ParamSchema& find_param_table(std::string_view name);
+
 /// All methods, in the order --help lists them.
 std::span<const MethodInfo> all_methods();
 /// The method called `name`; InputError listing the valid names otherwise.

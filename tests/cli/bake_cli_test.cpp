@@ -51,11 +51,6 @@ std::string cube_obj(bool uvs) {
 const std::string kBrokenObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 9/3\n";
 
 // One line on stderr, starting "ao: error:", that mentions `needle`.
-void expect_one_line_error(const RunResult& r, const std::string& needle) {
-  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
-}
 
 TEST(BakeCli, HistogramBakeWritesMapAndJsonSummary) {
   TempDir dir;

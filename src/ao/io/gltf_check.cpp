@@ -21,9 +21,11 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
 
 namespace ao {
 namespace {
@@ -155,13 +157,14 @@ struct View {
 
 class Checker {
  public:
-  Checker(const fs::path& path, const json& root, std::optional<std::string_view> glb_bin, std::size_t file_size)
-      : path_(path), root_(root), glb_bin_(glb_bin), file_size_(file_size) {}
+  Checker(const fs::path& path, const json& root, std::optional<std::string_view> glb_bin, std::size_t file_size, fs::path folder)
+      : path_(path), root_(root), glb_bin_(glb_bin), file_size_(file_size), folder_(std::move(folder)) {}
 
   void run() {
     if (!root_.is_object()) fail(path_, "glTF JSON is not an object");
     check_version();
     read_buffers();
+    check_images();
     read_views();
     read_accessors();
     check_meshes();
@@ -173,6 +176,7 @@ class Checker {
   const json& root_;
   std::optional<std::string_view> glb_bin_;
   std::size_t file_size_;
+  fs::path folder_;                         // what external files must lie inside (asset_path.h)
   std::vector<std::string> owned_;          // decoded data URIs and external files
   std::vector<std::string_view> buffers_;   // each buffer's bytes, byteLength long
   std::vector<View> views_;
@@ -260,13 +264,30 @@ class Checker {
       return owned_.emplace_back(std::move(*decoded));
     }
     if (uri.find("://") != std::string::npos) bad(where + ": external URL '" + one_line(uri.substr(0, 60)) + "' is not supported, only files");
-    const fs::path file = path_.parent_path() / fs::path(percent_decode(uri));
+    const fs::path file = resolve_asset_reference(path_, folder_, percent_decode(uri), where + ": its file");
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) bad(where + ": its file '" + one_line(uri.substr(0, 60)) + "' does not exist beside the glTF");
     std::ifstream in(file, std::ios::binary);
     std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) bad(where + ": cannot read its file '" + one_line(uri.substr(0, 60)) + "'");
     return owned_.emplace_back(std::move(content));
+  }
+
+  /// Images are not decoded here, but `ao bake --gltf` embeds the files they name in its GLB, and
+  /// assimp may open them: a file URI must name a file inside the asset's folder, as buffers do.
+  void check_images() {
+    const json& images = array(root_, "images", "glTF");
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      const std::string where = "image " + std::to_string(i);
+      const json& image = object(images[i], where);
+      const auto uri = image.find("uri");
+      if (uri == image.end()) continue;
+      if (!uri->is_string()) bad(where + ".uri is not a string");
+      const std::string& text = uri->get_ref<const std::string&>();
+      if (text.starts_with("data:")) continue;
+      if (text.find("://") != std::string::npos) bad(where + ": external URL '" + one_line(text.substr(0, 60)) + "' is not supported, only files");
+      resolve_asset_reference(path_, folder_, percent_decode(text), where + ": its file");
+    }
   }
 
   void read_views() {
@@ -502,7 +523,7 @@ bool looks_like_gltf(const fs::path& path, std::string_view data) {
   return start != std::string_view::npos && data[start] == '{';
 }
 
-void check_gltf(const fs::path& path, std::string_view data) {
+void check_gltf(const fs::path& path, std::string_view data, const fs::path& asset_root) {
   std::optional<std::string_view> bin;
   std::string_view text = data;
   if (data.size() >= 4 && read_u32(data.data()) == kGlbMagic) {
@@ -511,7 +532,7 @@ void check_gltf(const fs::path& path, std::string_view data) {
     bin = chunks.bin;
   }
   const json root = parse_json(path, text);
-  Checker(path, root, bin, data.size()).run();
+  Checker(path, root, bin, data.size(), asset_folder(path, asset_root)).run();
 }
 
 }  // namespace ao

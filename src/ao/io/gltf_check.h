@@ -22,11 +22,12 @@ bool looks_like_gltf(const std::filesystem::path& path, std::string_view data);
 /// than a small multiple of its size: GLB chunk lengths against the file size; JSON nesting depth
 /// (kMaxGltfJsonDepth); the node graph (indices in range, one parent per node, no cycle, depth at
 /// most kMaxGltfNodeDepth); buffers (GLB BIN chunk, base64 data URI or a file beside `path`)
-/// against their byteLength; bufferViews and accessors inside their buffers; byteStride at least
+/// against their byteLength; file URIs of buffers and images inside `asset_root` (empty, the
+/// default: the folder of `path`; see asset_path.h), after resolving "..", "." and symbolic links; bufferViews and accessors inside their buffers; byteStride at least
 /// the element size; POSITION accessors VEC3 float, all attributes of a primitive of one count;
 /// index accessors unsigned SCALAR with every index below the primitive's vertex count; sparse
 /// accessors in range. Throws InputError "<file>: <what>, <which accessor/node/...>" on the first
 /// problem. glTF 1.0 (asset.version 1.x, GLB version 1) is refused.
-void check_gltf(const std::filesystem::path& path, std::string_view data);
+void check_gltf(const std::filesystem::path& path, std::string_view data, const std::filesystem::path& asset_root = {});
 
 }  // namespace ao

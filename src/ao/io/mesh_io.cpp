@@ -558,7 +558,7 @@ Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
     }
   }
   const bool is_gltf = looks_like_gltf(path, data);
-  if (is_gltf) check_gltf(path, data);
+  if (is_gltf) check_gltf(path, data, options.asset_root);
   else if (ext == ".obj") check_obj(path, data);
   return read_with_assimp(path, data, options, is_gltf);
 }

@@ -210,7 +210,7 @@ void declare(OutputSet& set, const fs::path& input, const BakeOptions& o, const 
 
 // Bakes write per-vertex values and UV maps of each placed mesh, so glTF instances are loaded as
 // copies (LoadOptions::flatten_instances).
-constexpr LoadOptions kBakeLoad{.flatten_instances = true};
+const LoadOptions kBakeLoad{.flatten_instances = true};
 
 // The high meshes of --high, one scene (their UVs are not used).
 Scene load_high_scene(const std::vector<std::string>& files) {

@@ -318,6 +318,22 @@ struct GltfDocument::Impl {
     return m;
   }
 
+  /// A node that places triangles needs a finite transform that does not flatten them: with
+  /// determinant 0 every triangle is degenerate (the same rule as validate_and_prepare's for
+  /// instances, and load_scene_file's for every glTF node).
+  void check_transform(int node, int mesh, const Mat4& world) const {
+    bool triangles = false;
+    for (const tinygltf::Primitive& p : model.meshes[static_cast<std::size_t>(mesh)].primitives) triangles = triangles || is_triangles(p);
+    if (!triangles) return;
+    const tinygltf::Node& n = model.nodes[static_cast<std::size_t>(node)];
+    const std::string label = n.name.empty() ? "node " + std::to_string(node) : "node '" + one_line(n.name.substr(0, 64)) + "'";
+    for (double v : world)
+      if (!std::isfinite(v)) fail(path, label + " has a non-finite transform");
+    double det = 0;
+    normal_matrix(world, det);
+    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) fail(path, label + " has a transform with determinant 0 (it flattens the mesh)");
+  }
+
   void collect_instances() {
     std::vector<int> roots;
     const int scene = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
@@ -343,6 +359,7 @@ struct GltfDocument::Impl {
       const Mat4 world = mul(parent, local_matrix(n));
       if (n.mesh >= 0) {
         if (static_cast<std::size_t>(n.mesh) >= model.meshes.size()) fail(path, "node " + std::to_string(node) + " uses mesh " + std::to_string(n.mesh) + ", the file has " + std::to_string(model.meshes.size()));
+        check_transform(node, n.mesh, world);
         instances.push_back({node, n.mesh, world});
       }
       for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, world});

@@ -1,5 +1,5 @@
-// Mesh files -> Scene. OFF and PLY are read by our own strict readers; OBJ, STL and glTF/GLB go
-// through assimp, OBJ and glTF after checks of our own (see mesh_io.cpp for why).
+// Mesh files -> Scene. OFF, PLY and one-mesh OBJ files are read by our own strict readers; other
+// OBJ files, STL and glTF/GLB go through assimp, after checks of our own (see mesh_io.cpp for why).
 #pragma once
 
 #include <filesystem>

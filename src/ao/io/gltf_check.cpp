@@ -181,7 +181,12 @@ class Checker {
   std::vector<std::string_view> buffers_;   // each buffer's bytes, byteLength long
   std::vector<View> views_;
   std::vector<Accessor> accessors_;
+  std::vector<GltfSize::Counts> mesh_size_;  // per mesh, all its primitives
 
+ public:
+  GltfSize size_;
+
+ private:
   [[noreturn]] void bad(const std::string& problem) const { fail(path_, problem); }
 
   const json& array(const json& obj, const char* key, const std::string& where) const {
@@ -411,14 +416,35 @@ class Checker {
 
   void check_meshes() {
     const json& meshes = array(root_, "meshes", "glTF");
+    mesh_size_.assign(meshes.size(), {});
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const json& mesh = object(meshes[m], "mesh " + std::to_string(m));
       const json& primitives = array(mesh, "primitives", "mesh " + std::to_string(m));
       for (std::size_t p = 0; p < primitives.size(); ++p) {
         const std::string where = "mesh " + std::to_string(m) + " primitive " + std::to_string(p);
-        check_primitive(object(primitives[p], where), where);
+        const json& prim = object(primitives[p], where);
+        check_primitive(prim, where);
+        add_size(prim, mesh_size_[m]);
       }
+      size_.stored.add(mesh_size_[m]);
     }
+  }
+
+  /// What a reader makes of a primitive: assimp copies every attribute of every vertex as 12 bytes
+  /// (aiVector3D; colours 16) and every triangle as an aiFace (16 bytes) with its own 3 indices (a
+  /// 12-byte allocation, 32 with malloc's header and rounding).
+  void add_size(const json& prim, GltfSize::Counts& c) const {
+    const json& attributes = prim["attributes"];
+    const std::uint64_t vertices = accessors_[attributes["POSITION"].get<std::size_t>()].count;
+    std::uint64_t per_vertex = 0;
+    for (const auto& [name, value] : attributes.items()) per_vertex += name.starts_with("COLOR_") ? 16 : 12;
+    std::uint64_t corners = vertices;
+    if (prim.contains("indices")) corners = accessors_[prim["indices"].get<std::size_t>()].count;
+    const std::uint64_t mode = prim.contains("mode") ? prim["mode"].get<std::uint64_t>() : 4;
+    const std::uint64_t triangles = mode == 4 ? corners / 3 : (mode == 5 || mode == 6) && corners >= 3 ? corners - 2 : 0;
+    c.vertices += vertices;
+    c.triangles += triangles;
+    c.bytes += vertices * per_vertex + triangles * (16 + 32);
   }
 
   void check_primitive(const json& prim, const std::string& where) {
@@ -501,6 +527,14 @@ class Checker {
           bad("node " + std::to_string(*it) + " lies more than " + std::to_string(kMaxGltfNodeDepth) + " levels deep in the node hierarchy, the limit");
       }
     }
+    // Every node that uses a mesh places one copy of it (the graph is a forest: one parent each).
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto mesh = nodes[i].find("mesh");
+      if (mesh == nodes[i].end()) continue;
+      const std::size_t m = index(*mesh, mesh_size_.size(), "mesh", "node " + std::to_string(i) + ".mesh");
+      size_.world.add(mesh_size_[m]);
+      ++size_.uses;
+    }
     const json& scenes = array(root_, "scenes", "glTF");
     for (std::size_t s = 0; s < scenes.size(); ++s) {
       const std::string where = "scene " + std::to_string(s);
@@ -523,7 +557,7 @@ bool looks_like_gltf(const fs::path& path, std::string_view data) {
   return start != std::string_view::npos && data[start] == '{';
 }
 
-void check_gltf(const fs::path& path, std::string_view data, const fs::path& asset_root) {
+GltfSize check_gltf(const fs::path& path, std::string_view data, const fs::path& asset_root) {
   std::optional<std::string_view> bin;
   std::string_view text = data;
   if (data.size() >= 4 && read_u32(data.data()) == kGlbMagic) {
@@ -532,7 +566,9 @@ void check_gltf(const fs::path& path, std::string_view data, const fs::path& ass
     bin = chunks.bin;
   }
   const json root = parse_json(path, text);
-  Checker(path, root, bin, data.size(), asset_folder(path, asset_root)).run();
+  Checker checker(path, root, bin, data.size(), asset_folder(path, asset_root));
+  checker.run();
+  return checker.size_;
 }
 
 }  // namespace ao

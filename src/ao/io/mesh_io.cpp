@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/core/memory.h"
 #include "ao/io/gltf_check.h"
 #include "ao/io/number_text.h"
 #include "ao/io/obj_check.h"
@@ -557,6 +558,20 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   return scene;
 }
 
+/// Refuses, before assimp reads anything, a glTF whose meshes (shared accessors, meshes used by
+/// many nodes) expand beyond the memory available: assimp's copy of every mesh, its world-space
+/// copy per use when flattening (pre-transform; each copy joined once more), and the Scene's
+/// arrays (positions, normals and UVs 32 bytes per vertex, 12 per triangle). Instancing keeps
+/// each mesh once, and an instance costs next to nothing. Measured against this bound: a 100k-
+/// instance file reached 8.1 GB when flattened (issue 27), what the world term gives.
+void check_gltf_memory(const fs::path& path, const GltfSize& size, const LoadOptions& options) {
+  const GltfSize::Counts& placed = options.flatten_instances ? size.world : size.stored;
+  const std::uint64_t scene_bytes = placed.vertices * 32 + placed.triangles * 12;
+  const std::uint64_t bytes = 2 * size.stored.bytes + 2 * placed.bytes + scene_bytes;
+  check_memory(bytes, path.string() + ": loading " + std::to_string(placed.triangles) + " triangles (" + std::to_string(size.uses) +
+                          " mesh uses" + (options.flatten_instances ? ", each a copy" : "") + ")");
+}
+
 }  // namespace
 
 Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
@@ -583,7 +598,7 @@ Scene load_scene_file(const fs::path& path, const LoadOptions& options) {
     }
   }
   const bool is_gltf = looks_like_gltf(path, data);
-  if (is_gltf) check_gltf(path, data, options.asset_root);
+  if (is_gltf) check_gltf_memory(path, check_gltf(path, data, options.asset_root), options);
   else if (ext == ".obj") {
     if (std::optional<Scene> scene = read_simple_obj(path, data, options)) return std::move(*scene);
     check_obj(path, data, options.asset_root);

@@ -264,7 +264,7 @@ TEST(GltfDocument, BadDocumentsAreOneLineInputErrors) {
   draco["extensionsUsed"] = draco["extensionsRequired"] = {"KHR_draco_mesh_compression"};
   const std::pair<std::string, std::string> cases[] = {
       {make_glb(index, g.bin), "99"},
-      {make_glb(material, g.bin), "uses material 5, the file has 1"},
+      {make_glb(material, g.bin), "material 5, the file has 1"},
       {make_glb(draco, g.bin), "compressed with KHR_draco_mesh_compression"},
       {make_glb(deep, g.bin), "nests deeper"},
       {make_glb(no_position, g.bin), "bad.glb"},

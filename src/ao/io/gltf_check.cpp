@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -93,6 +94,13 @@ json parse_json(const fs::path& path, std::string_view text) {
     });
   } catch (const TooDeep&) {
     fail(path, "glTF JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) + " levels");
+  } catch (const json::parse_error& e) {
+    // nlohmann's text names its own grammar; the byte where it stopped, and the text there, is
+    // what a person can look at.
+    if (e.byte >= text.size()) fail(path, "truncated glTF JSON: it ends inside a value (byte " + std::to_string(text.size()) + ")");
+    const std::size_t at = e.byte > 0 ? e.byte - 1 : 0, from = at > 12 ? at - 12 : 0;
+    fail(path, "malformed glTF JSON: unexpected text at byte " + std::to_string(e.byte) + " ('" + one_line(text.substr(from, std::min<std::size_t>(24, text.size() - from))) +
+                   "')");
   } catch (const json::exception& e) {
     fail(path, "malformed or truncated glTF JSON (" + one_line(e.what()) + ")");
   }
@@ -169,6 +177,55 @@ class Checker {
     read_accessors();
     check_meshes();
     check_nodes();
+    check_references();
+  }
+
+  /// When `obj` has `key`: it must be an array of `count` numbers (true); false when absent.
+  bool numbers(const json& obj, const char* key, std::size_t count, const std::string& where) const {
+    const auto it = obj.find(key);
+    if (it == obj.end()) return false;
+    bool ok = it->is_array() && it->size() == count;
+    for (std::size_t k = 0; ok && k < count; ++k) ok = (*it)[k].is_number();
+    if (!ok) bad(where + "." + key + " is not an array of " + std::to_string(count) + " numbers");
+    return true;
+  }
+
+  /// The indices assimp follows without a word of its own ("GLTF: No scene", "Missing section"):
+  /// the displayed scene, and each primitive's material.
+  void check_references() {
+    const json& scenes = array(root_, "scenes", "glTF");
+    if (root_.contains("scene")) index(root_["scene"], scenes.size(), "scene", "scene");
+    const json& materials = array(root_, "materials", "glTF");
+    for (std::size_t i = 0; i < materials.size(); ++i) {
+      const std::string where = "material " + std::to_string(i);
+      const json& material = object(materials[i], where);
+      const auto pbr = material.find("pbrMetallicRoughness");
+      if (pbr != material.end()) numbers(object(*pbr, where + ".pbrMetallicRoughness"), "baseColorFactor", 4, where + ".pbrMetallicRoughness");
+    }
+    // A node's transform properties have fixed sizes; a reader that meets another size ignores
+    // the property (the mesh lands elsewhere, or unscaled) without a word.
+    const json& nodes = array(root_, "nodes", "glTF");
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const std::string where = "node " + std::to_string(i);
+      numbers(nodes[i], "matrix", 16, where);
+      numbers(nodes[i], "translation", 3, where);
+      numbers(nodes[i], "scale", 3, where);
+      if (numbers(nodes[i], "rotation", 4, where)) {
+        double len2 = 0;
+        for (const json& q : nodes[i]["rotation"]) len2 += q.get<double>() * q.get<double>();
+        // Exporters round unit quaternions to a few digits; a length off by more than 1% is not
+        // a rotation (assimp would scale and shear by it, tinygltf-based readers normalise it).
+        if (!(std::abs(std::sqrt(len2) - 1.0) <= 0.01))
+          bad(where + ".rotation is not a unit quaternion (length " + std::to_string(std::sqrt(len2)) + ")");
+      }
+    }
+    const json& meshes = array(root_, "meshes", "glTF");
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      const json& primitives = array(meshes[m], "primitives", "mesh " + std::to_string(m));
+      for (std::size_t p = 0; p < primitives.size(); ++p)
+        if (primitives[p].contains("material"))
+          index(primitives[p]["material"], materials.size(), "material", "mesh " + std::to_string(m) + " primitive " + std::to_string(p) + ".material");
+    }
   }
 
  private:
@@ -538,9 +595,12 @@ class Checker {
     const json& scenes = array(root_, "scenes", "glTF");
     for (std::size_t s = 0; s < scenes.size(); ++s) {
       const std::string where = "scene " + std::to_string(s);
+      std::vector<char> listed(n, 0);
       for (const json& r : array(object(scenes[s], where), "nodes", where)) {
         const std::size_t root = index(r, n, "node", where + " root");
         if (parent[root] != kNone) bad(where + " lists node " + std::to_string(root) + " as a root, but it is a child of node " + std::to_string(parent[root]));
+        // glTF requires unique roots; a reader would place the node's meshes twice.
+        if (listed[root]++) bad(where + " lists node " + std::to_string(root) + " twice");
       }
     }
   }

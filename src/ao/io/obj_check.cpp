@@ -71,8 +71,9 @@ void check_obj(const fs::path& path, std::string_view data, const fs::path& asse
       else if (key == "vn") ++total[kNormal];
     }
   }
-  // Pass 2: numbers and indices.
+  // Pass 2: numbers and indices; at the end, whether there was anything to draw.
   std::array<long long, 3> seen{0, 0, 0};
+  bool elements = false;
   Lines lines{data};
   std::string_view line;
   while (lines.next(line)) {
@@ -81,6 +82,7 @@ void check_obj(const fs::path& path, std::string_view data, const fs::path& asse
     };
     std::size_t pos = 0;
     const std::string_view key = next_token(line, pos);
+    if (key == "f" || key == "l" || key == "p") elements = true;
     if (key == "v" || key == "vt" || key == "vn") {
       const Kind kind = key == "v" ? kVertex : key == "vt" ? kUv : kNormal;
       ++seen[kind];
@@ -138,6 +140,8 @@ void check_obj(const fs::path& path, std::string_view data, const fs::path& asse
       }
     }
   }
+  // assimp makes a point cloud of such a file, or fails with words about normals.
+  if (!elements) throw InputError(path.string() + ": the file has no faces (f lines), only vertices");
 }
 
 }  // namespace ao

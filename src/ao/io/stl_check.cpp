@@ -69,6 +69,17 @@ bool is_ascii_stl(std::string_view data) {
   return true;
 }
 
+void check_binary_stl(const fs::path& path, std::string_view data) {
+  if (data.size() < 84)
+    throw InputError(path.string() + ": truncated binary STL: " + std::to_string(data.size()) + " bytes, its header alone takes 84");
+  std::uint32_t n = 0;
+  std::memcpy(&n, data.data() + 80, 4);  // little-endian, as the test machines
+  const std::uint64_t expected = 84 + 50 * static_cast<std::uint64_t>(n);
+  if (expected != data.size())
+    throw InputError(path.string() + ": binary STL header says " + std::to_string(n) + " triangles, which take 84 + 50 x " + std::to_string(n) + " = " +
+                     std::to_string(expected) + " bytes; the file has " + std::to_string(data.size()) + " (or an ASCII STL that does not start with 'solid')");
+}
+
 void check_ascii_stl(const fs::path& path, std::string_view data) {
   Tokens t(data);
   long long facet = 0;

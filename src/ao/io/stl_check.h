@@ -20,4 +20,9 @@ bool is_ascii_stl(std::string_view data);
 /// facet or a solid.
 void check_ascii_stl(const std::filesystem::path& path, std::string_view data);
 
+/// Checks `data`, an STL that is not ASCII (is_ascii_stl false), as binary STL: at least the
+/// 84-byte header, and exactly 84 + 50 bytes per triangle the header counts. Throws InputError
+/// "<file>: truncated binary STL: ..." or "<file>: binary STL header says N triangles, ...".
+void check_binary_stl(const std::filesystem::path& path, std::string_view data);
+
 }  // namespace ao

@@ -182,7 +182,8 @@ TEST(FullDisk, TheErrorSaysTheDiskIsFull) {
   // ENOSPC, whatever the writer's library makes of it.
   TempDir dir;
   fs::create_directory(dir / "small");
-  if (std::system("unshare -rm true >/dev/null 2>&1") != 0) GTEST_SKIP() << "unshare -rm (user and mount namespaces) is not available";
+  const std::string probe = "unshare -rm sh -c 'mount -t tmpfs -o size=64k none " + (dir / "small").string() + "' >/dev/null 2>&1";
+  if (std::system(probe.c_str()) != 0) GTEST_SKIP() << "a tmpfs cannot be mounted in user and mount namespaces here (unshare -rm)";
   const RunResult r = run_ao_under("unshare -rm sh -c 'mount -t tmpfs -o size=64k none small && (head -c 1000000 /dev/zero > small/fill) 2>/dev/null;"
                                    " exec \"$0\" \"$@\"'",
                                    "render -o small/big.exr --width 512 --height 512 --spp 1 -q", dir.path());

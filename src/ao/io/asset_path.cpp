@@ -11,14 +11,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path canonical_absolute(const fs::path& p) {
-  std::error_code ec;
-  fs::path abs = fs::absolute(p, ec);
-  if (ec) abs = p;
-  const fs::path r = fs::weakly_canonical(abs, ec);
-  return ec ? abs.lexically_normal() : r;
-}
-
 /// Text of a reference for a message: printable and short, whatever the file holds.
 std::string printable(std::string_view s) {
   std::string out;
@@ -28,15 +20,23 @@ std::string printable(std::string_view s) {
 
 }  // namespace
 
+fs::path resolved_path(const fs::path& p) {
+  std::error_code ec;
+  fs::path abs = fs::absolute(p, ec);
+  if (ec) abs = p;
+  const fs::path r = fs::weakly_canonical(abs, ec);
+  return ec ? abs.lexically_normal() : r;
+}
+
 fs::path asset_folder(const fs::path& model, const fs::path& root) {
-  if (!root.empty()) return canonical_absolute(root);
+  if (!root.empty()) return resolved_path(root);
   const fs::path abs = fs::absolute(model);
-  return canonical_absolute(abs.parent_path());
+  return resolved_path(abs.parent_path());
 }
 
 bool inside_folder(const fs::path& file, const fs::path& folder) {
   if (folder.empty()) return false;
-  const fs::path rel = canonical_absolute(file).lexically_relative(folder);
+  const fs::path rel = resolved_path(file).lexically_relative(folder);
   return !rel.empty() && *rel.begin() != "..";
 }
 

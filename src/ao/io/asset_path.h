@@ -11,6 +11,10 @@
 
 namespace ao {
 
+/// `p` made absolute, with ".", ".." and symbolic links resolved as far as the path exists
+/// (fs::weakly_canonical; lexically normalised when that fails).
+std::filesystem::path resolved_path(const std::filesystem::path& p);
+
 /// The folder the references of `model` must stay inside, absolute and with symbolic links
 /// resolved: `root` when it is not empty (LoadOptions::asset_root), else the folder of `model`.
 std::filesystem::path asset_folder(const std::filesystem::path& model, const std::filesystem::path& root = {});

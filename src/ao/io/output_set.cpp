@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
 
 namespace ao {
 
@@ -15,13 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path resolve(const fs::path& p) {
-  std::error_code ec;
-  fs::path abs = fs::absolute(p, ec);
-  if (ec) abs = p;
-  fs::path r = fs::weakly_canonical(abs, ec);
-  return ec ? abs.lexically_normal() : r;
-}
+fs::path resolve(const fs::path& p) { return resolved_path(p); }
 
 // The same file: the same path once resolved, or (when both exist) the same inode, which also
 // catches hard links and bind mounts.

@@ -165,8 +165,16 @@ bool read_corner(std::string_view c, long long idx[3], Form& form) {
 }
 
 /// assimp's concave-corner test for a quad (TriangulateProcess): the corner whose two angles to
-/// the opposite diagonal sum above pi, or 0.
+/// the opposite diagonal sum above pi, or 0. Without fused multiply-adds, which the build's
+/// -march=native would allow and Debian's assimp does not use: the same roundings as assimp's.
+#if defined(__clang__)
 int quad_start(const Vec3 p[4]) {
+#pragma clang fp contract(off)
+#elif defined(__GNUC__)
+__attribute__((optimize("fp-contract=off"))) int quad_start(const Vec3 p[4]) {
+#else
+int quad_start(const Vec3 p[4]) {
+#endif
   // As aiVector3D::Normalize, bit for bit: times the reciprocal of the length, a zero vector kept.
   const auto unit = [](Vec3 a) {
     const float len = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);

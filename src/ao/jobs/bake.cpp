@@ -278,7 +278,7 @@ std::vector<Mesh> load_occluders(const Plan& plan, const Scene& scene, const Sce
   std::vector<Mesh> out;
   for (const fs::path& f : plan.r.occluders) {
     Scene s = load_scene_file(f, kBakeLoad);
-    for (const std::string& w : s.warnings) reporter.warn(f.string() + ": " + w);
+    for (const std::string& w : s.warnings) reporter.warn(w);  // the loader names the file
     for (Mesh& m : s.meshes) {
       m.uvs.clear();
       out.push_back(std::move(m));

@@ -50,7 +50,7 @@ void declare(OutputSet& set, const fs::path& input, const Plan& plan, const Mesh
 
 /// Bakes write per-vertex values and UV maps of each placed mesh, so glTF instances are loaded as
 /// copies.
-inline constexpr LoadOptions kBakeLoad{.flatten_instances = true};
+inline const LoadOptions kBakeLoad{.flatten_instances = true};
 
 /// The --occluder meshes (UVs dropped: they occlude, they are not baked) and the floor under
 /// `scene` (and `high`).

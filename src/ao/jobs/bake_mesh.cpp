@@ -59,7 +59,7 @@ Scene load_high_scene(const std::vector<fs::path>& files, const JobReporter& rep
   high.name = files.size() == 1 ? files.front().string() : "--high meshes";
   for (const fs::path& f : files) {
     Scene s = load_scene_file(f, kBakeLoad);
-    for (const std::string& w : s.warnings) reporter.warn(f.string() + ": " + w);
+    for (const std::string& w : s.warnings) reporter.warn(w);  // the loader names the file
     for (Mesh& m : s.meshes) high.meshes.push_back(std::move(m));
   }
   return high;
@@ -341,7 +341,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
   if (is_gltf_round_trip(input, plan)) return bake_gltf_input(plan, input, outs, outputs, reporter);
   Stopwatch clock;
   Scene scene = load_scene_file(input, {.uv_set = plan.r.uv_set, .flatten_instances = true});
-  for (const std::string& w : scene.warnings) reporter.warn(input.string() + ": " + w);
+  for (const std::string& w : scene.warnings) reporter.warn(w);  // the loader names the file
   MeshJob job{plan, input, reporter, scene};
   job.clock = clock;
   job.timings["load_ms"] = job.clock.lap_ms();

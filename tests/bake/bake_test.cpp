@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <set>
 
@@ -386,6 +387,26 @@ void expect_identical_at_one_and_two_threads(Bake&& bake) {
     EXPECT_EQ(one.visibility[i], two.visibility[i]);
     EXPECT_EQ(one.bent_normal[i], two.bent_normal[i]);
   }
+}
+
+// The ray-traced baker reports progress in covered texels (the texels that cast rays), not in
+// texels of the map: on a chart covering a quarter of the map it ends at the covered count.
+TEST(Bake, RaytracedProgressCountsCoveredTexels) {
+  Scene s;
+  s.meshes.push_back(uv_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, {0, 0}, {0.5f, 0.5f}));
+  s = prepared(std::move(s));
+  const TexelCoverage cov = compute_texel_coverage(s, 32);
+  ASSERT_EQ(cov.covered_texels, 256u);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  std::atomic<std::size_t> last_done{0}, last_total{0};
+  bake_raytraced(rs, cov, {.samples = 4}, [&](std::size_t done, std::size_t total) {
+    std::size_t seen = last_done.load();
+    while (done > seen && !last_done.compare_exchange_weak(seen, done)) {
+    }
+    last_total = total;
+  });
+  EXPECT_EQ(last_total.load(), 256u);
+  EXPECT_EQ(last_done.load(), 256u);
 }
 
 TEST(Bake, HistogramIsIdenticalAtOneAndTwoThreads) {

@@ -20,13 +20,13 @@
 #include <cmath>
 #include <map>
 
+#include "ao/bake/denoise.h"
 #include "ao/bake/padding.h"
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
-#include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/embree_scene_internal.h"
-#include "ao/reference/packets_internal.h"
+#include "ao/reference/mean_accumulator_internal.h"
 #include "ao/reference/ray_offset.h"
 
 namespace ao {
@@ -38,6 +38,11 @@ constexpr int kMaxCageSkips = 64;  // back faces a cage ray may pass through bef
 
 using detail::PatchPiece;
 using detail::TriangleNormals;
+
+// What a sample of a texel becomes: a ray to trace, a sample that counts as occluded without a ray
+// (mu = 0: a direction below the face), or one left out of the texel's mean (its cage ray found no
+// surface).
+enum class SampleRay { Trace, Occluded, Skip };
 
 struct HighHit {
   bool hit = false;
@@ -95,6 +100,108 @@ std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
 }
 
 bool finite_nonnegative(const std::optional<float>& v) { return !v || (*v >= 0 && std::isfinite(*v)); }
+
+// Where the AO rays of a texel's samples leave: each sample's cage ray through its point of the low
+// patch, to the high mesh.
+struct CageRays {
+  const Scene& low;
+  const CagePositions& cage;
+  const std::vector<std::vector<Vec3>>& smooth;  // smoothed_normals(low)
+  const RayScene& targets;
+  const TriangleNormals& target_fn;
+  const HighToLowParams& params;
+  float surface_eps;  // cage this close to the surface: no direction from it
+  float offset;       // AO ray origin offset off the high surface
+
+  // The AO ray of one sample (point s on the low patch, u the uniforms of its direction): origin
+  // and direction set for Trace; Occluded for a direction below the high face (mu = 0); Skip when
+  // the cage ray finds no high surface (the sample is left out of the texel's mean).
+  SampleRay operator()(RTCIntersectContext& ctx, const detail::PatchSample& s, Vec2 u, Vec3& org, Vec3& dir) const {
+    const PatchPiece& pc = *s.piece;
+    const Vec3 p = s.position(), bary = s.barycentrics();
+    const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
+    const auto& cg = cage[pc.mesh];
+    const Vec3 c = cg[vi[0]] * bary.x + cg[vi[1]] * bary.y + cg[vi[2]] * bary.z;
+    const float cage_distance = length(c - p);
+    Vec3 d;
+    if (cage_distance > surface_eps) {
+      d = (p - c) / cage_distance;
+    } else {
+      const auto& sn = smooth[pc.mesh];
+      d = -normalize(sn[vi[0]] * bary.x + sn[vi[1]] * bary.y + sn[vi[2]] * bary.z);
+    }
+    const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
+    const HighHit h = trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
+    if (!h.hit) return SampleRay::Skip;
+    const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(u));
+    if (dot(w, h.ng) <= 0) return SampleRay::Occluded;  // below the high face: occluded by the surface itself (mu = 0)
+    org = h.p + h.ng * offset;
+    dir = w;
+    return SampleRay::Trace;
+  }
+};
+
+// A tile's worker for bake_high_to_low. Sample i of texel (x, y) is point i of a 4-D
+// Owen-scrambled Sobol set keyed by pixel_seed(seed, x, y): dimensions 0-1 make the direction,
+// 2-3 pick the point on the patch (one jointly stratified set; directions take the best
+// stratified 2-D projection, as the visibility varies far more over the hemisphere than over a
+// texel's patch).
+template <int N>
+class TexelWorker {
+ public:
+  TexelWorker(const CageRays& cage_rays, const detail::Tracer& tracer, const HighToLowParams& params, BakeResult& out, TexelGuides* guides,
+              std::atomic<std::uint64_t>& rays)
+      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), out_(out), guides_(guides), rays_(rays) {}
+
+  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
+    if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
+    const std::uint32_t key = pixel_seed(params_.ao.seed, x, y);
+    const int samples = params_.ao.samples;
+    detail::MeanAccumulator acc;  // over the samples whose cage ray found the high mesh
+    std::uint64_t traced = 0;
+    Vec3 bent{0, 0, 0};
+    for (int first = 0; first < samples; first += 16) {
+      const int count = std::min(16, samples - first);
+      SampleRay kind[16];
+      for (int k = 0; k < 16; ++k) {
+        batch_.valid[k] = 0;
+        if (k >= count) continue;
+        const std::array<float, 4> u = sobol_owen_4d(static_cast<std::uint32_t>(first + k), key);
+        Vec3 org, dir;
+        kind[k] = cage_rays_(ctx, detail::sample_patch(patch, {u[2], u[3]}), {u[0], u[1]}, org, dir);
+        if (kind[k] != SampleRay::Trace) continue;
+        batch_.valid[k] = -1;
+        batch_.ox[k] = org.x, batch_.oy[k] = org.y, batch_.oz[k] = org.z;
+        batch_.dx[k] = dir.x, batch_.dy[k] = dir.y, batch_.dz[k] = dir.z;
+      }
+      float mu[16];
+      batch_tracer_.trace(ctx, batch_, count, false, mu);
+      for (int k = 0; k < count; ++k) {
+        if (kind[k] == SampleRay::Skip) continue;
+        acc.add(mu[k]);  // 0 for Occluded
+        if (kind[k] != SampleRay::Trace) continue;
+        ++traced;
+        bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+      }
+    }
+    rays_ += static_cast<std::uint64_t>(samples) + traced;  // a cage ray per sample, and the AO rays
+    if (acc.n == 0) {
+      out_.missed[texel] = 1;
+      return;
+    }
+    out_.visibility[texel] = static_cast<float>(acc.mean());
+    if (params_.ao.bent_normals) out_.bent_normal[texel] = normalize(bent);
+  }
+
+ private:
+  const CageRays& cage_rays_;
+  detail::BatchTracer<N> batch_tracer_;
+  const HighToLowParams& params_;
+  BakeResult& out_;
+  TexelGuides* guides_;
+  std::atomic<std::uint64_t>& rays_;
+  alignas(64) detail::TexelRayBatch batch_;
+};
 
 }  // namespace
 
@@ -161,46 +268,17 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   out.warnings = cov.warnings();
   if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
   const float surface_eps = 1e-6f * occluders.bounds().diagonal();  // cage this close to the surface: no direction from it
-  std::atomic<std::uint64_t> traced{0};
-  const auto make_ray = [&](RTCIntersectContext& ctx, const detail::TexelSample& s, Vec3& org, Vec3& dir) {
-    const PatchPiece& pc = *s.point.piece;
-    const Vec3 p = s.point.position(), bary = s.point.barycentrics();
-    const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
-    const auto& cg = cage[pc.mesh];
-    const Vec3 c = cg[vi[0]] * bary.x + cg[vi[1]] * bary.y + cg[vi[2]] * bary.z;
-    const float cage_distance = length(c - p);
-    Vec3 d;
-    if (cage_distance > surface_eps) {
-      d = (p - c) / cage_distance;
-    } else {
-      const auto& sn = smooth[pc.mesh];
-      d = -normalize(sn[vi[0]] * bary.x + sn[vi[1]] * bary.y + sn[vi[2]] * bary.z);
-    }
-    const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
-    const HighHit h = trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
-    if (!h.hit) return detail::SampleRay::Skip;
-    const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(s.u_direction));
-    if (dot(w, h.ng) <= 0) return detail::SampleRay::Occluded;  // below the high face: occluded by the surface itself (mu = 0)
-    org = h.p + h.ng * offset;
-    dir = w;
-    return detail::SampleRay::Trace;
-  };
-  const auto finish = [&](std::size_t texel, const detail::TexelSums& sums) {
-    traced += static_cast<std::uint64_t>(sums.traced);
-    if (sums.counted == 0) {
-      out.missed[texel] = 1;
-      return;
-    }
-    out.visibility[texel] = static_cast<float>(sums.mu / sums.counted);
-    if (params.ao.bent_normals) out.bent_normal[texel] = normalize(sums.bent);
-  };
+  const CageRays cage_rays{low, cage, smooth, targets, target_fn, params, surface_eps, offset};
   // The filter's guides are the low mesh's patches: the map lives in its UV charts.
   const bool denoise = params.ao.denoise > 0;
   TexelGuides guides;
   if (denoise) guides = TexelGuides(width, height);
-  const std::size_t texels =
-      detail::bake_texels(low, cov, tracer, params.ao.samples, params.ao.seed, progress, denoise ? &guides : nullptr, make_ray, finish);
-  out.rays = static_cast<std::uint64_t>(texels) * static_cast<std::uint64_t>(params.ao.samples) + traced.load();  // a cage ray per sample, plus the AO rays
+  std::atomic<std::uint64_t> rays{0};
+  const TriangleNormals low_fn = detail::face_normals(low);
+  detail::for_each_texel_patch(occluders, low, cov, low_fn, progress, [&]<int N>() {
+    return TexelWorker<N>(cage_rays, tracer, params, out, denoise ? &guides : nullptr, rays);
+  });
+  out.rays = rays.load();
   for (std::size_t i = 0; i < out.missed.size(); ++i) out.missed_texels += out.missed[i];
   if (denoise) {  // over the texels that have a value; the missed ones are filled after, from filtered neighbours
     Image<std::uint8_t> valid = out.mask;

@@ -157,18 +157,21 @@ class TexelWorker {
     if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
     const std::uint32_t key = pixel_seed(params_.ao.seed, x, y);
     const int samples = params_.ao.samples;
+    if (guides_) noise_.reset(samples);
     detail::MeanAccumulator acc;  // over the samples whose cage ray found the high mesh
     std::uint64_t traced = 0;
     Vec3 bent{0, 0, 0};
     for (int first = 0; first < samples; first += 16) {
       const int count = std::min(16, samples - first);
       SampleRay kind[16];
+      std::uint32_t cell[16];
       for (int k = 0; k < 16; ++k) {
         batch_.valid[k] = 0;
         if (k >= count) continue;
         const std::array<float, 4> u = sobol_owen_4d(static_cast<std::uint32_t>(first + k), key);
         Vec3 org, dir;
         kind[k] = cage_rays_(ctx, detail::sample_patch(patch, {u[2], u[3]}), {u[0], u[1]}, org, dir);
+        cell[k] = noise_.cell(u[0], u[1]);
         if (kind[k] != SampleRay::Trace) continue;
         batch_.valid[k] = -1;
         batch_.ox[k] = org.x, batch_.oy[k] = org.y, batch_.oz[k] = org.z;
@@ -179,6 +182,7 @@ class TexelWorker {
       for (int k = 0; k < count; ++k) {
         if (kind[k] == SampleRay::Skip) continue;
         acc.add(mu[k]);  // 0 for Occluded
+        if (guides_) noise_.add(cell[k], mu[k]);
         if (kind[k] != SampleRay::Trace) continue;
         ++traced;
         bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
@@ -191,6 +195,7 @@ class TexelWorker {
     }
     out_.visibility[texel] = static_cast<float>(acc.mean());
     if (params_.ao.bent_normals) out_.bent_normal[texel] = normalize(bent);
+    if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
   }
 
  private:
@@ -200,6 +205,7 @@ class TexelWorker {
   BakeResult& out_;
   TexelGuides* guides_;
   std::atomic<std::uint64_t>& rays_;
+  detail::StratifiedVariance noise_;
   alignas(64) detail::TexelRayBatch batch_;
 };
 
@@ -283,7 +289,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   if (denoise) {  // over the texels that have a value; the missed ones are filled after, from filtered neighbours
     Image<std::uint8_t> valid = out.mask;
     for (std::size_t i = 0; i < valid.size(); ++i) valid[i] = valid[i] && !out.missed[i];
-    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise, params.ao.samples);
+    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise);
   }
   fill_missed_texels(out);
   out.stats = {{"rays", out.rays}, {"offset", offset}, {"missed_texels", out.missed_texels}};

@@ -88,6 +88,7 @@ class TexelWorker {
     table_.build(patch, params_.offset);
     if (guides_) detail::patch_guide(patch, geometric, guides_->position[texel], guides_->normal[texel]);
     points_.generate(pixel_seed(params_.seed, x, y), params_.samples);
+    if (guides_) noise_.reset(params_.samples);
     detail::MeanAccumulator acc;
     Vec3 bent{0, 0, 0};
     for (int first = 0; first < params_.samples; first += 16) {
@@ -99,15 +100,18 @@ class TexelWorker {
       batch_tracer_.trace(ctx, batch_, count, !params_.bent_normals, mu);
       for (int k = 0; k < count; ++k) {
         acc.add(mu[k]);  // a direction below the face (no ray) counts as occluded, mu = 0
+        if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
         if (batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
       }
     }
     out_.visibility[texel] = static_cast<float>(acc.mean());
     if (params_.bent_normals) out_.bent_normal[texel] = normalize(bent);
+    if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
   }
 
  private:
   detail::BatchTracer<N> batch_tracer_;
+  detail::StratifiedVariance noise_;
   const RaytracedBakeParams& params_;
   BakeResult& out_;
   TexelGuides* guides_;
@@ -160,14 +164,15 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
   if (params.bent_normals) out.bent_normal = Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0});
-  // The filter's guides, filled in the tile loop from the patches it builds anyway.
+  // The filter's guides, filled in the tile loop from the patches it builds anyway and each
+  // texel's samples.
   const bool denoise = params.denoise > 0;
   TexelGuides guides;
   if (denoise) guides = TexelGuides(cov.width, cov.height);
   detail::for_each_texel_patch(rs, scene, cov, fn, progress, [&]<int N>() {
     return TexelWorker<N>(tracer, params, out, denoise ? &guides : nullptr);
   });
-  if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise, params.samples);
+  if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise);
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
   out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;

@@ -126,6 +126,38 @@ void TexelPoints::generate(std::uint32_t key, int samples) {
   }
 }
 
+void StratifiedVariance::reset(int samples) {
+  int m = 0;
+  while ((2 << m) <= samples) ++m;  // 2^m <= samples < 2^(m+1)
+  // 2^(m-1) cells, as square as it goes.
+  const int c = std::max(m - 1, 0);
+  cols_ = 1 << ((c + 1) / 2), rows_ = 1 << (c / 2);
+  cells_.assign(static_cast<std::size_t>(cols_ * rows_), Sums{});
+}
+
+double StratifiedVariance::mean_variance() const {
+  double within = 0, pooled_ss = 0;
+  int n = 0, singles = 0, pooled_dof = 0;
+  for (const Sums& c : cells_) {
+    n += c.n;
+    if (c.n == 1) ++singles;
+    if (c.n < 2) continue;
+    const double ss = std::max(0.0, c.sum_sq - c.sum * c.sum / c.n);  // squares about the cell's mean: (n_c - 1) s_c^2
+    within += ss * c.n / (c.n - 1);  // n_c s_c^2
+    pooled_ss += ss;
+    pooled_dof += c.n - 1;
+  }
+  if (n < 2) return 0.0;
+  if (pooled_dof == 0) {
+    // No cell holds two samples (fewer than four samples): the plain sample variance.
+    double sum = 0, sum_sq = 0;
+    for (const Sums& c : cells_) sum += c.sum, sum_sq += c.sum_sq;
+    return std::max(0.0, (sum_sq - sum * sum / n) / (n - 1)) / n;
+  }
+  within += singles * (pooled_ss / pooled_dof);  // a lone sample's cell: the pooled within-cell variance
+  return within / (static_cast<double>(n) * n);
+}
+
 void TexelPoints::lanes(int first, int count, float (&out)[4][16]) const {
   for (int d = 0; d < 4; ++d) {
     std::copy_n(u[d].begin() + first, count, out[d]);

@@ -115,6 +115,43 @@ struct TexelPoints {
   void lanes(int first, int count, float (&out)[4][16]) const;
 };
 
+/// The variance of a texel's mean measured from its own samples, as a stratified estimate: the
+/// samples' direction uniforms (dimensions 0-1) are binned into a grid of 2^(m-1) cells, 2^m the
+/// largest power of two <= the sample count, and
+///   var(mean) = sum over cells c of n_c s_c^2 / n^2,
+/// s_c^2 the unbiased variance of the n_c samples in cell c (a cell with a single sample takes the
+/// pooled variance of the others). Each aligned block of 2^m points of the Sobol set is a
+/// (0, m, 2)-net in dimensions 0-1, so at a power-of-two count every cell holds exactly two
+/// samples: the finest strata the set guarantees. The visibility varies far more across the
+/// hemisphere than within one of these cells, so this measures the noise the stratified samples
+/// actually have, which the plain sample variance (for mu in {0, 1}, the V (1 - V) / n bound)
+/// overstates several times over.
+class StratifiedVariance {
+ public:
+  /// Empties the sums and sizes the grid for `samples` samples (>= 1).
+  void reset(int samples);
+  /// The cell of a sample whose direction uniforms are (u0, u1) in [0, 1)^2.
+  std::uint32_t cell(float u0, float u1) const {
+    const int a = std::min(static_cast<int>(u0 * static_cast<float>(cols_)), cols_ - 1);
+    const int b = std::min(static_cast<int>(u1 * static_cast<float>(rows_)), rows_ - 1);
+    return static_cast<std::uint32_t>(a * rows_ + b);
+  }
+  void add(std::uint32_t cell, double v) {
+    Sums& c = cells_[cell];
+    c.sum += v, c.sum_sq += v * v, ++c.n;
+  }
+  /// The variance of the mean of the samples added (0 with fewer than two).
+  double mean_variance() const;
+
+ private:
+  struct Sums {
+    double sum = 0, sum_sq = 0;
+    int n = 0;
+  };
+  int cols_ = 1, rows_ = 1;
+  std::vector<Sums> cells_;
+};
+
 /// A patch's pieces as columns of per-field rows (corner positions, corner normals, face normal,
 /// ray offset, and where the piece starts in the cumulative area with 1 / its area), built once
 /// per texel for make_texel_rays, which looks a lane's piece up in each row.

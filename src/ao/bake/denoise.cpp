@@ -8,6 +8,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "ao/reference/packets_internal.h"
+
 namespace ao {
 
 namespace {
@@ -43,6 +45,9 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
   const float range_scale = 1.0f / (kRangeTolerance * kRangeTolerance);
   const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    // The weights of far-apart neighbours underflow into denormals: flushed on every thread alike,
+    // whatever mode the pool thread was left in, so the result is the same at any thread count.
+    const detail::FlushDenormalsScope ftz;
     for (int y = rows.begin(); y < rows.end(); ++y)
       for (int x = 0; x < w; ++x) {
         const std::size_t c = at(x, y);

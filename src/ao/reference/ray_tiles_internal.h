@@ -3,7 +3,8 @@
 // flush-to-zero and denormals-are-zero on the thread that traces, and a fresh intersect context per
 // tile. Each pass says what one tile does and how much work it was, and progress is reported in
 // those units (covered pixels, texels, vertices), so a bar's rate is not skewed by tiles of
-// background. Internal to the ray-tracing passes (namespace detail).
+// background. The denormal mode is the tile's own and is restored after it, so code that runs on a
+// pool thread later does not inherit it. Internal to the ray-tracing passes (namespace detail).
 #pragma once
 
 #include <algorithm>
@@ -35,14 +36,14 @@ struct RayTiling {
 
 /// Calls fn.template operator()<N>(ctx, tile) for tiles covering [0, width) x [0, height), in
 /// parallel, N the scene's packet width (dispatch_packet_width), ctx an intersect context with
-/// `tiling.flags` made for that tile. fn returns the units of work the tile held (any unit the
+/// `tiling.flags` made for that tile, under FlushDenormalsScope. fn returns the units of work the tile held (any unit the
 /// pass's total is in), which are added to `progress`. Which thread runs a tile is not
 /// deterministic, so a tile's result may depend only on its own pixels.
 template <class Fn>
 void for_each_ray_tile(const RayScene& rs, int width, int height, const RayTiling& tiling, ProgressCounter& progress, Fn&& fn) {
   dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
     const auto run = [&](const Tile& t) {
-      flush_denormals_to_zero();
+      const FlushDenormalsScope ftz;
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
       ctx.flags = tiling.flags;

@@ -2,9 +2,12 @@
 //   V(T) = (1/A(T)) * integral over the low patch S of V_high(h(p)) dp,
 // where h(p) is where the cage ray through p first meets a front face of the high mesh and V_high
 // is eq. 2 of the per-texel AO paper (with mu(D) when a distance R is set) at h with the high
-// mesh's interpolated normal. Sample i of a texel takes a point p uniform by area on S and a
-// cosine-weighted direction about the high normal at h (pdf cos/pi cancels the cosine and 1/pi),
-// so V(T) is the plain mean of mu over the samples whose cage ray hit.
+// mesh's interpolated normal. Both integrals are estimated together, the area one with fewer points
+// than the hemisphere one: a texel's samples are split among P stratified points p_j of S (uniform
+// by area, HighToLowParams::cage_points), and each p_j's share of cosine-weighted directions about
+// the high normal at h(p_j) (pdf cos/pi cancels the cosine and 1/pi), so V(T) is the plain mean of
+// mu over the samples whose point's cage ray hit. V varies far less over a texel's patch than over
+// the hemisphere, so a few points per texel keep the area integration at a fraction of the cage rays.
 //
 // The cage ray: c(p) is the cage point with p's barycentrics (the extruded or explicit cage). The
 // ray runs along d = (p - c)/|p - c| (inwards) from p - f d to p + b d, f the front distance
@@ -38,11 +41,6 @@ constexpr int kMaxCageSkips = 64;  // back faces a cage ray may pass through bef
 
 using detail::PatchPiece;
 using detail::TriangleNormals;
-
-// What a sample of a texel becomes: a ray to trace, a sample that counts as occluded without a ray
-// (mu = 0: a direction below the face), or one left out of the texel's mean (its cage ray found no
-// surface).
-enum class SampleRay { Trace, Occluded, Skip };
 
 struct HighHit {
   bool hit = false;
@@ -101,8 +99,8 @@ std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
 
 bool finite_nonnegative(const std::optional<float>& v) { return !v || (*v >= 0 && std::isfinite(*v)); }
 
-// Where the AO rays of a texel's samples leave: each sample's cage ray through its point of the low
-// patch, to the high mesh.
+// Where the AO rays of a point of the low patch leave: its cage ray, through the point, to the
+// first front face of the high mesh.
 struct CageRays {
   const Scene& low;
   const CagePositions& cage;
@@ -111,12 +109,8 @@ struct CageRays {
   const TriangleNormals& target_fn;
   const HighToLowParams& params;
   float surface_eps;  // cage this close to the surface: no direction from it
-  float offset;       // AO ray origin offset off the high surface
 
-  // The AO ray of one sample (point s on the low patch, u the uniforms of its direction): origin
-  // and direction set for Trace; Occluded for a direction below the high face (mu = 0); Skip when
-  // the cage ray finds no high surface (the sample is left out of the texel's mean).
-  SampleRay operator()(RTCIntersectContext& ctx, const detail::PatchSample& s, Vec2 u, Vec3& org, Vec3& dir) const {
+  HighHit operator()(RTCIntersectContext& ctx, const detail::PatchSample& s) const {
     const PatchPiece& pc = *s.piece;
     const Vec3 p = s.position(), bary = s.barycentrics();
     const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
@@ -131,64 +125,56 @@ struct CageRays {
       d = -normalize(sn[vi[0]] * bary.x + sn[vi[1]] * bary.y + sn[vi[2]] * bary.z);
     }
     const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
-    const HighHit h = trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
-    if (!h.hit) return SampleRay::Skip;
-    const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(u));
-    if (dot(w, h.ng) <= 0) return SampleRay::Occluded;  // below the high face: occluded by the surface itself (mu = 0)
-    org = h.p + h.ng * offset;
-    dir = w;
-    return SampleRay::Trace;
+    return trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
   }
 };
 
-// A tile's worker for bake_high_to_low. Sample i of texel (x, y) is point i of a 4-D
-// Owen-scrambled Sobol set keyed by pixel_seed(seed, x, y): dimensions 0-1 make the direction,
-// 2-3 pick the point on the patch (one jointly stratified set; directions take the best
-// stratified 2-D projection, as the visibility varies far more over the hemisphere than over a
-// texel's patch).
+// A tile's worker for bake_high_to_low. A texel's P = min(cage_points, samples) cage points are
+// points 0 .. P - 1 of a 2-D Owen-scrambled Sobol set (keyed by the texel's key hashed once more)
+// mapped onto the patch by area (sample_patch): stratified over the texel's patch. Cage point j
+// carries the AO directions of samples [j n / P, (j + 1) n / P) of the texel's Owen-scrambled Sobol
+// set (dimensions 0-1 of sobol_owen_4d keyed by pixel_seed(seed, x, y), the single-mesh baker's
+// direction dimensions): at n / P a power of two each block is a (0, m, 2)-net of its own,
+// stratified over the hemisphere, and the blocks together are the texel's whole net.
+// All the directions of a cage point leave from its high-poly hit, so they go to Embree as packets
+// with one origin; the samples of a cage point that finds no high surface are left out.
 template <int N>
 class TexelWorker {
  public:
-  TexelWorker(const CageRays& cage_rays, const detail::Tracer& tracer, const HighToLowParams& params, BakeResult& out, TexelGuides* guides,
-              std::atomic<std::uint64_t>& rays)
-      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), out_(out), guides_(guides), rays_(rays) {}
+  TexelWorker(const CageRays& cage_rays, const detail::Tracer& tracer, const HighToLowParams& params, float offset, BakeResult& out,
+              TexelGuides* guides, std::atomic<std::uint64_t>& rays)
+      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), offset_(offset), out_(out), guides_(guides), rays_(rays) {}
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
     if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
-    const std::uint32_t key = pixel_seed(params_.ao.seed, x, y);
-    const int samples = params_.ao.samples;
+    const std::uint32_t key = pixel_seed(params_.ao.seed, x, y), point_key = hash_combine(key, 0x3c6ef372u);
+    const int samples = params_.ao.samples, points = std::min(params_.cage_points, samples);
+    const bool geometric = params_.ao.normal == SurfaceNormal::Geometric;
     if (guides_) noise_.reset(samples);
-    detail::MeanAccumulator acc;  // over the samples whose cage ray found the high mesh
+    detail::MeanAccumulator acc;  // over the samples whose cage point found the high mesh
     std::uint64_t traced = 0;
     Vec3 bent{0, 0, 0};
-    for (int first = 0; first < samples; first += 16) {
-      const int count = std::min(16, samples - first);
-      SampleRay kind[16];
-      std::uint32_t cell[16];
-      for (int k = 0; k < 16; ++k) {
-        batch_.valid[k] = 0;
-        if (k >= count) continue;
-        const std::array<float, 4> u = sobol_owen_4d(static_cast<std::uint32_t>(first + k), key);
-        Vec3 org, dir;
-        kind[k] = cage_rays_(ctx, detail::sample_patch(patch, {u[2], u[3]}), {u[0], u[1]}, org, dir);
-        cell[k] = noise_.cell(u[0], u[1]);
-        if (kind[k] != SampleRay::Trace) continue;
-        batch_.valid[k] = -1;
-        batch_.ox[k] = org.x, batch_.oy[k] = org.y, batch_.oz[k] = org.z;
-        batch_.dx[k] = dir.x, batch_.dy[k] = dir.y, batch_.dz[k] = dir.z;
-      }
-      float mu[16];
-      batch_tracer_.trace(ctx, batch_, count, false, mu);
-      for (int k = 0; k < count; ++k) {
-        if (kind[k] == SampleRay::Skip) continue;
-        acc.add(mu[k]);  // 0 for Occluded
-        if (guides_) noise_.add(cell[k], mu[k]);
-        if (kind[k] != SampleRay::Trace) continue;
-        ++traced;
-        bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+    for (int j = 0; j < points; ++j) {
+      const HighHit h = cage_rays_(ctx, detail::sample_patch(patch, sobol_owen_2d(static_cast<std::uint32_t>(j), point_key)));
+      if (!h.hit) continue;
+      const Vec3 origin = h.p + h.ng * offset_;
+      const int end = static_cast<int>(static_cast<std::int64_t>(j + 1) * samples / points);
+      for (int first = static_cast<int>(static_cast<std::int64_t>(j) * samples / points); first < end; first += 16) {
+        const int count = std::min(16, end - first);
+        sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, u_);  // dimensions 0-1: the direction
+        detail::make_hemisphere_rays(origin, geometric ? h.ng : h.n, h.ng, u_, count, batch_);
+        float mu[16];
+        batch_tracer_.trace(ctx, batch_, count, true, mu);
+        for (int k = 0; k < count; ++k) {
+          acc.add(mu[k]);
+          if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
+          if (!batch_.valid[k]) continue;
+          ++traced;
+          bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+        }
       }
     }
-    rays_ += static_cast<std::uint64_t>(samples) + traced;  // a cage ray per sample, and the AO rays
+    rays_ += static_cast<std::uint64_t>(points) + traced;  // a cage ray per cage point, and the AO rays
     if (acc.n == 0) {
       out_.missed[texel] = 1;
       return;
@@ -202,10 +188,12 @@ class TexelWorker {
   const CageRays& cage_rays_;
   detail::BatchTracer<N> batch_tracer_;
   const HighToLowParams& params_;
+  float offset_;
   BakeResult& out_;
   TexelGuides* guides_;
   std::atomic<std::uint64_t>& rays_;
   detail::StratifiedVariance noise_;
+  alignas(64) float u_[4][16] = {};  // lanes past a block's count keep any finite values
   alignas(64) detail::TexelRayBatch batch_;
 };
 
@@ -216,6 +204,9 @@ void HighToLowParams::validate() const {
   if (!finite_nonnegative(cage_extrusion)) throw InputError("high-to-low: cage extrusion must be a finite number >= 0 (world units)");
   if (!finite_nonnegative(max_front)) throw InputError("high-to-low: max front distance must be a finite number >= 0 (world units)");
   if (!finite_nonnegative(max_back)) throw InputError("high-to-low: max back distance must be a finite number >= 0 (world units)");
+  if (cage_points < 1 || cage_points > (1 << 20))
+    throw InputError("high-to-low: --cage-points must be in [1, 1048576] cage rays per texel (at most one per sample is used), got " +
+                     std::to_string(cage_points));
 }
 
 void to_json(nlohmann::json& j, const HighToLowParams& p) {
@@ -223,7 +214,8 @@ void to_json(nlohmann::json& j, const HighToLowParams& p) {
   j = {{"ao", p.ao},
        {"cage_extrusion", opt(p.cage_extrusion, "0.01 x low diagonal")},
        {"max_front", opt(p.max_front, "cage")},
-       {"max_back", opt(p.max_back, "cage distance")}};
+       {"max_back", opt(p.max_back, "cage distance")},
+       {"cage_points", p.cage_points}};
 }
 
 CagePositions extrude_cage(const Scene& low, float distance) {
@@ -274,7 +266,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   out.warnings = cov.warnings();
   if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
   const float surface_eps = 1e-6f * occluders.bounds().diagonal();  // cage this close to the surface: no direction from it
-  const CageRays cage_rays{low, cage, smooth, targets, target_fn, params, surface_eps, offset};
+  const CageRays cage_rays{low, cage, smooth, targets, target_fn, params, surface_eps};
   // The filter's guides are the low mesh's patches: the map lives in its UV charts.
   const bool denoise = params.ao.denoise > 0;
   TexelGuides guides;
@@ -282,7 +274,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   std::atomic<std::uint64_t> rays{0};
   const TriangleNormals low_fn = detail::face_normals(low);
   detail::for_each_texel_patch(occluders, low, cov, low_fn, progress, [&]<int N>() {
-    return TexelWorker<N>(cage_rays, tracer, params, out, denoise ? &guides : nullptr, rays);
+    return TexelWorker<N>(cage_rays, tracer, params, offset, out, denoise ? &guides : nullptr, rays);
   });
   out.rays = rays.load();
   for (std::size_t i = 0; i < out.missed.size(); ++i) out.missed_texels += out.missed[i];

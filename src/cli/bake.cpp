@@ -305,9 +305,8 @@ BakeResult bake_in_groups(const fs::path& input, const Scene& scene, const Scene
                                for (const Mesh& m : occluders) blockers.meshes.push_back(m);
                                CagePositions gc;
                                for (std::size_t i : g.meshes) gc.push_back((*cage)[i]);
-                               const RayScene target_rays(targets);
-                               if (occluders.empty()) return bake_high_to_low(gs, cov, gc, target_rays, target_rays, p, progress);
-                               const RayScene blocker_rays(blockers);
+                               const RayScene target_rays(targets, high_to_low_target_bvh_options(targets.triangle_count()));
+                               const RayScene blocker_rays(blockers, bake_bvh_options(blockers.triangle_count()));
                                return bake_high_to_low(gs, cov, gc, target_rays, blocker_rays, p, progress);
                              });
   if (groups.size() > 1) summary["groups"] = groups.size();
@@ -811,6 +810,9 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
                   "High to low: without --cage, push the low mesh out along its smoothed normals by this distance, world units (default 0.01 x diagonal)");
   cmd->add_option("--max-front", o->h2l.max_front, "High to low: rays start this far outside the low surface, world units (default: at the cage)");
   cmd->add_option("--max-back", o->h2l.max_back, "High to low: rays look this far inside the low surface, world units (default: the cage distance)");
+  cmd->add_option("--cage-points", o->h2l.cage_points,
+                  "High to low: cage rays per texel, stratified over its patch, each carrying an equal share of the texel's AO rays [1, 1048576]")
+      ->capture_default_str();
   cmd->add_option("--occluder", o->occluders, "Mesh that occludes but is not baked (repeatable)")->type_name("MESH");
   cmd->add_flag("--floor", o->floor, "Add a ground plane under the model (y up, at its lowest point) as an occluder");
   cmd->add_option("--group", o->groups, "Bake group: comma-separated mesh names that occlude each other and nothing else (repeatable; meshes not named form one more group)")

@@ -21,7 +21,7 @@ def load_mesh(path, name):
         mesh.polygons.foreach_set("use_smooth", [True] * len(faces))  # interpolated normals, as ao's loader gives an OFF
         obj = bpy.data.objects.new(name, mesh)
         bpy.context.scene.collection.objects.link(obj)
-        return obj, dict(forward_axis="NEGATIVE_Z", up_axis="Z")
+        return obj, dict(forward_axis="Y", up_axis="Z")  # Blender's own axes: written as read
     before = set(bpy.context.scene.objects)
     bpy.ops.import_scene.obj(filepath=path, axis_forward="-Z", axis_up="Y", split_mode="OFF")
     obj = [o for o in bpy.context.scene.objects if o.type == "MESH" and o not in before][0]

@@ -684,7 +684,7 @@ int run_bake(BakeOptions o, const GlobalOptions& global) {
   if (o.denoise_given && !wants_map(o)) throw InputError("--denoise filters maps; per-vertex AO is not filtered, so drop --denoise");
   // High to low bakes the high mesh's detail, often a few texels wide, which the filter would
   // soften: filtered only when asked (docs/methods/bake.md, "Denoising").
-  o.rt.denoise = wants_map(o) && (o.high.empty() || o.denoise_given) ? o.denoise : 0.0f;
+  o.rt.denoise = wants_map(o) ? o.denoise : 0.0f;
   o.rt.validate();  // before any mesh is loaded: --samples, --offset, --denoise
   o.hist.validate();
   const auto size = parse_map_size(o.size_text);
@@ -777,8 +777,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--samples,--spp", o->rt.samples, "raytraced: rays per texel (per vertex with --per-vertex)")->capture_default_str();
   auto* denoise_opt = cmd->add_option("--denoise", o->denoise,
                                       "raytraced maps: sigma in texels of the texture-space filter that averages the noise of texels that are "
-                                      "neighbours on the surface (not across charts or creases); 0 = off, the plain ray-traced estimate; --high maps: off "
-                                      "unless given [0, 4]")
+                                      "neighbours on the surface (not across charts or creases); 0 = off, the plain ray-traced estimate [0, 4]")
                           ->capture_default_str();
   cmd->add_option("--max-distance", o->max_distance, "raytraced: occluders count only within this distance R, world units (default: unlimited)");
   cmd->add_option("--membership", o->membership, "raytraced with --max-distance: falloff step, linear, sqrt or cubic")->capture_default_str();

@@ -82,7 +82,7 @@ for setting in $settings; do
   timed "$ao" --threads 2 bake "$mesh" "${h2l[@]}" -s "$size" "${args[@]}" --padding 0 -o "$out/$name.exr" --json > "$out/$name.json" 2>/dev/null
   t1=$(now)
   bake=$(python3 -c 'import json,sys; t=json.load(open(sys.argv[1]))["timings"]; print("%.2f" % ((t.get("bvh_ms", 0) + t["uv_coverage_ms"] + t["bake_ms"] + t["padding_ms"]) / 1000))' "$out/$name.json")
-  sigma_used=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["parameters"]["denoise"])' "$out/$name.json")
+  sigma_used=$(python3 -c 'import json,sys; p = json.load(open(sys.argv[1]))["parameters"]; print(p.get("denoise", p.get("ao", {}).get("denoise")))' "$out/$name.json")
   echo "| ao | $spp rays/texel, --denoise $sigma_used${points:+, --cage-points $points} | $(errors "$out/$name.exr") | $bake | $(secs "$t0" "$t1") | $(cat "$out/cpu") |"
 done
 for spp in ${SAMPLES:-32 64 128 256}; do

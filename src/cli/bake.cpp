@@ -80,8 +80,7 @@ void add_raytraced_options(CLI::App& cmd, BakeOptions& o) {
   const auto help = [&](std::string_view name) { return param_help(table, name, "raytraced: "); };
   cmd.add_option("--samples,--spp", rt.samples, help("samples"))->capture_default_str();
   cmd.add_option("--denoise", o.request.denoise,
-                 help("denoise") + ": averages the noise of texels that are neighbours on the surface (not across charts or creases); "
-                 "--high maps: off unless given")
+                 help("denoise") + ": averages the noise of texels that are neighbours on the surface (not across charts or creases)")
       ->default_str(float_text(kDefaultBakeDenoise));
   cmd.add_option("--max-distance", rt.max_distance, help("max_distance"));
   cmd.add_option("--membership", o.membership, help("membership"))->capture_default_str();
@@ -103,6 +102,7 @@ void add_high_to_low_options(CLI::App& cmd, BakeOptions& o) {
   cmd.add_option("--cage-extrusion", r.high_to_low.cage_extrusion, help("cage_extrusion"));
   cmd.add_option("--max-front", r.high_to_low.max_front, help("max_front"));
   cmd.add_option("--max-back", r.high_to_low.max_back, help("max_back"));
+  cmd.add_option("--cage-points", r.high_to_low.cage_points, help("cage_points"))->capture_default_str();
   cmd.add_option("--occluder", r.occluders, "Mesh that occludes but is not baked (repeatable)")->type_name("MESH");
   cmd.add_flag("--floor", r.floor, "Add a ground plane under the model (y up, at its lowest point) as an occluder");
   cmd.add_option("--group", o.groups, "Bake group: comma-separated mesh names that occlude each other and nothing else (repeatable; meshes not named form one more group)")

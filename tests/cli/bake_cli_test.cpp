@@ -312,7 +312,7 @@ TEST(BakeCliHighToLow, ConvexHighMeshBakesOpenWithNoMisses) {
   EXPECT_EQ(j["high_triangles"], 12);
   const Image<float> miss = read_image(dir / "miss.png");
   for (std::size_t i = 0; i < miss.size(); ++i) ASSERT_EQ(miss[i], 0.0f);
-  // Filtered when asked (high to low is not filtered by default): an open map stays exactly 1.
+  // Filtered (high to low is filtered by default too): an open map stays exactly 1.
   const RunResult f = run_ao("bake low.obj --high high.obj --cage-extrusion 0.05 -o ao.exr --json --size 16 --samples 8 --denoise 1", dir.path());
   ASSERT_EQ(f.exit_code, 0) << f.err;
   EXPECT_EQ(nlohmann::json::parse(f.out)["mean_visibility"].get<double>(), 1.0);

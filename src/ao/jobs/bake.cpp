@@ -187,13 +187,12 @@ void check_udim(const Plan& plan) {
       throw InputError(r.outputs.map.string() + ": UDIM tiles are written for the map only; " + what + " needs a single map, drop it or the tile pattern");
 }
 
-// Both bakers' settings as the request sets them: the filter of ray-traced maps (off for high to
-// low unless asked: it softens the high mesh's texel-scale detail, docs/methods/bake.md), bent
-// normals when their output is named.
+// Both bakers' settings as the request sets them: the filter of ray-traced maps (high to low
+// included: docs/methods/bake.md, "Denoising"), bent normals when their output is named.
 void resolve_baker_settings(Plan& plan) {
   BakeRequest& r = plan.r;
   if (r.denoise && !plan.wants_map()) throw InputError("--denoise filters maps; per-vertex AO is not filtered, so drop --denoise");
-  r.raytraced.denoise = plan.wants_map() ? r.denoise.value_or(plan.high_to_low() ? 0.0f : kDefaultBakeDenoise) : 0.0f;
+  r.raytraced.denoise = plan.wants_map() ? r.denoise.value_or(kDefaultBakeDenoise) : 0.0f;
   r.raytraced.bent_normals = r.histogram.bent_normals = !r.outputs.bent_normals.empty();
   r.raytraced.validate();  // before any mesh is loaded: --samples, --offset, --denoise
   r.histogram.validate();

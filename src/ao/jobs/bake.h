@@ -77,8 +77,7 @@ struct BakeRequest {
   /// set by the job from `outputs` and `denoise`.
   RaytracedBakeParams raytraced;
   /// Sigma, texels, of the texture-space filter of ray-traced maps, [0, kMaxDenoiseSigma]; 0 = off.
-  /// Unset: kDefaultBakeDenoise, but off for high-to-low maps (their point is the high mesh's
-  /// texel-scale detail, docs/methods/bake.md). Per-vertex AO is never filtered.
+  /// Unset: kDefaultBakeDenoise (docs/methods/bake.md, "Denoising"). Per-vertex AO is never filtered.
   std::optional<float> denoise;
   HistogramParams histogram;        ///< The histogram baker's settings; bent_normals set by the job.
   int vertex_resolution = 1024;     ///< Histogram per-vertex bakes: view size in pixels, [64, 8192].

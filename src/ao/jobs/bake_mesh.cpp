@@ -100,9 +100,9 @@ BakeResult bake_group_high_to_low(const MeshJob& job, const Scene& group_scene, 
   for (const Mesh& m : job.occluders) blockers.meshes.push_back(m);
   CagePositions gc;
   for (std::size_t i : g.meshes) gc.push_back(cage[i]);
-  const RayScene target_rays(targets);
-  if (job.occluders.empty()) return bake_high_to_low(group_scene, cov, gc, target_rays, target_rays, p, progress);
-  const RayScene blocker_rays(blockers);
+  // Cage rays want triangles (their hits are interpolated); AO rays take the bake's quad BVH.
+  const RayScene target_rays(targets, high_to_low_target_bvh_options(targets.triangle_count()));
+  const RayScene blocker_rays(blockers, bake_bvh_options(blockers.triangle_count()));
   return bake_high_to_low(group_scene, cov, gc, target_rays, blocker_rays, p, progress);
 }
 

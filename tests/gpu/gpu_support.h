@@ -1,0 +1,56 @@
+// Shared by the GPU backend's tests: one device for the whole test binary (Mesa's software
+// renderer, so results do not depend on the machine's GPU; CI has no GPU), and small scenes with
+// their CPU G-buffers (the images are small: llvmpipe runs the shaders on the CPU).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/gpu/device.h"
+#include "ao/gpu/gbuffer.h"
+#include "ao/reference/ray_scene.h"
+#include "ao/scene/procedural.h"
+
+namespace ao::test {
+
+/// The test binary's device: llvmpipe through EGL, opened on first use. A machine without a usable
+/// GL fails the GPU tests with the device's one-line error (scripts/setup installs Mesa).
+inline GpuDevice& gpu_device() {
+  static GpuDevice device = GpuDevice::open({.software = true});
+  return device;
+}
+
+/// A built-in scene, its ray tracer, its GPU copy and its CPU G-buffer from the scene's own view at
+/// width x height.
+struct GpuFixture {
+  Scene scene;
+  std::unique_ptr<RayScene> rays;
+  std::unique_ptr<GpuScene> gpu_scene;
+  GBuffer g;
+  float radius = 0;  ///< R: 0.1 x the diagonal of the scene's bounds, as `ao render`'s default order of magnitude.
+};
+
+inline GpuFixture gpu_fixture(const std::string& name, int width = 96, int height = 64) {
+  GpuFixture f{make_builtin_scene(name), nullptr, nullptr, {}, 0};
+  f.rays = std::make_unique<RayScene>(f.scene);
+  f.gpu_scene = std::make_unique<GpuScene>(GpuScene::upload(gpu_device(), f.scene));
+  Camera c = *f.scene.preferred_view;
+  c.width = width;
+  c.height = height;
+  f.g = render_gbuffer(*f.rays, c);
+  f.radius = 0.1f * f.scene.bounds().diagonal();
+  return f;
+}
+
+/// A test name from a scene name ("sphere-on-plane" -> "sphere_on_plane").
+inline std::string scene_test_name(const ::testing::TestParamInfo<std::string>& info) {
+  std::string n = info.param;
+  for (char& ch : n)
+    if (ch == '-' || ch == '*') ch = '_';
+  return n;
+}
+
+}  // namespace ao::test

@@ -87,6 +87,9 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   const int w = g.width(), h = g.height();
   if (w < 1 || h < 1 || g.position.width() != w || g.normal.width() != w || g.object_id.width() != w)
     throw InputError("--device gpu: the G-buffer to upload is empty or its channels differ in size");
+  Program& p = c.program({"gbuffer_depth.comp"});
+  std::vector<PassQuery> passes;
+  c.begin_pass(passes, "upload");  // the copies and the depth pass
   auto t = std::make_shared<GBufferTextures>();
   t->context = device.shared_context();
   t->camera = g.camera;
@@ -118,9 +121,6 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
     t->direct = make_texture(c, w, h, GL_RGBA32F);
     gpu_detail::upload(c, t->direct, GL_RGB, GL_FLOAT, g.direct.data());
   }
-  std::vector<PassQuery> passes;
-  c.begin_pass(passes, "upload");
-  Program& p = c.program({"gbuffer_depth.comp"});
   c.gl.UseProgram(p.id);
   c.gl.Uniform2i(c.uniform(p, "u_size"), w, h);
   t->bind();
@@ -169,6 +169,7 @@ GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const
   if (c.gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw SystemError("--device gpu: the G-buffer's render targets are not supported by " + c.renderer);
 
+  Program& p = c.program({"gbuffer.vert", "gbuffer.geom", "gbuffer.frag"});
   std::vector<PassQuery> passes;
   c.begin_pass(passes, "gbuffer");
   c.gl.Viewport(0, 0, w, h);
@@ -190,13 +191,12 @@ GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const
   const Bounds3 bounds = scene.scene().bounds();
   float farthest = 0;
   for (int k = 0; k < 8; ++k) {
-    const Vec3 p{k & 1 ? bounds.hi.x : bounds.lo.x, k & 2 ? bounds.hi.y : bounds.lo.y, k & 4 ? bounds.hi.z : bounds.lo.z};
-    farthest = std::max(farthest, -basis.to_local(p - camera.eye).z);
+    const Vec3 corner{k & 1 ? bounds.hi.x : bounds.lo.x, k & 2 ? bounds.hi.y : bounds.lo.y, k & 4 ? bounds.hi.z : bounds.lo.z};
+    farthest = std::max(farthest, -basis.to_local(corner - camera.eye).z);
   }
   const float near = std::max(1e-6f * farthest, 1e-30f);
   const float tan_half = camera.tan_half_fov();
 
-  Program& p = c.program({"gbuffer.vert", "gbuffer.geom", "gbuffer.frag"});
   c.gl.UseProgram(p.id);
   set_vec3(c, p, "u_eye", camera.eye);
   set_vec3(c, p, "u_basis_x", basis.t);

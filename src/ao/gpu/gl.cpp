@@ -116,8 +116,8 @@ std::string shader_source(std::string_view name) {
   return out;
 }
 
-Program& Context::program(std::initializer_list<std::string_view> stages) {
-  std::string key;
+Program& Context::program(std::initializer_list<std::string_view> stages, std::string_view defines) {
+  std::string key(defines);
   for (std::string_view s : stages) key += std::string(s) + ";";
   if (auto it = programs_.find(key); it != programs_.end()) return it->second;
   const GLuint prog = gl.CreateProgram();
@@ -132,7 +132,8 @@ Program& Context::program(std::initializer_list<std::string_view> stages) {
     return log.substr(0, log.find('\0'));
   };
   for (std::string_view s : stages) {
-    const std::string source = shader_source(s);
+    std::string source = shader_source(s);
+    source.insert(source.find('\n') + 1, defines);
     const GLuint sh = gl.CreateShader(stage_of(s));
     const char* text = source.c_str();
     gl.ShaderSource(sh, 1, &text, nullptr);
@@ -169,21 +170,29 @@ GLint Context::uniform(Program& p, std::string_view name) {
 }
 
 void Context::begin_pass(std::vector<PassQuery>& passes, std::string name) {
-  GLuint q = 0;
-  gl.GenQueries(1, &q);
-  gl.BeginQuery(GL_TIME_ELAPSED, q);
-  passes.push_back({std::move(name), q});
+  // Two GL_TIMESTAMP counters per pass, not a GL_TIME_ELAPSED query: llvmpipe reports no elapsed
+  // time for compute dispatches, while its timestamps (and every GPU's) bracket them.
+  PassQuery q{std::move(name), {0, 0}};
+  gl.GenQueries(2, q.query.data());
+  gl.QueryCounter(q.query[0], GL_TIMESTAMP);
+  passes.push_back(std::move(q));
+  open_pass_ = &passes;
 }
 
-void Context::end_pass() { gl.EndQuery(GL_TIME_ELAPSED); }
+void Context::end_pass() {
+  if (!open_pass_ || open_pass_->empty()) return;
+  gl.QueryCounter(open_pass_->back().query[1], GL_TIMESTAMP);
+  open_pass_ = nullptr;
+}
 
 std::vector<GpuPassTime> Context::resolve(std::vector<PassQuery>& passes) {
   std::vector<GpuPassTime> out;
   for (PassQuery& p : passes) {
-    GLuint64 ns = 0;
-    gl.GetQueryObjectui64v(p.query, GL_QUERY_RESULT, &ns);  // waits for the pass to finish
-    gl.DeleteQueries(1, &p.query);
-    out.push_back({p.name, static_cast<double>(ns) * 1e-6});
+    GLuint64 t0 = 0, t1 = 0;
+    gl.GetQueryObjectui64v(p.query[0], GL_QUERY_RESULT, &t0);  // waits for the pass to finish
+    gl.GetQueryObjectui64v(p.query[1], GL_QUERY_RESULT, &t1);
+    gl.DeleteQueries(2, p.query.data());
+    out.push_back({p.name, t1 > t0 ? static_cast<double>(t1 - t0) * 1e-6 : 0.0});
   }
   passes.clear();
   return out;

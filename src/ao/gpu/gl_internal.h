@@ -6,6 +6,7 @@
 #define GL_GLEXT_PROTOTYPES 0
 #include <GL/glcorearb.h>
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -67,12 +68,13 @@ namespace ao::gpu_detail {
   X(PFNGLBUFFERDATAPROC, BufferData)                                                                                         \
   X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                                                                 \
   X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                                                                             \
+  X(PFNGLCLEARBUFFERDATAPROC, ClearBufferData)                                                                               \
+  X(PFNGLFRAMEBUFFERPARAMETERIPROC, FramebufferParameteri)                                                                   \
   X(PFNGLDISPATCHCOMPUTEPROC, DispatchCompute)                                                                               \
   X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                                                                   \
   X(PFNGLGENQUERIESPROC, GenQueries)                                                                                         \
   X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                                                                   \
-  X(PFNGLBEGINQUERYPROC, BeginQuery)                                                                                         \
-  X(PFNGLENDQUERYPROC, EndQuery)                                                                                             \
+  X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                                                                     \
   X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)                                                                       \
   X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                                                                               \
   X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                                                                         \
@@ -88,7 +90,6 @@ namespace ao::gpu_detail {
   X(PFNGLISENABLEDPROC, IsEnabled)                                                                                           \
   X(PFNGLDEPTHFUNCPROC, DepthFunc)                                                                                           \
   X(PFNGLDEPTHMASKPROC, DepthMask)                                                                                           \
-  X(PFNGLLOGICOPPROC, LogicOp)                                                                                               \
   X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                                                                               \
   X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                                                                         \
   X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                                                                               \
@@ -107,10 +108,10 @@ struct GlFunctions {
   void load(GlProcLoader loader);
 };
 
-/// One pass's GPU time: a GL_TIME_ELAPSED query around its commands, read when the run is over.
+/// One pass's GPU time: GL_TIMESTAMP queries before and after its commands, read when the run is over.
 struct PassQuery {
   std::string name;
-  GLuint query = 0;
+  std::array<GLuint, 2> query{};
 };
 
 /// A compiled program: its GL name and the uniform locations looked up so far.
@@ -147,16 +148,17 @@ class Context {
   void initialise(GlProcLoader loader);
 
   /// The program made of the embedded shader files `stages` (by file name; the stage follows from
-  /// the extension: .comp, .vert, .geom, .frag), compiled and linked on first use. SystemError with
-  /// the compiler's log on failure (a shader bug or a driver that rejects valid GLSL).
-  Program& program(std::initializer_list<std::string_view> stages);
+  /// the extension: .comp, .vert, .geom, .frag), compiled and linked on first use, with `defines`
+  /// ("#define CHANNELS 4\n") inserted after each file's #version line. SystemError with the
+  /// compiler's log on failure (a shader bug or a driver that rejects valid GLSL).
+  Program& program(std::initializer_list<std::string_view> stages, std::string_view defines = {});
   /// Location of uniform `name` in `p` (-1 when the compiler removed it: setting it is then a no-op).
   GLint uniform(Program& p, std::string_view name);
 
   /// Throws SystemError naming `what` when a GL error is pending (GL_OUT_OF_MEMORY above all).
   void check(std::string_view what);
 
-  /// Starts and ends a timed pass (GL_TIME_ELAPSED queries do not nest: one pass at a time).
+  /// Starts and ends a timed pass (one pass at a time: end_pass closes the last one begun).
   void begin_pass(std::vector<PassQuery>& passes, std::string name);
   void end_pass();
   /// The milliseconds of every pass (waits for the GPU to finish them); deletes the queries.
@@ -164,6 +166,7 @@ class Context {
 
  private:
   std::map<std::string, Program, std::less<>> programs_;
+  std::vector<PassQuery>* open_pass_ = nullptr;
 };
 
 /// The embedded text of shader file `name` (src/ao/gpu/shaders/), with every `#include "file"`

@@ -33,8 +33,25 @@ struct GpuFixture {
   float radius = 0;  ///< R: 0.1 x the diagonal of the scene's bounds, as `ao render`'s default order of magnitude.
 };
 
+/// Closed meshes only (a box for the ground, a sphere resting on it, a turned box and a torus): what
+/// the paper's parity voxelization, the GPU cone's, needs. Seen from the front right and above.
+inline Scene closed_scene() {
+  Scene s;
+  s.name = "closed";
+  s.meshes.push_back(make_box({-3.0f, -0.3f, -3.0f}, {3.0f, 0.0f, 3.0f}, {0.7f, 0.7f, 0.7f}));
+  s.meshes.push_back(make_sphere({-0.8f, 0.7f, 0.2f}, 0.7f, 48, 24, {0.8f, 0.3f, 0.2f}));
+  s.meshes.push_back(make_box({0.4f, 0.0f, -0.9f}, {1.4f, 1.2f, 0.1f}, {0.3f, 0.6f, 0.8f}, 30.0f));
+  s.meshes.push_back(make_torus({0.6f, 0.25f, 1.3f}, 0.6f, 0.25f, 48, 16, {0.8f, 0.8f, 0.3f}));
+  validate_and_prepare(s);
+  Bounds3 objects;  // framed without the ground, which would make them small
+  for (std::size_t m = 1; m < s.meshes.size(); ++m) objects.extend(s.meshes[m].bounds());
+  s.preferred_view = frame_bounds(objects, {0.6f, 0.7f, 1.0f}, 40.0f, 16, 16);
+  return s;
+}
+
+/// `name`: a built-in scene, or "closed" (closed_scene()).
 inline GpuFixture gpu_fixture(const std::string& name, int width = 96, int height = 64) {
-  GpuFixture f{make_builtin_scene(name), nullptr, nullptr, {}, 0};
+  GpuFixture f{name == "closed" ? closed_scene() : make_builtin_scene(name), nullptr, nullptr, {}, 0};
   f.rays = std::make_unique<RayScene>(f.scene);
   f.gpu_scene = std::make_unique<GpuScene>(GpuScene::upload(gpu_device(), f.scene));
   Camera c = *f.scene.preferred_view;

@@ -53,9 +53,12 @@ void check_parity_suffices(const std::vector<MeshClosure>& closure, OpenMeshes m
   for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0;
   const bool slabs = mode != OpenMeshes::Parity && open > 0, winding = mode == OpenMeshes::Winding && holed > 0;
   if (!slabs && !winding) return;
-  const std::string what = slabs ? std::to_string(open) + " open surface(s)" : std::to_string(holed) + " mesh(es) with holes";
-  throw InputError(std::string("cone on the GPU voxelizes by parity only, and the scene has ") + what + ", which open_meshes=" +
-                   (mode == OpenMeshes::Slab ? "slab" : "winding") + " voxelizes otherwise: give -p open_meshes=parity (the paper's) or run it on the CPU");
+  const std::string what = slabs ? std::to_string(open) + " open surface(s), which open_meshes=" + (mode == OpenMeshes::Slab ? "slab" : "winding") +
+                                       " thickens into slabs"
+                                 : std::to_string(holed) + " mesh(es) with holes, which open_meshes=winding closes";
+  throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the scene has " + what +
+                   ": run cone on the CPU (--device cpu), or give -p open_meshes=parity for the paper's voxelization, which fills the "
+                   "space beyond an open surface");
 }
 
 void set_instance(Context& c, Program& p, const Scene& s, const SceneObject& ob) {

@@ -82,6 +82,20 @@ GpuMethodOutput run_gpu_method(GpuDevice& device, std::string_view method, const
   if (!out.output.stats.is_object()) out.output.stats = nlohmann::json::object();
   out.output.stats["device"] = c.renderer;
   out.output.stats["gpu_ms"] = ms;
+  // The CPU methods' own timings in --json, from the GPU passes that do their work.
+  const auto pass_ms = [&](std::initializer_list<const char*> names) {
+    double sum = 0;
+    for (const char* n : names) sum += ms.value(n, 0.0);
+    return sum;
+  };
+  if (method == "cone") {
+    out.output.stats["voxelize_ms"] = pass_ms({"voxelize", "count"});
+    out.output.stats["trace_ms"] = pass_ms({"cone"});
+    out.output.stats["filter_ms"] = pass_ms({"filter"});
+  } else if (method == "alchemy") {
+    out.output.stats["estimator_ms"] = pass_ms({"alchemy"});
+    out.output.stats["filter_ms"] = pass_ms({"filter"});
+  }
   return out;
 }
 

@@ -36,11 +36,12 @@ Texture bilateral_filter(Run& r, const Texture& values, const BilateralParams& p
   r.c.begin_pass(r.passes, name);
   r.use(p);
   set_rays(r, p);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_taps"), params.taps);
+  r.set(p, "u_taps", params.taps);
   r.c.gl.Uniform1fv(r.c.uniform(p, "u_spatial"), params.taps, spatial.data());
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_plane_sigma"), params.plane_sigma);
+  r.set(p, "u_plane_sigma", params.plane_sigma);
+  // The horizontal pass into tmp, then the vertical one into out, in one timed pass.
   for (int vertical = 0; vertical < 2; ++vertical) {
-    r.c.gl.Uniform1i(r.c.uniform(p, "u_vertical"), vertical);
+    r.set(p, "u_vertical", vertical);
     bind_texture(r.c, 6, vertical ? tmp : values);
     bind_image(r.c, 0, vertical ? out : tmp, GL_WRITE_ONLY);
     dispatch_2d(r.c, r.width(), r.height());
@@ -62,27 +63,23 @@ MethodOutput run_alchemy(Run& r, const Falloff& falloff, const AlchemyParams& pa
   const Buffer direction_buffer = make_buffer(r.c, std::span<const float>(directions));
 
   Texture raw = r.image(GL_R32F);
-  Program& p = r.c.program({"alchemy.comp"});
-  r.c.begin_pass(r.passes, "alchemy");
-  r.use(p);
+  Program& p = r.begin("alchemy.comp", "alchemy");
   set_rays(r, p);
   // Screen radius of the world disk: both image axes have 0.5 h / tan(fov/2) pixels per unit of
   // x/(-z), so the disk of radius r at depth z_C spans r * that / z_C pixels (sec. 2.3).
   const float px_per_unit = 0.5f * static_cast<float>(r.height()) / r.g.camera.tan_half_fov();
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_samples"), s);
-  r.c.gl.Uniform1ui(r.c.uniform(p, "u_seed"), seed);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_radius_px"), k.radius * px_per_unit);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_r2"), k.radius * k.radius);
+  r.set(p, "u_samples", s);
+  r.set(p, "u_seed", seed);
+  r.set(p, "u_radius_px", k.radius * px_per_unit);
+  r.set(p, "u_r2", k.radius * k.radius);
   // 2 sigma / s: eq. 9's 2 pi u / s (uniform directions) times the paper's nominal 1/pi, u in sigma.
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_scale"), 2.0f * k.sigma / static_cast<float>(s));
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_epsilon"), k.epsilon);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_beta"), k.beta);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_contrast"), params.contrast);
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, rotation_buffer.id());
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, direction_buffer.id());
-  bind_image(r.c, 0, raw, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
+  r.set(p, "u_scale", 2.0f * k.sigma / static_cast<float>(s));
+  r.set(p, "u_epsilon", k.epsilon);
+  r.set(p, "u_beta", k.beta);
+  r.set(p, "u_contrast", params.contrast);
+  r.bind(0, rotation_buffer);
+  r.bind(1, direction_buffer);
+  r.finish(raw);
 
   MethodOutput out;
   if (params.filter && params.bilateral.taps > 1) {

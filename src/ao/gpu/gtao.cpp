@@ -23,23 +23,19 @@ MethodOutput run_gtao(Run& r, const Falloff& falloff, const GtaoParams& params, 
   const Buffer step_buffer = make_buffer(r.c, std::span<const float>(steps));
 
   Texture raw = r.image(GL_R32F);
-  Program& p = r.c.program({"gtao.comp"});
-  r.c.begin_pass(r.passes, "gtao");
-  r.use(p);
+  Program& p = r.begin("gtao.comp", "gtao");
   const Camera& cam = r.g.camera;
   const float t = cam.tan_half_fov();
   // Camera rays through pixel centres, and R's screen size per unit of x/(-z), as the CPU kernel.
   r.c.gl.Uniform4f(r.c.uniform(p, "u_rays"), 2.0f * t * cam.aspect() / static_cast<float>(r.width()), -t * cam.aspect(),
                    -2.0f * t / static_cast<float>(r.height()), t);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_px_per_unit"), 0.5f * static_cast<float>(r.height()) / t);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_slices"), params.slices);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_steps"), params.steps);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_radius"), radius);
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, direction_buffer.id());
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, step_buffer.id());
-  bind_image(r.c, 0, raw, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
+  r.set(p, "u_px_per_unit", 0.5f * static_cast<float>(r.height()) / t);
+  r.set(p, "u_slices", params.slices);
+  r.set(p, "u_steps", params.steps);
+  r.set(p, "u_radius", radius);
+  r.bind(0, direction_buffer);
+  r.bind(1, step_buffer);
+  r.finish(raw);
   const Texture v = params.interleave.interleave && params.interleave.filter
                         ? box_filter(r, raw, 1, effective_depth_limit(params.interleave, radius))
                         : std::move(raw);
@@ -48,14 +44,7 @@ MethodOutput run_gtao(Run& r, const Falloff& falloff, const GtaoParams& params, 
     out.visibility = read_float(r.c, v);
     return out;
   }
-  Texture bounce = r.image(GL_RGBA32F);
-  Program& b = r.c.program({"gtao_bounce.comp"});
-  r.c.begin_pass(r.passes, "multi_bounce");
-  r.use(b);
-  bind_texture(r.c, 6, v);
-  bind_image(r.c, 0, bounce, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
+  const Texture bounce = r.map("gtao_bounce.comp", "multi_bounce", v, GL_RGBA32F);
   out.color = read_rgb(r.c, bounce);
   out.visibility = read_alpha(r.c, bounce);
   return out;

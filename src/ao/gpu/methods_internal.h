@@ -34,6 +34,20 @@ struct Run {
   void use(Program& p);
   /// A texture of the G-buffer's size.
   Texture image(GLenum format) { return make_texture(c, width(), height(), format); }
+  /// The compute program of `shader` (compiled first: compiling is not part of the pass's time),
+  /// made current by use() inside the timed pass `name`, which finish() ends.
+  Program& begin(std::string_view shader, std::string name, std::string_view defines = {});
+  /// Runs the pass over every pixel, writing `out` through image unit 0, and ends it.
+  void finish(const Texture& out);
+  /// A whole pass of `shader` that reads `in` (texture unit 6) into a new texture of `format`.
+  Texture map(std::string_view shader, std::string name, const Texture& in, GLenum format, std::string_view defines = {});
+  /// Uniform `name` of `p`.
+  void set(Program& p, std::string_view name, int v) { c.gl.Uniform1i(c.uniform(p, name), v); }
+  void set(Program& p, std::string_view name, float v) { c.gl.Uniform1f(c.uniform(p, name), v); }
+  void set(Program& p, std::string_view name, std::uint32_t v) { c.gl.Uniform1ui(c.uniform(p, name), v); }
+  void set(Program& p, std::string_view name, Vec3 v) { c.gl.Uniform3f(c.uniform(p, name), v.x, v.y, v.z); }
+  /// Binds `b` as shader storage buffer `binding`.
+  void bind(GLuint binding, const Buffer& b) { c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, b.id()); }
 };
 
 /// The 16 (cos, sin) of interleave_rotations as the shaders' u_rotation[16].

@@ -19,6 +19,27 @@ void Run::use(Program& p) {
   g.bind();
 }
 
+Program& Run::begin(std::string_view shader, std::string name, std::string_view defines) {
+  Program& p = c.program({shader}, defines);
+  c.begin_pass(passes, std::move(name));
+  use(p);
+  return p;
+}
+
+void Run::finish(const Texture& out) {
+  bind_image(c, 0, out, GL_WRITE_ONLY);
+  dispatch_2d(c, width(), height());
+  c.end_pass();
+}
+
+Texture Run::map(std::string_view shader, std::string name, const Texture& in, GLenum format, std::string_view defines) {
+  Texture out = image(format);
+  begin(shader, std::move(name), defines);
+  bind_texture(c, 6, in);
+  finish(out);
+  return out;
+}
+
 void set_rotations(Run& r, Program& p, const std::array<Rotation, 16>& rotations) {
   float values[32];
   for (std::size_t k = 0; k < 16; ++k) values[2 * k] = rotations[k].c, values[2 * k + 1] = rotations[k].s;
@@ -27,14 +48,10 @@ void set_rotations(Run& r, Program& p, const std::array<Rotation, 16>& rotations
 
 Texture box_filter(Run& r, const Texture& values, int channels, float depth_limit) {
   Texture out = r.image(channels == 4 ? GL_RGBA32F : GL_R32F);
-  Program& p = r.c.program({"box_filter.comp"}, channels == 4 ? "#define CHANNELS 4\n" : "#define CHANNELS 1\n");
-  r.c.begin_pass(r.passes, "filter");
-  r.use(p);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_depth_limit"), depth_limit);
+  Program& p = r.begin("box_filter.comp", "filter", channels == 4 ? "#define CHANNELS 4\n" : "#define CHANNELS 1\n");
+  r.set(p, "u_depth_limit", depth_limit);
   bind_texture(r.c, 6, values);
-  bind_image(r.c, 0, out, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
+  r.finish(out);
   return out;
 }
 
@@ -61,13 +78,17 @@ Image<float> read_alpha(Context& c, const Texture& t) {
 
 namespace {
 
-// The uniforms containment, transfer and volumetric share: the depth-test bias and the 4x4
-// rotations.
-void set_sampling(Run& r, Program& p, float bias, const InterleaveOptions& interleave, std::uint32_t seed) {
+// The uniforms containment, transfer and volumetric share: the depth-test bias, the 4x4
+// rotations, the sample count and the silhouette elimination's limit (AT 4.3: a surface more than
+// R in front of the test point, or of the pipe's entry, does not occlude it).
+void set_sampling(Run& r, Program& p, int samples, float bias, bool silhouette_elimination, float radius, const InterleaveOptions& interleave,
+                  std::uint32_t seed) {
   set_rotations(r, p, interleave_rotations(seed, interleave.interleave));
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_bias"), bias);
+  r.set(p, "u_samples", samples);
+  r.set(p, "u_bias", bias);
+  r.set(p, "u_far_limit", silhouette_elimination ? -radius : -kInfinity);
   // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_footprint"), 2.0f * r.g.camera.tan_half_fov() / static_cast<float>(r.height()));
+  r.set(p, "u_footprint", 2.0f * r.g.camera.tan_half_fov() / static_cast<float>(r.height()));
 }
 
 // The containment-test offsets (X, Y, Z, r) of make_containment_samples, as vec4s.
@@ -90,21 +111,13 @@ MethodOutput run_containment(Run& r, const Falloff& falloff, const ContainmentPa
   falloff.validate();
   const Buffer offsets = containment_offsets(r, params.samples, falloff);
   Texture raw = r.image(GL_R32F);
-  Program& p = r.c.program({"containment.comp"});
-  r.c.begin_pass(r.passes, "containment");
-  r.use(p);
-  set_sampling(r, p, params.bias, params.interleave, seed);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_samples"), params.samples);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_ray_steps"), params.ray_steps);
-  // AT 4.3: a test point is occluded only if R > z - z* > bias, i.e. distance in (-R, -bias).
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_far_limit"), params.silhouette_elimination ? -falloff.radius : -kInfinity);
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, offsets.id());
-  bind_image(r.c, 0, raw, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
-  const Texture v = filtered(r, std::move(raw), 1, params.interleave, falloff.radius);
+  Program& p = r.begin("containment.comp", "containment");
+  set_sampling(r, p, params.samples, params.bias, params.silhouette_elimination, falloff.radius, params.interleave, seed);
+  r.set(p, "u_ray_steps", params.ray_steps);
+  r.bind(0, offsets);
+  r.finish(raw);
   MethodOutput out;
-  out.visibility = read_float(r.c, v);
+  out.visibility = read_float(r.c, filtered(r, std::move(raw), 1, params.interleave, falloff.radius));
   return out;
 }
 
@@ -122,22 +135,14 @@ MethodOutput run_volumetric(Run& r, const Falloff& falloff, const VolumetricPara
   const float F = params.normalizer == VolumeNormalizer::WeightedImportance ? radius * sum_h : 2.0f * radius * static_cast<float>(params.samples) / 3.0f;
   const Buffer points = make_buffer(r.c, std::span<const float>(disk));
   Texture raw = r.image(GL_R32F);
-  Program& p = r.c.program({"volumetric.comp"});
-  r.c.begin_pass(r.passes, "volumetric");
-  r.use(p);
-  set_sampling(r, p, params.bias, params.interleave, seed);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_samples"), params.samples);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_half_radius"), 0.5f * radius);
-  // AT 4.3 for pipes: a surface more than R in front of the pipe's entry does not occlude it.
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_far_limit"), params.silhouette_elimination ? -radius : -kInfinity);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_inv_f"), 1.0f / F);
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id());
-  bind_image(r.c, 0, raw, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
-  const Texture v = filtered(r, std::move(raw), 1, params.interleave, radius);
+  Program& p = r.begin("volumetric.comp", "volumetric");
+  set_sampling(r, p, params.samples, params.bias, params.silhouette_elimination, radius, params.interleave, seed);
+  r.set(p, "u_half_radius", 0.5f * radius);
+  r.set(p, "u_inv_f", 1.0f / F);
+  r.bind(0, points);
+  r.finish(raw);
   MethodOutput out;
-  out.visibility = read_float(r.c, v);
+  out.visibility = read_float(r.c, filtered(r, std::move(raw), 1, params.interleave, radius));
   return out;
 }
 
@@ -149,31 +154,17 @@ MethodOutput run_transfer(Run& r, const Falloff& falloff, const TransferParams& 
     throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
   const Buffer offsets = containment_offsets(r, params.samples, falloff);
   Texture raw = r.image(GL_RGBA32F);
-  Program& p = r.c.program({"transfer.comp"});
-  r.c.begin_pass(r.passes, "transfer");
-  r.use(p);
-  set_sampling(r, p, params.bias, params.interleave, seed);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_samples"), params.samples);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_ray_steps"), params.ray_steps);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_far_limit"), params.silhouette_elimination ? -falloff.radius : -kInfinity);
-  r.c.gl.Uniform1f(r.c.uniform(p, "u_albedo_scale"), params.albedo_scale);
-  r.c.gl.Uniform1i(r.c.uniform(p, "u_radiance"), radiance ? 1 : 0);
-  r.c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, offsets.id());
-  bind_image(r.c, 0, raw, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
+  Program& p = r.begin("transfer.comp", "transfer");
+  set_sampling(r, p, params.samples, params.bias, params.silhouette_elimination, falloff.radius, params.interleave, seed);
+  r.set(p, "u_ray_steps", params.ray_steps);
+  r.set(p, "u_albedo_scale", params.albedo_scale);
+  r.set(p, "u_radiance", radiance ? 1 : 0);
+  r.bind(0, offsets);
+  r.finish(raw);
   // Sec. 4.2's filter on W and O alike, then the luminance of W.
   const Texture wo = filtered(r, std::move(raw), 4, params.interleave, falloff.radius);
-  Texture luminance = r.image(GL_R32F);
-  Program& f = r.c.program({"transfer_finish.comp"});
-  r.c.begin_pass(r.passes, "luminance");
-  r.use(f);
-  bind_texture(r.c, 6, wo);
-  bind_image(r.c, 0, luminance, GL_WRITE_ONLY);
-  dispatch_2d(r.c, r.width(), r.height());
-  r.c.end_pass();
   MethodOutput out;
-  out.visibility = read_float(r.c, luminance);
+  out.visibility = read_float(r.c, r.map("transfer_finish.comp", "luminance", wo, GL_R32F));
   out.color = read_rgb(r.c, wo);
   out.extras["obscurance"] = read_alpha(r.c, wo);
   return out;

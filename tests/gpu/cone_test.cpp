@@ -2,10 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "ao/core/error.h"
 #include "ao/gpu/voxelize.h"
+#include "ao/io/mesh_io.h"
 #include "gpu/gpu_support.h"
 
 namespace ao {
@@ -22,7 +24,9 @@ class GpuVoxelGrid : public ::testing::TestWithParam<GridCase> {};
 
 TEST_P(GpuVoxelGrid, IsBitIdenticalToTheCpuGrid) {
   const GridCase& k = GetParam();
-  const Scene scene = make_builtin_scene(k.scene);
+  const Scene scene = k.scene == "dragon"        ? load_scene_file(std::filesystem::path(AO_TEST_MESHES) / "ChineseDragon-10kv.off")
+                      : k.scene == "instanced" ? test::instanced_scene()
+                                               : make_builtin_scene(k.scene);
   const GpuScene gpu_scene = GpuScene::upload(gpu_device(), scene);
   VoxelizeOptions o;
   o.columns = k.columns;
@@ -50,7 +54,8 @@ TEST_P(GpuVoxelGrid, IsBitIdenticalToTheCpuGrid) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, GpuVoxelGrid,
                          ::testing::Values(GridCase{"box-room", 128, 128}, GridCase{"default", 256, 128}, GridCase{"sphere-on-plane", 96, 96},
-                                           GridCase{"default", 64, 1024}, GridCase{"wedge", 64, 32}),
+                                           GridCase{"default", 64, 1024}, GridCase{"wedge", 64, 32}, GridCase{"dragon", 512, 128},
+                                           GridCase{"instanced", 200, 160}),
                          [](const ::testing::TestParamInfo<GridCase>& p) {
                            std::string n = p.param.scene + "_" + std::to_string(p.param.columns) + "_" + std::to_string(p.param.depth_bits);
                            for (char& ch : n)

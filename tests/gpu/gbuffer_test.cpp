@@ -91,7 +91,7 @@ TEST_P(GpuRasterizedGBuffer, AgreesWithTheRayTracedOneExceptOnSilhouettes) {
               interior, edges, worst_position, worst_normal);
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, GpuRasterizedGBuffer, ::testing::Values("default", "sphere-on-plane", "box-room", "wedge"), test::scene_test_name);
+INSTANTIATE_TEST_SUITE_P(Scenes, GpuRasterizedGBuffer, ::testing::Values("default", "sphere-on-plane", "box-room", "wedge", "instanced"), test::scene_test_name);
 
 }  // namespace
 }  // namespace ao

@@ -49,9 +49,26 @@ inline Scene closed_scene() {
   return s;
 }
 
-/// `name`: a built-in scene, or "closed" (closed_scene()).
+/// A torus drawn three times as instances (moved, turned and mirrored, stretched) over a closed
+/// floor: the glTF node tree's repeated mesh (docs/instancing.md), each instance an object.
+inline Scene instanced_scene() {
+  Scene s;
+  s.name = "instanced";
+  s.meshes.push_back(make_box({-3.0f, -0.3f, -3.0f}, {3.0f, 0.0f, 3.0f}));
+  s.meshes.push_back(make_torus({0, 0, 0}, 0.6f, 0.25f, 48, 16, {0.8f, 0.5f, 0.3f}));
+  Affine3 moved, turned, stretched;
+  moved.c3 = {-1.2f, 0.25f, 0.3f};
+  turned.c0 = {0, 0, 1}, turned.c1 = {0, -1, 0}, turned.c2 = {1, 0, 0}, turned.c3 = {0.6f, 0.85f, -0.8f};  // a mirror: det -1
+  stretched.c0 = {1.5f, 0, 0}, stretched.c1 = {0, 0.7f, 0.2f}, stretched.c3 = {0.9f, 0.2f, 1.2f};
+  s.instances = {{1, moved, "moved"}, {1, turned, "turned"}, {1, stretched, "stretched"}};
+  validate_and_prepare(s);
+  s.preferred_view = frame_bounds(Bounds3{{-2, 0, -1.5f}, {2, 1.5f, 2}}, {0.6f, 0.7f, 1.0f}, 40.0f, 16, 16);
+  return s;
+}
+
+/// `name`: a built-in scene, "closed" (closed_scene()) or "instanced" (instanced_scene()).
 inline GpuFixture gpu_fixture(const std::string& name, int width = 96, int height = 64) {
-  GpuFixture f{name == "closed" ? closed_scene() : make_builtin_scene(name), nullptr, nullptr, {}, 0};
+  GpuFixture f{name == "closed" ? closed_scene() : name == "instanced" ? instanced_scene() : make_builtin_scene(name), nullptr, nullptr, {}, 0};
   f.rays = std::make_unique<RayScene>(f.scene);
   f.gpu_scene = std::make_unique<GpuScene>(GpuScene::upload(gpu_device(), f.scene));
   Camera c = *f.scene.preferred_view;

@@ -267,9 +267,9 @@ MethodOutput run_cone(Run& r, SceneBuffers& sb, const Falloff& falloff, const Co
 
 VoxelGrid gpu_voxelize_world(GpuDevice& device, const GpuScene& scene, const VoxelizeOptions& options, VoxelStats* stats) {
   using namespace gpu_detail;
-  Context& c = device.context();
+  Context& c = Access::context(device);
   c.make_current();
-  SceneBuffers& sb = scene.buffers();
+  SceneBuffers& sb = Access::buffers(scene);
   if (sb.context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
   std::vector<PassQuery> passes;
   build_grid(c, sb, options, passes);

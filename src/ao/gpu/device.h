@@ -16,7 +16,8 @@ namespace ao {
 
 namespace gpu_detail {
 class Context;
-}
+struct Access;
+}  // namespace gpu_detail
 
 /// An OpenGL function as a loader returns it (cast to its real type before calling).
 using GlProc = void (*)();
@@ -59,11 +60,8 @@ class GpuDevice {
   /// True for a software renderer (llvmpipe, softpipe): GPU times then measure the CPU.
   bool software() const;
 
-  /// The context (for the backend's own files).
-  gpu_detail::Context& context() const { return *context_; }
-  const std::shared_ptr<gpu_detail::Context>& shared_context() const { return context_; }
-
  private:
+  friend struct gpu_detail::Access;
   explicit GpuDevice(std::shared_ptr<gpu_detail::Context> c) : context_(std::move(c)) {}
   std::shared_ptr<gpu_detail::Context> context_;
 };

@@ -44,10 +44,10 @@ void set_vec3(Context& c, Program& p, const char* name, Vec3 v) { c.gl.Uniform3f
 using namespace gpu_detail;
 
 GpuScene GpuScene::upload(GpuDevice& device, const Scene& scene) {
-  Context& c = device.context();
+  Context& c = Access::context(device);
   c.make_current();
   auto b = std::make_shared<SceneBuffers>();
-  b->context = device.shared_context();
+  b->context = Access::shared_context(device);
   b->scene = &scene;
   b->objects = scene.objects();
   for (const Mesh& m : scene.meshes) {
@@ -82,7 +82,7 @@ GpuScene GpuScene::upload(GpuDevice& device, const Scene& scene) {
 const Scene& GpuScene::scene() const { return *buffers_->scene; }
 
 GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
-  Context& c = device.context();
+  Context& c = Access::context(device);
   c.make_current();
   const int w = g.width(), h = g.height();
   if (w < 1 || h < 1 || g.position.width() != w || g.normal.width() != w || g.object_id.width() != w)
@@ -91,7 +91,7 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   std::vector<PassQuery> passes;
   c.begin_pass(passes, "upload");  // the copies and the depth pass
   auto t = std::make_shared<GBufferTextures>();
-  t->context = device.shared_context();
+  t->context = Access::shared_context(device);
   t->camera = g.camera;
   t->position = make_texture(c, w, h, GL_RGBA32F);
   t->normal = make_texture(c, w, h, GL_RGBA32F);
@@ -134,9 +134,9 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
 
 GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const Camera& camera, const GBufferOptions& options) {
   camera.validate();
-  Context& c = device.context();
+  Context& c = Access::context(device);
   c.make_current();
-  const SceneBuffers& sb = scene.buffers();
+  const SceneBuffers& sb = Access::buffers(scene);
   if (sb.context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
   const int w = camera.width, h = camera.height;
   auto t = std::make_shared<GBufferTextures>();

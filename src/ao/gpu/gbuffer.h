@@ -19,6 +19,7 @@ namespace ao {
 namespace gpu_detail {
 struct SceneBuffers;
 struct GBufferTextures;
+struct Access;
 }  // namespace gpu_detail
 
 /// A scene's meshes in a device's memory (vertex and index buffers, one draw per object of
@@ -31,10 +32,9 @@ class GpuScene {
   /// built-in scene has). SystemError when the device runs out of memory.
   static GpuScene upload(GpuDevice& device, const Scene& scene);
   const Scene& scene() const;
-  /// The internals (for the backend's own files).
-  gpu_detail::SceneBuffers& buffers() const { return *buffers_; }
 
  private:
+  friend struct gpu_detail::Access;
   explicit GpuScene(std::shared_ptr<gpu_detail::SceneBuffers> b) : buffers_(std::move(b)) {}
   std::shared_ptr<gpu_detail::SceneBuffers> buffers_;
 };
@@ -63,10 +63,9 @@ class GpuGBuffer {
   int height() const;
   /// The GPU time of making it: "upload" (the depth pass after the copy) or "gbuffer" (rasterization).
   const std::vector<GpuPassTime>& passes() const;
-  /// The internals (for the backend's own files).
-  gpu_detail::GBufferTextures& textures() const { return *textures_; }
 
  private:
+  friend struct gpu_detail::Access;
   explicit GpuGBuffer(std::shared_ptr<gpu_detail::GBufferTextures> t) : textures_(std::move(t)) {}
   std::shared_ptr<gpu_detail::GBufferTextures> textures_;
 };

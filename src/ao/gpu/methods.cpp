@@ -53,8 +53,8 @@ std::span<const std::string_view> gpu_method_names() { return kGpuMethods; }
 
 GpuMethodOutput run_gpu_method(GpuDevice& device, std::string_view method, const GpuMethodInput& in, const nlohmann::json& params) {
   using namespace gpu_detail;
-  Context& c = device.context();
-  if (&in.gbuffer.textures().context->gl != &c.gl) throw InputError("--device gpu: the G-buffer was made on another device");
+  Context& c = Access::context(device);
+  if (Access::textures(in.gbuffer).context.get() != &c) throw InputError("--device gpu: the G-buffer was made on another device");
   bool known = false;
   for (std::string_view n : kGpuMethods) known = known || n == method;
   if (!known) {
@@ -62,7 +62,7 @@ GpuMethodOutput run_gpu_method(GpuDevice& device, std::string_view method, const
     throw InputError("method " + std::string(m.name) + " runs on the CPU only (--device cpu); the GPU runs containment, volumetric, transfer, cone, alchemy, gtao");
   }
   c.make_current();
-  Run r{c, in.gbuffer.textures(), {}};
+  Run r{c, Access::textures(in.gbuffer), {}};
   GpuMethodOutput out;
   if (method == "containment") out.output = run_containment(r, in.falloff, screen_space_params<ContainmentParams>(method, params), in.seed);
   else if (method == "volumetric") out.output = run_volumetric(r, in.falloff, screen_space_params<VolumetricParams>(method, params), in.seed);
@@ -71,8 +71,8 @@ GpuMethodOutput run_gpu_method(GpuDevice& device, std::string_view method, const
   else if (method == "gtao") out.output = run_gtao(r, in.falloff, table_params<GtaoParams>(params), in.seed);
   else {
     if (!in.scene) throw InputError("method cone voxelizes the scene, and a G-buffer file has none: give a scene instead of --gbuffer-in");
-    if (in.scene->buffers().context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
-    out.output = run_cone(r, in.scene->buffers(), in.falloff, table_params<ConeParams>(params), in.seed);
+    if (Access::buffers(*in.scene).context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
+    out.output = run_cone(r, Access::buffers(*in.scene), in.falloff, table_params<ConeParams>(params), in.seed);
   }
   c.check(std::string("running ") + std::string(method));
   out.passes = c.resolve(r.passes);

@@ -48,4 +48,12 @@ struct GBufferTextures {
   void bind() const;
 };
 
+/// What the backend's files reach inside the public classes.
+struct Access {
+  static Context& context(const GpuDevice& d) { return *d.context_; }
+  static const std::shared_ptr<Context>& shared_context(const GpuDevice& d) { return d.context_; }
+  static SceneBuffers& buffers(const GpuScene& s) { return *s.buffers_; }
+  static GBufferTextures& textures(const GpuGBuffer& g) { return *g.textures_; }
+};
+
 }  // namespace ao::gpu_detail

@@ -1,6 +1,6 @@
 // GpuDevice: a headless OpenGL context through EGL, or the caller's current one (device.h).
 // libEGL is opened with dlopen and every EGL and GL function is resolved through
-// eglGetProcAddress (EGL_KHR_get_all_proc_addresses, EGL 1.5), so nothing links a GL library.
+// eglGetProcAddress (EGL_KHR_get_all_proc_addresses, EGL 1.5), so libao links no GL library.
 #define EGL_EGL_PROTOTYPES 0
 #include <EGL/egl.h>
 #include <EGL/eglext.h>

@@ -1,5 +1,5 @@
 // Internals of the GPU backend, not installed: the OpenGL functions it calls (resolved at run time,
-// so neither libao nor the ao binary links a GL library), the context a GpuDevice owns or borrows,
+// so libao links no GL library), the context a GpuDevice owns or borrows,
 // and small RAII wrappers of GL objects. Nothing outside src/ao/gpu/ includes this header.
 #pragma once
 

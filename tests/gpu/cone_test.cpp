@@ -65,3 +65,25 @@ INSTANTIATE_TEST_SUITE_P(Scenes, GpuVoxelGrid,
 
 }  // namespace
 }  // namespace ao
+
+namespace ao {
+namespace {
+
+TEST(GpuVoxelGridLimits, AGridBeyondTheLargestStorageBufferIsAnInputError) {
+  const Scene scene = make_builtin_scene("box-room");
+  const GpuScene gpu_scene = GpuScene::upload(test::gpu_device(), scene);
+  VoxelizeOptions o;
+  o.columns = 4096;
+  o.depth_bits = 1024;  // 2 GiB of bits
+  try {
+    gpu_voxelize_world(test::gpu_device(), gpu_scene, o);
+    ADD_FAILURE() << "no error for a 2 GiB grid";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("exceeds this GPU's largest storage buffer"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+}  // namespace ao

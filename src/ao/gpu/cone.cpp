@@ -86,6 +86,10 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
   Program& raster = c.program({"cone_voxelize.vert", "cone_voxelize.geom", "cone_voxelize.frag"});
   Program& count = c.program({"cone_count.comp"});
   const std::size_t words = static_cast<std::size_t>(g.nx) * g.ny * (g.depth_bits / 32);
+  if (static_cast<double>(words) * 4 > static_cast<double>(c.max_storage_block))
+    throw InputError("cone: a " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.depth_bits) + " voxel grid (" +
+                     std::to_string(words * 4 >> 20) + " MiB) exceeds this GPU's largest storage buffer (" +
+                     std::to_string(c.max_storage_block >> 20) + " MiB, " + c.renderer + "): fewer columns or depth_bits");
   const GLuint zero[4] = {0, 0, 0, 0};
   Buffer counters = make_buffer(c, sizeof zero, zero);
   cache.bits = make_buffer(c, words * sizeof(std::uint32_t), nullptr);

@@ -57,7 +57,9 @@ void Context::initialise(GlProcLoader loader) {
   software = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos ||
              renderer.find("Software") != std::string::npos;
   gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
-  gl.GetIntegerv(GL_MAX_DRAW_BUFFERS, &max_draw_buffers);
+  GLint block = 0;
+  gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  max_storage_block = block;
   while (gl.GetError() != GL_NO_ERROR) {
   }
 }

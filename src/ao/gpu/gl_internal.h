@@ -133,7 +133,7 @@ class Context {
   std::string renderer, version;
   bool software = false;   ///< Mesa's llvmpipe (or another software renderer).
   int max_texture_size = 0;
-  int max_draw_buffers = 0;
+  std::int64_t max_storage_block = 0;  ///< GL_MAX_SHADER_STORAGE_BLOCK_SIZE, bytes.
 
   /// Makes the context current on the calling thread (a headless device binds it; a borrowed
   /// context must already be current: SystemError otherwise).

@@ -10,6 +10,9 @@
 // directed edges, negated for clockwise triangles (so inside is E > 0), and the plane of the
 // voxel coordinate a over the column coordinates. It also counts the triangles the CPU voxelizer
 // would rasterize (those whose box covers a column centre of the grid; VoxelStats::triangles).
+//
+// Uniforms: u_columns (nx, ny). Buffer 1: the voxelization's counters (triangles, fragments,
+// solid voxels, odd columns).
 
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 4) out;

@@ -4,6 +4,8 @@
 // as wound (counter-clockwise seen from the front), then turned into camera space; the plane of the
 // camera-space triangle (normal nq, offset dq = nq . q0) lets each fragment meet its pixel's ray
 // with the triangle exactly, as the ray tracer's hit does.
+//
+// Uniforms: u_basis_x/y/z, the camera's basis in world space (as gbuffer.vert).
 
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;

@@ -83,7 +83,8 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
   if (g.nx > c.max_texture_size)
     throw InputError("cone: " + std::to_string(g.nx) + " columns exceed this GPU's largest framebuffer (" + std::to_string(c.max_texture_size) + ")");
 
-  Program& raster = c.program({"cone_voxelize.vert", "cone_voxelize.geom", "cone_voxelize.frag"});
+  Program& raster = c.program({"cone_voxelize.vert", "cone_voxelize.geom", "cone_voxelize.frag"},
+                              c.geometry_storage ? "" : "#define NO_GEOMETRY_COUNTER\n");
   Program& count = c.program({"cone_count.comp"});
   const std::size_t words = static_cast<std::size_t>(g.nx) * g.ny * (g.depth_bits / 32);
   if (static_cast<double>(words) * 4 > static_cast<double>(c.max_storage_block))

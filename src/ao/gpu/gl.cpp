@@ -60,6 +60,9 @@ void Context::initialise(GlProcLoader loader) {
   GLint block = 0;
   gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
   max_storage_block = block;
+  GLint geometry_blocks = 0;
+  gl.GetIntegerv(GL_MAX_GEOMETRY_SHADER_STORAGE_BLOCKS, &geometry_blocks);
+  geometry_storage = geometry_blocks > 0;
   while (gl.GetError() != GL_NO_ERROR) {
   }
 }

@@ -134,6 +134,7 @@ class Context {
   bool software = false;   ///< Mesa's llvmpipe (or another software renderer).
   int max_texture_size = 0;
   std::int64_t max_storage_block = 0;  ///< GL_MAX_SHADER_STORAGE_BLOCK_SIZE, bytes.
+  bool geometry_storage = false;       ///< Geometry shaders may write storage buffers (GL 4.3 allows 0 of them).
 
   /// Makes the context current on the calling thread (a headless device binds it; a borrowed
   /// context must already be current: SystemError otherwise).

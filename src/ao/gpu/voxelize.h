@@ -14,7 +14,7 @@ namespace ao {
 /// words, origin, voxel_size) and `bits`, equal to voxelize_world's for the same options (the
 /// coarse occupancy masks, which only the CPU kernel reads, are left empty). `stats`, when given,
 /// gets the counts voxelize_world reports (triangles, fragments, odd columns, set voxels, and the
-/// meshes' closure).
+/// meshes' closure; triangles stay 0 on a GPU whose geometry stage cannot write storage buffers).
 ///
 /// The GPU voxelizes by parity only (the paper's): InputError for options.open_meshes other than
 /// Parity when the scene has open surfaces (Slab, Winding) or holed meshes (Winding), which the CPU

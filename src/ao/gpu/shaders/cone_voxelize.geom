@@ -12,7 +12,8 @@
 // would rasterize (those whose box covers a column centre of the grid; VoxelStats::triangles).
 //
 // Uniforms: u_columns (nx, ny). Buffer 1: the voxelization's counters (triangles, fragments,
-// solid voxels, odd columns).
+// solid voxels, odd columns); with NO_GEOMETRY_COUNTER defined (a GPU that offers this stage no
+// storage buffers) the triangles are not counted.
 
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 4) out;
@@ -21,7 +22,9 @@ in vec3 v_grid[];
 
 uniform ivec2 u_columns;
 
+#ifndef NO_GEOMETRY_COUNTER
 layout(std430, binding = 1) buffer Counters { uint u_triangles; uint u_fragments; uint u_set_voxels; uint u_odd_columns; };
+#endif
 
 flat out dvec3 g_edge[3];  // (A, B, C) per edge
 flat out dvec3 g_plane;    // (a0 at (x0, y0), da/dx, da/dy)
@@ -35,7 +38,9 @@ void main() {
   if (!(xmax >= 0.5 && xmin <= float(u_columns.x) - 0.5)) return;
   const float j0 = ceil(ymin - 0.5), j1 = floor(ymax - 0.5);
   if (j1 < 0.0 || j0 > float(u_columns.y - 1) || j0 > j1) return;
+#ifndef NO_GEOMETRY_COUNTER  // GL 4.3 lets a GPU offer no storage buffers to this stage
   atomicAdd(u_triangles, 1u);
+#endif
   const double x0 = t0.x, y0 = t0.y;
   const double area2 = (double(t1.x) - x0) * (double(t2.y) - y0) - (double(t2.x) - x0) * (double(t1.y) - y0);
   if (area2 == 0.0LF) return;  // edge-on: no column centre lies inside

@@ -1,6 +1,7 @@
 // run_gpu_method (methods.h): parameters through the methods' tables, then the method's passes.
 #include "ao/gpu/methods.h"
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
@@ -15,36 +16,19 @@ namespace {
 
 constexpr std::array<std::string_view, 6> kGpuMethods{"containment", "volumetric", "transfer", "cone", "alchemy", "gtao"};
 
-// The parameters of a screen-space method with the registry's characteristic choice (registry.h):
-// the GPU reads the depth buffer only.
+// `j` read through method `m`'s parameter table by the registry (unknown keys, types, ranges and
+// the characteristic's names are checked there, with its messages), into Params. Of the
+// characteristic functions (registry.h) the GPU reads the depth buffer only.
 template <class Params>
-Params screen_space_params(std::string_view method, const nlohmann::json& j) {
-  nlohmann::json rest = j;
-  if (rest.is_object() && rest.contains(kCharacteristicParam)) {
-    const nlohmann::json value = rest.at(kCharacteristicParam);
-    rest.erase(kCharacteristicParam);
-    if (value != "depth") {
-      bool known = false;
-      for (std::string_view n : characteristic_names()) known = known || value == n;
-      if (!known) {
-        std::string names;
-        for (std::string_view n : characteristic_names()) names += (names.empty() ? "" : ", ") + std::string(n);
-        throw InputError(std::string(method) + ": characteristic must be one of " + names + ", got " + value.dump());
-      }
-      throw InputError(std::string(method) + " on the GPU reads the depth buffer only: characteristic " + value.get<std::string>() +
-                       " runs on the CPU (--device cpu)");
-    }
+Params params_of(const MethodInfo& m, const nlohmann::json& j) {
+  nlohmann::json c = m.canonical_params(j);
+  if (c.contains(kCharacteristicParam)) {
+    const std::string kind = c.at(kCharacteristicParam).get<std::string>();
+    if (kind != "depth")
+      throw InputError(std::string(m.name) + " on the GPU reads the depth buffer only: characteristic " + kind + " runs on the CPU (--device cpu)");
+    c.erase(kCharacteristicParam);
   }
-  Params p = rest.get<Params>();
-  p.validate();
-  return p;
-}
-
-template <class Params>
-Params table_params(const nlohmann::json& j) {
-  Params p = j.get<Params>();
-  p.validate();
-  return p;
+  return c.get<Params>();
 }
 
 }  // namespace
@@ -55,24 +39,22 @@ GpuMethodOutput run_gpu_method(GpuDevice& device, std::string_view method, const
   using namespace gpu_detail;
   Context& c = Access::context(device);
   if (Access::textures(in.gbuffer).context.get() != &c) throw InputError("--device gpu: the G-buffer was made on another device");
-  bool known = false;
-  for (std::string_view n : kGpuMethods) known = known || n == method;
-  if (!known) {
-    const MethodInfo& m = find_method(method);  // InputError listing the methods for an unknown name
+  const MethodInfo& m = find_method(method);  // InputError listing the methods for an unknown name
+  if (std::find(kGpuMethods.begin(), kGpuMethods.end(), method) == kGpuMethods.end())
     throw InputError("method " + std::string(m.name) + " runs on the CPU only (--device cpu); the GPU runs containment, volumetric, transfer, cone, alchemy, gtao");
-  }
   c.make_current();
   Run r{c, Access::textures(in.gbuffer), {}};
   GpuMethodOutput out;
-  if (method == "containment") out.output = run_containment(r, in.falloff, screen_space_params<ContainmentParams>(method, params), in.seed);
-  else if (method == "volumetric") out.output = run_volumetric(r, in.falloff, screen_space_params<VolumetricParams>(method, params), in.seed);
-  else if (method == "transfer") out.output = run_transfer(r, in.falloff, screen_space_params<TransferParams>(method, params), in.seed);
-  else if (method == "alchemy") out.output = run_alchemy(r, in.falloff, table_params<AlchemyParams>(params), in.seed);
-  else if (method == "gtao") out.output = run_gtao(r, in.falloff, table_params<GtaoParams>(params), in.seed);
+  if (method == "containment") out.output = run_containment(r, in.falloff, params_of<ContainmentParams>(m, params), in.seed);
+  else if (method == "volumetric") out.output = run_volumetric(r, in.falloff, params_of<VolumetricParams>(m, params), in.seed);
+  else if (method == "transfer") out.output = run_transfer(r, in.falloff, params_of<TransferParams>(m, params), in.seed);
+  else if (method == "alchemy") out.output = run_alchemy(r, in.falloff, params_of<AlchemyParams>(m, params), in.seed);
+  else if (method == "gtao") out.output = run_gtao(r, in.falloff, params_of<GtaoParams>(m, params), in.seed);
   else {
+    const ConeParams p = params_of<ConeParams>(m, params);
     if (!in.scene) throw InputError("method cone voxelizes the scene, and a G-buffer file has none: give a scene instead of --gbuffer-in");
     if (Access::buffers(*in.scene).context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
-    out.output = run_cone(r, Access::buffers(*in.scene), in.falloff, table_params<ConeParams>(params), in.seed);
+    out.output = run_cone(r, Access::buffers(*in.scene), in.falloff, p, in.seed);
   }
   c.check(std::string("running ") + std::string(method));
   out.passes = c.resolve(r.passes);

@@ -20,7 +20,7 @@ layout(binding = 3) uniform sampler2D u_albedo;
 layout(binding = 4) uniform usampler2D u_object;
 layout(binding = 5) uniform sampler2D u_direct;
 
-/// Image size in pixels.
+// u_size: the image's width and height, pixels.
 uniform ivec2 u_size;
 
 const float kInfinity = uintBitsToFloat(0x7f800000u);
@@ -54,7 +54,8 @@ void frame_from_normal(vec3 n, out vec3 t, out vec3 b) {
 // characteristic.h ScreenProjection::locate: the pixel holding camera-space point q's projection,
 // clamped to the image (a point projecting outside reads the nearest border pixel); `valid` is
 // false (and the pixel (0, 0)) for a point not in front of the camera.
-uniform vec4 u_projection;  // scale_x, scale_y (pixels per unit of x/(-z), y/(-z)), centre_x, centre_y
+// u_projection: scale_x, scale_y (pixels per unit of x/(-z), y/(-z)), centre_x, centre_y (pixels).
+uniform vec4 u_projection;
 ivec2 locate(vec3 q, out bool valid) {
   const float inv = -1.0 / q.z;
   valid = q.z < 0.0;

@@ -1,9 +1,10 @@
 // Internals of the GPU backend, not installed: the OpenGL functions it calls (resolved at run time,
-// so libao links no GL library), the context a GpuDevice owns or borrows,
-// and small RAII wrappers of GL objects. Nothing outside src/ao/gpu/ includes this header.
+// so libao links no GL library), the context a GpuDevice owns or borrows, and small RAII wrappers
+// of GL objects. Only src/ao/gpu/ and its tests include this header.
 #pragma once
 
-#define GL_GLEXT_PROTOTYPES 0
+// Without GL_GLEXT_PROTOTYPES the header declares the functions' pointer types only: nothing can
+// call a GL function but through GlFunctions.
 #include <GL/glcorearb.h>
 
 #include <array>
@@ -23,10 +24,8 @@ namespace ao::gpu_detail {
 // Every GL entry point the backend uses (OpenGL 4.3 core, nothing newer: a viewer's context may be
 // exactly 4.3), as (pointer type, name without the gl prefix).
 #define AO_GL_FUNCTIONS(X)                                                                                                   \
-  X(PFNGLGETSTRINGPROC, GetString)                                                                                           \
   X(PFNGLGETINTEGERVPROC, GetIntegerv)                                                                                       \
   X(PFNGLGETERRORPROC, GetError)                                                                                             \
-  X(PFNGLFINISHPROC, Finish)                                                                                                 \
   X(PFNGLCREATESHADERPROC, CreateShader)                                                                                     \
   X(PFNGLSHADERSOURCEPROC, ShaderSource)                                                                                     \
   X(PFNGLCOMPILESHADERPROC, CompileShader)                                                                                   \
@@ -51,7 +50,6 @@ namespace ao::gpu_detail {
   X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                                                                         \
   X(PFNGLUNIFORM2FVPROC, Uniform2fv)                                                                                         \
   X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                                                                         \
-  X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                                                                         \
   X(PFNGLGENTEXTURESPROC, GenTextures)                                                                                       \
   X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                                                                 \
   X(PFNGLBINDTEXTUREPROC, BindTexture)                                                                                       \
@@ -87,7 +85,6 @@ namespace ao::gpu_detail {
   X(PFNGLVIEWPORTPROC, Viewport)                                                                                             \
   X(PFNGLENABLEPROC, Enable)                                                                                                 \
   X(PFNGLDISABLEPROC, Disable)                                                                                               \
-  X(PFNGLISENABLEDPROC, IsEnabled)                                                                                           \
   X(PFNGLDEPTHFUNCPROC, DepthFunc)                                                                                           \
   X(PFNGLDEPTHMASKPROC, DepthMask)                                                                                           \
   X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                                                                               \

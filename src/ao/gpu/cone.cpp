@@ -1,8 +1,9 @@
 // Voxel cone tracing on the GPU (Dalla Favera & Celes 2012): the world voxel grid built by
-// rasterization, each fragment XOR-ing its depth-slab mask into its column (shaders/
-// cone_voxelize.vert, .geom, .frag; statistics: shaders/cone_count.comp), the cones of spheres and the prisms' bit counts in a compute shader
-// (shaders/cone_trace.comp), and the cross-bilateral filter (shaders/bilateral.comp). The
-// sampling tables are the CPU kernel's (derive_cone_setup, make_cone_pattern), uploaded.
+// rasterization, each fragment XOR-ing its depth-slab mask into its column
+// (shaders/cone_voxelize.vert, .geom, .frag; statistics: shaders/cone_count.comp), the cones of
+// spheres and the prisms' bit counts in a compute shader (shaders/cone_trace.comp), and the
+// cross-bilateral filter (shaders/bilateral.comp). The sampling tables are the CPU kernel's
+// (derive_cone_setup, make_cone_pattern), uploaded.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -33,7 +34,7 @@ VoxelGrid world_layout(const Scene& scene, const VoxelizeOptions& o) {
   const float floor_extent = std::max(1e-4f * b.diagonal(), 1e-6f);
   const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
   const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
-  const float side = v0;
+  const float side = v0;  // the CPU adds the slab thickness here when it makes slabs
   const Vec3 lo = b.lo - Vec3{side, side, side};
   const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
   g.origin = lo;

@@ -2,8 +2,8 @@
 // parameters, seed, sample sets and rotations; against the ray-traced reference; and their
 // refusals of what the GPU backend does not implement.
 //
-// The tolerance of the agreement tests: at most 1.5% of the pixels may differ from the CPU's by
-// more than 1e-5, and the mean |difference| stays below 1e-4. Both backends evaluate the same
+// The tolerance of the agreement tests: at most 2.5% of the pixels may differ from the CPU's by
+// more than 1e-5, and the mean |difference| stays below 2e-4. Both backends evaluate the same
 // formulas on the same inputs in float, in a different order and with multiply-adds fused in other
 // places (GCC contracts the CPU kernels, Mesa's compiler the shaders), so a continuous result
 // differs by float roundings: measured at most 2e-6 (alchemy), 2.4e-7 for the others. Where a
@@ -11,8 +11,10 @@
 // index, or cone's tangent frame of a wall whose world normal has z = +-1e-8 (Duff et al.'s frame
 // flips with the sign of n.z; one ulp of the normal moves the CPU's own result from 0.404 to 0.334
 // at box-room's pixel 42,13, which is the GPU's) -- a sample, or a cone, comes out otherwise; the
-// 4x4 filter or the 5-tap bilateral spreads it to 16-25 pixels. Measured: none for the screen-space
-// methods, 1-3 such pixels for cone (0.6% of the image after its filter, mean 4e-5).
+// 4x4 filter or the 5-tap bilateral spreads it to 16-25 pixels, and a cone of 6 moves the mean
+// |difference| of a 96 x 64 image by about (1/6) / 6144 = 3e-5. Measured: none for the
+// screen-space methods, 1-3 such pixels for cone (0.6% of the image after its filter, mean 4e-5);
+// the bounds allow about 6 (a CPU without AVX-512 runs other CPU code paths, rounded otherwise).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,10 +51,10 @@ void expect_agreement(const Image<float>& gpu, const Image<float>& cpu, const st
     if (e > worst) worst = e, worst_at = i;
   }
   const double mean = sum / static_cast<double>(cpu.size());
-  EXPECT_LE(static_cast<double>(apart), 0.015 * static_cast<double>(cpu.size()))
+  EXPECT_LE(static_cast<double>(apart), 0.025 * static_cast<double>(cpu.size()))
       << what << ": " << apart << " pixels differ by more than 1e-5; worst " << worst << " at pixel " << worst_at % cpu.width() << ","
       << worst_at / cpu.width();
-  EXPECT_LE(mean, 1e-4) << what << ": mean |difference| " << mean;
+  EXPECT_LE(mean, 2e-4) << what << ": mean |difference| " << mean;
 }
 
 // Parameters every scene can run: cone's paper voxelization (the GPU's; the CPU's slabs for open

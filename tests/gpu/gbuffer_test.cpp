@@ -8,6 +8,7 @@
 
 #include "ao/core/error.h"
 #include "gpu/gpu_support.h"
+#include "support/errors.h"
 
 namespace ao {
 namespace {
@@ -92,6 +93,20 @@ TEST_P(GpuRasterizedGBuffer, AgreesWithTheRayTracedOneExceptOnSilhouettes) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, GpuRasterizedGBuffer, ::testing::Values("default", "sphere-on-plane", "box-room", "wedge", "instanced"), test::scene_test_name);
+
+}  // namespace
+}  // namespace ao
+
+namespace ao {
+namespace {
+
+TEST(GpuScene, AMeshWithoutNormalsIsRefusedBeforeUpload) {
+  Scene s;
+  s.name = "hand-made";
+  s.meshes.push_back(make_quad({0, 0, 0}, {1, 0, 0}, {1, 0, -1}, {0, 0, -1}));
+  s.meshes.back().normals.clear();  // as a scene that skipped validate_and_prepare
+  test::expect_one_line_error<InputError>([&] { GpuScene::upload(test::gpu_device(), s); }, "hand-made", "validate_and_prepare");
+}
 
 }  // namespace
 }  // namespace ao

@@ -51,6 +51,11 @@ GpuScene GpuScene::upload(GpuDevice& device, const Scene& scene) {
   b->scene = &scene;
   b->objects = scene.objects();
   for (const Mesh& m : scene.meshes) {
+    // The vertex stage reads a normal (and, when there are any, a UV) per vertex: a scene that has
+    // not passed validate_and_prepare may lack them, and an attribute read past its buffer is
+    // undefined on a GPU.
+    if (m.normals.size() != m.positions.size() || (!m.uvs.empty() && m.uvs.size() != m.positions.size()))
+      throw InputError(scene.name + ": mesh '" + m.name + "' has no normal (or UV) for every vertex: the scene must pass validate_and_prepare");
     SceneBuffers::MeshBuffers mb;
     GLuint vao = 0;
     c.gl.GenVertexArrays(1, &vao);

@@ -90,8 +90,9 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   Context& c = Access::context(device);
   c.make_current();
   const int w = g.width(), h = g.height();
-  if (w < 1 || h < 1 || g.position.width() != w || g.normal.width() != w || g.object_id.width() != w)
-    throw InputError("--device gpu: the G-buffer to upload is empty or its channels differ in size");
+  const auto fits = [&](const auto& img) { return img.width() == w && img.height() == h; };
+  if (w < 1 || h < 1 || !fits(g.position) || !fits(g.normal) || !fits(g.object_id))
+    throw InputError("--device gpu: the G-buffer to upload is empty, or its position, normal or object id differ from its camera's size");
   Program& p = c.program({"gbuffer_depth.comp"});
   std::vector<PassQuery> passes;
   c.begin_pass(passes, "upload");  // the copies and the depth pass
@@ -106,23 +107,22 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   gpu_detail::upload(c, t->position, GL_RGB, GL_FLOAT, g.position.data());
   gpu_detail::upload(c, t->normal, GL_RGB, GL_FLOAT, g.normal.data());
   gpu_detail::upload(c, t->object, GL_RED_INTEGER, GL_UNSIGNED_INT, g.object_id.data());
-  const auto same_size = [&](const auto& img) { return img.width() == w && img.height() == h; };
-  if (!g.albedo.empty() && same_size(g.albedo)) {
+  if (!g.albedo.empty() && fits(g.albedo)) {
     t->albedo = make_texture(c, w, h, GL_RGBA32F);
     gpu_detail::upload(c, t->albedo, GL_RGB, GL_FLOAT, g.albedo.data());
     t->has_albedo = true;
   }
-  if (!g.uv.empty() && same_size(g.uv)) {
+  if (!g.uv.empty() && fits(g.uv)) {
     t->uv = make_texture(c, w, h, GL_RG32F);
     gpu_detail::upload(c, t->uv, GL_RG, GL_FLOAT, g.uv.data());
     t->has_uv = true;
   }
-  if (!g.primitive_id.empty() && same_size(g.primitive_id)) {
+  if (!g.primitive_id.empty() && fits(g.primitive_id)) {
     t->primitive = make_texture(c, w, h, GL_R32UI);
     gpu_detail::upload(c, t->primitive, GL_RED_INTEGER, GL_UNSIGNED_INT, g.primitive_id.data());
     t->has_primitive = true;
   }
-  if (!g.direct.empty() && same_size(g.direct)) {
+  if (!g.direct.empty() && fits(g.direct)) {
     t->direct = make_texture(c, w, h, GL_RGBA32F);
     gpu_detail::upload(c, t->direct, GL_RGB, GL_FLOAT, g.direct.data());
   }

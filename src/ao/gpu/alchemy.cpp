@@ -46,7 +46,7 @@ Texture bilateral_filter(Run& r, const Texture& values, const BilateralParams& p
     bind_image(r.c, 0, vertical ? out : tmp, GL_WRITE_ONLY);
     dispatch_2d(r.c, r.width(), r.height());
   }
-  r.c.end_pass();
+  r.c.end_pass(r.passes);
   return out;
 }
 

@@ -128,14 +128,14 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
   c.gl.BindVertexArray(0);
   c.gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   c.gl.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  c.end_pass();
+  c.end_pass(passes);
 
   c.begin_pass(passes, "count");
   c.gl.UseProgram(count.id);
   c.gl.Uniform2i(c.uniform(count, "u_columns"), g.nx, g.ny);
   c.gl.Uniform1i(c.uniform(count, "u_depth_bits"), g.depth_bits);
   dispatch_2d(c, g.nx, g.ny);
-  c.end_pass();
+  c.end_pass(passes);
   c.check("voxelizing the scene");
 
   GLuint counts[4] = {0, 0, 0, 0};

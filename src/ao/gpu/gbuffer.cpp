@@ -93,6 +93,7 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   const auto fits = [&](const auto& img) { return img.width() == w && img.height() == h; };
   if (w < 1 || h < 1 || !fits(g.position) || !fits(g.normal) || !fits(g.object_id))
     throw InputError("--device gpu: the G-buffer to upload is empty, or its position, normal or object id differ from its camera's size");
+  check_image_size(c, w, h);
   Program& p = c.program({"gbuffer_depth.comp"});
   std::vector<PassQuery> passes;
   c.begin_pass(passes, "upload");  // the copies and the depth pass
@@ -131,7 +132,7 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   t->bind();
   bind_image(c, 0, t->depth, GL_WRITE_ONLY);
   dispatch_2d(c, w, h);
-  c.end_pass();
+  c.end_pass(passes);
   c.check("deriving the uploaded G-buffer's depth");
   t->passes = c.resolve(passes);
   return GpuGBuffer(std::move(t));
@@ -144,6 +145,7 @@ GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const
   const SceneBuffers& sb = Access::buffers(scene);
   if (sb.context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
   const int w = camera.width, h = camera.height;
+  check_image_size(c, w, h);
   auto t = std::make_shared<GBufferTextures>();
   t->context = sb.context;
   t->camera = camera;
@@ -233,7 +235,7 @@ GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const
     c.gl.DrawElements(GL_TRIANGLES, mb.index_count, GL_UNSIGNED_INT, nullptr);
   }
   c.gl.BindVertexArray(0);
-  c.end_pass();
+  c.end_pass(passes);
   c.gl.Disable(GL_DEPTH_TEST);
   c.gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   c.gl.MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);

@@ -181,13 +181,10 @@ void Context::begin_pass(std::vector<PassQuery>& passes, std::string name) {
   gl.GenQueries(2, q.query.data());
   gl.QueryCounter(q.query[0], GL_TIMESTAMP);
   passes.push_back(std::move(q));
-  open_pass_ = &passes;
 }
 
-void Context::end_pass() {
-  if (!open_pass_ || open_pass_->empty()) return;
-  gl.QueryCounter(open_pass_->back().query[1], GL_TIMESTAMP);
-  open_pass_ = nullptr;
+void Context::end_pass(std::vector<PassQuery>& passes) {
+  if (!passes.empty()) gl.QueryCounter(passes.back().query[1], GL_TIMESTAMP);
 }
 
 std::vector<GpuPassTime> Context::resolve(std::vector<PassQuery>& passes) {
@@ -203,10 +200,14 @@ std::vector<GpuPassTime> Context::resolve(std::vector<PassQuery>& passes) {
   return out;
 }
 
-Texture make_texture(Context& c, int width, int height, GLenum format) {
+void check_image_size(const Context& c, int width, int height) {
   if (width > c.max_texture_size || height > c.max_texture_size)
     throw InputError("--device gpu: a " + std::to_string(width) + "x" + std::to_string(height) + " image exceeds this GPU's largest texture (" +
                      std::to_string(c.max_texture_size) + " per side, " + c.renderer + ")");
+}
+
+Texture make_texture(Context& c, int width, int height, GLenum format) {
+  check_image_size(c, width, height);
   GLuint id = 0;
   c.gl.GenTextures(1, &id);
   Texture t{{c, id}, width, height, format};

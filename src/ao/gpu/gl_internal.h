@@ -156,15 +156,14 @@ class Context {
   /// Throws SystemError naming `what` when a GL error is pending (GL_OUT_OF_MEMORY above all).
   void check(std::string_view what);
 
-  /// Starts and ends a timed pass (one pass at a time: end_pass closes the last one begun).
+  /// Starts a timed pass at the end of `passes`, and ends the last one begun there (one at a time).
   void begin_pass(std::vector<PassQuery>& passes, std::string name);
-  void end_pass();
+  void end_pass(std::vector<PassQuery>& passes);
   /// The milliseconds of every pass (waits for the GPU to finish them); deletes the queries.
   std::vector<GpuPassTime> resolve(std::vector<PassQuery>& passes);
 
  private:
   std::map<std::string, Program, std::less<>> programs_;
-  std::vector<PassQuery>* open_pass_ = nullptr;
 };
 
 /// The embedded text of shader file `name` (src/ao/gpu/shaders/), with every `#include "file"`
@@ -228,6 +227,8 @@ struct Texture {
   explicit operator bool() const { return static_cast<bool>(object); }
 };
 
+/// InputError when a width x height image exceeds the device's largest texture.
+void check_image_size(const Context& c, int width, int height);
 /// A texture of `format` (nearest filtering, clamp to edge: the shaders read it with texelFetch).
 Texture make_texture(Context& c, int width, int height, GLenum format);
 /// Uploads `data` (width * height pixels of `pixel_format` x `type`) into `t`.

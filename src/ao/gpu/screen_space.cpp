@@ -29,7 +29,7 @@ Program& Run::begin(std::string_view shader, std::string name, std::string_view 
 void Run::finish(const Texture& out) {
   bind_image(c, 0, out, GL_WRITE_ONLY);
   dispatch_2d(c, width(), height());
-  c.end_pass();
+  c.end_pass(passes);
 }
 
 Texture Run::map(std::string_view shader, std::string name, const Texture& in, GLenum format, std::string_view defines) {

@@ -60,6 +60,12 @@
 #include "ao/bake/sphere_directions.h"
 #include "ao/bake/texel_coverage.h"
 
+// gpu: the methods as OpenGL compute shaders (docs/gpu.md); without AO_GPU, opening a device says so.
+#include "ao/gpu/device.h"
+#include "ao/gpu/gbuffer.h"
+#include "ao/gpu/methods.h"
+#include "ao/gpu/voxelize.h"
+
 // eval: error metrics against a reference.
 #include "ao/eval/metrics.h"
 

@@ -20,7 +20,7 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/bilateral.h"
 #include "ao/methods/interleave.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/scene/procedural.h"
 #include "ao/simd/target.h"
 
@@ -94,7 +94,7 @@ Differences differences(const Image<float>& a, const Image<float>& b) {
 // the best one. Targets with FMA agree bit for bit, and so do the targets without it among
 // themselves; between the two groups the images differ by rounding (kRounding), and by a flipped
 // test in at most 0.1% of the pixels. Measured here: containment and transfer bit for bit on every
-// target, the others in 5-30% of the pixels by at most 1.0e-6 (BENCHMARKS.md, "SIMD targets").
+// target, the others in 5-30% of the pixels by at most 1.0e-6 (BENCHMARKS.md, "Portable build against -march=native").
 TEST(SimdTargets, MethodImagesAgreeBetweenTargets) {
   const TargetGuard guard;
   const Scene scene = make_builtin_scene("default");
@@ -105,7 +105,7 @@ TEST(SimdTargets, MethodImagesAgreeBetweenTargets) {
   const Falloff falloff{Membership::Step, 0.1f * scene.bounds().diagonal()};
   const std::vector<std::string> targets = simd_targets();
   for (const MethodInfo& m : all_methods()) {
-    if (m.name == "raytraced") continue;  // Embree's own dispatch, not the kernel layer
+    if (m.ground_truth) continue;  // Embree's own dispatch, not the kernel layer
     auto run = [&](const std::string& target) {
       set_simd_target(target);
       return m.run(MethodInput{g, &rays, falloff, 5, {}, &scene.analytic}, m.default_params()).visibility;

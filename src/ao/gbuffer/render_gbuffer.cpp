@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-
-#include "ao/core/parallel.h"
+#include "ao/reference/ray_tiles_internal.h"
 #include "ao/simd/gbuffer_internal.h"
 
 namespace ao {
@@ -40,20 +37,14 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   g.direct = Image<Vec3>();  // belongs to the lighting of the previous view: render_direct_light makes a new one
   const Frame basis = camera.basis();
   // Each tile is traced and written by the SIMD kernel layer (simd::render_gbuffer_tile).
-  const simd::GBufferTileJob job{&rs, &camera, basis, simd::RayGenerator(camera, basis), options.normal, rs.native_packet_width(), &g};
-  ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);
-  // The range is of tile indices, so the tiles are the same however TBB splits it. TBB's auto
-  // partitioner hands each thread a few blocks of tiles (splitting further only when a thread runs
-  // dry) instead of one task per tile: fewer task switches.
-  constexpr int tw = simd::kGBufferTileWidth, th = simd::kGBufferTileHeight;
-  const int columns = (camera.width + tw - 1) / tw, rows = (camera.height + th - 1) / th;
-  tbb::parallel_for(tbb::blocked_range2d<int>(0, rows, 0, columns), [&](const tbb::blocked_range2d<int>& r) {
-    for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
-      for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
-        const int x0 = tx * tw, y0 = ty * th, x1 = std::min(x0 + tw, camera.width), y1 = std::min(y0 + th, camera.height);
-        simd::render_gbuffer_tile(job, x0, y0, x1, y1);
-        counter.add(static_cast<std::size_t>(x1 - x0) * (y1 - y0));
-      }
+  const simd::GBufferTileJob job{&rs, &camera, basis, simd::RayGenerator(camera, basis), options.normal, &g};
+  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);  // a primary ray per pixel
+  // Primary rays of neighbouring pixels are coherent; every tile costs about the same, so TBB
+  // hands each thread blocks of tiles.
+  const detail::RayTiling tiling{simd::kGBufferTileWidth, simd::kGBufferTileHeight, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, true};
+  detail::for_each_ray_tile(rs, w, h, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    simd::render_gbuffer_tile(job, N, ctx, t);
+    return static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0);
   });
 }
 

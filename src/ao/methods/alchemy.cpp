@@ -10,40 +10,48 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/methods/alchemy_internal.h"
 #include "ao/simd/alchemy_internal.h"
 
 namespace ao {
 
+namespace alchemy_internal {
+
+const RotationTable& rotations() {
+  static const RotationTable t = [] {
+    RotationTable r;
+    for (int i = 0; i < kRotations; ++i) {
+      const double a = 2.0 * M_PI * (i + 0.5) / kRotations;
+      r.c[i] = static_cast<float>(std::cos(a));
+      r.s[i] = static_cast<float>(std::sin(a));
+    }
+    return r;
+  }();
+  return t;
+}
+
+Directions sample_directions(int s) {
+  // Golden angle: successive samples of the pattern are spread evenly in angle.
+  constexpr float kGoldenAngle = 2.39996322972865332f;
+  Directions d;
+  for (int i = 0; i < s; ++i) d.x[i] = std::cos(kGoldenAngle * i), d.y[i] = std::sin(kGoldenAngle * i);
+  return d;
+}
+
+}  // namespace alchemy_internal
+
 namespace {
 
-constexpr int kMaxSamples = 1024;
+using alchemy_internal::kMaxPixelRadius;
+using alchemy_internal::kMaxSamples;
+using alchemy_internal::RotationTable;
+using alchemy_internal::rotations;
 // Tiles of 128 x 8 pixels: rows long enough to vectorise over pixels, and a tile's sample footprint
 // (the tile grown by the disk's pixel radius) small enough to stay in L2 for typical radii.
 constexpr int kTileWidth = 128, kTileHeight = 8;
 static_assert(kTileWidth <= simd::kMaxAlchemySegment);
-// The disk's screen radius is capped (a pixel whose disk covers the whole image gains nothing from a
-// larger one) so that pixel coordinates stay below the kernel's offset (65536) and truncation acts as floor.
-constexpr float kMaxPixelRadius = 16384.0f;
-// Per-pixel rotations of the sample pattern come from a table of this many angles (no trig per
-// pixel); 1024 steps of 0.35 degrees are far finer than any sample spacing.
-constexpr int kRotations = 1024;
-// Golden angle: successive samples of the pattern are spread evenly in angle.
-constexpr float kGoldenAngle = 2.39996322972865332f;
-
-struct RotationTable {
-  std::array<float, kRotations> c, s;
-  RotationTable() {
-    for (int i = 0; i < kRotations; ++i) {
-      const double a = 2.0 * M_PI * (i + 0.5) / kRotations;
-      c[i] = static_cast<float>(std::cos(a));
-      s[i] = static_cast<float>(std::sin(a));
-    }
-  }
-};
-const RotationTable& rotations() {
-  static const RotationTable t;
-  return t;
-}
+// The kernel's coordinate offset and rotation mask are the pattern's (ao/simd/alchemy.cpp).
+static_assert(alchemy_internal::kCoordOffset == 65536.0f && alchemy_internal::kRotations == 1024);
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -116,8 +124,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
   // its samples agree exactly on a plane.
   const Image<float> depth_image = depth_plane(g);  // also the filter's
   const float t = g.camera.tan_half_fov();
-  std::array<float, kMaxSamples> ux{}, uy{};
-  for (int i = 0; i < s; ++i) ux[i] = std::cos(kGoldenAngle * i), uy[i] = std::sin(kGoldenAngle * i);
+  const alchemy_internal::Directions directions = alchemy_internal::sample_directions(s);
+  const std::array<float, kMaxSamples>&ux = directions.x, &uy = directions.y;
   const RotationTable& rot = rotations();
   simd::AlchemyInputs in;
   in.depth = depth_image.data(), in.normal = &g.normal.data()->x, in.object_id = g.object_id.data();

@@ -9,13 +9,15 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/methods/gtao_internal.h"
 #include "ao/simd/gtao_internal.h"
 
 namespace ao {
 
 namespace {
 
-constexpr int kMaxSlices = 16, kMaxSteps = 32;
+using gtao_internal::kMaxSlices;
+using gtao_internal::kMaxSteps;
 // Tiles of 128 x 16 pixels, as the other screen-space kernels: long row segments for the SIMD
 // loops over pixels, few rows per tile.
 constexpr int kTileWidth = 128, kTileHeight = 16;
@@ -67,6 +69,30 @@ const ParamTable<GtaoParams>& gtao_param_table() {
   return table;
 }
 
+namespace gtao_internal {
+
+Tables make_tables(const GtaoParams& params, std::uint32_t seed) {
+  const int slices = params.slices, steps = params.steps;
+  const Pattern pattern = make_pattern(seed, params.interleave.interleave);
+  Tables t;
+  // Slice k of pattern entry p has screen angle phi = pi (k + rotation_p) / slices: the slices
+  // split the half circle evenly (a slice covers both of its sides), rotated per pixel.
+  for (int k = 0; k < slices; ++k)
+    for (int p = 0; p < 16; ++p) {
+      const double phi = kPi * (k + pattern.rotation[static_cast<std::size_t>(p)]) / slices;
+      t.dir_c[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::cos(phi));
+      t.dir_s[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::sin(phi));
+    }
+  // Step j of pattern entry p lies at t = ((j + offset_p) / steps)^step_power of the screen radius.
+  for (int j = 0; j < steps; ++j)
+    for (int p = 0; p < 16; ++p)
+      t.step_t[static_cast<std::size_t>(j)][static_cast<std::size_t>(p)] =
+          std::pow((static_cast<float>(j) + pattern.offset[static_cast<std::size_t>(p)]) / static_cast<float>(steps), params.step_power);
+  return t;
+}
+
+}  // namespace gtao_internal
+
 void GtaoParams::validate() const { gtao_param_table().validate(*this); }
 void to_json(nlohmann::json& j, const GtaoParams& p) { j = gtao_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, GtaoParams& p) { gtao_param_table().from_json(j, p); }
@@ -82,22 +108,7 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   if (!(radius > 0.0f) || !std::isfinite(radius)) throw InputError("gtao: radius R must be a positive number of world units");
   const int w = g.width(), h = g.height();
   const int slices = params.slices, steps = params.steps;
-  const Pattern pattern = make_pattern(seed, params.interleave.interleave);
-  // Slice k of pattern entry p has screen angle phi = pi (k + rotation_p) / slices: the slices
-  // split the half circle evenly (a slice covers both of its sides), rotated per pixel.
-  std::array<float, kMaxSlices * 16> dir_c{}, dir_s{};
-  for (int k = 0; k < slices; ++k)
-    for (int p = 0; p < 16; ++p) {
-      const double phi = kPi * (k + pattern.rotation[static_cast<std::size_t>(p)]) / slices;
-      dir_c[static_cast<std::size_t>(k * 16 + p)] = static_cast<float>(std::cos(phi));
-      dir_s[static_cast<std::size_t>(k * 16 + p)] = static_cast<float>(std::sin(phi));
-    }
-  // Step j of pattern entry p lies at t = ((j + offset_p) / steps)^step_power of the screen radius.
-  std::array<float, kMaxSteps * 16> step_t{};
-  for (int j = 0; j < steps; ++j)
-    for (int p = 0; p < 16; ++p)
-      step_t[static_cast<std::size_t>(j * 16 + p)] =
-          std::pow((static_cast<float>(j) + pattern.offset[static_cast<std::size_t>(p)]) / static_cast<float>(steps), params.step_power);
+  const gtao_internal::Tables tables = gtao_internal::make_tables(params, seed);
 
   // Camera rays through pixel centres: ray(x, y) = (ax (x + 0.5) + bx, ay (y + 0.5) + by, -1), so a
   // sample's camera-space point is depth * ray (one 4-byte gather per sample).
@@ -112,7 +123,9 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   // Both image axes have 0.5 h / tan(fov/2) pixels per unit of x/(-z): R at depth z spans R * that / z pixels.
   in.px_per_unit = 0.5f * static_cast<float>(h) / t;
   in.slices = slices, in.steps = steps;
-  in.dir_c = dir_c.data(), in.dir_s = dir_s.data(), in.step_t = step_t.data();
+  // The kernel reads each table as one row-major array, [k * 16 + p].
+  static_assert(sizeof(tables.dir_c) == sizeof(float) * kMaxSlices * 16 && sizeof(tables.step_t) == sizeof(float) * kMaxSteps * 16);
+  in.dir_c = tables.dir_c[0].data(), in.dir_s = tables.dir_s[0].data(), in.step_t = tables.step_t[0].data();
 
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& tile) {

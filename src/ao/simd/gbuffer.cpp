@@ -39,10 +39,7 @@ struct TileHits {
 
 // Traces the primary rays of tile t into `hits`.
 template <int N>
-void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const Tile& t, TileHits& hits) {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+void trace_tile(RTCScene bvh, RTCIntersectContext& ctx, const Camera& cam, const RayGenerator& gen, const Tile& t, TileHits& hits) {
   const int tw = t.x1 - t.x0;
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
@@ -191,9 +188,8 @@ void shade_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const
 }
 
 template <int N>
-void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const RayGenerator& gen, SurfaceNormal which, GBuffer& g,
-                 const Tile& t) {
-  detail::flush_denormals_to_zero();
+void render_tile(const RayScene& rs, RTCIntersectContext& ctx, const Camera& cam, const Frame& basis, const RayGenerator& gen, SurfaceNormal which,
+                 GBuffer& g, const Tile& t) {
   // Strips one packet block high: a strip's streamed stores drain while the next strip's rays
   // traverse the BVH, and its hits stay in the L1 cache between the two phases.
   constexpr int kStrip = N == 1 ? 1 : N / 4;
@@ -201,7 +197,7 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
   TileHits hits;
   for (int y = t.y0; y < t.y1; y += kStrip) {
     const Tile s{t.x0, y, t.x1, std::min(y + kStrip, t.y1)};
-    trace_tile<N>(ao::embree_scene(rs), cam, gen, s, hits);
+    trace_tile<N>(ao::embree_scene(rs), ctx, cam, gen, s, hits);
     const bool extras = !g.albedo.empty() || !g.uv.empty();
     if (which == SurfaceNormal::Shading) {
       if (extras) shade_tile<SurfaceNormal::Shading, true>(rs, cam, basis, hits, g, s);
@@ -216,9 +212,8 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
 
 }  // namespace
 
-void RenderGBufferTile(const GBufferTileJob& job, int x0, int y0, int x1, int y1) {
-  const Tile t{x0, y0, x1, y1};
-  detail::dispatch_packet_width(job.packet_width, [&]<int N>() { render_tile<N>(*job.scene, *job.camera, job.basis, job.rays, job.normal, *job.g, t); });
+void RenderGBufferTile(const GBufferTileJob& job, int packet_width, RTCIntersectContext& ctx, const Tile& t) {
+  detail::dispatch_packet_width(packet_width, [&]<int N>() { render_tile<N>(*job.scene, ctx, *job.camera, job.basis, job.rays, job.normal, *job.g, t); });
 }
 
 }  // namespace ao::simd::HWY_NAMESPACE
@@ -229,7 +224,9 @@ namespace ao::simd {
 
 HWY_EXPORT(RenderGBufferTile);
 
-void render_gbuffer_tile(const GBufferTileJob& job, int x0, int y0, int x1, int y1) { HWY_DYNAMIC_DISPATCH(RenderGBufferTile)(job, x0, y0, x1, y1); }
+void render_gbuffer_tile(const GBufferTileJob& job, int packet_width, RTCIntersectContext& ctx, const Tile& t) {
+  HWY_DYNAMIC_DISPATCH(RenderGBufferTile)(job, packet_width, ctx, t);
+}
 
 }  // namespace ao::simd
 #endif

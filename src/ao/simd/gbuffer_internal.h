@@ -3,9 +3,12 @@
 // streamed to the images. render_gbuffer sizes the images and hands out the tiles.
 #pragma once
 
+#include <embree3/rtcore.h>
+
 #include "ao/core/camera.h"
 #include "ao/core/gbuffer.h"
 #include "ao/core/math.h"
+#include "ao/core/parallel.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao::simd {
@@ -35,13 +38,13 @@ struct GBufferTileJob {
   Frame basis;                 ///< camera->basis().
   RayGenerator rays;           ///< Of camera and basis.
   SurfaceNormal normal = SurfaceNormal::Shading;
-  int packet_width = 1;        ///< Rays per Embree packet: 16, 8, 4 or 1 (RayScene::native_packet_width).
   GBuffer* g = nullptr;
 };
 
-/// Traces the primary rays of the tile [x0, x1) x [y0, y1) (at most kGBufferTileWidth wide) and
-/// writes its pixels of every channel of job.g, as render_gbuffer states, with non-temporal stores
-/// followed by a fence.
-void render_gbuffer_tile(const GBufferTileJob& job, int x0, int y0, int x1, int y1);
+/// Traces the primary rays of tile t (at most kGBufferTileWidth wide) in packets of packet_width
+/// rays (16, 8, 4 or 1: the tile loop's, detail::for_each_ray_tile) with the intersect context ctx,
+/// and writes its pixels of every channel of job.g, as render_gbuffer states, with non-temporal
+/// stores followed by a fence.
+void render_gbuffer_tile(const GBufferTileJob& job, int packet_width, RTCIntersectContext& ctx, const Tile& t);
 
 }  // namespace ao::simd

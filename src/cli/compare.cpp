@@ -30,6 +30,7 @@ struct CompareOptions {
   std::uint32_t seed = 1;
   std::vector<std::string> params;  ///< method.key=value.
   std::string reference;            ///< NAME or method=NAME, comma-separated; empty = matched.
+  std::string common_reference = "obscurance";
   bool json = false;
 };
 
@@ -61,6 +62,7 @@ CompareRequest make_request(const CompareOptions& o) {
     if (eq == std::string::npos) settings.references[""] = item;
     else settings.references[item.substr(0, eq)] = item.substr(eq + 1);
   }
+  settings.common_reference = o.common_reference;
   settings.spp_reference = o.spp_reference;
   settings.seed = o.seed;
   if (!o.sweep.empty()) {
@@ -113,6 +115,10 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   cmd->add_option("--reference", o->reference,
                   "Reference to judge against: NAME for every method or method=NAME, comma-separated; NAME is matched (each method's own, "
                   "the default), obscurance (the obscurance of the membership it implies), tangent-sphere or transfer");
+  cmd->add_option("--common-reference", o->common_reference,
+                  "The one reference every method is also judged against, so that rows can be ranked: obscurance (of --membership, "
+                  "step at R by default), tangent-sphere, transfer, or none")
+      ->capture_default_str();
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d) requested: " + membership_names() + " (methods may imply their own)");
   cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + "; the same for every method and its reference")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();

@@ -45,6 +45,8 @@ Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, c
     if (!kp.empty()) label.push_back(kp);
     label.push_back("reference: " + result.references[row.reference].spec.label());
     label.push_back("RMSE " + fixed4(row.metrics.rmse));  // as in table.md
+    if (result.common && *result.common != row.reference)
+      label.push_back("vs " + result.references[*result.common].spec.label() + ": " + fixed4(row.common.rmse));
     rows.push_back({&row.visibility, &result.references[row.reference].visibility, &row.heat, std::move(label)});
   }
   std::string font_error;

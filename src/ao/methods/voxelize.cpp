@@ -15,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <tuple>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -33,25 +34,48 @@ struct GridTri {
   float x[3], y[3], a[3];
   int j0, j1;  // rows whose centres the bounding box covers
   int fill;    // 0: parity fragment; +1 / -1: open-mesh slab filled towards larger / smaller k;
-               // 2: parity fragment of an open wall's prism (scratch grid)
+               // 2: fragment of an open wall's prism (listed, voxelize_into step 4); 3 + s: parity fragment
+               // of a fan closing a hole that is not flat, of the solid with holes in slot s
+               // (recorded: the winding number is evaluated from there, voxelize_into step 3)
 };
 
 struct Tri3 {
   Vec3 v[3];
-  int kind;     // 0: parity; 1: open-mesh face, filled behind; 2: side of an open face's prism
-  Vec3 normal;  // geometric normal of the front face (counter-clockwise, mesh.h); set when kind 1
+  int kind;      // 0: parity; 1: open-mesh face, filled behind `normal`; 2: side of an open face's prism
+  Vec3 normal;   // kind 1: the side the slab is away from (the front's normal, or its opposite for
+                 // a grid traced from the back side, voxelize.h)
+  int fan = -1;  // kind 0: slot of the solid with holes whose non-flat hole this fan triangle closes
 };
 
-// The centroid of each hole's boundary vertices (each boundary edge contributes its two ends).
-std::vector<Vec3> hole_centroids(const Mesh& m, const MeshClosure& c) {
-  std::vector<Vec3> sum(c.holes, Vec3{0, 0, 0});
+// The centroid of each hole's boundary vertices (each boundary edge contributes its two ends), and
+// whether the hole is flat: its boundary within 1e-6 of the mesh's extent of the plane through the
+// centroid normal to the fan's vector area. Off a flat fan |w_fan| < 1/2 (voxelize_world), so the
+// parity of the mesh with its fans is its winding-number solid there without evaluating w.
+struct Holes {
+  std::vector<Vec3> centre;
+  std::vector<std::uint8_t> flat;
+};
+Holes hole_centroids(const Mesh& m, const MeshClosure& c) {
+  Holes h{std::vector<Vec3>(c.holes, Vec3{0, 0, 0}), std::vector<std::uint8_t>(c.holes, 1)};
   std::vector<float> n(c.holes, 0.0f);
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    sum[c.hole[e]] = sum[c.hole[e]] + m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
+    h.centre[c.hole[e]] += m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
     n[c.hole[e]] += 2.0f;
   }
-  for (std::uint32_t h = 0; h < c.holes; ++h) sum[h] = sum[h] * (1.0f / n[h]);
-  return sum;
+  for (std::uint32_t k = 0; k < c.holes; ++k) h.centre[k] = h.centre[k] * (1.0f / n[k]);
+  std::vector<Vec3> area(c.holes, Vec3{0, 0, 0});
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const Vec3 o = h.centre[c.hole[e]];
+    area[c.hole[e]] += cross(m.positions[c.boundary[e][1]] - o, m.positions[c.boundary[e][0]] - o);
+  }
+  const float tol = 1e-6f * m.bounds().diagonal();
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const std::uint32_t k = c.hole[e];
+    const Vec3 nk = normalize(area[k]);
+    for (int end = 0; end < 2; ++end)
+      if (!(std::abs(dot(nk, m.positions[c.boundary[e][end]] - h.centre[k])) <= tol)) h.flat[k] = 0;
+  }
+  return h;
 }
 
 Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
@@ -61,12 +85,16 @@ Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
 
 // An open face steep to the columns (a wall, for the world grid) has few or no fragments: a span
 // along the column cannot stand for it. It becomes the closed prism between it and its copy
-// moved `thickness` behind its front face, voxelized by parity in a scratch grid (kind 2) that is
-// ORed into the grid. Calls emit for the prism's 8 triangles.
+// moved `thickness` behind `normal` (kind 2), whose triangles face out of it; their union is
+// ORed into the grid (voxelize_into, step 4). Calls emit for the prism's 8 triangles.
 template <class Emit>
 void emit_prism(const Tri3& t, float thickness, Emit&& emit) {
   const Vec3 o = t.normal * -thickness;
-  const Vec3 top[3] = {t.v[0], t.v[1], t.v[2]}, bottom[3] = {t.v[0] + o, t.v[1] + o, t.v[2] + o};
+  // The top (the face itself) faces out when its counter-clockwise normal is `normal`; otherwise
+  // (a slab in front of a face) its vertices are taken in the other order.
+  const bool out = dot(cross(t.v[1] - t.v[0], t.v[2] - t.v[0]), t.normal) >= 0;
+  const Vec3 a = t.v[0], b = out ? t.v[1] : t.v[2], c = out ? t.v[2] : t.v[1];
+  const Vec3 top[3] = {a, b, c}, bottom[3] = {a + o, b + o, c + o};
   emit(Tri3{{top[0], top[1], top[2]}, 2, {}});
   emit(Tri3{{bottom[0], bottom[2], bottom[1]}, 2, {}});
   for (int e = 0; e < 3; ++e) {
@@ -123,7 +151,7 @@ void emit_world(std::vector<GridTri>& out, const Tri3& t, const WorldMap& m, int
   GridTri& g = out.emplace_back();
   for (int k = 0; k < 3; ++k) m(t.v[k], g.x[k], g.y[k], g.a[k]);
   // Behind the front face: below a face looking up (+y is +k), above a face looking down.
-  g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : 0;
+  g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : t.fan >= 0 ? 3 + t.fan : 0;
   if (!finish_visible(g, nx, ny)) out.pop_back();
 }
 
@@ -145,7 +173,7 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
   }
   if (n < 3) return;
   // Behind the front face: deeper for a face turned to the eye, nearer for one turned away.
-  const int fill = t.kind == 1 ? (facing < 0 ? 1 : -1) : t.kind == 2 ? 2 : 0;
+  const int fill = t.kind == 1 ? (facing < 0 ? 1 : -1) : t.kind == 2 ? 2 : t.fan >= 0 ? 3 + t.fan : 0;
   float x[4], y[4], a[4];
   for (int k = 0; k < n; ++k) {
     const float inv = 1.0f / -poly[k].z;
@@ -184,11 +212,20 @@ inline void set_bits(std::uint64_t* col, int nbits, int b0, int b1) {
   }
 }
 
+// A fragment listed rather than toggled: column (i, j), the first voxel beyond it, and a tag (the
+// slot of the solid with holes for a fan's fragment; +-1 as the prism is entered or left for a
+// prism's).
+struct ColumnHit {
+  int i, j, k, tag;
+};
+
 // Rasterises one triangle's rows [r0, r1]. A parity fragment toggles one bit (XOR to the end after
-// the scan); a slab fragment of an open mesh ORs the voxels within `slab` (world units) behind it.
-// Returns fragments.
+// the scan), and is listed in `hits` when it belongs to a fan over a hole that is not flat; a slab
+// fragment of an open mesh ORs the voxels within `slab` (world units) behind it; a prism's fragment
+// is listed in `hits` with the side it crosses to (prisms face out: the sign of the triangle's
+// area in grid space). Returns fragments.
 template <bool kPerspective>
-std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab) {
+std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab, std::vector<ColumnHit>& hits) {
   const double x0 = t.x[0], y0 = t.y[0];
   const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
   if (area2 == 0) return 0;  // edge-on: no column centre lies inside
@@ -233,8 +270,13 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
       const double first = std::ceil(k - 0.5);
       if (first >= nbits) continue;
       const int b = first <= 0 ? 0 : static_cast<int>(first);
-      row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
       ++fragments;
+      if (t.fill == 2) {
+        hits.push_back({i, j, b, area2 > 0 ? 1 : -1});
+        continue;
+      }
+      row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
+      if (t.fill >= 3) hits.push_back({i, j, b, t.fill - 3});
     }
   }
   return fragments;
@@ -369,12 +411,70 @@ std::size_t build_coarse(VoxelGrid& g) {
   return set;
 }
 
-// Stages 1-3 for any grid whose geometry fields are set; `emit` maps one Tri3 into a vector.
-template <bool kPerspective, class Emit>
-void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, float slab_thickness,
-                   Emit&& emit, VoxelStats* stats) {
+// How one object is voxelized (voxelize.h: OpenMeshes, and the `back` side of a grid).
+enum class Treat : std::uint8_t {
+  Parity,       // as it is
+  Fans,         // a solid with holes: parity with its holes closed by fans, w evaluated near non-flat ones
+  Slab,         // a slab behind its fronts
+  SlabFlipped,  // a slab in front of its fronts
+};
+
+// Per object, and the number of open objects voxelized for their back side.
+struct Treatments {
+  std::vector<Treat> of;
+  std::size_t back = 0;
+};
+Treatments treatments(const Scene& scene, std::span<const MeshClosure> closure, OpenMeshes mode, std::span<const std::uint8_t> back) {
   if (closure.size() != scene.meshes.size()) throw InputError("voxelize: closure has " + std::to_string(closure.size()) +
                                                               " meshes, the scene " + std::to_string(scene.meshes.size()));
+  const std::vector<SceneObject> objects = scene.objects();
+  if (!back.empty() && back.size() != objects.size())
+    throw InputError("voxelize: " + std::to_string(back.size()) + " back-side flags for " + std::to_string(objects.size()) + " objects");
+  Treatments r{std::vector<Treat>(objects.size(), Treat::Parity), 0};
+  std::vector<Treat>& t = r.of;
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    const MeshClosure& c = closure[objects[o].mesh];
+    const bool from_back = mode == OpenMeshes::Winding && !c.closed() && !back.empty() && back[o];
+    r.back += from_back ? 1 : 0;
+    if (mode == OpenMeshes::Slab && c.open_surface()) {
+      t[o] = Treat::Slab;
+    } else if (mode == OpenMeshes::Winding && c.open_surface()) {
+      t[o] = from_back ? Treat::SlabFlipped : Treat::Slab;
+    } else if (mode == OpenMeshes::Winding && c.holed()) {
+      // Seen from inside (through a hole), the shell's outside is what occludes: a slab on the
+      // side its fronts face when they face out.
+      const Affine3* tf = objects[o].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[o].instance].object_to_world;
+      const int out = c.orientation * (tf && tf->determinant() < 0 ? -1 : 1);
+      t[o] = !from_back ? Treat::Fans : out > 0 ? Treat::SlabFlipped : Treat::Slab;
+    }
+  }
+  return r;
+}
+
+bool any_slab(std::span<const Treat> t) {
+  return std::any_of(t.begin(), t.end(), [](Treat x) { return x == Treat::Slab || x == Treat::SlabFlipped; });
+}
+
+// Object space of an object: the inverse of its instance's map (identity for a world-space mesh),
+// and the sign of its determinant (a mirror turns fronts into backs: w changes sign).
+struct ObjectSpace {
+  bool instanced = false;
+  Affine3 to_object;
+  int sign = 1;
+  Vec3 operator()(Vec3 p) const { return instanced ? to_object.point(p) : p; }
+};
+ObjectSpace object_space(const Scene& scene, const SceneObject& ob) {
+  if (ob.instance == SceneObject::kNoInstance) return {};
+  const Affine3& m = scene.instances[ob.instance].object_to_world;
+  return {true, inverse(m), m.determinant() < 0 ? -1 : 1};
+}
+
+// Stages 1-4 for any grid whose geometry fields are set; `emit` maps one Tri3 into a vector,
+// `voxel_centre(i, j, k)` gives the world point of a voxel's centre.
+template <bool kPerspective, class Emit, class Centre>
+void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, const Treatments& treatment,
+                   float slab_thickness, Emit&& emit, Centre&& voxel_centre, VoxelStats* stats) {
+  const std::span<const Treat> treat = treatment.of;
   g.depth_bits = o.depth_bits;
   g.words = (o.depth_bits + 63) / 64;
   g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
@@ -387,29 +487,33 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   std::vector<int> band_of(g.ny);
   for (int b = 0; b < bands; ++b)
     for (int j = band_first_row(b); j < band_first_row(b + 1); ++j) band_of[j] = b;
-  const auto kind_of = [](const GridTri& t) { return t.fill == 0 ? 0 : t.fill == 2 ? 2 : 1; };
+  const auto kind_of = [](const GridTri& t) { return t.fill == 0 || t.fill >= 3 ? 0 : t.fill == 2 ? 2 : 1; };
   struct Buckets {
     std::vector<std::uint32_t> start, index;  // bucket (kind * bands + band): index[start[k], start[k + 1])
   };
-  // A holed mesh voxelized by winding number (voxelize.h) gets one fan triangle per boundary
-  // edge after its own triangles: (b, a, centroid) for the boundary edge a -> b, so that every
-  // edge of the mesh and its fans is used twice and the parity pass sees a closed surface.
+  // A solid with holes (Treat::Fans) gets one fan triangle per boundary edge after its own
+  // triangles: (b, a, centroid) for the boundary edge a -> b, so that every edge of the mesh and
+  // its fans is used twice and the parity pass sees a closed surface.
   // The triangles are those of every object (Scene::objects(): a world-space mesh, or an instance
   // whose mesh's triangles go through its transform); closure and hole centroids are per mesh, as
   // an affine map keeps both (it maps centroids to centroids).
   const std::vector<SceneObject> objects = scene.objects();
-  std::vector<std::vector<Vec3>> centre(scene.meshes.size());
-  std::vector<std::uint8_t> mesh_capped(scene.meshes.size(), 0);
-  std::size_t capped = 0;
-  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    const bool cap = o.open_meshes == OpenMeshes::Winding && closure[mi].holed();
-    if (cap) centre[mi] = hole_centroids(scene.meshes[mi], closure[mi]), ++capped;
-    mesh_capped[mi] = cap ? 1 : 0;
-  }
+  std::vector<Holes> holes(scene.meshes.size());
+  std::vector<std::uint8_t> hole_info(scene.meshes.size(), 0);
+  std::vector<int> slot_of(objects.size(), -1);  // objects with a non-flat hole: their slot
+  std::vector<std::size_t> slot_object;
   std::vector<std::size_t> first{0};
-  for (const SceneObject& ob : objects) {
-    g.capped.push_back(mesh_capped[ob.mesh]);
-    first.push_back(first.back() + scene.meshes[ob.mesh].triangle_count() + (mesh_capped[ob.mesh] ? closure[ob.mesh].boundary.size() : 0));
+  std::size_t fanned = 0;
+  for (std::size_t oi = 0; oi < objects.size(); ++oi) {
+    const std::size_t mi = objects[oi].mesh;
+    const bool fans = treat[oi] == Treat::Fans;
+    if (fans && !hole_info[mi]) holes[mi] = hole_centroids(scene.meshes[mi], closure[mi]), hole_info[mi] = 1;
+    if (fans && std::find(holes[mi].flat.begin(), holes[mi].flat.end(), 0) != holes[mi].flat.end()) {
+      slot_of[oi] = static_cast<int>(slot_object.size());
+      slot_object.push_back(oi);
+    }
+    fanned += fans ? 1 : 0;
+    first.push_back(first.back() + scene.meshes[mi].triangle_count() + (fans ? closure[mi].boundary.size() : 0));
   }
   const std::size_t total = first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
@@ -424,7 +528,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       while (t >= first[oi + 1]) ++oi;
       const std::size_t mi = objects[oi].mesh;
       const Affine3* tf = objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[oi].instance].object_to_world;
-      const bool open = o.open_meshes != OpenMeshes::Parity && closure[mi].open_surface();
+      const bool open = treat[oi] == Treat::Slab || treat[oi] == Treat::SlabFlipped;
       const Mesh& m = scene.meshes[mi];
       const std::size_t local = t - first[oi];
       Tri3 tri;
@@ -433,12 +537,14 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       } else {
         const std::size_t e = local - m.triangle_count();
         const auto [a, b] = closure[mi].boundary[e];
-        tri = Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}};
+        const std::uint32_t h = closure[mi].hole[e];
+        tri = Tri3{{m.positions[b], m.positions[a], holes[mi].centre[h]}, 0, {}, holes[mi].flat[h] ? -1 : slot_of[oi]};
       }
       if (tf) {
         for (Vec3& v : tri.v) v = tf->point(v);
         if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
       }
+      if (treat[oi] == Treat::SlabFlipped) tri.normal = -tri.normal;
       emit(out, tri);
     }
     Buckets& bk = buckets[c];
@@ -455,7 +561,8 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // 2. Raster bands of rows; parity fragments first, then (after the scan) open-mesh slabs,
   // which are ORed: a union, so overlapping slabs of neighbouring open triangles do not cancel.
   std::vector<std::size_t> fragments(bands, 0);
-  const auto raster_pass = [&](VoxelGrid& target, int fill_kind) {  // 0 parity, 1 spans, 2 prisms
+  std::vector<std::vector<ColumnHit>> hits(bands);  // fans' fragments (pass 0), then prisms' (pass 2)
+  const auto raster_pass = [&](int fill_kind) {      // 0 parity, 1 spans, 2 prisms
     tbb::parallel_for(0, bands, [&](int b) {
       const int r0 = band_first_row(b), r1 = band_first_row(b + 1) - 1;
       const std::size_t k = static_cast<std::size_t>(fill_kind) * bands + b;
@@ -463,29 +570,73 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       for (std::size_t c = 0; c < chunks; ++c)
         for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
           const GridTri& t = tris[c][buckets[c].index[q]];
-          f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), target, slab_thickness);
+          f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), g, slab_thickness, hits[b]);
         }
       fragments[b] += f;
     });
   };
-  raster_pass(g, 0);
+  raster_pass(0);
 
   // 3. Toggles -> solid.
   const std::size_t odd = scan_columns(g);
-  bool any_open = false;
-  for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
-  if (any_open && o.open_meshes != OpenMeshes::Parity) {
-    raster_pass(g, 1);
-    bool any_prism = false;
-    for (const auto& chunk : tris)
-      for (const GridTri& t : chunk) any_prism = any_prism || t.fill == 2;
-    if (any_prism) {
-      VoxelGrid scratch = g;  // same geometry; bits cleared below
-      std::fill(scratch.bits.begin(), scratch.bits.end(), 0);
-      raster_pass(scratch, 2);
-      scan_columns(scratch);
-      for (std::size_t w = 0; w < g.bits.size(); ++w) g.bits[w] |= scratch.bits[w];
+
+  // The winding-number solid near holes that are not flat. Parity with the fans is the solid
+  // chi of the mesh plus its fans C; the mesh's own winding number is w = chi - w_C (w is a sum
+  // over triangles; sigma w with sigma the orientation, voxelize.h), and the solid is w > 1/2. The
+  // two differ only where |w_C| >= 1/2, which is next to a fan that is not flat: in the pocket
+  // between the fan and the surface w = 1/2 that spans the hole. Along a column the pocket is
+  // entered through the fan (fan and that surface bound it), so from each fan fragment we walk
+  // the column both ways, setting each voxel to [sigma w(centre) > 1/2], and stop at the first
+  // voxel where that agrees with parity: the pocket's end (the next voxel on the other side).
+  std::size_t evaluated = 0, changed = 0;
+  if (!slot_object.empty()) {
+    std::vector<ObjectSpace> space;
+    std::vector<int> sign;
+    for (std::size_t oi : slot_object) {
+      space.push_back(object_space(scene, objects[oi]));
+      sign.push_back(closure[objects[oi].mesh].orientation * space.back().sign);
     }
+    std::vector<std::size_t> evaluated_in(bands, 0), changed_in(bands, 0);
+    tbb::parallel_for(0, bands, [&](int b) {
+      for (const ColumnHit& h : hits[b]) {
+        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(h.j) * g.nx + h.i) * g.words;
+        const WindingNumber& w = *closure[objects[slot_object[h.tag]].mesh].winding;
+        for (int dir : {1, -1})
+          for (int k = dir > 0 ? h.k : h.k - 1; k >= 0 && k < g.depth_bits; k += dir) {
+            const bool solid = sign[h.tag] * w(space[h.tag](voxel_centre(h.i, h.j, k))) > 0.5;
+            ++evaluated_in[b];
+            const std::uint64_t bit = std::uint64_t{1} << (k & 63);
+            if (solid == ((col[k >> 6] & bit) != 0)) break;
+            col[k >> 6] ^= bit;
+            ++changed_in[b];
+          }
+      }
+    });
+    for (int b = 0; b < bands; ++b) evaluated += evaluated_in[b], changed += changed_in[b];
+  }
+
+  // 4. Slabs of open meshes, ORed after the parity; walls' prisms as the union of the prisms: per
+  // column, the voxels where the count of prisms entered minus left is not 0 (prisms overlap
+  // where walls meet, and parity would cancel them there).
+  if (any_slab(treat)) {
+    raster_pass(1);
+    for (auto& h : hits) h.clear();
+    raster_pass(2);
+    tbb::parallel_for(0, bands, [&](int b) {
+      std::vector<ColumnHit>& list = hits[b];
+      std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.k) < std::tie(y.j, y.i, y.k); });
+      for (std::size_t q = 0; q < list.size();) {
+        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(list[q].j) * g.nx + list[q].i) * g.words;
+        int count = 0;
+        std::size_t e = q;
+        for (; e < list.size() && list[e].i == list[q].i && list[e].j == list[q].j; ++e) {
+          count += list[e].tag;
+          const int end = e + 1 < list.size() && list[e + 1].i == list[q].i && list[e + 1].j == list[q].j ? list[e + 1].k : g.depth_bits;
+          if (count != 0) set_bits(col, g.depth_bits, list[e].k, end);
+        }
+        q = e;
+      }
+    });
   }
   const std::size_t set_voxels = build_coarse(g);  // also counts the solid voxels
   if (stats) {
@@ -500,7 +651,10 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       stats->boundary_edges += c.boundary_edges;
     }
     stats->set_voxels = set_voxels;
-    stats->capped_meshes = capped;
+    stats->capped_meshes = fanned;
+    stats->back_objects = treatment.back;
+    stats->winding_evaluations = evaluated;
+    stats->winding_voxels_changed = changed;
   }
 }
 
@@ -519,6 +673,57 @@ std::size_t VoxelGrid::count_set() const {
   for (std::uint64_t w : bits) n += static_cast<std::size_t>(std::popcount(w));
   return n;
 }
+
+namespace {
+
+// Sheet or solid with holes, from the winding number of the mesh itself (voxelize.h, MeshKind).
+// Just in front of and just behind a triangle's centroid c, w(c + n d) + w(c - n d) = 2 w_rest(c):
+// the triangle's own solid angles cancel (mirror images), leaving twice the winding number of
+// the rest of the mesh at c. A closed mesh has w_rest = 1/2 everywhere (the rest subtends the
+// whole half-space behind the face), a flat sheet 0. `enclosure` is |2 w_rest| averaged over the
+// area, `orientation` its sign.
+void classify_open_mesh(const Mesh& m, MeshClosure& c) {
+  c.winding = std::make_shared<const WindingNumber>(m.positions, m.indices);
+  const std::size_t nt = m.triangle_count();
+  const std::size_t step = std::max<std::size_t>(1, nt / kEnclosureSamples);
+  double sum = 0, area = 0;
+  Vec3 vector_area{0, 0, 0};
+  for (std::size_t t = 0; t < nt; ++t) {
+    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
+    vector_area += cross(b - a, d - a) * 0.5f;
+  }
+  for (std::size_t t = 0; t < nt; t += step) {
+    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
+    const Vec3 n2 = cross(b - a, d - a);
+    const float len = length(n2);
+    if (!(len > 0.0f)) continue;
+    const float at = 0.5f * len;
+    // 1% of the inradius (2 area / perimeter): far closer to c than any other triangle is.
+    const float delta = 0.01f * 2.0f * at / (length(b - a) + length(d - b) + length(a - d));
+    const Vec3 centre = (a + b + d) * (1.0f / 3.0f), n = n2 / len;
+    sum += at * ((*c.winding)(centre + n * delta) + (*c.winding)(centre - n * delta));
+    area += at;
+  }
+  const double mean = area > 0 ? sum / area : 0.0;
+  c.enclosure = static_cast<float>(std::min(1.0, std::abs(mean)));
+  c.orientation = mean < 0 ? -1 : 1;
+  c.kind = c.enclosure >= kSolidEnclosure ? MeshKind::SolidWithHoles : MeshKind::Sheet;
+  // A flat sheet (a ground, a wall): every vertex within 1e-5 of its extent of one plane. Its
+  // winding number then has the sign of the side of that plane everywhere.
+  const float len = length(vector_area);
+  if (len > 0.0f) {
+    const Vec3 n = vector_area / len;
+    const Bounds3 box = m.bounds();
+    const float tol = 1e-5f * box.diagonal();
+    const float offset = dot(n, m.positions[m.indices[0]]);
+    bool flat = true;
+    for (std::uint32_t i : m.indices) flat = flat && std::abs(dot(n, m.positions[i]) - offset) <= tol;
+    if (flat) c.plane = {n.x, n.y, n.z, -offset};
+    c.flat = flat;
+  }
+}
+
+}  // namespace
 
 std::vector<MeshClosure> analyze_closure(const Scene& scene) {
   std::vector<MeshClosure> out;
@@ -578,24 +783,17 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
         if (n == ~0u) n = c.holes++;
         c.hole.push_back(n);
       }
-      // The vector area of a closed surface is zero, so an open mesh's is minus that of any
-      // surface closing its holes: its length is the holes' area seen from their best direction.
-      double vx = 0, vy = 0, vz = 0, area = 0;
-      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-        const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
-        const Vec3 n = cross(b - a, d - a);
-        vx += 0.5 * n.x, vy += 0.5 * n.y, vz += 0.5 * n.z;
-        area += 0.5 * length(n);
-      }
-      c.cap_area_fraction = area > 0 ? static_cast<float>(std::sqrt(vx * vx + vy * vy + vz * vz) / area) : 1.0f;
+      classify_open_mesh(m, c);
     }
     out.push_back(std::move(c));
   }
   return out;
 }
 
-VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats) {
+VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats,
+                         std::span<const std::uint8_t> back) {
   o.validate();
+  const Treatments treat = treatments(scene, closure, o.open_meshes, back);
   VoxelGrid g;
   g.space = GridSpace::World;
   g.nx = g.ny = o.columns;
@@ -605,24 +803,30 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const float floor_extent = std::max(1e-4f * b.diagonal(), 1e-6f);
   const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
   const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
-  bool any_open = false;
-  for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
   // (a ground plane's slab hangs below it, a wall's prism stands behind it).
-  const float side = (any_open && o.open_meshes != OpenMeshes::Parity ? slab : 0.0f) + v0;
+  const float side = (any_slab(treat.of) ? slab : 0.0f) + v0;
   const Vec3 lo = b.lo - Vec3{side, side, side};
   const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
   g.origin = lo;
   g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
   const WorldMap map{lo, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}, slab};
-  voxelize_into<false>(g, scene, closure, o, slab,
-                       [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); }, stats);
+  const Vec3 origin = g.origin, size = g.voxel_size;
+  voxelize_into<false>(
+      g, scene, closure, o, treat, slab, [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); },
+      [origin, size](int i, int j, int k) {
+        return Vec3{origin.x + (static_cast<float>(i) + 0.5f) * size.x, origin.y + (static_cast<float>(k) + 0.5f) * size.z,
+                    origin.z + (static_cast<float>(j) + 0.5f) * size.y};
+      },
+      stats);
   return g;
 }
 
-VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const VoxelizeOptions& o, VoxelStats* stats) {
+VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const VoxelizeOptions& o, VoxelStats* stats,
+                       std::span<const std::uint8_t> back) {
   o.validate();
+  const Treatments treat = treatments(scene, closure, o.open_meshes, back);
   VoxelGrid g;
   g.space = GridSpace::Eye;
   const Camera& cam = gb.camera;
@@ -691,8 +895,16 @@ VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure,
   map.oy = 0.5f * H / g.pixels_per_column_y;
   map.z_clip = z_clip;
   map.slab = slab;
-  voxelize_into<true>(g, scene, closure, o, slab, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); },
-                      stats);
+  // The inverse of eq. 2 and of the projection: column (i, j)'s centre is the view ray through
+  // ((i + 0.5 - ox) / sx, (j + 0.5 - oy) / sy) per unit depth, voxel k at depth z_near + (k + 0.5) / vpu.
+  const auto centre = [&g, &map](int i, int j, int k) {
+    const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
+    const float depth = g.z_near[c] + (static_cast<float>(k) + 0.5f) / g.voxels_per_unit[c];
+    const Vec3 local{(static_cast<float>(i) + 0.5f - map.ox) / map.sx * depth, (static_cast<float>(j) + 0.5f - map.oy) / map.sy * depth, -depth};
+    return map.eye + map.basis.to_world(local);
+  };
+  voxelize_into<true>(
+      g, scene, closure, o, treat, slab, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); }, centre, stats);
   return g;
 }
 

@@ -16,6 +16,7 @@
 #include "ao/methods/bilateral.h"
 #include "ao/methods/cone_kernel_internal.h"
 #include "ao/methods/cone_pattern_internal.h"
+#include "ao/methods/cone_sides_internal.h"
 
 namespace ao {
 
@@ -305,18 +306,33 @@ ConeParams checked_resolved(const ConeParams& params, float r_max) {
   return p;
 }
 
-VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max, VoxelStats* stats) {
-  return p.grid == GridSpace::World ? voxelize_world(scene, closure, p.voxelize_options(r_max), stats)
-                                    : voxelize_eye(scene, closure, gb, p.voxelize_options(r_max), stats);
+VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max, VoxelStats* stats,
+                   std::span<const std::uint8_t> back = {}) {
+  return p.grid == GridSpace::World ? voxelize_world(scene, closure, p.voxelize_options(r_max), stats, back)
+                                    : voxelize_eye(scene, closure, gb, p.voxelize_options(r_max), stats, back);
 }
 
-// The kernel and the filter on a built grid; `p` resolved and checked.
-void trace_and_filter(const GBuffer& gb, const VoxelGrid& g, float r_max, const ConeParams& p, std::uint32_t seed, const ProgressFn& progress,
-                      ConeResult& r) {
+// The kernel, on each side's grid over that side's pixels (one grid: all pixels at once), then
+// the filter over the whole image.
+void trace_and_filter(const GBuffer& gb, std::span<const VoxelGrid* const> grids, const cone_internal::PixelSides& sides, float r_max,
+                      const ConeParams& p, std::uint32_t seed, const ProgressFn& progress, ConeResult& r) {
   using Clock = std::chrono::steady_clock;
   const auto t1 = Clock::now();
   r.visibility = Image<float>(gb.width(), gb.height(), 1.0f);
-  compute_cone(gb, g, r_max, p, seed, r.visibility.view(), progress);
+  if (grids.size() == 1) {
+    compute_cone(gb, *grids[0], r_max, p, seed, r.visibility.view(), progress);
+  } else {
+    // Each pass sees only its pixels as covered; the kernel works per pixel, so the pixels of a
+    // pass come out as they would in one pass over a scene with that side's grid.
+    GBuffer part = gb;
+    Image<float> v(gb.width(), gb.height(), 1.0f);
+    for (std::size_t k = 0; k < grids.size(); ++k) {
+      for (std::size_t i = 0; i < part.object_id.size(); ++i) part.object_id[i] = sides.key_of[i] == k ? gb.object_id[i] : 0u;
+      compute_cone(part, *grids[k], r_max, p, seed, v.view(), k == 0 ? progress : ProgressFn{});
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (sides.key_of[i] == k && gb.covered(i)) r.visibility[i] = v[i];
+    }
+  }
   const auto t2 = Clock::now();
   if (p.filter_taps > 1) {
     BilateralParams f;
@@ -325,8 +341,23 @@ void trace_and_filter(const GBuffer& gb, const VoxelGrid& g, float r_max, const 
   }
   r.trace_ms = ms_between(t1, t2);
   r.filter_ms = ms_between(t2, Clock::now());
-  r.grid_nx = g.nx;
-  r.grid_ny = g.ny;
+  r.grid_nx = grids[0]->nx;
+  r.grid_ny = grids[0]->ny;
+  r.side_grids = static_cast<int>(grids.size());
+  for (std::size_t i = 0; i < sides.key_of.size(); ++i) r.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
+  r.unresolved_pixels = sides.unresolved;
+}
+
+std::vector<OpenMeshInfo> open_mesh_info(const Scene& scene, std::span<const MeshClosure> closure) {
+  std::vector<OpenMeshInfo> out;
+  for (std::size_t m = 0; m < closure.size(); ++m)
+    if (!closure[m].closed()) out.push_back({scene.meshes[m].name, closure[m].kind, closure[m].boundary_edges, closure[m].holes, closure[m].enclosure});
+  return out;
+}
+
+void add_grid_stats(ConeResult& r, const VoxelStats& s) {
+  r.voxel_stats.winding_evaluations += s.winding_evaluations;
+  r.voxel_stats.winding_voxels_changed += s.winding_voxels_changed;
 }
 
 }  // namespace
@@ -336,17 +367,33 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
   const ConeParams p = checked_resolved(params, r_max);
   ConeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  const VoxelGrid g = voxelize(scene, closure, gb, p, r_max, &r.voxel_stats);
-  r.voxelize_ms = ms_between(t0, std::chrono::steady_clock::now());
-  trace_and_filter(gb, g, r_max, p, seed, progress, r);
+  std::vector<VoxelGrid> grids;
+  grids.push_back(voxelize(scene, closure, gb, p, r_max, &r.voxel_stats));
+  const auto t1 = std::chrono::steady_clock::now();
+  const cone_internal::PixelSides sides = cone_internal::pixel_sides(
+      gb, scene, p.open_meshes == OpenMeshes::Winding ? cone_internal::make_side_setup(scene, closure, r_max) : cone_internal::SideSetup{}, grids[0]);
+  const auto t2 = std::chrono::steady_clock::now();
+  for (std::size_t k = 1; k < sides.keys.size(); ++k) {
+    VoxelStats s;
+    grids.push_back(voxelize(scene, closure, gb, p, r_max, &s, sides.keys[k]));
+    add_grid_stats(r, s);
+  }
+  r.voxelize_ms = ms_between(t0, t1) + ms_between(t2, std::chrono::steady_clock::now());
+  r.sides_ms = ms_between(t1, t2);
+  r.side_evaluations = sides.evaluations;
+  r.open_meshes = open_mesh_info(scene, closure);
+  r.open_mode = p.open_meshes;
+  std::vector<const VoxelGrid*> use;
+  for (const VoxelGrid& g : grids) use.push_back(&g);
+  trace_and_filter(gb, use, sides, r_max, p, seed, progress, r);
   return r;
 }
 
 ConeContext::ConeContext(const Scene& scene) : scene_(scene), closure_(analyze_closure(scene)) {}
 
 bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const VoxelizeOptions& o) const {
-  if (!valid_ || grid_.space != space || o.columns != options_.columns || o.depth_bits != options_.depth_bits ||
-      o.open_meshes != options_.open_meshes || o.slab_thickness != options_.slab_thickness)
+  if (!valid_ || space != space_ || o.columns != options_.columns || o.depth_bits != options_.depth_bits || o.open_meshes != options_.open_meshes ||
+      o.slab_thickness != options_.slab_thickness)
     return false;
   if (space == GridSpace::World) return true;
   const Camera& c = gb.camera;
@@ -362,12 +409,12 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
   const ConeParams p = checked_resolved(params, r_max);
   const VoxelizeOptions options = p.voxelize_options(r_max);
   ConeResult r;
-  const auto t0 = std::chrono::steady_clock::now();
-  r.grid_reused = grid_is_current(gb, p.grid, options);
-  if (!r.grid_reused) {
-    valid_ = false;  // until the new grid is complete (a build that throws leaves none)
-    grid_ = voxelize(scene_, closure_, gb, p, r_max, &stats_);
+  const int builds_before = builds_;
+  if (!grid_is_current(gb, p.grid, options)) {
+    valid_ = false;  // until the inputs below are recorded (a build that throws leaves no grid)
+    grids_.clear();
     options_ = options;
+    space_ = p.grid;
     if (p.grid == GridSpace::Eye) {
       camera_ = gb.camera;
       depth_.resize(gb.object_id.size());
@@ -375,13 +422,61 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
       for (std::size_t i = 0; i < depth_.size(); ++i) depth_[i] = gb.depth(i), coverage_[i] = gb.covered(i) ? 1 : 0;
     }
     valid_ = true;
-    ++builds_;
-    r.voxelize_ms = ms_between(t0, std::chrono::steady_clock::now());
   }
-  r.voxel_stats = stats_;
-  trace_and_filter(gb, grid_, r_max, p, seed, progress, r);
+  double voxelize_ms = 0;
+  const auto grid_for = [&](const std::vector<std::uint8_t>& back) -> const CachedGrid& {
+    std::vector<std::uint32_t> key;  // the objects seen from their back
+    for (std::size_t o = 0; o < back.size(); ++o)
+      if (back[o]) key.push_back(static_cast<std::uint32_t>(o));
+    auto it = grids_.find(key);
+    if (it == grids_.end()) {
+      const auto t = std::chrono::steady_clock::now();
+      CachedGrid c;
+      c.grid = voxelize(scene_, closure_, gb, p, r_max, &c.stats, back);
+      it = grids_.emplace(key, std::move(c)).first;
+      ++builds_;
+      voxelize_ms += ms_between(t, std::chrono::steady_clock::now());
+    }
+    return it->second;
+  };
+  std::vector<const VoxelGrid*> use{&grid_for({}).grid};
+  r.voxel_stats = grid_for({}).stats;
+  const auto t1 = std::chrono::steady_clock::now();
+  if (p.open_meshes == OpenMeshes::Winding && (!sides_ || sides_->r_max != r_max))
+    sides_ = std::make_shared<cone_internal::SideSetup>(cone_internal::make_side_setup(scene_, closure_, r_max));
+  const cone_internal::PixelSides sides =
+      cone_internal::pixel_sides(gb, scene_, p.open_meshes == OpenMeshes::Winding ? *sides_ : cone_internal::SideSetup{}, *use[0]);
+  r.sides_ms = ms_between(t1, std::chrono::steady_clock::now());
+  for (std::size_t k = 1; k < sides.keys.size(); ++k) {
+    const CachedGrid& c = grid_for(sides.keys[k]);
+    use.push_back(&c.grid);
+    add_grid_stats(r, c.stats);
+  }
+  r.grid_reused = builds_ == builds_before;
+  r.voxelize_ms = voxelize_ms;
+  r.side_evaluations = sides.evaluations;
+  r.open_meshes = open_mesh_info(scene_, closure_);
+  r.open_mode = p.open_meshes;
+  trace_and_filter(gb, use, sides, r_max, p, seed, progress, r);
   return r;
 }
+
+namespace {
+
+const char* kind_name(MeshKind k) { return k == MeshKind::Closed ? "closed" : k == MeshKind::SolidWithHoles ? "solid with holes" : "sheet"; }
+
+// "a, b and 2 more": the names of the open meshes of one kind, for a warning.
+std::string names_of(const std::vector<OpenMeshInfo>& meshes, MeshKind kind) {
+  std::vector<std::string> n;
+  for (const OpenMeshInfo& m : meshes)
+    if (m.kind == kind) n.push_back(m.name.empty() ? "unnamed" : m.name);
+  std::string out;
+  for (std::size_t i = 0; i < n.size() && i < 3; ++i) out += (i ? ", " : "") + n[i];
+  if (n.size() > 3) out += " and " + std::to_string(n.size() - 3) + " more";
+  return out;
+}
+
+}  // namespace
 
 nlohmann::json cone_stats(const ConeResult& r) {
   const VoxelStats& v = r.voxel_stats;
@@ -389,13 +484,25 @@ nlohmann::json cone_stats(const ConeResult& r) {
   if (v.odd_columns > 0)
     warnings.push_back("cone: " + std::to_string(v.odd_columns) +
                        " voxel columns end with odd parity: the scene is not watertight there, voxels behind the leak are wrong");
-  if (v.open_meshes > 0)
-    warnings.push_back("cone: " + std::to_string(v.open_meshes) + " open surface(s) (" + std::to_string(v.boundary_edges) +
-                       " boundary edges in all meshes): filled as one-sided slabs behind their front faces");
+  const bool winding = r.open_mode == OpenMeshes::Winding;
+  if (v.open_meshes > 0 && r.open_mode != OpenMeshes::Parity)
+    warnings.push_back("cone: " + std::to_string(v.open_meshes) + " sheet(s) (" + names_of(r.open_meshes, MeshKind::Sheet) + "; " +
+                       std::to_string(v.boundary_edges) + " boundary edges in all meshes): " +
+                       (winding ? "two-sided, each a slab on its far side from the pixel (" + std::to_string(r.side_grids) + " grid(s), " +
+                                      std::to_string(r.back_pixels) + " pixels on a back side)"
+                                : std::string("filled as one-sided slabs behind their front faces")));
   if (v.holed_meshes > 0)
-    warnings.push_back("cone: " + std::to_string(v.holed_meshes) + " mesh(es) not closed (" + std::to_string(v.holes) + " hole(s)): " +
-                       (v.capped_meshes > 0 ? "solid taken where the generalized winding number exceeds 1/2 (holes closed by fans)"
-                                            : "voxelized by parity, wrong in the columns through the holes"));
+    warnings.push_back("cone: " + std::to_string(v.holed_meshes) + " solid(s) with holes (" + names_of(r.open_meshes, MeshKind::SolidWithHoles) +
+                       "; " + std::to_string(v.holes) + " hole(s)): " +
+                       (winding ? "solid where the generalized winding number exceeds 1/2 (holes closed by fans, w evaluated at " +
+                                      std::to_string(v.winding_evaluations) + " voxels next to holes that are not flat)"
+                                : std::string("voxelized by parity, wrong in the columns through the holes")));
+  if (r.unresolved_pixels > 0)
+    warnings.push_back("cone: " + std::to_string(r.unresolved_pixels) +
+                       " pixels lie on a combination of sides of the open meshes beyond the 8 grids of a frame: traced as if in front of all");
+  nlohmann::json meshes = nlohmann::json::array();
+  for (const OpenMeshInfo& m : r.open_meshes)
+    meshes.push_back({{"name", m.name}, {"kind", kind_name(m.kind)}, {"boundary_edges", m.boundary_edges}, {"holes", m.holes}, {"enclosure", m.enclosure}});
   return {{"grid_columns", {r.grid_nx, r.grid_ny}},
           {"triangles_rasterised", v.triangles},
           {"fragments", v.fragments},
@@ -404,8 +511,16 @@ nlohmann::json cone_stats(const ConeResult& r) {
           {"boundary_edges", v.boundary_edges},
           {"holed_meshes", v.holed_meshes},
           {"holes", v.holes},
+          {"open_mesh_kinds", meshes},
+          {"winding_evaluations", v.winding_evaluations},
+          {"winding_voxels_changed", v.winding_voxels_changed},
+          {"side_grids", r.side_grids},
+          {"back_pixels", r.back_pixels},
+          {"side_evaluations", r.side_evaluations},
+          {"unresolved_pixels", r.unresolved_pixels},
           {"set_voxels", v.set_voxels},
           {"voxelize_ms", r.voxelize_ms},
+          {"sides_ms", r.sides_ms},
           {"trace_ms", r.trace_ms},
           {"filter_ms", r.filter_ms},
           {"grid_reused", r.grid_reused},

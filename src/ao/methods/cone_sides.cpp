@@ -1,0 +1,213 @@
+// Which side of each open mesh a pixel's point lies on (cone_sides_internal.h).
+#include "ao/methods/cone_sides_internal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <tbb/parallel_for.h>
+
+#include "ao/core/affine.h"
+#include "ao/methods/winding_number.h"
+
+namespace ao::cone_internal {
+
+namespace {
+
+// A point within this much of the threshold of w (or exactly on a flat sheet's plane) lies on the
+// surface that separates the sides (the mesh itself, or its spanning surface w = 1/2): it votes for
+// neither side. 1e-3 is far above the float error of a point's position in w and far below the
+// fast winding number's truncation error away from that surface (winding_number.h, tests).
+constexpr double kUndecided = 1e-3;
+
+Bounds3 object_bounds(const Scene& scene, const SceneObject& ob) {
+  const Bounds3 b = scene.meshes[ob.mesh].bounds();
+  return ob.instance == SceneObject::kNoInstance ? b : transform_bounds(scene.instances[ob.instance].object_to_world, b);
+}
+
+bool overlap(const Bounds3& a, const Bounds3& b) {
+  return !(a.hi.x < b.lo.x || b.hi.x < a.lo.x || a.hi.y < b.lo.y || b.hi.y < a.lo.y || a.hi.z < b.lo.z || b.hi.z < a.lo.z);
+}
+
+bool contains(const Bounds3& b, Vec3 p) {
+  return p.x >= b.lo.x && p.x <= b.hi.x && p.y >= b.lo.y && p.y <= b.hi.y && p.z >= b.lo.z && p.z <= b.hi.z;
+}
+
+// +1 behind open object `o` (sign x w > threshold), -1 in front, 0 undecided. Counts evaluations of w.
+int side_of(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
+  const Vec3 p = o.instanced ? o.to_object.point(world) : world;
+  const MeshClosure& c = *o.closure;
+  if (c.flat) {
+    // A flat sheet's w has the sign of -(n.p + d) (voxelize.h, MeshClosure::plane).
+    const double d = double(c.plane[0]) * p.x + double(c.plane[1]) * p.y + double(c.plane[2]) * p.z + c.plane[3];
+    return d == 0 ? 0 : (o.sign * -d > 0 ? 1 : -1);
+  }
+  ++evaluations;
+  const double v = o.sign * (*c.winding)(p) - o.threshold;
+  return std::abs(v) < kUndecided ? 0 : (v > 0 ? 1 : -1);
+}
+
+// The voxel of `g` at world point p (false outside the grid).
+bool solid_at(const VoxelGrid& g, Vec3 p) {
+  float fx, fy, fk;
+  std::size_t col;
+  if (g.space == GridSpace::World) {
+    fx = (p.x - g.origin.x) / g.voxel_size.x, fy = (p.z - g.origin.z) / g.voxel_size.y, fk = (p.y - g.origin.y) / g.voxel_size.z;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < float(g.nx) && fy < float(g.ny))) return false;
+    col = static_cast<std::size_t>(fy) * g.nx + static_cast<std::size_t>(fx);
+  } else {
+    const Vec3 c = g.camera.world_to_camera_point(p);
+    const float depth = -c.z;
+    if (!(depth > 0)) return false;
+    const Vec2 pix = g.camera.project(c);
+    fx = pix.x / g.pixels_per_column_x, fy = pix.y / g.pixels_per_column_y;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < float(g.nx) && fy < float(g.ny))) return false;
+    col = static_cast<std::size_t>(fy) * g.nx + static_cast<std::size_t>(fx);
+    fk = (depth - g.z_near[col]) * g.voxels_per_unit[col];
+  }
+  if (!(fk >= 0.0f && fk < float(g.depth_bits))) return false;
+  const int k = static_cast<int>(fk);
+  return (g.bits[col * g.words + (k >> 6)] >> (k & 63)) & 1u;
+}
+
+}  // namespace
+
+SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closure, float r_max) {
+  SideSetup s;
+  s.r_max = r_max;
+  const std::vector<SceneObject> objects = scene.objects();
+  s.votes.resize(objects.size());
+  std::vector<Bounds3> bounds;
+  for (const SceneObject& ob : objects) bounds.push_back(object_bounds(scene, ob));
+  for (std::size_t oi = 0; oi < objects.size(); ++oi) {
+    const MeshClosure& c = closure[objects[oi].mesh];
+    if (c.closed()) continue;
+    SideSetup::Open o;
+    o.object = static_cast<std::uint32_t>(oi);
+    o.closure = &c;
+    int det_sign = 1;
+    if (objects[oi].instance != SceneObject::kNoInstance) {
+      const Affine3& m = scene.instances[objects[oi].instance].object_to_world;
+      o.instanced = true;
+      o.to_object = inverse(m);
+      det_sign = m.determinant() < 0 ? -1 : 1;  // a mirror turns fronts into backs
+    }
+    // A sheet's slab reaches R_max past it, and a point's cones R_max further: only points within
+    // 2 R_max of it can tell its sides apart. A solid with holes is entered only inside its box.
+    const float pad = c.open_surface() ? 2.0f * r_max : 0.0f;
+    o.reach = bounds[oi];
+    o.reach.lo -= Vec3{pad, pad, pad};
+    o.reach.hi += Vec3{pad, pad, pad};
+    o.sign = det_sign * (c.holed() ? c.orientation : 1);
+    o.threshold = c.holed() ? 0.5 : 0.0;
+    s.open.push_back(o);
+  }
+  // Votes: an object entirely on one side of a flat sheet (its box's corners) takes that side;
+  // any other object within reach is tested per pixel (its vertices are too sparse a sample: a
+  // ground quad has four, none under a sheet that stands on it).
+  for (std::uint32_t q = 0; q < s.open.size(); ++q) {
+    const SideSetup::Open& o = s.open[q];
+    for (std::size_t a = 0; a < objects.size(); ++a) {
+      if (a == o.object || !overlap(bounds[a], o.reach)) continue;
+      SideSetup::Vote vote = SideSetup::Mixed;
+      if (o.closure->flat) {
+        int behind = 0, front = 0;
+        for (int k = 0; k < 8; ++k) {
+          const Bounds3& b = bounds[a];
+          const int side = side_of(o, {k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z}, s.evaluations);
+          behind += side > 0, front += side < 0;
+        }
+        vote = behind == 0 ? SideSetup::Front : front == 0 ? SideSetup::Back : SideSetup::Mixed;
+      }
+      if (vote != SideSetup::Front) s.votes[a].push_back({q, vote});
+    }
+  }
+  return s;
+}
+
+PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& setup, const VoxelGrid& front) {
+  PixelSides out;
+  const std::vector<SceneObject> objects = scene.objects();
+  out.keys.push_back({});
+  out.key_of.assign(static_cast<std::size_t>(gb.width()) * gb.height(), 0);
+  if (setup.open.empty()) return out;
+  std::vector<int> open_of(objects.size(), -1);
+  for (std::uint32_t q = 0; q < setup.open.size(); ++q) open_of[setup.open[q].object] = static_cast<int>(q);
+  const Frame basis = gb.camera.basis();
+  const Vec3 eye = gb.camera.eye;
+  // A point just off the surface on the camera's side, to test a pixel of an open object whose
+  // triangle is not known (a G-buffer built by hand): 1e-3 R_max, far below any feature the grid
+  // resolves and far above the float error of the position.
+  const float offset = 1e-3f * setup.r_max;
+  // Rows in parallel; each pixel's back flags (open objects, in `open` order) go to its row's list.
+  struct Flagged {
+    std::size_t pixel;
+    std::vector<std::uint32_t> back;
+  };
+  std::vector<std::vector<Flagged>> rows(gb.height());
+  std::vector<std::size_t> evaluations(gb.height(), 0);
+  tbb::parallel_for(0, gb.height(), [&](int y) {
+    for (int x = 0; x < gb.width(); ++x) {
+      if (!gb.covered(x, y)) continue;
+      const std::uint32_t a = gb.object_id(x, y) - 1;
+      if (a >= objects.size()) continue;
+      const int own = open_of[a];
+      const auto& votes = setup.votes[a];
+      if (own < 0 && votes.empty()) continue;
+      const Vec3 p = basis.to_world(gb.position(x, y)) + eye, n = basis.to_world(gb.normal(x, y));
+      std::vector<std::uint32_t> back;
+      if (own >= 0) {
+        const SideSetup::Open& o = setup.open[own];
+        bool behind;
+        if (!gb.primitive_id.empty()) {
+          // The side of its own triangle the camera sees (world winding, mirrors included).
+          const Mesh& m = scene.meshes[objects[a].mesh];
+          const std::uint32_t* t = m.indices.data() + 3 * static_cast<std::size_t>(gb.primitive_id(x, y));
+          Vec3 v[3] = {m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]};
+          if (o.instanced)
+            for (Vec3& vk : v) vk = scene.instances[objects[a].instance].object_to_world.point(vk);
+          const bool sees_back = dot(cross(v[1] - v[0], v[2] - v[0]), n) < 0;
+          // A sheet's back is its triangles' back; a solid's inside is its outside's back.
+          // (o.sign < 0: the world fronts of the solid face in, mirrors and orientation included.)
+          behind = o.closure->holed() ? sees_back != (o.sign < 0) : sees_back;
+        } else {
+          behind = side_of(o, p + n * offset, evaluations[y]) > 0;
+        }
+        if (behind) back.push_back(static_cast<std::uint32_t>(own));
+      }
+      for (const auto& [q, vote] : votes) {
+        const SideSetup::Open& o = setup.open[q];
+        bool behind = vote == SideSetup::Back;
+        if (vote == SideSetup::Mixed && contains(o.reach, p)) {
+          // Inside a solid with holes is inside its winding-number solid, which the all-front grid
+          // holds: only points whose front is solid there need w.
+          if (!o.closure->holed() || solid_at(front, p + n * offset)) behind = side_of(o, p, evaluations[y]) > 0;
+        }
+        if (behind) back.push_back(q);
+      }
+      if (!back.empty()) rows[y].push_back({static_cast<std::size_t>(y) * gb.width() + x, std::move(back)});
+    }
+  });
+  std::map<std::vector<std::uint32_t>, std::uint8_t> index;
+  for (int y = 0; y < gb.height(); ++y) {
+    out.evaluations += evaluations[y];
+    for (Flagged& f : rows[y]) {
+      std::sort(f.back.begin(), f.back.end());
+      auto it = index.find(f.back);
+      if (it == index.end()) {
+        if (static_cast<int>(out.keys.size()) >= kMaxSideGrids) {
+          ++out.unresolved;
+          continue;
+        }
+        std::vector<std::uint8_t> key(objects.size(), 0);
+        for (std::uint32_t q : f.back) key[setup.open[q].object] = 1;
+        it = index.emplace(f.back, static_cast<std::uint8_t>(out.keys.size())).first;
+        out.keys.push_back(std::move(key));
+      }
+      out.key_of[f.pixel] = it->second;
+    }
+  }
+  return out;
+}
+
+}  // namespace ao::cone_internal

@@ -22,7 +22,6 @@ namespace ao {
 
 namespace {
 
-using cone_internal::faces_inside;
 using cone_internal::kOpaque;
 using cone_internal::kTile;
 using cone_internal::solid_length;
@@ -43,18 +42,6 @@ struct EyeSampler {
     const int i = std::clamp(static_cast<int>(fx), 0, g.nx - 1), j = std::clamp(static_cast<int>(fy), 0, g.ny - 1);
     const float width = depth * std::max(1.0f / std::abs(sx), 1.0f / std::abs(sy));
     return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
-  }
-
-  // The voxel at camera-space point c (false outside the grid).
-  bool solid_at(Vec3 c) const {
-    const float depth = -c.z;
-    if (!(depth > 0)) return false;
-    const float fx = c.x / depth * sx + ox, fy = c.y / depth * sy + oy;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return false;
-    const std::size_t col = static_cast<std::size_t>(static_cast<int>(fy)) * g.nx + static_cast<int>(fx);
-    const float k = (depth - g.z_near[col]) * g.voxels_per_unit[col];
-    if (!(k >= 0.0f && k < static_cast<float>(g.depth_bits))) return false;
-    return g.voxel(static_cast<int>(fx), static_cast<int>(fy), static_cast<int>(k));
   }
 
   // centre in camera space; the prisms run along the camera's z (the grid's columns are view rays:
@@ -104,14 +91,12 @@ void chain_spheres(const ConeSetup& setup, float r_max, float near, float chain_
 
 // Front-to-back along one cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed fraction
 // f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
-// `inside`: a surface point facing into the winding-number solid counts the complement.
 template <class Fraction>
-float transmittance(const ChainSphere* chain, int n, bool inside, Fraction&& fraction) {
+float transmittance(const ChainSphere* chain, int n, Fraction&& fraction) {
   float t = 1.0f;
   for (int k = 0; k < n && t > kOpaque; ++k) {
     if (!chain[k].used) continue;
-    const float f = fraction(k);
-    t *= inside ? f : 1.0f - f;
+    t *= 1.0f - fraction(k);
   }
   return t;
 }
@@ -134,7 +119,6 @@ void trace_eye(const GBuffer& gb, const EyeSampler& sample, float r_max, const C
         const Vec3 pos = gb.position(x, y), n = gb.normal(x, y);
         const Frame frame = Frame::from_normal(n);
         const float near = sample.near_limit(pos);
-        const bool inside = faces_inside(gb, sample, x, y, pos, n, near);
         const int slot = pat.slot(x, y);
         const float rot_c = pat.rot[2 * slot], rot_s = pat.rot[2 * slot + 1];
         float v = 0;
@@ -142,8 +126,7 @@ void trace_eye(const GBuffer& gb, const EyeSampler& sample, float r_max, const C
           const ConePattern::Cone& cone = pat.cone[static_cast<std::size_t>(slot) * nc + c];
           chain_spheres(setup, r_max, near, cone.scale, chain.data());
           const Vec3 axis = frame.to_world({cone.x, cone.y, cone.z});
-          v += weight * transmittance(chain.data(), per_cone, inside,
-                                      [&](int k) { return sample(pos + axis * chain[k].distance, chain[k].k, chain[k].scale, rot_c, rot_s); });
+          v += weight * transmittance(chain.data(), per_cone, [&](int k) { return sample(pos + axis * chain[k].distance, chain[k].k, chain[k].scale, rot_c, rot_s); });
         }
         out(x, y) = std::clamp(v, 0.0f, 1.0f);
       }

@@ -192,11 +192,6 @@ struct VoxelGrid {
   std::vector<std::uint64_t> window;
   std::uint64_t window_mask(int w, int ci, int cj) const { return window[(static_cast<std::size_t>(cj) * dnx + ci) * (kWindowCap + 1) + w]; }
 
-  /// Per object of the scene (Scene::objects(), G-buffer object id - 1): 1 when its mesh had holes and was voxelized as
-  /// its winding-number solid (OpenMeshes::Winding), so that a surface point of it whose front is
-  /// solid is the inside of its shell, seen through a hole.
-  std::vector<std::uint8_t> capped;
-
   /// Words of column (i, j), which must be inside the grid.
   const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
   /// Bit k of column (i, j).

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "ao/core/affine.h"
@@ -104,6 +105,18 @@ TEST(WindingNumber, FastAgreesWithTheExactSum) {
     }
     EXPECT_LT(worst, 0.02) << m.triangle_count() << " triangles";
   }
+}
+
+// The nearest triangle's distance, signed by its side: negative in front, positive behind.
+TEST(WindingNumber, SignedDistanceToTheNearestTriangle) {
+  Mesh two = make_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1});  // facing +y at y = 0
+  append_mesh(two, make_quad({-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}));  // facing -y at y = 2
+  const WindingNumber w(two.positions, two.indices);
+  EXPECT_NEAR(w.signed_distance({0.2f, 0.3f, 0.1f}), -0.3, 1e-6) << "in front of the lower one";
+  EXPECT_NEAR(w.signed_distance({0.2f, 1.5f, 0.1f}), -0.5, 1e-6) << "in front of the upper one";
+  EXPECT_NEAR(w.signed_distance({0.2f, -0.4f, 0.1f}), 0.4, 1e-6) << "behind the lower one";
+  EXPECT_NEAR(w.signed_distance({3.0f, -0.5f, 0.0f}), std::sqrt(4.0 + 0.25), 1e-6) << "past its edge, below";
+  EXPECT_EQ(WindingNumber().signed_distance({0, 0, 0}), std::numeric_limits<double>::infinity());
 }
 
 TEST(WindingNumber, EmptyMeshIsZeroAndBadBetaIsRejected) {

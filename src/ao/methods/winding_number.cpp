@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "ao/core/error.h"
@@ -135,6 +136,71 @@ double WindingNumber::solid_angle(const Tri& t, Vec3 q) {
   const double la = dlen(a), lb = dlen(b), lc = dlen(c);
   const double den = la * lb * lc + ddot(a, b) * lc + ddot(a, c) * lb + ddot(b, c) * la;
   return 2.0 * std::atan2(det, den);
+}
+
+namespace {
+
+// Closest point of triangle abc to p (Ericson, "Real-Time Collision Detection", sec. 5.1.5).
+D3 closest_on_triangle(D3 p, D3 a, D3 b, D3 c) {
+  const D3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  const double d1 = ddot(ab, ap), d2 = ddot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const D3 bp = sub(p, b);
+  const double d3 = ddot(ab, bp), d4 = ddot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {a.x + v * ab.x, a.y + v * ab.y, a.z + v * ab.z};
+  }
+  const D3 cp = sub(p, c);
+  const double d5 = ddot(ab, cp), d6 = ddot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {a.x + w * ac.x, a.y + w * ac.y, a.z + w * ac.z};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {b.x + w * (c.x - b.x), b.y + w * (c.y - b.y), b.z + w * (c.z - b.z)};
+  }
+  const double denom = 1.0 / (va + vb + vc), v = vb * denom, w = vc * denom;
+  return {a.x + ab.x * v + ac.x * w, a.y + ab.y * v + ac.y * w, a.z + ab.z * v + ac.z * w};
+}
+
+}  // namespace
+
+double WindingNumber::signed_distance(Vec3 q) const {
+  if (nodes_.empty()) return std::numeric_limits<double>::infinity();
+  const D3 qd = d3(q);
+  double best2 = std::numeric_limits<double>::infinity(), side = 0;
+  std::uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    // No point of the node is nearer than its bounding sphere (centre p~, radius).
+    const double gap = std::max(0.0, dlen(sub(d3(n.centre), qd)) - n.radius);
+    if (gap * gap >= best2) continue;
+    if (n.count == 0) {
+      stack[top++] = n.left;
+      stack[top++] = n.right;
+      continue;
+    }
+    for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+      const Tri& t = tris_[i];
+      const D3 a = d3(t.a), b = d3(t.b), c = d3(t.c);
+      const D3 e = sub(qd, closest_on_triangle(qd, a, b, c));
+      const double d2 = ddot(e, e);
+      if (d2 < best2) {
+        best2 = d2;
+        side = -ddot(dcross(sub(b, a), sub(c, a)), sub(qd, a));  // > 0 behind the triangle
+      }
+    }
+  }
+  return side > 0 ? std::sqrt(best2) : side < 0 ? -std::sqrt(best2) : 0.0;
 }
 
 double WindingNumber::exact(Vec3 q) const {

@@ -43,6 +43,11 @@ class WindingNumber {
   double operator()(Vec3 q) const;
   /// w(q) summed exactly over every triangle (O(triangles); for tests and small meshes).
   double exact(Vec3 q) const;
+  /// Distance from q to the nearest triangle, positive behind it (its normal turned away from q),
+  /// negative in front, 0 in its plane; +infinity for an empty mesh. Where w is near 0 (a point
+  /// that sees as much of the mesh's fronts as of its backs) this tells the side of the part of
+  /// the mesh nearest to q. Branch and bound over the same hierarchy.
+  double signed_distance(Vec3 q) const;
   /// Number of triangles.
   std::size_t size() const { return tris_.size(); }
 

@@ -35,8 +35,8 @@ struct GridTri {
   int j0, j1;  // rows whose centres the bounding box covers
   int fill;    // 0: parity fragment; +1 / -1: open-mesh slab filled towards larger / smaller k;
                // 2: fragment of an open wall's prism (listed, voxelize_into step 4); 3 + s: parity fragment
-               // of a fan closing a hole that is not flat, of the solid with holes in slot s
-               // (recorded: the winding number is evaluated from there, voxelize_into step 3)
+               // of a fan closing a hole that is not flat, or of a triangle near it, of the solid with
+               // holes in slot s (recorded: the winding number is evaluated from there, step 3)
 };
 
 struct Tri3 {
@@ -44,19 +44,24 @@ struct Tri3 {
   int kind;      // 0: parity; 1: open-mesh face, filled behind `normal`; 2: side of an open face's prism
   Vec3 normal;   // kind 1: the side the slab is away from (the front's normal, or its opposite for
                  // a grid traced from the back side, voxelize.h)
-  int fan = -1;  // kind 0: slot of the solid with holes whose non-flat hole this fan triangle closes
+  int fan = -1;  // kind 0: slot of the solid with holes whose non-flat hole this fan triangle closes,
+                 // or near which this triangle of it lies (Holes::near)
 };
 
 // The centroid of each hole's boundary vertices (each boundary edge contributes its two ends), and
 // whether the hole is flat: its boundary within 1e-6 of the mesh's extent of the plane through the
 // centroid normal to the fan's vector area. Off a flat fan |w_fan| < 1/2 (voxelize_world), so the
 // parity of the mesh with its fans is its winding-number solid there without evaluating w.
+// `near` marks the mesh's triangles whose centroid lies in the box of a hole that is not flat
+// (padded by 1% of the mesh's extent): where the pocket between that hole's fan and its spanning
+// surface can meet the mesh.
 struct Holes {
   std::vector<Vec3> centre;
   std::vector<std::uint8_t> flat;
+  std::vector<std::uint8_t> near;  // per triangle
 };
 Holes hole_centroids(const Mesh& m, const MeshClosure& c) {
-  Holes h{std::vector<Vec3>(c.holes, Vec3{0, 0, 0}), std::vector<std::uint8_t>(c.holes, 1)};
+  Holes h{std::vector<Vec3>(c.holes, Vec3{0, 0, 0}), std::vector<std::uint8_t>(c.holes, 1), std::vector<std::uint8_t>(m.triangle_count(), 0)};
   std::vector<float> n(c.holes, 0.0f);
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
     h.centre[c.hole[e]] += m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
@@ -64,16 +69,26 @@ Holes hole_centroids(const Mesh& m, const MeshClosure& c) {
   }
   for (std::uint32_t k = 0; k < c.holes; ++k) h.centre[k] = h.centre[k] * (1.0f / n[k]);
   std::vector<Vec3> area(c.holes, Vec3{0, 0, 0});
+  std::vector<Bounds3> box(c.holes);
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
     const Vec3 o = h.centre[c.hole[e]];
     area[c.hole[e]] += cross(m.positions[c.boundary[e][1]] - o, m.positions[c.boundary[e][0]] - o);
+    box[c.hole[e]].extend(m.positions[c.boundary[e][0]]);
   }
-  const float tol = 1e-6f * m.bounds().diagonal();
+  const float extent = m.bounds().diagonal(), tol = 1e-6f * extent, pad = 0.01f * extent;
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
     const std::uint32_t k = c.hole[e];
     const Vec3 nk = normalize(area[k]);
     for (int end = 0; end < 2; ++end)
       if (!(std::abs(dot(nk, m.positions[c.boundary[e][end]] - h.centre[k])) <= tol)) h.flat[k] = 0;
+  }
+  for (std::uint32_t k = 0; k < c.holes; ++k) {
+    if (h.flat[k]) continue;
+    const Vec3 lo = box[k].lo - Vec3{pad, pad, pad}, hi = box[k].hi + Vec3{pad, pad, pad};
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const Vec3 p = (m.positions[m.indices[3 * t]] + m.positions[m.indices[3 * t + 1]] + m.positions[m.indices[3 * t + 2]]) * (1.0f / 3.0f);
+      if (p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z) h.near[t] = 1;
+    }
   }
   return h;
 }
@@ -455,6 +470,25 @@ bool any_slab(std::span<const Treat> t) {
   return std::any_of(t.begin(), t.end(), [](Treat x) { return x == Treat::Slab || x == Treat::SlabFlipped; });
 }
 
+// Whether a slab rises above any face (world +y): a face turned down with a slab behind it, or
+// turned up with one in front.
+bool slab_rises(const Scene& scene, std::span<const Treat> t) {
+  const std::vector<SceneObject> objects = scene.objects();
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    if (t[o] != Treat::Slab && t[o] != Treat::SlabFlipped) continue;
+    const Mesh& m = scene.meshes[objects[o].mesh];
+    const Affine3* tf = objects[o].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[o].instance].object_to_world;
+    const float side = t[o] == Treat::Slab ? 1.0f : -1.0f;
+    for (std::size_t k = 0; k < m.triangle_count(); ++k) {
+      Vec3 v[3] = {m.positions[m.indices[3 * k]], m.positions[m.indices[3 * k + 1]], m.positions[m.indices[3 * k + 2]]};
+      if (tf)
+        for (Vec3& p : v) p = tf->point(p);
+      if (side * cross(v[1] - v[0], v[2] - v[0]).y < 0) return true;
+    }
+  }
+  return false;
+}
+
 // Object space of an object: the inverse of its instance's map (identity for a world-space mesh),
 // and the sign of its determinant (a mirror turns fronts into backs: w changes sign).
 struct ObjectSpace {
@@ -534,6 +568,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       Tri3 tri;
       if (local < m.triangle_count()) {
         tri = source_triangle(m, local, open);
+        if (slot_of[oi] >= 0 && holes[mi].near[local]) tri.fan = slot_of[oi];
       } else {
         const std::size_t e = local - m.triangle_count();
         const auto [a, b] = closure[mi].boundary[e];
@@ -584,10 +619,12 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // chi of the mesh plus its fans C; the mesh's own winding number is w = chi - w_C (w is a sum
   // over triangles; sigma w with sigma the orientation, voxelize.h), and the solid is w > 1/2. The
   // two differ only where |w_C| >= 1/2, which is next to a fan that is not flat: in the pocket
-  // between the fan and the surface w = 1/2 that spans the hole. Along a column the pocket is
-  // entered through the fan (fan and that surface bound it), so from each fan fragment we walk
+  // between the fan and the surface w = 1/2 that spans the hole, which the mesh itself can also
+  // cut near the hole's rim. Along a column the pocket is entered through the fan or through the
+  // mesh near the hole (it is bounded by them and that surface), so from each such fragment we walk
   // the column both ways, setting each voxel to [sigma w(centre) > 1/2], and stop at the first
-  // voxel where that agrees with parity: the pocket's end (the next voxel on the other side).
+  // voxel where that agrees with parity: the pocket's end. (A column that crossed the spanning
+  // surface twice and neither the fan nor the mesh would be missed.)
   std::size_t evaluated = 0, changed = 0;
   if (!slot_object.empty()) {
     std::vector<ObjectSpace> space;
@@ -805,10 +842,12 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
-  // (a ground plane's slab hangs below it, a wall's prism stands behind it).
+  // (a ground plane's slab hangs below it, a wall's prism stands behind it), and above when a
+  // slab rises from a face (a roof seen from below, a ceiling seen from the room).
   const float side = (any_slab(treat.of) ? slab : 0.0f) + v0;
+  const float top = (slab_rises(scene, treat.of) ? slab : 0.0f) + v0;
   const Vec3 lo = b.lo - Vec3{side, side, side};
-  const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
+  const Vec3 ext = e + Vec3{2 * side, side + top, 2 * side};
   g.origin = lo;
   g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
   const WorldMap map{lo, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}, slab};

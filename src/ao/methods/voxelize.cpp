@@ -49,18 +49,20 @@ struct Tri3 {
 };
 
 // The centroid of each hole's boundary vertices (each boundary edge contributes its two ends), and
-// whether the hole is flat: its boundary within 1e-6 of the mesh's extent of the plane through the
-// centroid normal to the fan's vector area. Off a flat fan |w_fan| < 1/2 (voxelize_world), so the
-// parity of the mesh with its fans is its winding-number solid there without evaluating w.
-// `near` marks the mesh's triangles whose centroid lies in the box of a hole that is not flat
-// (padded by 1% of the mesh's extent): where the pocket between that hole's fan and its spanning
-// surface can meet the mesh.
+// whether the hole is flat to the grid: its boundary within `flat` (world units: two voxels) of the
+// plane through the centroid normal to the fan's vector area. Off a flat fan |w_fan| < 1/2
+// (voxelize_world), so the parity of the mesh with its fans is its winding-number solid there;
+// within two voxels of a plane, the pocket between the fan and the surface w = 1/2 that spans the
+// hole lies in a sliver of that thickness along the plane (a scan's base cut through its
+// triangles zigzags by a triangle's height), which is left to parity.
+// `near` marks the mesh's triangles near the rim of a hole that is not flat: where the pocket
+// between that hole's fan and its spanning surface can meet the mesh.
 struct Holes {
   std::vector<Vec3> centre;
   std::vector<std::uint8_t> flat;
   std::vector<std::uint8_t> near;  // per triangle
 };
-Holes hole_centroids(const Mesh& m, const MeshClosure& c) {
+Holes hole_centroids(const Mesh& m, const MeshClosure& c, float flat) {
   Holes h{std::vector<Vec3>(c.holes, Vec3{0, 0, 0}), std::vector<std::uint8_t>(c.holes, 1), std::vector<std::uint8_t>(m.triangle_count(), 0)};
   std::vector<float> n(c.holes, 0.0f);
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
@@ -75,22 +77,68 @@ Holes hole_centroids(const Mesh& m, const MeshClosure& c) {
     area[c.hole[e]] += cross(m.positions[c.boundary[e][1]] - o, m.positions[c.boundary[e][0]] - o);
     box[c.hole[e]].extend(m.positions[c.boundary[e][0]]);
   }
-  const float extent = m.bounds().diagonal(), tol = 1e-6f * extent, pad = 0.01f * extent;
+  const float extent = m.bounds().diagonal(), tol = flat, pad = 0.01f * extent;
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
     const std::uint32_t k = c.hole[e];
     const Vec3 nk = normalize(area[k]);
     for (int end = 0; end < 2; ++end)
       if (!(std::abs(dot(nk, m.positions[c.boundary[e][end]] - h.centre[k])) <= tol)) h.flat[k] = 0;
   }
+  // Near a hole: within its rim's deviation from its plane (how far the pocket reaches from the
+  // rim) plus 1% of the mesh's extent of one of its rim vertices.
+  std::vector<float> deviation(c.holes, 0.0f);
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const std::uint32_t k = c.hole[e];
+    deviation[k] = std::max(deviation[k], std::abs(dot(normalize(area[k]), m.positions[c.boundary[e][0]] - h.centre[k])));
+  }
   for (std::uint32_t k = 0; k < c.holes; ++k) {
     if (h.flat[k]) continue;
-    const Vec3 lo = box[k].lo - Vec3{pad, pad, pad}, hi = box[k].hi + Vec3{pad, pad, pad};
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      const Vec3 p = (m.positions[m.indices[3 * t]] + m.positions[m.indices[3 * t + 1]] + m.positions[m.indices[3 * t + 2]]) * (1.0f / 3.0f);
-      if (p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z) h.near[t] = 1;
-    }
+    const float reach = deviation[k] + pad;
+    const Vec3 lo = box[k].lo - Vec3{reach, reach, reach}, hi = box[k].hi + Vec3{reach, reach, reach};
+    for (std::size_t t = 0; t < m.triangle_count(); ++t)
+      for (int v = 0; v < 3 && !h.near[t]; ++v) {
+        const Vec3 p = m.positions[m.indices[3 * t + v]];
+        if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
+        for (std::size_t e = 0; e < c.boundary.size() && !h.near[t]; ++e)
+          if (c.hole[e] == k && length(p - m.positions[c.boundary[e][0]]) <= reach) h.near[t] = 1;
+      }
   }
   return h;
+}
+
+// The winding number w_C of one mesh's fans (the triangles (b, a, centroid) over its boundary
+// edges a -> b), summed exactly with Van Oosterom and Strackee's formula (winding_number.h): fan
+// triangles are slivers from the rim to the centroid, which a hierarchy cannot group. The rim's
+// vertices are shared by two edges each, so their offsets and lengths are computed once per point.
+struct FanWinding {
+  std::vector<Vec3> vertex;                      // rim vertices, then the holes' centroids
+  std::vector<std::array<std::uint32_t, 3>> tri;  // (b, a, centroid) into `vertex`
+  double operator()(Vec3 q, std::vector<Vec3>& r, std::vector<float>& len) const {
+    r.resize(vertex.size());
+    len.resize(vertex.size());
+    for (std::size_t v = 0; v < vertex.size(); ++v) r[v] = vertex[v] - q, len[v] = length(r[v]);
+    double sum = 0;
+    for (const auto& [b, a, c] : tri) {
+      const float det = dot(r[b], cross(r[a], r[c]));
+      if (det == 0.0f) continue;  // q in the triangle's plane: 0 (winding_number.cpp)
+      const float den = len[b] * len[a] * len[c] + dot(r[b], r[a]) * len[c] + dot(r[b], r[c]) * len[a] + dot(r[a], r[c]) * len[b];
+      sum += std::atan2(det, den);
+    }
+    return sum * (2.0 / (4.0 * 3.14159265358979323846));
+  }
+};
+FanWinding fan_winding(const Mesh& m, const MeshClosure& c, const Holes& h) {
+  FanWinding f;
+  std::vector<std::uint32_t> slot(m.positions.size(), ~0u);
+  const auto at = [&](std::uint32_t v) {
+    if (slot[v] == ~0u) slot[v] = static_cast<std::uint32_t>(f.vertex.size()), f.vertex.push_back(m.positions[v]);
+    return slot[v];
+  };
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) f.tri.push_back({at(c.boundary[e][1]), at(c.boundary[e][0]), 0});
+  const std::uint32_t first_centre = static_cast<std::uint32_t>(f.vertex.size());
+  f.vertex.insert(f.vertex.end(), h.centre.begin(), h.centre.end());
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) f.tri[e][2] = first_centre + c.hole[e];
+  return f;
 }
 
 Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
@@ -503,11 +551,12 @@ ObjectSpace object_space(const Scene& scene, const SceneObject& ob) {
   return {true, inverse(m), m.determinant() < 0 ? -1 : 1};
 }
 
-// Stages 1-4 for any grid whose geometry fields are set; `emit` maps one Tri3 into a vector,
-// `voxel_centre(i, j, k)` gives the world point of a voxel's centre.
+// Stages 1-4 for any grid whose geometry fields are set; `voxel` is the largest extent of a voxel
+// (world units), `emit` maps one Tri3 into a vector, `voxel_centre(i, j, k)` gives the world point
+// of a voxel's centre.
 template <bool kPerspective, class Emit, class Centre>
 void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, const Treatments& treatment,
-                   float slab_thickness, Emit&& emit, Centre&& voxel_centre, VoxelStats* stats) {
+                   float slab_thickness, float voxel, Emit&& emit, Centre&& voxel_centre, VoxelStats* stats) {
   const std::span<const Treat> treat = treatment.of;
   g.depth_bits = o.depth_bits;
   g.words = (o.depth_bits + 63) / 64;
@@ -541,7 +590,13 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   for (std::size_t oi = 0; oi < objects.size(); ++oi) {
     const std::size_t mi = objects[oi].mesh;
     const bool fans = treat[oi] == Treat::Fans;
-    if (fans && !hole_info[mi]) holes[mi] = hole_centroids(scene.meshes[mi], closure[mi]), hole_info[mi] = 1;
+    if (fans && !hole_info[mi]) {
+      // Two voxels, in the mesh's own units (an instance's scale divides them).
+      const float scale = objects[oi].instance == SceneObject::kNoInstance
+                              ? 1.0f
+                              : static_cast<float>(std::cbrt(std::abs(scene.instances[objects[oi].instance].object_to_world.determinant())));
+      holes[mi] = hole_centroids(scene.meshes[mi], closure[mi], 2.0f * voxel / scale), hole_info[mi] = 1;
+    }
     if (fans && std::find(holes[mi].flat.begin(), holes[mi].flat.end(), 0) != holes[mi].flat.end()) {
       slot_of[oi] = static_cast<int>(slot_object.size());
       slot_object.push_back(oi);
@@ -627,26 +682,49 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // surface twice and neither the fan nor the mesh would be missed.)
   std::size_t evaluated = 0, changed = 0;
   if (!slot_object.empty()) {
+    // Per slot: object space, sigma (orientation, mirrors included) and the winding number of its
+    // fans alone (w_C needs no triangle near the point but the fans' own, unlike w of the mesh).
     std::vector<ObjectSpace> space;
     std::vector<int> sign;
+    std::vector<FanWinding> fans;
     for (std::size_t oi : slot_object) {
+      const std::size_t mi = objects[oi].mesh;
       space.push_back(object_space(scene, objects[oi]));
-      sign.push_back(closure[objects[oi].mesh].orientation * space.back().sign);
+      sign.push_back(closure[mi].orientation * space.back().sign);
+      fans.push_back(fan_winding(scene.meshes[mi], closure[mi], holes[mi]));
     }
     std::vector<std::size_t> evaluated_in(bands, 0), changed_in(bands, 0);
     tbb::parallel_for(0, bands, [&](int b) {
-      for (const ColumnHit& h : hits[b]) {
-        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(h.j) * g.nx + h.i) * g.words;
-        const WindingNumber& w = *closure[objects[slot_object[h.tag]].mesh].winding;
-        for (int dir : {1, -1})
-          for (int k = dir > 0 ? h.k : h.k - 1; k >= 0 && k < g.depth_bits; k += dir) {
-            const bool solid = sign[h.tag] * w(space[h.tag](voxel_centre(h.i, h.j, k))) > 0.5;
-            ++evaluated_in[b];
-            const std::uint64_t bit = std::uint64_t{1} << (k & 63);
-            if (solid == ((col[k >> 6] & bit) != 0)) break;
-            col[k >> 6] ^= bit;
-            ++changed_in[b];
-          }
+      std::vector<ColumnHit>& list = hits[b];
+      std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.tag, x.k) < std::tie(y.j, y.i, y.tag, y.k); });
+      std::vector<std::uint64_t> chi(g.words), seen(g.words);
+      std::vector<Vec3> r;
+      std::vector<float> len;
+      for (std::size_t q = 0; q < list.size();) {
+        // One column and slot at a time: chi is the column as parity left it, each voxel is
+        // decided once however many walks reach it.
+        const ColumnHit& at = list[q];
+        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(at.j) * g.nx + at.i) * g.words;
+        std::copy(col, col + g.words, chi.begin());
+        std::fill(seen.begin(), seen.end(), 0);
+        const int s = at.tag;
+        for (; q < list.size() && list[q].i == at.i && list[q].j == at.j && list[q].tag == s; ++q)
+          for (int dir : {1, -1})
+            for (int k = dir > 0 ? list[q].k : list[q].k - 1; k >= 0 && k < g.depth_bits; k += dir) {
+              const std::uint64_t bit = std::uint64_t{1} << (k & 63);
+              const bool parity = (chi[k >> 6] & bit) != 0;
+              bool solid;
+              if (seen[k >> 6] & bit) {
+                solid = (col[k >> 6] & bit) != 0;
+              } else {
+                // w = chi - w_C: solid where sigma w = chi - sigma w_C > 1/2.
+                solid = (parity ? 1.0 : 0.0) - sign[s] * fans[s](space[s](voxel_centre(at.i, at.j, k)), r, len) > 0.5;
+                seen[k >> 6] |= bit;
+                ++evaluated_in[b];
+                if (solid != parity) col[k >> 6] ^= bit, ++changed_in[b];
+              }
+              if (solid == parity) break;
+            }
       }
     });
     for (int b = 0; b < bands; ++b) evaluated += evaluated_in[b], changed += changed_in[b];
@@ -660,18 +738,27 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     for (auto& h : hits) h.clear();
     raster_pass(2);
     tbb::parallel_for(0, bands, [&](int b) {
-      std::vector<ColumnHit>& list = hits[b];
-      std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.k) < std::tie(y.j, y.i, y.k); });
-      for (std::size_t q = 0; q < list.size();) {
-        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(list[q].j) * g.nx + list[q].i) * g.words;
+      // The band's prism fragments by column (a counting sort), each column's by depth.
+      const std::vector<ColumnHit>& list = hits[b];
+      if (list.empty()) return;
+      const int r0 = band_first_row(b);
+      const std::size_t columns = static_cast<std::size_t>(band_first_row(b + 1) - r0) * g.nx;
+      std::vector<std::uint32_t> start(columns + 1, 0);
+      for (const ColumnHit& h : list) ++start[static_cast<std::size_t>(h.j - r0) * g.nx + h.i + 1];
+      for (std::size_t c = 0; c < columns; ++c) start[c + 1] += start[c];
+      std::vector<std::pair<int, int>> sorted(list.size());  // (k, +-1)
+      std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+      for (const ColumnHit& h : list) sorted[next[static_cast<std::size_t>(h.j - r0) * g.nx + h.i]++] = {h.k, h.tag};
+      for (std::size_t c = 0; c < columns; ++c) {
+        if (start[c] == start[c + 1]) continue;
+        const auto begin = sorted.begin() + start[c], end = sorted.begin() + start[c + 1];
+        std::sort(begin, end);
+        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(r0) * g.nx + c) * g.words;
         int count = 0;
-        std::size_t e = q;
-        for (; e < list.size() && list[e].i == list[q].i && list[e].j == list[q].j; ++e) {
-          count += list[e].tag;
-          const int end = e + 1 < list.size() && list[e + 1].i == list[q].i && list[e + 1].j == list[q].j ? list[e + 1].k : g.depth_bits;
-          if (count != 0) set_bits(col, g.depth_bits, list[e].k, end);
+        for (auto e = begin; e != end; ++e) {
+          count += e->second;
+          if (count != 0) set_bits(col, g.depth_bits, e->first, e + 1 != end ? (e + 1)->first : g.depth_bits);
         }
-        q = e;
       }
     });
   }
@@ -853,7 +940,7 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const WorldMap map{lo, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}, slab};
   const Vec3 origin = g.origin, size = g.voxel_size;
   voxelize_into<false>(
-      g, scene, closure, o, treat, slab, [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); },
+      g, scene, closure, o, treat, slab, std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}), [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); },
       [origin, size](int i, int j, int k) {
         return Vec3{origin.x + (static_cast<float>(i) + 0.5f) * size.x, origin.y + (static_cast<float>(k) + 0.5f) * size.z,
                     origin.z + (static_cast<float>(j) + 0.5f) * size.y};
@@ -943,7 +1030,7 @@ VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure,
     return map.eye + map.basis.to_world(local);
   };
   voxelize_into<true>(
-      g, scene, closure, o, treat, slab, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); }, centre, stats);
+      g, scene, closure, o, treat, slab, v0, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); }, centre, stats);
   return g;
 }
 

@@ -482,7 +482,7 @@ nlohmann::json cone_stats(const ConeResult& r) {
                                 : std::string("voxelized by parity, wrong in the columns through the holes")));
   if (r.unresolved_pixels > 0)
     warnings.push_back("cone: " + std::to_string(r.unresolved_pixels) +
-                       " pixels lie on a combination of sides of the open meshes beyond the 8 grids of a frame: traced as if in front of all");
+                       " pixels lie on a side of the open meshes that got no grid of its own (over 8 sides, or too few pixels): traced as if in front of all");
   nlohmann::json meshes = nlohmann::json::array();
   for (const OpenMeshInfo& m : r.open_meshes)
     meshes.push_back({{"name", m.name}, {"kind", kind_name(m.kind)}, {"boundary_edges", m.boundary_edges}, {"holes", m.holes}, {"enclosure", m.enclosure}});

@@ -125,10 +125,11 @@ struct ConeResult {
   int grid_nx = 0, grid_ny = 0;
   bool grid_reused = false;  ///< ConeContext: the grids of earlier calls were traced (no voxelization).
   /// Grids traced: one per combination of sides of the open meshes that the pixels lie on
-  /// (voxelize.h: a sheet is a slab on the far side of it from the point), at most 8.
+  /// (voxelize.h: a sheet is a slab on the far side of it from the point), at most 8, each for at
+  /// least 32 pixels (or a thousandth of the covered ones, if fewer).
   int side_grids = 1;
   std::size_t back_pixels = 0;        ///< Covered pixels traced with a grid for the back side of an open mesh.
-  std::size_t unresolved_pixels = 0;  ///< Pixels whose sides needed a ninth grid: traced with the all-front one.
+  std::size_t unresolved_pixels = 0;  ///< Pixels whose sides got no grid (a ninth, or one for too few pixels): traced with the all-front one.
   std::size_t side_evaluations = 0;   ///< Winding numbers evaluated per pixel to tell their sides.
   std::vector<OpenMeshInfo> open_meshes;  ///< The scene's meshes that are not closed.
   OpenMeshes open_mode = OpenMeshes::Winding;  ///< ConeParams::open_meshes of the call.
@@ -137,7 +138,8 @@ struct ConeResult {
 /// Voxelizes `scene` (rebuilt on every call: a dynamic-scene method), runs the kernel and the filter.
 /// `closure` comes from analyze_closure(scene) (reusable across frames while the scene stays).
 /// With open_meshes=winding each pixel is traced in the grid for the sides of the open meshes its
-/// point lies on (voxelize.h; at most 8 grids per call, usually one or two).
+/// point lies on (voxelize.h; at most 8 grids per call, usually one or two; cone_stats reports
+/// pixels left to the all-front grid).
 ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, float r_max, const ConeParams& params,
                        std::uint32_t seed, const ProgressFn& progress = {});
 

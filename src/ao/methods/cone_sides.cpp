@@ -21,6 +21,10 @@ namespace {
 // the part of the sheet nearest to the point decides. Inside a solid with holes (w near 1/2 in
 // the mouth of a hole) the point is taken as outside.
 constexpr double kUndecided = 0.01;
+// Lattice (SideSetup::Open::lattice): points R_max / 2 apart, at most 24 cells per axis; corners
+// whose w is within 0.05 of the threshold leave the decision to the point itself.
+constexpr int kLatticeCells = 24;
+constexpr float kLatticeMargin = 0.05f;
 
 Bounds3 object_bounds(const Scene& scene, const SceneObject& ob) {
   const Bounds3 b = scene.meshes[ob.mesh].bounds();
@@ -50,6 +54,20 @@ int side_of(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
   if (c.holed()) return -1;
   const double d = o.sign * c.winding->signed_distance(p);
   return d == 0 ? 0 : (d > 0 ? 1 : -1);
+}
+
+// The side of `o` that its lattice gives for p: +1 / -1 when the corners of p's cell agree, else 0.
+int lattice_side(const SideSetup::Open& o, Vec3 p) {
+  if (o.lattice.empty()) return 0;
+  const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
+  const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
+            z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
+  int behind = 0, front = 0;
+  for (int k = 0; k < 8; ++k) {
+    const float v = o.lattice[(static_cast<std::size_t>(z + (k >> 2)) * o.ly + y + ((k >> 1) & 1)) * o.lx + x + (k & 1)];
+    behind += v >= kLatticeMargin, front += v <= -kLatticeMargin;
+  }
+  return behind == 8 ? 1 : front == 8 ? -1 : 0;
 }
 
 // The voxel of `g` at world point p (false outside the grid).
@@ -127,6 +145,30 @@ SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closu
       if (vote != SideSetup::Front) s.votes[a].push_back({q, vote});
     }
   }
+  // Lattices for the open meshes that some object votes Mixed on.
+  std::vector<std::uint8_t> mixed(s.open.size(), 0);
+  for (const auto& list : s.votes)
+    for (const auto& [q, vote] : list) mixed[q] |= vote == SideSetup::Mixed && !s.open[q].closure->flat;
+  for (std::uint32_t q = 0; q < s.open.size(); ++q) {
+    if (!mixed[q]) continue;
+    SideSetup::Open& o = s.open[q];
+    const Vec3 e = o.reach.extent();
+    o.lattice_step = std::max(0.5f * r_max, std::max({e.x, e.y, e.z}) / kLatticeCells);
+    o.lattice_lo = o.reach.lo;
+    o.lx = static_cast<int>(std::ceil(e.x / o.lattice_step)) + 1;
+    o.ly = static_cast<int>(std::ceil(e.y / o.lattice_step)) + 1;
+    o.lz = static_cast<int>(std::ceil(e.z / o.lattice_step)) + 1;
+    o.lattice.resize(static_cast<std::size_t>(o.lx) * o.ly * o.lz);
+    tbb::parallel_for(0, o.lz, [&](int z) {
+      for (int y = 0; y < o.ly; ++y)
+        for (int x = 0; x < o.lx; ++x) {
+          const Vec3 p = o.lattice_lo + Vec3{float(x), float(y), float(z)} * o.lattice_step;
+          o.lattice[(static_cast<std::size_t>(z) * o.ly + y) * o.lx + x] =
+              static_cast<float>(o.sign * (*o.closure->winding)(o.instanced ? o.to_object.point(p) : p) - o.threshold);
+        }
+    });
+    s.evaluations += o.lattice.size();
+  }
   return s;
 }
 
@@ -186,32 +228,45 @@ PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& s
         if (vote == SideSetup::Mixed && contains(o.reach, p)) {
           // Inside a solid with holes is inside its winding-number solid, which the all-front grid
           // holds: only points whose front is solid there need w.
-          if (!o.closure->holed() || solid_at(front, p + n * offset)) behind = side_of(o, p, evaluations[y]) > 0;
+          if (!o.closure->holed() || solid_at(front, p + n * offset)) {
+            const int coarse = lattice_side(o, p);
+            behind = coarse != 0 ? coarse > 0 : side_of(o, p, evaluations[y]) > 0;
+          }
         }
         if (behind) back.push_back(q);
       }
       if (!back.empty()) rows[y].push_back({static_cast<std::size_t>(y) * gb.width() + x, std::move(back)});
     }
   });
-  std::map<std::vector<std::uint32_t>, std::uint8_t> index;
+  // Sides by how many pixels lie on them: the largest groups get the grids.
+  std::map<std::vector<std::uint32_t>, std::size_t> count;
   for (int y = 0; y < gb.height(); ++y) {
     out.evaluations += evaluations[y];
     for (Flagged& f : rows[y]) {
       std::sort(f.back.begin(), f.back.end());
-      auto it = index.find(f.back);
-      if (it == index.end()) {
-        if (static_cast<int>(out.keys.size()) >= kMaxSideGrids) {
-          ++out.unresolved;
-          continue;
-        }
-        std::vector<std::uint8_t> key(objects.size(), 0);
-        for (std::uint32_t q : f.back) key[setup.open[q].object] = 1;
-        it = index.emplace(f.back, static_cast<std::uint8_t>(out.keys.size())).first;
-        out.keys.push_back(std::move(key));
-      }
-      out.key_of[f.pixel] = it->second;
+      ++count[f.back];
     }
   }
+  std::vector<std::pair<std::size_t, const std::vector<std::uint32_t>*>> by_size;
+  for (const auto& [back, n] : count) by_size.push_back({n, &back});
+  std::stable_sort(by_size.begin(), by_size.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < out.key_of.size(); ++i) covered += gb.covered(i) ? 1 : 0;
+  const std::size_t least = std::min(kMinSidePixels, covered / 1000);
+  std::map<std::vector<std::uint32_t>, std::uint8_t> index;
+  for (const auto& [n, back] : by_size) {
+    if (static_cast<int>(out.keys.size()) >= kMaxSideGrids || n < least) break;
+    std::vector<std::uint8_t> key(objects.size(), 0);
+    for (std::uint32_t q : *back) key[setup.open[q].object] = 1;
+    index.emplace(*back, static_cast<std::uint8_t>(out.keys.size()));
+    out.keys.push_back(std::move(key));
+  }
+  for (int y = 0; y < gb.height(); ++y)
+    for (const Flagged& f : rows[y]) {
+      const auto it = index.find(f.back);
+      if (it == index.end()) ++out.unresolved;
+      else out.key_of[f.pixel] = it->second;
+    }
   return out;
 }
 

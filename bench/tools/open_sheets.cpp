@@ -6,7 +6,12 @@
 // Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
 // top), and the closed box, sphere and torus. The ground is a quad of twice the object's diagonal
 // under it, and the camera looks at the object from the front right and above, as
-// tests/methods/cone_test.cpp does. Write them outside the repository.
+// tests/methods/cone_test.cpp does. With a second argument, the folder of the shared meshes, also
+// ChineseDragon-10kv and elephant opened as scans come (tests/support/open_sheets.h: the bottom
+// 10% cut off, -cut.obj; holes of 3% of the diagonal punched, -holes.obj), alone:
+//   ao_open_sheets /tmp/open-sheets ../shared/data/meshes
+//   ao compare /tmp/open-sheets/elephant-cut.obj --methods cone
+// Write them outside the repository.
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -16,6 +21,7 @@
 #include <vector>
 
 #include "ao/io/camera_json.h"
+#include "ao/io/mesh_io.h"
 #include "ao/scene/procedural.h"
 #include "support/open_sheets.h"
 
@@ -52,8 +58,8 @@ ao::Mesh ground_under(const ao::Mesh& object) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: ao_open_sheets OUTPUT_FOLDER\n";
+  if (argc != 2 && argc != 3) {
+    std::cerr << "usage: ao_open_sheets OUTPUT_FOLDER [SHARED_MESHES_FOLDER]\n";
     return 2;
   }
   try {
@@ -73,6 +79,15 @@ int main(int argc, char** argv) {
       camera << ao::camera_to_json(ao::frame_bounds(mesh.bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 640, 360)).dump() << "\n";
       if (!camera) throw std::runtime_error("cannot write " + (dir / (name + ".camera.json")).string());
       std::cout << (dir / (name + ".obj")).string() << "\n";
+    }
+    if (argc == 3) {
+      for (const std::string name : {"ChineseDragon-10kv", "elephant"}) {
+        const ao::Mesh closed = ao::load_scene_file(std::filesystem::path(argv[2]) / (name + ".off")).meshes.at(0);
+        for (const auto& [suffix, open] : {std::pair{"-cut", ao::test::cut_base(closed, 0.1f)}, std::pair{"-holes", ao::test::punch_holes(closed, 0.03f)}}) {
+          write_obj(dir / (name + suffix + ".obj"), {{name, open}});
+          std::cout << (dir / (name + suffix + ".obj")).string() << "\n";
+        }
+      }
     }
   } catch (const std::exception& e) {
     std::cerr << "ao_open_sheets: " << e.what() << "\n";

@@ -133,40 +133,8 @@ TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
   }
 }
 
-// Open meshes made from closed ones, as scans come: `keep` decides per triangle from its centroid.
-template <class Keep>
-Mesh cut(const Mesh& closed, Keep keep) {
-  Mesh m = closed;
-  m.indices.clear();
-  for (std::size_t t = 0; t < closed.triangle_count(); ++t) {
-    const std::uint32_t* v = closed.indices.data() + 3 * t;
-    const Vec3 c = (closed.positions[v[0]] + closed.positions[v[1]] + closed.positions[v[2]]) * (1.0f / 3.0f);
-    if (keep(c)) m.indices.insert(m.indices.end(), v, v + 3);
-  }
-  return m;
-}
-// Removes the cap below y = lo + fraction * height (a bust open at its base).
-Mesh cut_base(const Mesh& closed, float fraction) {
-  Bounds3 b;
-  for (const Vec3& p : closed.positions) b.extend(p);
-  const float y = b.lo.y + fraction * (b.hi.y - b.lo.y);
-  return cut(closed, [&](Vec3 c) { return c.y > y; });
-}
-// Punches holes: drops the triangles within `radius` of three vertices on the upper half.
-Mesh punch_holes(const Mesh& closed, float radius_fraction) {
-  Bounds3 b;
-  for (const Vec3& p : closed.positions) b.extend(p);
-  std::vector<Vec3> centres;
-  const float mid = 0.5f * (b.lo.y + b.hi.y);
-  for (std::size_t v = 0; v < closed.positions.size() && centres.size() < 3; v += closed.positions.size() / 7 + 1)
-    if (closed.positions[v].y > mid) centres.push_back(closed.positions[v]);
-  const float r = radius_fraction * b.diagonal();
-  return cut(closed, [&](Vec3 c) {
-    for (const Vec3& q : centres)
-      if (length(c - q) < r) return false;
-    return true;
-  });
-}
+using test::cut_base;
+using test::punch_holes;
 
 struct OpenError {
   double rmse, mean_signed;
@@ -274,9 +242,7 @@ TEST(Cone, ASheetOccludesFromBothSidesAsTheSolidItHides) {
 // (a grid is taller by a slab when a slab rises above a face, which moves the voxel boundaries:
 // 0.0065 at worst, measured unfiltered), on the same G-buffer.
 TEST(Cone, SheetsLookTheSameTurnedOver) {
-  Mesh arch = test::make_holed_arch();
-  Mesh turned = arch;
-  for (std::size_t t = 0; t < turned.triangle_count(); ++t) std::swap(turned.indices[3 * t + 1], turned.indices[3 * t + 2]);
+  const Mesh arch = test::make_holed_arch(), turned = test::turned_over(arch);
   const Mesh ground = make_quad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3});
   const Scene original = scene_of({arch, ground});
   const GBuffer g = render_gbuffer(RayScene(original), frame_bounds(arch.bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 64, 48));

@@ -18,18 +18,6 @@
 namespace ao {
 namespace {
 
-// Keeps the triangles whose centroid passes `keep`.
-template <class Keep>
-Mesh keep_triangles(const Mesh& m, Keep keep) {
-  Mesh out = m;
-  out.indices.clear();
-  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    const std::uint32_t* v = m.indices.data() + 3 * t;
-    if (keep((m.positions[v[0]] + m.positions[v[1]] + m.positions[v[2]]) * (1.0f / 3.0f))) out.indices.insert(out.indices.end(), v, v + 3);
-  }
-  return out;
-}
-
 TEST(WindingNumber, ClosedMeshIsOneInsideAndZeroOutside) {
   const Mesh sphere = make_sphere({0.2f, -0.1f, 0.3f}, 1.0f, 48, 24);
   const WindingNumber w(sphere.positions, sphere.indices);
@@ -44,8 +32,7 @@ TEST(WindingNumber, ClosedMeshIsOneInsideAndZeroOutside) {
     EXPECT_NEAR(w(q), 0.0, 0.01);
   }
   // Turning every triangle over negates w.
-  Mesh flipped = sphere;
-  for (std::size_t t = 0; t < flipped.triangle_count(); ++t) std::swap(flipped.indices[3 * t + 1], flipped.indices[3 * t + 2]);
+  const Mesh flipped = test::turned_over(sphere);
   EXPECT_NEAR(WindingNumber(flipped.positions, flipped.indices).exact({0.2f, -0.1f, 0.3f}), -1.0, 1e-9);
 }
 
@@ -68,7 +55,7 @@ TEST(WindingNumber, FlatSheetIsMinusHalfInFrontAndPlusHalfBehind) {
 TEST(WindingNumber, SphereWithACapCutOffSeenFromItsCentre) {
   const Mesh sphere = make_sphere({0, 0, 0}, 1.0f, 192, 96);
   for (double a : {0.3, 1.0, 2.0}) {
-    const Mesh open = keep_triangles(sphere, [a](Vec3 c) { return c.y / length(c) < std::cos(a); });
+    const Mesh open = test::cut(sphere, [a](Vec3 c) { return c.y / length(c) < std::cos(a); });
     const WindingNumber w(open.positions, open.indices);
     const double expected = 1.0 - (1.0 - std::cos(a)) / 2.0;
     // 0.01: the cut follows whole triangles (96 rings: the rim lies up to 1/96 of pi off the cone).

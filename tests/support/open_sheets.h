@@ -1,16 +1,31 @@
 // Open meshes (sheets and containers) for the cone method's open-surface voxelization, generated
 // so that the tests and bench/tools/open_sheets.cpp (which writes them as OBJ for `ao compare`)
 // need no files. Each is one mesh whose fronts (counter-clockwise) face out, standing on y = 0.
+// And closed meshes opened as scans come (a base cut off, holes punched).
 #pragma once
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "ao/scene/mesh.h"
 #include "ao/scene/procedural.h"
 
 namespace ao::test {
+
+// Open meshes made from closed ones, as scans come: `keep` decides per triangle from its centroid.
+template <class Keep>
+inline Mesh cut(const Mesh& closed, Keep keep) {
+  Mesh m = closed;
+  m.indices.clear();
+  for (std::size_t t = 0; t < closed.triangle_count(); ++t) {
+    const std::uint32_t* v = closed.indices.data() + 3 * t;
+    const Vec3 c = (closed.positions[v[0]] + closed.positions[v[1]] + closed.positions[v[2]]) * (1.0f / 3.0f);
+    if (keep(c)) m.indices.insert(m.indices.end(), v, v + 3);
+  }
+  return m;
+}
 
 /// A sheet bent through 180 degrees into an arch (half a cylinder of `radius` about the z axis,
 /// `length` long, centred on the origin, its two edges on y = 0), with `holes` round holes of
@@ -53,26 +68,41 @@ inline Mesh make_holed_arch(float radius = 0.8f, float length = 2.4f, int holes 
 
 /// Half a sphere shell of `radius`, opening up, its lowest point on y = 0: a bowl.
 inline Mesh make_bowl(float radius = 1.0f, int segments = 96, int rings = 48) {
-  const Mesh sphere = make_sphere({0, radius, 0}, radius, segments, rings);  // rings even: a ring on the equator
-  Mesh m;
-  m.positions = sphere.positions;
-  for (std::size_t t = 0; t < sphere.triangle_count(); ++t) {
-    const std::uint32_t* i = sphere.indices.data() + 3 * t;
-    if (sphere.positions[i[0]].y + sphere.positions[i[1]].y + sphere.positions[i[2]].y < 3.0f * radius) m.indices.insert(m.indices.end(), i, i + 3);
-  }
-  return m;
+  // rings even: a ring on the equator, so the rim is flat.
+  return cut(make_sphere({0, radius, 0}, radius, segments, rings), [radius](Vec3 c) { return c.y < radius; });
 }
 
 /// A box from `lo` to `hi` without its top face: an open container seen into through the gap.
 inline Mesh make_open_box(Vec3 lo = {-0.9f, 0.0f, -0.7f}, Vec3 hi = {0.9f, 1.0f, 0.7f}) {
-  const Mesh box = make_box(lo, hi);
-  Mesh m;
-  m.positions = box.positions;
-  for (std::size_t t = 0; t < box.triangle_count(); ++t) {
-    const std::uint32_t* i = box.indices.data() + 3 * t;
-    if (box.positions[i[0]].y + box.positions[i[1]].y + box.positions[i[2]].y < 3.0f * hi.y) m.indices.insert(m.indices.end(), i, i + 3);
-  }
+  return cut(make_box(lo, hi), [hi](Vec3 c) { return c.y < hi.y; });
+}
+
+// The same mesh with every triangle turned over (fronts become backs).
+inline Mesh turned_over(Mesh m) {
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
   return m;
+}
+// Removes the cap below y = lo + fraction * height (a bust open at its base).
+inline Mesh cut_base(const Mesh& closed, float fraction) {
+  Bounds3 b;
+  for (const Vec3& p : closed.positions) b.extend(p);
+  const float y = b.lo.y + fraction * (b.hi.y - b.lo.y);
+  return cut(closed, [&](Vec3 c) { return c.y > y; });
+}
+// Punches holes: drops the triangles within `radius` of three vertices on the upper half.
+inline Mesh punch_holes(const Mesh& closed, float radius_fraction) {
+  Bounds3 b;
+  for (const Vec3& p : closed.positions) b.extend(p);
+  std::vector<Vec3> centres;
+  const float mid = 0.5f * (b.lo.y + b.hi.y);
+  for (std::size_t v = 0; v < closed.positions.size() && centres.size() < 3; v += closed.positions.size() / 7 + 1)
+    if (closed.positions[v].y > mid) centres.push_back(closed.positions[v]);
+  const float r = radius_fraction * b.diagonal();
+  return cut(closed, [&](Vec3 c) {
+    for (const Vec3& q : centres)
+      if (length(c - q) < r) return false;
+    return true;
+  });
 }
 
 }  // namespace ao::test

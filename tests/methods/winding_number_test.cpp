@@ -104,6 +104,20 @@ TEST(WindingNumber, SignedDistanceToTheNearestTriangle) {
   EXPECT_NEAR(w.signed_distance({0.2f, -0.4f, 0.1f}), 0.4, 1e-6) << "behind the lower one";
   EXPECT_NEAR(w.signed_distance({3.0f, -0.5f, 0.0f}), std::sqrt(4.0 + 0.25), 1e-6) << "past its edge, below";
   EXPECT_EQ(WindingNumber().signed_distance({0, 0, 0}), std::numeric_limits<double>::infinity());
+  // The branch and bound against every triangle on its own, around the half sphere shell.
+  const Mesh bowl = test::make_bowl(1.0f, 48, 24);
+  const WindingNumber all(bowl.positions, bowl.indices);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  for (int k = 0; k < 100; ++k) {
+    const Vec3 q{u(rng), u(rng) + 1.0f, u(rng)};
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < bowl.triangle_count(); ++t) {
+      const double d = WindingNumber(bowl.positions, std::span(bowl.indices).subspan(3 * t, 3)).signed_distance(q);
+      if (std::abs(d) < std::abs(nearest)) nearest = d;
+    }
+    EXPECT_NEAR(all.signed_distance(q), nearest, 1e-6) << q.x << ", " << q.y << ", " << q.z;
+  }
 }
 
 TEST(WindingNumber, EmptyMeshIsZeroAndBadBetaIsRejected) {

@@ -72,6 +72,7 @@ std::uint32_t WindingNumber::build(std::vector<std::uint32_t>& order, std::uint3
   const D3 p{cx / sa, cy / sa, cz / sa};
   double t2[9] = {}, t3[18] = {};
   double radius2 = 0;
+  Bounds3 vertices;
   for (std::uint32_t k = first; k < first + count; ++k) {
     const std::uint32_t i = order[k];
     const D3 n2 = dcross(sub(d3(tris[i].b), d3(tris[i].a)), sub(d3(tris[i].c), d3(tris[i].a)));
@@ -79,22 +80,26 @@ std::uint32_t WindingNumber::build(std::vector<std::uint32_t>& order, std::uint3
     const double nv[3] = {n2.x / len, n2.y / len, n2.z / len};  // unit normal
     // Vertices and centroid relative to p~: the integral of p' p'^T over a triangle is
     // (a / 12) (sum of w w^T over its vertices w + (sum w)(sum w)^T).
-    D3 w[3];
-    for (int v = 0; v < 3; ++v) w[v] = sub(d3(v == 0 ? tris[i].a : v == 1 ? tris[i].b : tris[i].c), p);
-    const double c[3] = {(w[0].x + w[1].x + w[2].x) / 3, (w[0].y + w[1].y + w[2].y) / 3, (w[0].z + w[1].z + w[2].z) / 3};
+    double w[3][3];
+    for (int v = 0; v < 3; ++v) {
+      const Vec3 corner = v == 0 ? tris[i].a : v == 1 ? tris[i].b : tris[i].c;
+      vertices.extend(corner);
+      w[v][0] = double(corner.x) - p.x, w[v][1] = double(corner.y) - p.y, w[v][2] = double(corner.z) - p.z;
+      radius2 = std::max(radius2, w[v][0] * w[v][0] + w[v][1] * w[v][1] + w[v][2] * w[v][2]);
+    }
+    const double c[3] = {(w[0][0] + w[1][0] + w[2][0]) / 3, (w[0][1] + w[1][1] + w[2][1]) / 3, (w[0][2] + w[1][2] + w[2][2]) / 3};
     for (int r = 0; r < 3; ++r)
       for (int col = 0; col < 3; ++col) t2[3 * r + col] += a * c[r] * nv[col];
     double m[3][3];
     for (int r = 0; r < 3; ++r)
       for (int col = 0; col < 3; ++col) {
         double s = 9.0 * c[r] * c[col];
-        for (const D3& wv : w) s += (&wv.x)[r] * (&wv.x)[col];
+        for (const auto& wv : w) s += wv[r] * wv[col];
         m[r][col] = a / 12.0 * s;
       }
     for (int j = 0; j < 3; ++j)
       for (int kk = 0, q = 0; kk < 3; ++kk)
         for (int l = kk; l < 3; ++l, ++q) t3[6 * j + q] += nv[j] * m[kk][l];
-    for (const D3& e : w) radius2 = std::max(radius2, ddot(e, e));
   }
   {
     Node& n = nodes_[id];
@@ -104,6 +109,8 @@ std::uint32_t WindingNumber::build(std::vector<std::uint32_t>& order, std::uint3
     n.t1 = {static_cast<float>(t1.x), static_cast<float>(t1.y), static_cast<float>(t1.z)};
     for (int k = 0; k < 9; ++k) n.t2[k] = static_cast<float>(t2[k]);
     for (int k = 0; k < 18; ++k) n.t3[k] = static_cast<float>(t3[k]);
+    n.lo = vertices.lo;
+    n.hi = vertices.hi;
   }
   if (count <= kLeafSize) {
     nodes_[id].first = first;
@@ -176,17 +183,24 @@ double WindingNumber::signed_distance(Vec3 q) const {
   if (nodes_.empty()) return std::numeric_limits<double>::infinity();
   const D3 qd = d3(q);
   double best2 = std::numeric_limits<double>::infinity(), side = 0;
+  // Squared distance from q to a node's box: no point of the node is nearer.
+  const auto gap2 = [&](const Node& n) {
+    const double dx = std::max({double(n.lo.x) - q.x, 0.0, double(q.x) - n.hi.x});
+    const double dy = std::max({double(n.lo.y) - q.y, 0.0, double(q.y) - n.hi.y});
+    const double dz = std::max({double(n.lo.z) - q.z, 0.0, double(q.z) - n.hi.z});
+    return dx * dx + dy * dy + dz * dz;
+  };
   std::uint32_t stack[64];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& n = nodes_[stack[--top]];
-    // No point of the node is nearer than its bounding sphere (centre p~, radius).
-    const double gap = std::max(0.0, dlen(sub(d3(n.centre), qd)) - n.radius);
-    if (gap * gap >= best2) continue;
+    if (gap2(n) >= best2) continue;
     if (n.count == 0) {
-      stack[top++] = n.left;
-      stack[top++] = n.right;
+      // The nearer child last, so that it is searched first and tightens the bound.
+      const bool left_first = gap2(nodes_[n.left]) <= gap2(nodes_[n.right]);
+      stack[top++] = left_first ? n.right : n.left;
+      stack[top++] = left_first ? n.left : n.right;
       continue;
     }
     for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
@@ -201,6 +215,17 @@ double WindingNumber::signed_distance(Vec3 q) const {
     }
   }
   return side > 0 ? std::sqrt(best2) : side < 0 ? -std::sqrt(best2) : 0.0;
+}
+
+// The same in single precision, for the hierarchy's leaves: its rounding (1e-7 relative per
+// triangle) is far below the far field's truncation error.
+double WindingNumber::solid_angle_float(const Tri& t, Vec3 q) {
+  const Vec3 a = t.a - q, b = t.b - q, c = t.c - q;
+  const float det = dot(a, cross(b, c));
+  if (det == 0.0f) return 0.0;
+  const float la = length(a), lb = length(b), lc = length(c);
+  const float den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2.0 * static_cast<double>(std::atan2(det, den));
 }
 
 double WindingNumber::exact(Vec3 q) const {
@@ -248,7 +273,7 @@ double WindingNumber::operator()(Vec3 q) const {
       const double third = 0.5 * (-3.0 * inv_r5 * (2.0 * xu + xv3) + 15.0 * inv_r5 * inv_r2 * xxx);
       sum += (double(n.t1.x) * x.x + double(n.t1.y) * x.y + double(n.t1.z) * x.z + trace) * inv_r3 - 3.0 * xtx * inv_r5 + third;
     } else if (n.count > 0) {
-      for (std::uint32_t i = n.first; i < n.first + n.count; ++i) sum += solid_angle(tris_[i], q);
+      for (std::uint32_t i = n.first; i < n.first + n.count; ++i) sum += solid_angle_float(tris_[i], q);
     } else {
       stack[top++] = n.left;
       stack[top++] = n.right;

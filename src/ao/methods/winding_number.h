@@ -61,12 +61,14 @@ class WindingNumber {
     Vec3 t1;                        // sum of area x unit normal (first order)
     std::array<float, 9> t2{};      // sum of the integral of (p - p~) n^T, row-major (second order)
     std::array<float, 18> t3{};     // sum of n_j x the integral of (p - p~)_k (p - p~)_l, j x (k <= l) (third order)
+    Vec3 lo, hi;                    // box of its triangles (the nearest-triangle search's bound)
     std::uint32_t first = 0, count = 0;  // leaf: triangles [first, first + count)
     std::uint32_t left = 0, right = 0;   // inner node: children (count == 0)
   };
   std::uint32_t build(std::vector<std::uint32_t>& order, std::uint32_t first, std::uint32_t count, const std::vector<Tri>& tris,
                       const std::vector<Vec3>& centroid, const std::vector<float>& area);
   static double solid_angle(const Tri& t, Vec3 q);
+  static double solid_angle_float(const Tri& t, Vec3 q);
 
   std::vector<Tri> tris_;
   std::vector<Node> nodes_;

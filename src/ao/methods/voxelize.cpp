@@ -15,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <tuple>
 
 #include <tbb/blocked_range.h>
@@ -558,6 +559,7 @@ template <bool kPerspective, class Emit, class Centre>
 void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, const Treatments& treatment,
                    float slab_thickness, float voxel, Emit&& emit, Centre&& voxel_centre, VoxelStats* stats) {
   const std::span<const Treat> treat = treatment.of;
+  const Bounds3& region = o.slab_region;
   g.depth_bits = o.depth_bits;
   g.words = (o.depth_bits + 63) / 64;
   g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
@@ -623,6 +625,15 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       Tri3 tri;
       if (local < m.triangle_count()) {
         tri = source_triangle(m, local, open);
+        if (open && !region.empty()) {
+          Bounds3 reach;  // the triangle and its slab
+          for (const Vec3& v : tri.v) reach.extend(tf ? tf->point(v) : v);
+          reach.lo -= Vec3{slab_thickness, slab_thickness, slab_thickness};
+          reach.hi += Vec3{slab_thickness, slab_thickness, slab_thickness};
+          if (reach.hi.x < region.lo.x || reach.lo.x > region.hi.x || reach.hi.y < region.lo.y || reach.lo.y > region.hi.y ||
+              reach.hi.z < region.lo.z || reach.lo.z > region.hi.z)
+            continue;
+        }
         if (slot_of[oi] >= 0 && holes[mi].near[local]) tri.fan = slot_of[oi];
       } else {
         const std::size_t e = local - m.triangle_count();
@@ -807,8 +818,34 @@ namespace {
 // whole half-space behind the face), a flat sheet 0. `enclosure` is |2 w_rest| averaged over the
 // area, `orientation` its sign.
 void classify_open_mesh(const Mesh& m, MeshClosure& c) {
-  c.winding = std::make_shared<const WindingNumber>(m.positions, m.indices);
+  c.winding = MeshWinding(m);
   const std::size_t nt = m.triangle_count();
+  // Small holes (kSmallHoles): each hole's vector area from its boundary edges (about any point,
+  // here its first vertex), the orientation from the sign of the enclosed volume (about the box's
+  // centre; the holes change it little).
+  {
+    std::vector<Vec3> hole_area(c.holes, Vec3{0, 0, 0}), origin(c.holes, Vec3{0, 0, 0});
+    std::vector<std::uint8_t> has(c.holes, 0);
+    for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+      const std::uint32_t h = c.hole[e];
+      if (!has[h]) origin[h] = m.positions[c.boundary[e][0]], has[h] = 1;
+      hole_area[h] += cross(m.positions[c.boundary[e][0]] - origin[h], m.positions[c.boundary[e][1]] - origin[h]) * 0.5f;
+    }
+    double holes = 0, area = 0, volume = 0;
+    for (const Vec3& a : hole_area) holes += length(a);
+    const Vec3 o = m.bounds().center();
+    for (std::size_t t = 0; t < nt; ++t) {
+      const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
+      area += 0.5 * length(cross(b - a, d - a));
+      volume += dot(a, cross(b, d)) / 6.0;
+    }
+    if (area > 0 && holes < kSmallHoles * area) {
+      c.kind = MeshKind::SolidWithHoles;
+      c.enclosure = static_cast<float>(1.0 - holes / area);
+      c.orientation = volume < 0 ? -1 : 1;
+      return;
+    }
+  }
   const std::size_t step = std::max<std::size_t>(1, nt / kEnclosureSamples);
   double sum = 0, area = 0;
   Vec3 vector_area{0, 0, 0};
@@ -825,7 +862,7 @@ void classify_open_mesh(const Mesh& m, MeshClosure& c) {
     // 1% of the inradius (2 area / perimeter): far closer to c than any other triangle is.
     const float delta = 0.01f * 2.0f * at / (length(b - a) + length(d - b) + length(a - d));
     const Vec3 centre = (a + b + d) * (1.0f / 3.0f), n = n2 / len;
-    sum += at * ((*c.winding)(centre + n * delta) + (*c.winding)(centre - n * delta));
+    sum += at * (c.winding.get()(centre + n * delta) + c.winding.get()(centre - n * delta));
     area += at;
   }
   const double mean = area > 0 ? sum / area : 0.0;
@@ -848,6 +885,21 @@ void classify_open_mesh(const Mesh& m, MeshClosure& c) {
 }
 
 }  // namespace
+
+struct MeshWinding::State {
+  const Mesh* mesh = nullptr;
+  std::once_flag once;
+  std::unique_ptr<WindingNumber> field;
+};
+
+MeshWinding::MeshWinding(const Mesh& mesh) : state_(std::make_shared<State>()) { state_->mesh = &mesh; }
+
+const WindingNumber& MeshWinding::get() const {
+  static const WindingNumber empty;
+  if (!state_) return empty;
+  std::call_once(state_->once, [&] { state_->field = std::make_unique<WindingNumber>(state_->mesh->positions, state_->mesh->indices); });
+  return *state_->field;
+}
 
 std::vector<MeshClosure> analyze_closure(const Scene& scene) {
   std::vector<MeshClosure> out;

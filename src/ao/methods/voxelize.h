@@ -83,6 +83,25 @@ inline constexpr float kSolidEnclosure = 0.5f;
 /// Triangles sampled (evenly by index) to measure the enclosure of one open mesh.
 inline constexpr std::size_t kEnclosureSamples = 256;
 
+/// The winding number field of one mesh (winding_number.h), built on first use (from any thread,
+/// once) and shared by copies. Keeps a pointer to the mesh, which must outlive it.
+class MeshWinding {
+ public:
+  MeshWinding() = default;
+  explicit MeshWinding(const Mesh& mesh);
+  /// The field, in the mesh's own space; an empty field for a default-constructed one.
+  const WindingNumber& get() const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+/// Holes whose areas (each |vector area|, the area it spans seen from its best direction) sum to
+/// less than this fraction of the mesh's area make it a solid with holes without measuring its
+/// enclosure: holes that small cannot open it (its enclosure is then about 1 minus that fraction).
+inline constexpr float kSmallHoles = 0.01f;
+
 /// One mesh's topology and what it stands for, computed once per scene (the scene must not change
 /// while it is used).
 struct MeshClosure {
@@ -96,17 +115,19 @@ struct MeshClosure {
   MeshKind kind = MeshKind::Closed;
   /// Open meshes: |2 w_rest| averaged over the surface, in [0, 1], where w_rest is the winding
   /// number at a point of the surface of the rest of the mesh (all but the point's own triangle):
-  /// 1 for a closed surface (the rest wraps all around), 0 for a flat sheet. 1 for closed meshes.
+  /// 1 for a closed surface (the rest wraps all around), 0 for a flat sheet. 1 for closed meshes;
+  /// 1 minus the holes' area fraction for meshes with small holes (kSmallHoles).
   float enclosure = 1;
-  /// Open meshes: +1 when the fronts face out of what the mesh wraps around (the sign of w_rest),
-  /// -1 when they face in (a solid with holes then has w < -1/2 inside: its w is used negated).
+  /// Open meshes: +1 when the fronts face out of what the mesh wraps around (the sign of w_rest, or
+  /// of the enclosed volume for small holes), -1 when they face in (a solid with holes then has
+  /// w < -1/2 inside: its w is used negated).
   int orientation = 1;
   /// Open meshes: every vertex within 1e-5 of the extent of one plane (a ground, a wall): then
   /// `plane` (n.x, n.y, n.z, d; n unit along the vector area) has n.p + d < 0 exactly where w > 0.
   bool flat = false;
   std::array<float, 4> plane{};
-  /// Open meshes: the winding number field of the mesh in its own space (shared by copies).
-  std::shared_ptr<const WindingNumber> winding;
+  /// Open meshes: the winding number field of the mesh in its own space.
+  MeshWinding winding;
 
   bool closed() const { return kind == MeshKind::Closed; }
   /// A sheet (MeshKind::Sheet).
@@ -128,6 +149,10 @@ struct VoxelizeOptions {
   float slab_thickness = 0.0f;    ///< World units behind open faces; 0 = two voxels. >= 0. The cone
                                   ///< method uses R_max: under an open ground a cone then meets
                                   ///< solid as deep as it can look, as under a closed floor.
+  /// World box the grid is traced in (empty: everywhere). Faces given slabs (sheets, a solid with
+  /// holes seen from inside) whose slab cannot reach into it are left out: slabs are a union of
+  /// one per face. Closed meshes and fans are always whole (parity needs them whole).
+  Bounds3 slab_region;
 
   /// Throws InputError naming the bad field.
   void validate() const;

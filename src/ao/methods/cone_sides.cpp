@@ -21,9 +21,10 @@ namespace {
 // the part of the sheet nearest to the point decides. Inside a solid with holes (w near 1/2 in
 // the mouth of a hole) the point is taken as outside.
 constexpr double kUndecided = 0.01;
-// Lattice (SideSetup::Open::lattice): points R_max / 2 apart, at most 24 cells per axis; corners
-// whose w is within 0.05 of the threshold leave the decision to the point itself.
-constexpr int kLatticeCells = 24;
+// Lattice (SideSetup::Open::lattice): points R_max / 2 apart (farther apart for a lattice of more
+// than 2^15 points); corners whose w is within 0.05 of the threshold leave the decision to the
+// point itself.
+constexpr double kLatticePoints = 32768;
 constexpr float kLatticeMargin = 0.05f;
 
 Bounds3 object_bounds(const Scene& scene, const SceneObject& ob) {
@@ -39,6 +40,13 @@ bool contains(const Bounds3& b, Vec3 p) {
   return p.x >= b.lo.x && p.x <= b.hi.x && p.y >= b.lo.y && p.y <= b.hi.y && p.z >= b.lo.z && p.z <= b.hi.z;
 }
 
+// The side of the nearest triangle of sheet `o` (0 in its plane).
+int nearest_side(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
+  ++evaluations;
+  const double d = o.sign * o.closure->winding.get().signed_distance(o.instanced ? o.to_object.point(world) : world);
+  return d > 0 ? 1 : d < 0 ? -1 : 0;
+}
+
 // +1 behind open object `o` (sign x w > threshold), -1 in front, 0 on it. Counts evaluations of w.
 int side_of(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
   const Vec3 p = o.instanced ? o.to_object.point(world) : world;
@@ -49,25 +57,40 @@ int side_of(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
     return d == 0 ? 0 : (o.sign * -d > 0 ? 1 : -1);
   }
   ++evaluations;
-  const double v = o.sign * (*c.winding)(p) - o.threshold;
+  const double v = o.sign * c.winding.get()(p) - o.threshold;
   if (std::abs(v) >= kUndecided) return v > 0 ? 1 : -1;
-  if (c.holed()) return -1;
-  const double d = o.sign * c.winding->signed_distance(p);
-  return d == 0 ? 0 : (d > 0 ? 1 : -1);
+  return c.holed() ? -1 : nearest_side(o, world, evaluations);
 }
 
-// The side of `o` that its lattice gives for p: +1 / -1 when the corners of p's cell agree, else 0.
-int lattice_side(const SideSetup::Open& o, Vec3 p) {
+// The side of `o` that its lattice gives for p: +1 / -1 when the corners of p's cell agree, else 0;
+// `crossed` when they do not agree but all lie at least 0.25 from the threshold: the mesh itself
+// passes through the cell, not the surface beyond its rim where w meets the threshold smoothly.
+int lattice_side(const SideSetup::Open& o, Vec3 p, bool& crossed) {
+  crossed = false;
   if (o.lattice.empty()) return 0;
   const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
   const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
             z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
-  int behind = 0, front = 0;
+  int behind = 0, front = 0, strong = 0;
   for (int k = 0; k < 8; ++k) {
     const float v = o.lattice[(static_cast<std::size_t>(z + (k >> 2)) * o.ly + y + ((k >> 1) & 1)) * o.lx + x + (k & 1)];
-    behind += v >= kLatticeMargin, front += v <= -kLatticeMargin;
+    behind += v >= kLatticeMargin, front += v <= -kLatticeMargin, strong += std::abs(v) >= 0.25f;
   }
+  crossed = strong == 8;
   return behind == 8 ? 1 : front == 8 ? -1 : 0;
+}
+
+// How far along its normal a surface point must go to be clear of its own surface's voxels: 1.5
+// voxels, as the kernel's near limit (cone.cpp, cone_world.cpp).
+float clearance(const VoxelGrid& g, Vec3 p) {
+  if (g.space == GridSpace::World) return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z});
+  const Vec3 c = g.camera.world_to_camera_point(p);
+  const float depth = std::max(-c.z, 0.0f);
+  const Vec2 pix = g.camera.project(c);
+  const int i = std::clamp(static_cast<int>(pix.x / g.pixels_per_column_x), 0, g.nx - 1);
+  const int j = std::clamp(static_cast<int>(pix.y / g.pixels_per_column_y), 0, g.ny - 1);
+  const float width = 2.0f * g.camera.tan_half_fov() * depth / static_cast<float>(g.ny);
+  return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
 }
 
 // The voxel of `g` at world point p (false outside the grid).
@@ -123,7 +146,15 @@ SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closu
     o.reach.hi += Vec3{pad, pad, pad};
     o.sign = det_sign * (c.holed() ? c.orientation : 1);
     o.threshold = c.holed() ? 0.5 : 0.0;
-    s.open.push_back(o);
+    const Mesh& m = scene.meshes[objects[oi].mesh];
+    o.face.resize(m.triangle_count());
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      Vec3 v[3] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+      if (o.instanced)
+        for (Vec3& vk : v) vk = scene.instances[objects[oi].instance].object_to_world.point(vk);
+      o.face[t] = cross(v[1] - v[0], v[2] - v[0]);
+    }
+    s.open.push_back(std::move(o));
   }
   // Votes: an object entirely on one side of a flat sheet (its box's corners) takes that side;
   // any other object within reach is tested per pixel (its vertices are too sparse a sample: a
@@ -153,7 +184,8 @@ SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closu
     if (!mixed[q]) continue;
     SideSetup::Open& o = s.open[q];
     const Vec3 e = o.reach.extent();
-    o.lattice_step = std::max(0.5f * r_max, std::max({e.x, e.y, e.z}) / kLatticeCells);
+    const double cells = (double(e.x) / (0.5 * r_max) + 1) * (double(e.y) / (0.5 * r_max) + 1) * (double(e.z) / (0.5 * r_max) + 1);
+    o.lattice_step = 0.5f * r_max * static_cast<float>(std::max(1.0, std::cbrt(cells / kLatticePoints)));
     o.lattice_lo = o.reach.lo;
     o.lx = static_cast<int>(std::ceil(e.x / o.lattice_step)) + 1;
     o.ly = static_cast<int>(std::ceil(e.y / o.lattice_step)) + 1;
@@ -164,7 +196,7 @@ SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closu
         for (int x = 0; x < o.lx; ++x) {
           const Vec3 p = o.lattice_lo + Vec3{float(x), float(y), float(z)} * o.lattice_step;
           o.lattice[(static_cast<std::size_t>(z) * o.ly + y) * o.lx + x] =
-              static_cast<float>(o.sign * (*o.closure->winding)(o.instanced ? o.to_object.point(p) : p) - o.threshold);
+              static_cast<float>(o.sign * o.closure->winding.get()(o.instanced ? o.to_object.point(p) : p) - o.threshold);
         }
     });
     s.evaluations += o.lattice.size();
@@ -186,6 +218,11 @@ PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& s
   // triangle is not known (a G-buffer built by hand): 1e-3 R_max, far below any feature the grid
   // resolves and far above the float error of the position.
   const float offset = 1e-3f * setup.r_max;
+
+  std::vector<std::uint8_t> camera_behind(setup.open.size(), 0);
+  std::size_t unused = 0;
+  for (std::size_t q = 0; q < setup.open.size(); ++q)
+    camera_behind[q] = setup.open[q].closure->flat && side_of(setup.open[q], eye, unused) > 0;
   // Rows in parallel; each pixel's back flags (open objects, in `open` order) go to its row's list.
   struct Flagged {
     std::size_t pixel;
@@ -206,14 +243,12 @@ PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& s
       if (own >= 0) {
         const SideSetup::Open& o = setup.open[own];
         bool behind;
-        if (!gb.primitive_id.empty()) {
+        if (o.closure->flat) {
+          // A flat sheet is seen from the camera's side of its plane, at every pixel.
+          behind = camera_behind[own];
+        } else if (!gb.primitive_id.empty() && gb.primitive_id(x, y) < o.face.size()) {
           // The side of its own triangle the camera sees (world winding, mirrors included).
-          const Mesh& m = scene.meshes[objects[a].mesh];
-          const std::uint32_t* t = m.indices.data() + 3 * static_cast<std::size_t>(gb.primitive_id(x, y));
-          Vec3 v[3] = {m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]};
-          if (o.instanced)
-            for (Vec3& vk : v) vk = scene.instances[objects[a].instance].object_to_world.point(vk);
-          const bool sees_back = dot(cross(v[1] - v[0], v[2] - v[0]), n) < 0;
+          const bool sees_back = dot(o.face[gb.primitive_id(x, y)], n) < 0;
           // A sheet's back is its triangles' back; a solid's inside is its outside's back.
           // (o.sign < 0: the world fronts of the solid face in, mirrors and orientation included.)
           behind = o.closure->holed() ? sees_back != (o.sign < 0) : sees_back;
@@ -226,12 +261,21 @@ PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& s
         const SideSetup::Open& o = setup.open[q];
         bool behind = vote == SideSetup::Back;
         if (vote == SideSetup::Mixed && contains(o.reach, p)) {
-          // Inside a solid with holes is inside its winding-number solid, which the all-front grid
-          // holds: only points whose front is solid there need w.
-          if (!o.closure->holed() || solid_at(front, p + n * offset)) {
-            const int coarse = lattice_side(o, p);
-            behind = coarse != 0 ? coarse > 0 : side_of(o, p, evaluations[y]) > 0;
+          bool crossed;
+          int side = lattice_side(o, p, crossed);
+          // Where the lattice cannot tell, the point lies within a cell's diagonal of the mesh or
+          // of where w crosses its threshold. With cells R_max / 2 wide that is within 0.87 R_max:
+          // inside a solid with holes, or behind a sheet that crosses its cell, its front is solid
+          // in the all-front grid (the solid holds its inside; the sheet's slab is R_max thick),
+          // so only such points need w. Elsewhere (beside a sheet's rim, under a hole in it) the
+          // side of the sheet's nearest triangle decides: the side of the part of it that the
+          // point's cones reach, the same whichever way its triangles face.
+          if (side == 0) {
+            const bool pretest = o.lattice_step * 1.7320508f < setup.r_max && (o.closure->holed() || crossed);
+            if (pretest && !solid_at(front, p + n * clearance(front, p))) side = -1;
+            else side = o.closure->holed() ? side_of(o, p, evaluations[y]) : nearest_side(o, p, evaluations[y]);
           }
+          behind = side > 0;
         }
         if (behind) back.push_back(q);
       }

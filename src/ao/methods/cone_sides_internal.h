@@ -40,6 +40,7 @@ struct SideSetup {
     int sign = 1;              // world w = sign x mesh w (mirror instances), times the orientation for solids
     double threshold = 0;      // behind: sign x w > threshold (0 for sheets, 1/2 for solids with holes)
     const MeshClosure* closure = nullptr;
+    std::vector<Vec3> face;    // per triangle: its world normal (counter-clockwise, not unit)
     // A coarse lattice of sign x w - threshold over `reach` (non-flat meshes other objects vote
     // Mixed on): a point whose cell's 8 corners all lie on one side by kLatticeMargin takes that
     // side without an evaluation of w (w is harmonic off the mesh: it jumps only across the mesh,

@@ -288,7 +288,9 @@ struct ColumnHit {
 // fragment of an open mesh ORs the voxels within `slab` (world units) behind it; a prism's fragment
 // is listed in `hits` with the side it crosses to (prisms face out: the sign of the triangle's
 // area in grid space). Returns fragments.
-template <bool kPerspective>
+// kListed: the triangle's fragments are listed (fill 2 or >= 3), a separate instantiation so that
+// the plain parity loop carries no test for it.
+template <bool kPerspective, bool kListed>
 std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab, std::vector<ColumnHit>& hits) {
   const double x0 = t.x[0], y0 = t.y[0];
   const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
@@ -335,12 +337,14 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
       if (first >= nbits) continue;
       const int b = first <= 0 ? 0 : static_cast<int>(first);
       ++fragments;
-      if (t.fill == 2) {
-        hits.push_back({i, j, b, area2 > 0 ? 1 : -1});
-        continue;
+      if constexpr (kListed) {
+        if (t.fill == 2) {
+          hits.push_back({i, j, b, area2 > 0 ? 1 : -1});
+          continue;
+        }
+        hits.push_back({i, j, b, t.fill - 3});
       }
       row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
-      if (t.fill >= 3) hits.push_back({i, j, b, t.fill - 3});
     }
   }
   return fragments;
@@ -671,7 +675,9 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
       for (std::size_t c = 0; c < chunks; ++c)
         for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
           const GridTri& t = tris[c][buckets[c].index[q]];
-          f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), g, slab_thickness, hits[b]);
+          const int lo = std::max(r0, t.j0), hi = std::min(r1, t.j1);
+          f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits[b])
+                                          : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits[b]);
         }
       fragments[b] += f;
     });

@@ -276,22 +276,35 @@ inline void set_bits(std::uint64_t* col, int nbits, int b0, int b1) {
   }
 }
 
-// A fragment listed rather than toggled: column (i, j), the first voxel beyond it, and a tag (the
-// slot of the solid with holes for a fan's fragment; +-1 as the prism is entered or left for a
-// prism's).
+// A fragment listed rather than toggled: column (i, j), the first voxel beyond it, and the slot of
+// the solid with holes whose fan (or triangle near a hole) it belongs to.
 struct ColumnHit {
   int i, j, k, tag;
+};
+
+// One band of rows' prism faces: per voxel of its columns, how many prisms are entered there minus
+// how many are left (prisms face out, so a face's side is the sign of its area in grid space);
+// a column is zeroed when first crossed.
+struct PrismCounts {
+  int r0 = 0, nx = 0, nbits = 0;
+  std::unique_ptr<std::int16_t[]> delta;  // (j - r0, i, k)
+  std::vector<std::uint8_t> touched;      // (j - r0, i)
+  void add(int i, int j, int k, int sign) {
+    const std::size_t c = static_cast<std::size_t>(j - r0) * nx + i;
+    std::int16_t* d = delta.get() + c * nbits;
+    if (!touched[c]) touched[c] = 1, std::fill_n(d, nbits, std::int16_t{0});
+    d[k] = static_cast<std::int16_t>(d[k] + sign);
+  }
 };
 
 // Rasterises one triangle's rows [r0, r1]. A parity fragment toggles one bit (XOR to the end after
 // the scan), and is listed in `hits` when it belongs to a fan over a hole that is not flat; a slab
 // fragment of an open mesh ORs the voxels within `slab` (world units) behind it; a prism's fragment
-// is listed in `hits` with the side it crosses to (prisms face out: the sign of the triangle's
-// area in grid space). Returns fragments.
+// is counted in `prisms`. Returns fragments.
 // kListed: the triangle's fragments are listed (fill 2 or >= 3), a separate instantiation so that
 // the plain parity loop carries no test for it.
 template <bool kPerspective, bool kListed>
-std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab, std::vector<ColumnHit>& hits) {
+std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab, std::vector<ColumnHit>& hits, PrismCounts* prisms) {
   const double x0 = t.x[0], y0 = t.y[0];
   const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
   if (area2 == 0) return 0;  // edge-on: no column centre lies inside
@@ -339,7 +352,7 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
       ++fragments;
       if constexpr (kListed) {
         if (t.fill == 2) {
-          hits.push_back({i, j, b, area2 > 0 ? 1 : -1});
+          prisms->add(i, j, b, area2 > 0 ? 1 : -1);
           continue;
         }
         hits.push_back({i, j, b, t.fill - 3});
@@ -666,20 +679,41 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // 2. Raster bands of rows; parity fragments first, then (after the scan) open-mesh slabs,
   // which are ORed: a union, so overlapping slabs of neighbouring open triangles do not cancel.
   std::vector<std::size_t> fragments(bands, 0);
-  std::vector<std::vector<ColumnHit>> hits(bands);  // fans' fragments (pass 0), then prisms' (pass 2)
-  const auto raster_pass = [&](int fill_kind) {      // 0 parity, 1 spans, 2 prisms
+  std::vector<std::vector<ColumnHit>> hits(bands);  // fans' fragments (pass 0)
+  // Pass 0: parity; 1: spans; 2: prisms, counted per band and then turned into voxels.
+  const auto raster_pass = [&](int fill_kind) {
     tbb::parallel_for(0, bands, [&](int b) {
       const int r0 = band_first_row(b), r1 = band_first_row(b + 1) - 1;
       const std::size_t k = static_cast<std::size_t>(fill_kind) * bands + b;
+      bool any = false;
+      for (std::size_t c = 0; c < chunks && !any; ++c) any = buckets[c].start[k] < buckets[c].start[k + 1];
+      if (!any) return;
+      PrismCounts counts;
+      if (fill_kind == 2) {
+        const std::size_t columns = static_cast<std::size_t>(r1 - r0 + 1) * g.nx;
+        counts = {r0, g.nx, g.depth_bits, std::unique_ptr<std::int16_t[]>(new std::int16_t[columns * g.depth_bits]),
+                  std::vector<std::uint8_t>(columns, 0)};
+      }
       std::size_t f = 0;
       for (std::size_t c = 0; c < chunks; ++c)
         for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
           const GridTri& t = tris[c][buckets[c].index[q]];
           const int lo = std::max(r0, t.j0), hi = std::min(r1, t.j1);
-          f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits[b])
-                                          : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits[b]);
+          f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits[b], &counts)
+                                          : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits[b], nullptr);
         }
       fragments[b] += f;
+      // The union of the prisms: the voxels where the running count is not 0.
+      for (std::size_t c = 0; c < counts.touched.size(); ++c) {
+        if (!counts.touched[c]) continue;
+        const std::int16_t* d = counts.delta.get() + c * g.depth_bits;
+        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(r0) * g.nx + c) * g.words;
+        int count = 0;
+        for (int v = 0; v < g.depth_bits; ++v) {
+          count += d[v];
+          if (count != 0) col[v >> 6] |= std::uint64_t{1} << (v & 63);
+        }
+      }
     });
   };
   raster_pass(0);
@@ -752,32 +786,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // where walls meet, and parity would cancel them there).
   if (any_slab(treat)) {
     raster_pass(1);
-    for (auto& h : hits) h.clear();
     raster_pass(2);
-    tbb::parallel_for(0, bands, [&](int b) {
-      // The band's prism fragments by column (a counting sort), each column's by depth.
-      const std::vector<ColumnHit>& list = hits[b];
-      if (list.empty()) return;
-      const int r0 = band_first_row(b);
-      const std::size_t columns = static_cast<std::size_t>(band_first_row(b + 1) - r0) * g.nx;
-      std::vector<std::uint32_t> start(columns + 1, 0);
-      for (const ColumnHit& h : list) ++start[static_cast<std::size_t>(h.j - r0) * g.nx + h.i + 1];
-      for (std::size_t c = 0; c < columns; ++c) start[c + 1] += start[c];
-      std::vector<std::pair<int, int>> sorted(list.size());  // (k, +-1)
-      std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
-      for (const ColumnHit& h : list) sorted[next[static_cast<std::size_t>(h.j - r0) * g.nx + h.i]++] = {h.k, h.tag};
-      for (std::size_t c = 0; c < columns; ++c) {
-        if (start[c] == start[c + 1]) continue;
-        const auto begin = sorted.begin() + start[c], end = sorted.begin() + start[c + 1];
-        std::sort(begin, end);
-        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(r0) * g.nx + c) * g.words;
-        int count = 0;
-        for (auto e = begin; e != end; ++e) {
-          count += e->second;
-          if (count != 0) set_bits(col, g.depth_bits, e->first, e + 1 != end ? (e + 1)->first : g.depth_bits);
-        }
-      }
-    });
   }
   const std::size_t set_voxels = build_coarse(g);  // also counts the solid voxels
   if (stats) {

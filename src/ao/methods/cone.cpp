@@ -173,7 +173,8 @@ const ParamTable<ConeParams>& cone_param_table() {
                                      "cone cells of equal cosine-weighted measure or of equal solid angle"),
        P::enumeration<OpenMeshes>("open_meshes", &ConeParams::open_meshes,
                                   {{"winding", OpenMeshes::Winding}, {"slab", OpenMeshes::Slab}, {"parity", OpenMeshes::Parity}},
-                                  "open meshes: the generalized-winding-number solid, slabs behind their front faces, or parity as the paper"),
+                                  "open meshes by their winding number: solids with holes where w > 1/2, sheets as slabs on their far side from each point; "
+                                  "slab: sheets as slabs behind their fronts; parity: as they are (the paper)"),
        P::real("slab_fraction", &ConeParams::slab_fraction, Range::open_closed(0, 16), "R_max", "thickness of the slab behind open meshes"),
        P::boolean("jitter", &ConeParams::jitter, "per pixel: random cone axes in their cells, sphere-chain scale, prism turn (noise instead of rings)"),
        P::integer("filter_taps", &ConeParams::filter_taps, Range::closed(1, 63), "", "taps per pass of the cross-bilateral filter on V, odd; 1 = no filter")}};

@@ -53,7 +53,7 @@ struct ConeParams {
   int columns = 512;         ///< Grid columns per side (world) or along the longer image side (eye). [8, 4096].
   GridSpace grid = GridSpace::World;               ///< "world" (default) or the paper's "eye".
   ConeWeighting weighting = ConeWeighting::Cosine; ///< "cosine" (default) or "uniform".
-  OpenMeshes open_meshes = OpenMeshes::Winding;    ///< "winding" (default), "slab" or "parity" (the paper); voxelize.h.
+  OpenMeshes open_meshes = OpenMeshes::Winding;    ///< "winding" (default: by what each mesh is), "slab" or "parity" (the paper); voxelize.h.
   float slab_fraction = 1.0f;  ///< Thickness of the slab behind open meshes, as a fraction of R_max. (0, 16].
   bool jitter = true;        ///< Per pixel: each cone's axis at a random point of its cell, a random scale of its
                              ///< sphere chain, a random turn of the prism pattern (noise instead of rings). false: the paper's fixed pattern.

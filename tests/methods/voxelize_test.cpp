@@ -371,6 +371,10 @@ TEST(Voxelize, RejectsBadOptions) {
   VoxelizeOptions o;
   o.columns = 4;
   EXPECT_THROW(voxelize_world(s, closure, o), InputError);
+  // Back-side flags are one per object of the scene.
+  const std::vector<std::uint8_t> two_flags{0, 1};
+  EXPECT_THROW(voxelize_world(s, closure, VoxelizeOptions{}, nullptr, two_flags), InputError);
+  EXPECT_THROW(voxelize_world(s, std::span<const MeshClosure>(), VoxelizeOptions{}), InputError);
 }
 
 }  // namespace

@@ -85,7 +85,8 @@ int lattice_side(const SideSetup::Open& o, Vec3 p, bool& crossed) {
 float clearance(const VoxelGrid& g, Vec3 p) {
   if (g.space == GridSpace::World) return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z});
   const Vec3 c = g.camera.world_to_camera_point(p);
-  const float depth = std::max(-c.z, 0.0f);
+  const float depth = -c.z;
+  if (!(depth > 0)) return 0.0f;  // not in front of the camera: not a pixel's point
   const Vec2 pix = g.camera.project(c);
   const int i = std::clamp(static_cast<int>(pix.x / g.pixels_per_column_x), 0, g.nx - 1);
   const int j = std::clamp(static_cast<int>(pix.y / g.pixels_per_column_y), 0, g.ny - 1);
@@ -187,9 +188,10 @@ SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closu
     const double cells = (double(e.x) / (0.5 * r_max) + 1) * (double(e.y) / (0.5 * r_max) + 1) * (double(e.z) / (0.5 * r_max) + 1);
     o.lattice_step = 0.5f * r_max * static_cast<float>(std::max(1.0, std::cbrt(cells / kLatticePoints)));
     o.lattice_lo = o.reach.lo;
-    o.lx = static_cast<int>(std::ceil(e.x / o.lattice_step)) + 1;
-    o.ly = static_cast<int>(std::ceil(e.y / o.lattice_step)) + 1;
-    o.lz = static_cast<int>(std::ceil(e.z / o.lattice_step)) + 1;
+    // At least one cell along each axis (a box flat along one).
+    o.lx = std::max(2, static_cast<int>(std::ceil(e.x / o.lattice_step)) + 1);
+    o.ly = std::max(2, static_cast<int>(std::ceil(e.y / o.lattice_step)) + 1);
+    o.lz = std::max(2, static_cast<int>(std::ceil(e.z / o.lattice_step)) + 1);
     o.lattice.resize(static_cast<std::size_t>(o.lx) * o.ly * o.lz);
     tbb::parallel_for(0, o.lz, [&](int z) {
       for (int y = 0; y < o.ly; ++y)

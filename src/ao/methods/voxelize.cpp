@@ -569,6 +569,255 @@ ObjectSpace object_space(const Scene& scene, const SceneObject& ob) {
   return {true, inverse(m), m.determinant() < 0 ? -1 : 1};
 }
 
+// Row bands of the raster stage (kBands, fewer for a short grid) and the band of each row.
+struct Bands {
+  int ny = 0, count = 0;
+  std::vector<int> of;  // per row
+  int first_row(int b) const { return static_cast<int>(static_cast<long long>(ny) * b / count); }
+};
+Bands make_bands(int ny) {
+  Bands b{ny, std::min(ny, kBands), std::vector<int>(ny)};
+  for (int k = 0; k < b.count; ++k)
+    for (int j = b.first_row(k); j < b.first_row(k + 1); ++j) b.of[j] = k;
+  return b;
+}
+
+// A chunk's triangles bucketed by (fill kind, row band), a counting sort: bucket
+// kind * bands + band is index[start[k], start[k + 1]); a triangle spanning bands is in each.
+struct Buckets {
+  std::vector<std::uint32_t> start, index;
+};
+// Fill kinds: 0 parity (fans included), 1 slab spans, 2 prisms (GridTri::fill).
+int kind_of(const GridTri& t) { return t.fill == 0 || t.fill >= 3 ? 0 : t.fill == 2 ? 2 : 1; }
+Buckets bucket(const std::vector<GridTri>& tris, const Bands& bands) {
+  Buckets bk;
+  bk.start.assign(3 * static_cast<std::size_t>(bands.count) + 1, 0);
+  for (const GridTri& t : tris)
+    for (int b = bands.of[t.j0]; b <= bands.of[t.j1]; ++b) ++bk.start[kind_of(t) * bands.count + b + 1];
+  for (std::size_t k = 1; k < bk.start.size(); ++k) bk.start[k] += bk.start[k - 1];
+  bk.index.resize(bk.start.back());
+  std::vector<std::uint32_t> pos(bk.start.begin(), bk.start.end() - 1);
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    for (int b = bands.of[tris[i].j0]; b <= bands.of[tris[i].j1]; ++b) bk.index[pos[kind_of(tris[i]) * bands.count + b]++] = static_cast<std::uint32_t>(i);
+  return bk;
+}
+
+// The triangles voxelize_into maps: those of every object (Scene::objects(): a world-space mesh,
+// or an instance whose mesh's triangles go through its transform), and for a solid with holes
+// (Treat::Fans) one fan triangle per boundary edge after its own triangles: (b, a, centroid) for
+// the boundary edge a -> b, so that every edge of the mesh and its fans is used twice and the
+// parity pass sees a closed surface. Closure and hole centroids are per mesh, as an affine map
+// keeps both (it maps centroids to centroids).
+struct ObjectPlan {
+  std::vector<SceneObject> objects;
+  std::vector<Holes> holes;              // per mesh of a solid with holes
+  std::vector<int> slot_of;              // per object with a hole that is not flat: its slot, else -1
+  std::vector<std::size_t> slot_object;  // per slot: the object
+  std::vector<std::size_t> first{0};     // object o's triangles are [first[o], first[o + 1])
+  std::size_t fanned = 0;                // objects voxelized as solids with holes
+};
+ObjectPlan plan_objects(const Scene& scene, std::span<const MeshClosure> closure, std::span<const Treat> treat, float voxel) {
+  ObjectPlan p;
+  p.objects = scene.objects();
+  p.holes.resize(scene.meshes.size());
+  p.slot_of.assign(p.objects.size(), -1);
+  std::vector<std::uint8_t> hole_info(scene.meshes.size(), 0);
+  for (std::size_t oi = 0; oi < p.objects.size(); ++oi) {
+    const std::size_t mi = p.objects[oi].mesh;
+    const bool fans = treat[oi] == Treat::Fans;
+    if (fans && !hole_info[mi]) {
+      // Two voxels, in the mesh's own units (an instance's scale divides them).
+      const float scale = p.objects[oi].instance == SceneObject::kNoInstance
+                              ? 1.0f
+                              : static_cast<float>(std::cbrt(std::abs(scene.instances[p.objects[oi].instance].object_to_world.determinant())));
+      p.holes[mi] = hole_centroids(scene.meshes[mi], closure[mi], 2.0f * voxel / scale), hole_info[mi] = 1;
+    }
+    if (fans && std::find(p.holes[mi].flat.begin(), p.holes[mi].flat.end(), 0) != p.holes[mi].flat.end()) {
+      p.slot_of[oi] = static_cast<int>(p.slot_object.size());
+      p.slot_object.push_back(oi);
+    }
+    p.fanned += fans ? 1 : 0;
+    p.first.push_back(p.first.back() + scene.meshes[mi].triangle_count() + (fans ? closure[mi].boundary.size() : 0));
+  }
+  return p;
+}
+
+// Triangle `local` of object `oi` (ObjectPlan) in world space, its slab's side for
+// Treat::SlabFlipped; false for a face given a slab that cannot reach `region` (VoxelizeOptions).
+bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan, std::span<const Treat> treat, std::size_t oi,
+                     std::size_t local, const Bounds3& region, float slab_thickness, Tri3& tri) {
+  const std::size_t mi = plan.objects[oi].mesh;
+  const Affine3* tf = plan.objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[plan.objects[oi].instance].object_to_world;
+  const bool open = treat[oi] == Treat::Slab || treat[oi] == Treat::SlabFlipped;
+  const Mesh& m = scene.meshes[mi];
+  if (local < m.triangle_count()) {
+    tri = source_triangle(m, local, open);
+    if (open && !region.empty()) {
+      Bounds3 reach;  // the triangle and its slab
+      for (const Vec3& v : tri.v) reach.extend(tf ? tf->point(v) : v);
+      reach.lo -= Vec3{slab_thickness, slab_thickness, slab_thickness};
+      reach.hi += Vec3{slab_thickness, slab_thickness, slab_thickness};
+      if (reach.hi.x < region.lo.x || reach.lo.x > region.hi.x || reach.hi.y < region.lo.y || reach.lo.y > region.hi.y || reach.hi.z < region.lo.z ||
+          reach.lo.z > region.hi.z)
+        return false;
+    }
+    if (plan.slot_of[oi] >= 0 && plan.holes[mi].near[local]) tri.fan = plan.slot_of[oi];
+  } else {
+    const std::size_t e = local - m.triangle_count();
+    const auto [a, b] = closure[mi].boundary[e];
+    const std::uint32_t h = closure[mi].hole[e];
+    tri = Tri3{{m.positions[b], m.positions[a], plan.holes[mi].centre[h]}, 0, {}, plan.holes[mi].flat[h] ? -1 : plan.slot_of[oi]};
+  }
+  if (tf) {
+    for (Vec3& v : tri.v) v = tf->point(v);
+    if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+  }
+  if (treat[oi] == Treat::SlabFlipped) tri.normal = -tri.normal;
+  return true;
+}
+
+// The union of one band's prisms (PrismCounts): the voxels where the running count is not 0.
+void unite_prisms(VoxelGrid& g, const PrismCounts& counts) {
+  for (std::size_t c = 0; c < counts.touched.size(); ++c) {
+    if (!counts.touched[c]) continue;
+    const std::int16_t* d = counts.delta.get() + c * g.depth_bits;
+    std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(counts.r0) * g.nx + c) * g.words;
+    int count = 0;
+    for (int v = 0; v < g.depth_bits; ++v) {
+      count += d[v];
+      if (count != 0) col[v >> 6] |= std::uint64_t{1} << (v & 63);
+    }
+  }
+}
+
+// Rasterises band b's triangles of one fill kind (Buckets; 0: parity, 1: spans, 2: prisms, counted
+// and then turned into voxels), listing the fans' fragments in `hits`. Returns fragments.
+template <bool kPerspective>
+std::size_t raster_band(VoxelGrid& g, const Bands& bands, int b, int fill_kind, const std::vector<std::vector<GridTri>>& tris,
+                        const std::vector<Buckets>& buckets, float slab_thickness, std::vector<ColumnHit>& hits) {
+  const int r0 = bands.first_row(b), r1 = bands.first_row(b + 1) - 1;
+  const std::size_t k = static_cast<std::size_t>(fill_kind) * bands.count + b;
+  bool any = false;
+  for (std::size_t c = 0; c < buckets.size() && !any; ++c) any = buckets[c].start[k] < buckets[c].start[k + 1];
+  if (!any) return 0;
+  PrismCounts counts;
+  if (fill_kind == 2) {
+    const std::size_t columns = static_cast<std::size_t>(r1 - r0 + 1) * g.nx;
+    counts = {r0, g.nx, g.depth_bits, std::unique_ptr<std::int16_t[]>(new std::int16_t[columns * g.depth_bits]), std::vector<std::uint8_t>(columns, 0)};
+  }
+  std::size_t f = 0;
+  for (std::size_t c = 0; c < buckets.size(); ++c)
+    for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
+      const GridTri& t = tris[c][buckets[c].index[q]];
+      const int lo = std::max(r0, t.j0), hi = std::min(r1, t.j1);
+      f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits, &counts)
+                                      : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits, nullptr);
+    }
+  unite_prisms(g, counts);
+  return f;
+}
+
+// Per slot of a solid with holes (ObjectPlan): object space, sigma (orientation, mirrors
+// included) and the winding number of its fans alone (w_C needs no triangle near the point but
+// the fans' own, unlike w of the mesh).
+struct SlotWinding {
+  std::vector<ObjectSpace> space;
+  std::vector<int> sign;
+  std::vector<FanWinding> fans;
+};
+SlotWinding slot_winding(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan) {
+  SlotWinding s;
+  for (std::size_t oi : plan.slot_object) {
+    const std::size_t mi = plan.objects[oi].mesh;
+    s.space.push_back(object_space(scene, plan.objects[oi]));
+    s.sign.push_back(closure[mi].orientation * s.space.back().sign);
+    s.fans.push_back(fan_winding(scene.meshes[mi], closure[mi], plan.holes[mi]));
+  }
+  return s;
+}
+
+// Voxels where w was evaluated, and of those, where it changed the parity's answer; and one
+// band's scratch space.
+struct WalkCount {
+  std::size_t evaluated = 0, changed = 0;
+};
+struct WalkScratch {
+  std::vector<std::uint64_t> chi, seen;
+  std::vector<Vec3> r;
+  std::vector<float> len;
+};
+
+// Walks the column of list[q] from each of its fragments of the same slot (sorted together),
+// both ways, setting each voxel to [sigma w(centre) > 1/2] until that agrees with parity (see
+// winding_solid). chi is the column as parity left it, so each voxel is decided once however many
+// walks reach it. Returns the index past those fragments.
+template <class Centre>
+std::size_t walk_column(VoxelGrid& g, const std::vector<ColumnHit>& list, std::size_t q, const SlotWinding& sw, Centre& voxel_centre, WalkScratch& sc,
+                        WalkCount& n) {
+  std::vector<std::uint64_t>& chi = sc.chi;
+  std::vector<std::uint64_t>& seen = sc.seen;
+  const ColumnHit& at = list[q];
+  std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(at.j) * g.nx + at.i) * g.words;
+  chi.assign(col, col + g.words);
+  seen.assign(g.words, 0);
+  const int s = at.tag;
+  for (; q < list.size() && list[q].i == at.i && list[q].j == at.j && list[q].tag == s; ++q)
+    for (int dir : {1, -1})
+      for (int k = dir > 0 ? list[q].k : list[q].k - 1; k >= 0 && k < g.depth_bits; k += dir) {
+        const std::uint64_t bit = std::uint64_t{1} << (k & 63);
+        const bool parity = (chi[k >> 6] & bit) != 0;
+        bool solid;
+        if (seen[k >> 6] & bit) {
+          solid = (col[k >> 6] & bit) != 0;
+        } else {
+          // w = chi - w_C: solid where sigma w = chi - sigma w_C > 1/2.
+          solid = (parity ? 1.0 : 0.0) - sw.sign[s] * sw.fans[s](sw.space[s](voxel_centre(at.i, at.j, k)), sc.r, sc.len) > 0.5;
+          seen[k >> 6] |= bit;
+          ++n.evaluated;
+          if (solid != parity) col[k >> 6] ^= bit, ++n.changed;
+        }
+        if (solid == parity) break;
+      }
+  return q;
+}
+
+// The winding-number solid near holes that are not flat. Parity with the fans is the solid chi
+// of the mesh plus its fans C; the mesh's own winding number is w = chi - w_C (w is a sum over
+// triangles; sigma w with sigma the orientation, voxelize.h), and the solid is w > 1/2. The two
+// differ only where |w_C| >= 1/2, which is next to a fan that is not flat: in the pocket between
+// the fan and the surface w = 1/2 that spans the hole, which the mesh itself can also cut near
+// the hole's rim. Along a column the pocket is entered through the fan or through the mesh near
+// the hole (it is bounded by them and that surface), so from each such fragment (`hits`, per
+// band) we walk the column both ways and stop at the first voxel where w agrees with parity: the
+// pocket's end. (A column that crossed the spanning surface twice and neither the fan nor the
+// mesh would be missed.)
+template <class Centre>
+WalkCount winding_solid(VoxelGrid& g, std::vector<std::vector<ColumnHit>>& hits, const SlotWinding& sw, Centre& voxel_centre) {
+  std::vector<WalkCount> in(hits.size());
+  tbb::parallel_for(0, static_cast<int>(hits.size()), [&](int b) {
+    std::vector<ColumnHit>& list = hits[b];
+    std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.tag, x.k) < std::tie(y.j, y.i, y.tag, y.k); });
+    WalkScratch scratch;
+    for (std::size_t q = 0; q < list.size();) q = walk_column(g, list, q, sw, voxel_centre, scratch, in[b]);
+  });
+  WalkCount n;
+  for (const WalkCount& w : in) n.evaluated += w.evaluated, n.changed += w.changed;
+  return n;
+}
+
+VoxelStats grid_stats(const std::vector<std::vector<GridTri>>& tris, std::span<const std::size_t> fragments, std::span<const MeshClosure> closure) {
+  VoxelStats s;
+  for (const auto& chunk : tris) s.triangles += chunk.size();
+  for (std::size_t f : fragments) s.fragments += f;
+  for (const MeshClosure& c : closure) {
+    s.open_meshes += c.open_surface() ? 1 : 0;
+    s.holed_meshes += c.holed() ? 1 : 0;
+    s.holes += c.holed() ? c.holes : 0;
+    s.boundary_edges += c.boundary_edges;
+  }
+  return s;
+}
+
 // Stages 1-4 for any grid whose geometry fields are set; `voxel` is the largest extent of a voxel
 // (world units), `emit` maps one Tri3 into a vector, `voxel_centre(i, j, k)` gives the world point
 // of a voxel's centre.
@@ -576,210 +825,44 @@ template <bool kPerspective, class Emit, class Centre>
 void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, const Treatments& treatment,
                    float slab_thickness, float voxel, Emit&& emit, Centre&& voxel_centre, VoxelStats* stats) {
   const std::span<const Treat> treat = treatment.of;
-  const Bounds3& region = o.slab_region;
   g.depth_bits = o.depth_bits;
   g.words = (o.depth_bits + 63) / 64;
   g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
 
   // 1. Map triangles to the grid, chunk by chunk (chunk boundaries are fixed: deterministic),
   // and bucket each chunk's triangles by (fill kind, row band) so that a band visits only the
-  // triangles overlapping it (a counting sort; a triangle spanning bands is listed in each).
-  const int bands = std::min(g.ny, kBands);
-  const auto band_first_row = [&](int b) { return static_cast<int>(static_cast<long long>(g.ny) * b / bands); };
-  std::vector<int> band_of(g.ny);
-  for (int b = 0; b < bands; ++b)
-    for (int j = band_first_row(b); j < band_first_row(b + 1); ++j) band_of[j] = b;
-  const auto kind_of = [](const GridTri& t) { return t.fill == 0 || t.fill >= 3 ? 0 : t.fill == 2 ? 2 : 1; };
-  struct Buckets {
-    std::vector<std::uint32_t> start, index;  // bucket (kind * bands + band): index[start[k], start[k + 1])
-  };
-  // A solid with holes (Treat::Fans) gets one fan triangle per boundary edge after its own
-  // triangles: (b, a, centroid) for the boundary edge a -> b, so that every edge of the mesh and
-  // its fans is used twice and the parity pass sees a closed surface.
-  // The triangles are those of every object (Scene::objects(): a world-space mesh, or an instance
-  // whose mesh's triangles go through its transform); closure and hole centroids are per mesh, as
-  // an affine map keeps both (it maps centroids to centroids).
-  const std::vector<SceneObject> objects = scene.objects();
-  std::vector<Holes> holes(scene.meshes.size());
-  std::vector<std::uint8_t> hole_info(scene.meshes.size(), 0);
-  std::vector<int> slot_of(objects.size(), -1);  // objects with a non-flat hole: their slot
-  std::vector<std::size_t> slot_object;
-  std::vector<std::size_t> first{0};
-  std::size_t fanned = 0;
-  for (std::size_t oi = 0; oi < objects.size(); ++oi) {
-    const std::size_t mi = objects[oi].mesh;
-    const bool fans = treat[oi] == Treat::Fans;
-    if (fans && !hole_info[mi]) {
-      // Two voxels, in the mesh's own units (an instance's scale divides them).
-      const float scale = objects[oi].instance == SceneObject::kNoInstance
-                              ? 1.0f
-                              : static_cast<float>(std::cbrt(std::abs(scene.instances[objects[oi].instance].object_to_world.determinant())));
-      holes[mi] = hole_centroids(scene.meshes[mi], closure[mi], 2.0f * voxel / scale), hole_info[mi] = 1;
-    }
-    if (fans && std::find(holes[mi].flat.begin(), holes[mi].flat.end(), 0) != holes[mi].flat.end()) {
-      slot_of[oi] = static_cast<int>(slot_object.size());
-      slot_object.push_back(oi);
-    }
-    fanned += fans ? 1 : 0;
-    first.push_back(first.back() + scene.meshes[mi].triangle_count() + (fans ? closure[mi].boundary.size() : 0));
-  }
-  const std::size_t total = first.back();
+  // triangles overlapping it.
+  const Bands bands = make_bands(g.ny);
+  const ObjectPlan plan = plan_objects(scene, closure, treat, voxel);
+  const std::size_t total = plan.first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
   std::vector<std::vector<GridTri>> tris(chunks);
   std::vector<Buckets> buckets(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
     const std::size_t t0 = c * kChunk, t1 = std::min(total, t0 + kChunk);
-    std::size_t oi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
+    std::size_t oi = static_cast<std::size_t>(std::upper_bound(plan.first.begin(), plan.first.end(), t0) - plan.first.begin()) - 1;
     auto& out = tris[c];
     out.reserve(t1 - t0);
     for (std::size_t t = t0; t < t1; ++t) {
-      while (t >= first[oi + 1]) ++oi;
-      const std::size_t mi = objects[oi].mesh;
-      const Affine3* tf = objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[oi].instance].object_to_world;
-      const bool open = treat[oi] == Treat::Slab || treat[oi] == Treat::SlabFlipped;
-      const Mesh& m = scene.meshes[mi];
-      const std::size_t local = t - first[oi];
+      while (t >= plan.first[oi + 1]) ++oi;
       Tri3 tri;
-      if (local < m.triangle_count()) {
-        tri = source_triangle(m, local, open);
-        if (open && !region.empty()) {
-          Bounds3 reach;  // the triangle and its slab
-          for (const Vec3& v : tri.v) reach.extend(tf ? tf->point(v) : v);
-          reach.lo -= Vec3{slab_thickness, slab_thickness, slab_thickness};
-          reach.hi += Vec3{slab_thickness, slab_thickness, slab_thickness};
-          if (reach.hi.x < region.lo.x || reach.lo.x > region.hi.x || reach.hi.y < region.lo.y || reach.lo.y > region.hi.y ||
-              reach.hi.z < region.lo.z || reach.lo.z > region.hi.z)
-            continue;
-        }
-        if (slot_of[oi] >= 0 && holes[mi].near[local]) tri.fan = slot_of[oi];
-      } else {
-        const std::size_t e = local - m.triangle_count();
-        const auto [a, b] = closure[mi].boundary[e];
-        const std::uint32_t h = closure[mi].hole[e];
-        tri = Tri3{{m.positions[b], m.positions[a], holes[mi].centre[h]}, 0, {}, holes[mi].flat[h] ? -1 : slot_of[oi]};
-      }
-      if (tf) {
-        for (Vec3& v : tri.v) v = tf->point(v);
-        if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
-      }
-      if (treat[oi] == Treat::SlabFlipped) tri.normal = -tri.normal;
-      emit(out, tri);
+      if (object_triangle(scene, closure, plan, treat, oi, t - plan.first[oi], o.slab_region, slab_thickness, tri)) emit(out, tri);
     }
-    Buckets& bk = buckets[c];
-    bk.start.assign(3 * static_cast<std::size_t>(bands) + 1, 0);
-    for (const GridTri& t : out)
-      for (int b = band_of[t.j0]; b <= band_of[t.j1]; ++b) ++bk.start[kind_of(t) * bands + b + 1];
-    for (std::size_t k = 1; k < bk.start.size(); ++k) bk.start[k] += bk.start[k - 1];
-    bk.index.resize(bk.start.back());
-    std::vector<std::uint32_t> pos(bk.start.begin(), bk.start.end() - 1);
-    for (std::size_t i = 0; i < out.size(); ++i)
-      for (int b = band_of[out[i].j0]; b <= band_of[out[i].j1]; ++b) bk.index[pos[kind_of(out[i]) * bands + b]++] = static_cast<std::uint32_t>(i);
+    buckets[c] = bucket(out, bands);
   });
 
   // 2. Raster bands of rows; parity fragments first, then (after the scan) open-mesh slabs,
   // which are ORed: a union, so overlapping slabs of neighbouring open triangles do not cancel.
-  std::vector<std::size_t> fragments(bands, 0);
-  std::vector<std::vector<ColumnHit>> hits(bands);  // fans' fragments (pass 0)
-  // Pass 0: parity; 1: spans; 2: prisms, counted per band and then turned into voxels.
+  std::vector<std::size_t> fragments(bands.count, 0);
+  std::vector<std::vector<ColumnHit>> hits(bands.count);  // fans' fragments (pass 0)
   const auto raster_pass = [&](int fill_kind) {
-    tbb::parallel_for(0, bands, [&](int b) {
-      const int r0 = band_first_row(b), r1 = band_first_row(b + 1) - 1;
-      const std::size_t k = static_cast<std::size_t>(fill_kind) * bands + b;
-      bool any = false;
-      for (std::size_t c = 0; c < chunks && !any; ++c) any = buckets[c].start[k] < buckets[c].start[k + 1];
-      if (!any) return;
-      PrismCounts counts;
-      if (fill_kind == 2) {
-        const std::size_t columns = static_cast<std::size_t>(r1 - r0 + 1) * g.nx;
-        counts = {r0, g.nx, g.depth_bits, std::unique_ptr<std::int16_t[]>(new std::int16_t[columns * g.depth_bits]),
-                  std::vector<std::uint8_t>(columns, 0)};
-      }
-      std::size_t f = 0;
-      for (std::size_t c = 0; c < chunks; ++c)
-        for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
-          const GridTri& t = tris[c][buckets[c].index[q]];
-          const int lo = std::max(r0, t.j0), hi = std::min(r1, t.j1);
-          f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits[b], &counts)
-                                          : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits[b], nullptr);
-        }
-      fragments[b] += f;
-      // The union of the prisms: the voxels where the running count is not 0.
-      for (std::size_t c = 0; c < counts.touched.size(); ++c) {
-        if (!counts.touched[c]) continue;
-        const std::int16_t* d = counts.delta.get() + c * g.depth_bits;
-        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(r0) * g.nx + c) * g.words;
-        int count = 0;
-        for (int v = 0; v < g.depth_bits; ++v) {
-          count += d[v];
-          if (count != 0) col[v >> 6] |= std::uint64_t{1} << (v & 63);
-        }
-      }
-    });
+    tbb::parallel_for(0, bands.count, [&](int b) { fragments[b] += raster_band<kPerspective>(g, bands, b, fill_kind, tris, buckets, slab_thickness, hits[b]); });
   };
   raster_pass(0);
 
-  // 3. Toggles -> solid.
+  // 3. Toggles -> solid, then the winding-number solid near holes that are not flat.
   const std::size_t odd = scan_columns(g);
-
-  // The winding-number solid near holes that are not flat. Parity with the fans is the solid
-  // chi of the mesh plus its fans C; the mesh's own winding number is w = chi - w_C (w is a sum
-  // over triangles; sigma w with sigma the orientation, voxelize.h), and the solid is w > 1/2. The
-  // two differ only where |w_C| >= 1/2, which is next to a fan that is not flat: in the pocket
-  // between the fan and the surface w = 1/2 that spans the hole, which the mesh itself can also
-  // cut near the hole's rim. Along a column the pocket is entered through the fan or through the
-  // mesh near the hole (it is bounded by them and that surface), so from each such fragment we walk
-  // the column both ways, setting each voxel to [sigma w(centre) > 1/2], and stop at the first
-  // voxel where that agrees with parity: the pocket's end. (A column that crossed the spanning
-  // surface twice and neither the fan nor the mesh would be missed.)
-  std::size_t evaluated = 0, changed = 0;
-  if (!slot_object.empty()) {
-    // Per slot: object space, sigma (orientation, mirrors included) and the winding number of its
-    // fans alone (w_C needs no triangle near the point but the fans' own, unlike w of the mesh).
-    std::vector<ObjectSpace> space;
-    std::vector<int> sign;
-    std::vector<FanWinding> fans;
-    for (std::size_t oi : slot_object) {
-      const std::size_t mi = objects[oi].mesh;
-      space.push_back(object_space(scene, objects[oi]));
-      sign.push_back(closure[mi].orientation * space.back().sign);
-      fans.push_back(fan_winding(scene.meshes[mi], closure[mi], holes[mi]));
-    }
-    std::vector<std::size_t> evaluated_in(bands, 0), changed_in(bands, 0);
-    tbb::parallel_for(0, bands, [&](int b) {
-      std::vector<ColumnHit>& list = hits[b];
-      std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.tag, x.k) < std::tie(y.j, y.i, y.tag, y.k); });
-      std::vector<std::uint64_t> chi(g.words), seen(g.words);
-      std::vector<Vec3> r;
-      std::vector<float> len;
-      for (std::size_t q = 0; q < list.size();) {
-        // One column and slot at a time: chi is the column as parity left it, each voxel is
-        // decided once however many walks reach it.
-        const ColumnHit& at = list[q];
-        std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(at.j) * g.nx + at.i) * g.words;
-        std::copy(col, col + g.words, chi.begin());
-        std::fill(seen.begin(), seen.end(), 0);
-        const int s = at.tag;
-        for (; q < list.size() && list[q].i == at.i && list[q].j == at.j && list[q].tag == s; ++q)
-          for (int dir : {1, -1})
-            for (int k = dir > 0 ? list[q].k : list[q].k - 1; k >= 0 && k < g.depth_bits; k += dir) {
-              const std::uint64_t bit = std::uint64_t{1} << (k & 63);
-              const bool parity = (chi[k >> 6] & bit) != 0;
-              bool solid;
-              if (seen[k >> 6] & bit) {
-                solid = (col[k >> 6] & bit) != 0;
-              } else {
-                // w = chi - w_C: solid where sigma w = chi - sigma w_C > 1/2.
-                solid = (parity ? 1.0 : 0.0) - sign[s] * fans[s](space[s](voxel_centre(at.i, at.j, k)), r, len) > 0.5;
-                seen[k >> 6] |= bit;
-                ++evaluated_in[b];
-                if (solid != parity) col[k >> 6] ^= bit, ++changed_in[b];
-              }
-              if (solid == parity) break;
-            }
-      }
-    });
-    for (int b = 0; b < bands; ++b) evaluated += evaluated_in[b], changed += changed_in[b];
-  }
+  const WalkCount walked = plan.slot_object.empty() ? WalkCount{} : winding_solid(g, hits, slot_winding(scene, closure, plan), voxel_centre);
 
   // 4. Slabs of open meshes, ORed after the parity; walls' prisms as the union of the prisms: per
   // column, the voxels where the count of prisms entered minus left is not 0 (prisms overlap
@@ -790,21 +873,13 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   }
   const std::size_t set_voxels = build_coarse(g);  // also counts the solid voxels
   if (stats) {
-    *stats = {};
-    for (const auto& chunk : tris) stats->triangles += chunk.size();
-    for (std::size_t f : fragments) stats->fragments += f;
+    *stats = grid_stats(tris, fragments, closure);
     stats->odd_columns = odd;
-    for (const MeshClosure& c : closure) {
-      stats->open_meshes += c.open_surface() ? 1 : 0;
-      stats->holed_meshes += c.holed() ? 1 : 0;
-      stats->holes += c.holed() ? c.holes : 0;
-      stats->boundary_edges += c.boundary_edges;
-    }
     stats->set_voxels = set_voxels;
-    stats->capped_meshes = fanned;
+    stats->capped_meshes = plan.fanned;
     stats->back_objects = treatment.back;
-    stats->winding_evaluations = evaluated;
-    stats->winding_voxels_changed = changed;
+    stats->winding_evaluations = walked.evaluated;
+    stats->winding_voxels_changed = walked.changed;
   }
 }
 
@@ -1016,6 +1091,34 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   return g;
 }
 
+namespace {
+
+// z_nearest per column of an eye grid whose camera, columns and z_far are set: the smallest
+// G-buffer depth among the pixels whose centres it holds (eq. 2's local slice); columns that see no
+// surface use `zmin`, the scene's nearest corner. Then the voxels per unit depth of each column.
+void set_z_near(VoxelGrid& g, const GBuffer& gb, float zmin, float z_clip, int depth_bits) {
+  const std::size_t ncol = static_cast<std::size_t>(g.nx) * g.ny;
+  g.z_near.assign(ncol, kInfinity);
+  for (int y = 0; y < g.camera.height; ++y) {
+    const int j = std::min(g.ny - 1, static_cast<int>((y + 0.5f) / g.pixels_per_column_y));
+    for (int x = 0; x < g.camera.width; ++x) {
+      if (!gb.covered(x, y)) continue;
+      const int i = std::min(g.nx - 1, static_cast<int>((x + 0.5f) / g.pixels_per_column_x));
+      float& zn = g.z_near[static_cast<std::size_t>(j) * g.nx + i];
+      zn = std::min(zn, gb.depth(x, y));
+    }
+  }
+  g.voxels_per_unit.resize(ncol);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    float& zn = g.z_near[c];
+    if (!std::isfinite(zn)) zn = zmin;
+    zn = std::clamp(zn, z_clip, g.z_far * 0.999f);
+    g.voxels_per_unit[c] = static_cast<float>(depth_bits) / (g.z_far - zn);
+  }
+}
+
+}  // namespace
+
 VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const VoxelizeOptions& o, VoxelStats* stats,
                        std::span<const std::uint8_t> back) {
   o.validate();
@@ -1056,26 +1159,7 @@ VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure,
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   g.z_far = std::max(zmax + slab + v0, zmin * 2.0f);
 
-  // z_nearest per column: the smallest G-buffer depth among the pixels whose centres it holds
-  // (eq. 2's local slice); columns that see no surface use the scene's nearest corner.
-  const std::size_t ncol = static_cast<std::size_t>(g.nx) * g.ny;
-  g.z_near.assign(ncol, kInfinity);
-  for (int y = 0; y < H; ++y) {
-    const int j = std::min(g.ny - 1, static_cast<int>((y + 0.5f) / g.pixels_per_column_y));
-    for (int x = 0; x < W; ++x) {
-      if (!gb.covered(x, y)) continue;
-      const int i = std::min(g.nx - 1, static_cast<int>((x + 0.5f) / g.pixels_per_column_x));
-      float& zn = g.z_near[static_cast<std::size_t>(j) * g.nx + i];
-      zn = std::min(zn, gb.depth(x, y));
-    }
-  }
-  g.voxels_per_unit.resize(ncol);
-  for (std::size_t c = 0; c < ncol; ++c) {
-    float& zn = g.z_near[c];
-    if (!std::isfinite(zn)) zn = zmin;
-    zn = std::clamp(zn, z_clip, g.z_far * 0.999f);
-    g.voxels_per_unit[c] = static_cast<float>(o.depth_bits) / (g.z_far - zn);
-  }
+  set_z_near(g, gb, zmin, z_clip, o.depth_bits);
 
   // Camera-space (x, y, depth) -> column: camera.project divided by the pixels per column.
   const float t = cam.tan_half_fov();

@@ -32,6 +32,15 @@ int centres_inside(float origin, float size, int n, float lo, float hi) {
   return c;
 }
 
+// Options of a small grid: columns x columns columns of depth_bits voxels, slabs `slab` thick.
+VoxelizeOptions grid_options(int columns, int depth_bits, float slab = 0.0f) {
+  VoxelizeOptions o;
+  o.columns = columns;
+  o.depth_bits = depth_bits;
+  o.slab_thickness = slab;
+  return o;
+}
+
 TEST(Voxelize, ClosedAxisAlignedBoxGivesExactVoxelCount) {
   // A second box widens the bounds so the first one's faces fall between voxel centres at
   // arbitrary offsets rather than on the grid's boundary.
@@ -138,9 +147,7 @@ TEST(Voxelize, ClosedMeshGridIsTheParityOfEveryColumn) {
   const Scene s = scene_of({make_sphere({0.13f, 0.41f, -0.27f}, 0.9f, 40, 20), make_torus({1.1f, 0.2f, 0.9f}, 0.6f, 0.2f, 32, 12),
                             make_box({-1.7f, -0.3f, 0.6f}, {-0.9f, 0.9f, 1.3f}, {}, 23.0f)});
   const auto closure = analyze_closure(s);
-  VoxelizeOptions o;
-  o.columns = 64;
-  o.depth_bits = 96;
+  VoxelizeOptions o = grid_options(64, 96);
   const VoxelGrid g = voxelize_world(s, closure, o);
   std::size_t checked = 0;
   for (int j = 0; j < g.ny; ++j)
@@ -195,9 +202,7 @@ TEST(Voxelize, SolidWithAHoleThatIsNotFlatIsItsWindingNumberSolid) {
     const Scene s = scene_of({m});
     const auto closure = analyze_closure(s);
     ASSERT_TRUE(closure[0].holed());
-    VoxelizeOptions o;
-    o.columns = 40;
-    o.depth_bits = 64;
+    const VoxelizeOptions o = grid_options(40, 64);
     VoxelStats stats;
     const VoxelGrid g = voxelize_world(s, closure, o, &stats);
     EXPECT_GT(stats.winding_voxels_changed, 0u) << "the pocket holds voxel centres";
@@ -221,10 +226,7 @@ TEST(Voxelize, SolidWithAHoleThatIsNotFlatIsItsWindingNumberSolid) {
 TEST(Voxelize, SheetSlabLiesOnTheFarSideFromThePoints) {
   const Scene s = scene_of({make_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1})});
   const auto closure = analyze_closure(s);
-  VoxelizeOptions o;
-  o.columns = 32;
-  o.depth_bits = 64;
-  o.slab_thickness = 0.5f;
+  const VoxelizeOptions o = grid_options(32, 64, 0.5f);
   for (std::uint8_t side : {0, 1}) {
     const std::vector<std::uint8_t> back{side};
     VoxelStats stats;
@@ -247,10 +249,7 @@ TEST(Voxelize, WallPrismsAreUnitedWhereWallsMeet) {
   const Scene s = scene_of({walls});
   const auto closure = analyze_closure(s);
   ASSERT_TRUE(closure[0].open_surface());
-  VoxelizeOptions o;
-  o.columns = 64;
-  o.depth_bits = 64;
-  o.slab_thickness = 0.5f;
+  const VoxelizeOptions o = grid_options(64, 64, 0.5f);
   const VoxelGrid g = voxelize_world(s, closure, o);
   const auto solid = [&](float x, float y, float z) {
     return g.voxel(static_cast<int>((x - g.origin.x) / g.voxel_size.x), static_cast<int>((z - g.origin.z) / g.voxel_size.y),

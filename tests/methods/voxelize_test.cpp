@@ -132,8 +132,9 @@ TEST(Voxelize, OpenMeshesAreClassifiedByTheirWindingNumber) {
   EXPECT_TRUE(c[0].flat);
   EXPECT_NEAR(c[0].enclosure, 0.0f, 1e-6f);
   EXPECT_FALSE(c[1].flat);
-  // A sphere missing one triangle wraps around its inside all but entirely (256 sampled
-  // triangles, each seeing the hole from its own distance).
+  // A sphere missing one triangle wraps around its inside all but entirely: its hole spans far
+  // less than kSmallHoles of its area, so its enclosure is 1 minus that fraction and its
+  // orientation the sign of its volume.
   EXPECT_GT(c[4].enclosure, 0.95f);
   EXPECT_EQ(c[4].orientation, 1);
   EXPECT_EQ(c[5].orientation, -1);

@@ -4,10 +4,11 @@
 //
 // The side is the generalized winding number's (winding_number.h): behind a sheet where its w > 0,
 // inside a solid with holes where sigma w > 1/2. A pixel on the open object itself is on the side
-// the camera sees of its triangle. Every other object is tested once at its vertices (within reach
-// of the open object): when they all agree, its pixels take that side; otherwise each pixel is
-// tested at its point. The pixels are then grouped by their sides (a key: one flag per object of
-// Scene::objects()), one voxel grid per key.
+// the camera sees of its triangle. Every other object within reach of the open object is tested
+// once at the corners of its box when the open object is a flat sheet: when they all agree, its
+// pixels take that side; otherwise each pixel is tested at its point (through a coarse lattice of
+// w where the lattice can tell, SideSetup::Open). The pixels are then grouped by their sides (a
+// key: one flag per object of Scene::objects()), one voxel grid per key.
 #pragma once
 
 #include <cstdint>
@@ -21,10 +22,11 @@ namespace ao::cone_internal {
 
 /// At most this many grids per frame (the all-front one included), each for at least
 /// kMinSidePixels pixels or a thousandth of the covered ones, whichever is fewer: a grid costs a
-/// voxelization (a solid with holes seen from inside, a slab around its whole shell: 0.5 s for a
-/// 20,000-triangle scan at 512 columns), which a few pixels at a silhouette that see into a hole
-/// do not pay for. Other pixels are traced with the all-front grid and counted
-/// (ConeResult::unresolved_pixels); the largest groups get the grids.
+/// voxelization (a solid with holes seen from inside, a slab around its shell within reach of
+/// those pixels: 0.1-0.2 s for a 5,000-triangle scan at 512 columns, docs/methods/cone.md), which
+/// a few pixels at a silhouette that see into a hole do not pay for. Other pixels are traced with
+/// the all-front grid and counted (ConeResult::unresolved_pixels); the largest groups get the
+/// grids.
 inline constexpr int kMaxSideGrids = 8;
 inline constexpr std::size_t kMinSidePixels = 32;
 

@@ -905,8 +905,8 @@ namespace {
 // Just in front of and just behind a triangle's centroid c, w(c + n d) + w(c - n d) = 2 w_rest(c):
 // the triangle's own solid angles cancel (mirror images), leaving twice the winding number of
 // the rest of the mesh at c. A closed mesh has w_rest = 1/2 everywhere (the rest subtends the
-// whole half-space behind the face), a flat sheet 0. `enclosure` is |2 w_rest| averaged over the
-// area, `orientation` its sign.
+// whole half-space behind the face), a flat sheet 0. `enclosure` is the magnitude of 2 w_rest
+// averaged over the area (at every (n / kEnclosureSamples)-th triangle), `orientation` its sign.
 void classify_open_mesh(const Mesh& m, MeshClosure& c) {
   c.winding = MeshWinding(m);
   const std::size_t nt = m.triangle_count();

@@ -68,17 +68,19 @@ enum class MeshKind {
   Closed,          ///< No boundary edge: a solid; parity voxelizes it exactly.
   SolidWithHoles,  ///< Boundary edges, but it wraps around a volume as a closed surface does
                    ///< (MeshClosure::enclosure >= kSolidEnclosure): a scan open at its base, a part
-                   ///< with a few holes. It stands for the solid where w > 1/2.
-  Sheet,           ///< Any other open mesh (a ground, a wall, sheet metal, a bowl, an open box): a
-                   ///< two-sided surface of no thickness, which the ray-traced reference sees as such.
+                   ///< with a few holes, an open container (a bowl, a box without its top). It
+                   ///< stands for the solid where w > 1/2.
+  Sheet,           ///< Any other open mesh (a ground, a wall, sheet metal bent less than a
+                   ///< container: an arch): a two-sided surface of no thickness, which the
+                   ///< ray-traced reference sees as such.
 };
 
 /// Enclosure (MeshClosure::enclosure) from which an open mesh is a solid with holes rather than a
 /// sheet: from its surface, the rest of it covers at least half of what the rest of a closed
 /// surface covers (the half-space behind the face). Measured: a flat sheet 0, a bent sheet with
-/// holes (an arch) 0.32, half a sphere shell 0.60, a box without its top 0.72, a torus with its
-/// base cut off 0.73, a sphere with its top tenth cut off 0.88, the shared scans with their bases
-/// cut 0.92-0.996 and with holes punched 0.98-0.998 (docs/methods/cone.md, "Open meshes").
+/// holes (an arch) 0.34, half a sphere shell 0.63, a box without its top 0.72, a torus with its
+/// base cut off 0.74, a sphere with its top tenth cut off 0.91, the shared scans with their bases
+/// cut 0.93-0.996 and with holes punched 0.99-1.00 (docs/methods/cone.md, "Open meshes").
 inline constexpr float kSolidEnclosure = 0.5f;
 /// Triangles sampled (evenly by index) to measure the enclosure of one open mesh.
 inline constexpr std::size_t kEnclosureSamples = 256;
@@ -113,8 +115,9 @@ struct MeshClosure {
   std::vector<std::uint32_t> hole;
   std::uint32_t holes = 0;
   MeshKind kind = MeshKind::Closed;
-  /// Open meshes: |2 w_rest| averaged over the surface, in [0, 1], where w_rest is the winding
-  /// number at a point of the surface of the rest of the mesh (all but the point's own triangle):
+  /// Open meshes: the magnitude of the area-weighted mean of 2 w_rest over the surface (sampled at
+  /// kEnclosureSamples triangles), in [0, 1], where w_rest is the winding number at a point of the
+  /// surface of the rest of the mesh (all but the point's own triangle):
   /// 1 for a closed surface (the rest wraps all around), 0 for a flat sheet. 1 for closed meshes;
   /// 1 minus the holes' area fraction for meshes with small holes (kSmallHoles).
   float enclosure = 1;

@@ -13,6 +13,11 @@ install(TARGETS ao_core ao_lib EXPORT aoTargets
 if(AO_BUILD_CLI)
   install(TARGETS ao RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endif()
+# The GPU backend's shaders as readable files (docs/gpu.md), for engines that take one: the library
+# itself carries them embedded and never reads these.
+if(AO_GPU)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/ao/gpu/shaders/ DESTINATION ${CMAKE_INSTALL_DATADIR}/ao/shaders)
+endif()
 install(EXPORT aoTargets NAMESPACE ao:: DESTINATION ${AO_CMAKE_DIR})
 export(EXPORT aoTargets NAMESPACE ao:: FILE ${PROJECT_BINARY_DIR}/aoTargets.cmake)
 
@@ -37,6 +42,9 @@ else()
   set(AO_PC_REQUIRES "${AO_PC_REQUIRES} assimp OpenEXR libpng libtiff-4 libjpeg freetype2")
   set(AO_PC_REQUIRES_PRIVATE "")
   set(AO_PC_LIBS "-lembree3 -pthread")
+  if(AO_GPU AND CMAKE_DL_LIBS)
+    string(APPEND AO_PC_LIBS " -l${CMAKE_DL_LIBS}")  # the GPU backend opens libEGL at run time (dlopen)
+  endif()
 endif()
 # The prefix relative to the .pc file's folder, so that the package can be installed anywhere
 # (cmake --install --prefix P) and moved.

@@ -5,7 +5,10 @@
 # and Cycles (margin 0) leaves its black background where no texel centre falls inside a triangle
 # (ao also covers texels a chart only partly overlaps, with the area-weighted mean). A covered texel
 # with V below 1e-6 would be left out too; there are none in practice.
-# --flip compares MAP upside down (a check of the UV convention). Prints "rmse R texels N mean_signed S".
+# --flip compares MAP upside down (a check of the UV convention). Prints "rmse R texels N mean_signed S se E":
+# S the mean of MAP minus the mean of REFERENCE over those texels, E = R / sqrt(N) the standard error
+# of MAP's mean were its texels' errors independent (a filtered map's errors are correlated over a
+# few texels, which makes its true standard error a few times larger).
 import sys
 
 import bpy
@@ -30,4 +33,5 @@ if flip:
     a = a[::-1]
 mask = (a[..., 0] > 1e-6) & (b[..., 0] > 0)
 diff = a[..., 0][mask] - b[..., 0][mask]
-print(f"rmse {np.sqrt(np.mean(diff * diff)):.5f} texels {int(mask.sum())} mean_signed {diff.mean():+.5f}")
+rmse = np.sqrt(np.mean(diff * diff))
+print(f"rmse {rmse:.5f} texels {int(mask.sum())} mean_signed {diff.mean():+.6f} se {rmse / np.sqrt(mask.sum()):.6f}")

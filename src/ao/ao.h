@@ -44,7 +44,7 @@
 #include "ao/methods/cone.h"
 #include "ao/methods/containment.h"
 #include "ao/methods/interleave.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/methods/samples.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
@@ -59,6 +59,12 @@
 #include "ao/bake/raytraced_bake.h"
 #include "ao/bake/sphere_directions.h"
 #include "ao/bake/texel_coverage.h"
+
+// gpu: the methods as OpenGL compute shaders (docs/gpu.md); without AO_GPU, opening a device says so.
+#include "ao/gpu/device.h"
+#include "ao/gpu/gbuffer.h"
+#include "ao/gpu/methods.h"
+#include "ao/gpu/voxelize.h"
 
 // eval: error metrics against a reference.
 #include "ao/eval/metrics.h"

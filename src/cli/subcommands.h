@@ -5,13 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
-namespace ao::cli {
+#include "common.h"
 
-/// Options of `ao` itself, before the subcommand.
-struct GlobalOptions {
-  int threads = 0;     ///< Worker threads; 0 = all cores.
-  bool quiet = false;  ///< No progress bar.
-};
+namespace ao::cli {
 
 void add_render_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);
 void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action);

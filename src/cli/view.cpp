@@ -4,7 +4,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/image_io.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "common.h"
 #include "subcommands.h"
 #include "view/viewer.h"
@@ -16,7 +16,7 @@ namespace {
 struct ViewOptions {
   std::vector<std::string> scene;
   std::string method = "containment";
-  CameraOptions camera{.width = 960, .height = 540};
+  CameraOptions camera{.request = {.default_width = 960, .default_height = 540}};
   FalloffOptions falloff;
   std::uint32_t seed = 1;
   std::vector<std::string> params;
@@ -34,7 +34,7 @@ struct ViewOptions {
 int run_view_command(const ViewOptions& o, const GlobalOptions& global) {
   const MethodInfo& method = find_method(o.method);
   nlohmann::json params = method.default_params();
-  apply_param_overrides(params, o.params, method.name);
+  apply_param_overrides(params, o.params, method.name, method.default_params());
   if (!o.screenshot.empty() && std::filesystem::path(o.screenshot).extension() != ".png")
     throw InputError(o.screenshot + ": --screenshot writes PNG, give it a .png name");
   if (!o.camera_out.empty() && o.screenshot.empty()) throw InputError("--camera-out is written with the screenshot: give --screenshot too");
@@ -43,11 +43,13 @@ int run_view_command(const ViewOptions& o, const GlobalOptions& global) {
   view::ViewSetup setup;
   for (const std::string& e : o.events) setup.events.push_back(view::parse_event(e));
   if (!o.ao_map.empty()) setup.ao_map = read_image(o.ao_map);
-  setup.scene = load_scene_arguments(o.scene);
-  for (const std::string& w : setup.scene.warnings) std::cerr << "warning: " << w << "\n";
-  setup.camera = choose_camera(setup.scene, o.camera);
-  setup.radius_basis = interest_diagonal(setup.scene);
-  setup.falloff = choose_falloff(o.falloff, setup.radius_basis);
+  const CameraRequest camera = camera_request(o.camera);
+  const FalloffRequest falloff = falloff_request(o.falloff);
+  setup.scene = SceneSource{.args = o.scene}.load();
+  for (const std::string& w : setup.scene->warnings) std::cerr << "warning: " << w << "\n";
+  setup.camera = choose_camera(*setup.scene, camera);
+  setup.radius_basis = interest_diagonal(*setup.scene);
+  setup.falloff = choose_falloff(falloff, setup.radius_basis);
   setup.method = o.method;
   setup.params = params;
   setup.seed = o.seed;
@@ -71,10 +73,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   std::string methods;
   for (const MethodInfo& m : all_methods()) methods += "\n  " + std::string(m.name) + ": " + std::string(m.summary);
   cmd->add_option("-m,--method", o->method, "AO method:" + methods)->capture_default_str();
-  cmd->add_option("--membership", o->falloff.membership, "Falloff mu(d): " + membership_names())->capture_default_str();
-  cmd->add_option("-R,--radius", o->falloff.radius, "Neighbourhood radius R, world units (default: --radius-fraction x scene diagonal)");
-  cmd->add_option("--radius-fraction", o->falloff.radius_fraction, "R as a fraction of the bounding-box diagonal")->capture_default_str();
-  cmd->add_option("--tau", o->falloff.tau, "Absorption coefficient of the exp membership, 1/world units (0: 3/R)")->capture_default_str();
+  add_falloff_options(*cmd, o->falloff, "Falloff mu(d): " + membership_names());
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
   add_camera_options(*cmd, o->camera, "Window");
   cmd->add_option("-p,--param", o->params, "Method parameter as key=value, repeatable (as ao render)");
@@ -91,10 +90,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--screenshot", o->screenshot, "With --frames: write the last frame as PNG");
   cmd->add_option("--camera-out", o->camera_out, "With --screenshot: also write the camera as JSON (ao render --camera reads it)");
   cmd->add_flag("--json", o->json, "On exit, print per-stage ms, fps and the reference's state as JSON on stdout");
-  cmd->callback([o, &global, &action, cmd] {
-    note_camera_size_given(*cmd, o->camera);
-    action = [o, &global] { return run_view_command(*o, global); };
-  });
+  cmd->callback([o, &global, &action] { action = [o, &global] { return run_view_command(*o, global); }; });
 }
 
 }  // namespace ao::cli

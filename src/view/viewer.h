@@ -1,9 +1,11 @@
 // `ao view`: the methods live in a window (GLFW 3.3, OpenGL 3.3 core, Dear ImGui), beside a
-// ray-traced reference that accumulates while the camera is still. The library does the work
-// (G-buffer, methods, reference, metrics); this folder only shows it and turns input into calls.
+// ray-traced reference that accumulates while the camera is still. The library's job layer does the
+// work (FrameRenderer: G-buffer and method; the references; metrics); this folder only shows it and
+// turns input into calls.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +32,7 @@ ScriptedEvent parse_event(const std::string& text);
 
 /// Everything the viewer starts from, already checked by the command line.
 struct ViewSetup {
-  Scene scene;
+  std::shared_ptr<const Scene> scene;
   Camera camera;                    ///< The start view, as ao render would choose it; its size is the window's.
   std::string method = "containment";
   nlohmann::json params;            ///< The method's parameters (defaults plus -p).

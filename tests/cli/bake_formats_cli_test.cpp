@@ -29,12 +29,6 @@ std::string quad_obj(double u0, double v0, double u1, double v1, const std::stri
   return s.str();
 }
 
-void expect_one_line_error(const RunResult& r, const std::string& needle) {
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
-}
 
 std::uint32_t be32(const std::string& s, std::size_t at) {
   return (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at])) << 24) | (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 1])) << 16) |

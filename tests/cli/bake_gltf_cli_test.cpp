@@ -19,12 +19,6 @@ namespace fs = std::filesystem;
 
 const std::string kRays = " --samples 64 --padding 2 -s 48 ";
 
-void expect_one_line_error(const RunResult& r, const std::string& needle) {
-  EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
-}
 
 // The embedded image `image` of a GLB, decoded.
 Image<float> embedded_map(const TempDir& dir, const GlbFile& g, int image) {

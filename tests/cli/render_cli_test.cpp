@@ -18,11 +18,6 @@ namespace {
 const std::string kSmall = " --width 40 --height 30 --spp 16 ";
 
 // One line on stderr, starting "ao: error:", that mentions `needle`.
-void expect_one_line_error(const RunResult& r, const std::string& needle) {
-  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
-}
 
 TEST(RenderCli, DefaultSceneWritesImageAndJsonSummary) {
   TempDir dir;

@@ -187,36 +187,43 @@ TEST(GltfDocument, ImagesBesideTheInputAreEmbeddedAndOthersAreNotRead) {
   write_text(dir / "outside.png", png);
   GlbFile g = parse_glb_file(instanced_cubes_glb());
   json j = g.json;
-  // An external buffer beside the .gltf, two images: one in a subfolder, one outside the folder.
+  // An external buffer beside the .gltf, two images in a subfolder, one of them missing.
   write_text(dir / "scene" / "cube.bin", g.bin);
   j["buffers"] = {{{"byteLength", g.bin.size()}, {"uri", "cube.bin"}}};
-  j["images"] = {{{"uri", "textures/albedo.png"}}, {{"uri", "../outside.png"}}};
+  j["images"] = {{{"uri", "textures/albedo.png"}}, {{"uri", "textures/missing.png"}}};
   j["textures"] = {{{"source", 0}}, {{"source", 1}}};
   j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
   j["materials"][0]["emissiveTexture"] = {{"index", 1}};
   write_text(dir / "scene" / "cube.gltf", j.dump());
   GltfDocument doc(dir / "scene" / "cube.gltf", 0);
   ASSERT_EQ(doc.warnings().size(), 1u);
-  EXPECT_NE(doc.warnings()[0].find("../outside.png"), std::string::npos) << doc.warnings()[0];
+  EXPECT_NE(doc.warnings()[0].find("textures/missing.png"), std::string::npos) << doc.warnings()[0];
   doc.save_glb(dir / "out.glb");
   const GlbFile out = parse_glb_file(read_text(dir / "out.glb"));
   EXPECT_FALSE(out.json["buffers"][0].contains("uri"));
   ASSERT_EQ(out.json["images"].size(), 2u);
   EXPECT_EQ(glb_view(out, out.json["images"][0]["bufferView"].get<int>()), png);
   EXPECT_EQ(out.json["images"][0]["mimeType"], "image/png");
-  EXPECT_EQ(out.json["images"][1]["uri"], "../outside.png");
-  // A buffer outside the folder is not read either: the document is refused.
+  EXPECT_EQ(out.json["images"][1]["uri"], "textures/missing.png");
+  // An image or a buffer outside the folder is not read: the document is refused.
+  const auto expect_refused = [&](const std::string& name) {
+    write_text(dir / "scene" / name, j.dump());
+    try {
+      GltfDocument escape(dir / "scene" / name, 0);
+      ADD_FAILURE() << "a file outside the glTF's folder was read";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      EXPECT_NE(what.find(name + ": "), std::string::npos) << what;
+      EXPECT_NE(what.find("lies outside the asset's folder"), std::string::npos) << what;
+    }
+  };
+  j["images"][1]["uri"] = "../outside.png";
+  expect_refused("image-escape.gltf");
+  j["images"][1]["uri"] = "textures/missing.png";
   write_text(dir / "outside.bin", g.bin);
   j["buffers"][0]["uri"] = "../outside.bin";
-  write_text(dir / "scene" / "escape.gltf", j.dump());
-  try {
-    GltfDocument escape(dir / "scene" / "escape.gltf", 0);
-    ADD_FAILURE() << "a buffer outside the glTF's folder was read";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    EXPECT_NE(what.find("escape.gltf"), std::string::npos) << what;
-  }
+  expect_refused("buffer-escape.gltf");
 }
 
 TEST(GltfDocument, AnOcclusionTextureOfTheInputIsReplacedWithAWarning) {
@@ -257,7 +264,7 @@ TEST(GltfDocument, BadDocumentsAreOneLineInputErrors) {
   draco["extensionsUsed"] = draco["extensionsRequired"] = {"KHR_draco_mesh_compression"};
   const std::pair<std::string, std::string> cases[] = {
       {make_glb(index, g.bin), "99"},
-      {make_glb(material, g.bin), "uses material 5, the file has 1"},
+      {make_glb(material, g.bin), "material 5, the file has 1"},
       {make_glb(draco, g.bin), "compressed with KHR_draco_mesh_compression"},
       {make_glb(deep, g.bin), "nests deeper"},
       {make_glb(no_position, g.bin), "bad.glb"},

@@ -20,7 +20,7 @@
 #include "ao/core/error.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/mesh_io.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 #include "support/bytes.h"

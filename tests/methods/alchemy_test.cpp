@@ -11,7 +11,7 @@
 #include "ao/core/error.h"
 #include "ao/eval/metrics.h"
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/reference/raytraced.h"
 #include "ao/scene/procedural.h"
 

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "ao/gbuffer/render_gbuffer.h"
@@ -148,6 +149,38 @@ TEST(Raytraced, TargetErrorStopsEachPixelBelowIt) {
   const auto img = render_raytraced(rs, g, {Membership::Step, 1.0f}, p, 2);
   EXPECT_LE(img.max_std_error, 0.01);
   EXPECT_LT(img.rays, static_cast<std::uint64_t>(16384) * 40 * 30 / 4) << "open pixels should stop early";
+}
+
+// Progress counts covered pixels (the pixels that cast rays), not tiles of the image, so a bar's
+// rate is not skewed by background: it ends at the covered count, which is less than the image.
+TEST(Raytraced, ProgressCountsCoveredPixels) {
+  const Scene s = make_builtin_scene("sphere-on-plane");
+  const RayScene rs(s);
+  Camera cam = *s.preferred_view;
+  cam.width = 64;
+  cam.height = 48;
+  cam.eye = cam.eye + (cam.eye - cam.target) * 2.0f;  // further back: the floor's far edge and sky in view
+  const GBuffer g = render_gbuffer(rs, cam);
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < g.object_id.size(); ++i) covered += g.covered(i) ? 1 : 0;
+  ASSERT_GT(covered, 0u);
+  ASSERT_LT(covered, g.object_id.size()) << "the view must show some background";
+  std::atomic<std::size_t> last_done{0}, last_total{0}, calls{0};
+  const ProgressFn progress = [&](std::size_t done, std::size_t total) {
+    std::size_t seen = last_done.load();
+    while (done > seen && !last_done.compare_exchange_weak(seen, done)) {
+    }
+    last_total = total;
+    ++calls;
+  };
+  render_raytraced(rs, g, {Membership::Step, 1.0f}, {.samples = 16}, 1, progress);
+  EXPECT_GT(calls.load(), 1u);
+  EXPECT_EQ(last_total.load(), covered);
+  EXPECT_EQ(last_done.load(), covered);
+  last_done = 0, last_total = 0;
+  render_gbuffer(rs, cam, progress);  // every pixel casts a primary ray
+  EXPECT_EQ(last_total.load(), g.object_id.size());
+  EXPECT_EQ(last_done.load(), g.object_id.size());
 }
 
 TEST(Raytraced, VisibilityIsMonotoneInRadius) {

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "ao/core/error.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "../methods/screen_space_fixtures.h"
 
 namespace ao {

@@ -11,7 +11,7 @@
 #include <tbb/global_control.h>
 
 #include "ao/core/error.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/scene/procedural.h"
 #include "../methods/screen_space_fixtures.h"
 

@@ -13,7 +13,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
-#include "ao/methods/registry.h"
+#include "ao/registry/registry.h"
 #include "ao/scene/procedural.h"
 #include "../methods/screen_space_fixtures.h"
 #include "../support/scenes.h"

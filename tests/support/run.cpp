@@ -1,5 +1,9 @@
 #include "support/run.h"
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -9,6 +13,13 @@
 #include <sstream>
 
 namespace ao::test {
+
+void expect_one_line_error(const RunResult& r, const std::string& needle, int exit_code) {
+  EXPECT_EQ(r.exit_code, exit_code) << r.err;
+  EXPECT_EQ(r.err.rfind("ao: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.err;
+}
 
 namespace {
 std::string quote(const std::string& s) {

@@ -22,6 +22,10 @@ RunResult run_ao_under(const std::string& prefix, const std::string& args, const
 /// with EFBIG, as on a full disk, instead of killing the process.
 RunResult run_ao_limited(const std::string& ulimits, const std::string& args, const std::filesystem::path& cwd = {});
 
+/// `r` failed with exit code `exit_code` (1: bad input; 3: system failure) and one line on stderr,
+/// "ao: error: ..." containing `needle`.
+void expect_one_line_error(const RunResult& r, const std::string& needle, int exit_code = 1);
+
 /// A fresh empty directory under the system temp directory, removed by the destructor: one per
 /// test, so tests never see each other's files.
 class TempDir {

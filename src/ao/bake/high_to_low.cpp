@@ -2,9 +2,12 @@
 //   V(T) = (1/A(T)) * integral over the low patch S of V_high(h(p)) dp,
 // where h(p) is where the cage ray through p first meets a front face of the high mesh and V_high
 // is eq. 2 of the per-texel AO paper (with mu(D) when a distance R is set) at h with the high
-// mesh's interpolated normal. Sample i of a texel takes a point p uniform by area on S and a
-// cosine-weighted direction about the high normal at h (pdf cos/pi cancels the cosine and 1/pi),
-// so V(T) is the plain mean of mu over the samples whose cage ray hit.
+// mesh's interpolated normal. Both integrals are estimated together, the area one with fewer points
+// than the hemisphere one: a texel's samples are split among P stratified points p_j of S (uniform
+// by area, HighToLowParams::cage_points), and each p_j's share of cosine-weighted directions about
+// the high normal at h(p_j) (pdf cos/pi cancels the cosine and 1/pi), so V(T) is the plain mean of
+// mu over the samples whose point's cage ray hit. V varies far less over a texel's patch than over
+// the hemisphere, so a few points per texel keep the area integration at a fraction of the cage rays.
 //
 // The cage ray: c(p) is the cage point with p's barycentrics (the extruded or explicit cage). The
 // ray runs along d = (p - c)/|p - c| (inwards) from p - f d to p + b d, f the front distance
@@ -20,13 +23,13 @@
 #include <cmath>
 #include <map>
 
+#include "ao/bake/denoise.h"
 #include "ao/bake/padding.h"
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
-#include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/embree_scene_internal.h"
-#include "ao/reference/packets_internal.h"
+#include "ao/reference/mean_accumulator_internal.h"
 #include "ao/reference/ray_offset.h"
 
 namespace ao {
@@ -94,24 +97,129 @@ std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
   return out;
 }
 
-bool finite_nonnegative(const std::optional<float>& v) { return !v || (*v >= 0 && std::isfinite(*v)); }
+// Where the AO rays of a point of the low patch leave: its cage ray, through the point, to the
+// first front face of the high mesh.
+struct CageRays {
+  const Scene& low;
+  const CagePositions& cage;
+  const std::vector<std::vector<Vec3>>& smooth;  // smoothed_normals(low)
+  const RayScene& targets;
+  const TriangleNormals& target_fn;
+  const HighToLowParams& params;
+  float surface_eps;  // cage this close to the surface: no direction from it
+
+  HighHit operator()(RTCIntersectContext& ctx, const detail::PatchSample& s) const {
+    const PatchPiece& pc = *s.piece;
+    const Vec3 p = s.position(), bary = s.barycentrics();
+    const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
+    const auto& cg = cage[pc.mesh];
+    const Vec3 c = cg[vi[0]] * bary.x + cg[vi[1]] * bary.y + cg[vi[2]] * bary.z;
+    const float cage_distance = length(c - p);
+    Vec3 d;
+    if (cage_distance > surface_eps) {
+      d = (p - c) / cage_distance;
+    } else {
+      const auto& sn = smooth[pc.mesh];
+      d = -normalize(sn[vi[0]] * bary.x + sn[vi[1]] * bary.y + sn[vi[2]] * bary.z);
+    }
+    const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
+    return trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
+  }
+};
+
+// A tile's worker for bake_high_to_low. A texel's P = min(cage_points, samples) cage points are
+// points 0 .. P - 1 of a 2-D Owen-scrambled Sobol set (keyed by the texel's key hashed once more)
+// mapped onto the patch by area (sample_patch): stratified over the texel's patch. Cage point j
+// carries the AO directions of samples [j n / P, (j + 1) n / P) of the texel's Owen-scrambled Sobol
+// set (dimensions 0-1 of sobol_owen_4d keyed by pixel_seed(seed, x, y), the single-mesh baker's
+// direction dimensions): at n / P a power of two each block is a (0, m, 2)-net of its own,
+// stratified over the hemisphere, and the blocks together are the texel's whole net.
+// All the directions of a cage point leave from its high-poly hit, so they go to Embree as packets
+// with one origin; the samples of a cage point that finds no high surface are left out.
+template <int N>
+class TexelWorker {
+ public:
+  TexelWorker(const CageRays& cage_rays, const detail::Tracer& tracer, const HighToLowParams& params, float offset, BakeResult& out,
+              TexelGuides* guides, std::atomic<std::uint64_t>& rays)
+      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), offset_(offset), out_(out), guides_(guides), rays_(rays) {}
+
+  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
+    if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
+    const std::uint32_t key = pixel_seed(params_.ao.seed, x, y), point_key = hash_combine(key, 0x3c6ef372u);
+    const int samples = params_.ao.samples, points = std::min(params_.cage_points, samples);
+    const bool geometric = params_.ao.normal == SurfaceNormal::Geometric;
+    if (guides_) noise_.reset(samples);
+    detail::MeanAccumulator acc;  // over the samples whose cage point found the high mesh
+    std::uint64_t traced = 0;
+    Vec3 bent{0, 0, 0};
+    for (int j = 0; j < points; ++j) {
+      const HighHit h = cage_rays_(ctx, detail::sample_patch(patch, sobol_owen_2d(static_cast<std::uint32_t>(j), point_key)));
+      if (!h.hit) continue;
+      const Vec3 origin = h.p + h.ng * offset_;
+      const int end = static_cast<int>(static_cast<std::int64_t>(j + 1) * samples / points);
+      for (int first = static_cast<int>(static_cast<std::int64_t>(j) * samples / points); first < end; first += 16) {
+        const int count = std::min(16, end - first);
+        sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, u_);  // dimensions 0-1: the direction
+        detail::make_hemisphere_rays(origin, geometric ? h.ng : h.n, h.ng, u_, count, batch_);
+        float mu[16];
+        batch_tracer_.trace(ctx, batch_, count, true, mu);
+        for (int k = 0; k < count; ++k) {
+          acc.add(mu[k]);
+          if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
+          if (!batch_.valid[k]) continue;
+          ++traced;
+          bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+        }
+      }
+    }
+    rays_ += static_cast<std::uint64_t>(points) + traced;  // a cage ray per cage point, and the AO rays
+    if (acc.n == 0) {
+      out_.missed[texel] = 1;
+      return;
+    }
+    out_.visibility[texel] = static_cast<float>(acc.mean());
+    if (params_.ao.bent_normals) out_.bent_normal[texel] = normalize(bent);
+    if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
+  }
+
+ private:
+  const CageRays& cage_rays_;
+  detail::BatchTracer<N> batch_tracer_;
+  const HighToLowParams& params_;
+  float offset_;
+  BakeResult& out_;
+  TexelGuides* guides_;
+  std::atomic<std::uint64_t>& rays_;
+  detail::StratifiedVariance noise_;
+  alignas(64) float u_[4][16] = {};  // lanes past a block's count keep any finite values
+  alignas(64) detail::TexelRayBatch batch_;
+};
 
 }  // namespace
 
-void HighToLowParams::validate() const {
-  ao.validate();
-  if (!finite_nonnegative(cage_extrusion)) throw InputError("high-to-low: cage extrusion must be a finite number >= 0 (world units)");
-  if (!finite_nonnegative(max_front)) throw InputError("high-to-low: max front distance must be a finite number >= 0 (world units)");
-  if (!finite_nonnegative(max_back)) throw InputError("high-to-low: max back distance must be a finite number >= 0 (world units)");
+const ParamTable<HighToLowParams>& high_to_low_param_table() {
+  using P = Param<HighToLowParams>;
+  using H = HighToLowParams;
+  static const ParamTable<H> table{
+      "bake high-to-low",
+      {nested_params<H>(raytraced_bake_param_table(), &H::ao),
+       {P::optional_real("cage_extrusion", &H::cage_extrusion, Range::closed(0, kMaxCoordinate), "world units",
+                         "D: cage = low vertex + D x smoothed normal; null = 0.01 x the low mesh's diagonal; not with an explicit cage"),
+        P::optional_real("max_front", &H::max_front, Range::closed(0, kMaxCoordinate), "world units",
+                         "how far outside the low surface a ray starts; null = at the cage"),
+        P::optional_real("max_back", &H::max_back, Range::closed(0, kMaxCoordinate), "world units",
+                         "how far inside the low surface a ray still looks for the high mesh; null = the cage distance at that point"),
+        P::integer("cage_points", &H::cage_points, Range::closed(1, 1 << 20), "",
+                   "cage rays per texel, stratified over its patch, each carrying an equal share of the texel's AO rays (at most one per sample)")}}};
+  return table;
 }
 
-void to_json(nlohmann::json& j, const HighToLowParams& p) {
-  auto opt = [](const std::optional<float>& v, const char* otherwise) { return v ? nlohmann::json(*v) : nlohmann::json(otherwise); };
-  j = {{"ao", p.ao},
-       {"cage_extrusion", opt(p.cage_extrusion, "0.01 x low diagonal")},
-       {"max_front", opt(p.max_front, "cage")},
-       {"max_back", opt(p.max_back, "cage distance")}};
+void HighToLowParams::validate() const {
+  high_to_low_param_table().validate(*this);
+  ao.validate();
 }
+void to_json(nlohmann::json& j, const HighToLowParams& p) { j = high_to_low_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, HighToLowParams& p) { high_to_low_param_table().from_json(j, p); }
 
 CagePositions extrude_cage(const Scene& low, float distance) {
   const auto normals = smoothed_normals(low);
@@ -161,51 +269,22 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   out.warnings = cov.warnings();
   if (params.ao.bent_normals) out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
   const float surface_eps = 1e-6f * occluders.bounds().diagonal();  // cage this close to the surface: no direction from it
-  std::atomic<std::uint64_t> traced{0};
-  const auto make_ray = [&](RTCIntersectContext& ctx, const detail::TexelSample& s, Vec3& org, Vec3& dir) {
-    const PatchPiece& pc = *s.point.piece;
-    const Vec3 p = s.point.position(), bary = s.point.barycentrics();
-    const std::uint32_t* vi = &low.meshes[pc.mesh].indices[3 * pc.triangle];
-    const auto& cg = cage[pc.mesh];
-    const Vec3 c = cg[vi[0]] * bary.x + cg[vi[1]] * bary.y + cg[vi[2]] * bary.z;
-    const float cage_distance = length(c - p);
-    Vec3 d;
-    if (cage_distance > surface_eps) {
-      d = (p - c) / cage_distance;
-    } else {
-      const auto& sn = smooth[pc.mesh];
-      d = -normalize(sn[vi[0]] * bary.x + sn[vi[1]] * bary.y + sn[vi[2]] * bary.z);
-    }
-    const float front = params.max_front.value_or(cage_distance), back = params.max_back.value_or(cage_distance);
-    const HighHit h = trace_cage_ray(targets, target_fn, ctx, p - d * front, d, front + back);
-    if (!h.hit) return detail::SampleRay::Skip;
-    const Vec3 w = Frame::from_normal(params.ao.normal == SurfaceNormal::Geometric ? h.ng : h.n).to_world(cosine_hemisphere(s.u_direction));
-    if (dot(w, h.ng) <= 0) return detail::SampleRay::Occluded;  // below the high face: occluded by the surface itself (mu = 0)
-    org = h.p + h.ng * offset;
-    dir = w;
-    return detail::SampleRay::Trace;
-  };
-  const auto finish = [&](std::size_t texel, const detail::TexelSums& sums) {
-    traced += static_cast<std::uint64_t>(sums.traced);
-    if (sums.counted == 0) {
-      out.missed[texel] = 1;
-      return;
-    }
-    out.visibility[texel] = static_cast<float>(sums.mu / sums.counted);
-    if (params.ao.bent_normals) out.bent_normal[texel] = normalize(sums.bent);
-  };
+  const CageRays cage_rays{low, cage, smooth, targets, target_fn, params, surface_eps};
   // The filter's guides are the low mesh's patches: the map lives in its UV charts.
   const bool denoise = params.ao.denoise > 0;
   TexelGuides guides;
   if (denoise) guides = TexelGuides(width, height);
-  const std::size_t texels =
-      detail::bake_texels(low, cov, tracer, params.ao.samples, params.ao.seed, progress, denoise ? &guides : nullptr, make_ray, finish);
-  out.rays = static_cast<std::uint64_t>(texels) * static_cast<std::uint64_t>(params.ao.samples) + traced.load();  // a cage ray per sample, plus the AO rays
+  std::atomic<std::uint64_t> rays{0};
+  const TriangleNormals low_fn = detail::face_normals(low);
+  detail::for_each_texel_patch(occluders, low, cov, low_fn, progress, [&]<int N>() {
+    return TexelWorker<N>(cage_rays, tracer, params, offset, out, denoise ? &guides : nullptr, rays);
+  });
+  out.rays = rays.load();
   for (std::size_t i = 0; i < out.missed.size(); ++i) out.missed_texels += out.missed[i];
   if (denoise) {  // over the texels that have a value; the missed ones are filled after, from filtered neighbours
     Image<std::uint8_t> valid = out.mask;
     for (std::size_t i = 0; i < valid.size(); ++i) valid[i] = valid[i] && !out.missed[i];
-    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise, params.ao.samples);
+    denoise_map(out.visibility, valid, cov, guides, params.ao.denoise);
   }
   fill_missed_texels(out);
   out.stats = {{"rays", out.rays}, {"offset", offset}, {"missed_texels", out.missed_texels}};

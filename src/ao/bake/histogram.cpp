@@ -100,18 +100,29 @@ std::optional<BakeNormalization> parse_normalization(std::string_view name) {
   return std::nullopt;
 }
 
-void HistogramParams::validate() const {
-  if (directions < 1 || directions > 65536) throw InputError("histogram: directions must be in [1, 65536], got " + std::to_string(directions));
-  if (!(pixels_per_texel > 0.0f && pixels_per_texel <= 8.0f)) throw InputError("histogram: pixels per texel must be in (0, 8]");
-  if (!(point_size >= 1.0f && point_size <= 16.0f)) throw InputError("histogram: point size must be in [1, 16] texels");
-  if (!(min_samples >= 0.0f && min_samples <= 1e6f)) throw InputError("histogram: min samples must be in [0, 1e6]");
+const ParamTable<HistogramParams>& histogram_param_table() {
+  using P = Param<HistogramParams>;
+  using H = HistogramParams;
+  static const ParamTable<H> table{
+      "bake histogram",
+      {P::integer("directions", &H::directions, Range::closed(1, 65536), "", "D: directions on the whole sphere (about half light a texel)"),
+       P::enumeration<DirectionSet>("direction_set", &H::direction_set, {{"fibonacci", DirectionSet::Fibonacci}, {"gaussian", DirectionSet::Gaussian}},
+                                    "fibonacci (stratified; lower error) or the paper's gaussian"),
+       P::real("pixels_per_texel", &H::pixels_per_texel, Range::open_closed(0, 8), "", "view resolution: pixels along an average texel's edge seen face-on"),
+       P::real("point_size", &H::point_size, Range::closed(1, 16), "texels", "sec. 3.2 splat size: 1 = one texel (no smoothing); > 1 blurs"),
+       P::enumeration<BakeNormalization>("normalization", &H::normalization, {{"area", BakeNormalization::Area}, {"max", BakeNormalization::Max}},
+                                         "area (exact, absolute V) or max (the paper's: the most open texel is 1)"),
+       P::boolean("seam_fix", &H::seam_fix, "sec. 3.3: refill chart-border texels less than half covered from the nearest well-covered texel"),
+       P::real("min_samples", &H::min_samples, Range::closed(0, 1e6), "",
+               "texels expected to get fewer pixel samples than this (chart slivers) copy the nearest texel that gets enough; 0 = off"),
+       P::boolean("bent_normals", &H::bent_normals, "also accumulate the average unoccluded direction (sec. 3)"),
+       P::seed("seed", &H::seed, "keys the directions and the per-direction pixel-grid offsets")}};
+  return table;
 }
 
-void to_json(nlohmann::json& j, const HistogramParams& p) {
-  j = {{"directions", p.directions},         {"direction_set", to_string(p.direction_set)}, {"pixels_per_texel", p.pixels_per_texel},
-       {"point_size", p.point_size},         {"normalization", to_string(p.normalization)}, {"seam_fix", p.seam_fix},
-       {"bent_normals", p.bent_normals},     {"min_samples", p.min_samples}, {"seed", p.seed}};
-}
+void HistogramParams::validate() const { histogram_param_table().validate(*this); }
+void to_json(nlohmann::json& j, const HistogramParams& p) { j = histogram_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, HistogramParams& p) { histogram_param_table().from_json(j, p); }
 
 float histogram_pixel_size(const TexelCoverage& coverage, float pixels_per_texel) {
   double area = 0;

@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/core/params.h"
+
 #include "ao/bake/bake_result.h"
 #include "ao/bake/sphere_directions.h"
 #include "ao/bake/texel_coverage.h"
@@ -38,6 +40,9 @@ struct HistogramParams {
   void validate() const;
 };
 void to_json(nlohmann::json& j, const HistogramParams& p);
+void from_json(const nlohmann::json& j, HistogramParams& p);
+/// The histogram baker's parameter table (core/params.h).
+const ParamTable<HistogramParams>& histogram_param_table();
 
 /// Bakes V per texel of a W x H map (coverage.width x coverage.height) for the meshes of `scene`
 /// that have UVs; meshes without UVs still occlude. `coverage` must come from

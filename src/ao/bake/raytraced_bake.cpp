@@ -9,9 +9,9 @@
 // the texel centre, is what keeps thin charts and texels that straddle several triangles from
 // aliasing. The patch (its pieces with world-space corners, built once per texel), the sample set
 // in direction order (TexelPoints), the lane-parallel ray maker and the tracer (reference/
-// raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) are
-// in texel_rays_internal.h, shared with high_to_low.cpp; the tile loop here hands the default bake's
-// 16 rays to Embree as one occlusion packet.
+// raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) and
+// the tile loop are in texel_rays_internal.h, shared with high_to_low.cpp; the default bake's 16
+// rays go to Embree as one occlusion packet (BatchTracer).
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>
@@ -27,10 +27,10 @@
 #include "ao/bake/denoise.h"
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
-#include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
-#include "ao/reference/packets_internal.h"
+#include "ao/reference/mean_accumulator_internal.h"
 #include "ao/reference/ray_offset.h"
+#include "ao/reference/ray_tiles_internal.h"
 
 namespace ao {
 
@@ -74,14 +74,80 @@ using detail::PatchPiece;
 using detail::Tracer;
 using detail::TriangleNormals;
 
+// A tile's worker for bake_raytraced: the texel's sample points in direction order (TexelPoints),
+// made into rays 16 at a time in SIMD lanes (make_texel_rays), and traced as one 16-wide occlusion
+// packet where the bake needs no more than that (BatchTracer).
+template <int N>
+class TexelWorker {
+ public:
+  TexelWorker(const Tracer& tracer, const RaytracedBakeParams& params, BakeResult& out, TexelGuides* guides)
+      : batch_tracer_(tracer), params_(params), out_(out), guides_(guides) {}
+
+  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
+    const bool geometric = params_.normal == SurfaceNormal::Geometric;
+    table_.build(patch, params_.offset);
+    if (guides_) detail::patch_guide(patch, geometric, guides_->position[texel], guides_->normal[texel]);
+    points_.generate(pixel_seed(params_.seed, x, y), params_.samples);
+    if (guides_) noise_.reset(params_.samples);
+    detail::MeanAccumulator acc;
+    Vec3 bent{0, 0, 0};
+    for (int first = 0; first < params_.samples; first += 16) {
+      const int count = std::min(16, params_.samples - first);
+      points_.lanes(first, count, u_);
+      detail::make_texel_rays(patch, table_, u_, count, geometric, batch_);
+      // The default bake (no bent normals) hands the batch to Embree as one packet.
+      float mu[16];
+      batch_tracer_.trace(ctx, batch_, count, !params_.bent_normals, mu);
+      for (int k = 0; k < count; ++k) {
+        acc.add(mu[k]);  // a direction below the face (no ray) counts as occluded, mu = 0
+        if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
+        if (batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+      }
+    }
+    out_.visibility[texel] = static_cast<float>(acc.mean());
+    if (params_.bent_normals) out_.bent_normal[texel] = normalize(bent);
+    if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
+  }
+
+ private:
+  detail::BatchTracer<N> batch_tracer_;
+  detail::StratifiedVariance noise_;
+  const RaytracedBakeParams& params_;
+  BakeResult& out_;
+  TexelGuides* guides_;
+  detail::TexelPoints points_;
+  alignas(64) detail::PatchTable table_;
+  alignas(64) float u_[4][16];
+  alignas(64) detail::TexelRayBatch batch_;
+};
+
 }  // namespace
 
+const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table() {
+  using P = Param<RaytracedBakeParams>;
+  using R = RaytracedBakeParams;
+  static const ParamTable<R> table{
+      "bake raytraced",
+      {P::integer("samples", &R::samples, Range::closed(1, kMaxSamples), "", "rays per texel (per vertex for per-vertex AO), each from its own point of the patch"),
+       P::optional_real("max_distance", &R::max_distance, Range::above(0), "world units",
+                        "R: occluders count only within this distance; null = unlimited (the paper's eq. 1)"),
+       P::enumeration<Membership>("membership", &R::membership,
+                                  {{"step", Membership::Step}, {"linear", Membership::Linear}, {"sqrt", Membership::Sqrt}, {"cubic", Membership::Cubic}},
+                                  "falloff mu(d) within max_distance"),
+       P::real("offset", &R::offset, Range::closed(0, kMaxCoordinate), "world units",
+               "ray origin offset along the face normal; 0 = scale-free, a few float spacings of the coordinates (reference/ray_offset.h)"),
+       P::boolean("ignore_back_faces", &R::ignore_back_faces, "rays pass through back faces (xNormal's and Substance's 'ignore backface')"),
+       P::enumeration<SurfaceNormal>("normal", &R::normal, {{"shading", SurfaceNormal::Shading}, {"geometric", SurfaceNormal::Geometric}},
+                                     "the hemisphere: about the interpolated shading normal, or the triangle's own"),
+       P::boolean("bent_normals", &R::bent_normals, "also average the unoccluded directions per texel"),
+       P::seed("seed", &R::seed, "keys the per-texel sample sets"),
+       P::real("denoise", &R::denoise, Range::closed(0, kMaxDenoiseSigma), "texels",
+               "sigma of the texture-space filter of maps (denoise.h); 0 = off, the plain estimate of eq. 2")}};
+  return table;
+}
+
 void RaytracedBakeParams::validate() const {
-  if (samples < 1 || samples > kMaxSamples) throw InputError("bake raytraced: samples must be in [1, 1048576], got " + std::to_string(samples));
-  if (max_distance && !(*max_distance > 0 && std::isfinite(*max_distance)))
-    throw InputError("bake raytraced: max distance must be a finite number > 0 (omit it for unlimited distance)");
-  if (!(offset >= 0.0f && offset <= kMaxCoordinate)) throw InputError("bake raytraced: --offset must be a number in [0, 1e9] world units (kMaxCoordinate)");
-  if (!(denoise >= 0.0f && denoise <= kMaxDenoiseSigma)) throw InputError("bake raytraced: --denoise must be a filter sigma in [0, 4] texels (0 = off)");
+  raytraced_bake_param_table().validate(*this);
   if (max_distance) falloff().validate();
 }
 
@@ -93,21 +159,11 @@ Falloff RaytracedBakeParams::falloff() const {
   return Falloff{membership, *max_distance};
 }
 
-void to_json(nlohmann::json& j, const RaytracedBakeParams& p) {
-  j = {{"samples", p.samples},
-       {"max_distance", p.max_distance ? nlohmann::json(*p.max_distance) : nlohmann::json("unlimited")},
-       {"membership", to_string(p.membership)},
-       {"offset", p.offset},
-       {"ignore_back_faces", p.ignore_back_faces},
-       {"bent_normals", p.bent_normals},
-       {"normal", p.normal == SurfaceNormal::Geometric ? "geometric" : "shading"},
-       {"seed", p.seed},
-       {"denoise", p.denoise}};
-}
+void to_json(nlohmann::json& j, const RaytracedBakeParams& p) { j = raytraced_bake_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, RaytracedBakeParams& p) { raytraced_bake_param_table().from_json(j, p); }
 
 BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const RaytracedBakeParams& params, const ProgressFn& progress) {
   params.validate();
-  const bool geometric = params.normal == SurfaceNormal::Geometric;
   const Scene& scene = rs.scene();
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
@@ -118,84 +174,15 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   out.covered_texels = cov.covered_texels;
   out.warnings = cov.warnings();
   if (params.bent_normals) out.bent_normal = Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0});
-  const float fixed_offset = params.offset;
-  // A step membership (unlimited distance is a step at infinity) needs only whether something lies
-  // within reach: Embree's any-hit occlusion query.
-  const bool occlusion_only = falloff.membership == Membership::Step && !params.ignore_back_faces;
-  const float reach = falloff.reach();
-  const TriangleNormals& surface_normals = fn;
-  // The filter's guides, filled in the tile loop from the patches it builds anyway.
+  // The filter's guides, filled in the tile loop from the patches it builds anyway and each
+  // texel's samples.
   const bool denoise = params.denoise > 0;
   TexelGuides guides;
   if (denoise) guides = TexelGuides(cov.width, cov.height);
-  ProgressCounter counter(progress, cov.texel_count());
-  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(cov.width, cov.height, detail::kTexelTile, [&](const Tile& t) {
-      detail::flush_denormals_to_zero();
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      std::vector<PatchPiece> patch;
-      detail::TexelPoints points;
-      alignas(64) detail::PatchTable table;
-      alignas(64) float u[4][16];
-      alignas(64) detail::TexelRayBatch batch;
-      alignas(64) RTCRay16 packet;  // the 16-wide occlusion packet; lanes' fixed fields set once
-      for (int k = 0; k < 16; ++k) detail::set_ray(packet, k, {0, 0, 0}, {0, 0, 1}, reach);
-      std::array<Vec3, 16> org, dir;
-      std::array<float, 16> mu;
-      for (int y = t.y0; y < t.y1; ++y)
-        for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
-          if (!cov.mask[texel]) continue;
-          detail::build_patch(scene, cov, surface_normals, texel, patch);
-          if (patch.empty()) continue;
-          table.build(patch, fixed_offset);
-          if (denoise) detail::patch_guide(patch, geometric, guides.position[texel], guides.normal[texel]);
-          points.generate(pixel_seed(params.seed, x, y), params.samples);
-          double sum = 0;
-          Vec3 bent{0, 0, 0};
-          for (int first = 0; first < params.samples; first += 16) {
-            const int count = std::min(16, params.samples - first);
-            points.lanes(first, count, u);
-            detail::make_texel_rays(patch, table, u, count, geometric, batch);
-            if constexpr (N == 16) {
-              if (occlusion_only && !params.bent_normals) {
-                // The default bake: the batch is the packet (tfar is reset, as Embree sets it to
-                // -infinity for an occluded lane); mu is 1 for a lane with nothing within reach.
-                for (int k = 0; k < 16; ++k) {
-                  packet.org_x[k] = batch.ox[k], packet.org_y[k] = batch.oy[k], packet.org_z[k] = batch.oz[k];
-                  packet.dir_x[k] = batch.dx[k], packet.dir_y[k] = batch.dy[k], packet.dir_z[k] = batch.dz[k];
-                  packet.tfar[k] = reach;
-                }
-                rtcOccluded16(batch.valid, embree_scene(rs), &ctx, &packet);
-                int unoccluded = 0;
-                for (int k = 0; k < 16; ++k) unoccluded += batch.valid[k] != 0 && packet.tfar[k] >= 0;
-                sum += unoccluded;
-                continue;
-              }
-            }
-            // Everything else: the traced lanes, compacted, through the general tracer.
-            int live = 0;
-            for (int k = 0; k < count; ++k)
-              if (batch.valid[k]) {
-                org[static_cast<std::size_t>(live)] = {batch.ox[k], batch.oy[k], batch.oz[k]};
-                dir[static_cast<std::size_t>(live)] = {batch.dx[k], batch.dy[k], batch.dz[k]};
-                ++live;
-              }
-            constexpr int step = N == 1 ? 16 : N;
-            for (int at = 0; at < live; at += step) tracer.template trace<N>(ctx, org.data() + at, dir.data() + at, std::min(step, live - at), mu.data() + at);
-            for (int k = 0; k < live; ++k) {
-              sum += mu[static_cast<std::size_t>(k)];
-              bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
-            }
-          }
-          out.visibility[texel] = static_cast<float>(sum / params.samples);
-          if (params.bent_normals) out.bent_normal[texel] = normalize(bent);
-        }
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0));
-    });
+  detail::for_each_texel_patch(rs, scene, cov, fn, progress, [&]<int N>() {
+    return TexelWorker<N>(tracer, params, out, denoise ? &guides : nullptr);
   });
-  if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise, params.samples);
+  if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise);
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
   out.stats = {{"rays", out.rays}, {"offset", params.offset > 0 ? nlohmann::json(params.offset) : nlohmann::json("scale-free")}};
   return out;
@@ -262,55 +249,51 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
   // index, so the result is the same in any order.
   const std::vector<std::uint32_t> order = morton_order(scene, verts);
   ProgressCounter counter(progress, verts.size());
-  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    // One "row" of vertices, tiled 256 at a time.
-    parallel_for_tiles(count, 1, 256, [&](const Tile& t) {
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      constexpr int batch = N == 1 ? 16 : N;
-      std::array<Vec3, batch> org, dir;
-      std::array<float, batch> mu;
-      for (int oi = t.x0; oi < t.x1; ++oi) {
-        const auto vi = static_cast<int>(order[static_cast<std::size_t>(oi)]);
-        const Mesh& m = scene.meshes[verts[static_cast<std::size_t>(vi)].first];
-        const std::uint32_t v = verts[static_cast<std::size_t>(vi)].second;
-        const std::uint32_t mi = verts[static_cast<std::size_t>(vi)].first;
-        const Vec3 nrm = normalize(m.normals[v]);
-        const Frame frame = Frame::from_normal(nrm);
-        const std::uint32_t key = pixel_seed(params.seed, vi, 0);
-        const float offset = mesh_offset[mi];
-        // Geometric: sample k takes the face whose share of the vertex's cumulative triangle area
-        // contains (k + 0.5) / samples (stratified by area), and its direction about that face.
-        std::span<const std::uint32_t> tris;
-        std::span<const float> cdf;
-        if (geometric) {
-          const VertexFaces& vf = faces[mi];
-          tris = std::span(vf.triangles).subspan(vf.first[v], vf.first[v + 1] - vf.first[v]);
-          cdf = std::span(vf.cumulative_area).subspan(vf.first[v], vf.first[v + 1] - vf.first[v]);
-        }
-        double sum = 0;
-        for (int first = 0; first < params.samples; first += batch) {
-          const int c = std::min(batch, params.samples - first);
-          for (int k = 0; k < c; ++k) {
-            Frame f = frame;
-            if (!tris.empty()) {
-              const float target = (static_cast<float>(first + k) + 0.5f) / static_cast<float>(params.samples) * cdf.back();
-              const std::size_t j = std::min<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), target) - cdf.begin(), tris.size() - 1);
-              f = Frame::from_normal(fn.per_mesh[mi][tris[j]]);
-            }
-            // Off along the vertex normal in both modes: it leans away from every face at the
-            // vertex, so the origin clears all of them (a face normal would leave it on the plane
-            // of a neighbouring face in a crease).
-            org[static_cast<std::size_t>(k)] = m.positions[v] + nrm * offset;
-            dir[static_cast<std::size_t>(k)] = f.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), key)));
-          }
-          tracer.template trace<N>(ctx, org.data(), dir.data(), c, mu.data());
-          for (int k = 0; k < c; ++k) sum += mu[static_cast<std::size_t>(k)];
-        }
-        out[static_cast<std::size_t>(vi)] = static_cast<float>(sum / params.samples);
+  // One "row" of vertices, tiled 256 at a time.
+  detail::for_each_ray_tile(rs, count, 1, detail::RayTiling{256, 1}, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    constexpr int batch = N == 1 ? 16 : N;
+    std::array<Vec3, batch> org, dir;
+    std::array<float, batch> mu;
+    for (int oi = t.x0; oi < t.x1; ++oi) {
+      const auto vi = static_cast<int>(order[static_cast<std::size_t>(oi)]);
+      const Mesh& m = scene.meshes[verts[static_cast<std::size_t>(vi)].first];
+      const std::uint32_t v = verts[static_cast<std::size_t>(vi)].second;
+      const std::uint32_t mi = verts[static_cast<std::size_t>(vi)].first;
+      const Vec3 nrm = normalize(m.normals[v]);
+      const Frame frame = Frame::from_normal(nrm);
+      const std::uint32_t key = pixel_seed(params.seed, vi, 0);
+      const float offset = mesh_offset[mi];
+      // Geometric: sample k takes the face whose share of the vertex's cumulative triangle area
+      // contains (k + 0.5) / samples (stratified by area), and its direction about that face.
+      std::span<const std::uint32_t> tris;
+      std::span<const float> cdf;
+      if (geometric) {
+        const VertexFaces& vf = faces[mi];
+        tris = std::span(vf.triangles).subspan(vf.first[v], vf.first[v + 1] - vf.first[v]);
+        cdf = std::span(vf.cumulative_area).subspan(vf.first[v], vf.first[v + 1] - vf.first[v]);
       }
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0));
-    });
+      detail::MeanAccumulator acc;
+      for (int first = 0; first < params.samples; first += batch) {
+        const int c = std::min(batch, params.samples - first);
+        for (int k = 0; k < c; ++k) {
+          Frame f = frame;
+          if (!tris.empty()) {
+            const float target = (static_cast<float>(first + k) + 0.5f) / static_cast<float>(params.samples) * cdf.back();
+            const std::size_t j = std::min<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), target) - cdf.begin(), tris.size() - 1);
+            f = Frame::from_normal(fn.per_mesh[mi][tris[j]]);
+          }
+          // Off along the vertex normal in both modes: it leans away from every face at the
+          // vertex, so the origin clears all of them (a face normal would leave it on the plane
+          // of a neighbouring face in a crease).
+          org[static_cast<std::size_t>(k)] = m.positions[v] + nrm * offset;
+          dir[static_cast<std::size_t>(k)] = f.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), key)));
+        }
+        tracer.template trace<N>(ctx, org.data(), dir.data(), c, mu.data());
+        for (int k = 0; k < c; ++k) acc.add(mu[static_cast<std::size_t>(k)]);
+      }
+      out[static_cast<std::size_t>(vi)] = static_cast<float>(acc.mean());
+    }
+    return static_cast<std::size_t>(t.x1 - t.x0);
   });
   if (rays_traced) *rays_traced = static_cast<std::uint64_t>(verts.size()) * static_cast<std::uint64_t>(params.samples);
   return out;

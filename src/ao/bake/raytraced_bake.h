@@ -14,6 +14,7 @@
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/core/params.h"
 #include "ao/core/progress.h"
 #include "ao/reference/ray_scene.h"
 
@@ -43,6 +44,10 @@ struct RaytracedBakeParams {
   Falloff falloff() const;
 };
 void to_json(nlohmann::json& j, const RaytracedBakeParams& p);
+void from_json(const nlohmann::json& j, RaytracedBakeParams& p);
+/// The ray-traced baker's parameter table (core/params.h): JSON in and out, validate(), the CLI's
+/// help and the docs come from it.
+const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table();
 
 /// Triangles above which a ray-traced bake builds a Medium BVH (binned SAH) instead of a High one
 /// (SAH with spatial splits). The spatial splits pay off on long thin triangles, the stuff of

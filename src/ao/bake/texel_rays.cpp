@@ -92,6 +92,18 @@ inline void sincos_quarter(float t, float& s, float& c) {
   c = 1.0f + t2 * (-1.0f / 2 + t2 * (1.0f / 24 + t2 * (-1.0f / 720 + t2 * (1.0f / 40320 + t2 * (-1.0f / 3628800)))));
 }
 
+// cosine_hemisphere: the concentric map with phi = (pi/4)(b/a) when |a| > |b|, else
+// pi/2 - (pi/4)(a/b), whose cosine and sine are the sine and cosine of (pi/4)(a/b).
+inline void concentric_hemisphere(float u0, float u1, float& lx, float& ly, float& lz) {
+  const float ca = 2.0f * u0 - 1.0f, cb = 2.0f * u1 - 1.0f;
+  const bool use_a = std::abs(ca) > std::abs(cb);
+  const float rad = use_a ? ca : cb, q = use_a ? cb : ca;
+  float s, c;
+  sincos_quarter((kPi / 4) * (q / (rad != 0.0f ? rad : 1.0f)), s, c);  // a = b = 0: rad = 0, so (0, 0, 1)
+  lx = rad * (use_a ? c : s), ly = rad * (use_a ? s : c);
+  lz = std::sqrt(std::max(0.0f, 1.0f - lx * lx - ly * ly));
+}
+
 }  // namespace
 
 void TexelPoints::generate(std::uint32_t key, int samples) {
@@ -124,6 +136,38 @@ void TexelPoints::generate(std::uint32_t key, int samples) {
     const std::size_t to = cell_count[cell_of[i]]++;
     for (int d = 0; d < 4; ++d) u[d][to] = scratch[d][i];
   }
+}
+
+void StratifiedVariance::reset(int samples) {
+  int m = 0;
+  while ((2 << m) <= samples) ++m;  // 2^m <= samples < 2^(m+1)
+  // 2^(m-1) cells, as square as it goes.
+  const int c = std::max(m - 1, 0);
+  cols_ = 1 << ((c + 1) / 2), rows_ = 1 << (c / 2);
+  cells_.assign(static_cast<std::size_t>(cols_ * rows_), Sums{});
+}
+
+double StratifiedVariance::mean_variance() const {
+  double within = 0, pooled_ss = 0;
+  int n = 0, singles = 0, pooled_dof = 0;
+  for (const Sums& c : cells_) {
+    n += c.n;
+    if (c.n == 1) ++singles;
+    if (c.n < 2) continue;
+    const double ss = std::max(0.0, c.sum_sq - c.sum * c.sum / c.n);  // squares about the cell's mean: (n_c - 1) s_c^2
+    within += ss * c.n / (c.n - 1);  // n_c s_c^2
+    pooled_ss += ss;
+    pooled_dof += c.n - 1;
+  }
+  if (n < 2) return 0.0;
+  if (pooled_dof == 0) {
+    // No cell holds two samples (fewer than four samples): the plain sample variance.
+    double sum = 0, sum_sq = 0;
+    for (const Sums& c : cells_) sum += c.sum, sum_sq += c.sum_sq;
+    return std::max(0.0, (sum_sq - sum * sum / n) / (n - 1)) / n;
+  }
+  within += singles * (pooled_ss / pooled_dof);  // a lone sample's cell: the pooled within-cell variance
+  return within / (static_cast<double>(n) * n);
 }
 
 void TexelPoints::lanes(int first, int count, float (&out)[4][16]) const {
@@ -205,15 +249,8 @@ void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& tab
     const float fc = nx * ny * fa;
     const float tx = 1.0f + sign * nx * nx * fa, ty = sign * fc, tz = -sign * nx;
     const float bx = fc, by = sign + ny * ny * fa, bz = -ny;
-    // cosine_hemisphere: the concentric map with phi = (pi/4)(b/a) when |a| > |b|, else
-    // pi/2 - (pi/4)(a/b), whose cosine and sine are the sine and cosine of (pi/4)(a/b).
-    const float ca = 2.0f * u[0][k] - 1.0f, cb = 2.0f * u[1][k] - 1.0f;
-    const bool use_a = std::abs(ca) > std::abs(cb);
-    const float rad = use_a ? ca : cb, q = use_a ? cb : ca;
-    float s, c;
-    sincos_quarter((kPi / 4) * (q / (rad != 0.0f ? rad : 1.0f)), s, c);  // a = b = 0: rad = 0, so (0, 0, 1)
-    const float lx = rad * (use_a ? c : s), ly = rad * (use_a ? s : c);
-    const float lz = std::sqrt(std::max(0.0f, 1.0f - lx * lx - ly * ly));
+    float lx, ly, lz;
+    concentric_hemisphere(u[0][k], u[1][k], lx, ly, lz);
     const float dx = tx * lx + bx * ly + nx * lz, dy = ty * lx + by * ly + ny * lz, dz = tz * lx + bz * ly + nz * lz;
     // Below the face: occluded by the surface itself (mu = 0), no ray.
     const bool above = dx * lane[kNg][k] + dy * lane[kNg + 1][k] + dz * lane[kNg + 2][k] > 0;
@@ -221,6 +258,18 @@ void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& tab
     out.ox[k] = pos[0] + lane[kNg][k] * lane[kOff][k];
     out.oy[k] = pos[1] + lane[kNg + 1][k] * lane[kOff][k];
     out.oz[k] = pos[2] + lane[kNg + 2][k] * lane[kOff][k];
+    out.dx[k] = dx, out.dy[k] = dy, out.dz[k] = dz;
+  }
+}
+
+void make_hemisphere_rays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, TexelRayBatch& out) {
+  const Frame f = Frame::from_normal(n);
+  for (int k = 0; k < TexelRayBatch::kWidth; ++k) {
+    float lx, ly, lz;
+    concentric_hemisphere(u[0][k], u[1][k], lx, ly, lz);
+    const float dx = f.t.x * lx + f.b.x * ly + f.n.x * lz, dy = f.t.y * lx + f.b.y * ly + f.n.y * lz, dz = f.t.z * lx + f.b.z * ly + f.n.z * lz;
+    out.valid[k] = k < count && dx * ng.x + dy * ng.y + dz * ng.z > 0 ? -1 : 0;
+    out.ox[k] = origin.x, out.oy[k] = origin.y, out.oz[k] = origin.z;
     out.dx[k] = dx, out.dy[k] = dy, out.dz[k] = dz;
   }
 }

@@ -1,26 +1,24 @@
 // Pieces shared by the inside-out bakers (raytraced_bake.cpp, high_to_low.cpp): a texel's patch of
 // surface as sub-triangles for sampling points by area, the ray tracer that turns a batch of rays
-// into mu(D), the lane-parallel ray maker (make_texel_rays, TexelPoints) the ray-traced baker's own
-// tile loop uses, and the general tile loop high-to-low runs (bake_texels). Internal to src/ao/bake
-// (namespace detail).
+// into mu(D), the lane-parallel ray maker (make_texel_rays, TexelPoints) of the ray-traced baker,
+// and the bakers' one tile loop (for_each_texel_patch). Internal to src/ao/bake (namespace detail).
 #pragma once
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
-#include "ao/bake/denoise.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/membership.h"
 #include "ao/core/parallel.h"
 #include "ao/core/progress.h"
 #include "ao/core/sampling.h"
-#include "ao/reference/packets_internal.h"
 #include "ao/reference/embree_scene_internal.h"
+#include "ao/reference/packets_internal.h"
 #include "ao/reference/ray_scene.h"
+#include "ao/reference/ray_tiles_internal.h"
 
 namespace ao::detail {
 
@@ -117,6 +115,43 @@ struct TexelPoints {
   void lanes(int first, int count, float (&out)[4][16]) const;
 };
 
+/// The variance of a texel's mean measured from its own samples, as a stratified estimate: the
+/// samples' direction uniforms (dimensions 0-1) are binned into a grid of 2^(m-1) cells, 2^m the
+/// largest power of two <= the sample count, and
+///   var(mean) = sum over cells c of n_c s_c^2 / n^2,
+/// s_c^2 the unbiased variance of the n_c samples in cell c (a cell with a single sample takes the
+/// pooled variance of the others). Each aligned block of 2^m points of the Sobol set is a
+/// (0, m, 2)-net in dimensions 0-1, so at a power-of-two count every cell holds exactly two
+/// samples: the finest strata the set guarantees. The visibility varies far more across the
+/// hemisphere than within one of these cells, so this measures the noise the stratified samples
+/// actually have, which the plain sample variance (for mu in {0, 1}, the V (1 - V) / n bound)
+/// overstates several times over.
+class StratifiedVariance {
+ public:
+  /// Empties the sums and sizes the grid for `samples` samples (>= 1).
+  void reset(int samples);
+  /// The cell of a sample whose direction uniforms are (u0, u1) in [0, 1)^2.
+  std::uint32_t cell(float u0, float u1) const {
+    const int a = std::min(static_cast<int>(u0 * static_cast<float>(cols_)), cols_ - 1);
+    const int b = std::min(static_cast<int>(u1 * static_cast<float>(rows_)), rows_ - 1);
+    return static_cast<std::uint32_t>(a * rows_ + b);
+  }
+  void add(std::uint32_t cell, double v) {
+    Sums& c = cells_[cell];
+    c.sum += v, c.sum_sq += v * v, ++c.n;
+  }
+  /// The variance of the mean of the samples added (0 with fewer than two).
+  double mean_variance() const;
+
+ private:
+  struct Sums {
+    double sum = 0, sum_sq = 0;
+    int n = 0;
+  };
+  int cols_ = 1, rows_ = 1;
+  std::vector<Sums> cells_;
+};
+
 /// A patch's pieces as columns of per-field rows (corner positions, corner normals, face normal,
 /// ray offset, and where the piece starts in the cumulative area with 1 / its area), built once
 /// per texel for make_texel_rays, which looks a lane's piece up in each row.
@@ -141,6 +176,13 @@ struct PatchTable {
 /// concentric map's sine and cosine are polynomials (error under 1e-7).
 void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& table, const float (&u)[4][16], int count, bool geometric,
                      TexelRayBatch& out);
+
+/// Lanes 0 .. count - 1 (count in [1, 16]) of `out`: rays from `origin` in the cosine-weighted
+/// directions about the unit normal n that u[0][k], u[1][k] make (cosine_hemisphere's concentric
+/// map in Frame::from_normal(n), computed lane-parallel as make_texel_rays does), a lane's ray
+/// valid where its direction is above the plane of the unit face normal ng (below it: occluded by
+/// the surface itself, mu = 0, no ray); lanes from count on are not valid.
+void make_hemisphere_rays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, TexelRayBatch& out);
 
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {
@@ -209,90 +251,83 @@ struct Tracer {
   }
 };
 
-/// Texels per tile side of the inside-out bakers' tile loops: neighbouring texels lie close on the
+/// Traces the rays of a texel's batch (TexelRayBatch) with a Tracer in packets of the scene's
+/// native width N, keeping the fixed fields of a 16-wide occlusion packet from batch to batch.
+template <int N>
+class BatchTracer {
+ public:
+  explicit BatchTracer(const Tracer& tracer) : tracer_(tracer) {
+    for (int k = 0; k < 16; ++k) set_ray(packet_, k, {0, 0, 0}, {0, 0, 1}, tracer.falloff.reach());
+  }
+
+  /// mu of lanes 0 .. count - 1 of `batch` (count in [1, 16]) into mu[k]: 0 where valid[k] is 0
+  /// (no ray). `as_packet`: with 16-wide packets and an occlusion-only tracer, the batch goes to
+  /// Embree as it is, one packet whose valid lanes may have gaps; otherwise the valid lanes are
+  /// packed, in order, into packets of N.
+  void trace(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, bool as_packet, float (&mu)[16]) {
+    const float reach = tracer_.falloff.reach();
+    if constexpr (N == 16) {
+      if (as_packet && tracer_.falloff.membership == Membership::Step && !tracer_.ignore_back) {
+        // tfar is reset, as Embree sets it to -infinity for an occluded lane; mu is 1 for a lane
+        // with nothing within reach.
+        for (int k = 0; k < 16; ++k) {
+          packet_.org_x[k] = batch.ox[k], packet_.org_y[k] = batch.oy[k], packet_.org_z[k] = batch.oz[k];
+          packet_.dir_x[k] = batch.dx[k], packet_.dir_y[k] = batch.dy[k], packet_.dir_z[k] = batch.dz[k];
+          packet_.tfar[k] = reach;
+        }
+        rtcOccluded16(batch.valid, embree_scene(tracer_.rs), &ctx, &packet_);
+        for (int k = 0; k < 16; ++k) mu[k] = batch.valid[k] != 0 && packet_.tfar[k] >= 0 ? 1.0f : 0.0f;
+        return;
+      }
+    }
+    int live = 0;
+    for (int k = 0; k < count; ++k)
+      if (batch.valid[k]) {
+        org_[static_cast<std::size_t>(live)] = {batch.ox[k], batch.oy[k], batch.oz[k]};
+        dir_[static_cast<std::size_t>(live)] = {batch.dx[k], batch.dy[k], batch.dz[k]};
+        ++live;
+      }
+    constexpr int step = N == 1 ? 16 : N;
+    for (int at = 0; at < live; at += step) tracer_.template trace<N>(ctx, org_.data() + at, dir_.data() + at, std::min(step, live - at), mu_.data() + at);
+    for (int k = 0, j = 0; k < 16; ++k) mu[k] = k < count && batch.valid[k] ? mu_[static_cast<std::size_t>(j++)] : 0.0f;
+  }
+
+ private:
+  const Tracer& tracer_;
+  alignas(64) RTCRay16 packet_;
+  std::array<Vec3, 16> org_, dir_;
+  std::array<float, 16> mu_;
+};
+
+/// Texels per tile side of the inside-out bakers' tile loop: neighbouring texels lie close on the
 /// surface, so a tile's rays share BVH nodes in cache.
 inline constexpr int kTexelTile = 16;
 
-/// One sample of a texel: its point on the patch and the two uniforms its direction is made from.
-struct TexelSample {
-  PatchSample point;
-  Vec2 u_direction;
-};
-
-/// What a baker makes of a sample: a ray to trace (origin and direction set), a sample that counts
-/// as occluded without a ray (mu = 0: a direction below the face), or one left out of the texel's
-/// mean (a high-to-low cage ray that found no surface).
-enum class SampleRay { Trace, Occluded, Skip };
-
-/// A texel's totals over its samples.
-struct TexelSums {
-  double mu = 0;      ///< Sum of mu over the counted samples.
-  int counted = 0;    ///< Samples not skipped (traced or occluded).
-  int traced = 0;     ///< Rays traced.
-  Vec3 bent{0, 0, 0}; ///< Sum of direction x mu over the traced rays.
-};
-
-/// The tile loop of the high-to-low baker. For each covered texel of `cov` (computed on
-/// `surface`) with a non-empty patch: `samples` samples, sample i the point i of a 4-D
-/// Owen-scrambled Sobol set keyed by pixel_seed(seed, x, y) (dimensions 0-1 make the direction,
-/// 2-3 pick the point on the patch: one jointly stratified set), `make_ray(ctx, sample, origin, direction)` turns each into a
-/// SampleRay, the rays are traced by `tracer` in packets of its scene's native width, and
-/// `finish(texel, sums)` receives the texel's totals. Each texel's work depends only on its
-/// coordinates and the seed, so the result is the same at any thread count. With `guides`, each
-/// texel's patch_guide (shading normals of `surface`) is stored there for denoise_map. Returns the
-/// number of texels finished.
-template <class MakeRay, class Finish>
-std::size_t bake_texels(const Scene& surface, const TexelCoverage& cov, const Tracer& tracer, int samples, std::uint32_t seed,
-                        const ProgressFn& progress, TexelGuides* guides, MakeRay&& make_ray, Finish&& finish) {
-  const TriangleNormals fn = face_normals(surface);
-  std::atomic<std::size_t> finished{0};
-  ProgressCounter counter(progress, cov.texel_count());
-  dispatch_packet_width(tracer.rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(cov.width, cov.height, kTexelTile, [&](const Tile& t) {
-      flush_denormals_to_zero();
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      std::vector<PatchPiece> patch;
-      constexpr int batch = N == 1 ? 16 : N;
-      std::array<Vec3, batch> org, dir;
-      std::array<float, batch> mu;
-      std::size_t done = 0;
-      for (int y = t.y0; y < t.y1; ++y)
-        for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
-          if (!cov.mask[texel]) continue;
-          build_patch(surface, cov, fn, texel, patch);
-          if (patch.empty()) continue;
-          if (guides) patch_guide(patch, false, guides->position[texel], guides->normal[texel]);
-          const std::uint32_t key = pixel_seed(seed, x, y);
-          TexelSums sums;
-          for (int first = 0; first < samples; first += batch) {
-            const int count = std::min(batch, samples - first);
-            int live = 0;
-            for (int k = 0; k < count; ++k) {
-              // Directions on dimensions 0-1, whose 2-D projection is the best stratified: the
-              // visibility varies far more over the hemisphere than over the texel's patch.
-              const std::array<float, 4> u = sobol_owen_4d(static_cast<std::uint32_t>(first + k), key);
-              const TexelSample s{sample_patch(patch, {u[2], u[3]}), {u[0], u[1]}};
-              const SampleRay r = make_ray(ctx, s, org[static_cast<std::size_t>(live)], dir[static_cast<std::size_t>(live)]);
-              if (r != SampleRay::Skip) ++sums.counted;
-              if (r == SampleRay::Trace) ++live;
-            }
-            tracer.template trace<N>(ctx, org.data(), dir.data(), live, mu.data());
-            sums.traced += live;
-            for (int k = 0; k < live; ++k) {
-              sums.mu += mu[static_cast<std::size_t>(k)];
-              sums.bent += dir[static_cast<std::size_t>(k)] * mu[static_cast<std::size_t>(k)];
-            }
-          }
-          finish(texel, sums);
-          ++done;
-        }
-      finished += done;
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0));
-    });
+/// The tile loop of the inside-out bakers: every covered texel of `cov` (computed on `surface`,
+/// whose face normals are `fn`) that has a non-empty patch, in tiles of kTexelTile texels traced
+/// in `rs` (ray_tiles_internal.h). Each tile makes its worker, w = make_worker.template
+/// operator()<N>() (its scratch: sample points, batches, packets), and calls w(ctx, x, y, texel,
+/// patch) for each such texel, texel = y * width + x. Progress is reported in covered texels. A
+/// texel's work may depend only on the texel (its coordinates, its seed), so that the result is
+/// the same at any thread count.
+template <class MakeWorker>
+void for_each_texel_patch(const RayScene& rs, const Scene& surface, const TexelCoverage& cov, const TriangleNormals& fn, const ProgressFn& progress,
+                          MakeWorker&& make_worker) {
+  ProgressCounter counter(progress, cov.covered_texels);
+  for_each_ray_tile(rs, cov.width, cov.height, RayTiling{kTexelTile, kTexelTile}, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    auto worker = make_worker.template operator()<N>();
+    std::vector<PatchPiece> patch;
+    std::size_t covered = 0;
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+        if (!cov.mask[texel]) continue;
+        ++covered;
+        build_patch(surface, cov, fn, texel, patch);
+        if (!patch.empty()) worker(ctx, x, y, texel, patch);
+      }
+    return covered;
   });
-  return finished.load();
 }
 
 }  // namespace ao::detail

@@ -19,7 +19,6 @@ std::string format_vec(Vec3 v) {
 
 static_assert(kMaxCameraCoordinate == 1e11f, "Camera::validate's message names the limit");
 
-constexpr int kMaxImageSide = 32768;  // 32k x 32k float images are 4 GiB: beyond that is a typo
 }
 
 void Camera::validate() const {

@@ -11,6 +11,8 @@ namespace ao {
 /// cube of half-side 1e9 seen from 5e11 away matches the unit cube's image (BENCHMARKS.md,
 /// "Input limits").
 inline constexpr float kMaxCameraCoordinate = 1e11f;
+/// The largest image side, pixels: 32k x 32k float images are 4 GiB, and beyond that is a typo.
+inline constexpr int kMaxImageSide = 32768;
 
 struct Camera {
   Vec3 eye{0, 0, 5};                ///< Centre of projection, world units, each |coordinate| <= kMaxCameraCoordinate.

@@ -17,12 +17,14 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <initializer_list>
 #include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -72,6 +74,15 @@ std::string float_text(float v);
 /// `j` in one line for a message; strings unquoted.
 std::string json_text(const nlohmann::json& j);
 
+namespace params_detail {
+/// The field `ref` names in `s`: a pointer to a member of S, or a function S& -> field&.
+template <class S, class Ref>
+decltype(auto) access(Ref ref, S& s) {
+  if constexpr (std::is_member_object_pointer_v<Ref>) return (s.*ref);
+  else return ref(s);
+}
+}  // namespace params_detail
+
 /// One parameter bound to its place in a struct P.
 template <class P>
 struct Param {
@@ -88,6 +99,11 @@ struct Param {
   template <class Ref>
   static Param real(std::string name, Ref ref, Range range, std::string unit, std::string help) {
     return make<float>(std::move(name), ParamType::Float, ref, range, std::move(unit), std::move(help));
+  }
+  /// A std::uint32_t seed: any integer in [0, 2^32 - 1].
+  template <class Ref>
+  static Param seed(std::string name, Ref ref, std::string help) {
+    return make<std::uint32_t>(std::move(name), ParamType::Int, ref, Range::closed(0, 4294967295.0), "", std::move(help));
   }
   template <class Ref>
   static Param boolean(std::string name, Ref ref, std::string help) {
@@ -129,8 +145,7 @@ struct Param {
  private:
   template <class Ref>
   static decltype(auto) access(Ref ref, P& s) {
-    if constexpr (std::is_member_object_pointer_v<Ref>) return (s.*ref);
-    else return ref(s);
+    return params_detail::access(ref, s);
   }
   template <class T, class Ref>
   static Param make(std::string name, ParamType type, Ref ref, Range range, std::string unit, std::string help) {
@@ -224,6 +239,59 @@ class ParamTable {
  private:
   std::string owner_;
   std::vector<Param<P>> params_;
+};
+
+/// The rows of `table` as rows of a struct W that holds its P where `part` says (a pointer to a
+/// member of W, or a function W& -> P&): a parameter object that extends another one keeps the
+/// other's rows, names, ranges and help, declared once.
+template <class W, class P, class Part>
+std::vector<Param<W>> nested_params(const ParamTable<P>& table, Part part) {
+  std::vector<Param<W>> rows;
+  for (const Param<P>& p : table.params()) {
+    Param<W> q;
+    q.spec = p.spec;
+    q.get = [get = p.get, part](const W& w) { return get(params_detail::access(part, const_cast<W&>(w))); };
+    q.set = [set = p.set, part](W& w, const nlohmann::json& j) { set(params_detail::access(part, w), j); };
+    rows.push_back(std::move(q));
+  }
+  return rows;
+}
+
+/// A parameter table seen without its struct: what code that treats every method's (and baker's)
+/// parameters alike works with (the registry, `ao params`, `ao tune`, the docs, a UI).
+class ParamSchema {
+ public:
+  /// The schema of `table`, which must outlive it (tables are function-local statics).
+  template <class P>
+  explicit ParamSchema(const ParamTable<P>& table)
+      : owner_(table.owner()), specs_(table.specs()), canonical_([&table](const nlohmann::json& j) {
+          P p{};
+          table.from_json(j, p);
+          if constexpr (requires { p.validate(); }) p.validate();
+          else table.validate(p);
+          return table.to_json(p);
+        }) {}
+
+  const std::string& owner() const { return owner_; }
+  /// The parameters in table order.
+  const std::vector<ParamSpec>& specs() const { return specs_; }
+  /// The parameter called `name`, or null.
+  const ParamSpec* find(std::string_view name) const {
+    for (const ParamSpec& s : specs_)
+      if (s.name == name) return &s;
+    return nullptr;
+  }
+  /// Every parameter at its default (the struct's member initialisers), as JSON.
+  nlohmann::json defaults() const { return canonical_(nlohmann::json::object()); }
+  /// `j` read over the defaults, checked (InputError, one line, naming the parameter: an unknown
+  /// key, a wrong type, a value out of its range, or a combination the struct's validate()
+  /// refuses) and written back complete.
+  nlohmann::json canonical(const nlohmann::json& j) const { return canonical_(j); }
+
+ private:
+  std::string owner_;
+  std::vector<ParamSpec> specs_;
+  std::function<nlohmann::json(const nlohmann::json&)> canonical_;
 };
 
 /// The Markdown table of `specs` (parameter, type and valid values, default, unit, meaning): what

@@ -7,11 +7,7 @@
 
 #include <emmintrin.h>
 
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-
-#include "ao/core/parallel.h"
-#include "ao/reference/packets_internal.h"
+#include "ao/reference/ray_tiles_internal.h"
 
 namespace ao {
 
@@ -46,10 +42,7 @@ struct TileHits {
 
 // Traces the primary rays of tile t into `hits`.
 template <int N>
-void trace_tile(RTCScene bvh, const Camera& cam, const RayGenerator& gen, const Tile& t, TileHits& hits) {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+void trace_tile(RTCScene bvh, RTCIntersectContext& ctx, const Camera& cam, const RayGenerator& gen, const Tile& t, TileHits& hits) {
   const int tw = t.x1 - t.x0;
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
@@ -214,9 +207,8 @@ void shade_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const
 }
 
 template <int N>
-void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, const RayGenerator& gen, SurfaceNormal which, GBuffer& g,
-                 const Tile& t) {
-  detail::flush_denormals_to_zero();
+void render_tile(const RayScene& rs, RTCIntersectContext& ctx, const Camera& cam, const Frame& basis, const RayGenerator& gen, SurfaceNormal which,
+                 GBuffer& g, const Tile& t) {
   // Strips one packet block high: a strip's streamed stores drain while the next strip's rays
   // traverse the BVH, and its hits stay in the L1 cache between the two phases.
   constexpr int kStrip = N == 1 ? 1 : N / 4;
@@ -224,7 +216,7 @@ void render_tile(const RayScene& rs, const Camera& cam, const Frame& basis, cons
   TileHits hits;
   for (int y = t.y0; y < t.y1; y += kStrip) {
     const Tile s{t.x0, y, t.x1, std::min(y + kStrip, t.y1)};
-    trace_tile<N>(embree_scene(rs), cam, gen, s, hits);
+    trace_tile<N>(embree_scene(rs), ctx, cam, gen, s, hits);
     const bool extras = !g.albedo.empty() || !g.uv.empty();
     if (which == SurfaceNormal::Shading) {
       if (extras) shade_tile<SurfaceNormal::Shading, true>(rs, cam, basis, hits, g, s);
@@ -268,20 +260,13 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   g.direct = Image<Vec3>();  // belongs to the lighting of the previous view: render_direct_light makes a new one
   const Frame basis = camera.basis();
   const RayGenerator gen(camera, basis);
-  ProgressCounter counter(progress, static_cast<std::size_t>(camera.width) * camera.height);
-  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    // The range is of tile indices, so the tiles are the same however TBB splits it. TBB's auto
-    // partitioner hands each thread a few blocks of tiles (splitting further only when a thread
-    // runs dry) instead of one task per tile: fewer task switches.
-    const int columns = (camera.width + kTileWidth - 1) / kTileWidth, rows = (camera.height + kTileHeight - 1) / kTileHeight;
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, rows, 0, columns), [&](const tbb::blocked_range2d<int>& r) {
-      for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
-        for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
-          const Tile t{tx * kTileWidth, ty * kTileHeight, std::min((tx + 1) * kTileWidth, camera.width), std::min((ty + 1) * kTileHeight, camera.height)};
-          render_tile<N>(rs, camera, basis, gen, options.normal, g, t);
-          counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-        }
-    });
+  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);  // a primary ray per pixel
+  // Primary rays of neighbouring pixels are coherent; every tile costs about the same, so TBB
+  // hands each thread blocks of tiles.
+  const detail::RayTiling tiling{kTileWidth, kTileHeight, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, true};
+  detail::for_each_ray_tile(rs, w, h, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    render_tile<N>(rs, ctx, camera, basis, gen, options.normal, g, t);
+    return static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0);
   });
 }
 

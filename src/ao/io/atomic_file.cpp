@@ -2,10 +2,14 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <system_error>
@@ -18,7 +22,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string errno_text(int err) { return std::generic_category().message(err); }
+std::string errno_text(int err) {
+  // The message a user can act on: strerror's "No space left on device" names no remedy.
+  if (err == ENOSPC || err == EDQUOT) return "the disk is full";
+  if (err == EFBIG) return "the file is larger than the file size limit allows";
+  return std::generic_category().message(err);
+}
+
+/// When this process started (static initialisation), for remove_stale_temporaries.
+const fs::file_time_type g_process_start = fs::file_time_type::clock::now();
 
 // --- registry of temporary paths, read by the signal handler -----------------------------------
 // A fixed table of slots, so the handler needs no allocation or lock: a slot is claimed with a
@@ -75,6 +87,49 @@ fs::path temp_path_for(const fs::path& target) {
   return target.parent_path() / name;
 }
 
+/// The pid in `name` when it is a temporary name of temp_path_for(destination), else -1.
+long temporary_pid(const std::string& name, const fs::path& destination) {
+  std::string prefix = ".";
+  prefix += destination.stem().string();
+  prefix += ".tmp-";
+  const std::string ext = destination.extension().string();
+  if (!name.starts_with(prefix) || !name.ends_with(ext) || name.size() <= prefix.size() + ext.size()) return -1;
+  const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - ext.size());  // "<pid>-<counter>"
+  const std::size_t dash = middle.find('-');
+  if (dash == 0 || dash == std::string::npos || dash + 1 == middle.size()) return -1;
+  if (middle.find_first_not_of("0123456789-") != std::string::npos || middle.find('-', dash + 1) != std::string::npos) return -1;
+  try {
+    return std::stol(middle.substr(0, dash));
+  } catch (const std::exception&) {
+    return -1;
+  }
+}
+
+/// Why writing `temp` in `dir` failed, when the cause is the disk or the file size limit (the
+/// writers' libraries say "Write Error" or "write failed"); empty when it is neither.
+std::string storage_failure(const fs::path& temp, const fs::path& dir) {
+  struct statvfs vfs {};
+  // Full when what an unprivileged writer may still use would not hold one more block.
+  if (::statvfs(dir.c_str(), &vfs) == 0 && vfs.f_bavail == 0) return "the disk is full";
+  struct rlimit limit {};
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(temp, ec);
+  if (!ec && ::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && size >= limit.rlim_cur)
+    return "the file reached the file size limit (ulimit -f) of " + std::to_string(limit.rlim_cur) + " bytes";
+  return {};
+}
+
+const char* file_type_name(fs::file_type t) {
+  switch (t) {
+    case fs::file_type::fifo: return "a FIFO (named pipe)";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::directory: return "a directory";
+    default: return "not a regular file";
+  }
+}
+
 // Flushes the file's data to disk before the rename, so that after a crash the destination holds
 // either the old file or the complete new one, never a renamed but empty file.
 void sync_file(const fs::path& file, const fs::path& reported) {
@@ -129,6 +184,8 @@ void remove_temporaries_on_signals() {
 
 namespace detail {
 
+fs::path temporary_path_for(const fs::path& destination) { return temp_path_for(destination); }
+
 DeferredRenames::DeferredRenames(Keep keep) : keep_(std::move(keep)), outer_(t_deferred) { t_deferred = this; }
 DeferredRenames::~DeferredRenames() { t_deferred = outer_; }
 DeferredRenames* DeferredRenames::current() { return t_deferred; }
@@ -138,8 +195,42 @@ void DeferredRenames::keep(const fs::path& temp, const fs::path& destination, Te
 
 }  // namespace detail
 
+void check_output_destination(const fs::path& path, const std::string& what) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);  // follows symbolic links
+  if (ec || !fs::exists(st) || fs::is_regular_file(st)) return;
+  const std::string type = file_type_name(st.type());
+  const std::string through = fs::is_symlink(fs::symlink_status(path, ec)) ? "a symbolic link to " : "";
+  if (fs::is_directory(st)) throw InputError(path.string() + ": " + what + " is " + through + "a directory, not a file");
+  throw InputError(path.string() + ": " + what + " is " + through + type + ", not a regular file; ao writes only regular files or new paths");
+}
+
+int remove_stale_temporaries(const fs::path& destination) {
+  std::error_code ec;
+  fs::path target = destination;
+  if (fs::is_symlink(destination, ec)) {
+    const fs::path resolved = fs::weakly_canonical(destination, ec);
+    if (!ec) target = resolved;
+  }
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  int removed = 0;
+  fs::directory_iterator it(dir, ec);
+  for (; !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const fs::path& p = it->path();
+    const long pid = temporary_pid(p.filename().string(), target);
+    if (pid <= 0 || pid == ::getpid()) continue;
+    // A process that still runs (or that we may not signal, EPERM) is not ours to clean up after.
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code file_ec;
+    if (!it->is_regular_file(file_ec) || it->last_write_time(file_ec) >= g_process_start || file_ec) continue;
+    if (fs::remove(p, file_ec)) ++removed;
+  }
+  return removed;
+}
+
 void write_file_atomically(const fs::path& path, const std::function<void(const fs::path& temp)>& write) {
   if (path.empty() || !path.has_filename()) throw InputError("'" + path.string() + "': output path names no file");
+  check_output_destination(path);
 
   // Replace the file a symbolic link points to rather than the link itself.
   std::error_code ec;
@@ -153,6 +244,7 @@ void write_file_atomically(const fs::path& path, const std::function<void(const 
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::exists(dir, ec)) throw InputError(path.string() + ": directory '" + dir.string() + "' does not exist");
   if (!fs::is_directory(dir, ec)) throw InputError(path.string() + ": '" + dir.string() + "' is not a directory");
+  remove_stale_temporaries(target);
 
   // Create the temporary file here (exclusively, so it cannot clobber anything) to report an
   // unwritable directory with the destination's name rather than a library's message about a
@@ -175,9 +267,14 @@ void write_file_atomically(const fs::path& path, const std::function<void(const 
       return;
     }
     fs::rename(temp, target, ec);
-    if (ec) throw SystemError(path.string() + ": cannot rename the temporary file into place: " + ec.message());
-  } catch (...) {
+    if (ec) throw SystemError(path.string() + ": cannot rename the temporary file into place: " + errno_text(ec.value()));
+  } catch (const SystemError&) {
+    const std::string cause = storage_failure(temp, dir);
     fs::remove(temp, ec);  // best effort: the original error is the one worth reporting
+    if (!cause.empty()) throw SystemError(path.string() + ": cannot write: " + cause);
+    throw;
+  } catch (...) {
+    fs::remove(temp, ec);
     throw;
   }
 }

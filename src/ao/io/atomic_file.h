@@ -19,12 +19,32 @@ namespace ao {
 /// (a symbolic link at `path` is followed, so the file it names is replaced and the link kept).
 /// Inside OutputSet::write the rename is left to OutputSet::commit.
 ///
+/// Before the temporary file is made, check_output_destination refuses a destination that is not
+/// a regular file, and remove_stale_temporaries clears what killed runs left for `path`.
 /// If `write` throws, the temporary file is removed and the exception propagates unchanged.
 /// Errors of its own are one line naming `path`: InputError when the destination cannot be used
-/// (its directory does not exist, it is a directory), SystemError when the environment fails
-/// (no permission to create the temporary file, cannot flush or rename).
+/// (its directory does not exist, it is a directory, a FIFO, a device or a socket), SystemError
+/// when the environment fails (no permission to create the temporary file, cannot flush or
+/// rename; a full disk says "the disk is full").
 void write_file_atomically(const std::filesystem::path& path,
                            const std::function<void(const std::filesystem::path& temp)>& write);
+
+/// InputError "<path>: <what> is a FIFO (named pipe), not a regular file; ao writes only regular
+/// files or new paths" (likewise a character or block device, a socket, a directory) when `path`
+/// exists, following symbolic links, and is not a regular file: replacing it by a regular file
+/// would break a pipe another program reads, or, through a symbolic link, a device node. A new
+/// path, a regular file and a symbolic link to either pass. `what` names the option ("-o").
+void check_output_destination(const std::filesystem::path& path, const std::string& what = "the output");
+
+/// Removes the temporary files that runs of ao killed before they could clean up (SIGKILL, a
+/// power cut) left beside `destination`: hidden files named as write_file_atomically names them
+/// for that destination, whose process is no longer running on this machine and which were last
+/// written before this process started. Returns how many it removed. Files it cannot remove are
+/// left alone; it never throws. The process test sees this machine only: in a folder shared by
+/// several machines, a run elsewhere that staged the same destination before this one started and
+/// has not committed yet loses its temporary file (its commit then fails cleanly); two runs writing
+/// one destination at once race anyway.
+int remove_stale_temporaries(const std::filesystem::path& destination);
 
 /// Installs handlers of SIGINT, SIGTERM and SIGHUP that remove every registered temporary file
 /// (those of write_file_atomically, OutputSet and ScratchFile not yet renamed or removed) and the
@@ -68,6 +88,10 @@ class ScratchFile {
 };
 
 namespace detail {
+
+/// A fresh temporary name for `destination` as write_file_atomically makes them (hidden, in the
+/// same folder, unique per process and call); nothing is created.
+std::filesystem::path temporary_path_for(const std::filesystem::path& destination);
 
 /// While alive, write_file_atomically on this thread does not rename its complete temporary file:
 /// it calls `keep(temp, destination, registration)` and leaves the file to the callee (OutputSet).

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -21,9 +22,11 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
 
 namespace ao {
 namespace {
@@ -91,6 +94,13 @@ json parse_json(const fs::path& path, std::string_view text) {
     });
   } catch (const TooDeep&) {
     fail(path, "glTF JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) + " levels");
+  } catch (const json::parse_error& e) {
+    // nlohmann's text names its own grammar; the byte where it stopped, and the text there, is
+    // what a person can look at.
+    if (e.byte >= text.size()) fail(path, "truncated glTF JSON: it ends inside a value (byte " + std::to_string(text.size()) + ")");
+    const std::size_t at = e.byte > 0 ? e.byte - 1 : 0, from = at > 12 ? at - 12 : 0;
+    fail(path, "malformed glTF JSON: unexpected text at byte " + std::to_string(e.byte) + " ('" + one_line(text.substr(from, std::min<std::size_t>(24, text.size() - from))) +
+                   "')");
   } catch (const json::exception& e) {
     fail(path, "malformed or truncated glTF JSON (" + one_line(e.what()) + ")");
   }
@@ -155,17 +165,67 @@ struct View {
 
 class Checker {
  public:
-  Checker(const fs::path& path, const json& root, std::optional<std::string_view> glb_bin, std::size_t file_size)
-      : path_(path), root_(root), glb_bin_(glb_bin), file_size_(file_size) {}
+  Checker(const fs::path& path, const json& root, std::optional<std::string_view> glb_bin, std::size_t file_size, fs::path folder)
+      : path_(path), root_(root), glb_bin_(glb_bin), file_size_(file_size), folder_(std::move(folder)) {}
 
   void run() {
     if (!root_.is_object()) fail(path_, "glTF JSON is not an object");
     check_version();
     read_buffers();
+    check_images();
     read_views();
     read_accessors();
     check_meshes();
     check_nodes();
+    check_references();
+  }
+
+  /// When `obj` has `key`: it must be an array of `count` numbers (true); false when absent.
+  bool numbers(const json& obj, const char* key, std::size_t count, const std::string& where) const {
+    const auto it = obj.find(key);
+    if (it == obj.end()) return false;
+    bool ok = it->is_array() && it->size() == count;
+    for (std::size_t k = 0; ok && k < count; ++k) ok = (*it)[k].is_number();
+    if (!ok) bad(where + "." + key + " is not an array of " + std::to_string(count) + " numbers");
+    return true;
+  }
+
+  /// The indices assimp follows without a word of its own ("GLTF: No scene", "Missing section"):
+  /// the displayed scene, and each primitive's material.
+  void check_references() {
+    const json& scenes = array(root_, "scenes", "glTF");
+    if (root_.contains("scene")) index(root_["scene"], scenes.size(), "scene", "scene");
+    const json& materials = array(root_, "materials", "glTF");
+    for (std::size_t i = 0; i < materials.size(); ++i) {
+      const std::string where = "material " + std::to_string(i);
+      const json& material = object(materials[i], where);
+      const auto pbr = material.find("pbrMetallicRoughness");
+      if (pbr != material.end()) numbers(object(*pbr, where + ".pbrMetallicRoughness"), "baseColorFactor", 4, where + ".pbrMetallicRoughness");
+    }
+    // A node's transform properties have fixed sizes; a reader that meets another size ignores
+    // the property (the mesh lands elsewhere, or unscaled) without a word.
+    const json& nodes = array(root_, "nodes", "glTF");
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const std::string where = "node " + std::to_string(i);
+      numbers(nodes[i], "matrix", 16, where);
+      numbers(nodes[i], "translation", 3, where);
+      numbers(nodes[i], "scale", 3, where);
+      if (numbers(nodes[i], "rotation", 4, where)) {
+        double len2 = 0;
+        for (const json& q : nodes[i]["rotation"]) len2 += q.get<double>() * q.get<double>();
+        // Exporters round unit quaternions to a few digits; a length off by more than 1% is not
+        // a rotation (assimp would scale and shear by it, tinygltf-based readers normalise it).
+        if (!(std::abs(std::sqrt(len2) - 1.0) <= 0.01))
+          bad(where + ".rotation is not a unit quaternion (length " + std::to_string(std::sqrt(len2)) + ")");
+      }
+    }
+    const json& meshes = array(root_, "meshes", "glTF");
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      const json& primitives = array(meshes[m], "primitives", "mesh " + std::to_string(m));
+      for (std::size_t p = 0; p < primitives.size(); ++p)
+        if (primitives[p].contains("material"))
+          index(primitives[p]["material"], materials.size(), "material", "mesh " + std::to_string(m) + " primitive " + std::to_string(p) + ".material");
+    }
   }
 
  private:
@@ -173,11 +233,17 @@ class Checker {
   const json& root_;
   std::optional<std::string_view> glb_bin_;
   std::size_t file_size_;
+  fs::path folder_;                         // what external files must lie inside (asset_path.h)
   std::vector<std::string> owned_;          // decoded data URIs and external files
   std::vector<std::string_view> buffers_;   // each buffer's bytes, byteLength long
   std::vector<View> views_;
   std::vector<Accessor> accessors_;
+  std::vector<GltfSize::Counts> mesh_size_;  // per mesh, all its primitives
 
+ public:
+  GltfSize size_;
+
+ private:
   [[noreturn]] void bad(const std::string& problem) const { fail(path_, problem); }
 
   const json& array(const json& obj, const char* key, const std::string& where) const {
@@ -260,13 +326,30 @@ class Checker {
       return owned_.emplace_back(std::move(*decoded));
     }
     if (uri.find("://") != std::string::npos) bad(where + ": external URL '" + one_line(uri.substr(0, 60)) + "' is not supported, only files");
-    const fs::path file = path_.parent_path() / fs::path(percent_decode(uri));
+    const fs::path file = resolve_asset_reference(path_, folder_, percent_decode(uri), where + ": its file");
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) bad(where + ": its file '" + one_line(uri.substr(0, 60)) + "' does not exist beside the glTF");
     std::ifstream in(file, std::ios::binary);
     std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) bad(where + ": cannot read its file '" + one_line(uri.substr(0, 60)) + "'");
     return owned_.emplace_back(std::move(content));
+  }
+
+  /// Images are not decoded here, but `ao bake --gltf` embeds the files they name in its GLB, and
+  /// assimp may open them: a file URI must name a file inside the asset's folder, as buffers do.
+  void check_images() {
+    const json& images = array(root_, "images", "glTF");
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      const std::string where = "image " + std::to_string(i);
+      const json& image = object(images[i], where);
+      const auto uri = image.find("uri");
+      if (uri == image.end()) continue;
+      if (!uri->is_string()) bad(where + ".uri is not a string");
+      const std::string& text = uri->get_ref<const std::string&>();
+      if (text.starts_with("data:")) continue;
+      if (text.find("://") != std::string::npos) bad(where + ": external URL '" + one_line(text.substr(0, 60)) + "' is not supported, only files");
+      resolve_asset_reference(path_, folder_, percent_decode(text), where + ": its file");
+    }
   }
 
   void read_views() {
@@ -390,14 +473,35 @@ class Checker {
 
   void check_meshes() {
     const json& meshes = array(root_, "meshes", "glTF");
+    mesh_size_.assign(meshes.size(), {});
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const json& mesh = object(meshes[m], "mesh " + std::to_string(m));
       const json& primitives = array(mesh, "primitives", "mesh " + std::to_string(m));
       for (std::size_t p = 0; p < primitives.size(); ++p) {
         const std::string where = "mesh " + std::to_string(m) + " primitive " + std::to_string(p);
-        check_primitive(object(primitives[p], where), where);
+        const json& prim = object(primitives[p], where);
+        check_primitive(prim, where);
+        add_size(prim, mesh_size_[m]);
       }
+      size_.stored.add(mesh_size_[m]);
     }
+  }
+
+  /// What a reader makes of a primitive: assimp copies every attribute of every vertex as 12 bytes
+  /// (aiVector3D; colours 16) and every triangle as an aiFace (16 bytes) with its own 3 indices (a
+  /// 12-byte allocation, 32 with malloc's header and rounding).
+  void add_size(const json& prim, GltfSize::Counts& c) const {
+    const json& attributes = prim["attributes"];
+    const std::uint64_t vertices = accessors_[attributes["POSITION"].get<std::size_t>()].count;
+    std::uint64_t per_vertex = 0;
+    for (const auto& [name, value] : attributes.items()) per_vertex += name.starts_with("COLOR_") ? 16 : 12;
+    std::uint64_t corners = vertices;
+    if (prim.contains("indices")) corners = accessors_[prim["indices"].get<std::size_t>()].count;
+    const std::uint64_t mode = prim.contains("mode") ? prim["mode"].get<std::uint64_t>() : 4;
+    const std::uint64_t triangles = mode == 4 ? corners / 3 : (mode == 5 || mode == 6) && corners >= 3 ? corners - 2 : 0;
+    c.vertices += vertices;
+    c.triangles += triangles;
+    c.bytes += vertices * per_vertex + triangles * (16 + 32);
   }
 
   void check_primitive(const json& prim, const std::string& where) {
@@ -480,12 +584,23 @@ class Checker {
           bad("node " + std::to_string(*it) + " lies more than " + std::to_string(kMaxGltfNodeDepth) + " levels deep in the node hierarchy, the limit");
       }
     }
+    // Every node that uses a mesh places one copy of it (the graph is a forest: one parent each).
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto mesh = nodes[i].find("mesh");
+      if (mesh == nodes[i].end()) continue;
+      const std::size_t m = index(*mesh, mesh_size_.size(), "mesh", "node " + std::to_string(i) + ".mesh");
+      size_.world.add(mesh_size_[m]);
+      ++size_.uses;
+    }
     const json& scenes = array(root_, "scenes", "glTF");
     for (std::size_t s = 0; s < scenes.size(); ++s) {
       const std::string where = "scene " + std::to_string(s);
+      std::vector<char> listed(n, 0);
       for (const json& r : array(object(scenes[s], where), "nodes", where)) {
         const std::size_t root = index(r, n, "node", where + " root");
         if (parent[root] != kNone) bad(where + " lists node " + std::to_string(root) + " as a root, but it is a child of node " + std::to_string(parent[root]));
+        // glTF requires unique roots; a reader would place the node's meshes twice.
+        if (listed[root]++) bad(where + " lists node " + std::to_string(root) + " twice");
       }
     }
   }
@@ -502,7 +617,7 @@ bool looks_like_gltf(const fs::path& path, std::string_view data) {
   return start != std::string_view::npos && data[start] == '{';
 }
 
-void check_gltf(const fs::path& path, std::string_view data) {
+GltfSize check_gltf(const fs::path& path, std::string_view data, const fs::path& asset_root) {
   std::optional<std::string_view> bin;
   std::string_view text = data;
   if (data.size() >= 4 && read_u32(data.data()) == kGlbMagic) {
@@ -511,7 +626,9 @@ void check_gltf(const fs::path& path, std::string_view data) {
     bin = chunks.bin;
   }
   const json root = parse_json(path, text);
-  Checker(path, root, bin, data.size()).run();
+  Checker checker(path, root, bin, data.size(), asset_folder(path, asset_root));
+  checker.run();
+  return checker.size_;
 }
 
 }  // namespace ao

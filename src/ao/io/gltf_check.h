@@ -3,6 +3,7 @@
 // declared here for the fuzz harness and the tests.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string_view>
 
@@ -18,15 +19,29 @@ inline constexpr int kMaxGltfNodeDepth = 1024;
 /// data whose first non-blank character is '{', for what should be read as glTF.
 bool looks_like_gltf(const std::filesystem::path& path, std::string_view data);
 
+/// What reading a glTF makes, counted from its JSON before anything is read (accessors may be
+/// shared by many meshes and meshes used by many nodes, so a small file can describe a huge scene).
+struct GltfSize {
+  struct Counts {
+    std::uint64_t vertices = 0, triangles = 0;
+    std::uint64_t bytes = 0;  ///< assimp's copy of them: 12 bytes per attribute and vertex (colours 16), 48 per triangle.
+    void add(const Counts& o) { vertices += o.vertices, triangles += o.triangles, bytes += o.bytes; }
+  };
+  Counts stored;           ///< Every mesh once (what is read, and what instancing keeps).
+  Counts world;            ///< Every mesh once per node that uses it (what flattening makes).
+  std::uint64_t uses = 0;  ///< Nodes that use a mesh.
+};
+
 /// Checks `data`, the whole content of `path`, as glTF 2.0 JSON or GLB, without allocating more
 /// than a small multiple of its size: GLB chunk lengths against the file size; JSON nesting depth
 /// (kMaxGltfJsonDepth); the node graph (indices in range, one parent per node, no cycle, depth at
 /// most kMaxGltfNodeDepth); buffers (GLB BIN chunk, base64 data URI or a file beside `path`)
-/// against their byteLength; bufferViews and accessors inside their buffers; byteStride at least
+/// against their byteLength; file URIs of buffers and images inside `asset_root` (empty, the
+/// default: the folder of `path`; see asset_path.h), after resolving "..", "." and symbolic links; bufferViews and accessors inside their buffers; byteStride at least
 /// the element size; POSITION accessors VEC3 float, all attributes of a primitive of one count;
 /// index accessors unsigned SCALAR with every index below the primitive's vertex count; sparse
 /// accessors in range. Throws InputError "<file>: <what>, <which accessor/node/...>" on the first
-/// problem. glTF 1.0 (asset.version 1.x, GLB version 1) is refused.
-void check_gltf(const std::filesystem::path& path, std::string_view data);
+/// problem. glTF 1.0 (asset.version 1.x, GLB version 1) is refused. Returns the sizes it counted.
+GltfSize check_gltf(const std::filesystem::path& path, std::string_view data, const std::filesystem::path& asset_root = {});
 
 }  // namespace ao

@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/gltf_check.h"
 
@@ -43,17 +44,14 @@ std::string one_line(const std::string& s) {
 // --- tinygltf's file system: the input's folder, read only ------------------------------------
 
 struct Folder {
-  fs::path dir;  ///< weakly_canonical folder of the input
+  fs::path dir;  ///< asset_folder of the input: what its references must lie inside
 };
 
-/// True when `file` is a regular file in the input's folder or below it (after resolving "..",
+/// True when `file` is a regular file in the asset's folder or below it (after resolving "..",
 /// "." and symbolic links).
 bool in_folder(const std::string& file, const Folder& f) {
   std::error_code ec;
-  const fs::path p = fs::weakly_canonical(fs::path(file), ec);
-  if (ec || f.dir.empty() || !fs::is_regular_file(p, ec)) return false;
-  const fs::path rel = p.lexically_relative(f.dir);
-  return !rel.empty() && *rel.begin() != "..";
+  return fs::is_regular_file(fs::path(file), ec) && inside_folder(fs::path(file), f.dir);
 }
 
 bool fs_exists(const std::string& file, void* user) { return in_folder(file, *static_cast<Folder*>(user)); }
@@ -320,6 +318,22 @@ struct GltfDocument::Impl {
     return m;
   }
 
+  /// A node that places triangles needs a finite transform that does not flatten them: with
+  /// determinant 0 every triangle is degenerate (the same rule as validate_and_prepare's for
+  /// instances, and load_scene_file's for every glTF node).
+  void check_transform(int node, int mesh, const Mat4& world) const {
+    bool triangles = false;
+    for (const tinygltf::Primitive& p : model.meshes[static_cast<std::size_t>(mesh)].primitives) triangles = triangles || is_triangles(p);
+    if (!triangles) return;
+    const tinygltf::Node& n = model.nodes[static_cast<std::size_t>(node)];
+    const std::string label = n.name.empty() ? "node " + std::to_string(node) : "node '" + one_line(n.name.substr(0, 64)) + "'";
+    for (double v : world)
+      if (!std::isfinite(v)) fail(path, label + " has a non-finite transform");
+    double det = 0;
+    normal_matrix(world, det);
+    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) fail(path, label + " has a transform with determinant 0 (it flattens the mesh)");
+  }
+
   void collect_instances() {
     std::vector<int> roots;
     const int scene = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
@@ -345,6 +359,7 @@ struct GltfDocument::Impl {
       const Mat4 world = mul(parent, local_matrix(n));
       if (n.mesh >= 0) {
         if (static_cast<std::size_t>(n.mesh) >= model.meshes.size()) fail(path, "node " + std::to_string(node) + " uses mesh " + std::to_string(n.mesh) + ", the file has " + std::to_string(model.meshes.size()));
+        check_transform(node, n.mesh, world);
         instances.push_back({node, n.mesh, world});
       }
       for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) stack.push_back({*c, world});
@@ -474,7 +489,7 @@ struct GltfDocument::Impl {
   }
 };
 
-GltfDocument::GltfDocument(const fs::path& path, int uv_set) : impl_(std::make_unique<Impl>()) {
+GltfDocument::GltfDocument(const fs::path& path, int uv_set, const fs::path& asset_root) : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   d.path = path;
   d.uv_set = uv_set;
@@ -484,7 +499,8 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set) : impl_(std::make_u
   std::string err, warn;
   bool ok = false;
   Folder folder;
-  folder.dir = fs::weakly_canonical(fs::absolute(path, ec).parent_path(), ec);
+  folder.dir = asset_folder(path, asset_root);
+  const fs::path base = fs::weakly_canonical(fs::absolute(path, ec).parent_path(), ec);
   {
     // The file's bytes live only for the parse: tinygltf copies the buffers out of them.
     std::ifstream in(path, std::ios::binary);
@@ -493,17 +509,16 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set) : impl_(std::make_u
     if (in.bad()) fail(path, "cannot be read");
     if (data.empty()) fail(path, "the file is empty");
     if (data.size() > std::numeric_limits<std::uint32_t>::max()) fail(path, "larger than 4 GB, more than glTF and GLB can address");
-    check_gltf(path, data);  // structure, sizes and nesting first: tinygltf trusts them
+    check_gltf(path, data, asset_root);  // structure, sizes, nesting and file references first: tinygltf trusts them
 
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &folder});
     loader.SetImageLoader(&keep_encoded, nullptr);
-    const std::string base = folder.dir.string();
     try {
       if (data.size() >= 4 && data.compare(0, 4, "glTF") == 0)
-        ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn, reinterpret_cast<const unsigned char*>(data.data()), static_cast<unsigned>(data.size()), base);
+        ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn, reinterpret_cast<const unsigned char*>(data.data()), static_cast<unsigned>(data.size()), base.string());
       else
-        ok = loader.LoadASCIIFromString(&d.model, &err, &warn, data.data(), static_cast<unsigned>(data.size()), base);
+        ok = loader.LoadASCIIFromString(&d.model, &err, &warn, data.data(), static_cast<unsigned>(data.size()), base.string());
     } catch (const std::bad_alloc&) {
       throw SystemError(path.string() + ": out of memory while reading the glTF document");
     } catch (const std::exception& e) {

@@ -32,14 +32,16 @@ struct GltfWorldScene {
 class GltfDocument {
  public:
   /// Reads `path` (glTF with its buffers and images beside it, or GLB): check_gltf first, then
-  /// tinygltf, which may read only files in the folder of `path` (or below it) and writes nothing.
+  /// tinygltf, which may read only files in `asset_root` (empty, the default: the folder of
+  /// `path`) or below it, and writes nothing; a buffer or image URI that leaves that folder is an
+  /// InputError (asset_path.h).
   /// Buffers are merged into one (the GLB's binary chunk), and images given by URI (data: or a
   /// file in that folder) are moved into it still encoded; an image file that cannot be read keeps
   /// its URI, with a warning. `uv_set` is the TEXCOORD_n baked into. Throws InputError "<file>: <problem>"
   /// for what check_gltf refuses, what tinygltf cannot parse, geometry compressed with
   /// KHR_draco_mesh_compression or EXT_meshopt_compression, primitives whose accessors cannot be read, a `uv_set` above 0 that no primitive has ("has K UV sets, --uv-set N asked for"),
   /// and a document with no triangles in its scene.
-  GltfDocument(const std::filesystem::path& path, int uv_set);
+  GltfDocument(const std::filesystem::path& path, int uv_set, const std::filesystem::path& asset_root = {});
   ~GltfDocument();
   GltfDocument(GltfDocument&&) noexcept;
   GltfDocument& operator=(GltfDocument&&) noexcept;

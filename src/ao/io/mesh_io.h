@@ -1,5 +1,5 @@
-// Mesh files -> Scene. OFF and PLY are read by our own strict readers; OBJ, STL and glTF/GLB go
-// through assimp, OBJ and glTF after checks of our own (see mesh_io.cpp for why).
+// Mesh files -> Scene. OFF, PLY and one-mesh OBJ files are read by our own strict readers; other
+// OBJ files, STL and glTF/GLB go through assimp, after checks of our own (see mesh_io.cpp for why).
 #pragma once
 
 #include <filesystem>
@@ -18,6 +18,10 @@ struct LoadOptions {
   /// kept once with one Scene::instances entry per use. On for baking, whose maps and per-vertex
   /// values belong to each placed copy; off (instances) by default.
   bool flatten_instances = false;
+  /// The folder that the files a model references (a glTF's external buffers and images, an OBJ's
+  /// material libraries) must lie in, after resolving "..", "." and symbolic links; a reference
+  /// outside it is an InputError naming it (asset_path.h). Empty, the default: the model's own folder.
+  std::filesystem::path asset_root;
 };
 
 /// Loads OBJ, PLY, OFF, STL, glTF/GLB (by content/extension; OBJ, STL and glTF via assimp) into a

@@ -12,6 +12,8 @@
 #include <system_error>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
+#include "ao/io/number_text.h"
 
 namespace ao {
 namespace {
@@ -54,7 +56,8 @@ constexpr std::array<const char*, 3> kPlural{"vertices", "UVs", "normals"};
 
 }  // namespace
 
-void check_obj(const fs::path& path, std::string_view data) {
+void check_obj(const fs::path& path, std::string_view data, const fs::path& asset_root) {
+  const fs::path folder = asset_folder(path, asset_root);
   // Pass 1: totals, for positive indices.
   std::array<long long, 3> total{0, 0, 0};
   {
@@ -68,8 +71,9 @@ void check_obj(const fs::path& path, std::string_view data) {
       else if (key == "vn") ++total[kNormal];
     }
   }
-  // Pass 2: numbers and indices.
+  // Pass 2: numbers and indices; at the end, whether there was anything to draw.
   std::array<long long, 3> seen{0, 0, 0};
+  bool elements = false;
   Lines lines{data};
   std::string_view line;
   while (lines.next(line)) {
@@ -78,6 +82,7 @@ void check_obj(const fs::path& path, std::string_view data) {
     };
     std::size_t pos = 0;
     const std::string_view key = next_token(line, pos);
+    if (key == "f" || key == "l" || key == "p") elements = true;
     if (key == "v" || key == "vt" || key == "vn") {
       const Kind kind = key == "v" ? kVertex : key == "vt" ? kUv : kNormal;
       ++seen[kind];
@@ -89,15 +94,25 @@ void check_obj(const fs::path& path, std::string_view data) {
           if (k < needed) fail(std::string(kNames[kind]) + " has " + std::to_string(k) + " numbers, expected " + std::to_string(needed));
           break;
         }
-        if (token.front() == '+') token.remove_prefix(1);
-        double value = 0;
-        const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-        if (ptr != token.data() + token.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+        float value = 0;
+        if (!parse_real(token, value))
           fail(std::string(kNames[kind]) + " " + std::to_string(seen[kind] - 1) + ": '" + printable(token) + "' is not a number");
-        // Beyond float range is infinite once stored as float.
-        if (ec == std::errc::result_out_of_range || !std::isfinite(value) || std::abs(value) > 3.4e38)
+        if (!std::isfinite(value))
           fail(std::string(kNames[kind]) + " " + std::to_string(seen[kind] - 1) + (kind == kVertex ? " has a non-finite coordinate" : " is not finite") +
                " ('" + printable(token) + "')");
+      }
+    } else if (key == "mtllib") {
+      std::string_view rest = line.substr(pos);
+      const std::size_t first = rest.find_first_not_of(" \t\r");
+      rest = first == std::string_view::npos ? std::string_view() : rest.substr(first);
+      while (!rest.empty() && std::isspace(static_cast<unsigned char>(rest.back()))) rest.remove_suffix(1);
+      try {
+        if (!rest.empty()) resolve_asset_reference(path, folder, rest, "material library");
+        for (std::string_view name = next_token(line, pos); !name.empty(); name = next_token(line, pos))
+          resolve_asset_reference(path, folder, name, "material library");
+      } catch (const InputError& e) {
+        const std::string what = e.what();
+        fail(what.substr(path.string().size() + 2));  // the same words, with the line number
       }
     } else if (key == "f" || key == "l" || key == "p") {
       for (std::string_view corner = next_token(line, pos); !corner.empty(); corner = next_token(line, pos)) {
@@ -125,6 +140,8 @@ void check_obj(const fs::path& path, std::string_view data) {
       }
     }
   }
+  // assimp makes a point cloud of such a file, or fails with words about normals.
+  if (!elements) throw InputError(path.string() + ": the file has no faces (f lines), only vertices");
 }
 
 }  // namespace ao

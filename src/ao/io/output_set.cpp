@@ -1,9 +1,14 @@
 #include "ao/io/output_set.h"
 
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
 #include <system_error>
 #include <utility>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
 
 namespace ao {
 
@@ -11,13 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path resolve(const fs::path& p) {
-  std::error_code ec;
-  fs::path abs = fs::absolute(p, ec);
-  if (ec) abs = p;
-  fs::path r = fs::weakly_canonical(abs, ec);
-  return ec ? abs.lexically_normal() : r;
-}
+fs::path resolve(const fs::path& p) { return resolved_path(p); }
 
 // The same file: the same path once resolved, or (when both exist) the same inode, which also
 // catches hard links and bind mounts.
@@ -73,11 +72,13 @@ void OutputSet::add_output(const fs::path& path, std::string what) {
     }
   std::error_code ec;
   if (fs::is_directory(out.resolved, ec)) throw InputError(path.string() + ": " + out.what + " names a directory, not a file");
+  check_output_destination(path, out.what);
   const fs::path dir = parent_of(out.resolved);
   if (!directory_for(dir)) {
     if (!fs::exists(dir, ec)) throw InputError(path.string() + ": folder '" + dir.string() + "' does not exist");
     if (!fs::is_directory(dir, ec)) throw InputError(path.string() + ": '" + dir.string() + "' is not a directory");
   }
+  remove_stale_temporaries(out.resolved);
   outputs_.push_back(std::move(out));
 }
 
@@ -134,15 +135,72 @@ fs::path OutputSet::staged(const fs::path& path) const {
 }
 
 void OutputSet::commit() {
-  for (Staged& s : staged_) {
-    std::error_code ec;
-    fs::rename(s.temp, s.destination, ec);
-    if (ec) throw SystemError(s.destination.string() + ": cannot rename the temporary file into place: " + ec.message());
+  // Each destination that holds a file keeps it under a hidden name (a hard link: the same file,
+  // no copy; a copy where the file system has no hard links) until every rename succeeded, so a
+  // rename that fails puts back the files already replaced and removes the new ones.
+  struct Replaced {
+    fs::path destination, backup;  ///< backup empty: there was no file before
+    TemporaryRegistration registration;
+  };
+  std::vector<Replaced> replaced;
+  std::error_code ec;
+  const auto undo = [&] {
+    for (auto it = replaced.rbegin(); it != replaced.rend(); ++it) {
+      if (it->backup.empty()) fs::remove(it->destination, ec);
+      else fs::rename(it->backup, it->destination, ec);
+    }
+    for (const Staged& s : staged_) fs::remove(s.temp, ec);
+  };
+  for (std::size_t i = 0; i < staged_.size(); ++i) {
+    Staged& s = staged_[i];
+    Replaced r{s.destination, {}, {}};
+    if (fs::is_regular_file(fs::symlink_status(s.destination, ec))) {
+      r.backup = detail::temporary_path_for(s.destination);
+      r.registration = TemporaryRegistration(r.backup);
+      if (::link(s.destination.c_str(), r.backup.c_str()) != 0) {
+        std::error_code copy_ec;
+        if (!fs::copy_file(s.destination, r.backup, fs::copy_options::overwrite_existing, copy_ec)) {
+          undo();
+          throw SystemError(s.destination.string() + ": cannot keep the previous file while the outputs are renamed: " + copy_ec.message() +
+                            "; no output was replaced");
+        }
+      }
+    }
+    const int injected = detail::commit_rename_fault(i);
+    if (injected != 0) ec = std::error_code(injected, std::generic_category());
+    else fs::rename(s.temp, s.destination, ec);
+    if (ec) {
+      const std::string why = ec == std::errc::no_space_on_device ? "the disk is full" : ec.message();
+      if (!r.backup.empty()) fs::remove(r.backup, ec);
+      undo();
+      throw SystemError(s.destination.string() + ": cannot rename the temporary file into place: " + why + "; no output was replaced");
+    }
     s.registration = TemporaryRegistration();
+    replaced.push_back(std::move(r));
   }
+  for (const Replaced& r : replaced)
+    if (!r.backup.empty()) fs::remove(r.backup, ec);
   for (Directory& d : directories_) d.registration = TemporaryRegistration();
   committed_ = true;
 }
+
+namespace detail {
+namespace {
+std::atomic<int> g_fault_index{-1};
+std::atomic<int> g_fault_errno{0};
+}  // namespace
+
+void fail_commit_rename_for_testing(int index, int error) {
+  g_fault_errno.store(error);
+  g_fault_index.store(index);
+}
+
+int commit_rename_fault(std::size_t index) {
+  if (g_fault_index.load() < 0 || static_cast<std::size_t>(g_fault_index.load()) != index) return 0;
+  g_fault_index.store(-1);
+  return g_fault_errno.load();
+}
+}  // namespace detail
 
 std::vector<fs::path> OutputSet::outputs() const {
   std::vector<fs::path> paths;

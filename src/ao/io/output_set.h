@@ -37,8 +37,10 @@ class OutputSet {
   /// Declares an output file, named by `what` in messages ("-o", "--shaded"). InputError, one line
   /// naming the path, when it names a declared input or output (the same path after resolving
   /// ".", ".." and symbolic links, or the same file through a hard link), when it is a directory,
+  /// a FIFO, a device node or a socket, or a symbolic link to one (check_output_destination),
   /// or when its folder does not exist (and is not one add_directory will create). Declaring the
-  /// same output twice with the same `what` is a no-op.
+  /// same output twice with the same `what` is a no-op. Removes the temporary files that killed
+  /// runs left for it (remove_stale_temporaries).
   void add_output(const std::filesystem::path& path, std::string what);
 
   /// Declares an output folder: used as it is when it exists (InputError when it is not a
@@ -56,9 +58,12 @@ class OutputSet {
   /// InputError if nothing was written for it.
   std::filesystem::path staged(const std::filesystem::path& path) const;
 
-  /// Renames every staged file over its destination, in the order they were written. Each rename
-  /// replaces one file in one step; they follow one another with nothing else in between, and a
-  /// rename within one folder fails only on a broken file system (SystemError naming the file).
+  /// Renames every staged file over its destination, in the order they were written, as one
+  /// transaction: each destination that holds a file keeps it under a hidden name (a hard link,
+  /// or a copy) until all renames succeeded. When a rename fails (a broken or full file system, a
+  /// destination turned into a directory meanwhile), the destinations already replaced get their
+  /// previous files back, the new ones are removed, and a SystemError names the file that failed:
+  /// every output is then as it was before the run.
   void commit();
 
   /// Paths of the declared outputs, in declaration order.
@@ -88,5 +93,17 @@ class OutputSet {
   std::vector<Directory> directories_;
   bool committed_ = false;
 };
+
+namespace detail {
+
+/// Test hook: in the next OutputSet::commit of the process, the rename of the staged file number
+/// `index` (0-based, in write order) fails with errno `error` as a broken file system would; -1
+/// disarms it. Tests only: a rename within one folder rarely fails, and root (which the tests may
+/// run as) ignores the read-only folders that would make it fail.
+void fail_commit_rename_for_testing(int index, int error);
+/// The errno injected for the rename number `index`, once (then disarmed); 0 when none.
+int commit_rename_fault(std::size_t index);
+
+}  // namespace detail
 
 }  // namespace ao

@@ -23,6 +23,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "ao/core/error.h"
+#include "ao/io/number_text.h"
 
 namespace ao {
 namespace {
@@ -441,10 +442,8 @@ void read_ascii(const fs::path& path, const Header& h, const Layout& l, std::str
       const auto number = [&](double& value) {
         std::string_view token = next_token(line, lp);
         if (token.empty()) return false;
-        if (token.front() == '+') token.remove_prefix(1);
-        const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-        if (ec == std::errc::result_out_of_range) value = std::numeric_limits<double>::infinity();  // reported by validation
-        else if (ec != std::errc() || ptr != token.data() + token.size()) fail(path, at + ": " + quote(token) + " is not a number");
+        // Beyond double's range reads as infinity (reported by validation) or 0 (number_text.h).
+        if (!parse_real(token, value)) fail(path, at + ": " + quote(token) + " is not a number");
         return true;
       };
       for (std::size_t pi = 0; pi < e.properties.size(); ++pi) {
@@ -452,7 +451,7 @@ void read_ascii(const fs::path& path, const Header& h, const Layout& l, std::str
         double value = 0;
         if (!q.is_list) {
           if (!number(value)) fail(path, at + ": expects " + std::to_string(e.properties.size()) + " values, the line has fewer");
-          if (is_vertex && q.slot != kSkip) out.set(i, q.slot, static_cast<float>(value));
+          if (is_vertex && q.slot != kSkip) out.set(i, q.slot, narrow_to_float(value));
           continue;
         }
         if (!number(value) || value < 0 || value != std::floor(value)) fail(path, at + ": missing or bad list count");

@@ -11,39 +11,46 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/methods/alchemy_internal.h"
 
 namespace ao {
 
+namespace alchemy_internal {
+
+const RotationTable& rotations() {
+  static const RotationTable t = [] {
+    RotationTable r;
+    for (int i = 0; i < kRotations; ++i) {
+      const double a = 2.0 * M_PI * (i + 0.5) / kRotations;
+      r.c[i] = static_cast<float>(std::cos(a));
+      r.s[i] = static_cast<float>(std::sin(a));
+    }
+    return r;
+  }();
+  return t;
+}
+
+Directions sample_directions(int s) {
+  // Golden angle: successive samples of the pattern are spread evenly in angle.
+  constexpr float kGoldenAngle = 2.39996322972865332f;
+  Directions d;
+  for (int i = 0; i < s; ++i) d.x[i] = std::cos(kGoldenAngle * i), d.y[i] = std::sin(kGoldenAngle * i);
+  return d;
+}
+
+}  // namespace alchemy_internal
+
 namespace {
 
-constexpr int kMaxSamples = 1024;
+using alchemy_internal::kCoordOffset;
+using alchemy_internal::kMaxPixelRadius;
+using alchemy_internal::kMaxSamples;
+using alchemy_internal::kRotations;
+using alchemy_internal::RotationTable;
+using alchemy_internal::rotations;
 // Tiles of 128 x 8 pixels: rows long enough to vectorise over pixels, and a tile's sample footprint
 // (the tile grown by the disk's pixel radius) small enough to stay in L2 for typical radii.
 constexpr int kTileWidth = 128, kTileHeight = 8;
-// The disk's screen radius is capped (a pixel whose disk covers the whole image gains nothing from a
-// larger one) so that pixel coordinates stay below kCoordOffset and truncation acts as floor.
-constexpr float kMaxPixelRadius = 16384.0f;
-constexpr float kCoordOffset = 65536.0f;
-// Per-pixel rotations of the sample pattern come from a table of this many angles (no trig per
-// pixel); 1024 steps of 0.35 degrees are far finer than any sample spacing.
-constexpr int kRotations = 1024;
-// Golden angle: successive samples of the pattern are spread evenly in angle.
-constexpr float kGoldenAngle = 2.39996322972865332f;
-
-struct RotationTable {
-  std::array<float, kRotations> c, s;
-  RotationTable() {
-    for (int i = 0; i < kRotations; ++i) {
-      const double a = 2.0 * M_PI * (i + 0.5) / kRotations;
-      c[i] = static_cast<float>(std::cos(a));
-      s[i] = static_cast<float>(std::sin(a));
-    }
-  }
-};
-const RotationTable& rotations() {
-  static const RotationTable t;
-  return t;
-}
 
 // Per-pixel data of one row segment, structure of arrays so the sample loop vectorises over pixels.
 struct Row {
@@ -138,8 +145,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
   // camera_direction(px, py) = (ax * px + bx, ay * py + by, -1) for continuous pixel coordinates.
   const float ax = 2.0f * t * g.camera.aspect() / static_cast<float>(w), bx = -t * g.camera.aspect();
   const float ay = -2.0f * t / static_cast<float>(h), by = t;
-  std::array<float, kMaxSamples> ux{}, uy{};
-  for (int i = 0; i < s; ++i) ux[i] = std::cos(kGoldenAngle * i), uy[i] = std::sin(kGoldenAngle * i);
+  const alchemy_internal::Directions directions = alchemy_internal::sample_directions(s);
+  const std::array<float, kMaxSamples>&ux = directions.x, &uy = directions.y;
   const RotationTable& rot = rotations();
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
 

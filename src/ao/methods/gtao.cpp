@@ -9,13 +9,15 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
+#include "ao/methods/gtao_internal.h"
 #include "ao/methods/screen_space_internal.h"
 
 namespace ao {
 
 namespace {
 
-constexpr int kMaxSlices = 16, kMaxSteps = 32;
+using gtao_internal::kMaxSlices;
+using gtao_internal::kMaxSteps;
 // Tiles of 128 x 16 pixels, as the other screen-space kernels: long row segments for the SIMD
 // loops over pixels, few rows per tile.
 constexpr int kTileWidth = 128, kTileHeight = 16;
@@ -96,6 +98,30 @@ const ParamTable<GtaoParams>& gtao_param_table() {
   return table;
 }
 
+namespace gtao_internal {
+
+Tables make_tables(const GtaoParams& params, std::uint32_t seed) {
+  const int slices = params.slices, steps = params.steps;
+  const Pattern pattern = make_pattern(seed, params.interleave.interleave);
+  Tables t;
+  // Slice k of pattern entry p has screen angle phi = pi (k + rotation_p) / slices: the slices
+  // split the half circle evenly (a slice covers both of its sides), rotated per pixel.
+  for (int k = 0; k < slices; ++k)
+    for (int p = 0; p < 16; ++p) {
+      const double phi = kPi * (k + pattern.rotation[static_cast<std::size_t>(p)]) / slices;
+      t.dir_c[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::cos(phi));
+      t.dir_s[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::sin(phi));
+    }
+  // Step j of pattern entry p lies at t = ((j + offset_p) / steps)^step_power of the screen radius.
+  for (int j = 0; j < steps; ++j)
+    for (int p = 0; p < 16; ++p)
+      t.step_t[static_cast<std::size_t>(j)][static_cast<std::size_t>(p)] =
+          std::pow((static_cast<float>(j) + pattern.offset[static_cast<std::size_t>(p)]) / static_cast<float>(steps), params.step_power);
+  return t;
+}
+
+}  // namespace gtao_internal
+
 void GtaoParams::validate() const { gtao_param_table().validate(*this); }
 void to_json(nlohmann::json& j, const GtaoParams& p) { j = gtao_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, GtaoParams& p) { gtao_param_table().from_json(j, p); }
@@ -111,22 +137,9 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   if (!(radius > 0.0f) || !std::isfinite(radius)) throw InputError("gtao: radius R must be a positive number of world units");
   const int w = g.width(), h = g.height();
   const int slices = params.slices, steps = params.steps;
-  const Pattern pattern = make_pattern(seed, params.interleave.interleave);
-  // Slice k of pattern entry p has screen angle phi = pi (k + rotation_p) / slices: the slices
-  // split the half circle evenly (a slice covers both of its sides), rotated per pixel.
-  std::array<std::array<float, 16>, kMaxSlices> dir_c{}, dir_s{};
-  for (int k = 0; k < slices; ++k)
-    for (int p = 0; p < 16; ++p) {
-      const double phi = kPi * (k + pattern.rotation[static_cast<std::size_t>(p)]) / slices;
-      dir_c[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::cos(phi));
-      dir_s[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::sin(phi));
-    }
-  // Step j of pattern entry p lies at t = ((j + offset_p) / steps)^step_power of the screen radius.
-  std::array<std::array<float, 16>, kMaxSteps> step_t{};
-  for (int j = 0; j < steps; ++j)
-    for (int p = 0; p < 16; ++p)
-      step_t[static_cast<std::size_t>(j)][static_cast<std::size_t>(p)] =
-          std::pow((static_cast<float>(j) + pattern.offset[static_cast<std::size_t>(p)]) / static_cast<float>(steps), params.step_power);
+  const gtao_internal::Tables tables = gtao_internal::make_tables(params, seed);
+  const auto &dir_c = tables.dir_c, &dir_s = tables.dir_s;
+  const auto& step_t = tables.step_t;
 
   // Camera rays through pixel centres: ray(x, y) = (ax (x + 0.5) + bx, ay (y + 0.5) + by, -1), so a
   // sample's camera-space point is depth * ray (one 4-byte gather per sample; x is rebuilt the same

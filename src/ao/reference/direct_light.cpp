@@ -5,9 +5,8 @@
 #include <string>
 
 #include "ao/core/error.h"
-#include "ao/core/parallel.h"
-#include "ao/reference/packets_internal.h"
 #include "ao/reference/gbuffer_rays_internal.h"
+#include "ao/reference/pixel_loop_internal.h"
 
 namespace ao {
 
@@ -37,13 +36,10 @@ ShadowQuery query(const detail::PixelSurfaceContext& surface, Vec3 light, float 
   return q;
 }
 
+// Traces the shadow rays of tile t; returns its covered pixels (the pass's unit of progress).
 template <int N>
-void shade_tile(const RayScene& rs, const detail::PixelSurfaceContext& surface, Vec3 light, float e_over_pi, Image<Vec3>& out, const Tile& t) {
-  detail::flush_denormals_to_zero();
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  // Parallel rays from neighbouring pixels: as coherent as primary rays.
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+std::size_t shade_tile(const RayScene& rs, RTCIntersectContext& ctx, const detail::PixelSurfaceContext& surface, Vec3 light, float e_over_pi,
+                       Image<Vec3>& out, const Tile& t) {
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
@@ -77,6 +73,10 @@ void shade_tile(const RayScene& rs, const detail::PixelSurfaceContext& surface, 
           if (valid[static_cast<std::size_t>(k)] && rays.tfar[k] >= 0.0f) out(bx + k % bw, by + k / bw) = radiance[static_cast<std::size_t>(k)];
       }
   }
+  std::size_t covered = 0;
+  for (int y = t.y0; y < t.y1; ++y)
+    for (int x = t.x0; x < t.x1; ++x) covered += surface.g.covered(x, y) ? 1 : 0;
+  return covered;
 }
 
 }  // namespace
@@ -97,12 +97,11 @@ Image<Vec3> render_direct_light(const RayScene& rs, const GBuffer& g, const Sun&
   const Vec3 light = normalize(sun.direction);
   const float e_over_pi = sun.irradiance / kPi;  // the diffuse BRDF a/pi times E
   const detail::PixelSurfaceContext surface(g, rs.scene(), rs.bounds(), 0.0f);
-  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
-  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-      shade_tile<N>(rs, surface, light, e_over_pi, out, t);
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-    });
+  ProgressCounter counter(progress, detail::covered_pixel_count(g));
+  // Parallel rays from neighbouring pixels: as coherent as primary rays.
+  const detail::RayTiling tiling{kTile, kTile, RTC_INTERSECT_CONTEXT_FLAG_COHERENT};
+  detail::for_each_ray_tile(rs, w, h, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    return shade_tile<N>(rs, ctx, surface, light, e_over_pi, out, t);
   });
   return out;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <embree3/rtcore.h>
@@ -21,6 +22,12 @@ struct RayScene::Handles {
   std::vector<Affine3> normal_to_world;     ///< Per instance: cofactor of its transform (face normals; normalise).
   std::vector<detail::TrianglePairs> pairs; ///< Per mesh: its quads when built with BvhOptions::quads, else empty.
 };
+
+namespace detail {
+/// An RTCError code in words, for the one-line SystemError a failed Embree call becomes
+/// ("embree: building the BVH failed: out of memory (...)") instead of "error 4".
+std::string embree_error_text(int code);
+}  // namespace detail
 
 /// The committed top-level Embree scene of `rs`: object i (Scene::objects()) is geometry i, a
 /// triangle geometry for a mesh drawn in world space, an instance geometry for an instance.

@@ -1,7 +1,6 @@
 // The per-pixel loop the ray-traced references share (tangent_sphere.cpp, transfer_reference.cpp):
-// every covered pixel of a G-buffer, in parallel tiles, with the ray setup of
-// gbuffer_rays_internal.h (the one raytraced.cpp uses), an Embree intersect context per task, and
-// the packet width chosen once for the scene.
+// every covered pixel of a G-buffer, in the tiles of ray_tiles_internal.h, with the ray setup of
+// gbuffer_rays_internal.h (the one raytraced.cpp uses).
 // Internal to src/ao/reference/.
 #pragma once
 
@@ -12,57 +11,38 @@
 #include "ao/core/gbuffer.h"
 #include "ao/core/parallel.h"
 #include "ao/core/progress.h"
-#include "ao/reference/packets_internal.h"
-#include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/gbuffer_rays_internal.h"
+#include "ao/reference/mean_accumulator_internal.h"
+#include "ao/reference/ray_tiles_internal.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
 
 namespace ao::detail {
 
-/// Running sums of one point's samples of a value in [0, 1]; doubles so that a million samples
-/// stay exact enough.
-struct MeanAccumulator {
-  double sum = 0, sum_sq = 0;
-  int n = 0;
-
-  void add(double v) {
-    sum += v;
-    sum_sq += v * v;
-    ++n;
-  }
-  double mean() const { return n > 0 ? sum / n : 1.0; }
-  /// Standard error of the mean from the unbiased sample variance (conservative for scrambled
-  /// Sobol samples, whose error is usually smaller).
-  double std_error() const {
-    if (n < 2) return 0.0;
-    const double var = std::max(0.0, (sum_sq - sum * sum / n) / (n - 1));
-    return std::sqrt(var / n);
-  }
-};
+/// The number of covered pixels of `g`: the work of a pass that traces rays from them.
+inline std::size_t covered_pixel_count(const GBuffer& g) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < g.object_id.size(); ++i) n += g.covered(i) ? 1 : 0;
+  return n;
+}
 
 /// Calls fn.template operator()<N>(ctx, x, y, s) for every covered pixel (x, y) of `g`, with s
 /// its PixelSurface (gbuffer_rays_internal.h: world position, unit normal, the geometric normal
 /// and scale-free offset rays start along, or `fixed_offset` when > 0), N the scene's packet
-/// width; in parallel over 16x16 tiles, reporting progress per tile.
+/// width; in parallel over 16x16 tiles (ray_tiles_internal.h), reporting progress in covered pixels.
 template <class Fn>
 void for_each_covered_pixel(const RayScene& rs, const GBuffer& g, float fixed_offset, const ProgressFn& progress, Fn&& fn) {
-  constexpr int kTile = 16;
-  const int w = g.width(), h = g.height();
   const PixelSurfaceContext surface(g, rs.scene(), rs.bounds(), fixed_offset);
-  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
-  dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-      flush_denormals_to_zero();
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      for (int y = t.y0; y < t.y1; ++y)
-        for (int x = t.x0; x < t.x1; ++x) {
-          if (!g.covered(x, y)) continue;
-          fn.template operator()<N>(ctx, x, y, surface(x, y));
-        }
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-    });
+  ProgressCounter counter(progress, covered_pixel_count(g));
+  for_each_ray_tile(rs, g.width(), g.height(), RayTiling{}, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    std::size_t covered = 0;
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        if (!g.covered(x, y)) continue;
+        fn.template operator()<N>(ctx, x, y, surface(x, y));
+        ++covered;
+      }
+    return covered;
   });
 }
 

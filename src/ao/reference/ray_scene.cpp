@@ -1,6 +1,7 @@
 #include "ao/reference/ray_scene.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -12,16 +13,25 @@ namespace ao {
 
 namespace {
 
-void on_embree_error(void* /*user*/, RTCError code, const char* message) {
-  // Embree reports allocation failures and API misuse here; they surface as SystemError from
-  // the calls below (rtcGetDeviceError), so nothing is thrown across Embree's C frames.
-  (void)code;
-  (void)message;
+// Embree reports allocation failures and API misuse to this callback, in the thread of the call
+// that failed; they surface as SystemError from check() after that call (rtcGetDeviceError), so
+// nothing is thrown across Embree's C frames. The message is kept for check() to quote.
+thread_local std::string t_embree_message;
+
+void on_embree_error(void* /*user*/, RTCError /*code*/, const char* message) {
+  t_embree_message.clear();
+  // One printable line, short: it ends up in ao's error message.
+  for (const char* c = message; c != nullptr && *c != '\0' && t_embree_message.size() < 160; ++c)
+    t_embree_message += std::isprint(static_cast<unsigned char>(*c)) ? *c : ' ';
 }
 
 void check(RTCDevice device, const char* what) {
   const RTCError e = rtcGetDeviceError(device);
-  if (e != RTC_ERROR_NONE) throw SystemError(std::string("embree: ") + what + " failed (error " + std::to_string(static_cast<int>(e)) + ")");
+  if (e == RTC_ERROR_NONE) return;
+  std::string message = std::string("embree: ") + what + " failed: " + detail::embree_error_text(static_cast<int>(e));
+  if (!t_embree_message.empty() && e != RTC_ERROR_OUT_OF_MEMORY) message += " (" + t_embree_message + ")";
+  t_embree_message.clear();
+  throw SystemError(message);
 }
 
 RTCBuildQuality embree_quality(BvhQuality q) {
@@ -53,12 +63,28 @@ RTCGeometry mesh_geometry(RTCDevice device, const Mesh& m, const detail::Triangl
 
 }  // namespace
 
+namespace detail {
+
+std::string embree_error_text(int code) {
+  switch (code) {
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory (the scene's BVH does not fit in the memory this process may use)";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "this processor lacks instructions Embree needs";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    case RTC_ERROR_INVALID_ARGUMENT: return "Embree refused an argument (an error in ao: please report it)";
+    case RTC_ERROR_INVALID_OPERATION: return "Embree refused an operation (an error in ao: please report it)";
+    default: return "unknown Embree error " + std::to_string(code);
+  }
+}
+
+}  // namespace detail
+
 RayScene::RayScene(const Scene& scene, const BvhOptions& options)
     : source_(scene), bounds_(scene.bounds()), handles_(std::make_unique<Handles>()) {
   RTCDevice& device = handles_->device;
   RTCScene& bvh = handles_->scene;
   device = rtcNewDevice(nullptr);
-  if (!device) throw SystemError("embree: cannot create a device (does this CPU support SSE2?)");
+  // A device that could not be made leaves its error with no device (rtcGetDeviceError(NULL)).
+  if (!device) throw SystemError("embree: cannot create a device: " + detail::embree_error_text(static_cast<int>(rtcGetDeviceError(nullptr))));
   rtcSetDeviceErrorFunction(device, on_embree_error, nullptr);
   if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) packet_width_ = 16;
   else if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) packet_width_ = 8;

@@ -6,9 +6,7 @@
 #include <cmath>
 
 #include "ao/core/error.h"
-#include "ao/core/parallel.h"
 #include "ao/core/sampling.h"
-#include "ao/reference/packets_internal.h"
 #include "ao/reference/gbuffer_rays_internal.h"
 #include "ao/reference/pixel_loop_internal.h"
 #include "ao/reference/ray_offset.h"
@@ -17,7 +15,6 @@ namespace ao {
 
 namespace {
 
-constexpr int kTile = 16;
 constexpr int kMaxSamples = 1 << 20;
 
 // The sample set of every point: the first `samples` points of the 2-D Sobol sequence, stored as
@@ -92,20 +89,7 @@ PointSetup setup_point(Vec3 p, Vec3 n, Vec3 ng, float offset, std::uint32_t key)
   return s;
 }
 
-// Running sums for one point; doubles so a million samples of mu in [0,1] stay exact enough.
-struct Accumulator {
-  double sum = 0, sum_sq = 0;
-  int n = 0;
-
-  double mean() const { return n > 0 ? sum / n : 1.0; }
-  // Standard error of the mean from the unbiased sample variance. With stratified (Sobol) samples
-  // the true error is usually smaller, so this is a conservative stopping rule and report.
-  double std_error() const {
-    if (n < 2) return 0.0;
-    const double var = std::max(0.0, (sum_sq - sum * sum / n) / (n - 1));
-    return std::sqrt(var / n);
-  }
-};
+using detail::MeanAccumulator;
 
 // Directions of samples [first, first + N) of point `s` into the packet, with valid[k] = -1 for
 // the lanes to trace: inside the sample count and above the geometric tangent plane. A direction
@@ -140,7 +124,7 @@ int fill_directions(const SampleTable& tbl, const PointSetup& s, int first, int 
 // Traces samples [first, end) of one point, at most N, and adds their mu to acc.
 template <int N>
 void trace_batch(RTCScene bvh, RTCIntersectContext& ctx, const SampleTable& tbl, const PointSetup& s, const Falloff& falloff, int first,
-                 int end, typename detail::Packet<N>::RayHit& rh, Accumulator& acc) {
+                 int end, typename detail::Packet<N>::RayHit& rh, MeanAccumulator& acc) {
   const float reach = falloff.reach();
   alignas(64) std::array<int, N> valid;
   if constexpr (N == 1) {
@@ -157,12 +141,10 @@ void trace_batch(RTCScene bvh, RTCIntersectContext& ctx, const SampleTable& tbl,
         mu = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 1.0f : falloff.mu(rh.ray.tfar);
       }
     }
-    acc.sum += mu;
-    acc.sum_sq += static_cast<double>(mu) * mu;
-    acc.n += 1;
+    acc.add(1, mu, static_cast<double>(mu) * mu);
   } else {
     const int live = fill_directions<N>(tbl, s, first, end, rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z, valid.data());
-    acc.n += std::min(N, end - first);  // lanes below the surface count as mu = 0
+    acc.add(std::min(N, end - first), 0.0, 0.0);  // lanes below the surface count as mu = 0
     if (live == 0) return;
     for (int k = 0; k < N; ++k) rh.ray.tfar[k] = reach;
     if (falloff.membership == Membership::Step) {
@@ -171,8 +153,7 @@ void trace_batch(RTCScene bvh, RTCIntersectContext& ctx, const SampleTable& tbl,
       detail::Packet<N>::occluded(valid.data(), bvh, &ctx, &rh.ray);
       int open = 0;
       for (int k = 0; k < N; ++k) open += (valid[k] != 0) & (rh.ray.tfar[k] >= 0.0f);
-      acc.sum += open;
-      acc.sum_sq += open;
+      acc.add(0, open, open);
     } else {
       for (int k = 0; k < N; ++k) rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       detail::Packet<N>::intersect(valid.data(), bvh, &ctx, &rh);
@@ -183,8 +164,7 @@ void trace_batch(RTCScene bvh, RTCIntersectContext& ctx, const SampleTable& tbl,
         sum += mu;
         sum_sq += mu * mu;
       }
-      acc.sum += sum;
-      acc.sum_sq += sum_sq;
+      acc.add(0, sum, sum_sq);
     }
   }
 }
@@ -213,7 +193,7 @@ VisibilityEstimate estimate(RTCScene bvh, RTCIntersectContext& ctx, const Sample
       rh.ray.org_z[k] = s.origin.z;
     }
   }
-  Accumulator acc;
+  MeanAccumulator acc;
   const bool adaptive = params.target_error > 0;
   constexpr int batch = N == 1 ? 1 : N;
   for (int first = 0; first < params.samples; first += batch) {
@@ -253,14 +233,12 @@ VisibilityEstimate estimate_visibility(const RayScene& rs, Vec3 p, Vec3 n, const
                                        std::uint32_t seed) {
   falloff.validate();
   params.validate();
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
   const SampleTable tbl = make_sample_table(params.samples, table_packet(rs.native_packet_width()));
   // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
   const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
   const Vec3 nn = normalize(n);
   const PointSetup s = setup_point(p, nn, nn, offset, seed);
-  return detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
+  return detail::with_ray_context(rs, [&]<int N>(RTCIntersectContext& ctx) {
     alignas(64) typename detail::Packet<N>::RayHit rh;
     init_packet<N>(rh);
     return estimate<N>(embree_scene(rs), ctx, tbl, s, falloff, params, rh);
@@ -282,32 +260,29 @@ RaytracedImage render_raytraced(const RayScene& rs, const GBuffer& g, const Fall
   const detail::PixelSurfaceContext surface(g, rs.scene(), rs.bounds(), params.offset);
   const SampleTable tbl = make_sample_table(params.samples, table_packet(rs.native_packet_width()));
   const RTCScene bvh = embree_scene(rs);
-  ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
-  detail::dispatch_packet_width(rs.native_packet_width(), [&]<int N>() {
-    parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
-      detail::flush_denormals_to_zero();
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;  // directions spread over the hemisphere
-      alignas(64) typename detail::Packet<N>::RayHit rh;
-      init_packet<N>(rh);
-      for (int y = t.y0; y < t.y1; ++y)
-        for (int x = t.x0; x < t.x1; ++x) {
-          if (!g.covered(x, y)) {
-            out.visibility(x, y) = 1.0f;
-            out.std_error(x, y) = 0.0f;
-            samples(x, y) = 0;
-            continue;
-          }
-          const detail::PixelSurface ps = surface(x, y);
-          const PointSetup s = setup_point(ps.position, ps.normal, ps.geometric, ps.offset, pixel_seed(seed, x, y));
-          const VisibilityEstimate e = estimate<N>(bvh, ctx, tbl, s, falloff, params, rh);
-          out.visibility(x, y) = e.visibility;
-          out.std_error(x, y) = e.std_error;
-          samples(x, y) = e.samples;
+  ProgressCounter counter(progress, detail::covered_pixel_count(g));
+  // Directions spread over the hemisphere: Embree's incoherent hint (RayTiling's default).
+  detail::for_each_ray_tile(rs, w, h, detail::RayTiling{}, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+    alignas(64) typename detail::Packet<N>::RayHit rh;
+    init_packet<N>(rh);
+    std::size_t covered = 0;
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        if (!g.covered(x, y)) {
+          out.visibility(x, y) = 1.0f;
+          out.std_error(x, y) = 0.0f;
+          samples(x, y) = 0;
+          continue;
         }
-      counter.add(static_cast<std::size_t>(t.x1 - t.x0) * (t.y1 - t.y0));
-    });
+        const detail::PixelSurface ps = surface(x, y);
+        const PointSetup s = setup_point(ps.position, ps.normal, ps.geometric, ps.offset, pixel_seed(seed, x, y));
+        const VisibilityEstimate e = estimate<N>(bvh, ctx, tbl, s, falloff, params, rh);
+        out.visibility(x, y) = e.visibility;
+        out.std_error(x, y) = e.std_error;
+        samples(x, y) = e.samples;
+        ++covered;
+      }
+    return covered;
   });
   detail::summarise(out, samples, g);
   return out;

@@ -58,13 +58,10 @@ VisibilityEstimate estimate_tangent_sphere(const RayScene& rs, Vec3 p, Vec3 n, f
                                            std::uint32_t seed) {
   check_radius(radius);
   params.validate();
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
   // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
   const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
   const Vec3 nn = normalize(n);
-  return detail::dispatch_packet_width(rs.native_packet_width(),
-                                       [&]<int N>() { return estimate<N>(rs, ctx, p + nn * offset, nn, radius, params, seed); });
+  return detail::with_ray_context(rs, [&]<int N>(RTCIntersectContext& ctx) { return estimate<N>(rs, ctx, p + nn * offset, nn, radius, params, seed); });
 }
 
 RaytracedImage render_tangent_sphere(const RayScene& rs, const GBuffer& g, float radius, const RaytracedParams& params, std::uint32_t seed,

@@ -96,13 +96,10 @@ TransferEstimate estimate_transfer(const RayScene& rs, Vec3 p, Vec3 n, const Fal
   falloff.validate();
   params.validate();
   const std::vector<Vec3> albedo = scaled_albedos(rs, albedo_scale);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
   // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
   const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
   const Vec3 nn = normalize(n);
-  return detail::dispatch_packet_width(rs.native_packet_width(),
-                                       [&]<int N>() { return estimate<N>(rs, ctx, p + nn * offset, nn, falloff, albedo, params, seed); });
+  return detail::with_ray_context(rs, [&]<int N>(RTCIntersectContext& ctx) { return estimate<N>(rs, ctx, p + nn * offset, nn, falloff, albedo, params, seed); });
 }
 
 TransferReferenceImage render_transfer_reference(const RayScene& rs, const GBuffer& g, const Falloff& falloff, float albedo_scale,

@@ -120,6 +120,29 @@ std::size_t first_where(std::size_t n, const Bad& bad) {
       [](std::size_t a, std::size_t b) { return std::min(a, b); });
 }
 
+/// A power of two that brings a tiny mesh to an extent between 1/2 and 1; 1 for a mesh of ordinary
+/// size. The area test and the face normals square or multiply edge vectors, which underflows in
+/// float for a mesh smaller than about 1e-10 (its triangles would all look degenerate, its normals
+/// be noise). Edges multiplied by a power of two (exact: only the exponents change) give a tiny
+/// mesh the area test and the normals of the same mesh at unit size: the threshold is relative to
+/// the mesh's own scale. Meshes of 2^-20 (1e-6) and more are used as they are (a factor 1).
+float tiny_mesh_scale(const Mesh& mesh) {
+  const Bounds3 b = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, mesh.positions.size(), kGrain), Bounds3{},
+      [&](const tbb::blocked_range<std::size_t>& r, Bounds3 acc) {
+        for (std::size_t v = r.begin(); v < r.end(); ++v) acc.extend(mesh.positions[v]);
+        return acc;
+      },
+      [](Bounds3 x, const Bounds3& y) {
+        x.extend(y.lo);
+        x.extend(y.hi);
+        return x;
+      });
+  const float extent = std::max({b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z});
+  if (!(extent > 0) || extent >= std::ldexp(1.0f, -20)) return 1.0f;
+  return std::ldexp(1.0f, -std::ilogb(extent) - 1);
+}
+
 }  // namespace
 
 void generate_normals(Mesh& mesh) {
@@ -129,6 +152,7 @@ void generate_normals(Mesh& mesh) {
   // over the indices is repeated per task, but it is a sequential read; the angles, the costly
   // part, are computed once per corner.
   const std::size_t nv = mesh.positions.size(), nc = mesh.indices.size() - mesh.indices.size() % 3;
+  const float scale = tiny_mesh_scale(mesh);  // exact; 1 but for meshes below 1e-6
   mesh.normals.resize(nv);
   const auto parts = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, parts, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -140,7 +164,7 @@ void generate_normals(Mesh& mesh) {
         // i - v0 < size, unsigned, tests v0 <= i < v0 + size.
         const bool own[3] = {i[0] - v0 < size, i[1] - v0 < size, i[2] - v0 < size};
         if (!(own[0] || own[1] || own[2])) continue;
-        const Vec3 p[3] = {mesh.positions[i[0]], mesh.positions[i[1]], mesh.positions[i[2]]};
+        const Vec3 p[3] = {mesh.positions[i[0]] * scale, mesh.positions[i[1]] * scale, mesh.positions[i[2]] * scale};
         const Vec3 n = normalize(cross(p[1] - p[0], p[2] - p[0]));
         for (int k = 0; k < 3; ++k) {
           if (!own[k]) continue;
@@ -169,6 +193,12 @@ std::string format_magnitude(float v) {
 
 std::string where(const Scene& scene, const Mesh& mesh) {
   return mesh.name.empty() || scene.meshes.size() == 1 ? scene.name : scene.name + " (mesh '" + mesh.name + "')";
+}
+
+/// A triangle has area when its edges' cross product is not zero (in float, at `scale`).
+bool has_area(Vec3 a, Vec3 b, Vec3 c, float scale) {
+  const Vec3 n = cross((b - a) * scale, (c - a) * scale);
+  return dot(n, n) > 0.0f;
 }
 
 void validate_mesh(const Scene& scene, Mesh& mesh) {
@@ -209,6 +239,7 @@ void validate_mesh(const Scene& scene, Mesh& mesh) {
   };
   std::vector<Block> block(blocks);
   std::uint32_t* const idx = mesh.indices.data();
+  const float area_scale = tiny_mesh_scale(mesh);
   tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
     const std::size_t t0 = b * kGrain, t1 = std::min(triangle_count, t0 + kGrain);
     std::size_t kept = t0;
@@ -219,8 +250,7 @@ void validate_mesh(const Scene& scene, Mesh& mesh) {
           block[b] = {0, t, i};
           return;
         }
-      const Vec3 n = cross(mesh.positions[bb] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
-      if (a == bb || bb == c || a == c || !(dot(n, n) > 0.0f)) continue;
+      if (a == bb || bb == c || a == c || !has_area(mesh.positions[a], mesh.positions[bb], mesh.positions[c], area_scale)) continue;
       idx[3 * kept] = a;
       idx[3 * kept + 1] = bb;
       idx[3 * kept + 2] = c;

@@ -1,0 +1,29 @@
+# Loading a mesh into Blender's scene for the bench scripts: OBJ through Blender's importer (the
+# file's axes kept), OFF by hand (Blender reads no OFF). Returns the object and the axis arguments
+# that write it back in the file's coordinates (wm.obj_export).
+import bpy
+
+
+def load_mesh(path, name):
+    if path.lower().endswith(".off"):
+        words = open(path).read().split()
+        assert words[0] == "OFF", path
+        nv, nf = int(words[1]), int(words[2])
+        values = words[4:]
+        verts = [tuple(float(v) for v in values[3 * i:3 * i + 3]) for i in range(nv)]
+        at, faces = 3 * nv, []
+        for _ in range(nf):
+            n = int(values[at])
+            faces.append([int(v) for v in values[at + 1:at + 1 + n]])
+            at += 1 + n
+        mesh = bpy.data.meshes.new(name)
+        mesh.from_pydata(verts, [], faces)
+        mesh.polygons.foreach_set("use_smooth", [True] * len(faces))  # interpolated normals, as ao's loader gives an OFF
+        obj = bpy.data.objects.new(name, mesh)
+        bpy.context.scene.collection.objects.link(obj)
+        return obj, dict(forward_axis="Y", up_axis="Z")  # Blender's own axes: written as read
+    before = set(bpy.context.scene.objects)
+    bpy.ops.import_scene.obj(filepath=path, axis_forward="-Z", axis_up="Y", split_mode="OFF")
+    obj = [o for o in bpy.context.scene.objects if o.type == "MESH" and o not in before][0]
+    obj.name = name
+    return obj, dict(forward_axis="NEGATIVE_Z", up_axis="Y")

@@ -1,0 +1,336 @@
+// Fast OBJ reader for one-mesh files (obj_reader.h). One pass over the mapped file collects the
+// numbers and the face corners; anything outside the supported shape ends the attempt (nullopt),
+// and load_scene_file reads the file as it always did. What assimp 5.2 and ao's post-processing
+// made of a one-mesh OBJ, and how this reader gets the same:
+//  - The OBJ importer gives every face corner a vertex of its own; JoinIdenticalVertices welds the
+//    corners whose position, UV and normal are equal, keeping the first in corner order. Here each
+//    attribute value is numbered once (equal values, also from different lines, share a number;
+//    -0 and +0 are equal), and each distinct (position, UV, normal) triple becomes a vertex when a
+//    corner first uses it: the same vertices in the same order. (assimp welds within 1e-5; real
+//    meshes have no distinct vertices that close, and a mesh scaled far down keeps its vertices
+//    apart here, as a tiny mesh should.)
+//  - Triangulate splits a quad into (s, s+1, s+2) and (s, s+2, s+3), s being its concave corner if
+//    it has one (the angles at a corner to the diagonal and the two edges sum above pi), else 0;
+//    the test below is assimp's, in float.
+//  - The mesh is named after the object ("o name") or group ("g name") line, "defaultobject"
+//    without one; the albedo is the material's Kd (material_albedo in mesh_io.cpp).
+// Numbers are read by from_chars, correctly rounded; assimp's fast_atof can differ in the last bit.
+#include "ao/io/obj_reader.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/io/asset_path.h"
+#include "ao/io/number_text.h"
+
+namespace ao {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// Whitespace-separated tokens of one line (comment already removed).
+struct Tokens {
+  std::string_view line;
+  std::size_t pos = 0;
+  std::string_view next() {
+    while (pos < line.size() && is_blank(line[pos])) ++pos;
+    const std::size_t start = pos;
+    while (pos < line.size() && !is_blank(line[pos])) ++pos;
+    return line.substr(start, pos - start);
+  }
+};
+
+/// A finite float, or false.
+bool read_float(std::string_view token, float& value) {
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || ptr != token.data() + token.size()) {
+    // '+1', underflow to a denormal or 0: the reading every text format shares.
+    if (!parse_real(token, value)) return false;
+  }
+  return std::isfinite(value);
+}
+
+bool read_index(std::string_view part, long long& value) {
+  const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
+  return ec == std::errc() && ptr == part.data() + part.size() && value != 0;
+}
+
+/// Bits of a value for equality, with -0 and +0 alike (float equality, as assimp compares).
+template <std::size_t N>
+std::array<std::uint32_t, N> key_of(const std::array<float, N>& v) {
+  std::array<std::uint32_t, N> k{};
+  for (std::size_t i = 0; i < N; ++i) {
+    const float f = v[i] + 0.0f;  // -0 + 0 = +0
+    std::memcpy(&k[i], &f, 4);
+  }
+  return k;
+}
+
+struct KeyHash {
+  template <std::size_t N>
+  std::size_t operator()(const std::array<std::uint32_t, N>& k) const {
+    std::uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (std::uint32_t x : k) h = (h ^ x) * 0xFF51AFD7ED558CCDull, h ^= h >> 32;
+    return static_cast<std::size_t>(h);
+  }
+};
+
+/// For each value of `values`, the index of the first equal value.
+template <std::size_t N>
+std::vector<std::uint32_t> first_equal(const std::vector<std::array<float, N>>& values) {
+  std::unordered_map<std::array<std::uint32_t, N>, std::uint32_t, KeyHash> seen;
+  seen.reserve(values.size());
+  std::vector<std::uint32_t> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) out[i] = seen.try_emplace(key_of(values[i]), static_cast<std::uint32_t>(i)).first->second;
+  return out;
+}
+
+/// The Kd colour of material `name` in the library files `libraries` (in the asset's folder), or
+/// false when it is not there exactly once with one plain "Kd r g b" line.
+bool material_colour(const fs::path& model, const std::vector<std::string>& libraries, std::string_view name, Vec3& colour) {
+  int found = 0;
+  for (const std::string& lib : libraries) {
+    std::ifstream in(model.parent_path() / lib, std::ios::binary);
+    if (!in) return false;
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bool inside = false;
+    int kd_lines = 0;
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+      const std::size_t end = std::min(text.find('\n', pos), text.size());
+      std::string_view line = std::string_view(text).substr(pos, end - pos);
+      pos = end + 1;
+      line = line.substr(0, std::min(line.find('#'), line.size()));
+      Tokens t{line};
+      const std::string_view key = t.next();
+      if (key == "newmtl") {
+        if (inside && kd_lines != 1) return false;
+        const std::string_view n = t.next();
+        inside = n == name && t.next().empty();
+        if (inside && ++found > 1) return false;
+        kd_lines = 0;
+      } else if (inside && key == "Kd") {
+        float c[3];
+        for (float& v : c)
+          if (!read_float(t.next(), v)) return false;
+        if (!t.next().empty()) return false;
+        colour = {c[0], c[1], c[2]};
+        ++kd_lines;
+      }
+    }
+    if (inside && kd_lines != 1) return false;
+  }
+  return found == 1;
+}
+
+/// Corner forms, by which indices a corner has.
+enum Form { kV = 0, kVT = 1, kVN = 2, kVTN = 3, kUnset = -1 };
+
+/// A corner's "v", "v/vt", "v//vn" or "v/vt/vn"; false for anything else.
+bool read_corner(std::string_view c, long long idx[3], Form& form) {
+  const std::size_t s1 = c.find('/');
+  if (s1 == std::string_view::npos) {
+    form = kV;
+    return read_index(c, idx[0]);
+  }
+  if (!read_index(c.substr(0, s1), idx[0])) return false;
+  const std::size_t s2 = c.find('/', s1 + 1);
+  if (s2 == std::string_view::npos) {
+    form = kVT;
+    return read_index(c.substr(s1 + 1), idx[1]);
+  }
+  const std::string_view t = c.substr(s1 + 1, s2 - s1 - 1), n = c.substr(s2 + 1);
+  if (!read_index(n, idx[2])) return false;
+  if (t.empty()) {
+    form = kVN;
+    return true;
+  }
+  form = kVTN;
+  return read_index(t, idx[1]);
+}
+
+/// assimp's concave-corner test for a quad (TriangulateProcess): the corner whose two angles to
+/// the opposite diagonal sum above pi, or 0. Without fused multiply-adds, which the build's
+/// -march=native would allow and Debian's assimp does not use: the same roundings as assimp's.
+#if defined(__clang__)
+int quad_start(const Vec3 p[4]) {
+#pragma clang fp contract(off)
+#elif defined(__GNUC__)
+__attribute__((optimize("fp-contract=off"))) int quad_start(const Vec3 p[4]) {
+#else
+int quad_start(const Vec3 p[4]) {
+#endif
+  // As aiVector3D::Normalize, bit for bit: times the reciprocal of the length, a zero vector kept.
+  const auto unit = [](Vec3 a) {
+    const float len = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+    if (len == 0.0f) return a;
+    const float inv = 1.0f / len;
+    return Vec3{a.x * inv, a.y * inv, a.z * inv};
+  };
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 v = p[i];
+    const Vec3 left = unit(p[(i + 3) % 4] - v), diag = unit(p[(i + 2) % 4] - v), right = unit(p[(i + 1) % 4] - v);
+    const float angle = std::acos(left.x * diag.x + left.y * diag.y + left.z * diag.z) + std::acos(right.x * diag.x + right.y * diag.y + right.z * diag.z);
+    if (angle > 3.14159265358979323846f) return i;
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data, const LoadOptions& options) {
+  std::vector<std::array<float, 3>> positions, normals;
+  std::vector<std::array<float, 2>> uvs;
+  // Face corners as read (attribute indices resolved to 0-based), 3 or 4 per face.
+  std::vector<std::array<std::uint32_t, 3>> corners;
+  std::vector<std::uint8_t> face_sizes;
+  std::vector<std::array<long long, 3>> forward;  // positive indices, checked once the counts are known
+  std::vector<std::string> libraries;
+  std::string object_name = "defaultobject", material;
+  int object_lines = 0, material_lines = 0;
+  Form form = kUnset;
+  const fs::path folder = asset_folder(path, options.asset_root);
+
+  std::size_t pos = 0;
+  while (pos < data.size()) {
+    const char* nl = static_cast<const char*>(std::memchr(data.data() + pos, '\n', data.size() - pos));
+    const std::size_t end = nl ? static_cast<std::size_t>(nl - data.data()) : data.size();
+    std::string_view line = data.substr(pos, end - pos);
+    pos = end + 1;
+    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    if (!line.empty() && line.back() == '\\') return std::nullopt;  // continued lines: assimp's reading
+    Tokens t{line};
+    const std::string_view key = t.next();
+    if (key.empty()) continue;
+    if (key == "v" || key == "vn") {
+      std::array<float, 3> v;
+      for (float& x : v)
+        if (!read_float(t.next(), x)) return std::nullopt;
+      if (!t.next().empty()) return std::nullopt;  // w or a vertex colour
+      (key == "v" ? positions : normals).push_back(v);
+    } else if (key == "vt") {
+      std::array<float, 2> v;
+      for (float& x : v)
+        if (!read_float(t.next(), x)) return std::nullopt;
+      const std::string_view w = t.next();
+      float ignored = 0;
+      if (!w.empty() && (!read_float(w, ignored) || !t.next().empty())) return std::nullopt;
+      uvs.push_back(v);
+    } else if (key == "f") {
+      std::uint8_t n = 0;
+      for (std::string_view c = t.next(); !c.empty(); c = t.next()) {
+        long long idx[3] = {0, 0, 0};
+        Form f = kUnset;
+        if (n == 4 || !read_corner(c, idx, f)) return std::nullopt;
+        if (form == kUnset) form = f;
+        if (f != form) return std::nullopt;
+        const std::size_t counts[3] = {positions.size(), uvs.size(), normals.size()};
+        std::array<std::uint32_t, 3> resolved{0, 0, 0};
+        bool later = false;
+        for (int k = 0; k < 3; ++k) {
+          if (idx[k] == 0) continue;  // absent
+          if (idx[k] < 0) {
+            if (static_cast<unsigned long long>(-idx[k]) > counts[k]) return std::nullopt;
+            resolved[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(static_cast<long long>(counts[k]) + idx[k]);
+          } else {
+            if (idx[k] > 0xFFFFFFFFll) return std::nullopt;
+            resolved[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(idx[k] - 1);
+            later = later || static_cast<unsigned long long>(idx[k]) > counts[k];
+          }
+        }
+        if (later) forward.push_back({idx[0], idx[1], idx[2]});
+        corners.push_back(resolved);
+        ++n;
+      }
+      if (n < 3) return std::nullopt;
+      face_sizes.push_back(n);
+    } else if (key == "o" || key == "g") {
+      const std::string_view name = t.next();
+      if (!face_sizes.empty() || ++object_lines > 1 || name.empty() || !t.next().empty()) return std::nullopt;
+      object_name = name;
+    } else if (key == "usemtl") {
+      const std::string_view name = t.next();
+      if (!face_sizes.empty() || ++material_lines > 1 || name.empty() || !t.next().empty()) return std::nullopt;
+      material = name;
+    } else if (key == "mtllib") {
+      const std::string_view name = t.next();
+      // assimp looks the material up when it meets usemtl; a name with spaces is its reading too.
+      if (material_lines > 0 || name.empty() || !t.next().empty()) return std::nullopt;
+      resolve_asset_reference(path, folder, name, "material library");
+      libraries.emplace_back(name);
+    } else if (key != "s") {
+      return std::nullopt;
+    }
+  }
+  if (face_sizes.empty()) return std::nullopt;
+  for (const auto& idx : forward)
+    if (static_cast<unsigned long long>(idx[0]) > positions.size() || static_cast<unsigned long long>(idx[1]) > uvs.size() ||
+        static_cast<unsigned long long>(idx[2]) > normals.size())
+      return std::nullopt;
+  Vec3 albedo = Mesh{}.albedo;
+  if (!material.empty() && !material_colour(path, libraries, material, albedo)) return std::nullopt;
+
+  const bool has_uv = form == kVT || form == kVTN, has_normal = form == kVN || form == kVTN;
+  if (options.uv_set > 0)
+    throw InputError(path.string() + ": has " + std::string(has_uv ? "1 UV set" : "0 UV sets") + ", --uv-set " + std::to_string(options.uv_set) +
+                     " asked for");
+
+  // Weld: equal values share a number, then each distinct triple is a vertex in first-use order.
+  const std::vector<std::uint32_t> pos_id = first_equal(positions);
+  const std::vector<std::uint32_t> uv_id = has_uv ? first_equal(uvs) : std::vector<std::uint32_t>{};
+  const std::vector<std::uint32_t> normal_id = has_normal ? first_equal(normals) : std::vector<std::uint32_t>{};
+  std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, KeyHash> vertex_of;
+  vertex_of.reserve(corners.size());
+  Mesh mesh;
+  mesh.name = object_name;
+  mesh.albedo = albedo;
+  mesh.positions.reserve(positions.size() + kVertexPadding);  // see kVertexPadding
+  std::vector<std::uint32_t> corner_vertex(corners.size());
+  for (std::size_t c = 0; c < corners.size(); ++c) {
+    const std::array<std::uint32_t, 3> key{pos_id[corners[c][0]], has_uv ? uv_id[corners[c][1]] : 0u, has_normal ? normal_id[corners[c][2]] : 0u};
+    const auto [it, inserted] = vertex_of.try_emplace(key, static_cast<std::uint32_t>(mesh.positions.size()));
+    if (inserted) {
+      const auto& p = positions[key[0]];
+      mesh.positions.push_back({p[0], p[1], p[2]});
+      if (has_uv) mesh.uvs.push_back({uvs[key[1]][0], uvs[key[1]][1]});
+      if (has_normal) mesh.normals.push_back({normals[key[2]][0], normals[key[2]][1], normals[key[2]][2]});
+    }
+    corner_vertex[c] = it->second;
+  }
+  mesh.indices.reserve(corners.size() * 3 / 2 + 3);
+  std::size_t c = 0;
+  for (const std::uint8_t n : face_sizes) {
+    const std::uint32_t* v = &corner_vertex[c];
+    if (n == 3) {
+      mesh.indices.insert(mesh.indices.end(), v, v + 3);
+    } else {
+      const Vec3 p[4] = {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], mesh.positions[v[3]]};
+      const int s = quad_start(p);
+      for (int k : {0, 1, 2, 0, 2, 3}) mesh.indices.push_back(v[(s + k) % 4]);
+    }
+    c += n;
+  }
+
+  Scene scene;
+  scene.name = path.filename().string();
+  scene.meshes.push_back(std::move(mesh));
+  validate_and_prepare(scene);
+  return scene;
+}
+
+}  // namespace ao

@@ -1,0 +1,243 @@
+#include "ao/jobs/compare.h"
+
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "ao/core/error.h"
+#include "ao/registry/registry.h"
+#include "ao/reference/ray_scene.h"
+
+namespace ao {
+
+namespace {
+
+constexpr int kMaxReferenceSpp = 1 << 20;
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+std::string fixed(double v, int digits) {
+  if (std::isinf(v)) return "inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+// The reference name settings give `method`: its own entry, else the "" entry, else matched.
+std::string reference_name(const CompareSettings& s, const std::string& method) {
+  if (auto it = s.references.find(method); it != s.references.end()) return it->second;
+  if (auto it = s.references.find(""); it != s.references.end()) return it->second;
+  return kMatchedReference;
+}
+
+ProgressFn stage(const CompareSettings& s, const std::string& name) { return s.progress ? s.progress(name) : ProgressFn{}; }
+
+}  // namespace
+
+nlohmann::json shortest_floats(const nlohmann::json& j) {
+  if (j.is_object() || j.is_array()) {
+    nlohmann::json out = j;
+    for (auto& v : out) v = shortest_floats(v);
+    return out;
+  }
+  if (!j.is_number_float()) return j;
+  const double d = j.get<double>();
+  const float f = static_cast<float>(d);
+  if (!std::isfinite(d) || static_cast<double>(f) != d) return j;
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, f);
+  double shortest = 0;
+  std::from_chars(buf, r.ptr, shortest);
+  return shortest;
+}
+
+std::string format_value(const nlohmann::json& v) {
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_number_float()) {
+    const double d = v.get<double>();
+    const float f = static_cast<float>(d);
+    char buf[32];
+    const auto r = std::isfinite(d) && static_cast<double>(f) == d ? std::to_chars(buf, buf + sizeof buf, f, std::chars_format::general)
+                                                                   : std::to_chars(buf, buf + sizeof buf, d, std::chars_format::general);
+    return std::string(buf, r.ptr);
+  }
+  return v.dump();
+}
+
+CompareSettings resolve_compare_settings(const CompareSettings& in) {
+  CompareSettings s = in;
+  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError("--spp-reference must be in [1, 1048576]");
+  s.falloff.validate();
+  if (s.methods.empty()) {
+    // Every approximate method (the reference itself is not compared with itself).
+    for (const MethodInfo& m : all_methods())
+      if (!m.ground_truth) s.methods.emplace_back(m.name);
+    if (s.methods.empty()) throw InputError("--methods: the registry has no approximate methods");
+  }
+  for (const auto& [name, p] : in.params) {
+    bool chosen = false;
+    for (const std::string& m : s.methods) chosen = chosen || m == name;
+    if (!chosen) throw InputError("--param: method '" + name + "' is not among --methods");
+  }
+  s.params.clear();
+  for (const std::string& name : s.methods) {
+    const MethodInfo& m = find_method(name);
+    nlohmann::json p = m.default_params();
+    if (auto it = in.params.find(name); it != in.params.end()) {
+      if (!it->second.is_object()) throw InputError("--param: parameters of " + name + " must be a JSON object");
+      for (const auto& [k, v] : it->second.items()) {
+        if (!p.contains(k)) throw InputError("--param: " + name + " has no parameter '" + k + "'");
+        p[k] = v;
+      }
+    }
+    s.params[name] = shortest_floats(p);
+    choose_reference(m, reference_name(s, name), s.falloff, s.params[name]);  // throws for unknown names
+  }
+  for (const auto& [name, ref] : in.references)
+    if (!name.empty() && !s.params.count(name)) throw InputError("--reference: method '" + name + "' is not among --methods");
+  if (!s.sweep_key.empty()) {
+    if (s.sweep_values.empty()) throw InputError("--sweep: no values given for '" + s.sweep_key + "'");
+    bool any = false;
+    for (const auto& [name, p] : s.params) any = any || p.contains(s.sweep_key);
+    if (!any) throw InputError("--sweep: no chosen method has a parameter '" + s.sweep_key + "'");
+  }
+  return s;
+}
+
+CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const AnalyticSurfaces* surfaces, const CompareSettings& settings) {
+  const CompareSettings s = resolve_compare_settings(settings);
+  CompareResult result;
+  result.falloff = s.falloff;
+  result.spp_reference = s.spp_reference;
+  result.seed = s.seed;
+  result.width = g.width();
+  result.height = g.height();
+  result.sweep_key = s.sweep_key;
+
+  auto reference_for = [&](const ReferenceSpec& spec) -> std::size_t {
+    const std::string key = spec.key();
+    for (std::size_t i = 0; i < result.references.size(); ++i)
+      if (result.references[i].spec.key() == key) return i;
+    const auto start = std::chrono::steady_clock::now();
+    ReferenceImage img = render_reference(scene, g, spec, {.samples = s.spp_reference}, s.seed + 1, stage(s, "reference (" + spec.label() + ")"));
+    result.references.push_back({spec, std::move(img.scalar.visibility), elapsed_ms(start), img.scalar.mean_std_error});
+    return result.references.size() - 1;
+  };
+  auto run_method = [&](const MethodInfo& m, const nlohmann::json& p, double& ms) {
+    const auto start = std::chrono::steady_clock::now();
+    MethodOutput out = m.run(MethodInput{g, &scene, s.falloff, s.seed, stage(s, std::string(m.name)), surfaces}, p);
+    ms = elapsed_ms(start);
+    return out;
+  };
+
+  const Image<std::uint8_t> covered = coverage_mask(g);
+  for (const std::string& name : s.methods) {
+    const MethodInfo& m = find_method(name);
+    const nlohmann::json& p = s.params.at(name);
+    CompareRow row;
+    row.method = name;
+    row.params = p;
+    row.defaults = shortest_floats(m.default_params());
+    row.reference = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
+    MethodOutput out = run_method(m, p, row.ms);
+    const Image<float>& ref = result.references[row.reference].visibility;
+    row.metrics = compare_images(out.visibility, ref, covered);
+    row.heat = signed_error_heat_map(out.visibility, ref, covered, kCompareHeatRange);
+    row.stats = out.stats;
+    row.visibility = std::move(out.visibility);
+    result.rows.push_back(std::move(row));
+  }
+
+  if (!s.sweep_key.empty())
+    for (const std::string& name : s.methods) {
+      if (!s.params.at(name).contains(s.sweep_key)) continue;
+      const MethodInfo& m = find_method(name);
+      for (const nlohmann::json& v : s.sweep_values) {
+        nlohmann::json p = s.params.at(name);
+        p[s.sweep_key] = v;
+        const std::size_t r = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
+        double ms = 0;
+        const MethodOutput out = run_method(m, p, ms);
+        const ErrorMetrics e = compare_images(out.visibility, result.references[r].visibility, covered);
+        result.sweep.push_back({name, v, e.rmse, ms});
+      }
+    }
+  return result;
+}
+
+nlohmann::json compare_table_json(const CompareResult& r) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const CompareRow& row : r.rows) {
+    const CompareReference& ref = r.references[row.reference];
+    nlohmann::json reference = shortest_floats(ref.spec);
+    reference["label"] = ref.spec.label();
+    reference["spp"] = r.spp_reference;
+    reference["mean_std_error"] = ref.mean_std_error;
+    reference["ms"] = ref.ms;
+    const ErrorMetrics& e = row.metrics;
+    rows.push_back({{"method", row.method}, {"parameters", row.params}, {"ms", row.ms}, {"rmse", e.rmse}, {"psnr_db", e.psnr_db},
+                    {"ssim", e.ssim}, {"mean_signed_error", e.mean_signed}, {"max_abs_error", e.max_abs}, {"pixels", e.pixels},
+                    {"reference", reference}, {"stats", row.stats}});
+  }
+  return shortest_floats(nlohmann::json{{"width", r.width},
+                                        {"height", r.height},
+                                        {"membership", to_string(r.falloff.membership)},
+                                        {"radius", r.falloff.radius},
+                                        {"seed", r.seed},
+                                        {"spp_reference", r.spp_reference},
+                                        {"rows", rows}});
+}
+
+std::string compare_table_markdown(const CompareResult& r, const std::string& scene_name) {
+  std::ostringstream md;
+  md << "# ao compare: " << scene_name << "\n\n"
+     << r.width << "x" << r.height << ", R = " << format_value(shortest_floats(r.falloff.radius)) << " ("
+     << to_string(r.falloff.membership) << " requested), reference " << r.spp_reference << " rays/pixel, seed " << r.seed
+     << ". Errors are over covered pixels, V units; mean signed error > 0: the method is brighter than its reference.\n\n"
+     << "| method | parameters | reference | ms | RMSE | PSNR (dB) | SSIM | mean signed error |\n"
+     << "|---|---|---|---:|---:|---:|---:|---:|\n";
+  for (const CompareRow& row : r.rows) {
+    std::string params;
+    for (const auto& [k, v] : row.params.items()) params += (params.empty() ? "" : ", ") + k + "=" + format_value(v);
+    const ReferenceSpec& spec = r.references[row.reference].spec;
+    std::string ref = spec.label() + ", R = " + format_value(shortest_floats(spec.falloff.radius));
+    if (spec.kind != ReferenceKind::TangentSphere && spec.falloff.membership == Membership::Alchemy)
+      ref += ", u = " + fixed(spec.falloff.effective_alchemy_u(), 4);
+    const ErrorMetrics& e = row.metrics;
+    md << "| " << row.method << " | " << params << " | " << ref << " | " << fixed(row.ms, 1) << " | " << fixed(e.rmse, 4) << " | "
+       << (std::isfinite(e.psnr_db) ? fixed(e.psnr_db, 2) : "inf") << " | " << fixed(e.ssim, 4) << " | " << fixed(e.mean_signed, 4) << " |\n";
+  }
+  md << "\n`sheet.png`: one row per method in the order above, labelled with its name, its reference and its RMSE; columns: the "
+     << "method's V, the reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at "
+     << "|error| = " << kCompareHeatRange << "; grey: background).\n";
+  return md.str();
+}
+
+nlohmann::json compare_sweep_json(const CompareResult& r) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const SweepRow& s : r.sweep) rows.push_back({{"method", s.method}, {r.sweep_key, s.value}, {"rmse", s.rmse}, {"ms", s.ms}});
+  return {{"key", r.sweep_key}, {"rows", rows}};
+}
+
+std::string compare_sweep_markdown(const CompareResult& r) {
+  std::ostringstream s;
+  s << "# ao compare sweep: " << r.sweep_key << "\n\n| method | " << r.sweep_key << " | RMSE | ms |\n|---|---:|---:|---:|\n";
+  for (const SweepRow& row : r.sweep)
+    s << "| " << row.method << " | " << format_value(row.value) << " | " << fixed(row.rmse, 4) << " | " << fixed(row.ms, 1) << " |\n";
+  return s.str();
+}
+
+std::string compare_key_params(const CompareRow& row, std::size_t max_chars) {
+  std::string s;
+  for (const auto& [k, v] : row.params.items()) {
+    if (k != "samples" && k != "preset" && row.defaults.value(k, nlohmann::json()) == v) continue;
+    s += (s.empty() ? "" : ", ") + k + "=" + format_value(v);
+  }
+  return s.size() <= max_chars ? s : "";
+}
+
+}  // namespace ao

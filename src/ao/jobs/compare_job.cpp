@@ -1,0 +1,122 @@
+// `ao compare` as a library call (compare.h, run_compare): the scene and its G-buffer, the
+// comparison, and its table, sheet and sweep written as one transaction. docs/compare.md.
+#include <cstdio>
+#include <fstream>
+
+#include "ao/core/error.h"
+#include "ao/core/stopwatch.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/io/atomic_file.h"
+#include "ao/io/image_io.h"
+#include "ao/io/output_set.h"
+#include "ao/io/text.h"
+#include "ao/jobs/compare.h"
+#include "ao/jobs/contact_sheet.h"
+#include "ao/reference/ray_scene.h"
+
+namespace ao {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string fixed4(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
+  return buf;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  write_file_atomically(path, [&](const fs::path& temp) {
+    std::ofstream out(temp, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw SystemError(path.string() + ": cannot write");
+  });
+}
+
+// The sheet: per row the method's V, its reference's V and the heat map, labelled. A missing font
+// costs the labels, never the comparison.
+Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, const JobReporter& reporter) {
+  std::vector<SheetRow> rows;
+  for (const CompareRow& row : result.rows) {
+    std::vector<std::string> label = {row.method};
+    const std::string kp = compare_key_params(row);
+    if (!kp.empty()) label.push_back(kp);
+    label.push_back("reference: " + result.references[row.reference].spec.label());
+    label.push_back("RMSE " + fixed4(row.metrics.rmse));  // as in table.md
+    rows.push_back({&row.visibility, &result.references[row.reference].visibility, &row.heat, std::move(label)});
+  }
+  std::string font_error;
+  const std::optional<Font> font = Font::open(font_path.empty() ? fs::path(kDejaVuSansPath) : font_path, &font_error);
+  if (!font) reporter.warn(font_error + "; sheet.png has no labels (install fonts-dejavu-core or set AO_FONT)");
+  return contact_sheet(rows, kCompareHeatRange, font ? &*font : nullptr);
+}
+
+std::vector<std::string> output_files(bool sweep) {
+  std::vector<std::string> files = {"table.json", "table.md", "sheet.png"};
+  if (sweep) files.insert(files.end(), {"sweep.json", "sweep.md"});
+  return files;
+}
+
+void write_outputs(OutputSet& outputs, const fs::path& dir, CompareJobResult& out) {
+  auto text = [&](const std::string& name, const std::string& content) {
+    outputs.write(dir / name, [&] { write_text(dir / name, content); });
+  };
+  text("table.json", out.table.dump(2) + "\n");
+  text("table.md", out.markdown);
+  outputs.write(dir / "sheet.png", [&] { write_rgb_image(dir / "sheet.png", out.sheet); });
+  if (!out.result.sweep_key.empty()) {
+    text("sweep.json", compare_sweep_json(out.result).dump(2) + "\n");
+    text("sweep.md", compare_sweep_markdown(out.result));
+  }
+  outputs.commit();
+  for (const std::string& f : output_files(!out.result.sweep_key.empty())) out.written.push_back(dir / f);
+}
+
+}  // namespace
+
+fs::path default_compare_dir(const CompareRequest& request) { return "compare-" + fs::path(request.scene.name()).stem().string(); }
+
+CompareJobResult run_compare(const CompareRequest& request, const JobReporter& reporter) {
+  // Everything that can be checked without rendering is checked before anything is written.
+  CompareSettings settings = resolve_compare_settings(request.settings);  // R is set below; the check uses the default falloff
+  request.camera.validate();
+  request.falloff.validate();
+  OutputSet outputs;
+  request.scene.declare_inputs(outputs);
+  if (!request.out_dir.empty()) {
+    outputs.add_directory(request.out_dir, "--out-dir");
+    for (const std::string& f : output_files(!settings.sweep_key.empty())) outputs.add_output(request.out_dir / f, "--out-dir");
+  }
+
+  Stopwatch clock;
+  const std::shared_ptr<const Scene> scene = request.scene.load();
+  for (const std::string& w : scene->warnings) reporter.warn(w);
+  const RayScene rays(*scene);
+  CompareJobResult out;
+  out.camera = choose_camera(*scene, request.camera);
+  const GBuffer g = render_gbuffer(rays, out.camera, GBufferOptions{.normal = request.normal}, reporter.start("G-buffer"));
+  settings.falloff = choose_falloff(request.falloff, interest_diagonal(*scene));
+  const double setup_ms = clock.lap_ms();
+
+  settings.progress = reporter.stage;
+  out.result = compare_methods(rays, g, &scene->analytic, settings);
+  // Methods report problems they worked around (e.g. cone: open meshes).
+  for (const CompareRow& row : out.result.rows)
+    if (row.stats.contains("warnings"))
+      for (const auto& w : row.stats["warnings"]) reporter.warn(row.method + ": " + w.get<std::string>());
+  out.scene = scene->name;
+  out.table = compare_table_json(out.result);
+  out.table["scene"] = scene->name;
+  const Camera& c = g.camera;
+  out.table["camera"] = {{"eye", {c.eye.x, c.eye.y, c.eye.z}}, {"target", {c.target.x, c.target.y, c.target.z}}, {"up", {c.up.x, c.up.y, c.up.z}},
+                         {"fov", c.vertical_fov_deg}};
+  out.table["setup_ms"] = setup_ms;
+  out.markdown = compare_table_markdown(out.result, scene->name);
+  out.sheet = make_sheet(out.result, request.font, reporter);
+  if (!request.out_dir.empty()) write_outputs(outputs, request.out_dir, out);
+  return out;
+}
+
+}  // namespace ao

@@ -1,0 +1,164 @@
+// The contact sheet is built as horizontal bands (the header, then one per row: label above
+// images) that are stacked with gutters between them.
+#include "ao/jobs/contact_sheet.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "ao/core/error.h"
+#include "ao/eval/metrics.h"
+
+namespace ao {
+
+namespace {
+
+constexpr int kGap = 4;  // gutter between images and around the sheet, pixels
+constexpr Vec3 kBackground{0.1f, 0.1f, 0.1f};
+constexpr Vec3 kTitleColour{0.75f, 0.75f, 0.75f};  // the header is quieter than the row labels
+constexpr Vec3 kLabelColour{1.0f, 1.0f, 1.0f};
+// Column titles, as pieces that are wrapped between, never inside, so "too bright" stays whole.
+// Red above zero and blue below, as signed_error_colour draws them.
+const std::vector<std::string> kTitles[3] = {{"method"}, {"ray-traced", "reference"}, {"signed error", "(red: too bright", "/ blue: too dark)"}};
+constexpr const char* kLabelJoiner = "   ";
+
+// Text height: 1/20 of the image width, so the text keeps its proportion to the images when a page
+// shrinks the sheet (32 pixels at the docs' 640-pixel cells are still 15 on a sheet shown at half
+// size), and at least 12 pixels, below which DejaVu Sans stops being comfortable to read.
+int text_pixels(int image_width) { return std::clamp(image_width / 20, 12, 32); }
+
+// Greedy line breaking: as many units per line as fit in `width`, joined by `joiner`. A unit wider
+// than `width` gets a line of its own (and draw_text clips it at the edge of the band).
+std::vector<std::string> wrap(const Font& font, int px, const std::vector<std::string>& units, const std::string& joiner, int width) {
+  std::vector<std::string> lines;
+  std::string line;
+  for (const std::string& unit : units) {
+    const std::string longer = line.empty() ? unit : line + joiner + unit;
+    if (line.empty() || text_width(font, longer, px) <= width) {
+      line = longer;
+    } else {
+      lines.push_back(line);
+      line = unit;
+    }
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+void paste(Image<Vec3>& dst, int ox, int oy, const Image<Vec3>& src) {
+  for (int y = 0; y < src.height(); ++y)
+    for (int x = 0; x < src.width(); ++x) dst(ox + x, oy + y) = src(x, y);
+}
+
+void paste(Image<Vec3>& dst, int ox, int oy, const Image<float>& grey) {
+  for (int y = 0; y < grey.height(); ++y)
+    for (int x = 0; x < grey.width(); ++x) dst(ox + x, oy + y) = Vec3{grey(x, y), grey(x, y), grey(x, y)};
+}
+
+// "+0.25", "-0.25": shortest form, sign always shown.
+std::string with_sign(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+g", v);
+  return buf;
+}
+
+// What the header and labels share.
+struct Layout {
+  const Font& font;
+  int px;      // text height, pixels (the font's em size)
+  int line;    // line height
+  int pad;     // space above a block of text
+  int col_w;   // width of a column: the image's, or more when a title word or the scale needs it
+  int sheet_w;
+  int column_x(int c) const { return kGap + c * (col_w + kGap); }
+};
+
+// The heat map's scale: the numbers at its ends and middle, and the narrowest bar they fit under.
+struct Scale {
+  std::string low, mid, high;
+  int min_width = 0;
+};
+
+Scale scale_of(const Font& font, int px, float heat_range) {
+  Scale s{with_sign(-heat_range), "0", with_sign(heat_range)};
+  s.min_width = text_width(font, s.low, px) + text_width(font, s.mid, px) + text_width(font, s.high, px) + 2 * px;
+  return s;
+}
+
+// Column titles, and under the heat map's title its colour scale: a bar from -range (blue) through
+// 0 (white) to +range (red), coloured by the heat map's own function, with the three numbers below.
+Image<Vec3> header_band(const Layout& l, const Scale& scale, int image_width, float heat_range) {
+  std::vector<std::vector<std::string>> titles;
+  std::size_t title_lines = 0;
+  for (const std::vector<std::string>& t : kTitles) {
+    titles.push_back(wrap(l.font, l.px, t, " ", l.col_w));
+    title_lines = std::max(title_lines, titles.back().size());
+  }
+  const int bar_y = l.pad + static_cast<int>(title_lines) * l.line + l.pad / 2;
+  const int bar_h = std::max(6, l.px * 2 / 3);
+  const int bar_w = std::max(scale.min_width, std::min(image_width, 10 * l.px));  // <= col_w, which is >= both
+  Image<Vec3> band(l.sheet_w, bar_y + bar_h + 2 + l.line, kBackground);
+
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < titles[c].size(); ++i)
+      draw_text(l.font, band, l.column_x(c), l.pad + static_cast<int>(i) * l.line, titles[c][i], l.px, kTitleColour);
+
+  const int bar_x = l.column_x(2);
+  for (int x = 0; x < bar_w; ++x) {
+    const float error = heat_range * (2.0f * (static_cast<float>(x) + 0.5f) / static_cast<float>(bar_w) - 1.0f);
+    for (int y = 0; y < bar_h; ++y) band(bar_x + x, bar_y + y) = signed_error_colour(error, heat_range);
+  }
+  const int number_y = bar_y + bar_h + 2;
+  draw_text(l.font, band, bar_x, number_y, scale.low, l.px, kTitleColour);
+  draw_text(l.font, band, bar_x + (bar_w - text_width(l.font, scale.mid, l.px)) / 2, number_y, scale.mid, l.px, kTitleColour);
+  draw_text(l.font, band, bar_x + bar_w - text_width(l.font, scale.high, l.px), number_y, scale.high, l.px, kTitleColour);
+  return band;
+}
+
+// One row: its label (when there is a font) above its three images.
+Image<Vec3> row_band(const SheetRow& row, const Layout* l) {
+  std::vector<std::string> lines;
+  if (l != nullptr) lines = wrap(l->font, l->px, row.label, kLabelJoiner, l->sheet_w - 2 * kGap);
+  const int label_h = lines.empty() ? 0 : l->pad + static_cast<int>(lines.size()) * l->line + l->pad / 4;
+  const int w = row.method->width();
+  const int col_w = l != nullptr ? l->col_w : w;
+  Image<Vec3> band(3 * col_w + 4 * kGap, label_h + row.method->height(), kBackground);
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    draw_text(l->font, band, kGap, l->pad + static_cast<int>(i) * l->line, lines[i], l->px, kLabelColour);
+  paste(band, kGap, label_h, *row.method);
+  paste(band, kGap + (col_w + kGap), label_h, *row.reference);
+  paste(band, kGap + 2 * (col_w + kGap), label_h, *row.heat);
+  return band;
+}
+
+}  // namespace
+
+Image<Vec3> contact_sheet(std::span<const SheetRow> rows, float heat_range, const Font* font) {
+  AO_ASSERT(!rows.empty() && heat_range > 0);
+  const int w = rows[0].method->width();
+
+  std::vector<Image<Vec3>> bands;
+  if (font != nullptr) {
+    const int px = text_pixels(w);
+    const Scale scale = scale_of(*font, px, heat_range);
+    int col_w = std::max(w, scale.min_width);
+    for (const std::vector<std::string>& t : kTitles)
+      for (const std::string& piece : t) col_w = std::max(col_w, text_width(*font, piece, px));
+    const Layout layout{*font, px, line_height(*font, px), px / 2, col_w, 3 * col_w + 4 * kGap};
+    bands.push_back(header_band(layout, scale, w, heat_range));
+    for (const SheetRow& row : rows) bands.push_back(row_band(row, &layout));
+  } else {
+    for (const SheetRow& row : rows) bands.push_back(row_band(row, nullptr));
+  }
+
+  int height = kGap;
+  for (const Image<Vec3>& b : bands) height += b.height() + kGap;
+  Image<Vec3> sheet(bands[0].width(), height, kBackground);
+  int y = kGap;
+  for (const Image<Vec3>& b : bands) {
+    paste(sheet, 0, y, b);
+    y += b.height() + kGap;
+  }
+  return sheet;
+}
+
+}  // namespace ao

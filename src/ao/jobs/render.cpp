@@ -1,0 +1,280 @@
+#include "ao/jobs/render.h"
+
+#include <chrono>
+
+#include "ao/core/error.h"
+#include "ao/core/memory.h"
+#include "ao/eval/shading.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/io/gbuffer_exr.h"
+#include "ao/io/image_io.h"
+#include "ao/io/output_set.h"
+#include "ao/core/stopwatch.h"
+#include "ao/reference/ray_scene.h"
+
+namespace ao {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kAoMapMethod = "ao-map";
+
+bool has_gbuffer_input(const RenderRequest& r) { return r.gbuffer || !r.gbuffer_file.empty(); }
+
+// The parameters of the run: the method's, or none when an AO map is shown instead.
+nlohmann::json request_params(const RenderRequest& r, const MethodInfo& m) {
+  return r.ao_map.empty() ? method_params(m, r.params, r.samples, r.target_error) : nlohmann::json::object();
+}
+
+void check_outputs(const RenderOutputs& o) {
+  if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16, got " + std::to_string(o.png_bits));
+  for (const fs::path& out : {o.visibility, o.shaded})
+    if (!out.empty() && !is_supported_image_path(out))
+      throw InputError(out.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+  if (!o.gbuffer.empty() && o.gbuffer.extension() != ".exr")
+    throw InputError(o.gbuffer.string() + ": --gbuffer-out writes OpenEXR, give it a .exr name");
+}
+
+// <output-stem>-<name><ext>, beside the output.
+fs::path extra_path(const fs::path& output, std::string_view name) {
+  return output.parent_path() / (output.stem().string() + "-" + std::string(name) + output.extension().string());
+}
+
+// Every file of the run, declared before the work: one that names an input or another output is
+// refused now, and they are renamed into place together at the end.
+void declare_outputs(OutputSet& set, const RenderRequest& r, const MethodInfo& m) {
+  r.scene.declare_inputs(set);
+  set.add_input(r.gbuffer_file, "--gbuffer-in");
+  set.add_input(r.ao_map, "--ao-map");
+  const RenderOutputs& o = r.outputs;
+  if (!o.visibility.empty()) set.add_output(o.visibility, o.visibility == default_render_output(r) ? "the default output" : "-o");
+  if (!o.shaded.empty()) set.add_output(o.shaded, "--shaded");
+  if (!o.gbuffer.empty()) set.add_output(o.gbuffer, "--gbuffer-out");
+  if (o.extras && r.ao_map.empty() && !o.visibility.empty())
+    for (std::string_view name : m.extras) set.add_output(extra_path(o.visibility, name), "--extras");
+}
+
+void check_memory_of(const RenderRequest& r, const MethodInfo& m, const nlohmann::json& params) {
+  if (has_gbuffer_input(r)) return;
+  const int width = r.camera.width.value_or(r.camera.default_width), height = r.camera.height.value_or(r.camera.default_height);
+  const MethodMemory extra = r.ao_map.empty() && m.memory ? m.memory(params) : MethodMemory{};
+  check_memory(estimate_render_memory({.width = width, .height = height, .sun = r.sun.has_value(), .shaded = !r.outputs.shaded.empty(),
+                                       .gbuffer_out = !r.outputs.gbuffer.empty()}) +
+                   extra.bytes,
+               "ao render: " + std::to_string(width) + "x" + std::to_string(height) + " pixels" + (extra.bytes ? " and " + extra.what : ""));
+}
+
+// What the render reads, loaded: the scene and its BVH (or the G-buffer), and the AO map.
+struct Loaded {
+  std::optional<PreparedScene> scene;
+  GBuffer gbuffer;
+  float diagonal = 0;
+  Image<float> ao_map;
+};
+
+float covered_diagonal(const GBuffer& g) {
+  Bounds3 b;
+  for (std::size_t i = 0; i < g.position.size(); ++i)
+    if (g.covered(i)) b.extend(g.position[i]);
+  return b.diagonal();
+}
+
+Loaded load_inputs(const RenderRequest& r, const MethodInfo& m, const JobReporter& reporter, nlohmann::json& timings, Stopwatch& clock) {
+  Loaded in;
+  if (!r.ao_map.empty()) in.ao_map = read_image(r.ao_map);
+  if (has_gbuffer_input(r)) {
+    in.gbuffer = r.gbuffer ? *r.gbuffer : read_gbuffer_exr(r.gbuffer_file, {.vertical_fov_deg = r.camera.fov});
+    timings["load_gbuffer_ms"] = clock.lap_ms();
+    in.diagonal = covered_diagonal(in.gbuffer);
+    return in;
+  }
+  std::shared_ptr<const Scene> scene = r.scene.load();
+  for (const std::string& w : scene->warnings) reporter.warn(w);
+  timings["load_ms"] = clock.lap_ms();
+  in.scene.emplace(std::move(scene), "ao render", BvhOptions{});
+  timings["bvh_ms"] = clock.lap_ms();
+  const Camera cam = choose_camera(*in.scene->scene, r.camera);
+  const GBufferOptions options = gbuffer_options_for(m, r.normal.value_or(SurfaceNormal::Shading),
+                                                     r.sun || r.shade || !r.outputs.shaded.empty() || !r.outputs.gbuffer.empty(), !r.ao_map.empty());
+  in.gbuffer = render_gbuffer(*in.scene->rays, cam, options, reporter.start("G-buffer"));
+  timings["gbuffer_ms"] = clock.lap_ms();
+  in.diagonal = in.scene->radius_basis;
+  if (r.sun) {
+    in.gbuffer.direct = render_direct_light(*in.scene->rays, in.gbuffer, *r.sun, reporter.start("sun"));
+    timings["direct_ms"] = clock.lap_ms();
+  }
+  return in;
+}
+
+void write_outputs(OutputSet& set, const RenderRequest& r, RenderResult& result) {
+  const RenderOutputs& o = r.outputs;
+  const ImageWriteOptions write_opt{.png_bits = o.png_bits};
+  if (!o.visibility.empty()) set.write(o.visibility, [&] { write_image(o.visibility, result.output.visibility, write_opt); });
+  if (!o.shaded.empty()) set.write(o.shaded, [&] { write_rgb_image(o.shaded, result.shaded, {.png_bits = o.png_bits, .srgb = true}); });
+  if (o.extras && !o.visibility.empty())
+    for (const auto& extra : result.output.extras) {
+      const std::string& name = extra.first;
+      const auto& image = extra.second;  // a named reference: Clang 14 cannot capture structured bindings
+      const fs::path path = extra_path(o.visibility, name);
+      set.write(path, [&] { write_image(path, image, write_opt); }, "--extras");
+      result.extras_written[name] = path;
+    }
+  if (!o.gbuffer.empty()) set.write(o.gbuffer, [&] { write_gbuffer_exr(o.gbuffer, result.gbuffer); });
+  set.commit();
+}
+
+nlohmann::json to_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+nlohmann::json summary_of(const RenderRequest& r, const RenderResult& out, const Scene* scene, const nlohmann::json& timings) {
+  const Camera& c = out.gbuffer.camera;
+  nlohmann::json extras = nlohmann::json::object();
+  for (const auto& [name, path] : out.extras_written) extras[name] = path.string();
+  nlohmann::json s = {
+      {"scene", out.scene},
+      {"method", out.method},
+      {"parameters", out.params},
+      {"membership", to_string(out.falloff.membership)},
+      {"radius", out.falloff.radius},
+      {"normal", out.normal},
+      {"seed", r.seed},
+      {"width", out.gbuffer.width()},
+      {"height", out.gbuffer.height()},
+      {"camera", {{"eye", to_json(c.eye)}, {"target", to_json(c.target)}, {"up", to_json(c.up)}, {"fov", c.vertical_fov_deg}}},
+      {"covered_pixels", out.covered_pixels},
+      {"mean_visibility", out.mean_visibility},
+      {"timings", timings},
+      {"output", r.outputs.visibility.string()},
+      {"extras", extras},
+      {"stats", out.output.stats},
+  };
+  if (out.falloff.membership == Membership::Exp) s["tau"] = out.falloff.effective_tau();
+  if (r.sun) s["sun"] = {{"direction", to_json(r.sun->direction)}, {"irradiance", r.sun->irradiance}};
+  if (scene) {
+    s["triangles"] = scene->triangle_count();
+    s["instances"] = scene->instances.size();
+    s["warnings"] = scene->warnings;
+  }
+  if (out.output.stats.contains("rays") && out.method_ms > 0)
+    s["rays_per_second"] = out.output.stats["rays"].get<double>() / (out.method_ms / 1000.0);
+  return s;
+}
+
+}  // namespace
+
+nlohmann::json method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples,
+                             std::optional<float> target_error) {
+  nlohmann::json params = nlohmann::json::object();
+  if (samples) {
+    if (method.samples_param.empty()) throw InputError("--spp: method " + std::string(method.name) + " has no sample count");
+    params[std::string(method.samples_param)] = *samples;
+  }
+  if (target_error) {
+    if (method.target_error_param.empty()) throw InputError("--target-error: only the ray-traced method stops adaptively");
+    params[std::string(method.target_error_param)] = *target_error;
+  }
+  if (!overrides.is_null()) {
+    if (!overrides.is_object()) throw InputError(std::string(method.name) + ": parameters must be a JSON object, got " + overrides.dump());
+    for (const auto& [key, value] : overrides.items()) params[key] = value;
+  }
+  return method.canonical_params(params);
+}
+
+GBufferOptions gbuffer_options_for(const MethodInfo& method, SurfaceNormal normal, bool albedo_for_outputs, bool uv) {
+  // Only the channels something reads: screen-space methods read the albedo (transfer, GTAO's
+  // multi-bounce); the ray tracers take it from the scene. UVs serve an AO map only.
+  return {.normal = normal, .albedo = !method.needs_scene || albedo_for_outputs, .uv = uv};
+}
+
+GBuffer render_view_gbuffer(const PreparedScene& scene, const Camera& camera, const GBufferOptions& options, const std::optional<Sun>& sun,
+                            const JobReporter& reporter) {
+  GBuffer g = render_gbuffer(*scene.rays, camera, options, reporter.start("G-buffer"));
+  if (sun) g.direct = render_direct_light(*scene.rays, g, *sun, reporter.start("sun"));
+  return g;
+}
+
+MethodOutput run_method(const MethodInfo& method, const nlohmann::json& params, const GBuffer& gbuffer, const PreparedScene* scene,
+                        const Falloff& falloff, std::uint32_t seed, MethodCache* cache, const ProgressFn& progress) {
+  return method.run(MethodInput{gbuffer, scene ? scene->rays.get() : nullptr, falloff, seed, progress, scene ? &scene->scene->analytic : nullptr, cache},
+                    params);
+}
+
+void check_render_request(const RenderRequest& r) {
+  const MethodInfo& m = find_method(r.method);
+  const bool gbuffer_input = has_gbuffer_input(r);
+  if (gbuffer_input && (r.scene.scene || !r.scene.args.empty())) throw InputError("give either a scene or --gbuffer-in, not both");
+  if (!r.ao_map.empty() && gbuffer_input) throw InputError("--ao-map needs the scene's UVs: give a scene, not --gbuffer-in");
+  if (!r.ao_map.empty() && !m.ground_truth) throw InputError("--ao-map shows a baked map instead of a method: drop --method");
+  if (!r.ao_map.empty() && (r.samples || r.target_error)) throw InputError("--ao-map shows a baked map: --spp and --target-error do not apply");
+  check_outputs(r.outputs);
+  if (gbuffer_input && m.needs_scene)
+    throw InputError("method " + std::string(m.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
+  r.camera.validate();
+  r.falloff.validate();
+  const nlohmann::json params = request_params(r, m);
+  if (r.normal && gbuffer_input)
+    throw InputError("--normal chooses the normal a scene's G-buffer is rendered with; a --gbuffer-in file brings its own N");
+  if (r.sun) r.sun->validate();
+  if (r.sun && gbuffer_input)
+    throw InputError("--sun traces shadow rays in the scene, and --gbuffer-in gives only a G-buffer: give a scene, or a G-buffer EXR with "
+                     "direct.R direct.G direct.B channels");
+  if (r.ao_map.empty() && m.reads_direct_light && m.reads_direct_light(params) && !r.sun && !gbuffer_input)
+    throw InputError("-p reflectance=radiance reads the occluders' direct light: give a sun with --sun DX,DY,DZ[,E] (or --gbuffer-in "
+                     "with direct.R direct.G direct.B channels)");
+}
+
+fs::path default_render_output(const RenderRequest& r) {
+  std::string stem = fs::path(has_gbuffer_input(r) ? r.gbuffer_file : fs::path(r.scene.name())).stem().string();
+  if (stem.empty()) stem = "gbuffer";
+  return stem + "-" + (r.ao_map.empty() ? r.method : std::string(kAoMapMethod)) + ".png";
+}
+
+RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
+  Stopwatch clock;
+  nlohmann::json timings;
+  check_render_request(r);
+  const MethodInfo& m = find_method(r.method);
+  RenderResult out;
+  out.method = r.ao_map.empty() ? std::string(m.name) : kAoMapMethod;
+  out.params = request_params(r, m);
+  OutputSet outputs;
+  declare_outputs(outputs, r, m);
+  check_memory_of(r, m, out.params);
+
+  Loaded in = load_inputs(r, m, reporter, timings, clock);
+  const bool gbuffer_input = !in.scene;
+  if (r.ao_map.empty() && m.reads_direct_light && m.reads_direct_light(out.params) && in.gbuffer.direct.empty())
+    throw InputError(r.gbuffer_file.string() + ": -p reflectance=radiance reads the occluders' direct light, and the file has no direct.R direct.G "
+                     "direct.B channels (docs/gbuffer.md)");
+  out.falloff = choose_falloff(r.falloff, in.diagonal);
+  if (!in.ao_map.empty()) {
+    out.output.visibility = visibility_from_ao_map(in.gbuffer, *in.scene->scene, in.ao_map, r.ao_map.string());
+    out.output.stats = {{"ao_map", r.ao_map.string()}, {"map_width", in.ao_map.width()}, {"map_height", in.ao_map.height()}};
+  } else {
+    out.output = run_method(m, out.params, in.gbuffer, in.scene ? &*in.scene : nullptr, out.falloff, r.seed, nullptr, reporter.start(out.method));
+  }
+  out.method_ms = clock.lap_ms();
+  timings["ao_ms"] = out.method_ms;
+  // Methods report problems they worked around (e.g. cone: open meshes, odd voxel columns).
+  if (out.output.stats.contains("warnings"))
+    for (const auto& w : out.output.stats["warnings"]) reporter.warn(w.get<std::string>());
+
+  out.gbuffer = std::move(in.gbuffer);
+  if (r.shade || !r.outputs.shaded.empty()) out.shaded = shade_for_display(out.gbuffer, out.output.visibility, out.output.color);
+  write_outputs(outputs, r, out);
+  timings["write_ms"] = clock.lap_ms();
+
+  double sum_v = 0;
+  for (std::size_t i = 0; i < out.gbuffer.object_id.size(); ++i)
+    if (out.gbuffer.covered(i)) {
+      sum_v += out.output.visibility[i];
+      ++out.covered_pixels;
+    }
+  out.mean_visibility = out.covered_pixels ? sum_v / static_cast<double>(out.covered_pixels) : 1.0;
+  out.scene = gbuffer_input ? (r.gbuffer ? std::string("gbuffer") : r.gbuffer_file.string()) : in.scene->scene->name;
+  out.normal = gbuffer_input ? "file" : to_string(r.normal.value_or(SurfaceNormal::Shading));
+  out.summary = summary_of(r, out, in.scene ? in.scene->scene.get() : nullptr, timings);
+  return out;
+}
+
+}  // namespace ao

@@ -1,0 +1,108 @@
+// `ao render` as a library call: a scene (or a G-buffer) and a method in, the AO image, the
+// G-buffer, the method's other outputs and a summary out, and the files asked for written as one
+// transaction. The command line, the viewer and the Python module all render through here.
+//
+//   RenderRequest r;
+//   r.scene.args = {"mesh.obj"};
+//   r.method = "volumetric";
+//   r.outputs.visibility = "ao.png";
+//   RenderResult out = run_render(r);   // out.output.visibility: V per pixel
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "ao/core/gbuffer.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/jobs/inputs.h"
+#include "ao/jobs/reporter.h"
+#include "ao/reference/direct_light.h"
+#include "ao/registry/registry.h"
+
+namespace ao {
+
+/// The files a render writes; an empty path is not written.
+struct RenderOutputs {
+  std::filesystem::path visibility;  ///< V: .png (linear, png_bits), .exr (float), .tif, .tga, .jpg.
+  std::filesystem::path shaded;      ///< A picture for people (shade_for_display), sRGB.
+  std::filesystem::path gbuffer;     ///< The G-buffer as a multi-channel EXR (docs/gbuffer.md).
+  /// The method's extra outputs (MethodInfo::extras) beside `visibility`, as <stem>-<name><ext>.
+  bool extras = false;
+  int png_bits = 8;  ///< 8 or 16.
+};
+
+struct RenderRequest {
+  SceneSource scene;
+  /// A G-buffer EXR to read instead of rendering a scene (screen-space methods only).
+  std::filesystem::path gbuffer_file;
+  /// The caller's own G-buffer instead of a scene (screen-space methods only); wins over gbuffer_file.
+  std::shared_ptr<const GBuffer> gbuffer;
+  std::string method = "raytraced";  ///< A registry name (all_methods()).
+  nlohmann::json params = nlohmann::json::object();  ///< Overrides of the method's parameters (its table's names).
+  std::optional<int> samples;          ///< Sets the method's MethodInfo::samples_param.
+  std::optional<float> target_error;   ///< Sets the method's MethodInfo::target_error_param.
+  CameraRequest camera;                ///< 1280 x 720 unless given.
+  FalloffRequest falloff;
+  std::optional<SurfaceNormal> normal; ///< The G-buffer's N (default shading); not with a G-buffer input.
+  std::uint32_t seed = 1;              ///< Keys every per-pixel sample set.
+  std::optional<Sun> sun;              ///< A direct-light pass (read by --shaded and transfer's radiance mode).
+  std::filesystem::path ao_map;        ///< Show this baked AO map on the scene instead of running a method.
+  bool shade = false;                  ///< Make the shaded picture even when outputs.shaded is empty.
+  RenderOutputs outputs;
+};
+
+struct RenderResult {
+  std::string scene;        ///< Its name (the G-buffer file's path for a G-buffer input).
+  std::string method;       ///< The registry name, or "ao-map".
+  nlohmann::json params;    ///< Complete (the table's canonical form); empty object for ao-map.
+  Falloff falloff;
+  std::string normal;       ///< "shading", "geometric", or "file" for a G-buffer input.
+  GBuffer gbuffer;
+  MethodOutput output;
+  Image<Vec3> shaded;       ///< When asked for (RenderRequest::shade or outputs.shaded).
+  std::map<std::string, std::filesystem::path> extras_written;  ///< Extra name -> file.
+  std::size_t covered_pixels = 0;
+  double mean_visibility = 1.0;  ///< Over covered pixels.
+  double method_ms = 0;          ///< The method's run time.
+  nlohmann::json summary;        ///< What `ao render --json` prints (parameters, timings, rays/s, ...).
+};
+
+/// The checks that need no file: the method, its parameters, the camera, the falloff, the output
+/// names and the combination of options. InputError with one line naming the problem.
+void check_render_request(const RenderRequest& request);
+
+/// `<scene stem>-<method>.png`, the name `ao render` writes without -o.
+std::filesystem::path default_render_output(const RenderRequest& request);
+
+/// Renders `request`: checks it (check_render_request), declares every output against every input
+/// (InputError before any work when one names another), checks memory, loads, renders the
+/// G-buffer and the method, and writes the outputs asked for together at the end.
+RenderResult run_render(const RenderRequest& request, const JobReporter& reporter = {});
+
+// ---- One view of a prepared scene: what run_render does after loading, and the viewer per frame.
+
+/// The method's parameters: its defaults, then `samples` and `target_error` where the method has
+/// them (InputError where it has not), then `overrides`; complete and checked.
+nlohmann::json method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples = {},
+                             std::optional<float> target_error = {});
+
+/// The G-buffer channels a render needs: albedo for screen-space methods (and the sun pass, a
+/// shaded picture, a G-buffer file), UVs for an AO map.
+GBufferOptions gbuffer_options_for(const MethodInfo& method, SurfaceNormal normal, bool albedo_for_outputs, bool uv);
+
+/// The G-buffer of `camera` in `scene`, with the direct-light pass when `sun` is given.
+GBuffer render_view_gbuffer(const PreparedScene& scene, const Camera& camera, const GBufferOptions& options, const std::optional<Sun>& sun,
+                            const JobReporter& reporter = {});
+
+/// `method` with canonical `params` on `gbuffer` (rendered from `scene`, or from a file when
+/// `scene` is null). `cache`: null, or what the method keeps between frames of this scene.
+MethodOutput run_method(const MethodInfo& method, const nlohmann::json& params, const GBuffer& gbuffer, const PreparedScene* scene,
+                        const Falloff& falloff, std::uint32_t seed, MethodCache* cache = nullptr, const ProgressFn& progress = {});
+
+}  // namespace ao

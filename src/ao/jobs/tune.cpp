@@ -1,0 +1,185 @@
+#include "ao/jobs/tune.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "ao/core/error.h"
+#include "ao/gbuffer/render_gbuffer.h"
+#include "ao/io/atomic_file.h"
+#include "ao/reference/ray_scene.h"
+#include "ao/reference/reference.h"
+#include "ao/jobs/compare.h"
+#include "ao/eval/metrics.h"
+#include "ao/registry/registry.h"
+
+namespace ao {
+
+TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count(); };
+  const MethodInfo& m = find_method(s.method);
+  if (views.empty()) throw InputError("tune: no view to fit on");
+  if (s.parameters.empty()) throw InputError("tune: no parameter to fit");
+  if (!(s.time_budget_s > 0)) throw InputError("tune: the time budget must be > 0 seconds");
+  if (!(s.min_step > 0 && s.min_step < 1)) throw InputError("tune: min_step must be in (0, 1)");
+  nlohmann::json current = s.start.is_null() ? m.default_params() : s.start;
+  for (const TuneParameter& p : s.parameters) {
+    if (!current.contains(p.key)) throw InputError("tune: method " + s.method + " has no parameter '" + p.key + "'");
+    // An optional number left unset ("the preset's value") starts at the middle of its range.
+    if (current.at(p.key).is_null()) current[p.key] = 0.5 * (p.lo + p.hi);
+    if (!current.at(p.key).is_number()) throw InputError("tune: parameter '" + p.key + "' of " + s.method + " is not a number");
+    if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
+      throw InputError("tune: the range of '" + p.key + "' must be finite with lo < hi");
+  }
+
+  TuneResult r;
+  // Mean RMSE over the views; a parameter value the method refuses counts as infinitely bad.
+  std::vector<Image<std::uint8_t>> covered;
+  for (const TuneView& v : views) covered.push_back(coverage_mask(*v.gbuffer));
+  auto evaluate = [&](const nlohmann::json& params) {
+    ++r.evaluations;
+    double sum = 0;
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const TuneView& v = views[i];
+      MethodOutput out;
+      try {
+        out = m.run(MethodInput{*v.gbuffer, v.scene, v.falloff, s.seed, {}, v.surfaces}, params);
+      } catch (const InputError&) {
+        return std::numeric_limits<double>::infinity();
+      }
+      sum += compare_images(out.visibility, v.reference, covered[i]).rmse;
+    }
+    return sum / static_cast<double>(views.size());
+  };
+  auto value_of = [](const TuneParameter& p, double x) {
+    x = std::clamp(x, p.lo, p.hi);
+    return p.integer ? nlohmann::json(static_cast<long long>(std::llround(x))) : shortest_floats(nlohmann::json(static_cast<float>(x)));
+  };
+
+  double best = evaluate(current);
+  r.start_rmse = best;
+  std::vector<double> step;
+  for (const TuneParameter& p : s.parameters) step.push_back((p.hi - p.lo) / 4);
+  bool moving = true;
+  while (moving && seconds() < s.time_budget_s) {
+    moving = false;
+    for (std::size_t i = 0; i < s.parameters.size() && seconds() < s.time_budget_s; ++i) {
+      const TuneParameter& p = s.parameters[i];
+      if (step[i] < s.min_step * (p.hi - p.lo) || (p.integer && step[i] < 0.5)) continue;
+      moving = true;
+      const double x = current.at(p.key).get<double>();
+      bool improved = false;
+      for (double sign : {1.0, -1.0}) {
+        nlohmann::json trial = current;
+        trial[p.key] = value_of(p, x + sign * step[i]);
+        if (trial[p.key] == current[p.key]) continue;
+        const double e = evaluate(trial);
+        if (e < best) {
+          best = e;
+          current = std::move(trial);
+          improved = true;
+          if (s.log) s.log(p.key + " = " + format_value(current[p.key]) + ": mean RMSE " + std::to_string(best));
+          break;
+        }
+      }
+      if (!improved) step[i] /= 2;
+    }
+  }
+  r.params = shortest_floats(current);
+  r.best_rmse = best;
+  r.seconds = seconds();
+  return r;
+}
+
+}  // namespace ao
+
+// ---- The tune job.
+
+namespace ao {
+
+namespace {
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<TuneParameter> tune_parameters(const MethodInfo& m, const std::vector<TuneFit>& fit) {
+  if (fit.empty()) throw InputError("--fit: name at least one parameter to fit (key or key=lo:hi)");
+  std::vector<TuneParameter> out;
+  for (const TuneFit& f : fit) {
+    const ParamSpec* spec = m.params().find(f.key);
+    if (!spec) throw InputError("--fit: method " + std::string(m.name) + " has no parameter '" + f.key + "'");
+    const bool integer = spec->type == ParamType::Int || spec->type == ParamType::OptionalInt;
+    if (!integer && spec->type != ParamType::Float && spec->type != ParamType::OptionalFloat)
+      throw InputError("--fit: '" + f.key + "' of " + std::string(m.name) + " is " + spec->valid_text() + ", not a number to fit");
+    const Range& valid = spec->range;
+    TuneParameter p{.key = f.key, .lo = f.lo.value_or(valid.min), .hi = f.hi.value_or(valid.max), .integer = integer};
+    if (!f.lo && (valid.min_open || !std::isfinite(valid.min)))
+      throw InputError("--fit: '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
+    if (!f.hi && (valid.max_open || !std::isfinite(valid.max)))
+      throw InputError("--fit: '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
+    if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
+      throw InputError("--fit: the range of '" + f.key + "' must be finite with lo < hi, got " + number(p.lo) + ":" + number(p.hi));
+    if (!valid.contains(p.lo) || !valid.contains(p.hi))
+      throw InputError("--fit: the range " + number(p.lo) + ":" + number(p.hi) + " of '" + f.key + "' leaves its valid values, " + spec->valid_text());
+    out.push_back(p);
+  }
+  return out;
+}
+
+TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
+  const MethodInfo& m = find_method(r.method);
+  nlohmann::json start = r.params;
+  start = m.canonical_params(start);
+  TuneSettings settings{.method = r.method, .start = start, .time_budget_s = r.budget_s, .seed = r.seed};
+  settings.parameters = tune_parameters(m, r.fit);
+  if (r.spp_reference < 1 || r.spp_reference > (1 << 20)) throw InputError("--spp-reference must be in [1, 1048576]");
+  if (r.scenes.empty()) throw InputError("--scenes: no scene named");
+  r.camera.validate();
+  r.falloff.validate();
+
+  // Each view keeps its scene, BVH and G-buffer alive while tuning runs.
+  struct Loaded {
+    std::unique_ptr<PreparedScene> scene;
+    GBuffer g;
+  };
+  std::vector<std::unique_ptr<Loaded>> loaded;
+  std::vector<TuneView> views;
+  for (const std::string& name : r.scenes) {
+    auto l = std::make_unique<Loaded>();
+    l->scene = std::make_unique<PreparedScene>(SceneSource{.args = {name}}.load(), "ao tune", BvhOptions{});
+    const Scene& scene = *l->scene->scene;
+    l->g = render_gbuffer(*l->scene->rays, choose_camera(scene, r.camera));
+    const Falloff f = choose_falloff(r.falloff, scene.bounds().diagonal());
+    Image<float> ref = render_reference(*l->scene->rays, l->g, m.reference(f, start), {.samples = r.spp_reference}, r.seed + 1,
+                                        reporter.start("reference (" + name + ")"))
+                           .scalar.visibility;
+    views.push_back({l->scene->rays.get(), &l->g, &scene.analytic, f, std::move(ref)});
+    loaded.push_back(std::move(l));
+  }
+  settings.log = reporter.note;
+  TuneJobResult out;
+  out.tune = tune_method(views, settings);
+  const int width = r.camera.width.value_or(r.camera.default_width), height = r.camera.height.value_or(r.camera.default_height);
+  out.file = {{"method", r.method},       {"parameters", out.tune.params}, {"start_rmse", out.tune.start_rmse}, {"best_rmse", out.tune.best_rmse},
+              {"evaluations", out.tune.evaluations}, {"seconds", out.tune.seconds}, {"scenes", r.scenes},
+              {"width", width},           {"height", height}};
+  if (!r.output.empty())
+    write_file_atomically(r.output, [&](const std::filesystem::path& temp) {
+      std::ofstream file(temp, std::ios::binary);
+      file << out.file.dump(2) << "\n";
+      file.close();
+      if (!file) throw SystemError(r.output.string() + ": cannot write");
+    });
+  return out;
+}
+
+}  // namespace ao

@@ -76,10 +76,10 @@ void add_tune_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--scenes", o->scenes, "Comma-separated scenes, one view each (built-in names or mesh files)")->capture_default_str();
   cmd->add_option("-p,--param", o->params, "Starting value of a parameter: key=value, repeatable");
   cmd->add_option("--budget", o->request.budget_s, "Time budget, seconds")->capture_default_str();
-  cmd->add_option("--spp-reference", o->request.spp_reference, "Rays per pixel of the references")->capture_default_str();
+  cmd->add_option("--reference-samples,--spp-reference", o->request.spp_reference, "Rays per pixel of the references")->capture_default_str();
   cmd->add_option("-o,--output", o->request.output, "Parameter file to write (JSON; load with -p @FILE); required unless --json");
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d) requested: " + membership_names(), false);
-  cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + "; the same for the method and its reference")->capture_default_str();
+  add_normal_option(*cmd, o->normal, "; the same for the method and its reference");
   add_camera_options(*cmd, o->camera);  // every scene's view; without --eye/--camera each scene is framed on its own
   cmd->add_flag("--json", o->json, "Print the parameter file's content on stdout");
   cmd->add_option("--seed", o->request.seed, "Seed of the per-pixel sample sets")->capture_default_str();

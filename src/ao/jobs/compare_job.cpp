@@ -107,7 +107,10 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   // Methods report problems they worked around (e.g. cone: open meshes).
   for (const CompareRow& row : out.result.rows)
     if (row.stats.contains("warnings"))
-      for (const auto& w : row.stats["warnings"]) reporter.warn(row.method + ": " + w.get<std::string>());
+      for (const auto& w : row.stats["warnings"]) {
+        const std::string text = w.get<std::string>(), prefix = row.method + ": ";
+        reporter.warn(text.rfind(prefix, 0) == 0 ? text : prefix + text);  // named once
+      }
   out.scene = scene->name;
   out.table = compare_table_json(out.result);
   out.table["scene"] = scene->name;

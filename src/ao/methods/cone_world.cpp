@@ -165,7 +165,7 @@ void trace_world(const GBuffer& gb, const VoxelGrid& g, float r_max, const ConeS
   tb.axis_x = axes.x.data(), tb.axis_y = axes.y.data(), tb.axis_z = axes.z.data(), tb.axis_scale = axes.s.data();
   tb.inv_voxel = sample.inv;
 
-  const simd::ConeView view{gb.camera.basis(), gb.camera.eye, g.origin, sample.near_limit(), pat.period};
+  const simd::ConeView view{gb.camera.basis(), gb.camera.eye, g.origin, pat.period};
   ProgressCounter counter(progress, static_cast<std::size_t>(gb.width()) * gb.height());
   parallel_for_tiles(gb.width(), gb.height(), kTile, [&](const Tile& t) {
     simd::trace_cones(gb, g, tb, view, t.x0, t.x1, t.y0, t.y1, out);

@@ -95,17 +95,17 @@ struct Kernel {
   const ConeTables& tb;
   float weight;  // every cone stands for a cell of equal measure
   // The pixel's turned prism pattern, the cones' axes in voxels and chain scales, and per slot the
-  // sphere's centre (voxels) and radius scale and the bit arrays "sampled", "wider than the
-  // largest window" and "passed" (sampled and the window masks say maybe; wide: the blocks decide).
+  // sphere's centre (voxels) and radius scale and the bit arrays "wider than the largest window"
+  // and "passed" (sampled and the window masks say maybe; wide: the blocks decide).
   // On the stack, at the largest sizes the parameters allow (about 18 KB).
   HWY_ALIGN float u[kMaxConePrisms], v[kMaxConePrisms], ax[kMaxCones], ay[kMaxCones], az[kMaxCones], scale[kMaxCones];
   HWY_ALIGN float cx[kMaxConeSlots], cy[kMaxConeSlots], cz[kMaxConeSlots], rs[kMaxConeSlots];
-  std::uint8_t used[kMaxConeSlots / 8 + 8], wide[kMaxConeSlots / 8 + 8], pass[kMaxConeSlots / 8 + 8];
+  std::uint8_t wide[kMaxConeSlots / 8 + 8], pass[kMaxConeSlots / 8 + 8];
 
   Kernel(const VoxelGrid& grid, const ConeTables& tables) : g(grid), tb(tables), weight(1.0f / static_cast<float>(tables.cones)) {
     AO_ASSERT(tables.prism_lanes <= kMaxConePrisms && tables.cones_padded <= kMaxCones && tables.slots <= kMaxConeSlots);
     // The bytes past the slots stay 0 (bits() reads up to 4 bytes from any slot's byte).
-    std::fill(std::begin(used), std::end(used), 0), std::fill(std::begin(wide), std::end(wide), 0), std::fill(std::begin(pass), std::end(pass), 0);
+    std::fill(std::begin(wide), std::end(wide), 0), std::fill(std::begin(pass), std::end(pass), 0);
   }
 
   static bool bit(const std::uint8_t* b, int i) { return (b[static_cast<std::size_t>(i) >> 3] >> (i & 7)) & 1u; }
@@ -202,7 +202,7 @@ struct Kernel {
       const auto at = static_cast<std::size_t>(i >> 3);
       const int shift = i & 7;
       const auto put = [&](std::uint8_t* b, unsigned m) { b[at] = static_cast<std::uint8_t>((shift ? b[at] : 0u) | (m << shift)); };
-      put(used, use), put(wide, wid), put(pass, use & (any | wid));
+      put(wide, wid), put(pass, use & (any | wid));
     }
   }
 
@@ -310,22 +310,15 @@ struct Kernel {
 
   // Front to back along each cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
   // fraction f of the rays that reach it, T *= 1 - f, until T <= kOpaque; V = the cones' mean T.
-  float visibility(bool inside) const {
+  float visibility() const {
     float vis = 0;
     for (int c = 0; c < tb.cones; ++c) {
       float tr = 1.0f;
       const int i0 = c * tb.per_cone;
-      if (!inside) {
-        // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
-        // ones, in order (bit j: sphere j of the cone).
-        for (std::uint32_t m = bits(pass, i0, tb.per_cone); m && tr > cone_internal::kOpaque; m &= m - 1)
-          tr *= 1.0f - fraction(i0 + std::countr_zero(m));
-      } else {
-        // The inside of a shell counts the complement (faces_inside): T *= f, and an empty sphere
-        // (f = 0) closes the cone.
-        for (int j = 0; j < tb.per_cone && tr > cone_internal::kOpaque; ++j)
-          if (bit(used, i0 + j)) tr *= bit(pass, i0 + j) ? fraction(i0 + j) : 0.0f;
-      }
+      // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
+      // ones, in order (bit j: sphere j of the cone).
+      for (std::uint32_t m = bits(pass, i0, tb.per_cone); m && tr > cone_internal::kOpaque; m &= m - 1)
+        tr *= 1.0f - fraction(i0 + std::countr_zero(m));
       vis += weight * tr;
     }
     return std::clamp(vis, 0.0f, 1.0f);
@@ -336,17 +329,6 @@ struct Kernel {
 
 void TraceCones(const GBuffer& gb, const VoxelGrid& grid, const ConeTables& tables, const ConeView& view, int x0, int x1, int y0, int y1,
                 ImageView<float> out) {
-  // The voxel at a world point (false outside the grid), for the test of a shell's inside.
-  struct Solid {
-    const VoxelGrid& g;
-    const ConeView& view;
-    Vec3 inv;
-    bool solid_at(Vec3 p) const {
-      const float gx = (p.x - view.grid_origin.x) * inv.x, gy = (p.z - view.grid_origin.z) * inv.y, gz = (p.y - view.grid_origin.y) * inv.z;
-      if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
-      return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
-    }
-  } const solid{grid, view, tables.inv_voxel};
   Kernel k(grid, tables);
   const Vec3 inv = tables.inv_voxel;
   const int period = view.pattern_period;
@@ -363,7 +345,7 @@ void TraceCones(const GBuffer& gb, const VoxelGrid& grid, const ConeTables& tabl
       k.axes(frame, pattern);
       // World (x, y, z) is the grid's (i, k, j).
       k.place((pos.x - view.grid_origin.x) * inv.x, (pos.z - view.grid_origin.z) * inv.y, (pos.y - view.grid_origin.y) * inv.z);
-      out(x, y) = k.visibility(cone_internal::faces_inside(gb, solid, x, y, pos, n, view.near));
+      out(x, y) = k.visibility();
     }
 }
 

@@ -73,15 +73,12 @@ struct ConeView {
   Frame basis;           ///< Camera axes in world space (Camera::basis()).
   Vec3 eye;              ///< Camera position, world.
   Vec3 grid_origin;      ///< World point of voxel coordinate (0, 0, 0) (VoxelGrid::origin).
-  float near = 0;        ///< World distance in front of a pixel where a shell's inside is tested (cone_kernel_internal.h: faces_inside).
   int pattern_period = 1;  ///< ConePattern::period: pixel (x, y) takes pattern slot (y mod P) P + x mod P.
 };
 
 /// V of the covered pixels of the tile [x0, x1) x [y0, y1) of `gb` into `out` (1 on the others):
 /// per pixel, its point in the grid and its frame from the G-buffer (world: x, y, z are the grid's
-/// i, k, j), whether it faces the inside of a holed mesh's shell (its cones then count the
-/// complement of the solid: T *= f, and a sphere that is not sampled or shows empty closes the
-/// cone), then the mean over the cones of the transmittance T after the cone's spheres, front to
+/// i, k, j), then the mean over the cones of the transmittance T after the cone's spheres, front to
 /// back, T *= 1 - f (f: a sphere's obstructed fraction, the solid length of its prisms over their
 /// chords; spheres the window masks show empty have f = 0; a cone stops at T <= 1e-4), clamped to
 /// [0, 1].

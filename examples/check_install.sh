@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The library boundary, checked as a user meets it (run by CTest as `install_and_examples` and
 # `installed_headers_without_embree`, or by hand: examples/check_install.sh BUILD_DIR [examples|headers]):
-#   1. installs the build into a temporary prefix;
+#   1. installs the build into a temporary prefix, which carries the licence and its notice;
 # examples (the default):
 #   2. builds examples/ as a separate CMake project with find_package(ao 0.2 REQUIRED) and runs the
 #      three programs on a small OBJ written here (a floor with UVs and a cube on it);
@@ -21,6 +21,9 @@ cxx=${CXX:-c++}
 
 echo "== install into $prefix"
 cmake --install "$build" --prefix "$prefix" >/dev/null
+for f in LICENSE NOTICE; do
+  [ -s "$prefix/share/doc/ao/$f" ] || { echo "check_install: share/doc/ao/$f was not installed" >&2; exit 1; }
+done
 PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name ao.pc)")"
 export PKG_CONFIG_PATH
 

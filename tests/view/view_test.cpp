@@ -143,7 +143,8 @@ std::string xvfb() {
 
 const std::string kSize = " --width 160 --height 90 ";
 
-// The R channel of an RGB screenshot against the grey PNG ao render wrote, as 8-bit codes.
+// The R channel of an RGB screenshot against the grey PNG ao render wrote, as 8-bit codes (both
+// show display_background where no surface is visible).
 int max_code_difference(const std::filesystem::path& screenshot, const std::filesystem::path& render) {
   const Image<Vec3> shot = read_rgb_image(screenshot);
   const Image<float> ref = read_image(render);

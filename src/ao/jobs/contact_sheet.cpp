@@ -7,6 +7,7 @@
 
 #include "ao/core/error.h"
 #include "ao/eval/metrics.h"
+#include "ao/eval/shading.h"
 
 namespace ao {
 
@@ -52,6 +53,17 @@ void paste(Image<Vec3>& dst, int ox, int oy, const Image<Vec3>& src) {
 void paste(Image<Vec3>& dst, int ox, int oy, const Image<float>& grey) {
   for (int y = 0; y < grey.height(); ++y)
     for (int x = 0; x < grey.width(); ++x) dst(ox + x, oy + y) = Vec3{grey(x, y), grey(x, y), grey(x, y)};
+}
+
+// Over a pasted image at (ox, oy): display_background where `coverage` is 0, the checkerboard
+// counted from the image's own corner.
+void mark_background(Image<Vec3>& dst, int ox, int oy, const Image<std::uint8_t>& coverage) {
+  for (int y = 0; y < coverage.height(); ++y)
+    for (int x = 0; x < coverage.width(); ++x)
+      if (coverage(x, y) == 0) {
+        const float b = display_background(x, y);
+        dst(ox + x, oy + y) = {b, b, b};
+      }
 }
 
 // "+0.25", "-0.25": shortest form, sign always shown.
@@ -127,6 +139,8 @@ Image<Vec3> row_band(const SheetRow& row, const Layout* l) {
   paste(band, kGap, label_h, *row.method);
   paste(band, kGap + (col_w + kGap), label_h, *row.reference);
   paste(band, kGap + 2 * (col_w + kGap), label_h, *row.heat);
+  if (row.coverage != nullptr)
+    for (int c = 0; c < 3; ++c) mark_background(band, kGap + c * (col_w + kGap), label_h, *row.coverage);
   return band;
 }
 

@@ -3,6 +3,7 @@
 // heat map's colour scale, and a label above each row names the method and its RMSE.
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -21,6 +22,9 @@ struct SheetRow {
   /// Pieces of the row's label ("alchemy", "samples=12", "RMSE 0.1947"), drawn on one line when
   /// they fit and otherwise wrapped between pieces, never inside one.
   std::vector<std::string> label;
+  /// Optional, the images' size: 0 where no surface is visible, drawn as display_background
+  /// (eval/shading.h) in all three images so that it is not mistaken for open surface.
+  const Image<std::uint8_t>* coverage = nullptr;
 };
 
 /// Lays `rows` (at least one) out on a dark background with 4-pixel gutters. With `font`: a header

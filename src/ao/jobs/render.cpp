@@ -1,5 +1,6 @@
 #include "ao/jobs/render.h"
 
+#include <cctype>
 #include <chrono>
 
 #include "ao/core/error.h"
@@ -107,17 +108,31 @@ Loaded load_inputs(const RenderRequest& r, const MethodInfo& m, const JobReporte
   return in;
 }
 
+// .exr in any case, as write_image chooses the format.
+bool is_exr(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".exr";
+}
+
 void write_outputs(OutputSet& set, const RenderRequest& r, RenderResult& result) {
   const RenderOutputs& o = r.outputs;
   const ImageWriteOptions write_opt{.png_bits = o.png_bits};
-  if (!o.visibility.empty()) set.write(o.visibility, [&] { write_image(o.visibility, result.output.visibility, write_opt); });
+  const Image<std::uint8_t> coverage = coverage_mask(result.gbuffer);
+  // A picture (PNG, TIFF, TGA, JPEG) shows the background as display_background, never as open
+  // surface (V = 1, white); EXR is data and keeps V = 1 there, what scripts read (with the
+  // G-buffer's coverage, --gbuffer-out, for compositing).
+  auto write_v = [&](const fs::path& path, const Image<float>& v) {
+    write_image(path, is_exr(path) ? v : with_display_background(v, coverage), write_opt);
+  };
+  if (!o.visibility.empty()) set.write(o.visibility, [&] { write_v(o.visibility, result.output.visibility); });
   if (!o.shaded.empty()) set.write(o.shaded, [&] { write_rgb_image(o.shaded, result.shaded, {.png_bits = o.png_bits, .srgb = true}); });
   if (o.extras && !o.visibility.empty())
     for (const auto& extra : result.output.extras) {
       const std::string& name = extra.first;
       const auto& image = extra.second;  // a named reference: Clang 14 cannot capture structured bindings
       const fs::path path = extra_path(o.visibility, name);
-      set.write(path, [&] { write_image(path, image, write_opt); }, "--extras");
+      set.write(path, [&] { write_v(path, image); }, "--extras");
       result.extras_written[name] = path;
     }
   if (!o.gbuffer.empty()) set.write(o.gbuffer, [&] { write_gbuffer_exr(o.gbuffer, result.gbuffer); });

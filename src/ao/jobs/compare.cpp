@@ -213,7 +213,7 @@ std::string compare_table_markdown(const CompareResult& r, const std::string& sc
   }
   md << "\n`sheet.png`: one row per method in the order above, labelled with its name, its reference and its RMSE; columns: the "
      << "method's V, the reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at "
-     << "|error| = " << kCompareHeatRange << "; grey: background).\n";
+     << "|error| = " << kCompareHeatRange << "; grey checkerboard: background, no surface).\n";
   return md.str();
 }
 

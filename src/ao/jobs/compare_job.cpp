@@ -35,9 +35,9 @@ void write_text(const fs::path& path, const std::string& text) {
   });
 }
 
-// The sheet: per row the method's V, its reference's V and the heat map, labelled. A missing font
-// costs the labels, never the comparison.
-Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, const JobReporter& reporter) {
+// The sheet: per row the method's V, its reference's V and the heat map, labelled, the background
+// (coverage 0) marked. A missing font costs the labels, never the comparison.
+Image<Vec3> make_sheet(const CompareResult& result, const Image<std::uint8_t>& coverage, const fs::path& font_path, const JobReporter& reporter) {
   std::vector<SheetRow> rows;
   for (const CompareRow& row : result.rows) {
     std::vector<std::string> label = {row.method};
@@ -45,7 +45,7 @@ Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, c
     if (!kp.empty()) label.push_back(kp);
     label.push_back("reference: " + result.references[row.reference].spec.label());
     label.push_back("RMSE " + fixed4(row.metrics.rmse));  // as in table.md
-    rows.push_back({&row.visibility, &result.references[row.reference].visibility, &row.heat, std::move(label)});
+    rows.push_back({&row.visibility, &result.references[row.reference].visibility, &row.heat, std::move(label), &coverage});
   }
   std::string font_error;
   const std::optional<Font> font = Font::open(font_path.empty() ? fs::path(kDejaVuSansPath) : font_path, &font_error);
@@ -114,7 +114,7 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
                          {"fov", c.vertical_fov_deg}};
   out.table["setup_ms"] = setup_ms;
   out.markdown = compare_table_markdown(out.result, scene->name);
-  out.sheet = make_sheet(out.result, request.font, reporter);
+  out.sheet = make_sheet(out.result, coverage_mask(g), request.font, reporter);
   if (!request.out_dir.empty()) write_outputs(outputs, request.out_dir, out);
   return out;
 }

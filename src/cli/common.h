@@ -23,7 +23,7 @@ namespace ao::cli {
 /// Options of `ao` itself, before the subcommand.
 struct GlobalOptions {
   int threads = 0;     ///< Worker threads; 0 = all cores.
-  bool quiet = false;  ///< No progress bar.
+  bool quiet = false;  ///< No progress (bar or log lines).
 };
 
 /// Help text of the positional scene argument, shared by the subcommands that take a scene.
@@ -70,7 +70,8 @@ std::vector<std::string> split(const std::string& s, char sep);
 void apply_param_overrides(nlohmann::json& params, const std::vector<std::string>& overrides, std::string_view method,
                            const nlohmann::json& known);
 
-/// Prints a job's stages as progress bars (only when stderr is a terminal and not --quiet),
+/// Prints a job's stages' progress unless --quiet: a bar on a terminal, a line every few seconds
+/// (log_progress_interval) when stderr is not a terminal (jobs/progress_meter.h), and
 /// warnings as "warning: ..." lines and notes unless `json` (the JSON on stdout is then the report).
 class StderrReporter {
  public:

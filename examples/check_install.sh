@@ -24,6 +24,18 @@ cmake --install "$build" --prefix "$prefix" >/dev/null
 for f in LICENSE NOTICE; do
   [ -s "$prefix/share/doc/ao/$f" ] || { echo "check_install: share/doc/ao/$f was not installed" >&2; exit 1; }
 done
+echo "== libao exports no tinygltf symbol"
+libs=$(find "$prefix" -type f \( -name 'libao*.a' -o -name 'libao*.so*' \))
+[ -n "$libs" ] || { echo "check_install: no libao installed" >&2; exit 1; }
+for lib in $libs; do
+  nm -C "$lib" > "$tmp/symbols" 2>/dev/null
+  if grep -E -m 3 '(^|[^_[:alnum:]:])tinygltf::' "$tmp/symbols"; then echo "check_install: $lib has tinygltf symbols" >&2; exit 1; fi
+  # A shared library's exports: tinygltf, renamed into ao::gltf_detail, is hidden.
+  case $lib in *.so*)
+    nm -D -C --defined-only "$lib" > "$tmp/exports"
+    if grep -m 3 gltf_detail "$tmp/exports"; then echo "check_install: $lib exports tinygltf" >&2; exit 1; fi ;;
+  esac
+done
 PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name ao.pc)")"
 export PKG_CONFIG_PATH
 

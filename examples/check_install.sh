@@ -107,5 +107,8 @@ done
 (cd "$prefix/include" && find ao -name '*.h' | sort | sed 's/.*/#include <&>/') > "$tmp/all_headers.cpp"
 [ "$(grep -c . "$tmp/all_headers.cpp")" -gt 10 ] || { echo "check_install: too few headers installed" >&2; exit 1; }
 if grep -q "_internal.h" "$tmp/all_headers.cpp"; then echo "check_install: an internal header was installed" >&2; exit 1; fi
+echo "== ao/ao.h names every installed header"
+missing=$(cd "$prefix/include" && for h in $(find ao -name '*.h' ! -path ao/ao.h | sort); do grep -q "^#include \"$h\"" ao/ao.h || echo "$h"; done)
+[ -z "$missing" ] || { echo "check_install: ao/ao.h does not include:" $missing >&2; exit 1; }
 "$cxx" -std=c++20 -fsyntax-only -I"$poison" -I"$prefix/include" $(pkg-config --cflags-only-other tbb nlohmann_json) "$tmp/all_headers.cpp"
 echo "check_install: headers passed"

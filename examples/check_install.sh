@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # The library boundary, checked as a user meets it (run by CTest as `install_and_examples` and
 # `installed_headers_without_embree`, or by hand: examples/check_install.sh BUILD_DIR [examples|headers]):
-#   1. installs the build into a temporary prefix, which carries the licence and its notice;
+#   1. installs the build into a temporary prefix, which carries the licence and its notice, and
+#      whose libao has no tinygltf symbol (nm);
 # examples (the default):
 #   2. builds examples/ as a separate CMake project with find_package(ao 0.2 REQUIRED) and runs the
-#      three programs on a small OBJ written here (a floor with UVs and a cube on it);
+#      four programs on a small OBJ written here (a floor with UVs and a cube on it);
 #   3. builds a one-file program with `pkg-config --cflags --libs ao` and runs it;
 # headers:
-#   4. compiles every installed header in one translation unit with Embree's, assimp's, OpenEXR's,
-#      libpng's and FreeType's headers replaced by ones that fail: no installed header includes them.
+#   4. checks that ao/ao.h includes every other installed header, and compiles every installed
+#      header in one translation unit with Embree's, assimp's, OpenEXR's, libpng's and FreeType's
+#      headers replaced by ones that fail: no installed header includes them.
 # Everything is written below a temporary folder, removed at the end.
 set -euo pipefail
 build=$(cd "${1:?usage: check_install.sh BUILD_DIR [examples|headers]}" && pwd)
@@ -74,11 +76,13 @@ f 8 12 11 7
 f 5 9 12 8
 f 6 7 11 10
 OBJ
+head -n 11 "$tmp/scene.obj" > "$tmp/low.obj"  # the floor alone: the low mesh the floor and cube are baked into
 cd "$tmp"
 "$tmp/examples/mesh_to_exr" scene.obj ao.exr volumetric
 "$tmp/examples/own_gbuffer"
 "$tmp/examples/bake_map" scene.obj map.png 64
-for f in ao.exr own_gbuffer.pgm map.png; do [ -s "$f" ] || { echo "check_install: $f was not written" >&2; exit 1; }; done
+"$tmp/examples/bake_high_to_low" low.obj scene.obj 64
+for f in ao.exr own_gbuffer.pgm map.png low_ao.png high_ao.ply; do [ -s "$f" ] || { echo "check_install: $f was not written" >&2; exit 1; }; done
 
 echo "== a one-file program with pkg-config --cflags --libs ao"
 cat > "$tmp/version.cpp" <<'CPP'

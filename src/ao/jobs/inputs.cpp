@@ -65,50 +65,72 @@ constexpr float kDefaultFov = 40.0f;
 // each side, so no silhouette touches the edge.
 constexpr double kFill = 0.95;
 
-// The vertices of the objects of interest in world space: what auto-framing fits to the image, so
-// a model on a ground plane fills the frame and the plane runs out of it.
-std::vector<Vec3> framing_points(const Scene& scene) {
-  std::vector<Vec3> points;
-  for (const SceneObject& o : interest_objects(scene)) {
-    const Mesh& m = scene.meshes[o.mesh];
-    if (o.instance == SceneObject::kNoInstance) {
-      points.insert(points.end(), m.positions.begin(), m.positions.end());
-    } else {
-      const Affine3& to_world = scene.instances[o.instance].object_to_world;
-      for (const Vec3& p : m.positions) points.push_back(to_world.point(p));
+// What auto-framing fits to the image, in world space: the vertices of the meshes of interest, and
+// for each instance of a mesh the eight corners of its placed bounding box (20,000 instances of a
+// large mesh would be billions of vertices; the box keeps the fit conservative). So a model on a
+// ground plane fills the frame and the plane runs out of it. Visited, not copied: a scan's millions
+// of vertices cost no memory here.
+class FramingPoints {
+ public:
+  explicit FramingPoints(const Scene& scene) : scene_(scene), objects_(interest_objects(scene)), mesh_bounds_(scene.meshes.size()) {
+    for (const SceneObject& o : objects_)
+      if (o.instance != SceneObject::kNoInstance && mesh_bounds_[o.mesh].empty()) mesh_bounds_[o.mesh] = scene.meshes[o.mesh].bounds();
+  }
+
+  template <class Fn>
+  void for_each(Fn&& fn) const {
+    for (const SceneObject& o : objects_) {
+      const Mesh& m = scene_.meshes[o.mesh];
+      if (o.instance == SceneObject::kNoInstance) {
+        for (const Vec3& p : m.positions) fn(p);
+        continue;
+      }
+      const Affine3& to_world = scene_.instances[o.instance].object_to_world;
+      const Bounds3& b = mesh_bounds_[o.mesh];
+      for (int i = 0; i < 8; ++i) fn(to_world.point({i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z}));
     }
   }
-  return points;
-}
 
-// The offset e along one image axis that centres the points on it: with the points' coordinates a
-// along the axis and depths d from the eye, each projects to (a - e) / d, and the lowest and highest
-// of those, each decreasing in e, are opposite for one e, found by bisection in [lo, hi] (where the
-// sum of the two changes sign). 40 halvings take the interval below float precision.
-double centring_offset(const std::vector<double>& a, const std::vector<double>& d, double lo, double hi) {
-  auto sum_of_extremes = [&](double e) {
-    double low = kInfinity, high = -kInfinity;
-    for (std::size_t i = 0; i < a.size(); ++i) low = std::min(low, (a[i] - e) / d[i]), high = std::max(high, (a[i] - e) / d[i]);
-    return low + high;
-  };
-  for (int i = 0; i < 40; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (sum_of_extremes(mid) > 0 ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
+ private:
+  const Scene& scene_;
+  std::vector<SceneObject> objects_;
+  std::vector<Bounds3> mesh_bounds_;  // of the instanced meshes, computed once
+};
 
 struct Framing {
   Camera camera;
   double area = 0;  // the fraction of the image the points' projected bounding rectangle covers
 };
 
-// A viewer's "frame all" along -`direction`: the eye where `points` span kFill of the image along
+// The eye's offset e along one image axis (x: `axis` 0, y: 1) that centres the points on it: with
+// their coordinates a along the axis and depths d from the eye (camera basis, origin at `centre`,
+// eye at depth ez), each projects to (a - e) / d, and the lowest and highest of those, each
+// decreasing in e, are opposite for one e, found by bisection in [-reach, reach] (where the sum of
+// the two changes sign). 30 halvings take the interval below float precision.
+double centring_offset(const FramingPoints& points, const Frame& basis, Vec3 centre, double ez, int axis, double reach) {
+  auto sum_of_extremes = [&](double e) {
+    double low = kInfinity, high = -kInfinity;
+    points.for_each([&](Vec3 p) {
+      const Vec3 q = basis.to_local(p - centre);
+      const double v = ((axis == 0 ? q.x : q.y) - e) / (ez - q.z);
+      low = std::min(low, v), high = std::max(high, v);
+    });
+    return low + high;
+  };
+  double lo = -reach, hi = reach;
+  for (int i = 0; i < 30; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (sum_of_extremes(mid) > 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// A viewer's "frame all" along -`direction`: the eye where the points span kFill of the image along
 // the axis that limits them (vertical or horizontal), centred on that axis and, with `centre`, on
 // the other (else with equal room on both sides in depth units, which perspective makes a little
 // uneven); every point inside the image. frame_bounds gives the orientation (and the answer when
 // the points have no extent).
-Framing fit_points(const std::vector<Vec3>& points, const Bounds3& bounds, Vec3 direction, float fov, int width, int height, bool centre) {
+Framing fit_points(const FramingPoints& points, const Bounds3& bounds, Vec3 direction, float fov, int width, int height, bool centre) {
   Framing f{frame_bounds(bounds, direction, fov, width, height)};
   if (!(bounds.diagonal() > 0.0f)) return f;
   // In the camera basis (x right, y up, z towards the camera) with the origin at the box centre, a
@@ -119,33 +141,32 @@ Framing fit_points(const std::vector<Vec3>& points, const Bounds3& bounds, Vec3 
   // extreme points: tan_h e.z = (right + left) / 2 and e.x = (right - left) / 2; the larger of the
   // two axes' e.z fits both.
   const Frame basis = f.camera.basis();
-  const Vec3 centre_of_box = bounds.center();
+  const Vec3 box_centre = bounds.center();
   const double tan_v = static_cast<double>(f.camera.tan_half_fov()) * kFill, tan_h = tan_v * f.camera.aspect();
   double right = -kInfinity, left = -kInfinity, top = -kInfinity, bottom = -kInfinity, nearest = -kInfinity;
-  std::vector<double> xs(points.size()), ys(points.size()), depth(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Vec3 q = basis.to_local(points[i] - centre_of_box);
-    xs[i] = q.x, ys[i] = q.y, depth[i] = q.z;
+  points.for_each([&](Vec3 p) {
+    const Vec3 q = basis.to_local(p - box_centre);
     right = std::max(right, q.x + tan_h * q.z), left = std::max(left, tan_h * q.z - q.x);
     top = std::max(top, q.y + tan_v * q.z), bottom = std::max(bottom, tan_v * q.z - q.y);
     nearest = std::max(nearest, static_cast<double>(q.z));
-  }
+  });
   // A point on the view axis may set the eye on itself (a segment seen end on): keep the eye 1% of
   // the diagonal in front of the nearest point, so every point has a positive depth.
   const double ez_x = (right + left) / (2.0 * tan_h), ez_y = (top + bottom) / (2.0 * tan_v);
   const double ez = std::max({ez_x, ez_y, nearest + 0.01 * bounds.diagonal()});
-  for (double& z : depth) z = ez - z;
   double ex = (right - left) / 2.0, ey = (top - bottom) / 2.0;
   if (centre) {
     const double reach = 2.0 * (ez + bounds.diagonal());  // beyond every point, seen from ez
-    (ez_x >= ez_y ? ey : ex) = centring_offset(ez_x >= ez_y ? ys : xs, depth, -reach, reach);
+    (ez_x >= ez_y ? ey : ex) = centring_offset(points, basis, box_centre, ez, ez_x >= ez_y ? 1 : 0, reach);
   }
   const Vec3 offset{static_cast<float>(ex), static_cast<float>(ey), 0.0f};
-  f.camera.target = centre_of_box + basis.to_world(offset);
+  f.camera.target = box_centre + basis.to_world(offset);
   f.camera.eye = f.camera.target + basis.n * static_cast<float>(ez);
   double span_x = 0, span_y = 0;  // half the rectangle, in tangent units
-  for (std::size_t i = 0; i < points.size(); ++i)
-    span_x = std::max(span_x, std::abs(xs[i] - ex) / depth[i]), span_y = std::max(span_y, std::abs(ys[i] - ey) / depth[i]);
+  points.for_each([&](Vec3 p) {
+    const Vec3 q = basis.to_local(p - box_centre);
+    span_x = std::max(span_x, std::abs(q.x - ex) / (ez - q.z)), span_y = std::max(span_y, std::abs(q.y - ey) / (ez - q.z));
+  });
   f.area = std::min(1.0, span_x * kFill / tan_h) * std::min(1.0, span_y * kFill / tan_v);
   return f;
 }
@@ -155,9 +176,9 @@ Framing fit_points(const std::vector<Vec3>& points, const Bounds3& bounds, Vec3 
 // model in a wide image does when turned sideways. Never from behind: the front of a model is where
 // its author looked from.
 Camera auto_frame(const Scene& scene, float fov, int width, int height) {
-  const std::vector<Vec3> points = framing_points(scene);
+  const FramingPoints points(scene);
   Bounds3 bounds;
-  for (const Vec3& p : points) bounds.extend(p);
+  points.for_each([&](Vec3 p) { bounds.extend(p); });
   Vec3 direction = kFramingDirection;
   const double needed = 1.25 * fit_points(points, bounds, direction, fov, width, height, false).area;
   const float side = std::hypot(kFramingDirection.x, kFramingDirection.z);  // the same height above the horizon

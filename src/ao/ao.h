@@ -62,6 +62,7 @@
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
 #include "ao/methods/voxelize.h"
+#include "ao/methods/winding_number.h"
 
 // bake: AO maps (outside-in histogram, inside-out ray-traced), denoising, padding, per-vertex AO,
 // high to low, bake groups, UDIM tiles.

@@ -57,8 +57,11 @@ TEST(Vocabulary, TheDocumentedTableIsWhatEachCommandTakes) {
   const auto table = documented();
   ASSERT_GT(table.size(), 15u) << "docs/cli.md's table was not found";
   for (const auto& [option, commands] : table) EXPECT_EQ(seen[option], commands) << option << " in docs/cli.md";
-  for (const auto& [option, commands] : seen)
-    if (commands.size() > 1) EXPECT_TRUE(table.count(option)) << option << " is taken by several commands but not in docs/cli.md";
+  for (const auto& [option, commands] : seen) {
+    if (commands.size() > 1) {
+      EXPECT_TRUE(table.count(option)) << option << " is taken by several commands but not in docs/cli.md";
+    }
+  }
 }
 
 TEST(Vocabulary, AMistypedCommandOrOptionGetsTheClosestName) {

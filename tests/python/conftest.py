@@ -96,6 +96,12 @@ def read_ply_quality(path):
 
 
 @pytest.fixture(autouse=True)
+def _dask_files_in_tmp(tmp_path, monkeypatch):
+    """Dask workers (the tests' and --local ones) keep their scratch space in the test's folder."""
+    monkeypatch.setenv("DASK_TEMPORARY_DIRECTORY", str(tmp_path / "dask-scratch"))
+
+
+@pytest.fixture(autouse=True)
 def _one_thread_per_test():
     """All cores again after a test that limited them."""
     yield

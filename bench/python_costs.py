@@ -11,7 +11,6 @@
     PYTHONPATH=build/python /usr/bin/python3 bench/python_costs.py [render|tasks|batch ...]
 """
 
-import json
 import os
 import statistics
 import subprocess

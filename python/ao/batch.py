@@ -43,61 +43,42 @@ def _params(pairs):
 
 # ---- The tasks, run on the workers. Each returns {"status": "done" | "skipped" | "failed", ...}.
 
-def _start(out, threads):
+def _task(out, threads, work):
+    """Runs `work()`, which writes `out`, unless `out` exists; bad input becomes a failed result."""
     import ao
     if os.path.exists(out):
         return {"status": "skipped", "output": out}
     ao._ao.remove_abandoned_temporaries(out)
     ao.set_threads(threads)
-    return None
-
-
-def _finish(out, started):
+    started = time.monotonic()
+    try:
+        work()
+    except ao.InputError as e:
+        return {"status": "failed", "reason": str(e)}
     return {"status": "done", "output": out, "seconds": time.monotonic() - started}
 
 
 def bake_task(mesh, out, options, threads):
     """Bakes `mesh`'s AO map to `out` (ao.bake with `options`)."""
     import ao
-    skipped = _start(out, threads)
-    if skipped:
-        return skipped
-    started = time.monotonic()
-    try:
-        ao.bake(mesh, output=out, **options)
-    except ao.InputError as e:
-        return {"status": "failed", "reason": str(e)}
-    return _finish(out, started)
+    return _task(out, threads, lambda: ao.bake(mesh, output=out, **options))
 
 
 def render_task(view, out, threads):
     """Renders one view (a dict of ao.render's arguments: scene, camera, method, parameters) to `out`."""
     import ao
-    skipped = _start(out, threads)
-    if skipped:
-        return skipped
-    started = time.monotonic()
     kwargs = {k: v for k, v in view.items() if k not in ("scene", "camera", "output")}
-    try:
-        ao.render(view.get("scene"), view.get("camera"), output=out, **kwargs)
-    except ao.InputError as e:
-        return {"status": "failed", "reason": str(e)}
-    return _finish(out, started)
+    return _task(out, threads, lambda: ao.render(view.get("scene"), view.get("camera"), output=out, **kwargs))
 
 
 def compare_task(mesh, out, options, threads):
     """Compares the methods on `mesh` (ao.compare with `options`); its rows go to `out` (JSON)."""
     import ao
-    skipped = _start(out, threads)
-    if skipped:
-        return skipped
-    started = time.monotonic()
-    try:
+
+    def work():
         rows = ao.compare(mesh, **options)
-    except ao.InputError as e:
-        return {"status": "failed", "reason": str(e)}
-    ao._ao.write_text(out, json.dumps({"mesh": os.path.basename(mesh), "rows": rows}, indent=1) + "\n")
-    return _finish(out, started)
+        ao._ao.write_text(out, json.dumps({"mesh": os.path.basename(mesh), "rows": rows}, indent=1) + "\n")
+    return _task(out, threads, work)
 
 
 # ---- The client: the task list, the cluster, progress and summary.
@@ -124,14 +105,17 @@ def _key(kind, name, args):
     return f"ao-{kind}-{os.path.basename(name)}-{token}"
 
 
-def bake_tasks(args):
-    options = {"size": args.size, "seed": args.seed, **_params(args.param)}
+def _mesh_tasks(args, suffix, fn, options):
+    """One task per mesh of the input folder, writing OUT/<stem><suffix>."""
     tasks = []
     for mesh in _meshes(args.input):
-        stem = os.path.splitext(os.path.basename(mesh))[0]
-        out = os.path.join(args.out_dir, f"{stem}-ao.{args.format}")
-        tasks.append((os.path.basename(mesh), out, bake_task, (mesh, out, options)))
+        out = os.path.join(args.out_dir, os.path.splitext(os.path.basename(mesh))[0] + suffix)
+        tasks.append((os.path.basename(mesh), out, fn, (mesh, out, options)))
     return tasks
+
+
+def bake_tasks(args):
+    return _mesh_tasks(args, f"-ao.{args.format}", bake_task, {"size": args.size, "seed": args.seed, **_params(args.param)})
 
 
 def _turntable(spec, frames):
@@ -175,13 +159,8 @@ def render_tasks(args):
 
 
 def compare_tasks(args):
-    options = {"methods": args.methods.split(",") if args.methods else None, "spp_reference": args.spp_reference, "seed": args.seed}
-    tasks = []
-    for mesh in _meshes(args.input):
-        stem = os.path.splitext(os.path.basename(mesh))[0]
-        out = os.path.join(args.out_dir, f"{stem}-compare.json")
-        tasks.append((os.path.basename(mesh), out, compare_task, (mesh, out, options)))
-    return tasks
+    methods = args.methods.split(",") if args.methods else None
+    return _mesh_tasks(args, "-compare.json", compare_task, {"methods": methods, "spp_reference": args.spp_reference, "seed": args.seed})
 
 
 def _client(args):

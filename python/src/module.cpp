@@ -55,35 +55,33 @@ py::dict spec_dict(const ParamSpec& s) {
   return d;
 }
 
-py::list specs_list(const ParamSchema& schema) {
+// A Python list of f(x) for each x of `range`.
+template <class Range, class F>
+py::list list_of(const Range& range, F f) {
   py::list l;
-  for (const ParamSpec& s : schema.specs()) l.append(spec_dict(s));
+  for (const auto& x : range) l.append(f(x));
   return l;
 }
 
 py::list methods() {
-  py::list l;
-  for (const MethodInfo& m : all_methods()) {
+  return list_of(all_methods(), [](const MethodInfo& m) {
     py::dict d;
     d["name"] = std::string(m.name);
     d["summary"] = std::string(m.summary);
     d["ground_truth"] = m.ground_truth;
     d["needs_scene"] = m.needs_scene;
-    d["params"] = specs_list(m.params());
-    l.append(d);
-  }
-  return l;
+    d["params"] = list_of(m.params().specs(), spec_dict);
+    return d;
+  });
 }
 
 py::list param_tables() {
-  py::list l;
-  for (const ParamTableInfo& t : all_param_tables()) {
+  return list_of(all_param_tables(), [](const ParamTableInfo& t) {
     py::dict d;
     d["name"] = std::string(t.name);
-    d["params"] = specs_list(t.schema());
-    l.append(d);
-  }
-  return l;
+    d["params"] = list_of(t.schema().specs(), spec_dict);
+    return d;
+  });
 }
 
 // TBB's worker count for the calls that follow; 0 restores all cores.

@@ -45,6 +45,8 @@ Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, c
     if (!kp.empty()) label.push_back(kp);
     label.push_back("reference: " + result.references[row.reference].spec.label());
     label.push_back("RMSE " + fixed4(row.metrics.rmse));  // as in table.md
+    if (result.common && *result.common != row.reference)
+      label.push_back("vs " + result.references[*result.common].spec.label() + ": " + fixed4(row.common.rmse));
     rows.push_back({&row.visibility, &result.references[row.reference].visibility, &row.heat, std::move(label)});
   }
   std::string font_error;
@@ -105,7 +107,10 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   // Methods report problems they worked around (e.g. cone: open meshes).
   for (const CompareRow& row : out.result.rows)
     if (row.stats.contains("warnings"))
-      for (const auto& w : row.stats["warnings"]) reporter.warn(row.method + ": " + w.get<std::string>());
+      for (const auto& w : row.stats["warnings"]) {
+        const std::string text = w.get<std::string>(), prefix = row.method + ": ";
+        reporter.warn(text.rfind(prefix, 0) == 0 ? text : prefix + text);  // named once
+      }
   out.scene = scene->name;
   out.table = compare_table_json(out.result);
   out.table["scene"] = scene->name;

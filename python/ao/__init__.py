@@ -222,20 +222,26 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
     return out.get("map") if map else out.get("per_vertex")
 
 
-def compare(scene=None, camera=None, methods=None, *, reference=None, spp_reference=None, seed=1, radius=None,
-            radius_fraction=None, membership=None, tau=None, normal="shading", params=None, sweep=None, out_dir=None,
+def compare(scene=None, camera=None, methods=None, *, reference=None, common_reference=None, spp_reference=None, seed=1,
+            radius=None, radius_fraction=None, membership=None, tau=None, normal="shading", params=None, sweep=None, out_dir=None,
             full=False, images=False):
-    """compare(scene=None, camera=None, methods=None, *, reference=None, spp_reference=256, seed=1,
+    """compare(scene=None, camera=None, methods=None, *, reference=None, common_reference="obscurance",
+            spp_reference=256, seed=1,
             radius=None, radius_fraction=None, membership=None, tau=None, normal="shading",
             params=None, sweep=None, out_dir=None, full=False, images=False) -> list of dict
 
     Compares methods with the ray-traced reference as `ao compare` does; one dict per method:
     {"method", "parameters", "reference" {kind, label, ...}, "rmse", "psnr_db", "ssim",
-    "mean_signed_error", "max_abs_error", "ms", "pixels", "stats"}.
+    "mean_signed_error", "max_abs_error", "ms", "pixels", "common" {rmse, psnr_db, ssim, ...},
+    "stats"}.
 
     methods     registry names; None: every method but raytraced
     reference   the reference for every method ("matched", "obscurance", "tangent-sphere",
                 "transfer"), or {method: reference}
+    common_reference
+                the one reference every row is also judged against ("common"), so that rows can
+                be ranked: "obscurance" (of the requested falloff), "tangent-sphere", "transfer"
+                or "none"
     params      {method: {parameter: value}} over each method's defaults
     sweep       {parameter: [values]}: one extra table of RMSE and time per value
     out_dir     also write table.json, table.md and sheet.png there (atomically)
@@ -243,7 +249,8 @@ def compare(scene=None, camera=None, methods=None, *, reference=None, spp_refere
     images      with full: also "images", per row {"method", "visibility", "reference"} arrays
     camera      as for render; default 640 x 360
     """
-    request = {"methods": methods, "reference": reference, "spp_reference": spp_reference, "seed": seed, "radius": radius,
+    request = {"methods": methods, "reference": reference, "common_reference": common_reference, "spp_reference": spp_reference,
+               "seed": seed, "radius": radius,
                "radius_fraction": radius_fraction, "membership": membership, "tau": tau, "normal": normal, "params": params,
                "sweep": sweep, "out_dir": _path(out_dir), "camera": _camera_dict(camera), "images": images}
     out = _ao.compare(_scene_arg(scene), {k: v for k, v in request.items() if v is not None})

@@ -213,6 +213,7 @@ CompareRequest compare_request(py::handle scene, const nlohmann::json& q) {
   const nlohmann::json ref = q.value("reference", nlohmann::json());
   if (ref.is_string()) s.references[""] = ref.get<std::string>();
   else if (ref.is_object()) s.references = ref.get<std::map<std::string, std::string>>();
+  s.common_reference = q.value("common_reference", s.common_reference);
   s.spp_reference = q.value("spp_reference", s.spp_reference);
   s.seed = seed_of(q);
   const nlohmann::json sweep = q.value("sweep", nlohmann::json());

@@ -91,7 +91,7 @@ std::string format_value(const nlohmann::json& v) {
 
 CompareSettings resolve_compare_settings(const CompareSettings& in) {
   CompareSettings s = in;
-  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError("--spp-reference must be in [1, 1048576]");
+  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError("--reference-samples must be in [1, 1048576]");
   s.falloff.validate();
   if (s.methods.empty()) {
     // Every approximate method (the reference itself is not compared with itself).

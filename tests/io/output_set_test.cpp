@@ -291,6 +291,9 @@ TEST(StaleTemporaries, ThoseOfKilledRunsAreRemovedOthersAreKept) {
   for (const fs::path& p : {stale, live, other, user}) write_text(p, "x");
   for (const fs::path& p : {stale, live, other, user}) fs::last_write_time(p, an_hour_ago);
   write_text(young, "written after this process started");
+  // A file's time comes from the kernel's coarse clock, which can lag the clock read at start-up
+  // by a few milliseconds; set it explicitly so the test does not depend on that granularity.
+  fs::last_write_time(young, fs::file_time_type::clock::now() + std::chrono::seconds(1));
   OutputSet outputs;
   outputs.add_output(dir / "out.png", "-o");
   EXPECT_FALSE(fs::exists(stale));

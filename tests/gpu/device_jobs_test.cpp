@@ -1,6 +1,7 @@
 // `--device gpu` through the job layer and the command line: `ao render --device gpu` writes what
 // the library call computes, `ao compare --device gpu` puts the GPU backend's column beside the
-// CPU's with each method's RMSE within 0.002 of the CPU's, and without a usable OpenGL the option
+// CPU's with each method's RMSE within 0.002 of the CPU's, `ao view --device gpu` computes in its
+// window's context and reports fps and each pass's GPU ms, and without a usable OpenGL the option
 // is a one-line error with exit code 3 while the CPU path runs on.
 //
 // Both `ao` and these tests open the default device (GpuDevice::open: a hardware EGL device when
@@ -135,6 +136,48 @@ TEST(DeviceCli, WithoutUsableGlTheGpuDeviceIsAOneLineErrorAndTheCpuRunsOn) {
   EXPECT_EQ(dir.file_count(), 0);
   const RunResult cpu = run_ao_under(kNoGl, "-q render plane --method alchemy" + kSmall + "-o v.png", dir.path());
   EXPECT_EQ(cpu.exit_code, 0) << cpu.err;
+}
+
+TEST(DeviceCli, ViewOnTheGpuReportsFpsAndEachPassAndShowsWhatRenderComputes) {
+  TempDir dir;
+  // A few frames of a small window (the 300-frame run is BENCHMARKS.md's, "ao view").
+  const RunResult v = run_ao_under(xvfb(), "view sphere-on-plane -m gtao --device gpu" + kSmall + "--frames 4 --benchmark --json "
+                                           "--set panel=off --set hud=off --screenshot s.png --camera-out c.json", dir.path());
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  const nlohmann::json j = nlohmann::json::parse(v.out);
+  EXPECT_EQ(j["device"], "gpu");
+  EXPECT_FALSE(j["gl_renderer"].get<std::string>().empty());
+  EXPECT_GT(j["fps"].get<double>(), 0.0);
+  EXPECT_EQ(j["method_runs"], 4);  // --benchmark: every frame
+  std::vector<std::string> names;
+  for (const auto& p : j["gpu_passes"]) {
+    names.push_back(p["name"]);
+    EXPECT_GE(p["ms"].get<double>(), 0.0) << p;
+    EXPECT_EQ(p["runs"], 4) << p;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"upload", "gtao", "filter"}));
+  // The window shows the GPU's V as 8-bit codes, as the PNG writer makes them from the same floats:
+  // equal codes (tests/view/view_test.cpp holds the CPU's window to the same).
+  const RunResult r = run_ao("-q render sphere-on-plane -m gtao --device gpu --camera c.json -o r.png", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image<Vec3> shot = read_rgb_image(dir / "s.png");
+  const Image<float> ref = read_image(dir / "r.png");
+  ASSERT_EQ(shot.width(), ref.width());
+  ASSERT_EQ(shot.height(), ref.height());
+  for (std::size_t i = 0; i < ref.size(); ++i) ASSERT_EQ(std::lround(shot[i].x * 255), std::lround(ref[i] * 255)) << "pixel " << i;
+}
+
+TEST(DeviceCli, ViewSwitchesDeviceWithSet) {
+  TempDir dir;
+  const RunResult v =
+      run_ao_under(xvfb(), "view plane -m alchemy" + kSmall + "--frames 3 --benchmark --json --event 1:set:device=gpu", dir.path());
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  const nlohmann::json j = nlohmann::json::parse(v.out);
+  EXPECT_EQ(j["device"], "gpu");
+  ASSERT_FALSE(j["gpu_passes"].empty());
+  EXPECT_EQ(j["gpu_passes"][0]["runs"], 2);  // frames 1 and 2; frame 0 ran on the CPU
+  expect_one_line_error(run_ao_under(xvfb(), "view plane -m raytraced --device gpu" + kSmall + "--frames 1 --set method=alchemy --set device=tpu"),
+                        "cpu or gpu, got 'tpu'");
 }
 
 TEST(DeviceCli, BadDeviceRequestsAreOneLineInputErrors) {

@@ -13,6 +13,7 @@
 #include "ao/methods/cone.h"
 #include "ao/reference/raytraced.h"
 #include "bench_scenes.h"
+#include "support/open_sheets.h"
 
 namespace ao::bench {
 namespace {
@@ -33,14 +34,69 @@ struct ConeFixture {
   }
 };
 
+// An open mesh on a ground quad, as bench/tools/open_sheets writes them.
+Scene open_on_ground(Mesh m) {
+  const Bounds3 b = m.bounds();
+  const Vec3 c = b.center();
+  const float e = b.diagonal();
+  Scene s;
+  s.name = "open";
+  s.meshes = {std::move(m), make_quad({c.x - e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z - e}, {c.x - e, b.lo.y, c.z - e})};
+  validate_and_prepare(s);
+  return s;
+}
+
+// `file` is a shared mesh (on a ground), "default", one of the open test meshes ("arch", "bowl",
+// "open-box"), or a shared mesh alone: "NAME.off#closed" as it is, "NAME.off#cut" opened as a scan
+// (bottom 10% cut off) or "NAME.off#holes" (holes of 3% of its diagonal).
 ConeFixture* fixture(const std::string& file) {
   static std::map<std::string, std::unique_ptr<ConeFixture>> cache;
   auto it = cache.find(file);
   if (it != cache.end()) return it->second.get();
   std::unique_ptr<ConeFixture> f;
-  if (file == "default") f = std::make_unique<ConeFixture>(make_builtin_scene("default"));
-  else if (auto s = mesh_on_ground(file)) f = std::make_unique<ConeFixture>(std::move(*s));
+  const std::size_t hash = file.find('#');
+  if (file == "default") {
+    f = std::make_unique<ConeFixture>(make_builtin_scene("default"));
+  } else if (file == "arch" || file == "bowl" || file == "open-box") {
+    f = std::make_unique<ConeFixture>(
+        open_on_ground(file == "arch" ? test::make_holed_arch() : file == "bowl" ? test::make_bowl() : test::make_open_box()));
+  } else if (hash != std::string::npos) {
+    const std::filesystem::path path = shared_meshes_dir() / file.substr(0, hash);
+    if (std::filesystem::exists(path)) {
+      const Mesh closed = load_scene_file(path).meshes.at(0);
+      Scene s;
+      s.name = file;
+      const std::string how = file.substr(hash + 1);
+      s.meshes = {how == "cut" ? test::cut_base(closed, 0.1f) : how == "holes" ? test::punch_holes(closed, 0.03f) : closed};
+      validate_and_prepare(s);
+      f = std::make_unique<ConeFixture>(std::move(s));
+    }
+  } else if (auto s = mesh_on_ground(file)) {
+    f = std::make_unique<ConeFixture>(std::move(*s));
+  }
   return cache.emplace(file, std::move(f)).first->second.get();
+}
+
+// What analyze_closure costs: boundary edges, holes, and for open meshes the winding-number
+// hierarchy and the enclosure that classifies them.
+void cone_closure(benchmark::State& state, const std::string& file) {
+  ConeFixture* f = fixture(file);
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  for (auto _ : state) benchmark::DoNotOptimize(analyze_closure(f->scene));
+}
+
+// ConeContext frame after frame (`ao view`): the grids kept, the sides of the open meshes per
+// pixel and the cone pass.
+void cone_context_frame(benchmark::State& state, const std::string& file) {
+  ConeFixture* f = fixture(file);
+  if (!f) return state.SkipWithError("../shared/data/meshes not found");
+  const GBuffer& g = f->gbuffer(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  ConeContext ctx(f->scene);
+  const ConeParams p = cone_preset(ConeQuality::Medium);
+  ctx.render(g, f->r_max, p, 1);
+  double sides = 0;
+  for (auto _ : state) sides += ctx.render(g, f->r_max, p, 1).sides_ms;
+  state.counters["sides_ms"] = sides / static_cast<double>(state.iterations());
 }
 
 // Voxelization of a mesh into a world grid of columns x columns x depth_bits.
@@ -135,6 +191,25 @@ void cone_rmse(benchmark::State& state, const std::string& file) {
 }
 
 constexpr int kLow = 0, kMedium = 1, kHigh = 2;
+
+// Open meshes (docs/methods/cone.md, "Open meshes"): classification, voxelization and the whole
+// cone call (every side's grid, the sides per pixel) against the closed scans they are cut from.
+#define AO_CONE_OPEN(name, file)                                                                                            \
+  BENCHMARK_CAPTURE(cone_closure, name, std::string(file))->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);   \
+  BENCHMARK_CAPTURE(cone_voxelize, name, std::string(file))->Args({512, 128})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5); \
+  BENCHMARK_CAPTURE(cone_frame, name, std::string(file))->Args({640, 360})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5)
+AO_CONE_OPEN(dragon, "ChineseDragon-10kv.off#closed");
+AO_CONE_OPEN(dragon_cut, "ChineseDragon-10kv.off#cut");
+AO_CONE_OPEN(dragon_holes, "ChineseDragon-10kv.off#holes");
+AO_CONE_OPEN(elephant, "elephant.off#closed");
+AO_CONE_OPEN(elephant_cut, "elephant.off#cut");
+AO_CONE_OPEN(elephant_holes, "elephant.off#holes");
+AO_CONE_OPEN(arch, "arch");
+AO_CONE_OPEN(bowl, "bowl");
+AO_CONE_OPEN(open_box, "open-box");
+AO_CONE_OPEN(default_scene, "default");
+#undef AO_CONE_OPEN
+BENCHMARK_CAPTURE(cone_context_frame, default_scene, std::string("default"))->Args({960, 540})->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 
 BENCHMARK_CAPTURE(cone_voxelize, refined_elephant, std::string("refined_elephant.off"))
     ->Args({512, 256})->Args({512, 128})->Args({512, 512})->Args({512, 1024})->Args({256, 256})

@@ -210,4 +210,14 @@ StderrReporter::~StderrReporter() { state_->end(); }
 
 void StderrReporter::end_stage() { state_->end(); }
 
+namespace {
+template <class T>
+void declare_normal(CLI::App& cmd, T& normal, const std::string& more) {
+  cmd.add_option("--normal", normal, std::string(kNormalHelp) + more)->type_name("shading|geometric")->default_str("shading");
+}
+}  // namespace
+
+void add_normal_option(CLI::App& cmd, std::string& normal, const std::string& more) { declare_normal(cmd, normal, more); }
+void add_normal_option(CLI::App& cmd, std::optional<std::string>& normal, const std::string& more) { declare_normal(cmd, normal, more); }
+
 }  // namespace ao::cli

@@ -35,6 +35,10 @@ inline constexpr const char* kNormalHelp =
     "Normal every method integrates about: shading (interpolated vertex normals, the smooth surface a mesh stands for) or geometric "
     "(the triangle's own); it is the G-buffer's N";
 
+/// Declares --normal (kNormalHelp, then `more`) on `cmd`, the same way in every command that has it.
+void add_normal_option(CLI::App& cmd, std::string& normal, const std::string& more);
+void add_normal_option(CLI::App& cmd, std::optional<std::string>& normal, const std::string& more);
+
 /// The camera options as typed; `request` gets them through camera_request().
 struct CameraOptions {
   CameraRequest request;                        ///< width, height, fov and file bound directly.

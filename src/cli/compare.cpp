@@ -31,21 +31,38 @@ struct CompareOptions {
   std::string device = "cpu";
   std::vector<std::string> params;  ///< method.key=value.
   std::string reference;            ///< NAME or method=NAME, comma-separated; empty = matched.
+  std::string common_reference = "obscurance";
   bool json = false;
 };
 
-// -p method.key=value: each method's overrides over its defaults.
+// -p key=value (every chosen method that has the key) or -p method.key=value (that method): each
+// method's overrides over its defaults. Parameter names have no dots, so a dot before the '='
+// names a method.
 void parse_params(const std::vector<std::string>& params, CompareSettings& settings) {
-  for (const std::string& kv : params) {
-    const auto dot = kv.find('.');
-    if (dot == std::string::npos || dot == 0) throw InputError("--param: expected method.key=value, got '" + kv + "'");
-    const std::string name = kv.substr(0, dot);
-    if (!settings.methods.empty() && std::find(settings.methods.begin(), settings.methods.end(), name) == settings.methods.end())
-      throw InputError("--param: method '" + name + "' is not among --methods");
+  std::vector<std::string> chosen = settings.methods;
+  if (chosen.empty())
+    for (const MethodInfo& m : all_methods())
+      if (!m.ground_truth) chosen.emplace_back(m.name);
+  auto set = [&](const std::string& name, const std::string& kv) {
     nlohmann::json& p = settings.params[name];
     const nlohmann::json defaults = find_method(name).default_params();
     if (p.is_null()) p = defaults;
-    apply_param_overrides(p, {kv.substr(dot + 1)}, name, defaults);
+    apply_param_overrides(p, {kv}, name, defaults);
+  };
+  for (const std::string& kv : params) {
+    const auto eq = kv.find('='), dot = kv.find('.');
+    if (dot != std::string::npos && dot < eq) {
+      if (dot == 0) throw InputError("--param: expected key=value or method.key=value, got '" + kv + "'");
+      const std::string name = kv.substr(0, dot);
+      if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) throw InputError("--param: method '" + name + "' is not among --methods");
+      set(name, kv.substr(dot + 1));
+      continue;
+    }
+    const std::string key = kv.substr(0, eq);
+    bool any = false;
+    for (const std::string& name : chosen)
+      if (find_method(name).default_params().contains(key)) set(name, kv), any = true;
+    if (!any) throw InputError("--param: no chosen method has a parameter '" + key + "' among the " + std::to_string(chosen.size()) + " methods chosen");
   }
 }
 
@@ -62,6 +79,7 @@ CompareRequest make_request(const CompareOptions& o) {
     if (eq == std::string::npos) settings.references[""] = item;
     else settings.references[item.substr(0, eq)] = item.substr(eq + 1);
   }
+  settings.common_reference = o.common_reference;
   settings.spp_reference = o.spp_reference;
   settings.seed = o.seed;
   settings.device = device_from_name(o.device);
@@ -108,15 +126,20 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   std::string names;
   for (const MethodInfo& m : all_methods()) names += (names.empty() ? "" : ", ") + std::string(m.name);
   cmd->add_option("--methods", o->methods, "Comma-separated methods (" + names + "); default: every method but raytraced");
-  cmd->add_option("--spp-reference", o->spp_reference, "Rays per pixel of the ray-traced references")->capture_default_str();
+  cmd->add_option("--reference-samples,--spp-reference", o->spp_reference, "Rays per pixel of the ray-traced references")->capture_default_str();
   cmd->add_option("--sweep", o->sweep, "Also measure error against one parameter: key=v1,v2,... (e.g. samples=4,8,16,32)");
   cmd->add_option("--out-dir", o->out_dir, "Output directory (default: compare-<scene>)");
-  cmd->add_option("-p,--param", o->params, "Method parameter as method.key=value (JSON value), repeatable");
+  cmd->add_option("-p,--param", o->params,
+                  "Method parameter as key=value (every chosen method that has it) or method.key=value (that method); JSON value, repeatable");
   cmd->add_option("--reference", o->reference,
                   "Reference to judge against: NAME for every method or method=NAME, comma-separated; NAME is matched (each method's own, "
                   "the default), obscurance (the obscurance of the membership it implies), tangent-sphere or transfer");
+  cmd->add_option("--common-reference", o->common_reference,
+                  "The one reference every method is also judged against, so that rows can be ranked: obscurance (of --membership, "
+                  "step at R by default), tangent-sphere, transfer, or none")
+      ->capture_default_str();
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d) requested: " + membership_names() + " (methods may imply their own)");
-  cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + "; the same for every method and its reference")->capture_default_str();
+  add_normal_option(*cmd, o->normal, "; the same for every method and its reference");
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
   cmd->add_option("--device", o->device,
                   "cpu, or gpu: each method also runs on the GPU backend (OpenGL 4.3 compute shaders, headless; Mesa's llvmpipe where "

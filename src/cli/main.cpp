@@ -14,6 +14,7 @@
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
 #include "ao/version.h"
+#include "parse_errors.h"
 #include "subcommands.h"
 
 int main(int argc, char** argv) {
@@ -37,15 +38,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // A value of the wrong type ("--width abc", "--seed -1") or outside an option's range is a bad
-    // value, exit 1 with one line, like the values the subcommands check. (Matched by exit code: the
-    // exception does not always reach here with its derived type.)
-    const int code = e.get_exit_code();
-    if (code == static_cast<int>(CLI::ExitCodes::ConversionError) || code == static_cast<int>(CLI::ExitCodes::ValidationError)) {
-      std::fprintf(stderr, "ao: error: %s\n", e.what());
-      return 1;
-    }
-    return app.exit(e) == 0 ? 0 : 2;
+    // One line in ao's words; a value of the wrong type or out of range ("--width abc", "--seed -1")
+    // is a bad value (1), like the values the subcommands check; anything else bad usage (2).
+    return ao::cli::report_parse_error(app, e, argc, argv);
   }
   std::unique_ptr<tbb::global_control> limit;
   if (global.threads > 0)

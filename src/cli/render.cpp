@@ -9,6 +9,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/membership.h"
+#include "ao/io/image_io.h"
 #include "ao/jobs/render.h"
 #include "common.h"
 #include "subcommands.h"
@@ -115,13 +116,13 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand("render", "Render an AO image of a scene (or of a G-buffer EXR).");
   cmd->add_option("scene", o->scene, kSceneHelp)->type_name("SCENE");
-  cmd->add_option("-o,--output", o->output, "Visibility image: .png (linear, 8 or 16 bit) or .exr (float). Default: <scene>-<method>.png");
+  cmd->add_option("-o,--output", o->output, "Visibility image: " + supported_image_extensions() + " (.exr float; the others 8 or 16 bit where the format has it, linear V). Default: <scene>-<method>.png");
   std::string methods;
   for (const MethodInfo& m : all_methods()) methods += "\n  " + std::string(m.name) + ": " + std::string(m.summary);
   cmd->add_option("-m,--method", o->request.method, "AO method:" + methods)->capture_default_str();
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d): " + membership_names());
-  cmd->add_option("--normal", o->normal, std::string(kNormalHelp) + " (default: shading)")->type_name("shading|geometric");
-  cmd->add_option("--spp,--samples", o->request.samples,
+  add_normal_option(*cmd, o->normal, "");
+  cmd->add_option("--samples,--spp", o->request.samples,
                   "Samples per pixel (default: the method's own; 256 rays for raytraced, the maximum with --target-error)");
   cmd->add_option("--target-error", o->request.target_error, "Stop a pixel once its standard error is below this (raytraced; default off)");
   cmd->add_option("--seed", o->request.seed, "Seed of the per-pixel sample sets")->capture_default_str();

@@ -1,6 +1,7 @@
 // ao tune: parses the options into a TuneRequest (ao/jobs/tune.h), runs it, and says what it
 // found. docs/compare.md#ao-tune.
 #include <cstdio>
+#include <iostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -20,8 +21,10 @@ struct TuneOptions {
   std::string scenes = "default";   ///< Comma-separated.
   std::vector<std::string> fit;     ///< key or key=lo:hi.
   std::vector<std::string> params;  ///< key=value: the starting point.
-  int width = 320, height = 180;
+  CameraOptions camera{.request = {.default_width = 320, .default_height = 180}};
   FalloffOptions falloff;
+  std::string normal = "shading";
+  bool json = false;
 };
 
 // "key" (the table's range) or "key=lo:hi".
@@ -47,13 +50,17 @@ int run(const TuneOptions& o, const GlobalOptions& global) {
   apply_param_overrides(r.params, o.params, m.name, m.default_params());
   for (const std::string& f : o.fit) r.fit.push_back(parse_fit(f));
   r.scenes = split(o.scenes, ',');
-  r.camera.width = o.width;
-  r.camera.height = o.height;
+  r.camera = camera_request(o.camera);
   r.falloff = falloff_request(o.falloff);
-  if (r.output.empty()) throw InputError("-o: name the parameter file to write");
-  StderrReporter report(global, false);
+  r.normal = surface_normal_from_name(o.normal);
+  if (r.output.empty() && !o.json) throw InputError("-o: name the parameter file to write (or print it with --json)");
+  StderrReporter report(global, o.json);
   const TuneJobResult out = run_tune(r, report.reporter());
   report.end_stage();
+  if (o.json) {
+    std::cout << out.file.dump(2) << "\n";
+    return 0;
+  }
   std::fprintf(stderr, "mean RMSE %.4f -> %.4f in %d evaluations (%.1f s); wrote %s (load with -p @%s)\n", out.tune.start_rmse, out.tune.best_rmse,
                out.tune.evaluations, out.tune.seconds, r.output.string().c_str(), r.output.string().c_str());
   return 0;
@@ -69,11 +76,12 @@ void add_tune_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--scenes", o->scenes, "Comma-separated scenes, one view each (built-in names or mesh files)")->capture_default_str();
   cmd->add_option("-p,--param", o->params, "Starting value of a parameter: key=value, repeatable");
   cmd->add_option("--budget", o->request.budget_s, "Time budget, seconds")->capture_default_str();
-  cmd->add_option("--spp-reference", o->request.spp_reference, "Rays per pixel of the references")->capture_default_str();
-  cmd->add_option("-o,--output", o->request.output, "Parameter file to write (JSON; load with -p @FILE)")->required();
+  cmd->add_option("--reference-samples,--spp-reference", o->request.spp_reference, "Rays per pixel of the references")->capture_default_str();
+  cmd->add_option("-o,--output", o->request.output, "Parameter file to write (JSON; load with -p @FILE); required unless --json");
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d) requested: " + membership_names(), false);
-  cmd->add_option("--width", o->width, "Image width, pixels")->capture_default_str();
-  cmd->add_option("--height", o->height, "Image height, pixels")->capture_default_str();
+  add_normal_option(*cmd, o->normal, "; the same for the method and its reference");
+  add_camera_options(*cmd, o->camera);  // every scene's view; without --eye/--camera each scene is framed on its own
+  cmd->add_flag("--json", o->json, "Print the parameter file's content on stdout");
   cmd->add_option("--seed", o->request.seed, "Seed of the per-pixel sample sets")->capture_default_str();
   cmd->callback([o, &global, &action] { action = [o, &global] { return run(*o, global); }; });
 }

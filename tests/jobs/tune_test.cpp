@@ -51,6 +51,41 @@ TEST(Tune, AlchemyIntensityImprovesAndIsDeterministic) {
   EXPECT_EQ(r1.best_rmse, r2.best_rmse);
 }
 
+// An unset value starts where the method's preset puts it (Alchemy's fitted sigma 0.4), whatever the
+// range: with no time for a move the result is the start.
+TEST(Tune, StartsFromThePresetsValueNotTheMiddleOfTheRange) {
+  const auto s = test::builtin_gbuffer("sphere-on-plane");
+  const TuneView view{s.rays.get(), &s.g, nullptr, {Membership::Step, 0.8f}, Image<float>(s.g.width(), s.g.height(), 1.0f)};
+  for (const auto& [lo, hi] : {std::pair{0.1, 2.0}, std::pair{0.3, 0.5}}) {
+    const TuneResult r = tune_method({view}, {.method = "alchemy", .parameters = {{"intensity", lo, hi}}, .time_budget_s = 1e-9});
+    EXPECT_EQ(r.evaluations, 1);
+    EXPECT_DOUBLE_EQ(r.params.at("intensity").get<double>(), 0.4) << lo << ":" << hi;
+  }
+  nlohmann::json paper = find_method("alchemy").default_params();
+  paper["preset"] = "paper";
+  const TuneResult r = tune_method({view}, {.method = "alchemy", .start = paper, .parameters = {{"intensity", 0.1, 2.0}}, .time_budget_s = 1e-9});
+  EXPECT_DOUBLE_EQ(r.params.at("intensity").get<double>(), 1.0);
+  // A start outside the range begins at its nearest end.
+  const TuneResult c = tune_method({view}, {.method = "alchemy", .parameters = {{"intensity", 0.6, 2.0}}, .time_budget_s = 1e-9});
+  EXPECT_DOUBLE_EQ(c.params.at("intensity").get<double>(), 0.6);
+}
+
+// The optimum (albedo_scale = 0.4, as in FindsAKnownOptimum) lies below the range asked for: the
+// fit ends at the lower end and says so; inside the range it does not.
+TEST(Tune, SaysWhenTheResultIsAtAnEndOfItsRange) {
+  const auto s = test::builtin_gbuffer("sphere-on-plane");
+  const Falloff f{Membership::Step, 0.8f};
+  const MethodInfo& m = find_method("transfer");
+  nlohmann::json target = m.default_params();
+  target["albedo_scale"] = 0.4;
+  TuneView view{s.rays.get(), &s.g, &s.scene.analytic, f, m.run(MethodInput{s.g, s.rays.get(), f, 1}, target).visibility};
+  const TuneResult below = tune_method({view}, {.method = "transfer", .parameters = {{"albedo_scale", 0.6, 1.0}}, .time_budget_s = 120});
+  EXPECT_DOUBLE_EQ(below.params.at("albedo_scale").get<double>(), 0.6);
+  EXPECT_EQ(below.on_bound, std::vector<std::string>{"albedo_scale"});
+  const TuneResult inside = tune_method({view}, {.method = "transfer", .parameters = {{"albedo_scale", 0.0, 1.0}}, .time_budget_s = 120});
+  EXPECT_TRUE(inside.on_bound.empty()) << inside.params.at("albedo_scale");
+}
+
 TEST(Tune, RejectsBadSettings) {
   const auto s = test::builtin_gbuffer("plane");
   const TuneView view{s.rays.get(), &s.g, nullptr, {Membership::Step, 1.0f}, Image<float>(s.g.width(), s.g.height(), 1.0f)};

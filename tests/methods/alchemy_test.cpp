@@ -168,30 +168,23 @@ TEST(Alchemy, ContrastIsAPowerOfTheUnfilteredResult) {
   for (std::size_t i = 0; i < a.visibility.size(); ++i) EXPECT_NEAR(b.visibility[i], std::pow(a.visibility[i], 2.5f), 1e-6f);
 }
 
-TEST(Alchemy, ReferenceFalloffFollowsRadiusAndIntensity) {
+TEST(Alchemy, ReferenceIsStepObscuranceWithinRAtAnyIntensity) {
   AlchemyParams p;
   Falloff f = alchemy_reference_falloff(p, 2.0f);
-  EXPECT_EQ(f.membership, Membership::Alchemy);
+  EXPECT_EQ(f.membership, Membership::Step);
   EXPECT_EQ(f.radius, 2.0f);
-  EXPECT_FLOAT_EQ(f.alchemy_u, 1.6f);  // sigma = 0.4 paper metre, one paper metre = 2r world units
-  p.preset = AlchemyPreset::Paper;
-  EXPECT_FLOAT_EQ(alchemy_reference_falloff(p, 2.0f).alchemy_u, 4.0f);  // the paper's sigma = 1
-  p.intensity = 0.4f;
-  EXPECT_FLOAT_EQ(alchemy_reference_falloff(p, 2.0f).alchemy_u, 1.6f) << "a set intensity overrides the preset";
-  p.radius = 0.5f;
-  p.intensity = 0.2f;
-  p.meter = 1.0f;
-  f = alchemy_reference_falloff(p, 2.0f);
-  EXPECT_EQ(f.radius, 0.5f);
-  EXPECT_FLOAT_EQ(f.alchemy_u, 0.2f);
-  // The registry row hands the same falloff to `ao compare --reference obscurance`; its matched
-  // reference names it as what it is: step obscurance at the paper's preset (u = 2r >= r).
+  for (float sigma : {0.0f, 0.4f, 1.0f, 5.0f}) {
+    p.intensity = sigma;
+    EXPECT_EQ(alchemy_reference_falloff(p, 2.0f).membership, Membership::Step) << sigma;
+    EXPECT_EQ(alchemy_reference_falloff(p, 2.0f).radius, 2.0f) << sigma;
+  }
+  p.radius = 0.5f;  // the method's own r wins over the caller's R
+  EXPECT_EQ(alchemy_reference_falloff(p, 2.0f).radius, 0.5f);
   const MethodInfo& m = find_method("alchemy");
-  EXPECT_FLOAT_EQ(m.obscurance_falloff({Membership::Step, 2.0f}, m.default_params()).alchemy_u, 1.6f);  // fitted sigma 0.4: u = 0.8 R
-  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, m.default_params()).falloff.membership, Membership::Alchemy);
-  nlohmann::json paper = m.default_params();
-  paper["preset"] = "paper";
-  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, paper).falloff.membership, Membership::Step);  // u = 2r >= r: step
+  nlohmann::json off = m.default_params();
+  off["intensity"] = 0;  // AO switched off is judged against the same step reference
+  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, off).key(), m.reference({Membership::Step, 2.0f}, m.default_params()).key());
+  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, off).falloff.membership, Membership::Step);
 }
 
 TEST(Alchemy, RejectsBadParameters) {

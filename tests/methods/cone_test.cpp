@@ -15,6 +15,7 @@
 #include "ao/reference/raytraced.h"
 #include "ao/scene/procedural.h"
 
+#include "support/open_sheets.h"
 #include "support/scenes.h"
 
 namespace ao {
@@ -22,8 +23,9 @@ namespace {
 
 using test::scene_of;
 
-// A one-pixel G-buffer seeing world point p with world normal n from a camera 3 units along n.
-GBuffer one_pixel(Vec3 p, Vec3 n) {
+// A one-pixel G-buffer seeing world point p with world normal n from a camera 3 units along n, on
+// object `id` (1 = the scene's first mesh).
+GBuffer one_pixel(Vec3 p, Vec3 n, std::uint32_t id = 1) {
   Camera cam;
   cam.eye = p + normalize(n + Vec3{0.1f, 0.2f, 0.3f}) * 3.0f;
   cam.target = p;
@@ -32,12 +34,12 @@ GBuffer one_pixel(Vec3 p, Vec3 n) {
   g.position(0, 0) = cam.world_to_camera_point(p);
   g.normal(0, 0) = normalize(cam.world_to_camera_vector(n));
   g.albedo(0, 0) = {0.8f, 0.8f, 0.8f};
-  g.object_id(0, 0) = 1;
+  g.object_id(0, 0) = id;
   return g;
 }
 
-float cone_at(const Scene& s, Vec3 p, Vec3 n, float R, ConeParams params) {
-  const GBuffer g = one_pixel(p, n);
+float cone_at(const Scene& s, Vec3 p, Vec3 n, float R, ConeParams params, std::uint32_t id = 1) {
+  const GBuffer g = one_pixel(p, n, id);
   return render_cone(s, analyze_closure(s), g, R, params, 1).visibility(0, 0);
 }
 
@@ -131,48 +133,18 @@ TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
   }
 }
 
-// Open meshes made from closed ones, as scans come: `keep` decides per triangle from its centroid.
-template <class Keep>
-Mesh cut(const Mesh& closed, Keep keep) {
-  Mesh m = closed;
-  m.indices.clear();
-  for (std::size_t t = 0; t < closed.triangle_count(); ++t) {
-    const std::uint32_t* v = closed.indices.data() + 3 * t;
-    const Vec3 c = (closed.positions[v[0]] + closed.positions[v[1]] + closed.positions[v[2]]) * (1.0f / 3.0f);
-    if (keep(c)) m.indices.insert(m.indices.end(), v, v + 3);
-  }
-  return m;
-}
-// Removes the cap below y = lo + fraction * height (a bust open at its base).
-Mesh cut_base(const Mesh& closed, float fraction) {
-  Bounds3 b;
-  for (const Vec3& p : closed.positions) b.extend(p);
-  const float y = b.lo.y + fraction * (b.hi.y - b.lo.y);
-  return cut(closed, [&](Vec3 c) { return c.y > y; });
-}
-// Punches holes: drops the triangles within `radius` of three vertices on the upper half.
-Mesh punch_holes(const Mesh& closed, float radius_fraction) {
-  Bounds3 b;
-  for (const Vec3& p : closed.positions) b.extend(p);
-  std::vector<Vec3> centres;
-  const float mid = 0.5f * (b.lo.y + b.hi.y);
-  for (std::size_t v = 0; v < closed.positions.size() && centres.size() < 3; v += closed.positions.size() / 7 + 1)
-    if (closed.positions[v].y > mid) centres.push_back(closed.positions[v]);
-  const float r = radius_fraction * b.diagonal();
-  return cut(closed, [&](Vec3 c) {
-    for (const Vec3& q : centres)
-      if (length(c - q) < r) return false;
-    return true;
-  });
-}
+using test::cut_base;
+using test::punch_holes;
 
 struct OpenError {
   double rmse, mean_signed;
   nlohmann::json stats;
 };
 // Cone (medium preset) against the ray-traced step reference on `object` standing on a ground
-// quad, seen from the front right and above, R = 0.1 x the scene's diagonal.
-OpenError cone_error(const Mesh& object, int columns = 256) {
+// quad, seen from the front right and above, R = 0.1 x the scene's diagonal (or, with
+// `object_fraction`, that fraction of the object's own diagonal: the CLI's default R, which leaves
+// the flat ground out).
+OpenError cone_error(const Mesh& object, int columns = 256, float object_fraction = 0) {
   Bounds3 b;
   for (const Vec3& p : object.positions) b.extend(p);
   const Vec3 c = (b.lo + b.hi) * 0.5f;
@@ -182,7 +154,7 @@ OpenError cone_error(const Mesh& object, int columns = 256) {
   const RayScene rs(s);
   const Camera cam = frame_bounds(b, {1.0f, 0.8f, 1.3f}, 40.0f, 96, 72);
   const GBuffer g = render_gbuffer(rs, cam);
-  const float R = 0.1f * s.bounds().diagonal();
+  const float R = object_fraction > 0 ? object_fraction * e : 0.1f * s.bounds().diagonal();
   const auto ref = render_raytraced(rs, g, {Membership::Step, R}, {.samples = 256}, 9);
   ConeParams p;
   p.columns = columns;
@@ -220,6 +192,71 @@ TEST(Cone, OpenScannedMeshesCostAtMostTwiceTheClosedMeshError) {
       EXPECT_LE(e.rmse, 2.0 * ce.rmse) << name << ", " << what << ": closed " << ce.rmse << ", mean signed " << e.mean_signed;
     }
   }
+}
+
+// The requirement for sheets: cone on open meshes made as sheets and containers (a bent
+// sheet with holes, half a sphere shell, a box without its top, seen into) within 2x its error on
+// closed meshes of the same sizes in the same setting (the mean of a closed box, sphere and torus),
+// at the CLI's R (0.1 x the object's diagonal; at 0.1 x the scene's, 0.85 against the arch's radius
+// of 0.8, the sheet's slab no longer fits inside the arch: docs/methods/cone.md, Open meshes).
+// Measured 0.90-1.14x; before the two-sided voxelization `ao compare` gave 3.4-13x.
+TEST(Cone, OpenSheetsCostAtMostTwiceTheClosedMeshError) {
+  double closed = 0;
+  for (const Mesh& m : {make_box({-0.9f, 0.0f, -0.7f}, {0.9f, 1.0f, 0.7f}), make_sphere({0, 1, 0}, 1.0f, 96, 48), make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)})
+    closed += cone_error(m, 256, 0.1f).rmse / 3.0;
+  for (const auto& [what, open] : {std::pair{"bent sheet with holes", test::make_holed_arch()}, std::pair{"half sphere shell", test::make_bowl()},
+                                   std::pair{"box without its top", test::make_open_box()}}) {
+    const OpenError e = cone_error(open, 256, 0.1f);
+    EXPECT_LE(e.rmse, 2.0 * closed) << what << ": closed meshes " << closed << ", mean signed " << e.mean_signed;
+    EXPECT_EQ(e.stats["odd_columns"], 0) << what;
+    EXPECT_GE(e.stats["side_grids"], 2) << what << ": the inside or the underside is seen";
+  }
+}
+
+// A sheet stands for what it hides from the point, on the point's far side of it: under a roof (a
+// quad at height h < R, facing up or turned down) a point on the floor sees what it would see
+// under a closed roof as thick as R (cone's own answer for a solid roof, 0.41 here against the
+// reference's (h / R)^2 = 0.25: sphere volumes at the horizon). On top of the roof the point is
+// open. Before the two-sided voxelization the slab hung below a roof facing up whatever side the
+// point was on: V = 0 under it.
+TEST(Cone, ASheetOccludesFromBothSidesAsTheSolidItHides) {
+  const float h = 0.5f, R = 1.0f;
+  const Mesh floor = make_box({-4, -0.5f, -4}, {4, 0, 4});
+  ConeParams p = cone_preset(ConeQuality::High);
+  p.cones = 24;
+  p.columns = 256;
+  p.jitter = false;
+  const Vec3 under{0.3f, 0, 0.2f}, up{0, 1, 0};
+  const float solid = cone_at(scene_of({floor, make_box({-4, h, -4}, {4, h + R, 4})}), under, up, R, p);
+  for (bool turned : {false, true}) {
+    Mesh roof = make_quad({-4, h, 4}, {4, h, 4}, {4, h, -4}, {-4, h, -4});
+    if (turned) std::swap(roof.indices[1], roof.indices[2]), std::swap(roof.indices[4], roof.indices[5]);
+    const Scene s = scene_of({floor, roof});
+    // 0.02: the slab is R thick on the grid's voxels, the solid roof's faces fall elsewhere on them.
+    EXPECT_NEAR(cone_at(s, under, up, R, p), solid, 0.02) << (turned ? "roof facing down" : "roof facing up");
+    EXPECT_GT(cone_at(s, {0.3f, h, 0.2f}, up, R, p, 2), 0.97f) << (turned ? "roof facing down" : "roof facing up") << ", on top";
+  }
+}
+
+// Two-sided: turning every triangle of an open sheet over changes nothing but the grid's height
+// (a grid is taller by a slab when a slab rises above a face, which moves the voxel boundaries:
+// 0.0065 at worst, measured unfiltered), on the same G-buffer.
+TEST(Cone, SheetsLookTheSameTurnedOver) {
+  const Mesh arch = test::make_holed_arch(), turned = test::turned_over(arch);
+  const Mesh ground = make_quad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3});
+  const Scene original = scene_of({arch, ground});
+  const GBuffer g = render_gbuffer(RayScene(original), frame_bounds(arch.bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 64, 48));
+  ConeParams p;
+  p.columns = 128;
+  p.filter_taps = 1;
+  const ConeResult a = render_cone(original, analyze_closure(original), g, 0.3f, p, 1);
+  const Scene other = scene_of({turned, ground});
+  const ConeResult b = render_cone(other, analyze_closure(other), g, 0.3f, p, 1);
+  EXPECT_EQ(a.side_grids, 2);
+  EXPECT_EQ(b.side_grids, 2);
+  EXPECT_GT(a.back_pixels, 0u);
+  EXPECT_GT(b.back_pixels, 0u);
+  for (std::size_t i = 0; i < a.visibility.size(); ++i) ASSERT_NEAR(a.visibility[i], b.visibility[i], 0.01f) << "pixel " << i;
 }
 
 // A sphere that starts inside the surface voxel sees the surface's own voxels: with 10 spheres the
@@ -335,6 +372,25 @@ TEST(ConeContext, CachedGridGivesTheSamePixelsAndRebuildsOnlyWhenItsInputsChange
   same_as_uncached(ctx, g2, 1.2f, p, 3, true);
   same_as_uncached(ctx, g, 1.2f, p, 3, false);
   EXPECT_EQ(ctx.grid_builds(), 8);
+}
+
+// Pixels on the back of a sheet get a grid of their own, kept by the context per combination of
+// sides: the same pixels as render_cone, and no new grid for the same view.
+TEST(ConeContext, KeepsOneGridPerSide) {
+  const Scene s = scene_of({test::make_open_box(), make_quad({-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3})});
+  const GBuffer g = render_gbuffer(RayScene(s), frame_bounds(test::make_open_box().bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 64, 48));
+  ConeParams p;
+  p.columns = 128;
+  ConeContext ctx(s);
+  const ConeResult first = ctx.render(g, 0.25f, p, 1);
+  EXPECT_EQ(first.side_grids, 2) << "the box's inside is seen through its top";
+  EXPECT_GT(first.back_pixels, 0u);
+  EXPECT_EQ(ctx.grid_builds(), 2);
+  const ConeResult again = ctx.render(g, 0.25f, p, 2);
+  EXPECT_TRUE(again.grid_reused);
+  EXPECT_EQ(ctx.grid_builds(), 2);
+  const Image<float> plain = render_cone(s, analyze_closure(s), g, 0.25f, p, 2).visibility;
+  for (std::size_t i = 0; i < plain.size(); ++i) ASSERT_EQ(again.visibility[i], plain[i]) << "pixel " << i;
 }
 
 TEST(Cone, PresetsFollowTableOneAndExplicitCountsOverride) {

@@ -25,8 +25,9 @@ TEST(Reference, EachMethodIsJudgedAgainstWhatItEstimates) {
   EXPECT_EQ(matched("transfer", f).kind, ReferenceKind::Transfer);
   EXPECT_EQ(matched("transfer", f).label(), "transfer (linear)");
   EXPECT_EQ(matched("cone", f).label(), "step obscurance");
-  // Alchemy at its fitted default sigma 0.4 (u = 0.8 r < r) has its own falloff, named so.
-  EXPECT_EQ(matched("alchemy", f).label(), "alchemy obscurance");
+  // Alchemy: step obscurance within its r at any sigma (eq. 7 with the paper's u = 2r).
+  EXPECT_EQ(matched("alchemy", f).label(), "step obscurance");
+  EXPECT_EQ(matched("gtao", f).label(), "step obscurance");
 }
 
 TEST(Reference, OldReferencesRemainAvailableByName) {

@@ -1,10 +1,11 @@
 // Every method of the registry through the same checks, so that a new row is tested without a
 // line here: the open plane is fully visible, V stays in [0, 1], results are identical at 1 and 2
 // threads, the mean V falls as R grows, parameters round trip through JSON (floats at the
-// precision they were given), and bad parameter values are refused with one line that names the
-// parameter and its valid range.
+// precision they were given), bad parameter values are refused with one line that names the
+// parameter and its valid range, and no reference moves when an estimator parameter changes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -143,6 +144,36 @@ TEST_P(AllMethods, ParametersRoundTripThroughJson) {
     EXPECT_EQ(back, j) << s.name;
     // Floats print at the precision they were given, not as the float's binary expansion.
     EXPECT_EQ(back.at(s.name).dump(), j.at(s.name).dump()) << s.name;
+  }
+}
+
+// A reference depends on the scene, the camera, R, the membership and its own ray settings, never on
+// a knob of the estimator it judges: changing any parameter that is not one of the method's
+// quantity_params leaves the matched and the obscurance reference the same. ReferenceSpec::key is
+// everything render_reference takes beyond the scene, the G-buffer, its ray settings and the seed,
+// so equal keys are equal images.
+TEST_P(AllMethods, NoEstimatorParameterMovesTheReference) {
+  const MethodInfo& m = method();
+  const nlohmann::json defaults = m.default_params();
+  for (const Falloff requested : {Falloff{Membership::Step, 1.5f}, Falloff{Membership::Linear, 0.7f}}) {
+    const std::string matched = m.reference(requested, defaults).key();
+    const std::string obscurance = choose_reference(m, "obscurance", requested, defaults).key();
+    for (const ParamSpec& s : m.params().specs()) {
+      const bool quantity = std::find(m.quantity_params.begin(), m.quantity_params.end(), s.name) != m.quantity_params.end();
+      nlohmann::json j = defaults;
+      j[s.name] = other_value(s);
+      const std::string moved = m.reference(requested, m.canonical_params(j)).key();
+      if (quantity) continue;  // it chooses the quantity: its reference may differ
+      EXPECT_EQ(moved, matched) << m.name << ": " << s.name << " = " << j[s.name] << " moved the reference";
+      EXPECT_EQ(choose_reference(m, "obscurance", requested, m.canonical_params(j)).key(), obscurance) << m.name << ": " << s.name;
+    }
+    // Alchemy's intensity in particular, over its range, 0 included (V = 1 everywhere).
+    if (m.params().find("intensity"))
+      for (double sigma : {0.0, 0.1, 0.4, 1.0, 3.0}) {
+        nlohmann::json j = defaults;
+        j["intensity"] = sigma;
+        EXPECT_EQ(m.reference(requested, m.canonical_params(j)).key(), matched) << "intensity " << sigma;
+      }
   }
 }
 

@@ -54,6 +54,24 @@ double covered_mean(const Image<float>& v, const GBuffer& g) {
   return n ? sum / static_cast<double>(n) : 1.0;
 }
 
+// GTAO's multi-bounce fit estimates the light after interreflections with the surfaces' albedo
+// (Jimenez et al. 2016, sec. 5), which the ray-traced ambient transfer W computes; without it GTAO
+// estimates the cosine-weighted visibility within R, step obscurance, whatever membership is asked.
+TEST(Registry, GtaoWithMultiBounceIsJudgedAgainstAmbientTransfer) {
+  const MethodInfo& m = find_method("gtao");
+  nlohmann::json p = m.default_params();
+  const ReferenceSpec plain = m.reference({Membership::Linear, 1.5f}, p);
+  EXPECT_EQ(plain.kind, ReferenceKind::Obscurance);
+  EXPECT_EQ(plain.falloff.membership, Membership::Step);
+  EXPECT_EQ(plain.falloff.radius, 1.5f);
+  p["multi_bounce"] = true;
+  const ReferenceSpec bounced = m.reference({Membership::Linear, 1.5f}, m.canonical_params(p));
+  EXPECT_EQ(bounced.kind, ReferenceKind::Transfer);
+  EXPECT_EQ(bounced.falloff.membership, Membership::Step);
+  EXPECT_EQ(bounced.falloff.radius, 1.5f);
+  EXPECT_EQ(bounced.albedo_scale, 1.0f);
+}
+
 TEST(Registry, ScreenSpaceMethodsOfferTheFourCharacteristicFunctions) {
   ASSERT_EQ(characteristic_names().size(), 4u);
   EXPECT_EQ(characteristic_names()[0], "depth");

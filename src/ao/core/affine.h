@@ -39,6 +39,18 @@ inline Affine3 operator*(const Affine3& a, const Affine3& b) { return {a.vector(
 /// exists for every matrix. Normalise after applying it.
 inline Affine3 cofactor(const Affine3& m) { return {cross(m.c1, m.c2), cross(m.c2, m.c0), cross(m.c0, m.c1), {0, 0, 0}}; }
 
+/// The inverse map of m, whose determinant must not be 0 (validate_and_prepare refuses such
+/// instances): L^-1 = cof(L)^T / det(L), computed in double, and the translation -L^-1 c3.
+inline Affine3 inverse(const Affine3& m) {
+  const Affine3 c = cofactor(m);
+  const double inv = 1.0 / m.determinant();
+  const auto f = [inv](double v) { return static_cast<float>(v * inv); };
+  // Row k of L^-1 is column k of cof(L) over det(L).
+  Affine3 r{{f(c.c0.x), f(c.c1.x), f(c.c2.x)}, {f(c.c0.y), f(c.c1.y), f(c.c2.y)}, {f(c.c0.z), f(c.c1.z), f(c.c2.z)}, {0, 0, 0}};
+  r.c3 = -r.vector(m.c3);
+  return r;
+}
+
 /// The axis-aligned box of m applied to the corners of b (an empty box stays empty).
 inline Bounds3 transform_bounds(const Affine3& m, const Bounds3& b) {
   Bounds3 out;

@@ -36,6 +36,27 @@ std::string reference_name(const CompareSettings& s, const std::string& method) 
   return kMatchedReference;
 }
 
+nlohmann::json reference_json(const CompareReference& ref, int spp) {
+  nlohmann::json j = shortest_floats(ref.spec);
+  j["label"] = ref.spec.label();
+  j["spp"] = spp;
+  j["mean_std_error"] = ref.mean_std_error;
+  j["ms"] = ref.ms;
+  return j;
+}
+
+nlohmann::json metrics_json(const ErrorMetrics& e) {
+  return {{"rmse", e.rmse}, {"psnr_db", e.psnr_db}, {"ssim", e.ssim}, {"mean_signed_error", e.mean_signed}, {"max_abs_error", e.max_abs}};
+}
+
+// A reference as the table names it: its label and R (and Alchemy's u where it has one).
+std::string reference_text(const ReferenceSpec& spec) {
+  std::string ref = spec.label() + ", R = " + format_value(shortest_floats(spec.falloff.radius));
+  if (spec.kind != ReferenceKind::TangentSphere && spec.falloff.membership == Membership::Alchemy)
+    ref += ", u = " + fixed(spec.falloff.effective_alchemy_u(), 4);
+  return ref;
+}
+
 ProgressFn stage(const CompareSettings& s, const std::string& name) { return s.progress ? s.progress(name) : ProgressFn{}; }
 
 }  // namespace
@@ -101,6 +122,7 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
   }
   for (const auto& [name, ref] : in.references)
     if (!name.empty() && !s.params.count(name)) throw InputError("--reference: method '" + name + "' is not among --methods");
+  common_reference_spec(s);  // throws for unknown names
   if (!s.sweep_key.empty()) {
     if (s.sweep_values.empty()) throw InputError("--sweep: no values given for '" + s.sweep_key + "'");
     bool any = false;
@@ -108,6 +130,17 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
     if (!any) throw InputError("--sweep: no chosen method has a parameter '" + s.sweep_key + "'");
   }
   return s;
+}
+
+std::optional<ReferenceSpec> common_reference_spec(const CompareSettings& s) {
+  if (s.common_reference == "none") return std::nullopt;
+  const std::optional<ReferenceKind> kind = parse_reference_kind(s.common_reference);
+  if (!kind) throw InputError("--common-reference: unknown reference '" + s.common_reference + "' (known: " + reference_kind_names() + ", none)");
+  switch (*kind) {
+    case ReferenceKind::TangentSphere: return ReferenceSpec{ReferenceKind::TangentSphere, {Membership::Cubic, s.falloff.radius}};
+    case ReferenceKind::Transfer: return ReferenceSpec{ReferenceKind::Transfer, s.falloff};
+    default: return obscurance_reference(s.falloff);
+  }
 }
 
 CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const AnalyticSurfaces* surfaces, const CompareSettings& settings,
@@ -141,6 +174,10 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
   };
 
   const Image<std::uint8_t> covered = coverage_mask(g);
+  if (const std::optional<ReferenceSpec> common = common_reference_spec(s)) result.common = reference_for(*common);
+  auto against_common = [&](const Image<float>& v) {
+    return result.common ? compare_images(v, result.references[*result.common].visibility, covered) : ErrorMetrics{};
+  };
   for (const std::string& name : s.methods) {
     const MethodInfo& m = find_method(name);
     const nlohmann::json& p = s.params.at(name);
@@ -153,6 +190,7 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
     const Image<float>& ref = result.references[row.reference].visibility;
     row.metrics = compare_images(out.visibility, ref, covered);
     row.heat = signed_error_heat_map(out.visibility, ref, covered, kCompareHeatRange);
+    row.common = against_common(out.visibility);
     row.stats = out.stats;
     row.visibility = std::move(out.visibility);
     if (gpu_column) row.gpu = gpu_column->run(name, p, s.falloff, s.seed, ref, row.visibility, covered, true);
@@ -171,7 +209,7 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
         const MethodOutput out = run_method(m, p, ms);
         const Image<float>& ref = result.references[r].visibility;
         const ErrorMetrics e = compare_images(out.visibility, ref, covered);
-        result.sweep.push_back({name, v, e.rmse, ms, {}});
+        result.sweep.push_back({name, v, e.rmse, against_common(out.visibility).rmse, ms, {}});
         if (gpu_column) result.sweep.back().gpu = gpu_column->run(name, p, s.falloff, s.seed, ref, out.visibility, covered, false);
       }
     }
@@ -181,25 +219,20 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
 nlohmann::json compare_table_json(const CompareResult& r) {
   nlohmann::json rows = nlohmann::json::array();
   for (const CompareRow& row : r.rows) {
-    const CompareReference& ref = r.references[row.reference];
-    nlohmann::json reference = shortest_floats(ref.spec);
-    reference["label"] = ref.spec.label();
-    reference["spp"] = r.spp_reference;
-    reference["mean_std_error"] = ref.mean_std_error;
-    reference["ms"] = ref.ms;
+    const nlohmann::json reference = reference_json(r.references[row.reference], r.spp_reference);
     const ErrorMetrics& e = row.metrics;
-    rows.push_back({{"method", row.method}, {"parameters", row.params}, {"ms", row.ms}, {"rmse", e.rmse}, {"psnr_db", e.psnr_db},
-                    {"ssim", e.ssim}, {"mean_signed_error", e.mean_signed}, {"max_abs_error", e.max_abs}, {"pixels", e.pixels},
-                    {"reference", reference}, {"stats", row.stats}});
-    if (row.gpu) rows.back()["gpu"] = gpu_run_json(*row.gpu);
+    nlohmann::json j = {{"method", row.method}, {"parameters", row.params}, {"ms", row.ms}, {"rmse", e.rmse}, {"psnr_db", e.psnr_db},
+                        {"ssim", e.ssim}, {"mean_signed_error", e.mean_signed}, {"max_abs_error", e.max_abs}, {"pixels", e.pixels},
+                        {"reference", reference}, {"stats", row.stats}};
+    if (r.common) j["common"] = metrics_json(row.common);
+    if (row.gpu) j["gpu"] = gpu_run_json(*row.gpu);
+    rows.push_back(std::move(j));
   }
-  nlohmann::json table{{"width", r.width},
-                       {"height", r.height},
-                       {"membership", to_string(r.falloff.membership)},
-                       {"radius", r.falloff.radius},
-                       {"seed", r.seed},
-                       {"spp_reference", r.spp_reference},
-                       {"rows", rows}};
+  nlohmann::json table = {{"width", r.width},        {"height", r.height},
+                          {"membership", to_string(r.falloff.membership)}, {"radius", r.falloff.radius},
+                          {"seed", r.seed},          {"spp_reference", r.spp_reference}};
+  if (r.common) table["common_reference"] = reference_json(r.references[*r.common], r.spp_reference);
+  table["rows"] = std::move(rows);
   if (r.device == Device::Gpu) table.update({{"device", "gpu"}, {"gl_renderer", r.gl_renderer}, {"gpu_upload_ms", r.gpu_upload_ms}});
   return shortest_floats(table);
 }
@@ -234,27 +267,28 @@ std::string compare_table_markdown(const CompareResult& r, const std::string& sc
   md << "# ao compare: " << scene_name << "\n\n"
      << r.width << "x" << r.height << ", R = " << format_value(shortest_floats(r.falloff.radius)) << " ("
      << to_string(r.falloff.membership) << " requested), reference " << r.spp_reference << " rays/pixel, seed " << r.seed
-     << ". Errors are over covered pixels, V units; mean signed error > 0: the method is brighter than its reference.\n\n"
-     << "| method | parameters | reference |";
+     << ". Errors are over covered pixels, V units; mean signed error > 0: the method is brighter than its reference.";
+  if (r.common)
+    md << " Each method is judged against the reference of the quantity it estimates (matched); the common columns judge every "
+       << "method against one reference, " << reference_text(r.references[*r.common].spec) << ", so that rows can be ranked.";
+  md << "\n\n| method | parameters | reference |";
   for (const char* title : kMetricTitles) md << (gpu ? std::string(" ") + title + " cpu | " + title + " gpu |" : std::string(" ") + title + " |");
-  md << "\n|---|---|---|";
-  for (std::size_t i = 0; i < kMetricTitles.size() * (gpu ? 2 : 1); ++i) md << "---:|";
+  md << (r.common ? " RMSE (common) | mean signed (common) |" : "") << "\n|---|---|---|";
+  for (std::size_t i = 0; i < kMetricTitles.size() * (gpu ? 2 : 1) + (r.common ? 2 : 0); ++i) md << "---:|";
   md << "\n";
   for (const CompareRow& row : r.rows) {
     std::string params;
     for (const auto& [k, v] : row.params.items()) params += (params.empty() ? "" : ", ") + k + "=" + format_value(v);
-    const ReferenceSpec& spec = r.references[row.reference].spec;
-    std::string ref = spec.label() + ", R = " + format_value(shortest_floats(spec.falloff.radius));
-    if (spec.kind != ReferenceKind::TangentSphere && spec.falloff.membership == Membership::Alchemy)
-      ref += ", u = " + fixed(spec.falloff.effective_alchemy_u(), 4);
-    md << "| " << row.method << " | " << params << " | " << ref << " |";
+    md << "| " << row.method << " | " << params << " | " << reference_text(r.references[row.reference].spec) << " |";
     for (const std::string& cell : metric_cells(row)) md << " " << cell << " |";
+    if (r.common) md << " " << fixed(row.common.rmse, 4) << " | " << fixed(row.common.mean_signed, 4) << " |";
     md << "\n";
   }
   if (gpu) {
     md << gpu_markdown_notes(r);
   } else {
-    md << "\n`sheet.png`: one row per method in the order above, labelled with its name, its reference and its RMSE; columns: the "
+    md << "\n`sheet.png`: one row per method in the order above, labelled with its name, its parameters, its reference and its RMSE"
+       << (r.common ? " (and against the common reference)" : "") << "; columns: the "
        << "method's V, the reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at "
        << "|error| = " << kCompareHeatRange << "; grey: background).\n";
   }
@@ -264,8 +298,10 @@ std::string compare_table_markdown(const CompareResult& r, const std::string& sc
 nlohmann::json compare_sweep_json(const CompareResult& r) {
   nlohmann::json rows = nlohmann::json::array();
   for (const SweepRow& s : r.sweep) {
-    rows.push_back({{"method", s.method}, {r.sweep_key, s.value}, {"rmse", s.rmse}, {"ms", s.ms}});
-    if (s.gpu) rows.back()["gpu"] = s.gpu->skipped.empty() ? nlohmann::json{{"rmse", s.gpu->metrics.rmse}, {"ms", s.gpu->ms}} : gpu_run_json(*s.gpu);
+    nlohmann::json row = {{"method", s.method}, {r.sweep_key, s.value}, {"rmse", s.rmse}, {"ms", s.ms}};
+    if (r.common) row["rmse_common"] = s.rmse_common;
+    if (s.gpu) row["gpu"] = s.gpu->skipped.empty() ? nlohmann::json{{"rmse", s.gpu->metrics.rmse}, {"ms", s.gpu->ms}} : gpu_run_json(*s.gpu);
+    rows.push_back(std::move(row));
   }
   return {{"key", r.sweep_key}, {"rows", rows}};
 }
@@ -273,13 +309,15 @@ nlohmann::json compare_sweep_json(const CompareResult& r) {
 std::string compare_sweep_markdown(const CompareResult& r) {
   const bool gpu = r.device == Device::Gpu;
   std::ostringstream s;
-  s << "# ao compare sweep: " << r.sweep_key << "\n\n| method | " << r.sweep_key
-    << (gpu ? " | RMSE cpu | RMSE gpu | ms cpu | ms gpu |\n|---|---:|---:|---:|---:|---:|\n" : " | RMSE | ms |\n|---|---:|---:|---:|\n");
+  s << "# ao compare sweep: " << r.sweep_key << "\n\n| method | " << r.sweep_key << (gpu ? " | RMSE cpu | RMSE gpu |" : " | RMSE |")
+    << (r.common ? " RMSE (common) |" : "") << (gpu ? " ms cpu | ms gpu |" : " ms |") << "\n|---|---:|---:|" << (gpu ? "---:|" : "")
+    << (r.common ? "---:|" : "") << (gpu ? "---:|---:|" : "---:|") << "\n";
   for (const SweepRow& row : r.sweep) {
     const bool ran = row.gpu && row.gpu->skipped.empty();
-    s << "| " << row.method << " | " << format_value(row.value) << " | " << fixed(row.rmse, 4) << " | ";
-    if (gpu) s << (ran ? fixed(row.gpu->metrics.rmse, 4) : "-") << " | ";
-    s << fixed(row.ms, 1) << " |";
+    s << "| " << row.method << " | " << format_value(row.value) << " | " << fixed(row.rmse, 4) << " |";
+    if (gpu) s << " " << (ran ? fixed(row.gpu->metrics.rmse, 4) : "-") << " |";
+    if (r.common) s << " " << fixed(row.rmse_common, 4) << " |";
+    s << " " << fixed(row.ms, 1) << " |";
     if (gpu) s << " " << (ran ? fixed(row.gpu->ms, 1) : "-") << " |";
     s << "\n";
   }

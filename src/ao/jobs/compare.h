@@ -41,6 +41,11 @@ struct CompareSettings {
   /// Reference per method by name (choose_reference: "matched", "obscurance", "tangent-sphere",
   /// "transfer"); the key "" applies to every method without its own entry. Default "matched".
   std::map<std::string, std::string> references;
+  /// The reference every row is also judged against, so that rows can be ranked: a kind's name
+  /// ("obscurance": the requested falloff's obscurance, step at R by default; "transfer";
+  /// "tangent-sphere"), at the requested falloff and never at a method's own; "none" leaves the
+  /// column out. A method whose matched reference is the same image shares it.
+  std::string common_reference = "obscurance";
   Falloff falloff;                   ///< R and membership requested (methods may imply their own).
   int spp_reference = 256;           ///< Rays per pixel of the references, [1, 1048576].
   std::uint32_t seed = 1;            ///< Methods use it; references use seed + 1.
@@ -83,6 +88,7 @@ struct CompareRow {
   std::size_t reference = 0;   ///< Index into CompareResult::references.
   double ms = 0;               ///< The method's run time.
   ErrorMetrics metrics;        ///< Over covered pixels.
+  ErrorMetrics common;         ///< Against CompareResult::common (when it has one), over covered pixels.
   nlohmann::json stats;        ///< MethodOutput::stats.
   Image<float> visibility;     ///< The method's V.
   Image<Vec3> heat;            ///< signed_error_heat_map(V, reference, coverage, kCompareHeatRange).
@@ -93,6 +99,7 @@ struct SweepRow {
   std::string method;
   nlohmann::json value;  ///< Of CompareResult::sweep_key.
   double rmse = 0;
+  double rmse_common = 0;  ///< Against CompareResult::common; 0 when there is none.
   double ms = 0;
   std::optional<CompareGpuRun> gpu;  ///< With CompareSettings::device gpu; its images are not kept.
 };
@@ -100,6 +107,7 @@ struct SweepRow {
 struct CompareResult {
   std::vector<CompareRow> rows;          ///< In the order of CompareSettings::methods.
   std::vector<CompareReference> references;
+  std::optional<std::size_t> common;     ///< Index into references of the common reference; none when "none".
   std::string sweep_key;
   std::vector<SweepRow> sweep;
   Falloff falloff;                       ///< As requested.
@@ -123,13 +131,19 @@ CompareSettings resolve_compare_settings(const CompareSettings& settings);
 CompareResult compare_methods(const RayScene& scene, const GBuffer& gbuffer, const AnalyticSurfaces* surfaces, const CompareSettings& settings,
                               GpuDevice* gpu = nullptr);
 
+/// The common reference of `settings` at the requested falloff; nullopt for "none"; InputError
+/// naming --common-reference for an unknown name.
+std::optional<ReferenceSpec> common_reference_spec(const CompareSettings& settings);
+
 /// table.json's content: {"width", "height", "membership", "radius", "seed", "spp_reference",
+/// "common_reference": {kind, label, membership, radius, mean_std_error, ms} (absent for "none"),
 /// "rows": [{"method", "parameters", "ms", "rmse", "psnr_db", "ssim", "mean_signed_error",
 /// "max_abs_error", "pixels", "reference": {kind, label, membership, radius, spp, mean_std_error,
-/// ms, ...}, "stats"}]}; the caller adds what it knows (scene, camera, timings). With the GPU
-/// backend also "device": "gpu", "gl_renderer", "gpu_upload_ms", and per row "gpu": {"ms", "rmse",
-/// "psnr_db", "ssim", "mean_signed_error", "max_abs_error", "pixels", "max_abs_difference_from_cpu",
-/// "passes": [{"name", "ms"}], "stats"} or {"skipped": why}.
+/// ms, ...}, "common": {rmse, psnr_db, ssim, mean_signed_error, max_abs_error}, "stats"}]}; the
+/// caller adds what it knows (scene, camera, timings). With the GPU backend also "device": "gpu",
+/// "gl_renderer", "gpu_upload_ms", and per row "gpu": {"ms", "rmse", "psnr_db", "ssim",
+/// "mean_signed_error", "max_abs_error", "pixels", "max_abs_difference_from_cpu", "passes":
+/// [{"name", "ms"}], "stats"} or {"skipped": why} (judged against the row's matched reference).
 nlohmann::json compare_table_json(const CompareResult& result);
 /// table.md: a title line naming `scene_name`, the settings, and one row per method.
 std::string compare_table_markdown(const CompareResult& result, const std::string& scene_name);

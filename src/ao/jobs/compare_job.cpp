@@ -62,6 +62,8 @@ Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, c
     label.push_back("reference: " + result.references[row.reference].spec.label());
     label.push_back("RMSE " + fixed4(row.metrics.rmse));  // as in table.md
     if (row.gpu && row.gpu->skipped.empty()) label.back() = "RMSE cpu " + fixed4(row.metrics.rmse) + ", gpu " + fixed4(row.gpu->metrics.rmse);
+    if (result.common && *result.common != row.reference)
+      label.push_back("vs " + result.references[*result.common].spec.label() + ": " + fixed4(row.common.rmse));
     rows.push_back({sheet_cells(result, row), std::move(label)});
   }
   std::string font_error;
@@ -124,7 +126,10 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   // Methods report problems they worked around (e.g. cone: open meshes).
   for (const CompareRow& row : out.result.rows)
     if (row.stats.contains("warnings"))
-      for (const auto& w : row.stats["warnings"]) reporter.warn(row.method + ": " + w.get<std::string>());
+      for (const auto& w : row.stats["warnings"]) {
+        const std::string text = w.get<std::string>(), prefix = row.method + ": ";
+        reporter.warn(text.rfind(prefix, 0) == 0 ? text : prefix + text);  // named once
+      }
   out.scene = scene->name;
   out.table = compare_table_json(out.result);
   out.table["scene"] = scene->name;

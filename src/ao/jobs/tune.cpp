@@ -27,13 +27,20 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
   if (!(s.time_budget_s > 0)) throw InputError("tune: the time budget must be > 0 seconds");
   if (!(s.min_step > 0 && s.min_step < 1)) throw InputError("tune: min_step must be in (0, 1)");
   nlohmann::json current = s.start.is_null() ? m.default_params() : s.start;
+  // A value a preset leaves unset starts where the method has it (Alchemy's intensity 0.4 at the
+  // fitted preset), so the start does not depend on the range asked for.
+  const nlohmann::json resolved = m.resolve_presets ? m.resolve_presets(current) : current;
   for (const TuneParameter& p : s.parameters) {
     if (!current.contains(p.key)) throw InputError("tune: method " + s.method + " has no parameter '" + p.key + "'");
-    // An optional number left unset ("the preset's value") starts at the middle of its range.
-    if (current.at(p.key).is_null()) current[p.key] = 0.5 * (p.lo + p.hi);
-    if (!current.at(p.key).is_number()) throw InputError("tune: parameter '" + p.key + "' of " + s.method + " is not a number");
     if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
       throw InputError("tune: the range of '" + p.key + "' must be finite with lo < hi");
+    if (current.at(p.key).is_null()) current[p.key] = resolved.value(p.key, nlohmann::json());
+    if (current.at(p.key).is_null()) current[p.key] = 0.5 * (p.lo + p.hi);  // no preset gives it a value
+    if (!current.at(p.key).is_number()) throw InputError("tune: parameter '" + p.key + "' of " + s.method + " is not a number");
+    // A start outside the range begins at its nearest end.
+    const double x = current.at(p.key).get<double>();
+    if (x < p.lo || x > p.hi) current[p.key] = shortest_floats(nlohmann::json(static_cast<float>(std::clamp(x, p.lo, p.hi))));
+    if (p.integer) current[p.key] = static_cast<long long>(std::llround(current.at(p.key).get<double>()));
   }
 
   TuneResult r;
@@ -90,6 +97,10 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
     }
   }
   r.params = shortest_floats(current);
+  for (const TuneParameter& p : s.parameters) {
+    const double x = r.params.at(p.key).get<double>();
+    if (x <= p.lo || x >= p.hi) r.on_bound.push_back(p.key);
+  }
   r.best_rmse = best;
   r.seconds = seconds();
   return r;
@@ -157,8 +168,8 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
     auto l = std::make_unique<Loaded>();
     l->scene = std::make_unique<PreparedScene>(SceneSource{.args = {name}}.load(), "ao tune", BvhOptions{});
     const Scene& scene = *l->scene->scene;
-    l->g = render_gbuffer(*l->scene->rays, choose_camera(scene, r.camera));
-    const Falloff f = choose_falloff(r.falloff, scene.bounds().diagonal());
+    l->g = render_gbuffer(*l->scene->rays, choose_camera(scene, r.camera), GBufferOptions{.normal = r.normal});
+    const Falloff f = choose_falloff(r.falloff, interest_diagonal(scene));  // R as ao render and ao compare choose it
     Image<float> ref = render_reference(*l->scene->rays, l->g, m.reference(f, start), {.samples = r.spp_reference}, r.seed + 1,
                                         reporter.start("reference (" + name + ")"))
                            .scalar.visibility;
@@ -168,10 +179,16 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
   settings.log = reporter.note;
   TuneJobResult out;
   out.tune = tune_method(views, settings);
+  for (const std::string& key : out.tune.on_bound) {
+    const TuneParameter& p = *std::find_if(settings.parameters.begin(), settings.parameters.end(), [&](const TuneParameter& q) { return q.key == key; });
+    const bool low = out.tune.params.at(key).get<double>() <= p.lo;
+    reporter.warn(key + " = " + format_value(out.tune.params.at(key)) + " is the " + (low ? "lower" : "upper") + " end of its range " + number(p.lo) +
+                  ":" + number(p.hi) + "; the best value may lie beyond it: widen --fit " + key + "=lo:hi if the parameter's valid range allows");
+  }
   const int width = r.camera.width.value_or(r.camera.default_width), height = r.camera.height.value_or(r.camera.default_height);
   out.file = {{"method", r.method},       {"parameters", out.tune.params}, {"start_rmse", out.tune.start_rmse}, {"best_rmse", out.tune.best_rmse},
               {"evaluations", out.tune.evaluations}, {"seconds", out.tune.seconds}, {"scenes", r.scenes},
-              {"width", width},           {"height", height}};
+              {"width", width},           {"height", height}, {"on_bound", out.tune.on_bound}};
   if (!r.output.empty())
     write_file_atomically(r.output, [&](const std::filesystem::path& temp) {
       std::ofstream file(temp, std::ios::binary);

@@ -44,7 +44,10 @@ struct TuneView {
 
 struct TuneSettings {
   std::string method;                    ///< Registry name.
-  nlohmann::json start;                  ///< Complete parameters to start from (default_params() when null).
+  /// Complete parameters to start from (default_params() when null). A fitted value left null
+  /// starts where the method's preset puts it (MethodInfo::resolve_presets), else mid-range; a
+  /// start outside [lo, hi] at its nearest end.
+  nlohmann::json start;
   std::vector<TuneParameter> parameters; ///< At least one; keys the method has, numeric values.
   double time_budget_s = 60;             ///< Stops after the first evaluation past this, seconds, > 0.
   double min_step = 1e-3;                ///< Stops when every step is below this fraction of its range, (0, 1).
@@ -57,6 +60,8 @@ struct TuneResult {
   double start_rmse = 0;     ///< Mean RMSE over the views at the start.
   double best_rmse = 0;      ///< At `params`.
   int evaluations = 0;       ///< Method runs over all views.
+  /// The fitted parameters that ended at an end of their range: the best value may lie beyond it.
+  std::vector<std::string> on_bound;
   double seconds = 0;
 };
 
@@ -84,6 +89,7 @@ struct TuneRequest {
   int spp_reference = 256;                         ///< Rays per pixel of the references, [1, 1048576].
   CameraRequest camera{.default_width = 320, .default_height = 180};
   FalloffRequest falloff;
+  SurfaceNormal normal = SurfaceNormal::Shading;  ///< The G-buffer's N, for the method and its reference.
   std::uint32_t seed = 1;
   std::filesystem::path output;                    ///< The parameter file (JSON; `ao render -p @FILE`); empty: not written.
 };

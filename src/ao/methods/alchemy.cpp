@@ -110,12 +110,7 @@ AlchemyConstants alchemy_constants(const AlchemyParams& p, float default_radius)
 }
 
 Falloff alchemy_reference_falloff(const AlchemyParams& p, float default_radius) {
-  const AlchemyConstants k = alchemy_constants(p, default_radius);
-  Falloff f{Membership::Alchemy, k.radius};
-  // u = sigma in world units; an intensity of 0 means no obscurance at all, which u -> 0 reproduces
-  // (the smallest positive float keeps 0 from selecting the membership's default of 2R).
-  f.alchemy_u = std::max(k.sigma, std::numeric_limits<float>::min());
-  return f;
+  return Falloff{Membership::Step, alchemy_constants(p, default_radius).radius};
 }
 
 AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float default_radius, std::uint32_t seed, const ProgressFn& progress) {

@@ -16,12 +16,12 @@
 #include "ao/methods/bilateral.h"
 #include "ao/methods/cone_kernel_internal.h"
 #include "ao/methods/cone_pattern_internal.h"
+#include "ao/methods/cone_sides_internal.h"
 
 namespace ao {
 
 namespace {
 
-using cone_internal::faces_inside;
 using cone_internal::kOpaque;
 using cone_internal::kTile;
 using cone_internal::solid_length;
@@ -42,18 +42,6 @@ struct EyeSampler {
     const int i = std::clamp(static_cast<int>(fx), 0, g.nx - 1), j = std::clamp(static_cast<int>(fy), 0, g.ny - 1);
     const float width = depth * std::max(1.0f / std::abs(sx), 1.0f / std::abs(sy));
     return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
-  }
-
-  // The voxel at camera-space point c (false outside the grid).
-  bool solid_at(Vec3 c) const {
-    const float depth = -c.z;
-    if (!(depth > 0)) return false;
-    const float fx = c.x / depth * sx + ox, fy = c.y / depth * sy + oy;
-    if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.nx) && fy < static_cast<float>(g.ny))) return false;
-    const std::size_t col = static_cast<std::size_t>(static_cast<int>(fy)) * g.nx + static_cast<int>(fx);
-    const float k = (depth - g.z_near[col]) * g.voxels_per_unit[col];
-    if (!(k >= 0.0f && k < static_cast<float>(g.depth_bits))) return false;
-    return g.voxel(static_cast<int>(fx), static_cast<int>(fy), static_cast<int>(k));
   }
 
   // centre in camera space; the prisms run along the camera's z (the grid's columns are view rays:
@@ -103,14 +91,12 @@ void chain_spheres(const ConeSetup& setup, float r_max, float near, float chain_
 
 // Front-to-back along one cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed fraction
 // f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
-// `inside`: a surface point facing into the winding-number solid counts the complement.
 template <class Fraction>
-float transmittance(const ChainSphere* chain, int n, bool inside, Fraction&& fraction) {
+float transmittance(const ChainSphere* chain, int n, Fraction&& fraction) {
   float t = 1.0f;
   for (int k = 0; k < n && t > kOpaque; ++k) {
     if (!chain[k].used) continue;
-    const float f = fraction(k);
-    t *= inside ? f : 1.0f - f;
+    t *= 1.0f - fraction(k);
   }
   return t;
 }
@@ -133,7 +119,6 @@ void trace_eye(const GBuffer& gb, const EyeSampler& sample, float r_max, const C
         const Vec3 pos = gb.position(x, y), n = gb.normal(x, y);
         const Frame frame = Frame::from_normal(n);
         const float near = sample.near_limit(pos);
-        const bool inside = faces_inside(gb, sample, x, y, pos, n, near);
         const int slot = pat.slot(x, y);
         const float rot_c = pat.rot[2 * slot], rot_s = pat.rot[2 * slot + 1];
         float v = 0;
@@ -141,8 +126,7 @@ void trace_eye(const GBuffer& gb, const EyeSampler& sample, float r_max, const C
           const ConePattern::Cone& cone = pat.cone[static_cast<std::size_t>(slot) * nc + c];
           chain_spheres(setup, r_max, near, cone.scale, chain.data());
           const Vec3 axis = frame.to_world({cone.x, cone.y, cone.z});
-          v += weight * transmittance(chain.data(), per_cone, inside,
-                                      [&](int k) { return sample(pos + axis * chain[k].distance, chain[k].k, chain[k].scale, rot_c, rot_s); });
+          v += weight * transmittance(chain.data(), per_cone, [&](int k) { return sample(pos + axis * chain[k].distance, chain[k].k, chain[k].scale, rot_c, rot_s); });
         }
         out(x, y) = std::clamp(v, 0.0f, 1.0f);
       }
@@ -189,7 +173,8 @@ const ParamTable<ConeParams>& cone_param_table() {
                                      "cone cells of equal cosine-weighted measure or of equal solid angle"),
        P::enumeration<OpenMeshes>("open_meshes", &ConeParams::open_meshes,
                                   {{"winding", OpenMeshes::Winding}, {"slab", OpenMeshes::Slab}, {"parity", OpenMeshes::Parity}},
-                                  "open meshes: the generalized-winding-number solid, slabs behind their front faces, or parity as the paper"),
+                                  "open meshes by their winding number: solids with holes where w > 1/2, sheets as slabs on their far side from each point; "
+                                  "slab: sheets as slabs behind their fronts; parity: as they are (the paper)"),
        P::real("slab_fraction", &ConeParams::slab_fraction, Range::open_closed(0, 16), "R_max", "thickness of the slab behind open meshes"),
        P::boolean("jitter", &ConeParams::jitter, "per pixel: random cone axes in their cells, sphere-chain scale, prism turn (noise instead of rings)"),
        P::integer("filter_taps", &ConeParams::filter_taps, Range::closed(1, 63), "", "taps per pass of the cross-bilateral filter on V, odd; 1 = no filter")}};
@@ -305,18 +290,47 @@ ConeParams checked_resolved(const ConeParams& params, float r_max) {
   return p;
 }
 
-VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max, VoxelStats* stats) {
-  return p.grid == GridSpace::World ? voxelize_world(scene, closure, p.voxelize_options(r_max), stats)
-                                    : voxelize_eye(scene, closure, gb, p.voxelize_options(r_max), stats);
+VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max, VoxelStats* stats,
+                   std::span<const std::uint8_t> back = {}, const Bounds3& region = {}) {
+  VoxelizeOptions o = p.voxelize_options(r_max);
+  o.slab_region = region;
+  return p.grid == GridSpace::World ? voxelize_world(scene, closure, o, stats, back) : voxelize_eye(scene, closure, gb, o, stats, back);
 }
 
-// The kernel and the filter on a built grid; `p` resolved and checked.
-void trace_and_filter(const GBuffer& gb, const VoxelGrid& g, float r_max, const ConeParams& p, std::uint32_t seed, const ProgressFn& progress,
-                      ConeResult& r) {
+// Where the pixels of side `key` can look: their points' box grown by 2 R_max (a slab R_max thick
+// reaches R_max past its face; a point's cones R_max). A grid for a few pixels (one side of a
+// small part of the scene) then leaves out the slabs that no cone of theirs can reach.
+Bounds3 side_region(const GBuffer& gb, const cone_internal::PixelSides& sides, std::size_t key, float r_max) {
+  Bounds3 b;
+  const Frame basis = gb.camera.basis();
+  for (std::size_t i = 0; i < sides.key_of.size(); ++i)
+    if (sides.key_of[i] == key && gb.covered(i)) b.extend(basis.to_world(gb.position[i]) + gb.camera.eye);
+  b.lo -= Vec3{2 * r_max, 2 * r_max, 2 * r_max};
+  b.hi += Vec3{2 * r_max, 2 * r_max, 2 * r_max};
+  return b;
+}
+
+// The kernel, on each side's grid over that side's pixels (one grid: all pixels at once), then
+// the filter over the whole image.
+void trace_and_filter(const GBuffer& gb, std::span<const VoxelGrid* const> grids, const cone_internal::PixelSides& sides, float r_max,
+                      const ConeParams& p, std::uint32_t seed, const ProgressFn& progress, ConeResult& r) {
   using Clock = std::chrono::steady_clock;
   const auto t1 = Clock::now();
   r.visibility = Image<float>(gb.width(), gb.height(), 1.0f);
-  compute_cone(gb, g, r_max, p, seed, r.visibility.view(), progress);
+  if (grids.size() == 1) {
+    compute_cone(gb, *grids[0], r_max, p, seed, r.visibility.view(), progress);
+  } else {
+    // Each pass sees only its pixels as covered; the kernel works per pixel, so the pixels of a
+    // pass come out as they would in one pass over a scene with that side's grid.
+    GBuffer part = gb;
+    Image<float> v(gb.width(), gb.height(), 1.0f);
+    for (std::size_t k = 0; k < grids.size(); ++k) {
+      for (std::size_t i = 0; i < part.object_id.size(); ++i) part.object_id[i] = sides.key_of[i] == k ? gb.object_id[i] : 0u;
+      compute_cone(part, *grids[k], r_max, p, seed, v.view(), k == 0 ? progress : ProgressFn{});
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (sides.key_of[i] == k && gb.covered(i)) r.visibility[i] = v[i];
+    }
+  }
   const auto t2 = Clock::now();
   if (p.filter_taps > 1) {
     BilateralParams f;
@@ -325,8 +339,23 @@ void trace_and_filter(const GBuffer& gb, const VoxelGrid& g, float r_max, const 
   }
   r.trace_ms = ms_between(t1, t2);
   r.filter_ms = ms_between(t2, Clock::now());
-  r.grid_nx = g.nx;
-  r.grid_ny = g.ny;
+  r.grid_nx = grids[0]->nx;
+  r.grid_ny = grids[0]->ny;
+  r.side_grids = static_cast<int>(grids.size());
+  for (std::size_t i = 0; i < sides.key_of.size(); ++i) r.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
+  r.unresolved_pixels = sides.unresolved;
+}
+
+std::vector<OpenMeshInfo> open_mesh_info(const Scene& scene, std::span<const MeshClosure> closure) {
+  std::vector<OpenMeshInfo> out;
+  for (std::size_t m = 0; m < closure.size(); ++m)
+    if (!closure[m].closed()) out.push_back({scene.meshes[m].name, closure[m].kind, closure[m].boundary_edges, closure[m].holes, closure[m].enclosure});
+  return out;
+}
+
+void add_grid_stats(ConeResult& r, const VoxelStats& s) {
+  r.voxel_stats.winding_evaluations += s.winding_evaluations;
+  r.voxel_stats.winding_voxels_changed += s.winding_voxels_changed;
 }
 
 }  // namespace
@@ -336,17 +365,33 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
   const ConeParams p = checked_resolved(params, r_max);
   ConeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  const VoxelGrid g = voxelize(scene, closure, gb, p, r_max, &r.voxel_stats);
-  r.voxelize_ms = ms_between(t0, std::chrono::steady_clock::now());
-  trace_and_filter(gb, g, r_max, p, seed, progress, r);
+  std::vector<VoxelGrid> grids;
+  grids.push_back(voxelize(scene, closure, gb, p, r_max, &r.voxel_stats));
+  const auto t1 = std::chrono::steady_clock::now();
+  const cone_internal::PixelSides sides = cone_internal::pixel_sides(
+      gb, scene, p.open_meshes == OpenMeshes::Winding ? cone_internal::make_side_setup(scene, closure, r_max) : cone_internal::SideSetup{}, grids[0]);
+  const auto t2 = std::chrono::steady_clock::now();
+  for (std::size_t k = 1; k < sides.keys.size(); ++k) {
+    VoxelStats s;
+    grids.push_back(voxelize(scene, closure, gb, p, r_max, &s, sides.keys[k], side_region(gb, sides, k, r_max)));
+    add_grid_stats(r, s);
+  }
+  r.voxelize_ms = ms_between(t0, t1) + ms_between(t2, std::chrono::steady_clock::now());
+  r.sides_ms = ms_between(t1, t2);
+  r.side_evaluations = sides.evaluations;
+  r.open_meshes = open_mesh_info(scene, closure);
+  r.open_mode = p.open_meshes;
+  std::vector<const VoxelGrid*> use;
+  for (const VoxelGrid& g : grids) use.push_back(&g);
+  trace_and_filter(gb, use, sides, r_max, p, seed, progress, r);
   return r;
 }
 
 ConeContext::ConeContext(const Scene& scene) : scene_(scene), closure_(analyze_closure(scene)) {}
 
 bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const VoxelizeOptions& o) const {
-  if (!valid_ || grid_.space != space || o.columns != options_.columns || o.depth_bits != options_.depth_bits ||
-      o.open_meshes != options_.open_meshes || o.slab_thickness != options_.slab_thickness)
+  if (!valid_ || space != space_ || o.columns != options_.columns || o.depth_bits != options_.depth_bits || o.open_meshes != options_.open_meshes ||
+      o.slab_thickness != options_.slab_thickness)
     return false;
   if (space == GridSpace::World) return true;
   const Camera& c = gb.camera;
@@ -362,12 +407,12 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
   const ConeParams p = checked_resolved(params, r_max);
   const VoxelizeOptions options = p.voxelize_options(r_max);
   ConeResult r;
-  const auto t0 = std::chrono::steady_clock::now();
-  r.grid_reused = grid_is_current(gb, p.grid, options);
-  if (!r.grid_reused) {
-    valid_ = false;  // until the new grid is complete (a build that throws leaves none)
-    grid_ = voxelize(scene_, closure_, gb, p, r_max, &stats_);
+  const int builds_before = builds_;
+  if (!grid_is_current(gb, p.grid, options)) {
+    valid_ = false;  // until the inputs below are recorded (a build that throws leaves no grid)
+    grids_.clear();
     options_ = options;
+    space_ = p.grid;
     if (p.grid == GridSpace::Eye) {
       camera_ = gb.camera;
       depth_.resize(gb.object_id.size());
@@ -375,13 +420,61 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
       for (std::size_t i = 0; i < depth_.size(); ++i) depth_[i] = gb.depth(i), coverage_[i] = gb.covered(i) ? 1 : 0;
     }
     valid_ = true;
-    ++builds_;
-    r.voxelize_ms = ms_between(t0, std::chrono::steady_clock::now());
   }
-  r.voxel_stats = stats_;
-  trace_and_filter(gb, grid_, r_max, p, seed, progress, r);
+  double voxelize_ms = 0;
+  const auto grid_for = [&](const std::vector<std::uint8_t>& back) -> const CachedGrid& {
+    std::vector<std::uint32_t> key;  // the objects seen from their back
+    for (std::size_t o = 0; o < back.size(); ++o)
+      if (back[o]) key.push_back(static_cast<std::uint32_t>(o));
+    auto it = grids_.find(key);
+    if (it == grids_.end()) {
+      const auto t = std::chrono::steady_clock::now();
+      CachedGrid c;
+      c.grid = voxelize(scene_, closure_, gb, p, r_max, &c.stats, back);
+      it = grids_.emplace(key, std::move(c)).first;
+      ++builds_;
+      voxelize_ms += ms_between(t, std::chrono::steady_clock::now());
+    }
+    return it->second;
+  };
+  std::vector<const VoxelGrid*> use{&grid_for({}).grid};
+  r.voxel_stats = grid_for({}).stats;
+  const auto t1 = std::chrono::steady_clock::now();
+  if (p.open_meshes == OpenMeshes::Winding && (!sides_ || sides_->r_max != r_max))
+    sides_ = std::make_shared<cone_internal::SideSetup>(cone_internal::make_side_setup(scene_, closure_, r_max));
+  const cone_internal::PixelSides sides =
+      cone_internal::pixel_sides(gb, scene_, p.open_meshes == OpenMeshes::Winding ? *sides_ : cone_internal::SideSetup{}, *use[0]);
+  r.sides_ms = ms_between(t1, std::chrono::steady_clock::now());
+  for (std::size_t k = 1; k < sides.keys.size(); ++k) {
+    const CachedGrid& c = grid_for(sides.keys[k]);
+    use.push_back(&c.grid);
+    add_grid_stats(r, c.stats);
+  }
+  r.grid_reused = builds_ == builds_before;
+  r.voxelize_ms = voxelize_ms;
+  r.side_evaluations = sides.evaluations;
+  r.open_meshes = open_mesh_info(scene_, closure_);
+  r.open_mode = p.open_meshes;
+  trace_and_filter(gb, use, sides, r_max, p, seed, progress, r);
   return r;
 }
+
+namespace {
+
+const char* kind_name(MeshKind k) { return k == MeshKind::Closed ? "closed" : k == MeshKind::SolidWithHoles ? "solid with holes" : "sheet"; }
+
+// "a, b and 2 more": the names of the open meshes of one kind, for a warning.
+std::string names_of(const std::vector<OpenMeshInfo>& meshes, MeshKind kind) {
+  std::vector<std::string> n;
+  for (const OpenMeshInfo& m : meshes)
+    if (m.kind == kind) n.push_back(m.name.empty() ? "unnamed" : m.name);
+  std::string out;
+  for (std::size_t i = 0; i < n.size() && i < 3; ++i) out += (i ? ", " : "") + n[i];
+  if (n.size() > 3) out += " and " + std::to_string(n.size() - 3) + " more";
+  return out;
+}
+
+}  // namespace
 
 nlohmann::json cone_stats(const ConeResult& r) {
   const VoxelStats& v = r.voxel_stats;
@@ -389,13 +482,25 @@ nlohmann::json cone_stats(const ConeResult& r) {
   if (v.odd_columns > 0)
     warnings.push_back("cone: " + std::to_string(v.odd_columns) +
                        " voxel columns end with odd parity: the scene is not watertight there, voxels behind the leak are wrong");
-  if (v.open_meshes > 0)
-    warnings.push_back("cone: " + std::to_string(v.open_meshes) + " open surface(s) (" + std::to_string(v.boundary_edges) +
-                       " boundary edges in all meshes): filled as one-sided slabs behind their front faces");
+  const bool winding = r.open_mode == OpenMeshes::Winding;
+  if (v.open_meshes > 0 && r.open_mode != OpenMeshes::Parity)
+    warnings.push_back("cone: " + std::to_string(v.open_meshes) + " sheet(s) (" + names_of(r.open_meshes, MeshKind::Sheet) + "; " +
+                       std::to_string(v.boundary_edges) + " boundary edges in all meshes): " +
+                       (winding ? "two-sided, each a slab on its far side from the pixel (" + std::to_string(r.side_grids) + " grid(s), " +
+                                      std::to_string(r.back_pixels) + " pixels on a back side)"
+                                : std::string("filled as one-sided slabs behind their front faces")));
   if (v.holed_meshes > 0)
-    warnings.push_back("cone: " + std::to_string(v.holed_meshes) + " mesh(es) not closed (" + std::to_string(v.holes) + " hole(s)): " +
-                       (v.capped_meshes > 0 ? "solid taken where the generalized winding number exceeds 1/2 (holes closed by fans)"
-                                            : "voxelized by parity, wrong in the columns through the holes"));
+    warnings.push_back("cone: " + std::to_string(v.holed_meshes) + " solid(s) with holes (" + names_of(r.open_meshes, MeshKind::SolidWithHoles) +
+                       "; " + std::to_string(v.holes) + " hole(s)): " +
+                       (winding ? "solid where the generalized winding number exceeds 1/2 (holes closed by fans, w evaluated at " +
+                                      std::to_string(v.winding_evaluations) + " voxels next to holes that are not flat)"
+                                : std::string("voxelized by parity, wrong in the columns through the holes")));
+  if (r.unresolved_pixels > 0)
+    warnings.push_back("cone: " + std::to_string(r.unresolved_pixels) +
+                       " pixels lie on a side of the open meshes that got no grid of its own (over 8 sides, or too few pixels): traced as if in front of all");
+  nlohmann::json meshes = nlohmann::json::array();
+  for (const OpenMeshInfo& m : r.open_meshes)
+    meshes.push_back({{"name", m.name}, {"kind", kind_name(m.kind)}, {"boundary_edges", m.boundary_edges}, {"holes", m.holes}, {"enclosure", m.enclosure}});
   return {{"grid_columns", {r.grid_nx, r.grid_ny}},
           {"triangles_rasterised", v.triangles},
           {"fragments", v.fragments},
@@ -404,8 +509,16 @@ nlohmann::json cone_stats(const ConeResult& r) {
           {"boundary_edges", v.boundary_edges},
           {"holed_meshes", v.holed_meshes},
           {"holes", v.holes},
+          {"open_mesh_kinds", meshes},
+          {"winding_evaluations", v.winding_evaluations},
+          {"winding_voxels_changed", v.winding_voxels_changed},
+          {"side_grids", r.side_grids},
+          {"back_pixels", r.back_pixels},
+          {"side_evaluations", r.side_evaluations},
+          {"unresolved_pixels", r.unresolved_pixels},
           {"set_voxels", v.set_voxels},
           {"voxelize_ms", r.voxelize_ms},
+          {"sides_ms", r.sides_ms},
           {"trace_ms", r.trace_ms},
           {"filter_ms", r.filter_ms},
           {"grid_reused", r.grid_reused},

@@ -15,6 +15,8 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +29,10 @@
 #include "ao/methods/voxelize.h"
 
 namespace ao {
+
+namespace cone_internal {
+struct SideSetup;
+}
 
 /// The paper's quality settings (Table I).
 enum class ConeQuality { Low, Medium, High };
@@ -47,7 +53,7 @@ struct ConeParams {
   int columns = 512;         ///< Grid columns per side (world) or along the longer image side (eye). [8, 4096].
   GridSpace grid = GridSpace::World;               ///< "world" (default) or the paper's "eye".
   ConeWeighting weighting = ConeWeighting::Cosine; ///< "cosine" (default) or "uniform".
-  OpenMeshes open_meshes = OpenMeshes::Winding;    ///< "winding" (default), "slab" or "parity" (the paper); voxelize.h.
+  OpenMeshes open_meshes = OpenMeshes::Winding;    ///< "winding" (default: by what each mesh is), "slab" or "parity" (the paper); voxelize.h.
   float slab_fraction = 1.0f;  ///< Thickness of the slab behind open meshes, as a fraction of R_max. (0, 16].
   bool jitter = true;        ///< Per pixel: each cone's axis at a random point of its cell, a random scale of its
                              ///< sphere chain, a random turn of the prism pattern (noise instead of rings). false: the paper's fixed pattern.
@@ -101,16 +107,39 @@ ConeSetup derive_cone_setup(const ConeParams& resolved);
 void compute_cone(const GBuffer& gbuffer, const VoxelGrid& grid, float r_max, const ConeParams& params, std::uint32_t seed,
                   ImageView<float> visibility, const ProgressFn& progress = {});
 
+/// An open mesh of the scene and what analyze_closure took it for (voxelize.h, MeshKind).
+struct OpenMeshInfo {
+  std::string name;
+  MeshKind kind = MeshKind::Sheet;
+  std::size_t boundary_edges = 0;
+  std::uint32_t holes = 0;
+  float enclosure = 0;  ///< MeshClosure::enclosure.
+};
+
 struct ConeResult {
   Image<float> visibility;
-  VoxelStats voxel_stats;
-  double voxelize_ms = 0, trace_ms = 0, filter_ms = 0;
+  VoxelStats voxel_stats;  ///< Of the grid for the front of every object; winding_* summed over all grids.
+  double voxelize_ms = 0;  ///< Every grid built in the call.
+  double sides_ms = 0;     ///< Which side of the open meshes each pixel is on (open_meshes=winding).
+  double trace_ms = 0, filter_ms = 0;
   int grid_nx = 0, grid_ny = 0;
-  bool grid_reused = false;  ///< ConeContext: the grid of an earlier call was traced (no voxelization).
+  bool grid_reused = false;  ///< ConeContext: the grids of earlier calls were traced (no voxelization).
+  /// Grids traced: one per combination of sides of the open meshes that the pixels lie on
+  /// (voxelize.h: a sheet is a slab on the far side of it from the point), at most 8, each for at
+  /// least 32 pixels (or a thousandth of the covered ones, if fewer).
+  int side_grids = 1;
+  std::size_t back_pixels = 0;        ///< Covered pixels traced with a grid for the back side of an open mesh.
+  std::size_t unresolved_pixels = 0;  ///< Pixels whose sides got no grid (a ninth, or one for too few pixels): traced with the all-front one.
+  std::size_t side_evaluations = 0;   ///< Winding numbers evaluated per pixel to tell their sides.
+  std::vector<OpenMeshInfo> open_meshes;  ///< The scene's meshes that are not closed.
+  OpenMeshes open_mode = OpenMeshes::Winding;  ///< ConeParams::open_meshes of the call.
 };
 
 /// Voxelizes `scene` (rebuilt on every call: a dynamic-scene method), runs the kernel and the filter.
-/// `closure` comes from analyze_closure(scene) (topology, reusable across frames).
+/// `closure` comes from analyze_closure(scene) (reusable across frames while the scene stays).
+/// With open_meshes=winding each pixel is traced in the grid for the sides of the open meshes its
+/// point lies on (voxelize.h; at most 8 grids per call, usually one or two; cone_stats reports
+/// pixels left to the all-front grid).
 ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, float r_max, const ConeParams& params,
                        std::uint32_t seed, const ProgressFn& progress = {});
 
@@ -119,7 +148,8 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
 /// voxelizes every frame (a dynamic scene) and names building the grid once for static scenes as
 /// future work (sec. V); this is that. The grid is rebuilt only when what it depends on changes:
 ///  - world grid: the voxelization options (columns, depth_bits, open_meshes, and the slab
-///    thickness slab_fraction * R_max); the camera does not enter, so an orbiting view reuses it;
+///    thickness slab_fraction * R_max); the camera does not enter, so an orbiting view reuses it
+///    (and the grids for the back sides of open meshes, kept per combination of sides);
 ///  - eye grid (the paper's): also the G-buffer, whose camera lays out the columns and whose depths
 ///    give z_nearest (eq. 2); it is reused only while the camera and the depths stay the same.
 /// Every other parameter (cones, spheres, prisms, aperture, weighting, jitter, filter, seed) only
@@ -140,21 +170,27 @@ class ConeContext {
  private:
   bool grid_is_current(const GBuffer& gbuffer, GridSpace space, const VoxelizeOptions& options) const;
 
+  struct CachedGrid {
+    VoxelGrid grid;
+    VoxelStats stats;
+  };
   const Scene& scene_;
   std::vector<MeshClosure> closure_;
-  VoxelGrid grid_;
-  VoxelStats stats_;
-  bool valid_ = false;  // grid_ is complete and was built from the members below
+  std::map<std::vector<std::uint32_t>, CachedGrid> grids_;  // per set of objects seen from their back (voxelize.h, `back`)
+  std::shared_ptr<cone_internal::SideSetup> sides_;         // for sides_->r_max
+  bool valid_ = false;  // grids_ were built from the members below
   int builds_ = 0;
-  // What grid_ was built from.
+  // What grids_ were built from.
+  GridSpace space_ = GridSpace::World;
   VoxelizeOptions options_;
   Camera camera_;                     // eye grid only
   std::vector<float> depth_;          // eye grid only: the G-buffer's depth
   std::vector<std::uint8_t> coverage_;  // eye grid only
 };
 
-/// Numbers for --json: grid size, voxelization statistics, timings, and "warnings" (odd columns,
-/// open meshes thickened into slabs, meshes with holes), one line each, which the CLI prints.
+/// Numbers for --json: grid size, voxelization statistics, what each open mesh was taken for
+/// ("open_mesh_kinds"), the grids per side, timings, and "warnings" (odd columns, sheets, solids
+/// with holes, pixels beyond the grids of a frame), one line each, which the CLI prints.
 nlohmann::json cone_stats(const ConeResult& result);
 
 }  // namespace ao

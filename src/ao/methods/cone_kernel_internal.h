@@ -35,16 +35,6 @@ inline float solid_length(const std::uint64_t* col, int words, int nbits, float 
          bit(k1) * (zhi - static_cast<float>(k1));
 }
 
-// The inside of a holed mesh's shell, seen through a hole, faces into its winding-number solid
-// (voxelize.h); its occluders are the inside of the shell, so its cones count the complement of
-// the solid as occluded (1 - the obstructed fraction): a hollow inside.
-template <class Sampler>
-bool faces_inside(const GBuffer& gb, const Sampler& sample, int x, int y, Vec3 p, Vec3 n, float near) {
-  const std::uint32_t id = gb.object_id(x, y);
-  const std::vector<std::uint8_t>& capped = sample.g.capped;
-  return id > 0 && id <= capped.size() && capped[id - 1] && sample.solid_at(p + n * near);
-}
-
 // The kernel on a world grid (docs/methods/cone.md, Speed): V for every covered pixel of `gb`,
 // 1 elsewhere; `setup` and `pat` from derive_cone_setup and make_cone_pattern.
 void trace_world(const GBuffer& gb, const VoxelGrid& g, float r_max, const ConeSetup& setup, const ConePattern& pat, ImageView<float> out,

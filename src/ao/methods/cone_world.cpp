@@ -64,13 +64,6 @@ struct WorldSampler {
   // which the voxelized surface itself (its staircase on curved and slanted faces, and the surface
   // voxel whose centre is inside) fills them.
   float near_limit() const { return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}); }
-  // The voxel at world point p (false outside the grid).
-  bool solid_at(Vec3 p) const {
-    const float gx = (p.x - g.origin.x) * inv.x, gy = (p.z - g.origin.z) * inv.y, gz = (p.y - g.origin.y) * inv.z;
-    if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx < g.nx && gy < g.ny && gz < g.depth_bits)) return false;
-    return g.voxel(static_cast<int>(gx), static_cast<int>(gy), static_cast<int>(gz));
-  }
-
   // For spheres wider than the largest window: the OR of every block the sphere's box touches.
   bool maybe_solid_blocks(float gx, float gy, float gz, float rx, float ry, float rz) const {
     constexpr float kInvB = 1.0f / VoxelGrid::kBlock;
@@ -313,7 +306,6 @@ struct PixelSpheres {
   // The pixel, and its prism pattern turned (WorldSampler::turn).
   int x = 0, y = 0;
   float at_x = 0, at_y = 0, at_z = 0;  // the pixel's point in voxels
-  bool inside = false;
   std::vector<float> u, v;
   // Per cone (padded to a multiple of 8): chain scale and axis in voxels.
   std::vector<float> scale, ax, ay, az;
@@ -462,7 +454,6 @@ void trace_with(const GBuffer& gb, const WorldSampler& sample, float r_max, cons
   const int stride = lanes.padded;
 #endif
   const float weight = 1.0f / static_cast<float>(nc);  // every cone stands for a cell of equal measure
-  const float near = sample.near_limit();
   // Front to back along each cone (sec. III-C2, Fig. 8): each sphere absorbs its obstructed
   // fraction f of the rays that reach it, T *= 1 - f, until T <= kOpaque.
   const auto finish = [&](PixelSpheres& ps) {
@@ -482,18 +473,11 @@ void trace_with(const GBuffer& gb, const WorldSampler& sample, float r_max, cons
     for (int c = 0; c < nc; ++c) {
       float tr = 1.0f;
       const int i0 = c * stride;
-      if (!ps.inside) {
-        // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
-        // ones, in order (bit j: sphere j of the cone).
-        for (std::uint32_t m = PixelSpheres::bits(ps.pass, i0, per_cone); m && tr > kOpaque; m &= m - 1) {
-          const int j = std::countr_zero(m);
-          tr *= 1.0f - fraction(i0 + j, j);
-        }
-      } else {
-        // The inside of a shell counts the complement (faces_inside): T *= f, and an empty sphere
-        // (f = 0) closes the cone.
-        for (int j = 0; j < per_cone && tr > kOpaque; ++j)
-          if (PixelSpheres::bit(ps.used, i0 + j)) tr *= PixelSpheres::bit(ps.pass, i0 + j) ? fraction(i0 + j, j) : 0.0f;
+      // A sphere that failed the coarse test has f = 0 and leaves T as it is: only the passed
+      // ones, in order (bit j: sphere j of the cone).
+      for (std::uint32_t m = PixelSpheres::bits(ps.pass, i0, per_cone); m && tr > kOpaque; m &= m - 1) {
+        const int j = std::countr_zero(m);
+        tr *= 1.0f - fraction(i0 + j, j);
       }
       v += weight * tr;
     }
@@ -511,7 +495,6 @@ void trace_with(const GBuffer& gb, const WorldSampler& sample, float r_max, cons
         const Vec3 pos = basis.to_world(gb.position(x, y)) + eye, n = normalize(basis.to_world(gb.normal(x, y)));
         const Frame frame = Frame::from_normal(n);
         ps.x = x, ps.y = y;
-        ps.inside = faces_inside(gb, sample, x, y, pos, n, near);
         const int slot = pat.slot(x, y);
         sample.turn(pat.rot[2 * slot], pat.rot[2 * slot + 1], ps.u.data(), ps.v.data());
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512DQ__) && !defined(AO_NO_GATHER)

@@ -15,6 +15,8 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <mutex>
+#include <tuple>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -33,25 +35,111 @@ struct GridTri {
   float x[3], y[3], a[3];
   int j0, j1;  // rows whose centres the bounding box covers
   int fill;    // 0: parity fragment; +1 / -1: open-mesh slab filled towards larger / smaller k;
-               // 2: parity fragment of an open wall's prism (scratch grid)
+               // 2: fragment of an open wall's prism (listed, voxelize_into step 4); 3 + s: parity fragment
+               // of a fan closing a hole that is not flat, or of a triangle near it, of the solid with
+               // holes in slot s (recorded: the winding number is evaluated from there, step 3)
 };
 
 struct Tri3 {
   Vec3 v[3];
-  int kind;     // 0: parity; 1: open-mesh face, filled behind; 2: side of an open face's prism
-  Vec3 normal;  // geometric normal of the front face (counter-clockwise, mesh.h); set when kind 1
+  int kind;      // 0: parity; 1: open-mesh face, filled behind `normal`; 2: side of an open face's prism
+  Vec3 normal;   // kind 1: the side the slab is away from (the front's normal, or its opposite for
+                 // a grid traced from the back side, voxelize.h)
+  int fan = -1;  // kind 0: slot of the solid with holes whose non-flat hole this fan triangle closes,
+                 // or near which this triangle of it lies (Holes::near)
 };
 
-// The centroid of each hole's boundary vertices (each boundary edge contributes its two ends).
-std::vector<Vec3> hole_centroids(const Mesh& m, const MeshClosure& c) {
-  std::vector<Vec3> sum(c.holes, Vec3{0, 0, 0});
+// The centroid of each hole's boundary vertices (each boundary edge contributes its two ends), and
+// whether the hole is flat to the grid: its boundary within `flat` (world units: two voxels) of the
+// plane through the centroid normal to the fan's vector area. Off a flat fan |w_fan| < 1/2
+// (voxelize_world), so the parity of the mesh with its fans is its winding-number solid there;
+// within two voxels of a plane, the pocket between the fan and the surface w = 1/2 that spans the
+// hole lies in a sliver of that thickness along the plane (a scan's base cut through its
+// triangles zigzags by a triangle's height), which is left to parity.
+// `near` marks the mesh's triangles near the rim of a hole that is not flat: where the pocket
+// between that hole's fan and its spanning surface can meet the mesh.
+struct Holes {
+  std::vector<Vec3> centre;
+  std::vector<std::uint8_t> flat;
+  std::vector<std::uint8_t> near;  // per triangle
+};
+Holes hole_centroids(const Mesh& m, const MeshClosure& c, float flat) {
+  Holes h{std::vector<Vec3>(c.holes, Vec3{0, 0, 0}), std::vector<std::uint8_t>(c.holes, 1), std::vector<std::uint8_t>(m.triangle_count(), 0)};
   std::vector<float> n(c.holes, 0.0f);
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    sum[c.hole[e]] = sum[c.hole[e]] + m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
+    h.centre[c.hole[e]] += m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
     n[c.hole[e]] += 2.0f;
   }
-  for (std::uint32_t h = 0; h < c.holes; ++h) sum[h] = sum[h] * (1.0f / n[h]);
-  return sum;
+  for (std::uint32_t k = 0; k < c.holes; ++k) h.centre[k] = h.centre[k] * (1.0f / n[k]);
+  std::vector<Vec3> area(c.holes, Vec3{0, 0, 0});
+  std::vector<Bounds3> box(c.holes);
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const Vec3 o = h.centre[c.hole[e]];
+    area[c.hole[e]] += cross(m.positions[c.boundary[e][1]] - o, m.positions[c.boundary[e][0]] - o);
+    box[c.hole[e]].extend(m.positions[c.boundary[e][0]]);
+  }
+  const float extent = m.bounds().diagonal(), tol = flat, pad = 0.01f * extent;
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const std::uint32_t k = c.hole[e];
+    const Vec3 nk = normalize(area[k]);
+    for (int end = 0; end < 2; ++end)
+      if (!(std::abs(dot(nk, m.positions[c.boundary[e][end]] - h.centre[k])) <= tol)) h.flat[k] = 0;
+  }
+  // Near a hole: within its rim's deviation from its plane (how far the pocket reaches from the
+  // rim) plus 1% of the mesh's extent of one of its rim vertices.
+  std::vector<float> deviation(c.holes, 0.0f);
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const std::uint32_t k = c.hole[e];
+    deviation[k] = std::max(deviation[k], std::abs(dot(normalize(area[k]), m.positions[c.boundary[e][0]] - h.centre[k])));
+  }
+  for (std::uint32_t k = 0; k < c.holes; ++k) {
+    if (h.flat[k]) continue;
+    const float reach = deviation[k] + pad;
+    const Vec3 lo = box[k].lo - Vec3{reach, reach, reach}, hi = box[k].hi + Vec3{reach, reach, reach};
+    for (std::size_t t = 0; t < m.triangle_count(); ++t)
+      for (int v = 0; v < 3 && !h.near[t]; ++v) {
+        const Vec3 p = m.positions[m.indices[3 * t + v]];
+        if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
+        for (std::size_t e = 0; e < c.boundary.size() && !h.near[t]; ++e)
+          if (c.hole[e] == k && length(p - m.positions[c.boundary[e][0]]) <= reach) h.near[t] = 1;
+      }
+  }
+  return h;
+}
+
+// The winding number w_C of one mesh's fans (the triangles (b, a, centroid) over its boundary
+// edges a -> b), summed exactly with Van Oosterom and Strackee's formula (winding_number.h): fan
+// triangles are slivers from the rim to the centroid, which a hierarchy cannot group. The rim's
+// vertices are shared by two edges each, so their offsets and lengths are computed once per point.
+struct FanWinding {
+  std::vector<Vec3> vertex;                      // rim vertices, then the holes' centroids
+  std::vector<std::array<std::uint32_t, 3>> tri;  // (b, a, centroid) into `vertex`
+  double operator()(Vec3 q, std::vector<Vec3>& r, std::vector<float>& len) const {
+    r.resize(vertex.size());
+    len.resize(vertex.size());
+    for (std::size_t v = 0; v < vertex.size(); ++v) r[v] = vertex[v] - q, len[v] = length(r[v]);
+    double sum = 0;
+    for (const auto& [b, a, c] : tri) {
+      const float det = dot(r[b], cross(r[a], r[c]));
+      if (det == 0.0f) continue;  // q in the triangle's plane: 0 (winding_number.cpp)
+      const float den = len[b] * len[a] * len[c] + dot(r[b], r[a]) * len[c] + dot(r[b], r[c]) * len[a] + dot(r[a], r[c]) * len[b];
+      sum += std::atan2(det, den);
+    }
+    return sum * (2.0 / (4.0 * 3.14159265358979323846));
+  }
+};
+FanWinding fan_winding(const Mesh& m, const MeshClosure& c, const Holes& h) {
+  FanWinding f;
+  std::vector<std::uint32_t> slot(m.positions.size(), ~0u);
+  const auto at = [&](std::uint32_t v) {
+    if (slot[v] == ~0u) slot[v] = static_cast<std::uint32_t>(f.vertex.size()), f.vertex.push_back(m.positions[v]);
+    return slot[v];
+  };
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) f.tri.push_back({at(c.boundary[e][1]), at(c.boundary[e][0]), 0});
+  const std::uint32_t first_centre = static_cast<std::uint32_t>(f.vertex.size());
+  f.vertex.insert(f.vertex.end(), h.centre.begin(), h.centre.end());
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) f.tri[e][2] = first_centre + c.hole[e];
+  return f;
 }
 
 Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
@@ -61,12 +149,16 @@ Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
 
 // An open face steep to the columns (a wall, for the world grid) has few or no fragments: a span
 // along the column cannot stand for it. It becomes the closed prism between it and its copy
-// moved `thickness` behind its front face, voxelized by parity in a scratch grid (kind 2) that is
-// ORed into the grid. Calls emit for the prism's 8 triangles.
+// moved `thickness` behind `normal` (kind 2), whose triangles face out of it; their union is
+// ORed into the grid (voxelize_into, step 4). Calls emit for the prism's 8 triangles.
 template <class Emit>
 void emit_prism(const Tri3& t, float thickness, Emit&& emit) {
   const Vec3 o = t.normal * -thickness;
-  const Vec3 top[3] = {t.v[0], t.v[1], t.v[2]}, bottom[3] = {t.v[0] + o, t.v[1] + o, t.v[2] + o};
+  // The top (the face itself) faces out when its counter-clockwise normal is `normal`; otherwise
+  // (a slab in front of a face) its vertices are taken in the other order.
+  const bool out = dot(cross(t.v[1] - t.v[0], t.v[2] - t.v[0]), t.normal) >= 0;
+  const Vec3 a = t.v[0], b = out ? t.v[1] : t.v[2], c = out ? t.v[2] : t.v[1];
+  const Vec3 top[3] = {a, b, c}, bottom[3] = {a + o, b + o, c + o};
   emit(Tri3{{top[0], top[1], top[2]}, 2, {}});
   emit(Tri3{{bottom[0], bottom[2], bottom[1]}, 2, {}});
   for (int e = 0; e < 3; ++e) {
@@ -123,7 +215,7 @@ void emit_world(std::vector<GridTri>& out, const Tri3& t, const WorldMap& m, int
   GridTri& g = out.emplace_back();
   for (int k = 0; k < 3; ++k) m(t.v[k], g.x[k], g.y[k], g.a[k]);
   // Behind the front face: below a face looking up (+y is +k), above a face looking down.
-  g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : 0;
+  g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : t.fan >= 0 ? 3 + t.fan : 0;
   if (!finish_visible(g, nx, ny)) out.pop_back();
 }
 
@@ -145,7 +237,7 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
   }
   if (n < 3) return;
   // Behind the front face: deeper for a face turned to the eye, nearer for one turned away.
-  const int fill = t.kind == 1 ? (facing < 0 ? 1 : -1) : t.kind == 2 ? 2 : 0;
+  const int fill = t.kind == 1 ? (facing < 0 ? 1 : -1) : t.kind == 2 ? 2 : t.fan >= 0 ? 3 + t.fan : 0;
   float x[4], y[4], a[4];
   for (int k = 0; k < n; ++k) {
     const float inv = 1.0f / -poly[k].z;
@@ -184,11 +276,35 @@ inline void set_bits(std::uint64_t* col, int nbits, int b0, int b1) {
   }
 }
 
+// A fragment listed rather than toggled: column (i, j), the first voxel beyond it, and the slot of
+// the solid with holes whose fan (or triangle near a hole) it belongs to.
+struct ColumnHit {
+  int i, j, k, tag;
+};
+
+// One band of rows' prism faces: per voxel of its columns, how many prisms are entered there minus
+// how many are left (prisms face out, so a face's side is the sign of its area in grid space);
+// a column is zeroed when first crossed.
+struct PrismCounts {
+  int r0 = 0, nx = 0, nbits = 0;
+  std::unique_ptr<std::int16_t[]> delta;  // (j - r0, i, k)
+  std::vector<std::uint8_t> touched;      // (j - r0, i)
+  void add(int i, int j, int k, int sign) {
+    const std::size_t c = static_cast<std::size_t>(j - r0) * nx + i;
+    std::int16_t* d = delta.get() + c * nbits;
+    if (!touched[c]) touched[c] = 1, std::fill_n(d, nbits, std::int16_t{0});
+    d[k] = static_cast<std::int16_t>(d[k] + sign);
+  }
+};
+
 // Rasterises one triangle's rows [r0, r1]. A parity fragment toggles one bit (XOR to the end after
-// the scan); a slab fragment of an open mesh ORs the voxels within `slab` (world units) behind it.
-// Returns fragments.
-template <bool kPerspective>
-std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab) {
+// the scan), and is listed in `hits` when it belongs to a fan over a hole that is not flat; a slab
+// fragment of an open mesh ORs the voxels within `slab` (world units) behind it; a prism's fragment
+// is counted in `prisms`. Returns fragments.
+// kListed: the triangle's fragments are listed (fill 2 or >= 3), a separate instantiation so that
+// the plain parity loop carries no test for it.
+template <bool kPerspective, bool kListed>
+std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab, std::vector<ColumnHit>& hits, PrismCounts* prisms) {
   const double x0 = t.x[0], y0 = t.y[0];
   const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
   if (area2 == 0) return 0;  // edge-on: no column centre lies inside
@@ -233,8 +349,15 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
       const double first = std::ceil(k - 0.5);
       if (first >= nbits) continue;
       const int b = first <= 0 ? 0 : static_cast<int>(first);
-      row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
       ++fragments;
+      if constexpr (kListed) {
+        if (t.fill == 2) {
+          prisms->add(i, j, b, area2 > 0 ? 1 : -1);
+          continue;
+        }
+        hits.push_back({i, j, b, t.fill - 3});
+      }
+      row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
     }
   }
   return fragments;
@@ -369,138 +492,394 @@ std::size_t build_coarse(VoxelGrid& g) {
   return set;
 }
 
-// Stages 1-3 for any grid whose geometry fields are set; `emit` maps one Tri3 into a vector.
-template <bool kPerspective, class Emit>
-void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, float slab_thickness,
-                   Emit&& emit, VoxelStats* stats) {
+// How one object is voxelized (voxelize.h: OpenMeshes, and the `back` side of a grid).
+enum class Treat : std::uint8_t {
+  Parity,       // as it is
+  Fans,         // a solid with holes: parity with its holes closed by fans, w evaluated near non-flat ones
+  Slab,         // a slab behind its fronts
+  SlabFlipped,  // a slab in front of its fronts
+};
+
+// Per object, and the number of open objects voxelized for their back side.
+struct Treatments {
+  std::vector<Treat> of;
+  std::size_t back = 0;
+};
+Treatments treatments(const Scene& scene, std::span<const MeshClosure> closure, OpenMeshes mode, std::span<const std::uint8_t> back) {
   if (closure.size() != scene.meshes.size()) throw InputError("voxelize: closure has " + std::to_string(closure.size()) +
                                                               " meshes, the scene " + std::to_string(scene.meshes.size()));
+  const std::vector<SceneObject> objects = scene.objects();
+  if (!back.empty() && back.size() != objects.size())
+    throw InputError("voxelize: " + std::to_string(back.size()) + " back-side flags for " + std::to_string(objects.size()) + " objects");
+  Treatments r{std::vector<Treat>(objects.size(), Treat::Parity), 0};
+  std::vector<Treat>& t = r.of;
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    const MeshClosure& c = closure[objects[o].mesh];
+    const bool from_back = mode == OpenMeshes::Winding && !c.closed() && !back.empty() && back[o];
+    r.back += from_back ? 1 : 0;
+    if (mode == OpenMeshes::Slab && c.open_surface()) {
+      t[o] = Treat::Slab;
+    } else if (mode == OpenMeshes::Winding && c.open_surface()) {
+      t[o] = from_back ? Treat::SlabFlipped : Treat::Slab;
+    } else if (mode == OpenMeshes::Winding && c.holed()) {
+      // Seen from inside (through a hole), the shell's outside is what occludes: a slab on the
+      // side its fronts face when they face out.
+      const Affine3* tf = objects[o].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[o].instance].object_to_world;
+      const int out = c.orientation * (tf && tf->determinant() < 0 ? -1 : 1);
+      t[o] = !from_back ? Treat::Fans : out > 0 ? Treat::SlabFlipped : Treat::Slab;
+    }
+  }
+  return r;
+}
+
+bool any_slab(std::span<const Treat> t) {
+  return std::any_of(t.begin(), t.end(), [](Treat x) { return x == Treat::Slab || x == Treat::SlabFlipped; });
+}
+
+// Whether a slab rises above any face (world +y): a face turned down with a slab behind it, or
+// turned up with one in front.
+bool slab_rises(const Scene& scene, std::span<const Treat> t) {
+  const std::vector<SceneObject> objects = scene.objects();
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    if (t[o] != Treat::Slab && t[o] != Treat::SlabFlipped) continue;
+    const Mesh& m = scene.meshes[objects[o].mesh];
+    const Affine3* tf = objects[o].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[o].instance].object_to_world;
+    const float side = t[o] == Treat::Slab ? 1.0f : -1.0f;
+    for (std::size_t k = 0; k < m.triangle_count(); ++k) {
+      Vec3 v[3] = {m.positions[m.indices[3 * k]], m.positions[m.indices[3 * k + 1]], m.positions[m.indices[3 * k + 2]]};
+      if (tf)
+        for (Vec3& p : v) p = tf->point(p);
+      if (side * cross(v[1] - v[0], v[2] - v[0]).y < 0) return true;
+    }
+  }
+  return false;
+}
+
+// Object space of an object: the inverse of its instance's map (identity for a world-space mesh),
+// and the sign of its determinant (a mirror turns fronts into backs: w changes sign).
+struct ObjectSpace {
+  bool instanced = false;
+  Affine3 to_object;
+  int sign = 1;
+  Vec3 operator()(Vec3 p) const { return instanced ? to_object.point(p) : p; }
+};
+ObjectSpace object_space(const Scene& scene, const SceneObject& ob) {
+  if (ob.instance == SceneObject::kNoInstance) return {};
+  const Affine3& m = scene.instances[ob.instance].object_to_world;
+  return {true, inverse(m), m.determinant() < 0 ? -1 : 1};
+}
+
+// Row bands of the raster stage (kBands, fewer for a short grid) and the band of each row.
+struct Bands {
+  int ny = 0, count = 0;
+  std::vector<int> of;  // per row
+  int first_row(int b) const { return static_cast<int>(static_cast<long long>(ny) * b / count); }
+};
+Bands make_bands(int ny) {
+  Bands b{ny, std::min(ny, kBands), std::vector<int>(ny)};
+  for (int k = 0; k < b.count; ++k)
+    for (int j = b.first_row(k); j < b.first_row(k + 1); ++j) b.of[j] = k;
+  return b;
+}
+
+// A chunk's triangles bucketed by (fill kind, row band), a counting sort: bucket
+// kind * bands + band is index[start[k], start[k + 1]); a triangle spanning bands is in each.
+struct Buckets {
+  std::vector<std::uint32_t> start, index;
+};
+// Fill kinds: 0 parity (fans included), 1 slab spans, 2 prisms (GridTri::fill).
+int kind_of(const GridTri& t) { return t.fill == 0 || t.fill >= 3 ? 0 : t.fill == 2 ? 2 : 1; }
+Buckets bucket(const std::vector<GridTri>& tris, const Bands& bands) {
+  Buckets bk;
+  bk.start.assign(3 * static_cast<std::size_t>(bands.count) + 1, 0);
+  for (const GridTri& t : tris)
+    for (int b = bands.of[t.j0]; b <= bands.of[t.j1]; ++b) ++bk.start[kind_of(t) * bands.count + b + 1];
+  for (std::size_t k = 1; k < bk.start.size(); ++k) bk.start[k] += bk.start[k - 1];
+  bk.index.resize(bk.start.back());
+  std::vector<std::uint32_t> pos(bk.start.begin(), bk.start.end() - 1);
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    for (int b = bands.of[tris[i].j0]; b <= bands.of[tris[i].j1]; ++b) bk.index[pos[kind_of(tris[i]) * bands.count + b]++] = static_cast<std::uint32_t>(i);
+  return bk;
+}
+
+// The triangles voxelize_into maps: those of every object (Scene::objects(): a world-space mesh,
+// or an instance whose mesh's triangles go through its transform), and for a solid with holes
+// (Treat::Fans) one fan triangle per boundary edge after its own triangles: (b, a, centroid) for
+// the boundary edge a -> b, so that every edge of the mesh and its fans is used twice and the
+// parity pass sees a closed surface. Closure and hole centroids are per mesh, as an affine map
+// keeps both (it maps centroids to centroids).
+struct ObjectPlan {
+  std::vector<SceneObject> objects;
+  std::vector<Holes> holes;              // per mesh of a solid with holes
+  std::vector<int> slot_of;              // per object with a hole that is not flat: its slot, else -1
+  std::vector<std::size_t> slot_object;  // per slot: the object
+  std::vector<std::size_t> first{0};     // object o's triangles are [first[o], first[o + 1])
+  std::size_t fanned = 0;                // objects voxelized as solids with holes
+};
+ObjectPlan plan_objects(const Scene& scene, std::span<const MeshClosure> closure, std::span<const Treat> treat, float voxel) {
+  ObjectPlan p;
+  p.objects = scene.objects();
+  p.holes.resize(scene.meshes.size());
+  p.slot_of.assign(p.objects.size(), -1);
+  std::vector<std::uint8_t> hole_info(scene.meshes.size(), 0);
+  for (std::size_t oi = 0; oi < p.objects.size(); ++oi) {
+    const std::size_t mi = p.objects[oi].mesh;
+    const bool fans = treat[oi] == Treat::Fans;
+    if (fans && !hole_info[mi]) {
+      // Two voxels, in the mesh's own units (an instance's scale divides them).
+      const float scale = p.objects[oi].instance == SceneObject::kNoInstance
+                              ? 1.0f
+                              : static_cast<float>(std::cbrt(std::abs(scene.instances[p.objects[oi].instance].object_to_world.determinant())));
+      p.holes[mi] = hole_centroids(scene.meshes[mi], closure[mi], 2.0f * voxel / scale), hole_info[mi] = 1;
+    }
+    if (fans && std::find(p.holes[mi].flat.begin(), p.holes[mi].flat.end(), 0) != p.holes[mi].flat.end()) {
+      p.slot_of[oi] = static_cast<int>(p.slot_object.size());
+      p.slot_object.push_back(oi);
+    }
+    p.fanned += fans ? 1 : 0;
+    p.first.push_back(p.first.back() + scene.meshes[mi].triangle_count() + (fans ? closure[mi].boundary.size() : 0));
+  }
+  return p;
+}
+
+// Triangle `local` of object `oi` (ObjectPlan) in world space, its slab's side for
+// Treat::SlabFlipped; false for a face given a slab that cannot reach `region` (VoxelizeOptions).
+bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan, std::span<const Treat> treat, std::size_t oi,
+                     std::size_t local, const Bounds3& region, float slab_thickness, Tri3& tri) {
+  const std::size_t mi = plan.objects[oi].mesh;
+  const Affine3* tf = plan.objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[plan.objects[oi].instance].object_to_world;
+  const bool open = treat[oi] == Treat::Slab || treat[oi] == Treat::SlabFlipped;
+  const Mesh& m = scene.meshes[mi];
+  if (local < m.triangle_count()) {
+    tri = source_triangle(m, local, open);
+    if (open && !region.empty()) {
+      Bounds3 reach;  // the triangle and its slab
+      for (const Vec3& v : tri.v) reach.extend(tf ? tf->point(v) : v);
+      reach.lo -= Vec3{slab_thickness, slab_thickness, slab_thickness};
+      reach.hi += Vec3{slab_thickness, slab_thickness, slab_thickness};
+      if (reach.hi.x < region.lo.x || reach.lo.x > region.hi.x || reach.hi.y < region.lo.y || reach.lo.y > region.hi.y || reach.hi.z < region.lo.z ||
+          reach.lo.z > region.hi.z)
+        return false;
+    }
+    if (plan.slot_of[oi] >= 0 && plan.holes[mi].near[local]) tri.fan = plan.slot_of[oi];
+  } else {
+    const std::size_t e = local - m.triangle_count();
+    const auto [a, b] = closure[mi].boundary[e];
+    const std::uint32_t h = closure[mi].hole[e];
+    tri = Tri3{{m.positions[b], m.positions[a], plan.holes[mi].centre[h]}, 0, {}, plan.holes[mi].flat[h] ? -1 : plan.slot_of[oi]};
+  }
+  if (tf) {
+    for (Vec3& v : tri.v) v = tf->point(v);
+    if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+  }
+  if (treat[oi] == Treat::SlabFlipped) tri.normal = -tri.normal;
+  return true;
+}
+
+// The union of one band's prisms (PrismCounts): the voxels where the running count is not 0.
+void unite_prisms(VoxelGrid& g, const PrismCounts& counts) {
+  for (std::size_t c = 0; c < counts.touched.size(); ++c) {
+    if (!counts.touched[c]) continue;
+    const std::int16_t* d = counts.delta.get() + c * g.depth_bits;
+    std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(counts.r0) * g.nx + c) * g.words;
+    int count = 0;
+    for (int v = 0; v < g.depth_bits; ++v) {
+      count += d[v];
+      if (count != 0) col[v >> 6] |= std::uint64_t{1} << (v & 63);
+    }
+  }
+}
+
+// Rasterises band b's triangles of one fill kind (Buckets; 0: parity, 1: spans, 2: prisms, counted
+// and then turned into voxels), listing the fans' fragments in `hits`. Returns fragments.
+template <bool kPerspective>
+std::size_t raster_band(VoxelGrid& g, const Bands& bands, int b, int fill_kind, const std::vector<std::vector<GridTri>>& tris,
+                        const std::vector<Buckets>& buckets, float slab_thickness, std::vector<ColumnHit>& hits) {
+  const int r0 = bands.first_row(b), r1 = bands.first_row(b + 1) - 1;
+  const std::size_t k = static_cast<std::size_t>(fill_kind) * bands.count + b;
+  bool any = false;
+  for (std::size_t c = 0; c < buckets.size() && !any; ++c) any = buckets[c].start[k] < buckets[c].start[k + 1];
+  if (!any) return 0;
+  PrismCounts counts;
+  if (fill_kind == 2) {
+    const std::size_t columns = static_cast<std::size_t>(r1 - r0 + 1) * g.nx;
+    counts = {r0, g.nx, g.depth_bits, std::unique_ptr<std::int16_t[]>(new std::int16_t[columns * g.depth_bits]), std::vector<std::uint8_t>(columns, 0)};
+  }
+  std::size_t f = 0;
+  for (std::size_t c = 0; c < buckets.size(); ++c)
+    for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
+      const GridTri& t = tris[c][buckets[c].index[q]];
+      const int lo = std::max(r0, t.j0), hi = std::min(r1, t.j1);
+      f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits, &counts)
+                                      : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits, nullptr);
+    }
+  unite_prisms(g, counts);
+  return f;
+}
+
+// Per slot of a solid with holes (ObjectPlan): object space, sigma (orientation, mirrors
+// included) and the winding number of its fans alone (w_C needs no triangle near the point but
+// the fans' own, unlike w of the mesh).
+struct SlotWinding {
+  std::vector<ObjectSpace> space;
+  std::vector<int> sign;
+  std::vector<FanWinding> fans;
+};
+SlotWinding slot_winding(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan) {
+  SlotWinding s;
+  for (std::size_t oi : plan.slot_object) {
+    const std::size_t mi = plan.objects[oi].mesh;
+    s.space.push_back(object_space(scene, plan.objects[oi]));
+    s.sign.push_back(closure[mi].orientation * s.space.back().sign);
+    s.fans.push_back(fan_winding(scene.meshes[mi], closure[mi], plan.holes[mi]));
+  }
+  return s;
+}
+
+// Voxels where w was evaluated, and of those, where it changed the parity's answer; and one
+// band's scratch space.
+struct WalkCount {
+  std::size_t evaluated = 0, changed = 0;
+};
+struct WalkScratch {
+  std::vector<std::uint64_t> chi, seen;
+  std::vector<Vec3> r;
+  std::vector<float> len;
+};
+
+// Walks the column of list[q] from each of its fragments of the same slot (sorted together),
+// both ways, setting each voxel to [sigma w(centre) > 1/2] until that agrees with parity (see
+// winding_solid). chi is the column as parity left it, so each voxel is decided once however many
+// walks reach it. Returns the index past those fragments.
+template <class Centre>
+std::size_t walk_column(VoxelGrid& g, const std::vector<ColumnHit>& list, std::size_t q, const SlotWinding& sw, Centre& voxel_centre, WalkScratch& sc,
+                        WalkCount& n) {
+  std::vector<std::uint64_t>& chi = sc.chi;
+  std::vector<std::uint64_t>& seen = sc.seen;
+  const ColumnHit& at = list[q];
+  std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(at.j) * g.nx + at.i) * g.words;
+  chi.assign(col, col + g.words);
+  seen.assign(g.words, 0);
+  const int s = at.tag;
+  for (; q < list.size() && list[q].i == at.i && list[q].j == at.j && list[q].tag == s; ++q)
+    for (int dir : {1, -1})
+      for (int k = dir > 0 ? list[q].k : list[q].k - 1; k >= 0 && k < g.depth_bits; k += dir) {
+        const std::uint64_t bit = std::uint64_t{1} << (k & 63);
+        const bool parity = (chi[k >> 6] & bit) != 0;
+        bool solid;
+        if (seen[k >> 6] & bit) {
+          solid = (col[k >> 6] & bit) != 0;
+        } else {
+          // w = chi - w_C: solid where sigma w = chi - sigma w_C > 1/2.
+          solid = (parity ? 1.0 : 0.0) - sw.sign[s] * sw.fans[s](sw.space[s](voxel_centre(at.i, at.j, k)), sc.r, sc.len) > 0.5;
+          seen[k >> 6] |= bit;
+          ++n.evaluated;
+          if (solid != parity) col[k >> 6] ^= bit, ++n.changed;
+        }
+        if (solid == parity) break;
+      }
+  return q;
+}
+
+// The winding-number solid near holes that are not flat. Parity with the fans is the solid chi
+// of the mesh plus its fans C; the mesh's own winding number is w = chi - w_C (w is a sum over
+// triangles; sigma w with sigma the orientation, voxelize.h), and the solid is w > 1/2. The two
+// differ only where |w_C| >= 1/2, which is next to a fan that is not flat: in the pocket between
+// the fan and the surface w = 1/2 that spans the hole, which the mesh itself can also cut near
+// the hole's rim. Along a column the pocket is entered through the fan or through the mesh near
+// the hole (it is bounded by them and that surface), so from each such fragment (`hits`, per
+// band) we walk the column both ways and stop at the first voxel where w agrees with parity: the
+// pocket's end. (A column that crossed the spanning surface twice and neither the fan nor the
+// mesh would be missed.)
+template <class Centre>
+WalkCount winding_solid(VoxelGrid& g, std::vector<std::vector<ColumnHit>>& hits, const SlotWinding& sw, Centre& voxel_centre) {
+  std::vector<WalkCount> in(hits.size());
+  tbb::parallel_for(0, static_cast<int>(hits.size()), [&](int b) {
+    std::vector<ColumnHit>& list = hits[b];
+    std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.tag, x.k) < std::tie(y.j, y.i, y.tag, y.k); });
+    WalkScratch scratch;
+    for (std::size_t q = 0; q < list.size();) q = walk_column(g, list, q, sw, voxel_centre, scratch, in[b]);
+  });
+  WalkCount n;
+  for (const WalkCount& w : in) n.evaluated += w.evaluated, n.changed += w.changed;
+  return n;
+}
+
+VoxelStats grid_stats(const std::vector<std::vector<GridTri>>& tris, std::span<const std::size_t> fragments, std::span<const MeshClosure> closure) {
+  VoxelStats s;
+  for (const auto& chunk : tris) s.triangles += chunk.size();
+  for (std::size_t f : fragments) s.fragments += f;
+  for (const MeshClosure& c : closure) {
+    s.open_meshes += c.open_surface() ? 1 : 0;
+    s.holed_meshes += c.holed() ? 1 : 0;
+    s.holes += c.holed() ? c.holes : 0;
+    s.boundary_edges += c.boundary_edges;
+  }
+  return s;
+}
+
+// Stages 1-4 for any grid whose geometry fields are set; `voxel` is the largest extent of a voxel
+// (world units), `emit` maps one Tri3 into a vector, `voxel_centre(i, j, k)` gives the world point
+// of a voxel's centre.
+template <bool kPerspective, class Emit, class Centre>
+void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, const Treatments& treatment,
+                   float slab_thickness, float voxel, Emit&& emit, Centre&& voxel_centre, VoxelStats* stats) {
+  const std::span<const Treat> treat = treatment.of;
   g.depth_bits = o.depth_bits;
   g.words = (o.depth_bits + 63) / 64;
   g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
 
   // 1. Map triangles to the grid, chunk by chunk (chunk boundaries are fixed: deterministic),
   // and bucket each chunk's triangles by (fill kind, row band) so that a band visits only the
-  // triangles overlapping it (a counting sort; a triangle spanning bands is listed in each).
-  const int bands = std::min(g.ny, kBands);
-  const auto band_first_row = [&](int b) { return static_cast<int>(static_cast<long long>(g.ny) * b / bands); };
-  std::vector<int> band_of(g.ny);
-  for (int b = 0; b < bands; ++b)
-    for (int j = band_first_row(b); j < band_first_row(b + 1); ++j) band_of[j] = b;
-  const auto kind_of = [](const GridTri& t) { return t.fill == 0 ? 0 : t.fill == 2 ? 2 : 1; };
-  struct Buckets {
-    std::vector<std::uint32_t> start, index;  // bucket (kind * bands + band): index[start[k], start[k + 1])
-  };
-  // A holed mesh voxelized by winding number (voxelize.h) gets one fan triangle per boundary
-  // edge after its own triangles: (b, a, centroid) for the boundary edge a -> b, so that every
-  // edge of the mesh and its fans is used twice and the parity pass sees a closed surface.
-  // The triangles are those of every object (Scene::objects(): a world-space mesh, or an instance
-  // whose mesh's triangles go through its transform); closure and hole centroids are per mesh, as
-  // an affine map keeps both (it maps centroids to centroids).
-  const std::vector<SceneObject> objects = scene.objects();
-  std::vector<std::vector<Vec3>> centre(scene.meshes.size());
-  std::vector<std::uint8_t> mesh_capped(scene.meshes.size(), 0);
-  std::size_t capped = 0;
-  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    const bool cap = o.open_meshes == OpenMeshes::Winding && closure[mi].holed();
-    if (cap) centre[mi] = hole_centroids(scene.meshes[mi], closure[mi]), ++capped;
-    mesh_capped[mi] = cap ? 1 : 0;
-  }
-  std::vector<std::size_t> first{0};
-  for (const SceneObject& ob : objects) {
-    g.capped.push_back(mesh_capped[ob.mesh]);
-    first.push_back(first.back() + scene.meshes[ob.mesh].triangle_count() + (mesh_capped[ob.mesh] ? closure[ob.mesh].boundary.size() : 0));
-  }
-  const std::size_t total = first.back();
+  // triangles overlapping it.
+  const Bands bands = make_bands(g.ny);
+  const ObjectPlan plan = plan_objects(scene, closure, treat, voxel);
+  const std::size_t total = plan.first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
   std::vector<std::vector<GridTri>> tris(chunks);
   std::vector<Buckets> buckets(chunks);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
     const std::size_t t0 = c * kChunk, t1 = std::min(total, t0 + kChunk);
-    std::size_t oi = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), t0) - first.begin()) - 1;
+    std::size_t oi = static_cast<std::size_t>(std::upper_bound(plan.first.begin(), plan.first.end(), t0) - plan.first.begin()) - 1;
     auto& out = tris[c];
     out.reserve(t1 - t0);
     for (std::size_t t = t0; t < t1; ++t) {
-      while (t >= first[oi + 1]) ++oi;
-      const std::size_t mi = objects[oi].mesh;
-      const Affine3* tf = objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[objects[oi].instance].object_to_world;
-      const bool open = o.open_meshes != OpenMeshes::Parity && closure[mi].open_surface();
-      const Mesh& m = scene.meshes[mi];
-      const std::size_t local = t - first[oi];
+      while (t >= plan.first[oi + 1]) ++oi;
       Tri3 tri;
-      if (local < m.triangle_count()) {
-        tri = source_triangle(m, local, open);
-      } else {
-        const std::size_t e = local - m.triangle_count();
-        const auto [a, b] = closure[mi].boundary[e];
-        tri = Tri3{{m.positions[b], m.positions[a], centre[mi][closure[mi].hole[e]]}, 0, {}};
-      }
-      if (tf) {
-        for (Vec3& v : tri.v) v = tf->point(v);
-        if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
-      }
-      emit(out, tri);
+      if (object_triangle(scene, closure, plan, treat, oi, t - plan.first[oi], o.slab_region, slab_thickness, tri)) emit(out, tri);
     }
-    Buckets& bk = buckets[c];
-    bk.start.assign(3 * static_cast<std::size_t>(bands) + 1, 0);
-    for (const GridTri& t : out)
-      for (int b = band_of[t.j0]; b <= band_of[t.j1]; ++b) ++bk.start[kind_of(t) * bands + b + 1];
-    for (std::size_t k = 1; k < bk.start.size(); ++k) bk.start[k] += bk.start[k - 1];
-    bk.index.resize(bk.start.back());
-    std::vector<std::uint32_t> pos(bk.start.begin(), bk.start.end() - 1);
-    for (std::size_t i = 0; i < out.size(); ++i)
-      for (int b = band_of[out[i].j0]; b <= band_of[out[i].j1]; ++b) bk.index[pos[kind_of(out[i]) * bands + b]++] = static_cast<std::uint32_t>(i);
+    buckets[c] = bucket(out, bands);
   });
 
   // 2. Raster bands of rows; parity fragments first, then (after the scan) open-mesh slabs,
   // which are ORed: a union, so overlapping slabs of neighbouring open triangles do not cancel.
-  std::vector<std::size_t> fragments(bands, 0);
-  const auto raster_pass = [&](VoxelGrid& target, int fill_kind) {  // 0 parity, 1 spans, 2 prisms
-    tbb::parallel_for(0, bands, [&](int b) {
-      const int r0 = band_first_row(b), r1 = band_first_row(b + 1) - 1;
-      const std::size_t k = static_cast<std::size_t>(fill_kind) * bands + b;
-      std::size_t f = 0;
-      for (std::size_t c = 0; c < chunks; ++c)
-        for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
-          const GridTri& t = tris[c][buckets[c].index[q]];
-          f += rasterise<kPerspective>(t, std::max(r0, t.j0), std::min(r1, t.j1), target, slab_thickness);
-        }
-      fragments[b] += f;
-    });
+  std::vector<std::size_t> fragments(bands.count, 0);
+  std::vector<std::vector<ColumnHit>> hits(bands.count);  // fans' fragments (pass 0)
+  const auto raster_pass = [&](int fill_kind) {
+    tbb::parallel_for(0, bands.count, [&](int b) { fragments[b] += raster_band<kPerspective>(g, bands, b, fill_kind, tris, buckets, slab_thickness, hits[b]); });
   };
-  raster_pass(g, 0);
+  raster_pass(0);
 
-  // 3. Toggles -> solid.
+  // 3. Toggles -> solid, then the winding-number solid near holes that are not flat.
   const std::size_t odd = scan_columns(g);
-  bool any_open = false;
-  for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
-  if (any_open && o.open_meshes != OpenMeshes::Parity) {
-    raster_pass(g, 1);
-    bool any_prism = false;
-    for (const auto& chunk : tris)
-      for (const GridTri& t : chunk) any_prism = any_prism || t.fill == 2;
-    if (any_prism) {
-      VoxelGrid scratch = g;  // same geometry; bits cleared below
-      std::fill(scratch.bits.begin(), scratch.bits.end(), 0);
-      raster_pass(scratch, 2);
-      scan_columns(scratch);
-      for (std::size_t w = 0; w < g.bits.size(); ++w) g.bits[w] |= scratch.bits[w];
-    }
+  const WalkCount walked = plan.slot_object.empty() ? WalkCount{} : winding_solid(g, hits, slot_winding(scene, closure, plan), voxel_centre);
+
+  // 4. Slabs of open meshes, ORed after the parity; walls' prisms as the union of the prisms: per
+  // column, the voxels where the count of prisms entered minus left is not 0 (prisms overlap
+  // where walls meet, and parity would cancel them there).
+  if (any_slab(treat)) {
+    raster_pass(1);
+    raster_pass(2);
   }
   const std::size_t set_voxels = build_coarse(g);  // also counts the solid voxels
   if (stats) {
-    *stats = {};
-    for (const auto& chunk : tris) stats->triangles += chunk.size();
-    for (std::size_t f : fragments) stats->fragments += f;
+    *stats = grid_stats(tris, fragments, closure);
     stats->odd_columns = odd;
-    for (const MeshClosure& c : closure) {
-      stats->open_meshes += c.open_surface() ? 1 : 0;
-      stats->holed_meshes += c.holed() ? 1 : 0;
-      stats->holes += c.holed() ? c.holes : 0;
-      stats->boundary_edges += c.boundary_edges;
-    }
     stats->set_voxels = set_voxels;
-    stats->capped_meshes = capped;
+    stats->capped_meshes = plan.fanned;
+    stats->back_objects = treatment.back;
+    stats->winding_evaluations = walked.evaluated;
+    stats->winding_voxels_changed = walked.changed;
   }
 }
 
@@ -518,6 +897,98 @@ std::size_t VoxelGrid::count_set() const {
   std::size_t n = 0;
   for (std::uint64_t w : bits) n += static_cast<std::size_t>(std::popcount(w));
   return n;
+}
+
+namespace {
+
+// Sheet or solid with holes, from the winding number of the mesh itself (voxelize.h, MeshKind).
+// Just in front of and just behind a triangle's centroid c, w(c + n d) + w(c - n d) = 2 w_rest(c):
+// the triangle's own solid angles cancel (mirror images), leaving twice the winding number of
+// the rest of the mesh at c. A closed mesh has w_rest = 1/2 everywhere (the rest subtends the
+// whole half-space behind the face), a flat sheet 0. `enclosure` is the magnitude of 2 w_rest
+// averaged over the area (at every (n / kEnclosureSamples)-th triangle), `orientation` its sign.
+void classify_open_mesh(const Mesh& m, MeshClosure& c) {
+  c.winding = MeshWinding(m);
+  const std::size_t nt = m.triangle_count();
+  // Small holes (kSmallHoles): each hole's vector area from its boundary edges (about any point,
+  // here its first vertex), the orientation from the sign of the enclosed volume (about the box's
+  // centre; the holes change it little).
+  {
+    std::vector<Vec3> hole_area(c.holes, Vec3{0, 0, 0}), origin(c.holes, Vec3{0, 0, 0});
+    std::vector<std::uint8_t> has(c.holes, 0);
+    for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+      const std::uint32_t h = c.hole[e];
+      if (!has[h]) origin[h] = m.positions[c.boundary[e][0]], has[h] = 1;
+      hole_area[h] += cross(m.positions[c.boundary[e][0]] - origin[h], m.positions[c.boundary[e][1]] - origin[h]) * 0.5f;
+    }
+    double holes = 0, area = 0, volume = 0;
+    for (const Vec3& a : hole_area) holes += length(a);
+    const Vec3 o = m.bounds().center();
+    for (std::size_t t = 0; t < nt; ++t) {
+      const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
+      area += 0.5 * length(cross(b - a, d - a));
+      volume += dot(a, cross(b, d)) / 6.0;
+    }
+    if (area > 0 && holes < kSmallHoles * area) {
+      c.kind = MeshKind::SolidWithHoles;
+      c.enclosure = static_cast<float>(1.0 - holes / area);
+      c.orientation = volume < 0 ? -1 : 1;
+      return;
+    }
+  }
+  const std::size_t step = std::max<std::size_t>(1, nt / kEnclosureSamples);
+  double sum = 0, area = 0;
+  Vec3 vector_area{0, 0, 0};
+  for (std::size_t t = 0; t < nt; ++t) {
+    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
+    vector_area += cross(b - a, d - a) * 0.5f;
+  }
+  for (std::size_t t = 0; t < nt; t += step) {
+    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
+    const Vec3 n2 = cross(b - a, d - a);
+    const float len = length(n2);
+    if (!(len > 0.0f)) continue;
+    const float at = 0.5f * len;
+    // 1% of the inradius (2 area / perimeter): far closer to c than any other triangle is.
+    const float delta = 0.01f * 2.0f * at / (length(b - a) + length(d - b) + length(a - d));
+    const Vec3 centre = (a + b + d) * (1.0f / 3.0f), n = n2 / len;
+    sum += at * (c.winding.get()(centre + n * delta) + c.winding.get()(centre - n * delta));
+    area += at;
+  }
+  const double mean = area > 0 ? sum / area : 0.0;
+  c.enclosure = static_cast<float>(std::min(1.0, std::abs(mean)));
+  c.orientation = mean < 0 ? -1 : 1;
+  c.kind = c.enclosure >= kSolidEnclosure ? MeshKind::SolidWithHoles : MeshKind::Sheet;
+  // A flat sheet (a ground, a wall): every vertex within 1e-5 of its extent of one plane. Its
+  // winding number then has the sign of the side of that plane everywhere.
+  const float len = length(vector_area);
+  if (len > 0.0f) {
+    const Vec3 n = vector_area / len;
+    const Bounds3 box = m.bounds();
+    const float tol = 1e-5f * box.diagonal();
+    const float offset = dot(n, m.positions[m.indices[0]]);
+    bool flat = true;
+    for (std::uint32_t i : m.indices) flat = flat && std::abs(dot(n, m.positions[i]) - offset) <= tol;
+    if (flat) c.plane = {n.x, n.y, n.z, -offset};
+    c.flat = flat;
+  }
+}
+
+}  // namespace
+
+struct MeshWinding::State {
+  const Mesh* mesh = nullptr;
+  std::once_flag once;
+  std::unique_ptr<WindingNumber> field;
+};
+
+MeshWinding::MeshWinding(const Mesh& mesh) : state_(std::make_shared<State>()) { state_->mesh = &mesh; }
+
+const WindingNumber& MeshWinding::get() const {
+  static const WindingNumber empty;
+  if (!state_) return empty;
+  std::call_once(state_->once, [&] { state_->field = std::make_unique<WindingNumber>(state_->mesh->positions, state_->mesh->indices); });
+  return *state_->field;
 }
 
 std::vector<MeshClosure> analyze_closure(const Scene& scene) {
@@ -578,24 +1049,17 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
         if (n == ~0u) n = c.holes++;
         c.hole.push_back(n);
       }
-      // The vector area of a closed surface is zero, so an open mesh's is minus that of any
-      // surface closing its holes: its length is the holes' area seen from their best direction.
-      double vx = 0, vy = 0, vz = 0, area = 0;
-      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-        const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
-        const Vec3 n = cross(b - a, d - a);
-        vx += 0.5 * n.x, vy += 0.5 * n.y, vz += 0.5 * n.z;
-        area += 0.5 * length(n);
-      }
-      c.cap_area_fraction = area > 0 ? static_cast<float>(std::sqrt(vx * vx + vy * vy + vz * vz) / area) : 1.0f;
+      classify_open_mesh(m, c);
     }
     out.push_back(std::move(c));
   }
   return out;
 }
 
-VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats) {
+VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats,
+                         std::span<const std::uint8_t> back) {
   o.validate();
+  const Treatments treat = treatments(scene, closure, o.open_meshes, back);
   VoxelGrid g;
   g.space = GridSpace::World;
   g.nx = g.ny = o.columns;
@@ -605,24 +1069,60 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const float floor_extent = std::max(1e-4f * b.diagonal(), 1e-6f);
   const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
   const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
-  bool any_open = false;
-  for (const MeshClosure& c : closure) any_open = any_open || c.open_surface();
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
-  // (a ground plane's slab hangs below it, a wall's prism stands behind it).
-  const float side = (any_open && o.open_meshes != OpenMeshes::Parity ? slab : 0.0f) + v0;
+  // (a ground plane's slab hangs below it, a wall's prism stands behind it), and above when a
+  // slab rises from a face (a roof seen from below, a ceiling seen from the room).
+  const float side = (any_slab(treat.of) ? slab : 0.0f) + v0;
+  const float top = (slab_rises(scene, treat.of) ? slab : 0.0f) + v0;
   const Vec3 lo = b.lo - Vec3{side, side, side};
-  const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
+  const Vec3 ext = e + Vec3{2 * side, side + top, 2 * side};
   g.origin = lo;
   g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
   const WorldMap map{lo, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}, slab};
-  voxelize_into<false>(g, scene, closure, o, slab,
-                       [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); }, stats);
+  const Vec3 origin = g.origin, size = g.voxel_size;
+  voxelize_into<false>(
+      g, scene, closure, o, treat, slab, std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z}), [&](std::vector<GridTri>& out, const Tri3& t) { emit_world(out, t, map, g.nx, g.ny); },
+      [origin, size](int i, int j, int k) {
+        return Vec3{origin.x + (static_cast<float>(i) + 0.5f) * size.x, origin.y + (static_cast<float>(k) + 0.5f) * size.z,
+                    origin.z + (static_cast<float>(j) + 0.5f) * size.y};
+      },
+      stats);
   return g;
 }
 
-VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const VoxelizeOptions& o, VoxelStats* stats) {
+namespace {
+
+// z_nearest per column of an eye grid whose camera, columns and z_far are set: the smallest
+// G-buffer depth among the pixels whose centres it holds (eq. 2's local slice); columns that see no
+// surface use `zmin`, the scene's nearest corner. Then the voxels per unit depth of each column.
+void set_z_near(VoxelGrid& g, const GBuffer& gb, float zmin, float z_clip, int depth_bits) {
+  const std::size_t ncol = static_cast<std::size_t>(g.nx) * g.ny;
+  g.z_near.assign(ncol, kInfinity);
+  for (int y = 0; y < g.camera.height; ++y) {
+    const int j = std::min(g.ny - 1, static_cast<int>((y + 0.5f) / g.pixels_per_column_y));
+    for (int x = 0; x < g.camera.width; ++x) {
+      if (!gb.covered(x, y)) continue;
+      const int i = std::min(g.nx - 1, static_cast<int>((x + 0.5f) / g.pixels_per_column_x));
+      float& zn = g.z_near[static_cast<std::size_t>(j) * g.nx + i];
+      zn = std::min(zn, gb.depth(x, y));
+    }
+  }
+  g.voxels_per_unit.resize(ncol);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    float& zn = g.z_near[c];
+    if (!std::isfinite(zn)) zn = zmin;
+    zn = std::clamp(zn, z_clip, g.z_far * 0.999f);
+    g.voxels_per_unit[c] = static_cast<float>(depth_bits) / (g.z_far - zn);
+  }
+}
+
+}  // namespace
+
+VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const VoxelizeOptions& o, VoxelStats* stats,
+                       std::span<const std::uint8_t> back) {
   o.validate();
+  const Treatments treat = treatments(scene, closure, o.open_meshes, back);
   VoxelGrid g;
   g.space = GridSpace::Eye;
   const Camera& cam = gb.camera;
@@ -659,26 +1159,7 @@ VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure,
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   g.z_far = std::max(zmax + slab + v0, zmin * 2.0f);
 
-  // z_nearest per column: the smallest G-buffer depth among the pixels whose centres it holds
-  // (eq. 2's local slice); columns that see no surface use the scene's nearest corner.
-  const std::size_t ncol = static_cast<std::size_t>(g.nx) * g.ny;
-  g.z_near.assign(ncol, kInfinity);
-  for (int y = 0; y < H; ++y) {
-    const int j = std::min(g.ny - 1, static_cast<int>((y + 0.5f) / g.pixels_per_column_y));
-    for (int x = 0; x < W; ++x) {
-      if (!gb.covered(x, y)) continue;
-      const int i = std::min(g.nx - 1, static_cast<int>((x + 0.5f) / g.pixels_per_column_x));
-      float& zn = g.z_near[static_cast<std::size_t>(j) * g.nx + i];
-      zn = std::min(zn, gb.depth(x, y));
-    }
-  }
-  g.voxels_per_unit.resize(ncol);
-  for (std::size_t c = 0; c < ncol; ++c) {
-    float& zn = g.z_near[c];
-    if (!std::isfinite(zn)) zn = zmin;
-    zn = std::clamp(zn, z_clip, g.z_far * 0.999f);
-    g.voxels_per_unit[c] = static_cast<float>(o.depth_bits) / (g.z_far - zn);
-  }
+  set_z_near(g, gb, zmin, z_clip, o.depth_bits);
 
   // Camera-space (x, y, depth) -> column: camera.project divided by the pixels per column.
   const float t = cam.tan_half_fov();
@@ -691,8 +1172,16 @@ VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure,
   map.oy = 0.5f * H / g.pixels_per_column_y;
   map.z_clip = z_clip;
   map.slab = slab;
-  voxelize_into<true>(g, scene, closure, o, slab, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); },
-                      stats);
+  // The inverse of eq. 2 and of the projection: column (i, j)'s centre is the view ray through
+  // ((i + 0.5 - ox) / sx, (j + 0.5 - oy) / sy) per unit depth, voxel k at depth z_near + (k + 0.5) / vpu.
+  const auto centre = [&g, &map](int i, int j, int k) {
+    const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
+    const float depth = g.z_near[c] + (static_cast<float>(k) + 0.5f) / g.voxels_per_unit[c];
+    const Vec3 local{(static_cast<float>(i) + 0.5f - map.ox) / map.sx * depth, (static_cast<float>(j) + 0.5f - map.oy) / map.sy * depth, -depth};
+    return map.eye + map.basis.to_world(local);
+  };
+  voxelize_into<true>(
+      g, scene, closure, o, treat, slab, v0, [&](std::vector<GridTri>& out, const Tri3& tri) { emit_eye(out, tri, map, g.nx, g.ny); }, centre, stats);
   return g;
 }
 

@@ -17,24 +17,30 @@
 //    (z - z_nearest) / (z_far - z_nearest) * depth_bits, with z_nearest per column taken from the
 //    G-buffer's nearest depth (the "local slice" of sec. III-B) and z_far the far side of the scene.
 //
-// Parity needs closed surfaces. Open surfaces (a ground plane: more than 1% of the edges are
-// boundary, see MeshClosure::open_surface) are, by default, kept out of the parity pass and
-// turned into one-sided slabs: after the parity scan, each of their
-// fragments ORs the voxels within `slab_thickness` behind its front face (below a ground plane);
-// open faces steep to the columns (walls) become closed prisms of that thickness behind them,
-// voxelized by parity in a scratch grid and ORed in.
-// Columns whose parity still ends odd are counted and reported.
+// Parity needs closed surfaces. analyze_closure tells per mesh what it stands for (MeshKind):
+// closed (parity), a solid with holes (the solid where its generalized winding number w exceeds
+// 1/2: parity with each hole closed by a fan, and w evaluated where a hole is not flat), or a sheet
+// (a two-sided surface of no thickness). The cone method traces a sphere's occupied volume, so a
+// surface of no thickness must stand for what it hides: a sheet becomes a slab `slab_thickness`
+// thick on its far side from the points the grid is traced for. Which side that is depends on the
+// point (`back`, per object: cone.cpp picks a grid per pixel by the sign of w). After the parity
+// scan, each slab fragment ORs the voxels within `slab_thickness` behind it; faces steep to the
+// columns (walls) become closed prisms of that thickness, whose union (they overlap where walls
+// meet) is ORed in. A solid with holes traced from inside (seen through a hole) becomes a slab
+// outside its shell. Columns whose parity still ends odd are counted and reported.
 #pragma once
 
 #include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "ao/core/gbuffer.h"
+#include "ao/methods/winding_number.h"
 #include "ao/scene/mesh.h"
 
 namespace ao {
@@ -47,14 +53,59 @@ enum class GridSpace {
 
 /// What to do with meshes that are not closed (have boundary edges).
 enum class OpenMeshes {
-  Winding,  ///< Default. Open surfaces (MeshClosure::open_surface) become slabs; a closed mesh with
-            ///< holes is voxelized as the solid where its generalized winding number exceeds 1/2,
-            ///< by closing each hole with a fan (see voxelize_world).
-  Slab,     ///< Open surfaces become slabs; closed meshes with holes are voxelized as they are (parity).
+  Winding,  ///< Default. By what each mesh is (MeshKind, from its winding number): a solid with
+            ///< holes is the solid where w > 1/2 (see voxelize_world); a sheet is a slab on its far
+            ///< side from the points traced (`back`); a solid with holes seen from inside is a slab
+            ///< outside its shell.
+  Slab,     ///< Sheets become slabs behind their fronts (one-sided, whatever side a point is on); solids
+            ///< with holes are voxelized as they are (parity).
   Parity,   ///< Voxelize everything as it is: columns crossing an open mesh end odd (reported), as in the paper.
 };
 
-/// Topology of one mesh, computed once per scene (positions may move, connectivity does not).
+/// What a mesh stands for, decided per mesh by analyze_closure from its boundary edges and its
+/// generalized winding number w (winding_number.h).
+enum class MeshKind {
+  Closed,          ///< No boundary edge: a solid; parity voxelizes it exactly.
+  SolidWithHoles,  ///< Boundary edges, but it wraps around a volume as a closed surface does
+                   ///< (MeshClosure::enclosure >= kSolidEnclosure): a scan open at its base, a part
+                   ///< with a few holes, an open container (a bowl, a box without its top). It
+                   ///< stands for the solid where w > 1/2.
+  Sheet,           ///< Any other open mesh (a ground, a wall, sheet metal bent less than a
+                   ///< container: an arch): a two-sided surface of no thickness, which the
+                   ///< ray-traced reference sees as such.
+};
+
+/// Enclosure (MeshClosure::enclosure) from which an open mesh is a solid with holes rather than a
+/// sheet: from its surface, the rest of it covers at least half of what the rest of a closed
+/// surface covers (the half-space behind the face). Measured: a flat sheet 0, a bent sheet with
+/// holes (an arch) 0.34, half a sphere shell 0.63, a box without its top 0.72, a torus with its
+/// base cut off 0.74, a sphere with its top tenth cut off 0.91, the shared scans with their bases
+/// cut 0.93-0.996 and with holes punched 0.99-1.00 (docs/methods/cone.md, "Open meshes").
+inline constexpr float kSolidEnclosure = 0.5f;
+/// Triangles sampled (evenly by index) to measure the enclosure of one open mesh.
+inline constexpr std::size_t kEnclosureSamples = 256;
+
+/// The winding number field of one mesh (winding_number.h), built on first use (from any thread,
+/// once) and shared by copies. Keeps a pointer to the mesh, which must outlive it.
+class MeshWinding {
+ public:
+  MeshWinding() = default;
+  explicit MeshWinding(const Mesh& mesh);
+  /// The field, in the mesh's own space; an empty field for a default-constructed one.
+  const WindingNumber& get() const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+/// Holes whose areas (each |vector area|, the area it spans seen from its best direction) sum to
+/// less than this fraction of the mesh's area make it a solid with holes without measuring its
+/// enclosure: holes that small cannot open it (its enclosure is then about 1 minus that fraction).
+inline constexpr float kSmallHoles = 0.01f;
+
+/// One mesh's topology and what it stands for, computed once per scene (the scene must not change
+/// while it is used).
 struct MeshClosure {
   std::size_t boundary_edges = 0;  ///< Edges used by an odd number of triangles (positions compared exactly).
   std::size_t edges = 0;           ///< Distinct edges.
@@ -63,18 +114,29 @@ struct MeshClosure {
   std::vector<std::array<std::uint32_t, 2>> boundary;
   std::vector<std::uint32_t> hole;
   std::uint32_t holes = 0;
-  /// |vector area of the mesh| / its area, at analysis. A closed surface's vector area is zero, so
-  /// an open mesh's is the (net, projected) area of its holes: about 1 for a sheet (a ground
-  /// plane, a wall, a terrain), small for a solid with holes.
-  float cap_area_fraction = 0;
-  bool closed() const { return boundary_edges == 0; }
-  /// An open surface (a ground plane, a wall, a terrain) rather than a closed mesh with holes: its
-  /// holes' area is more than 40% of its own (a hemisphere bowl: 50%, a torus with its bottom 15%
-  /// cut off: 27%, a sphere with its top tenth cut off: 9%). Only these become slabs; slabs R_max
-  /// thick behind every face of a statue would fill its thin parts and the space in front of them.
-  bool open_surface() const { return boundary_edges > 0 && cap_area_fraction > 0.4f; }
-  /// A closed mesh with holes: neither closed nor an open surface.
-  bool holed() const { return boundary_edges > 0 && !open_surface(); }
+  MeshKind kind = MeshKind::Closed;
+  /// Open meshes: the magnitude of the area-weighted mean of 2 w_rest over the surface (sampled at
+  /// kEnclosureSamples triangles), in [0, 1], where w_rest is the winding number at a point of the
+  /// surface of the rest of the mesh (all but the point's own triangle):
+  /// 1 for a closed surface (the rest wraps all around), 0 for a flat sheet. 1 for closed meshes;
+  /// 1 minus the holes' area fraction for meshes with small holes (kSmallHoles).
+  float enclosure = 1;
+  /// Open meshes: +1 when the fronts face out of what the mesh wraps around (the sign of w_rest, or
+  /// of the enclosed volume for small holes), -1 when they face in (a solid with holes then has
+  /// w < -1/2 inside: its w is used negated).
+  int orientation = 1;
+  /// Open meshes: every vertex within 1e-5 of the extent of one plane (a ground, a wall): then
+  /// `plane` (n.x, n.y, n.z, d; n unit along the vector area) has n.p + d < 0 exactly where w > 0.
+  bool flat = false;
+  std::array<float, 4> plane{};
+  /// Open meshes: the winding number field of the mesh in its own space.
+  MeshWinding winding;
+
+  bool closed() const { return kind == MeshKind::Closed; }
+  /// A sheet (MeshKind::Sheet).
+  bool open_surface() const { return kind == MeshKind::Sheet; }
+  /// A solid with holes (MeshKind::SolidWithHoles).
+  bool holed() const { return kind == MeshKind::SolidWithHoles; }
 };
 
 /// Boundary edges of every mesh of `scene`, in mesh order. Vertices are matched by exact position,
@@ -90,6 +152,10 @@ struct VoxelizeOptions {
   float slab_thickness = 0.0f;    ///< World units behind open faces; 0 = two voxels. >= 0. The cone
                                   ///< method uses R_max: under an open ground a cone then meets
                                   ///< solid as deep as it can look, as under a closed floor.
+  /// World box the grid is traced in (empty: everywhere). Faces given slabs (sheets, a solid with
+  /// holes seen from inside) whose slab cannot reach into it are left out: slabs are a union of
+  /// one per face. Closed meshes and fans are always whole (parity needs them whole).
+  Bounds3 slab_region;
 
   /// Throws InputError naming the bad field.
   void validate() const;
@@ -100,10 +166,13 @@ struct VoxelStats {
   std::size_t triangles = 0;       ///< Triangles rasterised (after clipping and culling).
   std::size_t fragments = 0;       ///< Column-centre hits.
   std::size_t odd_columns = 0;     ///< Columns whose parity ends at 1: open or leaky geometry.
-  std::size_t open_meshes = 0;     ///< Meshes treated as open surfaces (slabs).
-  std::size_t holed_meshes = 0;    ///< Closed meshes with holes (MeshClosure::holed).
+  std::size_t open_meshes = 0;     ///< Sheets (MeshClosure::open_surface).
+  std::size_t holed_meshes = 0;    ///< Solids with holes (MeshClosure::holed).
   std::size_t holes = 0;           ///< Their holes.
-  std::size_t capped_meshes = 0;   ///< Holed meshes voxelized by winding number (OpenMeshes::Winding).
+  std::size_t capped_meshes = 0;   ///< Objects of solids with holes voxelized as their winding-number solid.
+  std::size_t back_objects = 0;    ///< Open objects voxelized for points on their back side (`back`).
+  std::size_t winding_evaluations = 0;     ///< Voxels where w was evaluated (next to fans over holes that are not flat).
+  std::size_t winding_voxels_changed = 0;  ///< Of those, voxels where w > 1/2 and the fans' parity differ.
   std::size_t boundary_edges = 0;  ///< Over all meshes.
   std::size_t set_voxels = 0;      ///< Solid voxels in the finished grid.
 };
@@ -151,11 +220,6 @@ struct VoxelGrid {
   std::vector<std::uint64_t> window;
   std::uint64_t window_mask(int w, int ci, int cj) const { return window[(static_cast<std::size_t>(cj) * dnx + ci) * (kWindowCap + 1) + w]; }
 
-  /// Per object of the scene (Scene::objects(), G-buffer object id - 1): 1 when its mesh had holes and was voxelized as
-  /// its winding-number solid (OpenMeshes::Winding), so that a surface point of it whose front is
-  /// solid is the inside of its shell, seen through a hole.
-  std::vector<std::uint8_t> capped;
-
   /// Words of column (i, j), which must be inside the grid.
   const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
   /// Bit k of column (i, j).
@@ -197,23 +261,31 @@ inline bool any_bits(const std::uint64_t* column, int words, int k0, int k1) {
 /// World-space grid of options.columns x options.columns columns over `scene`'s bounds, columns
 /// along world y.
 ///
-/// Closed meshes with holes (OpenMeshes::Winding): the solid is where the mesh's generalized
-/// winding number w (Jacobson, Kavan, Sorkine-Hornung, "Robust inside-outside segmentation using
-/// generalized winding numbers", SIGGRAPH 2013) exceeds 1/2. Each hole is closed by a fan C of
-/// triangles from its boundary edges to its centroid; the mesh plus C is closed, so its winding
-/// number is its parity indicator chi (what the parity pass computes exactly), and since w is a
-/// sum over triangles, w_mesh = chi - w_C. Off a planar fan |w_C| < 1/2 (the fan lies in a plane
-/// and subtends less than a hemisphere), so w_mesh > 1/2 exactly where chi = 1: parity of the mesh
-/// with its fans is the winding-number solid. For a non-planar hole the two differ between the fan
-/// and the w = 1/2 surface that spans the hole. The bounds are padded by a voxel, and below and at the sides by the slab
-/// thickness when there are open meshes. `closure` comes from analyze_closure(scene).
-VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& options, VoxelStats* stats = nullptr);
+/// Solids with holes (OpenMeshes::Winding): the solid is where the mesh's generalized winding
+/// number w (Jacobson, Kavan, Sorkine-Hornung, "Robust inside-outside segmentation using
+/// generalized winding numbers", SIGGRAPH 2013; winding_number.h) exceeds 1/2. Each hole is closed
+/// by a fan C of triangles from its boundary edges to its centroid; the mesh plus C is closed, so
+/// its winding number is its parity indicator chi (what the parity pass computes exactly), and
+/// since w is a sum over triangles, w_mesh = chi - w_C. Off a flat fan |w_C| < 1/2 (the fan lies in
+/// a plane and subtends less than a hemisphere), so there w_mesh > 1/2 exactly where chi = 1. Off
+/// the convex hull of a fan that is not flat |w_C| < 1/2 as well (the fan is seen within a
+/// hemisphere; this assumes the hole's outline seen from there does not cross itself), and inside
+/// it the two differ only in the pocket between the fan and the surface w = 1/2 that spans the
+/// hole; w is evaluated there (from each fan fragment along its column, voxelize.cpp). Objects are
+/// assumed not to overlap there (as parity assumes). The bounds are padded by a voxel, and below
+/// and at the sides by the slab thickness when there are slabs. `closure` comes from
+/// analyze_closure(scene). `back`: per object of Scene::objects(), 1 when the grid is for points on
+/// its back side (behind a sheet: w > 0; inside a solid with holes: w > 1/2); empty = the front of
+/// every object. Only OpenMeshes::Winding reads it.
+VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& options, VoxelStats* stats = nullptr,
+                         std::span<const std::uint8_t> back = {});
 
 /// The paper's eye-space grid for the G-buffer's camera (which must carry its world placement):
 /// columns are blocks of pixels, z_nearest per column is the smallest G-buffer depth in its block
 /// (eq. 2, local slice), z_far the farthest corner of the scene's bounds. Geometry outside the view
 /// frustum is not voxelized; triangles are clipped at a near plane in front of the eye.
+/// Open meshes and `back` as for voxelize_world.
 VoxelGrid voxelize_eye(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gbuffer, const VoxelizeOptions& options,
-                       VoxelStats* stats = nullptr);
+                       VoxelStats* stats = nullptr, std::span<const std::uint8_t> back = {});
 
 }  // namespace ao

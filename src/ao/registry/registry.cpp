@@ -278,6 +278,29 @@ MethodMemory cone_memory(const nlohmann::json& j) {
           "a " + std::to_string(p.columns) + "^2 x " + std::to_string(p.depth_bits) + " voxel grid"};
 }
 
+nlohmann::json cone_resolved(const nlohmann::json& j) { return cone_param_table().to_json(parse(cone_param_table(), j).resolved()); }
+
+nlohmann::json alchemy_resolved(const nlohmann::json& j) {
+  AlchemyParams p = parse(alchemy_param_table(), j);
+  p.intensity = p.effective_intensity();
+  return alchemy_param_table().to_json(p);
+}
+
+// GTAO without the multi-bounce fit estimates the cosine-weighted visibility within R: step
+// obscurance with the user's R (the membership asked for does not change what it computes). With
+// the fit it estimates the ambient light after interreflections among surfaces of the albedo
+// around the point (Jimenez et al. 2016, sec. 5), which the ray-traced ambient transfer W with the
+// occluders' albedo computes (reference/transfer_reference.h), scored on its luminance.
+ReferenceSpec gtao_reference(const Falloff& requested, const nlohmann::json& j) {
+  const Falloff step{Membership::Step, requested.radius};
+  if (parse(gtao_param_table(), j).multi_bounce) return ReferenceSpec{ReferenceKind::Transfer, step};
+  return obscurance_reference(step);
+}
+
+constexpr std::array<std::string_view, 1> kReferenceQuantity{kReferenceParam};
+constexpr std::array<std::string_view, 1> kAlbedoScaleQuantity{"albedo_scale"};
+constexpr std::array<std::string_view, 1> kMultiBounceQuantity{"multi_bounce"};
+constexpr std::array<std::string_view, 1> kRadiusQuantity{"radius"};  // Alchemy's r is the R it integrates within
 constexpr std::array<std::string_view, 1> kObscuranceExtra{"obscurance"};
 constexpr std::array<std::string_view, 1> kUnfilteredExtra{"unfiltered"};
 
@@ -288,6 +311,7 @@ const std::array kMethods{
                .ground_truth = true,
                .needs_scene = true,
                .extras = kObscuranceExtra,  // with reference=transfer: O from the same rays
+               .quantity_params = kReferenceQuantity,
                .samples_param = "samples",
                .target_error_param = "target_error",
                .params = schema<raytraced_method_table>,
@@ -326,6 +350,7 @@ const std::array kMethods{
                .takes_characteristic = true,
                .cached = true,
                .extras = kObscuranceExtra,
+               .quantity_params = kAlbedoScaleQuantity,
                .samples_param = "samples",
                .params = schema<screen_space_table<transfer_param_table>>,
                .run = run_transfer,
@@ -345,13 +370,15 @@ const std::array kMethods{
                .run = run_cone,
                .reference = step_reference,
                .obscurance_falloff = step_falloff,
+               .resolve_presets = cone_resolved,
                .memory = cone_memory},
-    // Alchemy approximates obscurance with its own falloff u/t (u = sigma in world units), radius r;
-    // with preset=paper (u = 2r >= r) that falloff is exactly step AO; at the fitted default sigma
-    // (u = 0.8 r) it is not, and obscurance_reference labels it as Alchemy's own (docs/methods/alchemy.md).
+    // Alchemy approximates classical obscurance within its radius r (step, R = r): at the paper's
+    // preset eq. 7's falloff is exactly that, and the reference never moves with sigma, the
+    // estimator's aesthetic knob (docs/methods/alchemy.md).
     MethodInfo{.name = "alchemy",
                .summary = "Alchemy AO: screen-space disk samples, eq. 10 (sigma, k, beta, epsilon, r, s) + 13-tap cross-bilateral filter",
                .extras = kUnfilteredExtra,
+               .quantity_params = kRadiusQuantity,
                .samples_param = "samples",
                .params = schema<alchemy_param_table>,
                .run = run_alchemy,
@@ -360,15 +387,15 @@ const std::array kMethods{
                      return obscurance_reference(alchemy_reference_falloff(parse(alchemy_param_table(), j), requested.radius));
                    },
                .obscurance_falloff = [](const Falloff& requested,
-                                        const nlohmann::json& j) { return alchemy_reference_falloff(parse(alchemy_param_table(), j), requested.radius); }},
-    // GTAO with a radius cut estimates the cosine-weighted visibility within R: step obscurance with
-    // the user's R (the membership asked for does not change what it computes).
+                                        const nlohmann::json& j) { return alchemy_reference_falloff(parse(alchemy_param_table(), j), requested.radius); },
+               .resolve_presets = alchemy_resolved},
     MethodInfo{.name = "gtao",
                .summary = "GTAO (Jimenez et al. 2016): horizons in screen-space slices, analytic cosine-weighted inner integral, 4x4 denoise; "
                           "-p multi_bounce=true adds its multi-bounce fit",
+               .quantity_params = kMultiBounceQuantity,
                .params = schema<gtao_param_table>,
                .run = run_gtao,
-               .reference = step_reference,
+               .reference = gtao_reference,
                .obscurance_falloff = step_falloff},
 };
 

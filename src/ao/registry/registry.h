@@ -118,6 +118,11 @@ struct MethodInfo {
   /// The names MethodOutput::extras may carry, written by `ao render --extras` as
   /// <output-stem>-<name><ext>.
   std::span<const std::string_view> extras;
+  /// The parameters that choose which quantity is estimated, and so which reference judges it
+  /// (raytraced's reference, transfer's albedo_scale, GTAO's multi_bounce). Every other parameter is
+  /// a knob of the estimator, which the reference never follows: a reference depends on the scene,
+  /// the camera, R, the membership and its own ray settings only (tests/registry).
+  std::span<const std::string_view> quantity_params;
   /// The parameter `--samples` sets; empty when the method has no sample count.
   std::string_view samples_param;
   /// The parameter `--target-error` sets; empty when the method does not stop adaptively.
@@ -137,6 +142,10 @@ struct MethodInfo {
   Falloff (*obscurance_falloff)(const Falloff& requested, const nlohmann::json& params);
   /// Whether these parameters read the G-buffer's direct-light pass (transfer's radiance mode).
   bool (*reads_direct_light)(const nlohmann::json& params) = nullptr;
+  /// `params` with every value a preset leaves unset (null) filled in as the method uses it (cone's
+  /// counts, Alchemy's intensity), for a caller that starts from the values in effect (ao tune);
+  /// null for a method without presets.
+  nlohmann::json (*resolve_presets)(const nlohmann::json& params) = nullptr;
   /// Memory beyond the images (cone's voxel grid); null when none.
   MethodMemory (*memory)(const nlohmann::json& params) = nullptr;
 

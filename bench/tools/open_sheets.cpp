@@ -1,0 +1,97 @@
+// Writes the open test meshes of the cone method's open-surface voxelization
+// (tests/support/open_sheets.h) and closed meshes of the same sizes, each on a ground quad, as OBJ
+// files for `ao compare`, with a camera that frames the object (docs/methods/cone.md, "Open meshes"):
+//   ao_open_sheets /tmp/open-sheets
+//   ao compare /tmp/open-sheets/arch.obj --camera /tmp/open-sheets/arch.camera.json --methods cone
+// Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
+// top), and the closed box, sphere and torus. The ground is a quad of twice the object's diagonal
+// under it, and the camera looks at the object from the front right and above, as
+// tests/methods/cone_test.cpp does. With a second argument, the folder of the shared meshes, also
+// ChineseDragon-10kv and elephant opened as scans come (tests/support/open_sheets.h: the bottom
+// 10% cut off, -cut.obj; holes of 3% of the diagonal punched, -holes.obj), alone:
+//   ao_open_sheets /tmp/open-sheets ../shared/data/meshes
+//   ao compare /tmp/open-sheets/elephant-cut.obj --methods cone
+// Write them outside the repository.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ao/io/camera_json.h"
+#include "ao/io/mesh_io.h"
+#include "ao/scene/procedural.h"
+#include "support/open_sheets.h"
+
+namespace {
+
+// One material per mesh (named after it, in a .mtl beside the file): the loader keeps meshes with
+// different materials apart, and each is classified on its own (closed, solid with holes, sheet).
+void write_obj(const std::filesystem::path& path, const std::vector<std::pair<std::string, ao::Mesh>>& meshes) {
+  std::filesystem::path mtl = path;
+  mtl.replace_extension(".mtl");
+  std::ofstream materials(mtl);
+  for (const auto& [name, m] : meshes) materials << "newmtl " << name << "\nKd " << m.albedo.x << ' ' << m.albedo.y << ' ' << m.albedo.z << "\n";
+  std::ofstream out(path);
+  out.precision(9);
+  out << "mtllib " << mtl.filename().string() << "\n";
+  std::size_t base = 1;
+  for (const auto& [name, m] : meshes) {
+    out << "o " << name << "\nusemtl " << name << "\n";
+    for (const ao::Vec3& p : m.positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << "\n";
+    for (std::size_t t = 0; t < m.triangle_count(); ++t)
+      out << "f " << base + m.indices[3 * t] << ' ' << base + m.indices[3 * t + 1] << ' ' << base + m.indices[3 * t + 2] << "\n";
+    base += m.positions.size();
+  }
+  if (!out || !materials) throw std::runtime_error("cannot write " + path.string());
+}
+
+ao::Mesh ground_under(const ao::Mesh& object) {
+  const ao::Bounds3 b = object.bounds();
+  const ao::Vec3 c = b.center();
+  const float e = b.diagonal();
+  return ao::make_quad({c.x - e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z - e}, {c.x - e, b.lo.y, c.z - e}, {0.75f, 0.73f, 0.70f});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2 && argc != 3) {
+    std::cerr << "usage: ao_open_sheets OUTPUT_FOLDER [SHARED_MESHES_FOLDER]\n";
+    return 2;
+  }
+  try {
+    const std::filesystem::path dir = argv[1];
+    std::filesystem::create_directories(dir);
+    const std::vector<std::pair<std::string, ao::Mesh>> objects{
+        {"arch", ao::test::make_holed_arch()},
+        {"bowl", ao::test::make_bowl()},
+        {"open-box", ao::test::make_open_box()},
+        {"box", ao::make_box({-0.9f, 0.0f, -0.7f}, {0.9f, 1.0f, 0.7f})},
+        {"sphere", ao::make_sphere({0, 1, 0}, 1.0f, 96, 48)},
+        {"torus", ao::make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)},
+    };
+    for (const auto& [name, mesh] : objects) {
+      write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ground_under(mesh)}});
+      std::ofstream camera(dir / (name + ".camera.json"));
+      camera << ao::camera_to_json(ao::frame_bounds(mesh.bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 640, 360)).dump() << "\n";
+      if (!camera) throw std::runtime_error("cannot write " + (dir / (name + ".camera.json")).string());
+      std::cout << (dir / (name + ".obj")).string() << "\n";
+    }
+    if (argc == 3) {
+      for (const std::string name : {"ChineseDragon-10kv", "elephant"}) {
+        const ao::Mesh closed = ao::load_scene_file(std::filesystem::path(argv[2]) / (name + ".off")).meshes.at(0);
+        for (const auto& [suffix, open] : {std::pair{"-cut", ao::test::cut_base(closed, 0.1f)}, std::pair{"-holes", ao::test::punch_holes(closed, 0.03f)}}) {
+          write_obj(dir / (name + suffix + ".obj"), {{name, open}});
+          std::cout << (dir / (name + suffix + ".obj")).string() << "\n";
+        }
+      }
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "ao_open_sheets: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

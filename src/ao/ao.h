@@ -114,6 +114,7 @@
 #include "ao/jobs/bake.h"
 #include "ao/jobs/compare.h"
 #include "ao/jobs/contact_sheet.h"
+#include "ao/jobs/device.h"
 #include "ao/jobs/frames.h"
 #include "ao/jobs/inputs.h"
 #include "ao/jobs/progress_meter.h"

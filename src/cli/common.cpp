@@ -78,8 +78,6 @@ Vec3 parse_vec3(const std::string& text, const char* option) {
   return v;
 }
 
-namespace {
-
 // A parameter file: {"parameters": {...}} (as ao tune writes) or the object itself, as key=value pairs.
 std::vector<std::string> parameter_file_pairs(const std::string& path) {
   std::ifstream in(path);
@@ -91,6 +89,8 @@ std::vector<std::string> parameter_file_pairs(const std::string& path) {
   for (const auto& [k, v] : j.items()) pairs.push_back(k + "=" + v.dump());
   return pairs;
 }
+
+namespace {
 
 // An integer parameter gets a whole number that fits its 32-bit field, checked here before the
 // method narrows it (a double beyond the int range converts to garbage); the method's own range is

@@ -68,6 +68,10 @@ Vec3 parse_vec3(const std::string& text, const char* option);
 /// The non-empty items of `s` between separators `sep` ("a,,b" -> a, b).
 std::vector<std::string> split(const std::string& s, char sep);
 
+/// The parameters of a parameter file ({"parameters": {...}}, as ao tune writes, or the object
+/// itself) as "key=value" pairs; InputError naming the file when it cannot be read or parsed.
+std::vector<std::string> parameter_file_pairs(const std::string& path);
+
 /// Applies "key=value" overrides (and "@file.json" parameter files) to a parameter object. The
 /// value is parsed as JSON when it is valid JSON (numbers, true/false, arrays) and taken as a
 /// string otherwise. `known` lists the parameters; an unknown key is an InputError naming them.

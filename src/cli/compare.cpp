@@ -49,7 +49,15 @@ void parse_params(const std::vector<std::string>& params, CompareSettings& setti
     if (p.is_null()) p = defaults;
     apply_param_overrides(p, {kv}, name, defaults);
   };
+  std::vector<std::string> pairs;  // -p @FILE: its parameters, each as -p key=value
   for (const std::string& kv : params) {
+    if (!kv.empty() && kv[0] == '@') {
+      for (std::string& p : parameter_file_pairs(kv.substr(1))) pairs.push_back(std::move(p));
+    } else {
+      pairs.push_back(kv);
+    }
+  }
+  for (const std::string& kv : pairs) {
     const auto eq = kv.find('='), dot = kv.find('.');
     if (dot != std::string::npos && dot < eq) {
       if (dot == 0) throw InputError("--param: expected key=value or method.key=value, got '" + kv + "'");

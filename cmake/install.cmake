@@ -1,6 +1,7 @@
 # Install rules: the libraries, the public headers (not *_internal.h), the ao command, the CMake
-# package (aoConfig.cmake, aoConfigVersion.cmake, aoTargets.cmake: find_package(ao 0.2)) and a
-# pkg-config file (ao.pc). export() makes the same targets usable from the build tree.
+# package (aoConfig.cmake, aoConfigVersion.cmake, aoTargets.cmake: find_package(ao 0.2)), a
+# pkg-config file (ao.pc) and the licence with its notice (share/doc/ao/). export() makes the same
+# targets usable from the build tree.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -18,6 +19,8 @@ endif()
 if(AO_GPU)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/ao/gpu/shaders/ DESTINATION ${CMAKE_INSTALL_DATADIR}/ao/shaders)
 endif()
+# Apache-2.0 section 4: a redistribution carries the licence and the NOTICE file.
+install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/NOTICE DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(EXPORT aoTargets NAMESPACE ao:: DESTINATION ${AO_CMAKE_DIR})
 export(EXPORT aoTargets NAMESPACE ao:: FILE ${PROJECT_BINARY_DIR}/aoTargets.cmake)
 

@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # The library boundary, checked as a user meets it (run by CTest as `install_and_examples` and
 # `installed_headers_without_embree`, or by hand: examples/check_install.sh BUILD_DIR [examples|headers]):
-#   1. installs the build into a temporary prefix;
+#   1. installs the build into a temporary prefix, which carries the licence and its notice, man
+#      pages and bash completion for ao and each subcommand, and whose libao has no tinygltf
+#      symbol (nm);
 # examples (the default):
 #   2. builds examples/ as a separate CMake project with find_package(ao 0.2 REQUIRED) and runs the
-#      three programs on a small OBJ written here (a floor with UVs and a cube on it);
+#      four programs on a small OBJ written here (a floor with UVs and a cube on it);
 #   3. builds a one-file program with `pkg-config --cflags --libs ao` and runs it;
 # headers:
-#   4. compiles every installed header in one translation unit with Embree's, assimp's, OpenEXR's,
-#      libpng's and FreeType's headers replaced by ones that fail: no installed header includes them.
+#   4. checks that ao/ao.h includes every other installed header, and compiles every installed
+#      header in one translation unit with Embree's, assimp's, OpenEXR's, libpng's and FreeType's
+#      headers replaced by ones that fail: no installed header includes them.
 # Everything is written below a temporary folder, removed at the end.
 set -euo pipefail
 build=$(cd "${1:?usage: check_install.sh BUILD_DIR [examples|headers]}" && pwd)
@@ -21,6 +24,33 @@ cxx=${CXX:-c++}
 
 echo "== install into $prefix"
 cmake --install "$build" --prefix "$prefix" >/dev/null
+for f in LICENSE NOTICE; do
+  [ -s "$prefix/share/doc/ao/$f" ] || { echo "check_install: share/doc/ao/$f was not installed" >&2; exit 1; }
+done
+echo "== libao exports no tinygltf symbol"
+libs=$(find "$prefix" -type f \( -name 'libao*.a' -o -name 'libao*.so*' \))
+[ -n "$libs" ] || { echo "check_install: no libao installed" >&2; exit 1; }
+for lib in $libs; do
+  nm -C "$lib" > "$tmp/symbols" 2>/dev/null
+  if grep -E -m 3 '(^|[^_[:alnum:]:])tinygltf::' "$tmp/symbols"; then echo "check_install: $lib has tinygltf symbols" >&2; exit 1; fi
+  # A shared library's exports: tinygltf, renamed into ao::gltf_detail, is hidden.
+  case $lib in *.so*)
+    nm -D -C --defined-only "$lib" > "$tmp/exports"
+    if grep -m 3 gltf_detail "$tmp/exports"; then echo "check_install: $lib exports tinygltf" >&2; exit 1; fi ;;
+  esac
+done
+echo "== man pages and bash completion for ao and every subcommand"
+subcommands=$("$prefix/bin/ao" --help | sed -n '/^Subcommands:/,$p' | awk 'NR > 1 && /^  [a-z]/ { print $1 }')
+[ -n "$subcommands" ] || { echo "check_install: no subcommands in ao --help" >&2; exit 1; }
+completion=$prefix/share/bash-completion/completions/ao
+[ -s "$completion" ] || { echo "check_install: no bash completion installed" >&2; exit 1; }
+[ -s "$prefix/share/man/man1/ao.1" ] || { echo "check_install: no man page ao.1 installed" >&2; exit 1; }
+for s in $subcommands; do
+  grep -q "ao-$s(1)" "$prefix/share/man/man1/ao.1" || { echo "check_install: ao.1 does not mention ao-$s(1)" >&2; exit 1; }
+  grep -q "^\.TH AO-${s^^} " "$prefix/share/man/man1/ao-$s.1" || { echo "check_install: no man page ao-$s.1" >&2; exit 1; }
+  grep -q "^    $s) words=" "$completion" || { echo "check_install: the completion does not know $s" >&2; exit 1; }
+done
+grep -q -- "--spp" "$completion" || { echo "check_install: the completion lacks render's options" >&2; exit 1; }
 PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name ao.pc)")"
 export PKG_CONFIG_PATH
 
@@ -59,11 +89,13 @@ f 8 12 11 7
 f 5 9 12 8
 f 6 7 11 10
 OBJ
+head -n 11 "$tmp/scene.obj" > "$tmp/low.obj"  # the floor alone: the low mesh the floor and cube are baked into
 cd "$tmp"
 "$tmp/examples/mesh_to_exr" scene.obj ao.exr volumetric
 "$tmp/examples/own_gbuffer"
 "$tmp/examples/bake_map" scene.obj map.png 64
-for f in ao.exr own_gbuffer.pgm map.png; do [ -s "$f" ] || { echo "check_install: $f was not written" >&2; exit 1; }; done
+"$tmp/examples/bake_high_to_low" low.obj scene.obj 64
+for f in ao.exr own_gbuffer.pgm map.png low_ao.png high_ao.ply; do [ -s "$f" ] || { echo "check_install: $f was not written" >&2; exit 1; }; done
 
 echo "== a one-file program with pkg-config --cflags --libs ao"
 cat > "$tmp/version.cpp" <<'CPP'
@@ -92,5 +124,8 @@ done
 (cd "$prefix/include" && find ao -name '*.h' | sort | sed 's/.*/#include <&>/') > "$tmp/all_headers.cpp"
 [ "$(grep -c . "$tmp/all_headers.cpp")" -gt 10 ] || { echo "check_install: too few headers installed" >&2; exit 1; }
 if grep -q "_internal.h" "$tmp/all_headers.cpp"; then echo "check_install: an internal header was installed" >&2; exit 1; fi
+echo "== ao/ao.h names every installed header"
+missing=$(cd "$prefix/include" && for h in $(find ao -name '*.h' ! -path ao/ao.h | sort); do grep -q "^#include \"$h\"" ao/ao.h || echo "$h"; done)
+[ -z "$missing" ] || { echo "check_install: ao/ao.h does not include:" $missing >&2; exit 1; }
 "$cxx" -std=c++20 -fsyntax-only -I"$poison" -I"$prefix/include" $(pkg-config --cflags-only-other tbb nlohmann_json) "$tmp/all_headers.cpp"
 echo "check_install: headers passed"

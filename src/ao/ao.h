@@ -1,9 +1,12 @@
 // ao: ambient occlusion on the CPU. The one header a program includes; it names every public
-// header of the library, grouped as the README's layout. Link ao::ao (CMake: find_package(ao 0.2),
+// header of the library (every installed header but this one: examples/check_install.sh checks),
+// grouped as the README's layout. Link ao::ao (CMake: find_package(ao 0.2),
 // or pkg-config ao); a program that needs only the G-buffer and in-memory-scene parts (core, scene,
 // methods but the registry, eval) may include those headers alone and link ao::core.
 //
-// A minimal program (examples/ has three complete ones; README "Use it as a library"):
+// The job calls do what the ao command does, with its defaults: run_render (jobs/render.h),
+// run_bake (jobs/bake.h), compare and tune (jobs/compare.h, jobs/tune.h). A minimal program at the
+// level below them (examples/ has complete ones; README "Use it as a library"):
 //   const ao::Scene scene = ao::load_scene_file("bunny.obj");
 //   const ao::RayScene rays(scene);
 //   const ao::GBuffer g = ao::render_gbuffer(rays, ao::frame_bounds(scene.bounds(), {0.55f, 0.5f, 1}, 40, 640, 360));
@@ -14,16 +17,21 @@
 
 #include "ao/version.h"
 
-// core: math, images, G-buffers, cameras, sampling, membership functions, parallel tiles, errors.
+// core: math, affine maps, images, G-buffers, cameras, sampling, membership functions, parallel
+// tiles, parameter tables, memory estimates, stopwatch, errors.
+#include "ao/core/affine.h"
 #include "ao/core/camera.h"
 #include "ao/core/error.h"
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
 #include "ao/core/math.h"
 #include "ao/core/membership.h"
+#include "ao/core/memory.h"
 #include "ao/core/parallel.h"
+#include "ao/core/params.h"
 #include "ao/core/progress.h"
 #include "ao/core/sampling.h"
+#include "ao/core/stopwatch.h"
 #include "ao/core/texture.h"
 
 // scene: meshes, scenes, built-in and analytic scenes.
@@ -34,8 +42,12 @@
 // The ray-traced ground truth and the scene -> G-buffer pass (Embree stays behind RayScene).
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/reference/direct_light.h"
+#include "ao/reference/ray_offset.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
+#include "ao/reference/reference.h"
+#include "ao/reference/tangent_sphere.h"
+#include "ao/reference/transfer_reference.h"
 
 // methods: one paper per header, and the registry that runs any of them by name.
 #include "ao/methods/alchemy.h"
@@ -43,15 +55,21 @@
 #include "ao/methods/characteristic.h"
 #include "ao/methods/cone.h"
 #include "ao/methods/containment.h"
+#include "ao/methods/gtao.h"
 #include "ao/methods/interleave.h"
 #include "ao/registry/registry.h"
 #include "ao/methods/samples.h"
 #include "ao/methods/transfer.h"
 #include "ao/methods/volumetric.h"
 #include "ao/methods/voxelize.h"
+#include "ao/methods/winding_number.h"
 
-// bake: AO maps (outside-in histogram, inside-out ray-traced), padding, per-vertex AO.
+// bake: AO maps (outside-in histogram, inside-out ray-traced), denoising, padding, per-vertex AO,
+// high to low, bake groups, UDIM tiles.
+#include "ao/bake/bake_groups.h"
 #include "ao/bake/bake_result.h"
+#include "ao/bake/denoise.h"
+#include "ao/bake/high_to_low.h"
 #include "ao/bake/histogram.h"
 #include "ao/bake/ortho_raster.h"
 #include "ao/bake/padding.h"
@@ -59,6 +77,7 @@
 #include "ao/bake/raytraced_bake.h"
 #include "ao/bake/sphere_directions.h"
 #include "ao/bake/texel_coverage.h"
+#include "ao/bake/udim.h"
 
 // gpu: the methods as OpenGL compute shaders (docs/gpu.md); without AO_GPU, opening a device says so.
 #include "ao/gpu/device.h"
@@ -66,14 +85,39 @@
 #include "ao/gpu/methods.h"
 #include "ao/gpu/voxelize.h"
 
-// eval: error metrics against a reference.
+// eval: error metrics against a reference, display shading.
 #include "ao/eval/metrics.h"
+#include "ao/eval/shading.h"
 
-// io: mesh and image files, G-buffer EXR passes, glTF and PLY export, atomic writes, text.
+// io: mesh and image files (and the checks run before assimp reads them), G-buffer EXR passes,
+// camera files, glTF and PLY export, glTF round trips, atomic writes and output sets, text.
+#include "ao/io/asset_path.h"
 #include "ao/io/atomic_file.h"
+#include "ao/io/camera_json.h"
 #include "ao/io/gbuffer_exr.h"
+#include "ao/io/gltf_check.h"
+#include "ao/io/gltf_document.h"
 #include "ao/io/gltf_export.h"
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
+#include "ao/io/number_text.h"
+#include "ao/io/obj_check.h"
+#include "ao/io/obj_reader.h"
+#include "ao/io/output_set.h"
 #include "ao/io/ply_export.h"
+#include "ao/io/ply_reader.h"
+#include "ao/io/stl_check.h"
 #include "ao/io/text.h"
+
+// jobs: render, bake, compare and tune as library calls, with the ao command's defaults; what
+// every job starts from (scene, camera, falloff), frame-after-frame rendering, progress reports.
+#include "ao/jobs/bake.h"
+#include "ao/jobs/compare.h"
+#include "ao/jobs/contact_sheet.h"
+#include "ao/jobs/device.h"
+#include "ao/jobs/frames.h"
+#include "ao/jobs/inputs.h"
+#include "ao/jobs/progress_meter.h"
+#include "ao/jobs/render.h"
+#include "ao/jobs/reporter.h"
+#include "ao/jobs/tune.h"

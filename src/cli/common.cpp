@@ -2,17 +2,16 @@
 
 #include <unistd.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <mutex>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
+#include "ao/jobs/progress_meter.h"
 
 namespace ao::cli {
 
@@ -79,8 +78,6 @@ Vec3 parse_vec3(const std::string& text, const char* option) {
   return v;
 }
 
-namespace {
-
 // A parameter file: {"parameters": {...}} (as ao tune writes) or the object itself, as key=value pairs.
 std::vector<std::string> parameter_file_pairs(const std::string& path) {
   std::ifstream in(path);
@@ -92,6 +89,8 @@ std::vector<std::string> parameter_file_pairs(const std::string& path) {
   for (const auto& [k, v] : j.items()) pairs.push_back(k + "=" + v.dump());
   return pairs;
 }
+
+namespace {
 
 // An integer parameter gets a whole number that fits its 32-bit field, checked here before the
 // method narrows it (a double beyond the int range converts to garbage); the method's own range is
@@ -133,60 +132,30 @@ void apply_param_overrides(nlohmann::json& params, const std::vector<std::string
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }
 
-namespace {
-
-// One stage's bar: drawn only once the stage has run for over a second; at most ten redraws a
-// second; thread-safe (progress arrives from worker threads).
-struct Bar {
-  std::string label;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  std::chrono::steady_clock::time_point last_draw{};
-  std::mutex mutex;
-  bool drawn = false;
-  bool closed = false;
-
-  void draw(std::size_t done, std::size_t total) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - start < std::chrono::seconds(1)) return;
-    std::unique_lock lock(mutex, std::try_to_lock);
-    if (!lock.owns_lock() || closed || now - last_draw < std::chrono::milliseconds(100)) return;
-    last_draw = now;
-    drawn = true;
-    const double f = total > 0 ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    const int width = 30, filled = static_cast<int>(f * width);
-    std::fprintf(stderr, "\r%s [%s%s] %3d%%  %.1fs, ~%.0fs left\033[K", label.c_str(), std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(), static_cast<int>(f * 100), elapsed, f > 0 ? elapsed * (1 - f) / f : 0.0);
-    std::fflush(stderr);
-  }
-  void close() {
-    std::lock_guard lock(mutex);
-    if (drawn) std::fputs("\r\033[K", stderr);
-    closed = true;
-  }
-};
-
-}  // namespace
-
 struct StderrReporter::State {
-  bool bars = false;
+  bool progress = false;
+  ProgressMeter::Style style = ProgressMeter::Style::Bar;
   bool notes = true;
-  std::shared_ptr<Bar> bar;
+  std::shared_ptr<ProgressMeter> meter;
   void end() {
-    if (bar) bar->close();
-    bar.reset();
+    if (meter) meter->close();
+    meter.reset();
   }
 };
 
 StderrReporter::StderrReporter(const GlobalOptions& global, bool json) : state_(std::make_shared<State>()) {
-  state_->bars = !global.quiet && stderr_is_terminal();
+  // A bar on a terminal; in a log (a file, CI, a farm) a line every few seconds.
+  state_->progress = !global.quiet;
+  state_->style = stderr_is_terminal() ? ProgressMeter::Style::Bar : ProgressMeter::Style::Log;
   state_->notes = !json;
   reporter_.stage = [s = state_](const std::string& stage) -> ProgressFn {
     s->end();
-    if (!s->bars) return {};
-    s->bar = std::make_shared<Bar>();
-    s->bar->label = stage;
-    return [bar = s->bar](std::size_t done, std::size_t total) { bar->draw(done, total); };
+    if (!s->progress) return {};
+    s->meter = std::make_shared<ProgressMeter>(stage, s->style, [](const std::string& text) {
+      std::fputs(text.c_str(), stderr);
+      std::fflush(stderr);
+    }, log_progress_interval());
+    return [meter = s->meter](std::size_t done, std::size_t total) { meter->update(done, total); };
   };
   reporter_.warning = [s = state_](const std::string& line) {
     s->end();

@@ -23,7 +23,7 @@ namespace ao::cli {
 /// Options of `ao` itself, before the subcommand.
 struct GlobalOptions {
   int threads = 0;     ///< Worker threads; 0 = all cores.
-  bool quiet = false;  ///< No progress bar.
+  bool quiet = false;  ///< No progress (bar or log lines).
 };
 
 /// Help text of the positional scene argument, shared by the subcommands that take a scene.
@@ -68,13 +68,18 @@ Vec3 parse_vec3(const std::string& text, const char* option);
 /// The non-empty items of `s` between separators `sep` ("a,,b" -> a, b).
 std::vector<std::string> split(const std::string& s, char sep);
 
+/// The parameters of a parameter file ({"parameters": {...}}, as ao tune writes, or the object
+/// itself) as "key=value" pairs; InputError naming the file when it cannot be read or parsed.
+std::vector<std::string> parameter_file_pairs(const std::string& path);
+
 /// Applies "key=value" overrides (and "@file.json" parameter files) to a parameter object. The
 /// value is parsed as JSON when it is valid JSON (numbers, true/false, arrays) and taken as a
 /// string otherwise. `known` lists the parameters; an unknown key is an InputError naming them.
 void apply_param_overrides(nlohmann::json& params, const std::vector<std::string>& overrides, std::string_view method,
                            const nlohmann::json& known);
 
-/// Prints a job's stages as progress bars (only when stderr is a terminal and not --quiet),
+/// Prints a job's stages' progress unless --quiet: a bar on a terminal, a line every few seconds
+/// (log_progress_interval) when stderr is not a terminal (jobs/progress_meter.h), and
 /// warnings as "warning: ..." lines and notes unless `json` (the JSON on stdout is then the report).
 class StderrReporter {
  public:

@@ -28,6 +28,7 @@ struct CompareOptions {
   FalloffOptions falloff;
   std::string normal = "shading";
   std::uint32_t seed = 1;
+  std::string device = "cpu";
   std::vector<std::string> params;  ///< method.key=value.
   std::string reference;            ///< NAME or method=NAME, comma-separated; empty = matched.
   std::string common_reference = "obscurance";
@@ -48,7 +49,15 @@ void parse_params(const std::vector<std::string>& params, CompareSettings& setti
     if (p.is_null()) p = defaults;
     apply_param_overrides(p, {kv}, name, defaults);
   };
+  std::vector<std::string> pairs;  // -p @FILE: its parameters, each as -p key=value
   for (const std::string& kv : params) {
+    if (!kv.empty() && kv[0] == '@') {
+      for (std::string& p : parameter_file_pairs(kv.substr(1))) pairs.push_back(std::move(p));
+    } else {
+      pairs.push_back(kv);
+    }
+  }
+  for (const std::string& kv : pairs) {
     const auto eq = kv.find('='), dot = kv.find('.');
     if (dot != std::string::npos && dot < eq) {
       if (dot == 0) throw InputError("--param: expected key=value or method.key=value, got '" + kv + "'");
@@ -81,6 +90,7 @@ CompareRequest make_request(const CompareOptions& o) {
   settings.common_reference = o.common_reference;
   settings.spp_reference = o.spp_reference;
   settings.seed = o.seed;
+  settings.device = device_from_name(o.device);
   if (!o.sweep.empty()) {
     const auto eq = o.sweep.find('=');
     if (eq == std::string::npos || eq == 0) throw InputError("--sweep: expected key=v1,v2,..., got '" + o.sweep + "'");
@@ -139,6 +149,11 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d) requested: " + membership_names() + " (methods may imply their own)");
   add_normal_option(*cmd, o->normal, "; the same for every method and its reference");
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
+  cmd->add_option("--device", o->device,
+                  "cpu, or gpu: each method also runs on the GPU backend (OpenGL 4.3 compute shaders, headless; Mesa's llvmpipe where "
+                  "there is no GPU), a column per backend in the tables and the sheet (docs/gpu.md)")
+      ->type_name("cpu|gpu")
+      ->capture_default_str();
   add_camera_options(*cmd, o->camera);
   cmd->add_flag("--json", o->json, "Print table.json on stdout");
   cmd->footer(std::string("Environment: AO_FONT, the font file of sheet.png's labels (default ") + kDejaVuSansPath +

@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   app.fallthrough();  // --threads and --quiet may also follow the subcommand
   ao::cli::GlobalOptions global;
   app.add_option("--threads", global.threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
-  app.add_flag("-q,--quiet", global.quiet, "No progress bar");
+  app.add_flag("-q,--quiet", global.quiet, "No progress output (bar or log lines)");
   std::function<int()> action;
   ao::cli::add_render_command(app, global, action);
   ao::cli::add_bake_command(app, global, action);

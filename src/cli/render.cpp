@@ -27,6 +27,7 @@ struct RenderOptions {
   std::optional<std::string> normal;
   std::vector<std::string> params;  ///< key=value overrides of the method's parameters.
   std::optional<std::string> sun;   ///< "DX,DY,DZ[,E]".
+  std::string device = "cpu";
   bool json = false;
 };
 
@@ -79,6 +80,7 @@ RenderRequest make_request(const RenderOptions& o) {
   if (o.normal) r.normal = surface_normal_from_name(*o.normal);
   apply_param_overrides(r.params, o.params, method.name, o.ao_map.empty() ? method.default_params() : nlohmann::json::object());
   if (o.sun) r.sun = parse_sun(*o.sun);
+  r.device = device_from_name(o.device);
   r.outputs.visibility = o.output;
   r.outputs.shaded = o.shaded;
   r.outputs.gbuffer = o.gbuffer_out;
@@ -94,6 +96,8 @@ void print_summary(const RenderResult& out) {
   if (stats.contains("mean_std_error"))
     std::fprintf(stderr, "  standard error: mean %.4f, max %.4f; %.1f M rays/s\n", stats["mean_std_error"].get<double>(),
                  stats["max_std_error"].get<double>(), out.summary.value("rays_per_second", 0.0) / 1e6);
+  if (out.device == Device::Gpu)
+    std::fprintf(stderr, "  GPU %s: %s\n", out.gl_renderer.c_str(), describe_gpu_passes(out.gpu_passes).c_str());
 }
 
 int run(const RenderOptions& o, const GlobalOptions& global) {
@@ -122,6 +126,11 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
                   "Samples per pixel (default: the method's own; 256 rays for raytraced, the maximum with --target-error)");
   cmd->add_option("--target-error", o->request.target_error, "Stop a pixel once its standard error is below this (raytraced; default off)");
   cmd->add_option("--seed", o->request.seed, "Seed of the per-pixel sample sets")->capture_default_str();
+  cmd->add_option("--device", o->device,
+                  "Where the method runs: cpu, or gpu (OpenGL 4.3 compute shaders on this render's G-buffer, headless; Mesa's llvmpipe "
+                  "where there is no GPU; docs/gpu.md)")
+      ->type_name("cpu|gpu")
+      ->capture_default_str();
   add_camera_options(*cmd, o->camera);
   cmd->add_option("--shaded", o->shaded,
                   "Also write albedo x ambient x V with a soft key light, for viewing (sRGB); transfer: a W La. With --sun (or direct.* "

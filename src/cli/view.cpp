@@ -19,6 +19,7 @@ struct ViewOptions {
   CameraOptions camera{.request = {.default_width = 960, .default_height = 540}};
   FalloffOptions falloff;
   std::uint32_t seed = 1;
+  std::string device = "cpu";
   std::vector<std::string> params;
   std::vector<std::string> sets;
   std::vector<std::string> events;
@@ -41,6 +42,7 @@ int run_view_command(const ViewOptions& o, const GlobalOptions& global) {
   if ((o.benchmark || o.wait_reference > 0 || !o.screenshot.empty()) && o.frames <= 0)
     throw InputError("--benchmark, --wait-reference and --screenshot belong to scripted runs: give --frames N");
   view::ViewSetup setup;
+  setup.device = device_from_name(o.device);
   for (const std::string& e : o.events) setup.events.push_back(view::parse_event(e));
   if (!o.ao_map.empty()) setup.ao_map = read_image(o.ao_map);
   const CameraRequest camera = camera_request(o.camera);
@@ -75,12 +77,15 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("-m,--method", o->method, "AO method:" + methods)->capture_default_str();
   add_falloff_options(*cmd, o->falloff, "Falloff mu(d): " + membership_names());
   cmd->add_option("--seed", o->seed, "Seed of the per-pixel sample sets")->capture_default_str();
+  cmd->add_option("--device", o->device, "Where the method runs at the start: cpu, or gpu (the GPU backend in the window's OpenGL 4.3 context)")
+      ->type_name("cpu|gpu")
+      ->capture_default_str();
   add_camera_options(*cmd, o->camera, "Window");
   cmd->add_option("-p,--param", o->params, "Method parameter as key=value, repeatable (as ao render)");
   cmd->add_option("--ao-map", o->ao_map, "A baked AO map to show on the mesh (view 'map')");
   cmd->add_option("--set", o->sets,
                   "A viewer setting or method parameter as key=value before the first frame: method, view (ao, shaded, transfer, map, error), "
-                  "wipe (0-1), scale (1, 2, 4), seed, threads, radius, radius_fraction, membership, up (y, z), panel, hud (on, off), "
+                  "wipe (0-1), scale (1, 2, 4), device (cpu, gpu), seed, threads, radius, radius_fraction, membership, up (y, z), panel, hud (on, off), "
                   "or any -p key");
   cmd->add_option("--event", o->events, "Scripted input FRAME:KIND:ARGS, repeatable: orbit:dx,dy  pan:dx,dy  zoom:steps  key:K  set:key=value");
   cmd->add_option("--frames", o->frames, "Render this many frames and exit (scripts, tests, benchmarks)")->check(CLI::Range(0, 1000000));

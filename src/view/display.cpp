@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "ao/eval/metrics.h"
+#include "ao/eval/shading.h"
 
 namespace ao::view {
 
@@ -26,10 +27,14 @@ float srgb(float v) { return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v,
 bool present(const Image<float>* i) { return i && !i->empty(); }
 bool present(const Image<Vec3>* i) { return i && !i->empty(); }
 
-// One RGBA pixel of the colour views.
-Vec3 colour_at(const DisplayInputs& in, std::size_t i, bool right_of_wipe, bool have_ref) {
+// One RGBA pixel of the colour views; display_background where no surface is visible.
+Vec3 colour_at(const DisplayInputs& in, int x, int y, bool right_of_wipe, bool have_ref) {
+  const std::size_t i = static_cast<std::size_t>(y) * in.gbuffer->width() + x;
+  if (!in.gbuffer->covered(i)) {
+    const float b = display_background(x, y);
+    return {b, b, b};
+  }
   if (in.view == ViewMode::Error) {
-    if (!in.gbuffer->covered(i)) return {0.5f, 0.5f, 0.5f};
     if (have_ref && present(in.method)) return signed_error_colour((*in.method)[i] - (*in.reference)[i], kHeatRange);
     return {1, 1, 1};
   }
@@ -70,10 +75,13 @@ void build_display(std::vector<std::uint8_t>& pixels, const DisplayInputs& in, i
         const float* v = map ? &(*in.map)[row] : present(in.method) ? &(*in.method)[row] : nullptr;
         for (int x = x0; x < std::min(split, w); ++x) out[x] = v ? to_byte(v[x]) : 255;
         for (int x = std::max(x0, split); x < w; ++x) out[x] = to_byte((*in.reference)[row + x]);
+        const std::uint32_t* id = &in.gbuffer->object_id[row];
+        for (int x = x0; x < w; ++x)
+          if (id[x] == 0) out[x] = to_byte(display_background(x, y));
         continue;
       }
       for (int x = x0; x < w; ++x) {
-        const Vec3 c = colour_at(in, row + x, x >= split, have_ref);
+        const Vec3 c = colour_at(in, x, y, x >= split, have_ref);
         std::uint8_t* px = out + 4 * x;
         px[0] = to_byte(c.x), px[1] = to_byte(c.y), px[2] = to_byte(c.z), px[3] = 255;
       }

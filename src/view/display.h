@@ -32,7 +32,9 @@ bool grey_view(ViewMode view);
 
 /// The bytes of columns [x0, width) of the image (rows in parallel), into `pixels` (resized to
 /// width x height x 1 or 4). A linear V of c becomes the byte lround(255 c) of the clamped value,
-/// as the PNG writer quantises, so a screenshot of the AO view holds the bytes of `ao render -o x.png`.
+/// as the PNG writer quantises, so a screenshot of the AO view holds the bytes of `ao render -o x.png`
+/// where a surface is visible; elsewhere every view shows display_background (eval/shading.h), where
+/// that PNG is transparent.
 void build_display(std::vector<std::uint8_t>& pixels, const DisplayInputs& in, int x0);
 
 }  // namespace ao::view

@@ -67,6 +67,10 @@ void draw_hud(const StageStats& stats, const ViewerReadout& readout) {
   ImGui::Text("display  %6.1f ms", t.display);
   ImGui::Text("ref %d spp, se %s", readout.reference_spp, readout.std_error.c_str());
   if (readout.rmse >= 0) ImGui::Text("RMSE %.4f", readout.rmse);
+  if (!readout.gl_renderer.empty()) {
+    ImGui::Text("GPU %s", readout.gl_renderer.c_str());
+    for (const GpuPassTime& p : readout.gpu_passes) ImGui::Text("  %-11s %6.2f ms", p.name.c_str(), p.ms);
+  }
   ImGui::End();
 }
 

@@ -7,8 +7,11 @@
 #include <deque>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "ao/gpu/device.h"
 
 namespace ao::view {
 
@@ -48,10 +51,12 @@ struct ViewerReadout {
   double rmse = -1;       ///< Of the method against the reference; < 0 when unknown.
   std::string error;      ///< The last one-line error; empty if none.
   int width = 0, height = 0;  ///< Of the computed image.
+  std::string gl_renderer;    ///< The GPU backend's renderer when the method ran on it; empty on the CPU.
+  std::vector<GpuPassTime> gpu_passes;  ///< Its passes in the last run, in the order they ran.
 };
 
 /// The HUD (top right): frames per second, each stage's ms, the reference's rays per pixel and
-/// standard error, and the method's RMSE against it.
+/// standard error, and the method's RMSE against it; on the GPU the renderer and each pass's GPU ms.
 void draw_hud(const StageStats& stats, const ViewerReadout& readout);
 
 }  // namespace ao::view

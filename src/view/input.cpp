@@ -154,6 +154,9 @@ void apply_set(const std::string& kv, ViewerState& state, ViewerControls& contro
   if (key == "method") {
     find_method(value);
     state.select_method(value);
+  } else if (key == "device") {
+    state.device = device_from_name(value);
+    state.dirty_method = true;
   } else if (key == "seed") {
     state.seed = static_cast<std::uint32_t>(set_number(key, value, 0, 4294967295.0f));
     state.dirty_method = true;

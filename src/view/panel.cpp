@@ -153,6 +153,13 @@ void draw_panel(ViewerState& state, ViewerControls& controls, const ViewerReadou
     ImGui::EndCombo();
   }
   tooltip(std::string(find_method(state.method).summary));
+  int device = state.device == Device::Gpu ? 1 : 0;
+  ImGui::TextUnformatted("device");
+  for (int i = 0; i < 2; ++i) {
+    ImGui::SameLine();
+    if (ImGui::RadioButton(i == 0 ? "cpu" : "gpu", &device, i)) state.device = i == 0 ? Device::Cpu : Device::Gpu, state.dirty_method = true;
+  }
+  tooltip("where the method runs: the CPU, or the GPU backend (OpenGL 4.3 compute shaders in this window's context)");
   if (ImGui::CollapsingHeader("parameters", ImGuiTreeNodeFlags_DefaultOpen)) draw_parameters(state);
   if (ImGui::CollapsingHeader("neighbourhood", ImGuiTreeNodeFlags_DefaultOpen)) draw_neighbourhood(state);
   if (ImGui::CollapsingHeader("view", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_settings(state, controls);

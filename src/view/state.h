@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ao/core/membership.h"
+#include "ao/jobs/device.h"
 
 namespace ao::view {
 
@@ -25,6 +26,7 @@ struct ViewerState {
   Falloff falloff;
   float radius_basis = 1.0f;  ///< The length R fractions refer to (the diagonal ao render uses), > 0.
   std::uint32_t seed = 1;
+  Device device = Device::Cpu;  ///< Where the method runs: the CPU, or the GPU backend in the window's context.
   ViewMode view = ViewMode::AO;
   float wipe = 1.0f;          ///< Left of wipe x width: the method; right: the reference.
   int scale = 1;              ///< The image is computed at 1/scale of the window: 1, 2 or 4.

@@ -14,8 +14,10 @@
 #include <limits>
 #include <malloc.h>
 #include <memory>
+#include <optional>
 
 #include "ao/core/error.h"
+#include "ao/gpu/device.h"
 #include "ao/eval/shading.h"
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
@@ -60,12 +62,14 @@ class Viewer final : public ViewerControls {
     state_.falloff = s_.falloff;
     state_.radius_basis = s_.radius_basis;
     state_.seed = s_.seed;
+    state_.device = s_.device;
     if (s_.threads > 0) set_threads(s_.threads);
     for (const std::string& kv : s_.sets) apply_set(kv, state_, *this);
   }
 
   int run() {
     window_ = std::make_unique<Window>(width_, height_, "ao view: " + s_.scene->name, !(s_.frames > 0 || s_.benchmark));
+    sync_device();  // --device gpu without a GL 4.3 window stops here
     Clock::time_point last_input = Clock::now();
     for (frame_ = 0;; ++frame_) {
       if (window_->should_close()) break;
@@ -80,9 +84,14 @@ class Viewer final : public ViewerControls {
     }
     if (s_.json) std::cout << summary().dump(2) << "\n";
     progressive_.stop();
+    release_gpu();
     window_.reset();
     return 0;
   }
+
+  ~Viewer() { release_gpu(); }
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
 
   // ViewerControls: what input drives.
   void orbit(float dx, float dy) override { orbit_.orbit(dx, dy, height_), camera_moved(); }
@@ -136,6 +145,34 @@ class Viewer final : public ViewerControls {
 
   const MethodInfo& method() const { return find_method(state_.method); }
 
+  // The method's device as the state asks: the GPU backend borrows the window's context.
+  void sync_device() {
+    if (state_.device == frames_.device()) return;
+    if (state_.device == Device::Gpu && !gpu_) {
+      if (!window_->has_gl43())
+        throw SystemError("--device gpu: the window's OpenGL context is older than 4.3, which the GPU backend's compute shaders need; "
+                          "use --device cpu");
+      gpu_.emplace(GpuDevice::from_current_context(window_->gl_proc_loader()));
+    }
+    frames_.set_device(state_.device, gpu_ ? &*gpu_ : nullptr);
+  }
+
+  // What the GPU backend holds in the window's context goes before the context does.
+  void release_gpu() {
+    frames_.set_device(Device::Cpu);
+    gpu_.reset();
+  }
+
+  // Each GPU pass's time, summed over the run for --json, in the order the passes first ran.
+  void add_gpu_passes(const std::vector<GpuPassTime>& passes) {
+    for (const GpuPassTime& p : passes) {
+      auto it = std::find_if(gpu_totals_.begin(), gpu_totals_.end(), [&](const PassTotal& t) { return t.name == p.name; });
+      if (it == gpu_totals_.end()) it = gpu_totals_.insert(gpu_totals_.end(), PassTotal{p.name});
+      it->ms += p.ms;
+      ++it->runs;
+    }
+  }
+
   Camera current_camera() const {
     const int w = std::max(1, width_ / state_.scale), h = std::max(1, height_ / state_.scale);
     // Until the user moves, the start view exactly as ao render chose it (no trip through yaw and pitch).
@@ -148,6 +185,13 @@ class Viewer final : public ViewerControls {
   // The work of the frame: the G-buffer when the camera moved, the method when anything it reads
   // changed (the ground truth shows the progressive reference itself), then the reference.
   void update(StageTimes& times) {
+    try {
+      sync_device();
+    } catch (const SystemError& e) {  // the panel asked for the GPU in a window that cannot run it
+      if (s_.frames > 0) throw;
+      error_ = e.what();
+      state_.device = Device::Cpu;
+    }
     try {
       if (state_.dirty_gbuffer) {
         const Clock::time_point t = Clock::now();
@@ -178,6 +222,7 @@ class Viewer final : public ViewerControls {
     const nlohmann::json params = state_.params();
     result_ = m.ground_truth ? MethodOutput{} : frames_.run(m, params, state_.falloff, state_.seed);
     times.method = ms_since(t);
+    add_gpu_passes(frames_.gpu_passes());
     if (result_.stats.contains("filter_ms")) {
       times.filter = result_.stats["filter_ms"].get<double>();
       times.method = std::max(0.0, times.method - times.filter);
@@ -267,6 +312,7 @@ class Viewer final : public ViewerControls {
       r.std_error = text;
     }
     if (const GBuffer* g = frames_.gbuffer()) r.width = g->width(), r.height = g->height();
+    if (frames_.device() == Device::Gpu) r.gl_renderer = gpu_->renderer(), r.gpu_passes = frames_.gpu_passes();
     return r;
   }
 
@@ -299,6 +345,13 @@ class Viewer final : public ViewerControls {
     j["height"] = height_;
     j["scale"] = state_.scale;
     j["threads"] = state_.threads;
+    j["device"] = to_string(state_.device);
+    if (gpu_) {
+      j["gl_renderer"] = gpu_->renderer();
+      nlohmann::json passes = nlohmann::json::array();  // mean GPU ms of each pass over the runs it was in
+      for (const PassTotal& p : gpu_totals_) passes.push_back({{"name", p.name}, {"ms", p.ms / static_cast<double>(p.runs)}, {"runs", p.runs}});
+      j["gpu_passes"] = passes;
+    }
     j["benchmark"] = s_.benchmark;
     j["camera"] = camera_to_json(current_camera());
     j["reference"] = {{"samples_per_pixel", ref_.samples_per_pixel},
@@ -316,6 +369,13 @@ class Viewer final : public ViewerControls {
   std::uint64_t reference_version_ = 0;
   ViewerState state_;
   std::unique_ptr<Window> window_;
+  std::optional<GpuDevice> gpu_;  // the window's context, borrowed when the GPU device is first chosen
+  struct PassTotal {
+    std::string name;
+    double ms = 0;
+    long runs = 0;
+  };
+  std::vector<PassTotal> gpu_totals_;
   bool shown_grey_ = true;  // which of the window's textures the frame shows
   std::vector<std::uint8_t> pixels_;
   int width_ = 0, height_ = 0;

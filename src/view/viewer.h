@@ -15,6 +15,7 @@
 #include "ao/core/camera.h"
 #include "ao/core/image.h"
 #include "ao/core/membership.h"
+#include "ao/jobs/device.h"
 #include "ao/scene/mesh.h"
 
 namespace ao::view {
@@ -39,6 +40,9 @@ struct ViewSetup {
   Falloff falloff;                  ///< R and membership the user asked for.
   float radius_basis = 1.0f;        ///< The length R fractions refer to (the diagonal ao render uses), > 0.
   std::uint32_t seed = 1;
+  /// Where the method runs at the start (the panel and --set device switch it): the GPU backend
+  /// borrows the window's context, which must then be OpenGL 4.3 (SystemError otherwise).
+  Device device = Device::Cpu;
   int threads = 0;                  ///< 0: all cores.
   Image<float> ao_map;              ///< --ao-map: shown by the "map" view; empty if none.
   std::vector<std::string> sets;    ///< --set key=value, applied before the first frame.
@@ -52,7 +56,7 @@ struct ViewSetup {
 };
 
 /// Opens the window and runs until it is closed (or `frames` are done). Returns the exit code.
-/// No display, or no OpenGL 3.3: SystemError with one line naming the problem.
+/// No display, or no OpenGL 3.3 (4.3 for the GPU device): SystemError with one line naming the problem.
 int run_view(ViewSetup setup);
 
 }  // namespace ao::view

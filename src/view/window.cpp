@@ -35,12 +35,16 @@ struct Window::Impl {
 Window::Window(int width, int height, const std::string& title, bool vsync) : impl_(std::make_unique<Impl>()) {
   glfwSetErrorCallback([](int, const char* message) { last_glfw_error() = message ? message : ""; });
   if (!glfwInit()) throw SystemError("ao view: no display (" + last_glfw_error() + "): set DISPLAY, or run it under xvfb-run");
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // the window is the image: its size is the camera's
-  impl_->window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  // 4.3 (compute shaders, for the GPU backend) when the driver has it, else 3.3 (the CPU's images).
+  for (const int minor_of_4 : {3, -1}) {
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, minor_of_4 < 0 ? 3 : 4);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, minor_of_4 < 0 ? 3 : minor_of_4);
+    impl_->window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    if (impl_->window) break;
+  }
   if (!impl_->window) {
     glfwTerminate();
     throw SystemError("ao view: cannot open an OpenGL 3.3 core window (" + last_glfw_error() + ")");
@@ -73,6 +77,13 @@ Window::~Window() {
   glfwDestroyWindow(impl_->window);
   glfwTerminate();
 }
+
+bool Window::has_gl43() const {
+  const int major = glfwGetWindowAttrib(impl_->window, GLFW_CONTEXT_VERSION_MAJOR);
+  return major > 4 || (major == 4 && glfwGetWindowAttrib(impl_->window, GLFW_CONTEXT_VERSION_MINOR) >= 3);
+}
+
+GlProcLoader Window::gl_proc_loader() const { return glfwGetProcAddress; }
 
 bool Window::should_close() const { return glfwWindowShouldClose(impl_->window); }
 void Window::wait_events(double seconds) { glfwWaitEventsTimeout(seconds); }

@@ -1,6 +1,7 @@
 // The window of `ao view` and everything OpenGL: GLFW, Dear ImGui's context, the two textures the
 // image is shown from, the frame's drawing, and reading it back for screenshots. The rest of the
-// viewer never calls GL.
+// viewer never calls GL (the GPU backend, src/ao/gpu/, computes in this window's context when the
+// viewer runs the method there).
 #pragma once
 
 #include <cstdint>
@@ -11,17 +12,24 @@
 
 #include "ao/core/image.h"
 #include "ao/core/math.h"
+#include "ao/gpu/device.h"
 
 namespace ao::view {
 
 class Window {
  public:
-  /// Opens a width x height window with an OpenGL 3.3 core context and Dear ImGui on it; `vsync`
-  /// paces frames to the display. SystemError with one line when there is no display or no GL 3.3.
+  /// Opens a width x height window with an OpenGL 4.3 core context (what the GPU backend needs),
+  /// else 3.3 core (enough to show images), and Dear ImGui on it; `vsync` paces frames to the
+  /// display. SystemError with one line when there is no display or no GL 3.3.
   Window(int width, int height, const std::string& title, bool vsync);
   ~Window();
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;
+
+  /// The context is OpenGL 4.3 core: GpuDevice::from_current_context(gl_proc_loader()) can borrow it.
+  bool has_gl43() const;
+  /// glfwGetProcAddress: the context's GL functions, for GpuDevice::from_current_context.
+  GlProcLoader gl_proc_loader() const;
 
   bool should_close() const;
   /// Waits for input for at most `seconds` (an idle interactive window), or only polls.

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ao/eval/shading.h"
+#include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
 #include "support/run.h"
 
@@ -36,6 +38,38 @@ TEST(RenderCli, DefaultSceneWritesImageAndJsonSummary) {
   EXPECT_GT(j["stats"]["rays"].get<double>(), 0.0);
   EXPECT_GE(j["stats"]["max_std_error"].get<double>(), j["stats"]["mean_std_error"].get<double>());
   for (const char* t : {"load_ms", "bvh_ms", "gbuffer_ms", "ao_ms", "write_ms"}) EXPECT_TRUE(j["timings"].contains(t)) << t;
+}
+
+// The check of a readable picture: a lone mesh with no camera options covers at least 30%
+// of the frame, and its background is not white: the V PNG and --shaded show display_background
+// there; the EXR keeps V = 1 (data).
+TEST(RenderCli, LoneMeshFillsTheFrameAndItsBackgroundIsNotOpenSurface) {
+  TempDir dir;
+  dir.write("cube.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+  const RunResult r = run_ao("render cube.obj --width 160 --height 90 --spp 4 -o v.png --shaded s.png --gbuffer-out g.exr", dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(run_ao("render cube.obj --width 160 --height 90 --spp 4 -o v.exr", dir.path()).exit_code, 0);
+  const StoredPng v = read_stored_png(dir / "v.png"), shaded = read_stored_png(dir / "s.png");
+  const Image<float> data = read_image(dir / "v.exr");
+  const GBuffer g = read_gbuffer_exr(dir / "g.exr");
+  ASSERT_EQ(v.channels, 1);
+  ASSERT_EQ(shaded.channels, 3);
+  std::size_t covered = 0, background = 0;
+  for (int y = 0; y < 90; ++y)
+    for (int x = 0; x < 160; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * 160 + x;
+      if (g.covered(i)) {
+        ++covered;
+        continue;
+      }
+      ++background;
+      EXPECT_EQ(v.samples[i], static_cast<unsigned>(std::lround(255 * display_background(x, y)))) << x << "," << y;
+      EXPECT_EQ(data[i], 1.0f) << "EXR: V = 1 on the background";
+      EXPECT_LT(shaded.samples[3 * i], 255u) << "the shaded background is not white";
+    }
+  EXPECT_GE(static_cast<double>(covered) / (160.0 * 90.0), 0.30);
+  EXPECT_GT(background, 0u);
 }
 
 TEST(RenderCli, WithoutOutputNamesTheFileAfterSceneAndMethod) {

@@ -57,8 +57,11 @@ TEST(Vocabulary, TheDocumentedTableIsWhatEachCommandTakes) {
   const auto table = documented();
   ASSERT_GT(table.size(), 15u) << "docs/cli.md's table was not found";
   for (const auto& [option, commands] : table) EXPECT_EQ(seen[option], commands) << option << " in docs/cli.md";
-  for (const auto& [option, commands] : seen)
-    if (commands.size() > 1) EXPECT_TRUE(table.count(option)) << option << " is taken by several commands but not in docs/cli.md";
+  for (const auto& [option, commands] : seen) {
+    if (commands.size() > 1) {
+      EXPECT_TRUE(table.count(option)) << option << " is taken by several commands but not in docs/cli.md";
+    }
+  }
 }
 
 TEST(Vocabulary, AMistypedCommandOrOptionGetsTheClosestName) {
@@ -85,6 +88,12 @@ TEST(Vocabulary, CompareTakesKeyValueForEveryChosenMethodThatHasIt) {
   EXPECT_NE(r.out.find("\"intensity\": 0.3"), std::string::npos);
   EXPECT_NE(r.out.find("\"slices\": 3"), std::string::npos);
   test::expect_one_line_error(test::run_ao("compare --methods gtao -p intensity=0.3", dir.path()), "no chosen method has a parameter 'intensity'");
+  // -p @FILE as in the other commands: a parameter file's keys for every chosen method that has them.
+  std::ofstream(dir / "p.json") << R"({"parameters": {"intensity": 0.25}})";
+  const test::RunResult f = test::run_ao("compare --methods alchemy,gtao -p @p.json --width 32 --height 18 --reference-samples 4 --json -q --out-dir out2",
+                                         dir.path());
+  ASSERT_EQ(f.exit_code, 0) << f.err;
+  EXPECT_NE(f.out.find("\"intensity\": 0.25"), std::string::npos);
 }
 
 }  // namespace

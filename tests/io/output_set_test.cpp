@@ -304,6 +304,21 @@ TEST(StaleTemporaries, ThoseOfKilledRunsAreRemovedOthersAreKept) {
   EXPECT_EQ(remove_stale_temporaries(dir / "out.png"), 0);
 }
 
+TEST(StaleTemporaries, AbandonedOnesAreRemovedWheneverWritten) {
+  // A batch task rerun after its worker was killed: the temporary files of other processes for
+  // its own output go, also those written after this process started; other names stay.
+  TempDir dir;
+  const std::string dead = std::to_string(dead_pid()), alive = std::to_string(::getppid());
+  const fs::path young = dir / (".out.tmp-" + dead + "-1.png"), live = dir / (".out.tmp-" + alive + "-3.png"),
+                 other = dir / (".other.tmp-" + dead + "-0.png"), user = dir / ".out.tmp-notes.png";
+  for (const fs::path& p : {young, live, other, user}) write_text(p, "x");
+  EXPECT_EQ(remove_abandoned_temporaries(dir / "out.png"), 2);
+  EXPECT_FALSE(fs::exists(young));
+  EXPECT_FALSE(fs::exists(live)) << "the caller owns the output: another writer of it is not live";
+  EXPECT_TRUE(fs::exists(other)) << "another output's";
+  EXPECT_TRUE(fs::exists(user)) << "not a name ao makes";
+}
+
 TEST(StaleTemporaries, ALaterCliRunRemovesWhatAKilledRunLeft) {
   TempDir dir;
   const fs::path stale = dir / (".demo.tmp-" + std::to_string(dead_pid()) + "-0.png");

@@ -33,7 +33,10 @@ namespace {
 RunResult run_command(const std::string& command, const std::string& args, const std::filesystem::path& cwd) {
   TempDir capture;
   const std::string cd = cwd.empty() ? "" : "cd " + quote(cwd.string()) + " && ";
-  const std::string cmd = cd + command + " " + args + " </dev/null >" + quote((capture / "out").string()) + " 2>" +
+  // Progress lines in a log come once a day here, so that what a test reads on stderr does not
+  // depend on how long the run took (under a sanitizer, on a loaded machine); a test of progress
+  // sets its own interval (`env AO_PROGRESS_SECONDS=...` in run_ao_under's prefix wins).
+  const std::string cmd = cd + "AO_PROGRESS_SECONDS=86400 " + command + " " + args + " </dev/null >" + quote((capture / "out").string()) + " 2>" +
                           quote((capture / "err").string());
   const int status = std::system(cmd.c_str());
   RunResult r;
@@ -87,6 +90,18 @@ std::string read_text(const std::filesystem::path& path) {
   std::ostringstream s;
   s << f.rdbuf();
   return s.str();
+}
+
+// xvfb-run searching for a free display from a number of this test's own: parallel tests starting
+// Xvfb with -a from the same number can pick the same display, and a stale lock (a killed Xvfb)
+// must not fail the test.
+std::string xvfb() {
+  static std::atomic<int> counter{0};
+  const int server = 200 + static_cast<int>(getpid() % 500) * 8 + (counter++ % 8);
+  // In the sanitizer build, leak checking is off for the window's process: Mesa's OpenGL driver,
+  // loaded and unloaded at run time, leaves a few small allocations at exit that LeakSanitizer
+  // reports from an unnamed module (nothing of ours).
+  return "xvfb-run -a -n " + std::to_string(server) + " -s '-screen 0 640x480x24' env ASAN_OPTIONS=detect_leaks=0";
 }
 
 }  // namespace ao::test

@@ -17,6 +17,10 @@ RunResult run_ao(const std::string& args, const std::filesystem::path& cwd = {})
 /// The same with `prefix` before the binary (e.g. "xvfb-run -a" for a command that opens a window).
 RunResult run_ao_under(const std::string& prefix, const std::string& args, const std::filesystem::path& cwd = {});
 
+/// The prefix that runs a command in a virtual X display of its own (xvfb-run, 640 x 480), for
+/// run_ao_under: `ao view` needs a display.
+std::string xvfb();
+
 /// run_ao under resource limits: `ulimits` are bash `ulimit` options ("-f 64": files of at most
 /// 64 KiB; "-v 4194304": 4 GiB of address space). SIGXFSZ is ignored, so a write beyond -f fails
 /// with EFBIG, as on a full disk, instead of killing the process.

@@ -4,7 +4,6 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -129,21 +128,10 @@ TEST(CameraJson, BadFilesAreOneLineErrors) {
   EXPECT_NE(bad(R"({"eye":[0,0,5],"target":[0,0,0],"up":[0,1,0],"fov":40,"width":0})").find("'width'"), std::string::npos);
 }
 
-// xvfb-run searching for a free display from a number of this test's own: parallel tests starting
-// Xvfb with -a from the same number can pick the same display, and a stale lock (a killed Xvfb)
-// must not fail the test.
-std::string xvfb() {
-  static std::atomic<int> counter{0};
-  const int server = 200 + static_cast<int>(getpid() % 500) * 8 + (counter++ % 8);
-  // In the sanitizer build, leak checking is off for the window's process: Mesa's OpenGL driver,
-  // loaded and unloaded at run time, leaves a few small allocations at exit that LeakSanitizer
-  // reports from an unnamed module (nothing of ours).
-  return "xvfb-run -a -n " + std::to_string(server) + " -s '-screen 0 640x480x24' env ASAN_OPTIONS=detect_leaks=0";
-}
-
 const std::string kSize = " --width 160 --height 90 ";
 
-// The R channel of an RGB screenshot against the grey PNG ao render wrote, as 8-bit codes.
+// The R channel of an RGB screenshot against the grey PNG ao render wrote, as 8-bit codes (both
+// show display_background where no surface is visible).
 int max_code_difference(const std::filesystem::path& screenshot, const std::filesystem::path& render) {
   const Image<Vec3> shot = read_rgb_image(screenshot);
   const Image<float> ref = read_image(render);

@@ -35,7 +35,9 @@ struct RaytracedBakeParams {
   std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
   /// Maps only: sigma, in texels, of the texture-space filter that averages the noise of texels
   /// that are neighbours on the surface (denoise.h); 0 = off, the plain estimate of eq. 2.
-  /// [0, kMaxDenoiseSigma]. Bent normals are not filtered.
+  /// [0, kMaxDenoiseSigma]. Bent normals are not filtered. 0 here, where this baker is a building
+  /// block; run_bake (jobs/bake.h), the one call that bakes as `ao bake` does, uses
+  /// kDefaultBakeDenoise.
   float denoise = 0.0f;
 
   /// Throws InputError naming the bad field.

@@ -11,9 +11,14 @@ Image<Vec3> shade_for_display(const GBuffer& g, const Image<float>& v, const Ima
   const Vec3 light = normalize(Vec3{-0.4f, 0.8f, 0.45f});  // camera space
   constexpr float kAmbient = 0.45f, kKey = 0.75f, kWrap = 0.5f;
   constexpr float kSkyWithSun = 0.5f;  // La in display units with a direct-light pass
-  Image<Vec3> out(g.width(), g.height(), Vec3{1, 1, 1});
+  Image<Vec3> out(g.width(), g.height());
+  const auto w = static_cast<std::size_t>(g.width());
   for (std::size_t i = 0; i < out.size(); ++i) {
-    if (!g.covered(i)) continue;
+    if (!g.covered(i)) {
+      const float b = display_background(static_cast<int>(i % w), static_cast<int>(i / w));
+      out[i] = {b, b, b};
+      continue;
+    }
     if (!g.direct.empty()) {
       const Vec3 ambient = color.empty() ? g.albedo[i] * v[i] : g.albedo[i] * color[i];  // a V or a W
       out[i] = (ambient + g.direct[i]) * kSkyWithSun;
@@ -23,6 +28,15 @@ Image<Vec3> shade_for_display(const GBuffer& g, const Image<float>& v, const Ima
     const float light_in = kAmbient + kKey * wrap;
     out[i] = color.empty() ? g.albedo[i] * (v[i] * light_in) : g.albedo[i] * color[i] * light_in;
   }
+  return out;
+}
+
+Image<float> with_display_background(const Image<float>& v, const Image<std::uint8_t>& coverage) {
+  AO_ASSERT(v.width() == coverage.width() && v.height() == coverage.height());
+  Image<float> out = v;
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x)
+      if (coverage(x, y) == 0) out(x, y) = display_background(x, y);
   return out;
 }
 

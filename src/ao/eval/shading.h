@@ -3,6 +3,7 @@
 // (`ao render --ao-map`). Neither is an AO method; both are what a viewer does with one.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "ao/core/gbuffer.h"
@@ -11,8 +12,19 @@
 
 namespace ao {
 
+/// The background of pictures for people (--shaded, compare's sheet, ao view) where no surface is
+/// visible: a checkerboard of 8-pixel squares of linear grey 0.3 and 0.45, pixel (x, y) from the
+/// image's top-left corner. The usual sign of "nothing here" (and what viewers draw under a PNG's
+/// transparent pixels); no smooth AO or shaded surface looks like it, whereas white is open surface
+/// (V = 1).
+inline float display_background(int x, int y) { return ((x >> 3) ^ (y >> 3)) & 1 ? 0.45f : 0.3f; }
+
+/// `v` with display_background where `coverage` (the same size; coverage_mask) is 0: what a picture
+/// of V shows, where white is open surface.
+Image<float> with_display_background(const Image<float>& v, const Image<std::uint8_t>& coverage);
+
 /// A picture for people, not data: albedo a x V x (ambient + a soft key light) per covered pixel,
-/// white background. The key light comes from above-left of the camera (camera space
+/// display_background elsewhere. The key light comes from above-left of the camera (camera space
 /// (-0.4, 0.8, 0.45), normalised); wrapping max(0, (n.l + w) / (1 + w)) with w = 0.5 keeps faces
 /// turned away from it from going black, so the AO stays readable everywhere; light = 0.45
 /// ambient + 0.75 key x wrap.

@@ -31,17 +31,34 @@ Params params_of(const MethodInfo& m, const nlohmann::json& j) {
   return c.get<Params>();
 }
 
+// The registry's row of `method`, when the GPU runs it.
+const MethodInfo& gpu_method(std::string_view method) {
+  const MethodInfo& m = find_method(method);  // InputError listing the methods for an unknown name
+  if (std::find(kGpuMethods.begin(), kGpuMethods.end(), method) == kGpuMethods.end())
+    throw InputError("method " + std::string(m.name) + " runs on the CPU only (--device cpu); the GPU runs containment, volumetric, transfer, cone, alchemy, gtao");
+  return m;
+}
+
 }  // namespace
 
 std::span<const std::string_view> gpu_method_names() { return kGpuMethods; }
+
+void check_gpu_method(std::string_view method, const nlohmann::json& params) {
+  const MethodInfo& m = gpu_method(method);
+  if (method == "containment") params_of<ContainmentParams>(m, params);
+  else if (method == "volumetric") params_of<VolumetricParams>(m, params);
+  else if (method == "transfer") params_of<TransferParams>(m, params);
+  else if (method == "alchemy") params_of<AlchemyParams>(m, params);
+  else if (method == "gtao") params_of<GtaoParams>(m, params);
+  else if (params_of<ConeParams>(m, params).resolved().grid == GridSpace::Eye)
+    throw InputError("cone on the GPU traces the world grid only: grid=eye runs on the CPU (--device cpu)");
+}
 
 GpuMethodOutput run_gpu_method(GpuDevice& device, std::string_view method, const GpuMethodInput& in, const nlohmann::json& params) {
   using namespace gpu_detail;
   Context& c = Access::context(device);
   if (Access::textures(in.gbuffer).context.get() != &c) throw InputError("--device gpu: the G-buffer was made on another device");
-  const MethodInfo& m = find_method(method);  // InputError listing the methods for an unknown name
-  if (std::find(kGpuMethods.begin(), kGpuMethods.end(), method) == kGpuMethods.end())
-    throw InputError("method " + std::string(m.name) + " runs on the CPU only (--device cpu); the GPU runs containment, volumetric, transfer, cone, alchemy, gtao");
+  const MethodInfo& m = gpu_method(method);
   c.make_current();
   Run r{c, Access::textures(in.gbuffer), {}};
   GpuMethodOutput out;

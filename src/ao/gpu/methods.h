@@ -47,6 +47,14 @@ struct GpuMethodOutput {
 /// cone, alchemy, gtao (not raytraced: the ground truth stays on the CPU).
 std::span<const std::string_view> gpu_method_names();
 
+/// The checks of run_gpu_method that need no device, for a caller that wants to refuse a run
+/// before loading anything: InputError (one line, naming the way out) when `method` is not one the
+/// GPU runs, when `params` (read through its parameter table, with its messages) are not valid, or
+/// when they ask for what the backend does not implement (a characteristic function other than the
+/// depth buffer, cone's eye grid). What depends on the scene (cone's open meshes) is checked when it
+/// runs. In a library built without the backend: SystemError saying so.
+void check_gpu_method(std::string_view method, const nlohmann::json& params);
+
 /// Runs `method` on the GPU with `params` read through its parameter table (InputError, one line,
 /// for unknown keys, wrong types, values out of range, as the CPU run does). What the GPU backend
 /// does not implement is an InputError naming it: a characteristic function other than the depth

@@ -36,6 +36,7 @@ int GpuGBuffer::height() const { unavailable(); }
 const std::vector<GpuPassTime>& GpuGBuffer::passes() const { unavailable(); }
 
 std::span<const std::string_view> gpu_method_names() { return {}; }
+void check_gpu_method(std::string_view, const nlohmann::json&) { unavailable(); }
 GpuMethodOutput run_gpu_method(GpuDevice&, std::string_view, const GpuMethodInput&, const nlohmann::json&) { unavailable(); }
 GpuMethodOutput run_gpu_method(GpuDevice&, std::string_view, const MethodInput&, const nlohmann::json&) { unavailable(); }
 VoxelGrid gpu_voxelize_world(GpuDevice&, const GpuScene&, const VoxelizeOptions&, VoxelStats*) { unavailable(); }

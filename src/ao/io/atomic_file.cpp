@@ -205,7 +205,11 @@ void check_output_destination(const fs::path& path, const std::string& what) {
   throw InputError(path.string() + ": " + what + " is " + through + type + ", not a regular file; ao writes only regular files or new paths");
 }
 
-int remove_stale_temporaries(const fs::path& destination) {
+namespace {
+
+// Removes the temporary files of other processes beside `destination` (write_file_atomically's
+// names) that `abandoned` accepts.
+int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned) {
   std::error_code ec;
   fs::path target = destination;
   if (fs::is_symlink(destination, ec)) {
@@ -219,13 +223,26 @@ int remove_stale_temporaries(const fs::path& destination) {
     const fs::path& p = it->path();
     const long pid = temporary_pid(p.filename().string(), target);
     if (pid <= 0 || pid == ::getpid()) continue;
-    // A process that still runs (or that we may not signal, EPERM) is not ours to clean up after.
-    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     std::error_code file_ec;
-    if (!it->is_regular_file(file_ec) || it->last_write_time(file_ec) >= g_process_start || file_ec) continue;
+    if (!it->is_regular_file(file_ec) || file_ec || !abandoned(pid, *it)) continue;
     if (fs::remove(p, file_ec)) ++removed;
   }
   return removed;
+}
+
+}  // namespace
+
+int remove_stale_temporaries(const fs::path& destination) {
+  return remove_temporaries_of(destination, [](long pid, const fs::directory_entry& file) {
+    // A process that still runs (or that we may not signal, EPERM) is not ours to clean up after.
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) return false;
+    std::error_code ec;
+    return file.last_write_time(ec) < g_process_start && !ec;
+  });
+}
+
+int remove_abandoned_temporaries(const fs::path& destination) {
+  return remove_temporaries_of(destination, [](long, const fs::directory_entry&) { return true; });
 }
 
 void write_file_atomically(const fs::path& path, const std::function<void(const fs::path& temp)>& write) {

@@ -46,6 +46,14 @@ void check_output_destination(const std::filesystem::path& path, const std::stri
 /// one destination at once race anyway.
 int remove_stale_temporaries(const std::filesystem::path& destination);
 
+/// Removes every temporary file that another process made for `destination` (named as
+/// write_file_atomically names them), whichever machine it ran on and whenever it wrote: for a
+/// caller that owns `destination` and knows no other writer of it is live, such as a task of a
+/// batch that the scheduler gives to one worker at a time, rerun after the worker that held it was
+/// killed (SIGKILL leaves its temporary files; remove_stale_temporaries keeps those written after
+/// this process started). Returns how many it removed; never throws.
+int remove_abandoned_temporaries(const std::filesystem::path& destination);
+
 /// Installs handlers of SIGINT, SIGTERM and SIGHUP that remove every registered temporary file
 /// (those of write_file_atomically, OutputSet and ScratchFile not yet renamed or removed) and the
 /// empty folders an OutputSet created, then end the process by the same signal with its default

@@ -5,8 +5,6 @@
 // else, and it cannot write at all (the GLB is serialised to memory and written atomically here).
 #include "ao/io/gltf_document.h"
 
-#include <tiny_gltf.h>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -24,6 +22,7 @@
 #include "ao/io/asset_path.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/gltf_check.h"
+#include "ao/io/tiny_gltf_internal.h"
 
 namespace ao {
 
@@ -145,7 +144,8 @@ std::array<double, 9> normal_matrix(const Mat4& m, double& det) {
 
 // --- the document -------------------------------------------------------------------------------
 
-struct GltfDocument::Impl {
+// Hidden, as the tinygltf model it holds (tiny_gltf_internal.h): nothing outside libao sees either.
+struct __attribute__((visibility("hidden"))) GltfDocument::Impl {
   fs::path path;
   int uv_set = 0;
   tinygltf::Model model;

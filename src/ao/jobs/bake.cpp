@@ -97,6 +97,7 @@ void check_high_to_low(const BakeRequest& r) {
   if (r.high.empty()) {
     if (!r.cage.empty() || h.cage_extrusion || h.max_front || h.max_back || !r.outputs.miss_mask.empty())
       throw InputError("--cage, --cage-extrusion, --max-front, --max-back and --miss-mask need --high (the high-poly mesh to bake from)");
+    h.validate();  // every value in its range even where it is not used (--cage-points 0)
     return;
   }
   if (r.method == Baker::Histogram)

@@ -1,5 +1,6 @@
 #include "ao/jobs/compare.h"
 
+#include <array>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -7,6 +8,7 @@
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/jobs/compare_gpu_internal.h"
 #include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
 
@@ -91,7 +93,7 @@ std::string format_value(const nlohmann::json& v) {
 
 CompareSettings resolve_compare_settings(const CompareSettings& in) {
   CompareSettings s = in;
-  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError("--spp-reference must be in [1, 1048576]");
+  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError("--reference-samples must be in [1, 1048576]");
   s.falloff.validate();
   if (s.methods.empty()) {
     // Every approximate method (the reference itself is not compared with itself).
@@ -141,8 +143,11 @@ std::optional<ReferenceSpec> common_reference_spec(const CompareSettings& s) {
   }
 }
 
-CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const AnalyticSurfaces* surfaces, const CompareSettings& settings) {
+CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const AnalyticSurfaces* surfaces, const CompareSettings& settings,
+                              GpuDevice* gpu) {
   const CompareSettings s = resolve_compare_settings(settings);
+  std::optional<CompareGpuColumn> gpu_column;
+  if (s.device == Device::Gpu) gpu_column.emplace(gpu, scene, g);
   CompareResult result;
   result.falloff = s.falloff;
   result.spp_reference = s.spp_reference;
@@ -150,6 +155,7 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
   result.width = g.width();
   result.height = g.height();
   result.sweep_key = s.sweep_key;
+  if (gpu_column) result.device = Device::Gpu, result.gl_renderer = gpu_column->renderer(), result.gpu_upload_ms = gpu_column->upload_ms();
 
   auto reference_for = [&](const ReferenceSpec& spec) -> std::size_t {
     const std::string key = spec.key();
@@ -187,6 +193,7 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
     row.common = against_common(out.visibility);
     row.stats = out.stats;
     row.visibility = std::move(out.visibility);
+    if (gpu_column) row.gpu = gpu_column->run(name, p, s.falloff, s.seed, ref, row.visibility, covered, true);
     result.rows.push_back(std::move(row));
   }
 
@@ -200,8 +207,10 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
         const std::size_t r = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
         double ms = 0;
         const MethodOutput out = run_method(m, p, ms);
-        const ErrorMetrics e = compare_images(out.visibility, result.references[r].visibility, covered);
-        result.sweep.push_back({name, v, e.rmse, against_common(out.visibility).rmse, ms});
+        const Image<float>& ref = result.references[r].visibility;
+        const ErrorMetrics e = compare_images(out.visibility, ref, covered);
+        result.sweep.push_back({name, v, e.rmse, against_common(out.visibility).rmse, ms, {}});
+        if (gpu_column) result.sweep.back().gpu = gpu_column->run(name, p, s.falloff, s.seed, ref, out.visibility, covered, false);
       }
     }
   return result;
@@ -216,6 +225,7 @@ nlohmann::json compare_table_json(const CompareResult& r) {
                         {"ssim", e.ssim}, {"mean_signed_error", e.mean_signed}, {"max_abs_error", e.max_abs}, {"pixels", e.pixels},
                         {"reference", reference}, {"stats", row.stats}};
     if (r.common) j["common"] = metrics_json(row.common);
+    if (row.gpu) j["gpu"] = gpu_run_json(*row.gpu);
     rows.push_back(std::move(j));
   }
   nlohmann::json table = {{"width", r.width},        {"height", r.height},
@@ -223,10 +233,36 @@ nlohmann::json compare_table_json(const CompareResult& r) {
                           {"seed", r.seed},          {"spp_reference", r.spp_reference}};
   if (r.common) table["common_reference"] = reference_json(r.references[*r.common], r.spp_reference);
   table["rows"] = std::move(rows);
+  if (r.device == Device::Gpu) table.update({{"device", "gpu"}, {"gl_renderer", r.gl_renderer}, {"gpu_upload_ms", r.gpu_upload_ms}});
   return shortest_floats(table);
 }
 
+namespace {
+
+constexpr std::array<const char*, 5> kMetricTitles{"ms", "RMSE", "PSNR (dB)", "SSIM", "mean signed error"};
+
+// A row's metric cells under kMetricTitles; with the GPU backend each is a pair, CPU then GPU ("-"
+// where the GPU did not run the method).
+std::vector<std::string> metric_cells(const CompareRow& row) {
+  const auto cells = [](double ms, const ErrorMetrics& e) {
+    return std::array<std::string, 5>{fixed(ms, 1), fixed(e.rmse, 4), std::isfinite(e.psnr_db) ? fixed(e.psnr_db, 2) : "inf", fixed(e.ssim, 4),
+                                      fixed(e.mean_signed, 4)};
+  };
+  const std::array<std::string, 5> cpu = cells(row.ms, row.metrics);
+  std::array<std::string, 5> gpu;
+  if (row.gpu) gpu = row.gpu->skipped.empty() ? cells(row.gpu->ms, row.gpu->metrics) : std::array<std::string, 5>{"-", "-", "-", "-", "-"};
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < cpu.size(); ++i) {
+    out.push_back(cpu[i]);
+    if (row.gpu) out.push_back(gpu[i]);
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string compare_table_markdown(const CompareResult& r, const std::string& scene_name) {
+  const bool gpu = r.device == Device::Gpu;
   std::ostringstream md;
   md << "# ao compare: " << scene_name << "\n\n"
      << r.width << "x" << r.height << ", R = " << format_value(shortest_floats(r.falloff.radius)) << " ("
@@ -235,22 +271,27 @@ std::string compare_table_markdown(const CompareResult& r, const std::string& sc
   if (r.common)
     md << " Each method is judged against the reference of the quantity it estimates (matched); the common columns judge every "
        << "method against one reference, " << reference_text(r.references[*r.common].spec) << ", so that rows can be ranked.";
-  md << "\n\n| method | parameters | reference | ms | RMSE | PSNR (dB) | SSIM | mean signed error |" << (r.common ? " RMSE (common) | mean signed (common) |" : "")
-     << "\n|---|---|---|---:|---:|---:|---:|---:|" << (r.common ? "---:|---:|" : "") << "\n";
+  md << "\n\n| method | parameters | reference |";
+  for (const char* title : kMetricTitles) md << (gpu ? std::string(" ") + title + " cpu | " + title + " gpu |" : std::string(" ") + title + " |");
+  md << (r.common ? " RMSE (common) | mean signed (common) |" : "") << "\n|---|---|---|";
+  for (std::size_t i = 0; i < kMetricTitles.size() * (gpu ? 2 : 1) + (r.common ? 2 : 0); ++i) md << "---:|";
+  md << "\n";
   for (const CompareRow& row : r.rows) {
     std::string params;
     for (const auto& [k, v] : row.params.items()) params += (params.empty() ? "" : ", ") + k + "=" + format_value(v);
-    const ErrorMetrics& e = row.metrics;
-    md << "| " << row.method << " | " << params << " | " << reference_text(r.references[row.reference].spec) << " | " << fixed(row.ms, 1)
-       << " | " << fixed(e.rmse, 4) << " | " << (std::isfinite(e.psnr_db) ? fixed(e.psnr_db, 2) : "inf") << " | " << fixed(e.ssim, 4) << " | "
-       << fixed(e.mean_signed, 4) << " |";
+    md << "| " << row.method << " | " << params << " | " << reference_text(r.references[row.reference].spec) << " |";
+    for (const std::string& cell : metric_cells(row)) md << " " << cell << " |";
     if (r.common) md << " " << fixed(row.common.rmse, 4) << " | " << fixed(row.common.mean_signed, 4) << " |";
     md << "\n";
   }
-  md << "\n`sheet.png`: one row per method in the order above, labelled with its name, its parameters, its reference and its RMSE"
-     << (r.common ? " (and against the common reference)" : "") << "; columns: the "
-     << "method's V, the reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at "
-     << "|error| = " << kCompareHeatRange << "; grey: background).\n";
+  if (gpu) {
+    md << gpu_markdown_notes(r);
+  } else {
+    md << "\n`sheet.png`: one row per method in the order above, labelled with its name, its parameters, its reference and its RMSE"
+       << (r.common ? " (and against the common reference)" : "") << "; columns: the "
+       << "method's V, the reference's V, the signed error (blue: darker than the reference, red: brighter, white: equal, saturated at "
+       << "|error| = " << kCompareHeatRange << "; grey checkerboard: background, no surface).\n";
+  }
   return md.str();
 }
 
@@ -259,19 +300,26 @@ nlohmann::json compare_sweep_json(const CompareResult& r) {
   for (const SweepRow& s : r.sweep) {
     nlohmann::json row = {{"method", s.method}, {r.sweep_key, s.value}, {"rmse", s.rmse}, {"ms", s.ms}};
     if (r.common) row["rmse_common"] = s.rmse_common;
+    if (s.gpu) row["gpu"] = s.gpu->skipped.empty() ? nlohmann::json{{"rmse", s.gpu->metrics.rmse}, {"ms", s.gpu->ms}} : gpu_run_json(*s.gpu);
     rows.push_back(std::move(row));
   }
   return {{"key", r.sweep_key}, {"rows", rows}};
 }
 
 std::string compare_sweep_markdown(const CompareResult& r) {
+  const bool gpu = r.device == Device::Gpu;
   std::ostringstream s;
-  s << "# ao compare sweep: " << r.sweep_key << "\n\n| method | " << r.sweep_key << " | RMSE |" << (r.common ? " RMSE (common) |" : "")
-    << " ms |\n|---|---:|---:|" << (r.common ? "---:|" : "") << "---:|\n";
+  s << "# ao compare sweep: " << r.sweep_key << "\n\n| method | " << r.sweep_key << (gpu ? " | RMSE cpu | RMSE gpu |" : " | RMSE |")
+    << (r.common ? " RMSE (common) |" : "") << (gpu ? " ms cpu | ms gpu |" : " ms |") << "\n|---|---:|---:|" << (gpu ? "---:|" : "")
+    << (r.common ? "---:|" : "") << (gpu ? "---:|---:|" : "---:|") << "\n";
   for (const SweepRow& row : r.sweep) {
+    const bool ran = row.gpu && row.gpu->skipped.empty();
     s << "| " << row.method << " | " << format_value(row.value) << " | " << fixed(row.rmse, 4) << " |";
+    if (gpu) s << " " << (ran ? fixed(row.gpu->metrics.rmse, 4) : "-") << " |";
     if (r.common) s << " " << fixed(row.rmse_common, 4) << " |";
-    s << " " << fixed(row.ms, 1) << " |\n";
+    s << " " << fixed(row.ms, 1) << " |";
+    if (gpu) s << " " << (ran ? fixed(row.gpu->ms, 1) : "-") << " |";
+    s << "\n";
   }
   return s.str();
 }

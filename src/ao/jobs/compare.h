@@ -19,6 +19,8 @@
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
 #include "ao/eval/metrics.h"
+#include "ao/gpu/device.h"
+#include "ao/jobs/device.h"
 #include "ao/jobs/inputs.h"
 #include "ao/jobs/reporter.h"
 #include "ao/reference/reference.h"
@@ -49,6 +51,10 @@ struct CompareSettings {
   std::uint32_t seed = 1;            ///< Methods use it; references use seed + 1.
   std::string sweep_key;             ///< Optional: a parameter to sweep for every method that has it.
   std::vector<nlohmann::json> sweep_values;  ///< Its values (at least one when sweep_key is set).
+  /// Cpu (default): the methods run on the CPU. Gpu: each method (and each swept value) also runs
+  /// on the GPU backend, on the same G-buffer uploaded once, against the same reference: a column
+  /// per backend. A method the GPU backend does not run is left out of the GPU column with the reason.
+  Device device = Device::Cpu;
   /// Optional: called when a stage starts ("G-buffer" is the caller's; here a method's name or
   /// "reference (tangent sphere)"); the returned function receives that stage's progress.
   std::function<ProgressFn(const std::string& stage)> progress;
@@ -62,6 +68,19 @@ struct CompareReference {
   double mean_std_error = 0;
 };
 
+/// A method's run on the GPU backend in a comparison (CompareSettings::device gpu): the CPU row's
+/// parameters, seed and G-buffer, judged against the same reference.
+struct CompareGpuRun {
+  std::string skipped;              ///< Why the GPU backend did not run it (its one-line InputError); empty when it ran.
+  double ms = 0;                    ///< The whole call: the passes and reading the images back (the G-buffer is on the device already).
+  std::vector<GpuPassTime> passes;  ///< GPU time of each pass, in the order they ran.
+  ErrorMetrics metrics;             ///< Over covered pixels, against the row's reference.
+  double max_abs_difference = 0;    ///< max |V on the GPU - V on the CPU| over covered pixels.
+  nlohmann::json stats;             ///< The GPU MethodOutput's stats (with "device" and "gpu_ms").
+  Image<float> visibility;
+  Image<Vec3> heat;                 ///< signed_error_heat_map(V, reference, coverage, kCompareHeatRange).
+};
+
 struct CompareRow {
   std::string method;
   nlohmann::json params;       ///< Complete, floats in their shortest form (shortest_floats).
@@ -73,6 +92,7 @@ struct CompareRow {
   nlohmann::json stats;        ///< MethodOutput::stats.
   Image<float> visibility;     ///< The method's V.
   Image<Vec3> heat;            ///< signed_error_heat_map(V, reference, coverage, kCompareHeatRange).
+  std::optional<CompareGpuRun> gpu;  ///< The same on the GPU backend (CompareSettings::device gpu).
 };
 
 struct SweepRow {
@@ -81,6 +101,7 @@ struct SweepRow {
   double rmse = 0;
   double rmse_common = 0;  ///< Against CompareResult::common; 0 when there is none.
   double ms = 0;
+  std::optional<CompareGpuRun> gpu;  ///< With CompareSettings::device gpu; its images are not kept.
 };
 
 struct CompareResult {
@@ -93,6 +114,9 @@ struct CompareResult {
   int spp_reference = 0;
   std::uint32_t seed = 0;
   int width = 0, height = 0;
+  Device device = Device::Cpu;  ///< Gpu: every row has its GPU run.
+  std::string gl_renderer;      ///< GL_RENDERER of the GPU device; empty on the CPU.
+  double gpu_upload_ms = 0;     ///< GPU time of uploading the G-buffer (once, for every row).
 };
 
 /// Everything compare_methods can check without rendering (method names, parameter keys,
@@ -102,8 +126,10 @@ CompareSettings resolve_compare_settings(const CompareSettings& settings);
 
 /// Runs the comparison on `gbuffer` (rendered from `scene` with its camera, which carries the world
 /// placement). `surfaces`: the scene's analytic description for the characteristic functions
-/// (may be null). Deterministic for a seed.
-CompareResult compare_methods(const RayScene& scene, const GBuffer& gbuffer, const AnalyticSurfaces* surfaces, const CompareSettings& settings);
+/// (may be null). With settings.device gpu the GPU runs are on `gpu` (null: a headless device,
+/// GpuDevice::open; SystemError without a usable OpenGL 4.3). Deterministic for a seed.
+CompareResult compare_methods(const RayScene& scene, const GBuffer& gbuffer, const AnalyticSurfaces* surfaces, const CompareSettings& settings,
+                              GpuDevice* gpu = nullptr);
 
 /// The common reference of `settings` at the requested falloff; nullopt for "none"; InputError
 /// naming --common-reference for an unknown name.
@@ -114,7 +140,10 @@ std::optional<ReferenceSpec> common_reference_spec(const CompareSettings& settin
 /// "rows": [{"method", "parameters", "ms", "rmse", "psnr_db", "ssim", "mean_signed_error",
 /// "max_abs_error", "pixels", "reference": {kind, label, membership, radius, spp, mean_std_error,
 /// ms, ...}, "common": {rmse, psnr_db, ssim, mean_signed_error, max_abs_error}, "stats"}]}; the
-/// caller adds what it knows (scene, camera, timings).
+/// caller adds what it knows (scene, camera, timings). With the GPU backend also "device": "gpu",
+/// "gl_renderer", "gpu_upload_ms", and per row "gpu": {"ms", "rmse", "psnr_db", "ssim",
+/// "mean_signed_error", "max_abs_error", "pixels", "max_abs_difference_from_cpu", "passes":
+/// [{"name", "ms"}], "stats"} or {"skipped": why} (judged against the row's matched reference).
 nlohmann::json compare_table_json(const CompareResult& result);
 /// table.md: a title line naming `scene_name`, the settings, and one row per method.
 std::string compare_table_markdown(const CompareResult& result, const std::string& scene_name);

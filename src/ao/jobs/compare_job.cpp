@@ -35,9 +35,26 @@ void write_text(const fs::path& path, const std::string& text) {
   });
 }
 
-// The sheet: per row the method's V, its reference's V and the heat map, labelled. A missing font
-// costs the labels, never the comparison.
-Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, const JobReporter& reporter) {
+// The sheet's columns: the method's V, its reference's V and the heat map; with the GPU backend
+// the method's V and heat map once per backend. Titles are pieces wrapped between, never inside,
+// so "too bright" stays whole; red above zero and blue below, as signed_error_colour draws them.
+std::vector<SheetColumn> sheet_columns(bool gpu) {
+  const SheetColumn heat{{"signed error", "(red: too bright", "/ blue: too dark)"}, true};
+  if (!gpu) return {{{"method"}}, {{"ray-traced", "reference"}}, heat};
+  return {{{"method", "(cpu)"}}, {{"method", "(gpu)"}}, {{"ray-traced", "reference"}}, {{"signed error", "(cpu)"}, true}, {{"signed error", "(gpu)"}, true}};
+}
+
+// A row's cells under sheet_columns; the GPU's are empty where it did not run the method.
+std::vector<SheetCell> sheet_cells(const CompareResult& result, const CompareRow& row) {
+  const Image<float>* reference = &result.references[row.reference].visibility;
+  if (result.device != Device::Gpu) return {{&row.visibility}, {reference}, {nullptr, &row.heat}};
+  const bool ran = row.gpu && row.gpu->skipped.empty();
+  return {{&row.visibility}, {ran ? &row.gpu->visibility : nullptr}, {reference}, {nullptr, &row.heat}, {nullptr, ran ? &row.gpu->heat : nullptr}};
+}
+
+// The sheet, labelled, the background (coverage 0) marked. A missing font costs the labels, never
+// the comparison.
+Image<Vec3> make_sheet(const CompareResult& result, const Image<std::uint8_t>& coverage, const fs::path& font_path, const JobReporter& reporter) {
   std::vector<SheetRow> rows;
   for (const CompareRow& row : result.rows) {
     std::vector<std::string> label = {row.method};
@@ -45,14 +62,15 @@ Image<Vec3> make_sheet(const CompareResult& result, const fs::path& font_path, c
     if (!kp.empty()) label.push_back(kp);
     label.push_back("reference: " + result.references[row.reference].spec.label());
     label.push_back("RMSE " + fixed4(row.metrics.rmse));  // as in table.md
+    if (row.gpu && row.gpu->skipped.empty()) label.back() = "RMSE cpu " + fixed4(row.metrics.rmse) + ", gpu " + fixed4(row.gpu->metrics.rmse);
     if (result.common && *result.common != row.reference)
       label.push_back("vs " + result.references[*result.common].spec.label() + ": " + fixed4(row.common.rmse));
-    rows.push_back({&row.visibility, &result.references[row.reference].visibility, &row.heat, std::move(label)});
+    rows.push_back({sheet_cells(result, row), std::move(label), &coverage});
   }
   std::string font_error;
   const std::optional<Font> font = Font::open(font_path.empty() ? fs::path(kDejaVuSansPath) : font_path, &font_error);
   if (!font) reporter.warn(font_error + "; sheet.png has no labels (install fonts-dejavu-core or set AO_FONT)");
-  return contact_sheet(rows, kCompareHeatRange, font ? &*font : nullptr);
+  return contact_sheet(sheet_columns(result.device == Device::Gpu), rows, kCompareHeatRange, font ? &*font : nullptr);
 }
 
 std::vector<std::string> output_files(bool sweep) {
@@ -93,6 +111,8 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   }
 
   Stopwatch clock;
+  std::optional<GpuDevice> gpu;
+  if (settings.device == Device::Gpu) gpu = GpuDevice::open();  // before anything is loaded: without a usable OpenGL the run stops here
   const std::shared_ptr<const Scene> scene = request.scene.load();
   for (const std::string& w : scene->warnings) reporter.warn(w);
   const RayScene rays(*scene);
@@ -103,7 +123,7 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   const double setup_ms = clock.lap_ms();
 
   settings.progress = reporter.stage;
-  out.result = compare_methods(rays, g, &scene->analytic, settings);
+  out.result = compare_methods(rays, g, &scene->analytic, settings, gpu ? &*gpu : nullptr);
   // Methods report problems they worked around (e.g. cone: open meshes).
   for (const CompareRow& row : out.result.rows)
     if (row.stats.contains("warnings"))
@@ -119,7 +139,7 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
                          {"fov", c.vertical_fov_deg}};
   out.table["setup_ms"] = setup_ms;
   out.markdown = compare_table_markdown(out.result, scene->name);
-  out.sheet = make_sheet(out.result, request.font, reporter);
+  out.sheet = make_sheet(out.result, coverage_mask(g), request.font, reporter);
   if (!request.out_dir.empty()) write_outputs(outputs, request.out_dir, out);
   return out;
 }

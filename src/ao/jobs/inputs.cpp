@@ -1,5 +1,6 @@
 #include "ao/jobs/inputs.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -45,9 +46,150 @@ bool is_flat(const Mesh& m) {
   return true;
 }
 
-// Auto-framing: from the front, a little to the right and above, the usual product shot.
+// The objects of interest: the scene's objects whose meshes are not flat, or every object when all
+// are flat (flatness survives an affine map, so an instance shares its mesh's).
+std::vector<SceneObject> interest_objects(const Scene& scene) {
+  std::vector<char> flat(scene.meshes.size());
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m) flat[m] = is_flat(scene.meshes[m]);
+  std::vector<SceneObject> all = scene.objects(), chosen;
+  for (const SceneObject& o : all)
+    if (!flat[o.mesh]) chosen.push_back(o);
+  return chosen.empty() ? all : chosen;
+}
+
+// Auto-framing: from the front, a little to the right and above, the usual product shot, with the
+// objects of interest fitted to the image.
 constexpr Vec3 kFramingDirection{0.55f, 0.5f, 1.0f};
 constexpr float kDefaultFov = 40.0f;
+// The objects fill this fraction of the image along the axis that limits them: a margin of 2.5% on
+// each side, so no silhouette touches the edge.
+constexpr double kFill = 0.95;
+
+// What auto-framing fits to the image, in world space: the vertices of the meshes of interest, and
+// for each instance of a mesh the eight corners of its placed bounding box (20,000 instances of a
+// large mesh would be billions of vertices; the box keeps the fit conservative). So a model on a
+// ground plane fills the frame and the plane runs out of it. Visited, not copied: a scan's millions
+// of vertices cost no memory here.
+class FramingPoints {
+ public:
+  explicit FramingPoints(const Scene& scene) : scene_(scene), objects_(interest_objects(scene)), mesh_bounds_(scene.meshes.size()) {
+    for (const SceneObject& o : objects_)
+      if (o.instance != SceneObject::kNoInstance && mesh_bounds_[o.mesh].empty()) mesh_bounds_[o.mesh] = scene.meshes[o.mesh].bounds();
+  }
+
+  template <class Fn>
+  void for_each(Fn&& fn) const {
+    for (const SceneObject& o : objects_) {
+      const Mesh& m = scene_.meshes[o.mesh];
+      if (o.instance == SceneObject::kNoInstance) {
+        for (const Vec3& p : m.positions) fn(p);
+        continue;
+      }
+      const Affine3& to_world = scene_.instances[o.instance].object_to_world;
+      const Bounds3& b = mesh_bounds_[o.mesh];
+      for (int i = 0; i < 8; ++i) fn(to_world.point({i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z}));
+    }
+  }
+
+ private:
+  const Scene& scene_;
+  std::vector<SceneObject> objects_;
+  std::vector<Bounds3> mesh_bounds_;  // of the instanced meshes, computed once
+};
+
+struct Framing {
+  Camera camera;
+  double area = 0;  // the fraction of the image the points' projected bounding rectangle covers
+};
+
+// The eye's offset e along one image axis (x: `axis` 0, y: 1) that centres the points on it: with
+// their coordinates a along the axis and depths d from the eye (camera basis, origin at `centre`,
+// eye at depth ez), each projects to (a - e) / d, and the lowest and highest of those, each
+// decreasing in e, are opposite for one e, found by bisection in [-reach, reach] (where the sum of
+// the two changes sign). 30 halvings take the interval below float precision.
+double centring_offset(const FramingPoints& points, const Frame& basis, Vec3 centre, double ez, int axis, double reach) {
+  auto sum_of_extremes = [&](double e) {
+    double low = kInfinity, high = -kInfinity;
+    points.for_each([&](Vec3 p) {
+      const Vec3 q = basis.to_local(p - centre);
+      const double v = ((axis == 0 ? q.x : q.y) - e) / (ez - q.z);
+      low = std::min(low, v), high = std::max(high, v);
+    });
+    return low + high;
+  };
+  double lo = -reach, hi = reach;
+  for (int i = 0; i < 30; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (sum_of_extremes(mid) > 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// A viewer's "frame all" along -`direction`: the eye where the points span kFill of the image along
+// the axis that limits them (vertical or horizontal), centred on that axis and, with `centre`, on
+// the other (else with equal room on both sides in depth units, which perspective makes a little
+// uneven); every point inside the image. frame_bounds gives the orientation (and the answer when
+// the points have no extent).
+Framing fit_points(const FramingPoints& points, const Bounds3& bounds, Vec3 direction, float fov, int width, int height, bool centre) {
+  Framing f{frame_bounds(bounds, direction, fov, width, height)};
+  if (!(bounds.diagonal() > 0.0f)) return f;
+  // In the camera basis (x right, y up, z towards the camera) with the origin at the box centre, a
+  // point q is inside the image seen from the eye e when |q.x - e.x| <= tan_h (e.z - q.z) and
+  // |q.y - e.y| <= tan_v (e.z - q.z). Each edge of the image is one family of parallel planes:
+  //   right:  q.x + tan_h q.z <= tan_h e.z + e.x      left:   tan_h q.z - q.x <= tan_h e.z - e.x
+  // and the same in y. The nearest eye makes both of an axis's inequalities equalities for its
+  // extreme points: tan_h e.z = (right + left) / 2 and e.x = (right - left) / 2; the larger of the
+  // two axes' e.z fits both.
+  const Frame basis = f.camera.basis();
+  const Vec3 box_centre = bounds.center();
+  const double tan_v = static_cast<double>(f.camera.tan_half_fov()) * kFill, tan_h = tan_v * f.camera.aspect();
+  double right = -kInfinity, left = -kInfinity, top = -kInfinity, bottom = -kInfinity, nearest = -kInfinity;
+  points.for_each([&](Vec3 p) {
+    const Vec3 q = basis.to_local(p - box_centre);
+    right = std::max(right, q.x + tan_h * q.z), left = std::max(left, tan_h * q.z - q.x);
+    top = std::max(top, q.y + tan_v * q.z), bottom = std::max(bottom, tan_v * q.z - q.y);
+    nearest = std::max(nearest, static_cast<double>(q.z));
+  });
+  // A point on the view axis may set the eye on itself (a segment seen end on): keep the eye 1% of
+  // the diagonal in front of the nearest point, so every point has a positive depth.
+  const double ez_x = (right + left) / (2.0 * tan_h), ez_y = (top + bottom) / (2.0 * tan_v);
+  const double ez = std::max({ez_x, ez_y, nearest + 0.01 * bounds.diagonal()});
+  double ex = (right - left) / 2.0, ey = (top - bottom) / 2.0;
+  if (centre) {
+    const double reach = 2.0 * (ez + bounds.diagonal());  // beyond every point, seen from ez
+    (ez_x >= ez_y ? ey : ex) = centring_offset(points, basis, box_centre, ez, ez_x >= ez_y ? 1 : 0, reach);
+  }
+  const Vec3 offset{static_cast<float>(ex), static_cast<float>(ey), 0.0f};
+  f.camera.target = box_centre + basis.to_world(offset);
+  f.camera.eye = f.camera.target + basis.n * static_cast<float>(ez);
+  double span_x = 0, span_y = 0;  // half the rectangle, in tangent units
+  points.for_each([&](Vec3 p) {
+    const Vec3 q = basis.to_local(p - box_centre);
+    span_x = std::max(span_x, std::abs(q.x - ex) / (ez - q.z)), span_y = std::max(span_y, std::abs(q.y - ey) / (ez - q.z));
+  });
+  f.area = std::min(1.0, span_x * kFill / tan_h) * std::min(1.0, span_y * kFill / tan_v);
+  return f;
+}
+
+// Auto-framing: the product shot from the front right and above, unless a view from further round
+// at the same height (front, front left, left, right) fills the image by a quarter more, as a tall
+// model in a wide image does when turned sideways. Never from behind: the front of a model is where
+// its author looked from.
+Camera auto_frame(const Scene& scene, float fov, int width, int height) {
+  const FramingPoints points(scene);
+  Bounds3 bounds;
+  points.for_each([&](Vec3 p) { bounds.extend(p); });
+  Vec3 direction = kFramingDirection;
+  const double needed = 1.25 * fit_points(points, bounds, direction, fov, width, height, false).area;
+  const float side = std::hypot(kFramingDirection.x, kFramingDirection.z);  // the same height above the horizon
+  double best = needed;
+  for (const Vec3 d : {Vec3{0, kFramingDirection.y, side}, Vec3{-kFramingDirection.x, kFramingDirection.y, kFramingDirection.z},
+                       Vec3{-side, kFramingDirection.y, 0}, Vec3{side, kFramingDirection.y, 0}}) {
+    const double area = fit_points(points, bounds, d, fov, width, height, false).area;
+    if (area > best) best = area, direction = d;
+  }
+  return fit_points(points, bounds, direction, fov, width, height, true).camera;
+}
 
 }  // namespace
 
@@ -89,9 +231,8 @@ std::shared_ptr<const Scene> SceneSource::load(const LoadOptions& options) const
 
 float interest_diagonal(const Scene& scene) {
   Bounds3 objects;
-  for (const SceneObject& o : scene.objects()) {
+  for (const SceneObject& o : interest_objects(scene)) {
     const Mesh& m = scene.meshes[o.mesh];
-    if (is_flat(m)) continue;  // flatness survives an affine map
     objects.extend(o.instance == SceneObject::kNoInstance ? m.bounds() : transform_bounds(scene.instances[o.instance].object_to_world, m.bounds()));
   }
   return objects.empty() ? scene.bounds().diagonal() : objects.diagonal();
@@ -133,7 +274,7 @@ Camera choose_camera(const Scene& scene, const CameraRequest& request) {
     if (request.width) cam.width = *request.width;
     if (request.height) cam.height = *request.height;
   } else {
-    cam = scene.preferred_view ? *scene.preferred_view : frame_bounds(scene.bounds(), kFramingDirection, request.fov.value_or(kDefaultFov), width, height);
+    cam = scene.preferred_view ? *scene.preferred_view : auto_frame(scene, request.fov.value_or(kDefaultFov), width, height);
     cam.width = width;
     cam.height = height;
   }
@@ -144,7 +285,7 @@ Camera choose_camera(const Scene& scene, const CameraRequest& request) {
     cam.eye = *request.eye;
   } else if (request.target && !scene.preferred_view && !request.file) {
     // Keep the framing distance and direction, looking at the new target.
-    const Camera framed = frame_bounds(scene.bounds(), kFramingDirection, cam.vertical_fov_deg, cam.width, cam.height);
+    const Camera framed = auto_frame(scene, cam.vertical_fov_deg, cam.width, cam.height);
     cam.eye = cam.target + (framed.eye - framed.target);
   }
   cam.validate();

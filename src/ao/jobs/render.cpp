@@ -1,11 +1,13 @@
 #include "ao/jobs/render.h"
 
+#include <cctype>
 #include <chrono>
 
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/eval/shading.h"
 #include "ao/gbuffer/render_gbuffer.h"
+#include "ao/gpu/methods.h"
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
 #include "ao/io/output_set.h"
@@ -107,17 +109,40 @@ Loaded load_inputs(const RenderRequest& r, const MethodInfo& m, const JobReporte
   return in;
 }
 
+// .exr in any case, as write_image chooses the format.
+bool is_exr(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".exr";
+}
+
+// The method on the GPU, on the G-buffer the render made (uploaded, with the scene for cone).
+void run_on_gpu(GpuDevice& device, const MethodInfo& m, const Loaded& in, std::uint32_t seed, RenderResult& out) {
+  const RayScene* rays = in.scene ? in.scene->rays.get() : nullptr;
+  GpuMethodOutput g = run_gpu_method(device, m.name, MethodInput{in.gbuffer, rays, out.falloff, seed}, out.params);
+  out.output = std::move(g.output);
+  out.gpu_passes = std::move(g.passes);
+  out.gl_renderer = std::move(g.renderer);
+}
+
 void write_outputs(OutputSet& set, const RenderRequest& r, RenderResult& result) {
   const RenderOutputs& o = r.outputs;
   const ImageWriteOptions write_opt{.png_bits = o.png_bits};
-  if (!o.visibility.empty()) set.write(o.visibility, [&] { write_image(o.visibility, result.output.visibility, write_opt); });
+  const Image<std::uint8_t> coverage = coverage_mask(result.gbuffer);
+  // A picture (PNG, TIFF, TGA, JPEG) shows the background as display_background, never as open
+  // surface (V = 1, white); EXR is data and keeps V = 1 there, what scripts read (with the
+  // G-buffer's coverage, --gbuffer-out, for compositing).
+  auto write_v = [&](const fs::path& path, const Image<float>& v) {
+    write_image(path, is_exr(path) ? v : with_display_background(v, coverage), write_opt);
+  };
+  if (!o.visibility.empty()) set.write(o.visibility, [&] { write_v(o.visibility, result.output.visibility); });
   if (!o.shaded.empty()) set.write(o.shaded, [&] { write_rgb_image(o.shaded, result.shaded, {.png_bits = o.png_bits, .srgb = true}); });
   if (o.extras && !o.visibility.empty())
     for (const auto& extra : result.output.extras) {
       const std::string& name = extra.first;
       const auto& image = extra.second;  // a named reference: Clang 14 cannot capture structured bindings
       const fs::path path = extra_path(o.visibility, name);
-      set.write(path, [&] { write_image(path, image, write_opt); }, "--extras");
+      set.write(path, [&] { write_v(path, image); }, "--extras");
       result.extras_written[name] = path;
     }
   if (!o.gbuffer.empty()) set.write(o.gbuffer, [&] { write_gbuffer_exr(o.gbuffer, result.gbuffer); });
@@ -154,6 +179,11 @@ nlohmann::json summary_of(const RenderRequest& r, const RenderResult& out, const
     s["triangles"] = scene->triangle_count();
     s["instances"] = scene->instances.size();
     s["warnings"] = scene->warnings;
+  }
+  s["device"] = to_string(out.device);
+  if (out.device == Device::Gpu) {
+    s["gl_renderer"] = out.gl_renderer;
+    s["gpu_passes"] = gpu_passes_json(out.gpu_passes);
   }
   if (out.output.stats.contains("rays") && out.method_ms > 0)
     s["rays_per_second"] = out.output.stats["rays"].get<double>() / (out.method_ms / 1000.0);
@@ -212,6 +242,9 @@ void check_render_request(const RenderRequest& r) {
   r.camera.validate();
   r.falloff.validate();
   const nlohmann::json params = request_params(r, m);
+  if (r.device == Device::Gpu && !r.ao_map.empty())
+    throw InputError("--ao-map shows a baked map instead of running a method: --device gpu does not apply");
+  if (r.ao_map.empty()) check_device(r.device, m, params);
   if (r.normal && gbuffer_input)
     throw InputError("--normal chooses the normal a scene's G-buffer is rendered with; a --gbuffer-in file brings its own N");
   if (r.sun) r.sun->validate();
@@ -240,6 +273,11 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   OutputSet outputs;
   declare_outputs(outputs, r, m);
   check_memory_of(r, m, out.params);
+  std::optional<GpuDevice> gpu;
+  if (r.device == Device::Gpu) {  // before anything is loaded: without a usable OpenGL the run stops here
+    gpu = GpuDevice::open();
+    timings["device_ms"] = clock.lap_ms();
+  }
 
   Loaded in = load_inputs(r, m, reporter, timings, clock);
   const bool gbuffer_input = !in.scene;
@@ -250,9 +288,13 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   if (!in.ao_map.empty()) {
     out.output.visibility = visibility_from_ao_map(in.gbuffer, *in.scene->scene, in.ao_map, r.ao_map.string());
     out.output.stats = {{"ao_map", r.ao_map.string()}, {"map_width", in.ao_map.width()}, {"map_height", in.ao_map.height()}};
+  } else if (gpu) {
+    reporter.start(out.method + " (gpu)");
+    run_on_gpu(*gpu, m, in, r.seed, out);
   } else {
     out.output = run_method(m, out.params, in.gbuffer, in.scene ? &*in.scene : nullptr, out.falloff, r.seed, nullptr, reporter.start(out.method));
   }
+  out.device = gpu ? Device::Gpu : Device::Cpu;
   out.method_ms = clock.lap_ms();
   timings["ao_ms"] = out.method_ms;
   // Methods report problems they worked around (e.g. cone: open meshes, odd voxel columns).

@@ -15,11 +15,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/gbuffer/render_gbuffer.h"
+#include "ao/gpu/device.h"
+#include "ao/jobs/device.h"
 #include "ao/jobs/inputs.h"
 #include "ao/jobs/reporter.h"
 #include "ao/reference/direct_light.h"
@@ -51,6 +54,10 @@ struct RenderRequest {
   FalloffRequest falloff;
   std::optional<SurfaceNormal> normal; ///< The G-buffer's N (default shading); not with a G-buffer input.
   std::uint32_t seed = 1;              ///< Keys every per-pixel sample set.
+  /// Where the method runs (default the CPU). Gpu: a headless device (GpuDevice::open: the first
+  /// hardware EGL device, else Mesa's llvmpipe) runs it on this render's G-buffer, uploaded, so the
+  /// image is the CPU's up to float rounding; SystemError when there is no usable OpenGL 4.3.
+  Device device = Device::Cpu;
   std::optional<Sun> sun;              ///< A direct-light pass (read by --shaded and transfer's radiance mode).
   std::filesystem::path ao_map;        ///< Show this baked AO map on the scene instead of running a method.
   bool shade = false;                  ///< Make the shaded picture even when outputs.shaded is empty.
@@ -69,7 +76,10 @@ struct RenderResult {
   std::map<std::string, std::filesystem::path> extras_written;  ///< Extra name -> file.
   std::size_t covered_pixels = 0;
   double mean_visibility = 1.0;  ///< Over covered pixels.
-  double method_ms = 0;          ///< The method's run time.
+  double method_ms = 0;          ///< The method's run time (on the GPU: the upload, the passes and reading the images back).
+  Device device = Device::Cpu;   ///< Where the method ran.
+  std::string gl_renderer;       ///< GL_RENDERER of the GPU device ("llvmpipe (LLVM 15.0.6, 256 bits)"); empty on the CPU.
+  std::vector<GpuPassTime> gpu_passes;  ///< GPU time of each pass in the order they ran (upload, the method's); empty on the CPU.
   nlohmann::json summary;        ///< What `ao render --json` prints (parameters, timings, rays/s, ...).
 };
 

@@ -152,7 +152,7 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
   start = m.canonical_params(start);
   TuneSettings settings{.method = r.method, .start = start, .time_budget_s = r.budget_s, .seed = r.seed};
   settings.parameters = tune_parameters(m, r.fit);
-  if (r.spp_reference < 1 || r.spp_reference > (1 << 20)) throw InputError("--spp-reference must be in [1, 1048576]");
+  if (r.spp_reference < 1 || r.spp_reference > (1 << 20)) throw InputError("--reference-samples must be in [1, 1048576]");
   if (r.scenes.empty()) throw InputError("--scenes: no scene named");
   r.camera.validate();
   r.falloff.validate();

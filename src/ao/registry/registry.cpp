@@ -169,6 +169,7 @@ MethodOutput run_raytraced(const MethodInput& in, const nlohmann::json& j) {
   out.visibility = std::move(img.scalar.visibility);
   if (!img.color.empty()) out.color = std::move(img.color);
   if (!img.obscurance.empty()) out.extras["obscurance"] = std::move(img.obscurance);
+  out.std_error = std::move(img.scalar.std_error);
   out.stats = {{"rays", img.scalar.rays}, {"mean_std_error", img.scalar.mean_std_error}, {"max_std_error", img.scalar.max_std_error}};
   return out;
 }

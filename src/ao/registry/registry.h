@@ -74,6 +74,9 @@ struct MethodOutput {
   Image<Vec3> color;  ///< Optional RGB result (e.g. ambient transfer's W per channel); empty if none.
   /// Further outputs by name, each one of the method's MethodInfo::extras (e.g. "obscurance").
   std::map<std::string, Image<float>> extras;
+  /// The ray-traced ground truth: the standard error of V per pixel (0 where not covered); empty
+  /// for the other methods. Not written by `ao render`; the Python module returns it.
+  Image<float> std_error;
   nlohmann::json stats;  ///< Method-specific numbers for --json (rays, standard errors, ...).
 };
 

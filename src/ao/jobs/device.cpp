@@ -1,0 +1,38 @@
+#include "ao/jobs/device.h"
+
+#include <cstdio>
+
+#include "ao/core/error.h"
+#include "ao/gpu/methods.h"
+
+namespace ao {
+
+const char* to_string(Device device) { return device == Device::Gpu ? "gpu" : "cpu"; }
+
+Device device_from_name(const std::string& name) {
+  if (name == "cpu") return Device::Cpu;
+  if (name == "gpu") return Device::Gpu;
+  throw InputError("--device: cpu or gpu, got '" + name + "'");
+}
+
+void check_device(Device device, const MethodInfo& method, const nlohmann::json& params) {
+  if (device == Device::Gpu) check_gpu_method(method.name, params);
+}
+
+std::string describe_gpu_passes(std::span<const GpuPassTime> passes) {
+  std::string text;
+  for (const GpuPassTime& p : passes) {
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%.3g", p.ms);
+    text += (text.empty() ? "" : ", ") + p.name + " " + ms + " ms";
+  }
+  return text;
+}
+
+nlohmann::json gpu_passes_json(std::span<const GpuPassTime> passes) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const GpuPassTime& p : passes) out.push_back({{"name", p.name}, {"ms", p.ms}});
+  return out;
+}
+
+}  // namespace ao

@@ -1,0 +1,78 @@
+"""ao.bake and ao.compare: arrays and tables equal `ao bake`'s and `ao compare`'s outputs for the
+same inputs and seed (the same job functions run underneath, so equality is exact)."""
+
+import json
+
+import numpy as np
+import pytest
+
+import ao
+from conftest import bumpy_grid, cli_error, read_ply_quality, run_cli
+
+
+def test_bake_map_equals_cli(ao_binary, grid_obj, tmp_path):
+    out = tmp_path / "map.exr"
+    run_cli(ao_binary, "bake", grid_obj, "-s", 48, "--spp", 16, "--seed", 5, "-o", out)
+    m = ao.bake(grid_obj, size=48, samples=16, seed=5, full=True)
+    assert m["map"].shape == (48, 48) and m["map"].dtype == np.float32
+    np.testing.assert_array_equal(m["map"], ao.read_image(out))
+    covered = m["mask"] != 0
+    # The grid's bump occludes its surroundings; a flat open corner sees the whole hemisphere.
+    assert covered.mean() > 0.9 and m["map"][covered].min() < 0.9 and m["map"][covered].max() == pytest.approx(1.0, abs=1e-6)
+
+
+def test_bake_from_arrays_equals_the_file(grid_obj):
+    vertices, faces, uvs = bumpy_grid()
+    scene = ao.Scene.from_arrays(vertices, faces, uvs=uvs, name="grid")
+    np.testing.assert_array_equal(ao.bake(scene, 32, samples=8), ao.bake(grid_obj, 32, samples=8))
+
+
+def test_per_vertex_equals_cli(ao_binary, grid_obj, tmp_path):
+    out = tmp_path / "v.ply"
+    run_cli(ao_binary, "bake", grid_obj, "--spp", 16, "--per-vertex", out)
+    values = ao.bake(grid_obj, map=False, per_vertex=True, samples=16)
+    assert values.ndim == 1 and values.dtype == np.float32 and len(values) == 13 * 13
+    np.testing.assert_array_equal(values, read_ply_quality(out))
+    both = ao.bake(grid_obj, 16, per_vertex=True, samples=16)
+    assert isinstance(both, tuple) and both[0].shape == (16, 16)
+    np.testing.assert_array_equal(both[1], values)
+
+
+def test_bake_errors_match_cli(ao_binary, grid_obj, tmp_path):
+    for kwargs, args in [(dict(samples=0), ["--spp", 0]), (dict(denoise=9), ["--denoise", 9]), (dict(size="0"), ["-s", 0]),
+                         (dict(method="sideways"), ["-m", "sideways"])]:
+        with pytest.raises(ValueError) as e:
+            ao.bake(grid_obj, **kwargs)
+        assert str(e.value) == cli_error(ao_binary, "bake", grid_obj, *args, "-o", tmp_path / "unused.png")
+    with pytest.raises(ao.InputError, match="missing.obj"):
+        ao.bake(tmp_path / "missing.obj")
+
+
+def test_compare_rows_equal_cli_table(ao_binary, tmp_path):
+    out = tmp_path / "cmp"
+    run_cli(ao_binary, "compare", "sphere-on-plane", "--methods", "alchemy,volumetric", "--spp-reference", 16, "--width", 48,
+            "--height", 27, "-p", "alchemy.samples=6", "--out-dir", out)
+    with open(out / "table.json") as f:
+        cli = json.load(f)["rows"]
+    rows = ao.compare("sphere-on-plane", ao.Camera(width=48, height=27), ["alchemy", "volumetric"], spp_reference=16,
+                      params={"alchemy": {"samples": 6}})
+    assert [r["method"] for r in rows] == ["alchemy", "volumetric"]
+    for mine, theirs in zip(rows, cli):
+        assert _same_except_ms(mine, theirs), (mine, theirs)
+        assert 0 < mine["rmse"] < 0.5 and mine["parameters"] == theirs["parameters"]
+
+
+def _same_except_ms(a, b):
+    """Equal but for run times, which are measured, wherever they are nested."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(k.endswith("ms") or _same_except_ms(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same_except_ms(x, y) for x, y in zip(a, b))
+    return a == b
+
+
+def test_compare_errors_match_cli(ao_binary, tmp_path):
+    with pytest.raises(ValueError) as e:
+        ao.compare("wedge", methods=["alchemy"], params={"alchemy": {"nosuch": 1}})
+    assert str(e.value) == cli_error(ao_binary, "compare", "wedge", "--methods", "alchemy", "-p", "alchemy.nosuch=1", "--out-dir",
+                                     tmp_path / "c")

@@ -33,6 +33,7 @@
 #include "ao/core/sampling.h"
 #include "ao/core/stopwatch.h"
 #include "ao/core/texture.h"
+#include "ao/simd/target.h"  // which SIMD instruction set the kernels run with
 
 // scene: meshes, scenes, built-in and analytic scenes.
 #include "ao/scene/analytic.h"

@@ -22,23 +22,20 @@
 #include <tbb/parallel_for.h>
 
 #include "ao/core/error.h"
+#include "ao/methods/voxel_raster_internal.h"
+#include "ao/simd/bits_internal.h"
+#include "ao/simd/raster_internal.h"
 
 namespace ao {
+
+using voxel_internal::ColumnHit;
+using voxel_internal::GridTri;
+using voxel_internal::PrismCounts;
 
 namespace {
 
 constexpr std::size_t kChunk = 4096;  // triangles per projection task
 constexpr int kBands = 48;            // row bands of the raster stage: enough to balance 2-16 threads
-
-// A triangle in grid space: column coordinates and the affine depth attribute.
-struct GridTri {
-  float x[3], y[3], a[3];
-  int j0, j1;  // rows whose centres the bounding box covers
-  int fill;    // 0: parity fragment; +1 / -1: open-mesh slab filled towards larger / smaller k;
-               // 2: fragment of an open wall's prism (listed, voxelize_into step 4); 3 + s: parity fragment
-               // of a fan closing a hole that is not flat, or of a triangle near it, of the solid with
-               // holes in slot s (recorded: the winding number is evaluated from there, step 3)
-};
 
 struct Tri3 {
   Vec3 v[3];
@@ -251,122 +248,10 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
   }
 }
 
-// Edge function E(x, y) = A x + B y + C of the directed edge p -> q. Swapping p and q negates A,
-// B and C exactly (C is an antisymmetric difference of two products), so two triangles sharing
-// an edge evaluate exactly opposite values at every column centre, and the tie rule below gives
-// a centre on the shared edge to exactly one of them: the voxelization stays watertight.
-struct Edge {
-  double A, B, C;
-  Edge(double px, double py, double qx, double qy) : A(py - qy), B(qx - px), C(px * qy - py * qx) {}
-  void negate() { A = -A, B = -B, C = -C; }
-  bool inside(double x, double y) const {
-    const double e = A * x + B * y + C;
-    return e > 0 || (e == 0 && (A > 0 || (A == 0 && B > 0)));
-  }
-};
-
-// Sets bits [b0, b1) of a column (clamped to the column).
-inline void set_bits(std::uint64_t* col, int nbits, int b0, int b1) {
-  b0 = std::max(b0, 0);
-  b1 = std::min(b1, nbits);
-  for (int b = b0; b < b1;) {
-    const int w = b >> 6, lo = b & 63, n = std::min(64 - lo, b1 - b);
-    col[w] |= (n == 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << n) - 1)) << lo;
-    b += n;
-  }
-}
-
-// A fragment listed rather than toggled: column (i, j), the first voxel beyond it, and the slot of
-// the solid with holes whose fan (or triangle near a hole) it belongs to.
-struct ColumnHit {
-  int i, j, k, tag;
-};
-
-// One band of rows' prism faces: per voxel of its columns, how many prisms are entered there minus
-// how many are left (prisms face out, so a face's side is the sign of its area in grid space);
-// a column is zeroed when first crossed.
-struct PrismCounts {
-  int r0 = 0, nx = 0, nbits = 0;
-  std::unique_ptr<std::int16_t[]> delta;  // (j - r0, i, k)
-  std::vector<std::uint8_t> touched;      // (j - r0, i)
-  void add(int i, int j, int k, int sign) {
-    const std::size_t c = static_cast<std::size_t>(j - r0) * nx + i;
-    std::int16_t* d = delta.get() + c * nbits;
-    if (!touched[c]) touched[c] = 1, std::fill_n(d, nbits, std::int16_t{0});
-    d[k] = static_cast<std::int16_t>(d[k] + sign);
-  }
-};
-
-// Rasterises one triangle's rows [r0, r1]. A parity fragment toggles one bit (XOR to the end after
-// the scan), and is listed in `hits` when it belongs to a fan over a hole that is not flat; a slab
-// fragment of an open mesh ORs the voxels within `slab` (world units) behind it; a prism's fragment
-// is counted in `prisms`. Returns fragments.
-// kListed: the triangle's fragments are listed (fill 2 or >= 3), a separate instantiation so that
-// the plain parity loop carries no test for it.
-template <bool kPerspective, bool kListed>
-std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab, std::vector<ColumnHit>& hits, PrismCounts* prisms) {
-  const double x0 = t.x[0], y0 = t.y[0];
-  const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
-  if (area2 == 0) return 0;  // edge-on: no column centre lies inside
-  Edge e[3] = {{t.x[0], t.y[0], t.x[1], t.y[1]}, {t.x[1], t.y[1], t.x[2], t.y[2]}, {t.x[2], t.y[2], t.x[0], t.y[0]}};
-  if (area2 < 0)
-    for (Edge& ed : e) ed.negate();  // back faces count as much as front faces (sec. III-B)
-  // Plane of the attribute over the column coordinates.
-  const double da1 = double(t.a[1]) - t.a[0], da2 = double(t.a[2]) - t.a[0];
-  const double dadx = (da1 * (double(t.y[2]) - y0) - da2 * (double(t.y[1]) - y0)) / area2;
-  const double dady = (da2 * (double(t.x[1]) - x0) - da1 * (double(t.x[2]) - x0)) / area2;
-  const float xmin = std::min({t.x[0], t.x[1], t.x[2]}), xmax = std::max({t.x[0], t.x[1], t.x[2]});
-  const int i0 = std::max(0, static_cast<int>(std::ceil(xmin - 0.5f)));
-  const int i1 = std::min(g.nx - 1, static_cast<int>(std::floor(xmax - 0.5f)));
-  const int nbits = g.depth_bits, words = g.words;
-  std::size_t fragments = 0;
-  for (int j = r0; j <= r1; ++j) {
-    const double yc = j + 0.5;
-    std::uint64_t* row = g.bits.data() + static_cast<std::size_t>(j) * g.nx * words;
-    for (int i = i0; i <= i1; ++i) {
-      const double xc = i + 0.5;
-      if (!(e[0].inside(xc, yc) && e[1].inside(xc, yc) && e[2].inside(xc, yc))) continue;
-      const double a = t.a[0] + dadx * (xc - x0) + dady * (yc - y0);
-      double k;  // continuous voxel coordinate of the fragment along the column
-      if constexpr (kPerspective) {
-        // eq. 2: z_GridIndex = (z - z_nearest) / (z_far - z_nearest), scaled to depth_bits.
-        const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
-        k = (1.0 / a - g.z_near[c]) * g.voxels_per_unit[c];
-      } else {
-        k = a;
-      }
-      if (t.fill == 1 || t.fill == -1) {
-        double thickness;  // slab thickness in voxels along the column
-        if constexpr (kPerspective) thickness = slab * g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i];
-        else thickness = slab / g.voxel_size.z;
-        const double lo = t.fill > 0 ? k : k - thickness, hi = t.fill > 0 ? k + thickness : k;
-        const double b0 = std::clamp(std::ceil(lo - 0.5), 0.0, double(nbits)), b1 = std::clamp(std::ceil(hi - 0.5), 0.0, double(nbits));
-        set_bits(row + static_cast<std::size_t>(i) * words, nbits, static_cast<int>(b0), static_cast<int>(b1));
-        ++fragments;
-        continue;
-      }
-      // The fragment flips every voxel whose centre (b + 0.5) lies beyond it.
-      const double first = std::ceil(k - 0.5);
-      if (first >= nbits) continue;
-      const int b = first <= 0 ? 0 : static_cast<int>(first);
-      ++fragments;
-      if constexpr (kListed) {
-        if (t.fill == 2) {
-          prisms->add(i, j, b, area2 > 0 ? 1 : -1);
-          continue;
-        }
-        hits.push_back({i, j, b, t.fill - 3});
-      }
-      row[static_cast<std::size_t>(i) * words + (b >> 6)] ^= std::uint64_t{1} << (b & 63);
-    }
-  }
-  return fragments;
-}
-
 // Prefix XOR along every column: bit k becomes the XOR of toggles 0..k. Returns odd columns.
 // Two passes per row of columns (the row stays in L1): the prefix XOR inside every word, a flat
-// loop over the row's words that the compiler vectorises (8 words per AVX-512 op), then the carry
-// between the words of each column (the top bit of a word is the parity of the column so far).
+// pass over the row's words in the SIMD layer (simd::prefix_xor_in_words), then the carry between
+// the words of each column (the top bit of a word is the parity of the column so far).
 std::size_t scan_columns(VoxelGrid& g) {
   const int words = g.words, nbits = g.depth_bits;
   const int last_bits = nbits - 64 * (words - 1);
@@ -375,17 +260,8 @@ std::size_t scan_columns(VoxelGrid& g) {
   tbb::parallel_for(tbb::blocked_range<int>(0, g.ny, 8), [&](const tbb::blocked_range<int>& r) {
     const std::size_t row_words = static_cast<std::size_t>(g.nx) * words;
     for (int j = r.begin(); j < r.end(); ++j) {
-      std::uint64_t* __restrict row = g.bits.data() + static_cast<std::size_t>(j) * row_words;
-      for (std::size_t w = 0; w < row_words; ++w) {
-        std::uint64_t x = row[w];
-        x ^= x << 1;
-        x ^= x << 2;
-        x ^= x << 4;
-        x ^= x << 8;
-        x ^= x << 16;
-        x ^= x << 32;
-        row[w] = x;
-      }
+      std::uint64_t* row = g.bits.data() + static_cast<std::size_t>(j) * row_words;
+      simd::prefix_xor_in_words(row, row_words);
       std::size_t odd = 0;
       for (int i = 0; i < g.nx; ++i) {
         std::uint64_t* col = row + static_cast<std::size_t>(i) * words;
@@ -435,11 +311,7 @@ std::size_t build_coarse(VoxelGrid& g) {
     std::vector<std::uint64_t> acc(row_words, 0);
     std::size_t set = 0;
     for (int j = cj * C; j < std::min(g.ny, (cj + 1) * C); ++j) {
-      const std::uint64_t* __restrict row = g.column(0, j);
-      for (std::size_t w = 0; w < row_words; ++w) {
-        acc[w] |= row[w];
-        set += static_cast<std::size_t>(std::popcount(row[w]));
-      }
+      set += simd::or_into_and_count(acc.data(), g.column(0, j), row_words);
     }
     set_per_row[cj] = set;
     for (int ci = 0; ci < dnx; ++ci) {
@@ -706,13 +578,12 @@ std::size_t raster_band(VoxelGrid& g, const Bands& bands, int b, int fill_kind, 
     counts = {r0, g.nx, g.depth_bits, std::unique_ptr<std::int16_t[]>(new std::int16_t[columns * g.depth_bits]), std::vector<std::uint8_t>(columns, 0)};
   }
   std::size_t f = 0;
-  for (std::size_t c = 0; c < buckets.size(); ++c)
-    for (std::uint32_t q = buckets[c].start[k]; q < buckets[c].start[k + 1]; ++q) {
-      const GridTri& t = tris[c][buckets[c].index[q]];
-      const int lo = std::max(r0, t.j0), hi = std::min(r1, t.j1);
-      f += t.fill == 2 || t.fill >= 3 ? rasterise<kPerspective, true>(t, lo, hi, g, slab_thickness, hits, &counts)
-                                      : rasterise<kPerspective, false>(t, lo, hi, g, slab_thickness, hits, nullptr);
-    }
+  for (std::size_t c = 0; c < buckets.size(); ++c) {
+    const std::uint32_t q0 = buckets[c].start[k], q1 = buckets[c].start[k + 1];
+    if (q0 < q1)
+      f += simd::rasterise_triangles(tris[c].data(), buckets[c].index.data() + q0, q1 - q0, kPerspective, r0, r1, g, slab_thickness, hits,
+                                     fill_kind == 2 ? &counts : nullptr);
+  }
   unite_prisms(g, counts);
   return f;
 }
@@ -894,9 +765,7 @@ void VoxelizeOptions::validate() const {
 }
 
 std::size_t VoxelGrid::count_set() const {
-  std::size_t n = 0;
-  for (std::uint64_t w : bits) n += static_cast<std::size_t>(std::popcount(w));
-  return n;
+  return simd::count_set_bits(bits.data(), bits.size());
 }
 
 namespace {

@@ -3,11 +3,10 @@
 #pragma once
 
 #include <embree3/rtcore.h>
-#include <pmmintrin.h>
-#include <xmmintrin.h>
 
 #include "ao/core/math.h"
 #include "ao/reference/embree_scene_internal.h"
+#include "ao/simd/denormals_internal.h"
 
 namespace ao::detail {
 
@@ -35,25 +34,6 @@ inline void set_ray_hit(RayHitN& rh, int k, Vec3 origin, Vec3 direction, float t
   rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
 }
 
-/// Flush-to-zero and denormals-are-zero for the lifetime of the object, on this thread, restored
-/// on destruction. Embree asks for them on every thread that traces (denormal arithmetic in
-/// traversal is slow), and a kernel whose float results may underflow (the bake filter's weights)
-/// sets them so that its results do not depend on the mode a pool thread was left in: a thread's
-/// mode is whatever the last task it ran set, so work that does not set its own would round
-/// differently on different threads. Two register writes each way, cheap against a tile of rays.
-class FlushDenormalsScope {
- public:
-  FlushDenormalsScope() : saved_(_mm_getcsr()) {
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-  }
-  ~FlushDenormalsScope() { _mm_setcsr(saved_); }
-  FlushDenormalsScope(const FlushDenormalsScope&) = delete;
-  FlushDenormalsScope& operator=(const FlushDenormalsScope&) = delete;
-
- private:
-  unsigned saved_;
-};
 
 template <int N>
 struct Packet;

@@ -248,7 +248,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
   const bool kernel_writes_final = !filter && kDepthBuffer;
   Vec3* final_rgb = kernel_writes_final ? out.transfer.data() : nullptr;
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
-    simd::CoveredPixels row;
+    thread_local simd::CoveredPixels row;  // its arrays kept between tiles: one allocation per thread, not 17 per tile
     for (int y = t.y0; y < t.y1; ++y) {
       const std::size_t base = static_cast<std::size_t>(y) * w;
       // Uncovered pixels: W = O = 1. Writing the final images, only those (raw_g, raw_b unused).

@@ -48,6 +48,7 @@ BakeRequest make_request(BakeOptions& o) {
 
 int run(BakeOptions& o, const GlobalOptions& global) {
   const BakeRequest request = make_request(o);
+  if (global.request_only) return 0;
   StderrReporter report(global, o.json);
   const BakeBatchResult result = run_bake(request, report.reporter());
   report.end_stage();

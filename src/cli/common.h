@@ -24,6 +24,9 @@ namespace ao::cli {
 struct GlobalOptions {
   int threads = 0;     ///< Worker threads; 0 = all cores.
   bool quiet = false;  ///< No progress (bar or log lines).
+  /// Stop once the command line is turned into the job's request, before any scene is read or
+  /// work done: the option parser's fuzzing harness (fuzz/fuzz_options.cpp) sets it.
+  bool request_only = false;
 };
 
 /// Help text of the positional scene argument, shared by the subcommands that take a scene.

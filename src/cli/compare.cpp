@@ -112,6 +112,7 @@ CompareRequest make_request(const CompareOptions& o) {
 
 int run(const CompareOptions& o, const GlobalOptions& global) {
   const CompareRequest request = make_request(o);
+  if (global.request_only) return 0;
   StderrReporter report(global, o.json);
   const CompareJobResult out = run_compare(request, report.reporter());
   report.end_stage();

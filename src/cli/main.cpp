@@ -13,26 +13,14 @@
 
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
-#include "ao/simd/target.h"
-#include "ao/version.h"
+#include "app.h"
 #include "parse_errors.h"
-#include "subcommands.h"
 
 int main(int argc, char** argv) {
   CLI::App app("ao: ambient occlusion on the CPU. Ray-traced ground truth and published AO methods.", "ao");
-  app.set_version_flag("--version", [] { return "ao " AO_VERSION_STRING " (SIMD: " + ao::simd_target() + ")"; });
-  app.require_subcommand(1);
-  app.fallthrough();  // --threads and --quiet may also follow the subcommand
   ao::cli::GlobalOptions global;
-  app.add_option("--threads", global.threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
-  app.add_flag("-q,--quiet", global.quiet, "No progress output (bar or log lines)");
   std::function<int()> action;
-  ao::cli::add_render_command(app, global, action);
-  ao::cli::add_bake_command(app, global, action);
-  ao::cli::add_compare_command(app, global, action);
-  ao::cli::add_params_command(app, global, action);
-  ao::cli::add_view_command(app, global, action);
-  ao::cli::add_tune_command(app, global, action);
+  ao::cli::add_ao_commands(app, global, action);
 
   // Interrupted runs remove their temporary files (atomic_file.h).
   ao::remove_temporaries_on_signals();

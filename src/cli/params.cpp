@@ -12,7 +12,7 @@
 
 namespace ao::cli {
 
-void add_params_command(CLI::App& app, const GlobalOptions&, std::function<int()>& action) {
+void add_params_command(CLI::App& app, const GlobalOptions& global, std::function<int()>& action) {
   auto name = std::make_shared<std::string>();
   auto dir = std::make_shared<std::string>();
   std::string names;
@@ -21,9 +21,10 @@ void add_params_command(CLI::App& app, const GlobalOptions&, std::function<int()
   CLI::Option* one = cmd->add_option("NAME", *name, "A method or a baker: " + names);
   CLI::Option* all = cmd->add_option("--all", *dir, "Write every table as DIR/NAME.md instead (the build's docs/params)");
   one->excludes(all);
-  cmd->callback([&action, name, dir] {
-    action = [name, dir] {
+  cmd->callback([&action, &global, name, dir] {
+    action = [name, dir, &global] {
       if (dir->empty() == name->empty()) throw InputError("ao params: give a NAME, or --all DIR");
+      if (global.request_only) return 0;
       if (!name->empty()) {
         std::fputs(params_markdown(find_param_table(*name).specs()).c_str(), stdout);
         return 0;

@@ -102,6 +102,7 @@ void print_summary(const RenderResult& out) {
 
 int run(const RenderOptions& o, const GlobalOptions& global) {
   const RenderRequest request = make_request(o);
+  if (global.request_only) return 0;
   StderrReporter report(global, o.json);
   const RenderResult out = run_render(request, report.reporter());
   report.end_stage();

@@ -54,6 +54,7 @@ int run(const TuneOptions& o, const GlobalOptions& global) {
   r.falloff = falloff_request(o.falloff);
   r.normal = surface_normal_from_name(o.normal);
   if (r.output.empty() && !o.json) throw InputError("-o: name the parameter file to write (or print it with --json)");
+  if (global.request_only) return 0;
   StderrReporter report(global, o.json);
   const TuneJobResult out = run_tune(r, report.reporter());
   report.end_stage();

@@ -44,9 +44,10 @@ int run_view_command(const ViewOptions& o, const GlobalOptions& global) {
   view::ViewSetup setup;
   setup.device = device_from_name(o.device);
   for (const std::string& e : o.events) setup.events.push_back(view::parse_event(e));
-  if (!o.ao_map.empty()) setup.ao_map = read_image(o.ao_map);
   const CameraRequest camera = camera_request(o.camera);
   const FalloffRequest falloff = falloff_request(o.falloff);
+  if (global.request_only) return 0;
+  if (!o.ao_map.empty()) setup.ao_map = read_image(o.ao_map);
   setup.scene = SceneSource{.args = o.scene}.load();
   for (const std::string& w : setup.scene->warnings) std::cerr << "warning: " << w << "\n";
   setup.camera = choose_camera(*setup.scene, camera);

@@ -1,7 +1,7 @@
 // The voxelizer's raster stage (raster_internal.h), compiled once per SIMD target. The loops are
 // scalar (one column centre at a time: the tests decide which of two triangles sharing an edge owns
-// a centre on it); each target compiles them with its own instructions (fused multiply-add where
-// the target has it, like every kernel of the layer: simd/target.h).
+// a centre on it); each target compiles them with its own instructions, none of them fused
+// multiply-adds (the layer is compiled with -ffp-contract=off), so every target gives the same grid.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "ao/simd/raster.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep

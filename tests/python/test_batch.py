@@ -6,6 +6,7 @@ file be left, and a second run bake nothing."""
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -124,7 +125,10 @@ def test_bake_folder_on_cluster_survives_a_lost_worker(ao_binary, mesh_folder, c
     progress = [line for line in lines if line.startswith("[")]
     assert len(progress) == 7, text
     assert sum("broken.obj" in line for line in progress) == 1 and "failed broken.obj: " in text
-    assert "done 6, failed 1, skipped 0" in text, text
+    # A task the killed worker had finished writing (the rename is the commit) but not reported runs
+    # again on the other worker and finds its output there: skipped, not redone (batch.py).
+    summary = re.search(r"done (\d+), failed 1, skipped (\d+)", text)
+    assert summary and int(summary[1]) + int(summary[2]) == 6 and int(summary[2]) <= len(holding), text
     assert sorted(os.listdir(out)) == expected  # each output once, no temporary file (hidden .*.tmp-*)
     for name in expected:
         assert (out / name).read_bytes() == (reference / name).read_bytes(), name

@@ -79,6 +79,19 @@ void gbuffer_ao(benchmark::State& state, const char* mesh, bool full) {
   set_rate(state, static_cast<double>(cam.width) * cam.height);
 }
 
+// The deep G-buffer's second layer (render_second_layer) at the automatic separation R/4: one more
+// ray per covered pixel, from the visible surface on; what layers=2 adds to a screen-space method.
+void second_layer(benchmark::State& state, const char* mesh) {
+  Fixture* f = fixture(mesh);
+  GBuffer g = f->gbuffer;
+  const float separation = 0.25f * f->falloff.radius;
+  for (auto _ : state) {
+    render_second_layer(f->rays, g, separation);
+    benchmark::DoNotOptimize(g.second_depth.data());
+  }
+  set_rate(state, static_cast<double>(g.width()) * g.height());
+}
+
 // The bare loop's primary pass over the same camera (hit point and geometric normal per pixel).
 void gbuffer_bare(benchmark::State& state, const char* mesh) {
   Fixture* f = fixture(mesh);
@@ -176,6 +189,8 @@ BENCHMARK_CAPTURE(sampling_error, dragon_on_ground, kDragon)->Unit(benchmark::kM
 BENCHMARK_CAPTURE(direct_light, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer_ao, default_scene, "default", false)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer_ao, default_scene_all_channels, "default", true)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(second_layer, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK_CAPTURE(second_layer, dragon_on_ground, kDragon)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer_bare, default_scene, "default")->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer_ao, elephant_on_ground, kElephant, false)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);
 BENCHMARK_CAPTURE(gbuffer_ao, elephant_on_ground_all_channels, kElephant, true)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->MinTime(1.0);

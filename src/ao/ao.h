@@ -56,6 +56,7 @@
 #include "ao/methods/characteristic.h"
 #include "ao/methods/cone.h"
 #include "ao/methods/containment.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/gtao.h"
 #include "ao/methods/interleave.h"
 #include "ao/registry/registry.h"

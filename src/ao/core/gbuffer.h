@@ -39,6 +39,14 @@ struct GBuffer {
   /// off it robustly (reference/ray_offset.h). Filled by render_gbuffer; empty when unknown (a
   /// G-buffer read from a file without a `primid` channel, or built by hand).
   Image<std::uint32_t> primitive_id;
+  /// Optional second depth layer (a deep G-buffer, Mara et al. 2016; render_second_layer fills it):
+  /// per pixel the signed linear depth of the nearest surface at least `second_separation` behind
+  /// the visible one along the pixel's ray. > 0: a back face, where the solid entered at the
+  /// visible surface ends; < 0: a front face (its depth negated): the visible surface was thinner
+  /// than the separation and another solid begins there; +infinity: nothing behind (or not
+  /// covered). Empty (the default) = one layer.
+  Image<float> second_depth;
+  float second_separation = 0;  ///< The minimum separation second_depth was rendered with, world units.
 
   GBuffer() = default;
   explicit GBuffer(const Camera& cam)

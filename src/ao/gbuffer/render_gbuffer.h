@@ -39,4 +39,15 @@ void render_gbuffer(const RayScene& scene, const Camera& camera, const GBufferOp
 /// The same with default options.
 void render_gbuffer(const RayScene& scene, const Camera& camera, GBuffer& out, const ProgressFn& progress = {});
 
+/// The deep G-buffer's second layer (Mara et al. 2016, "Deep G-Buffers for Stable Global
+/// Illumination Approximation"): along each covered pixel's primary ray, the nearest surface at
+/// least `separation` (world units, > 0: the paper's minimum separation Delta) behind the visible
+/// one, by one more Embree ray from depth + separation. Written into g.second_depth (see GBuffer for
+/// its signed encoding) and g.second_separation; `g` must come from render_gbuffer of `scene`
+/// (its camera carries the world placement). InputError for a separation that is not finite and > 0.
+void render_second_layer(const RayScene& scene, GBuffer& g, float separation, const ProgressFn& progress = {});
+/// The same layer as a new image, leaving `g` as it is (a method that needs the layer of a
+/// G-buffer it may only read).
+Image<float> render_second_layer_depth(const RayScene& scene, const GBuffer& g, float separation, const ProgressFn& progress = {});
+
 }  // namespace ao

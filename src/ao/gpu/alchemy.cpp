@@ -52,6 +52,8 @@ Texture bilateral_filter(Run& r, const Texture& values, const BilateralParams& p
 
 MethodOutput run_alchemy(Run& r, const Falloff& falloff, const AlchemyParams& params, std::uint32_t seed) {
   const AlchemyConstants k = alchemy_constants(params, falloff.radius);
+  if (params.layers.layers != 1)
+    throw InputError("alchemy: layers=2 (a second depth layer) runs on the CPU backend only; the GPU shaders read one layer");
   const int s = params.samples;
   // The pattern's tables, as (cos, sin) pairs.
   const alchemy_internal::RotationTable& rot = alchemy_internal::rotations();

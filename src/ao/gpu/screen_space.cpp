@@ -4,6 +4,7 @@
 // CPU kernel's sample set (make_containment_samples, make_disk_samples) and 4x4 rotations
 // (interleave_rotations) as uploaded tables, so both backends sample the same points.
 #include <cmath>
+#include <string>
 
 #include "ao/core/error.h"
 #include "ao/gpu/methods_internal.h"
@@ -99,6 +100,12 @@ Buffer containment_offsets(Run& r, int n, const Falloff& falloff) {
   return make_buffer(r.c, std::span<const float>(v));
 }
 
+// The GPU shaders read one depth layer: a second one (a deep G-buffer) is the CPU's only.
+void require_one_layer(const DepthLayers& layers, const char* method) {
+  if (layers.layers != 1)
+    throw InputError(std::string(method) + ": layers=2 (a second depth layer) runs on the CPU backend only; the GPU shaders read one layer");
+}
+
 // The filter after an interleaved pass, when the options ask for it.
 Texture filtered(Run& r, Texture raw, int channels, const InterleaveOptions& o, float radius) {
   if (!(o.interleave && o.filter)) return raw;
@@ -109,6 +116,7 @@ Texture filtered(Run& r, Texture raw, int channels, const InterleaveOptions& o, 
 
 MethodOutput run_containment(Run& r, const Falloff& falloff, const ContainmentParams& params, std::uint32_t seed) {
   falloff.validate();
+  require_one_layer(params.layers, "containment");
   const Buffer offsets = containment_offsets(r, params.samples, falloff);
   Texture raw = r.image(GL_R32F);
   Program& p = r.begin("containment.comp", "containment");
@@ -123,6 +131,7 @@ MethodOutput run_containment(Run& r, const Falloff& falloff, const ContainmentPa
 
 MethodOutput run_volumetric(Run& r, const Falloff& falloff, const VolumetricParams& params, std::uint32_t seed) {
   Falloff{Membership::Cubic, falloff.radius}.validate();
+  require_one_layer(params.layers, "volumetric");
   const float radius = falloff.radius;
   const DiskSamples s = make_disk_samples(params.samples);
   std::vector<float> disk;
@@ -148,6 +157,7 @@ MethodOutput run_volumetric(Run& r, const Falloff& falloff, const VolumetricPara
 
 MethodOutput run_transfer(Run& r, const Falloff& falloff, const TransferParams& params, std::uint32_t seed) {
   falloff.validate();
+  require_one_layer(params.layers, "transfer");
   if (!r.g.has_albedo) throw InputError("transfer: the indirect reflectance image must have the G-buffer's size (the G-buffer has no albedo)");
   const bool radiance = params.reflectance == TransferReflectance::Radiance;
   if (radiance && !r.g.direct)

@@ -73,7 +73,8 @@ const ParamTable<AlchemyParams>& alchemy_param_table() {
         P::real("epsilon", &AlchemyParams::epsilon, Range::above(0), "paper square metres", "epsilon of eq. 10"),
         P::real("meter", &AlchemyParams::meter, Range::at_least(0), "world units", "world units per paper metre; 0 = r / 0.5"),
         P::boolean("filter", &AlchemyParams::filter, "apply the cross-bilateral filter (sec. 2, pass 5)")},
-       bilateral_params<AlchemyParams>("filter_", [](AlchemyParams& p) -> BilateralParams& { return p.bilateral; })}};
+       bilateral_params<AlchemyParams>("filter_", [](AlchemyParams& p) -> BilateralParams& { return p.bilateral; }),
+       depth_layer_params(&AlchemyParams::layers)}};
   return table;
 }
 
@@ -100,7 +101,16 @@ Falloff alchemy_reference_falloff(const AlchemyParams& p, float default_radius) 
 }
 
 AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float default_radius, std::uint32_t seed, const ProgressFn& progress) {
+  if (params.layers.layers < 2) return render_alchemy(g, nullptr, params, default_radius, seed, progress);
+  const float separation = effective_separation(params.layers, alchemy_constants(params, default_radius).radius);
+  if (!has_second_layer(g, separation)) throw_missing_second_layer("alchemy", separation);
+  return render_alchemy(g, &g.second_depth, params, default_radius, seed, progress);
+}
+
+AlchemyImage render_alchemy(const GBuffer& g, const Image<float>* second_layer, const AlchemyParams& params, float default_radius,
+                            std::uint32_t seed, const ProgressFn& progress) {
   const AlchemyConstants k = alchemy_constants(params, default_radius);
+  if (params.layers.layers == 2 && !second_layer) throw_missing_second_layer("alchemy", effective_separation(params.layers, k.radius));
   const int w = g.width(), h = g.height(), s = params.samples;
   AlchemyImage out{Image<float>(w, h, 1.0f)};
   const auto t0 = std::chrono::steady_clock::now();
@@ -131,6 +141,10 @@ AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float
   in.radius = k.radius, in.px_per_unit = px_per_unit, in.max_pixel_radius = kMaxPixelRadius;
   in.epsilon = k.epsilon, in.beta = k.beta, in.scale = scale, in.samples = s;
   in.ux = ux.data(), in.uy = uy.data(), in.rot_c = rot.c.data(), in.rot_s = rot.s.data(), in.seed = seed;
+  if (params.layers.layers == 2) {
+    if (second_layer->width() != w || second_layer->height() != h) throw InputError("alchemy: the second depth layer must have the G-buffer's size");
+    in.second = second_layer->data();
+  }
   const float contrast = params.contrast;
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   tbb::parallel_for(

@@ -28,6 +28,7 @@
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
 #include "ao/methods/bilateral.h"
+#include "ao/methods/depth_layers.h"
 
 namespace ao {
 
@@ -52,6 +53,7 @@ struct AlchemyParams {
   float meter = 0.0f;       ///< World units per paper metre, >= 0; 0 = r / 0.5 (r is the paper's 0.5 m). 1 for metric scenes.
   bool filter = true;       ///< Apply the cross-bilateral filter (sec. 2, pass 5). Default on, as the paper.
   BilateralParams bilateral;  ///< The filter's parameters (JSON keys filter_taps, filter_spatial_sigma, filter_plane_sigma).
+  DepthLayers layers;         ///< A second depth layer (deep G-buffer): each tap also reads its point (depth_layers.h).
 
   /// Throws InputError naming the bad field.
   void validate() const;
@@ -92,7 +94,13 @@ struct AlchemyImage {
 
 /// Alchemy AO for every covered pixel of `gbuffer`. Pixel (x, y) draws its sample pattern from
 /// pixel_seed(seed, x, y), so the result does not depend on the thread count.
+/// With params.layers asking for two, the G-buffer's second layer (GBuffer::second_depth, at the
+/// separation in effect; InputError otherwise) adds a point to every tap (depth_layers.h).
 AlchemyImage render_alchemy(const GBuffer& gbuffer, const AlchemyParams& params, float default_radius, std::uint32_t seed,
                             const ProgressFn& progress = {});
+/// The same with the second layer given (`second_layer`: the G-buffer's size, rendered at the
+/// separation params.layers gives with r; read only when they ask for two layers, then not null).
+AlchemyImage render_alchemy(const GBuffer& gbuffer, const Image<float>* second_layer, const AlchemyParams& params, float default_radius,
+                            std::uint32_t seed, const ProgressFn& progress = {});
 
 }  // namespace ao

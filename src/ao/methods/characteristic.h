@@ -78,8 +78,22 @@ struct DepthBufferCharacteristic {
   std::shared_ptr<const Image<float>> plane;  ///< The G-buffer's depth_plane(), built once and shared by copies.
   const float* depth = nullptr;               ///< The depth read, width * height values: plane's.
 
+  /// The deep G-buffer's second layer (GBuffer::second_depth's signed encoding), or null: one
+  /// layer. The SIMD kernels read it (depth_layers.h states the solid it describes); distance()
+  /// below is the first layer's, which is all a product of characteristics takes.
+  std::shared_ptr<const Image<float>> second_plane;
+  const float* second = nullptr;
+  float separation = 0;  ///< The second layer's minimum separation, world units.
+
   explicit DepthBufferCharacteristic(const GBuffer& g)
       : projection(ScreenProjection::from_camera(g.camera)), plane(std::make_shared<const Image<float>>(depth_plane(g))), depth(plane->data()) {}
+  /// With a second layer (`layer`: the G-buffer's size, rendered at `separation`).
+  DepthBufferCharacteristic(const GBuffer& g, std::shared_ptr<const Image<float>> layer, float layer_separation)
+      : DepthBufferCharacteristic(g) {
+    second_plane = std::move(layer);
+    second = second_plane->data();
+    separation = layer_separation;
+  }
 
   float distance(float x, float y, float z) const {
     int i;

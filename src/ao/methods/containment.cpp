@@ -32,7 +32,7 @@ const ParamTable<ContainmentParams>& containment_param_table() {
                    "AT 4.3: a point is occluded only if the surface in front of it is less than R in front"),
         P::real("bias", &ContainmentParams::bias, Range::at_least(0), "world units",
                 "depth-test bias; 0 = auto (one pixel footprint x (1 + tan theta_v))")},
-       interleave_params(&ContainmentParams::interleave)}};
+       interleave_params(&ContainmentParams::interleave), depth_layer_params(&ContainmentParams::layers)}};
   return table;
 }
 
@@ -88,6 +88,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
   const float inv_n = 1.0f / static_cast<float>(params.samples);
   const int m = params.ray_steps;
   const simd::Rotations16 rot = simd_rotations(rotations);
+  check_layers(ch, params.layers, "containment");
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     simd::CoveredPixels row;
@@ -95,7 +96,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
     for (int y = t.y0; y < t.y1; ++y) {
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rot, params.bias, true);
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>)
-        simd::count_open_rays(row, simd_depth_plane(ch), simd_points(s), m, far_limit, open.data());
+        simd::count_open_rays(row, simd_depth_plane(ch, params.layers), simd_points(s), m, far_limit, open.data());
       else
         count_open_rays(row, ch, s, m, far_limit, open.data());
       // Eq. 5: V = the fraction of free test points (of free rays, with m > 1).
@@ -108,7 +109,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
 }
 
 Image<float> containment_ao(const GBuffer& g, const Falloff& falloff, const ContainmentParams& params, std::uint32_t seed) {
-  return containment_ao(g, DepthBufferCharacteristic(g), falloff, params, seed);
+  return containment_ao(g, depth_characteristic(g, params.layers, falloff.radius, "containment"), falloff, params, seed);
 }
 
 template Image<float> containment_ao(const GBuffer&, const DepthBufferCharacteristic&, const Falloff&, const ContainmentParams&, std::uint32_t);

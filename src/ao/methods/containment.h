@@ -20,6 +20,7 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/interleave.h"
 
 namespace ao {
@@ -32,6 +33,7 @@ struct ContainmentParams {
   bool silhouette_elimination = true; ///< AT 4.3: a point is occluded only if the surface in front of it is less than R in front.
   float bias = 0.0f;                  ///< Depth-test bias, world units, >= 0; 0 = auto (one pixel footprint x (1 + tan theta_v)).
   InterleaveOptions interleave;       ///< sec. 4.2 options.
+  DepthLayers layers;                 ///< A second depth layer (deep G-buffer), read from GBuffer::second_depth (depth_layers.h).
 
   /// Throws InputError naming the bad field.
   void validate() const;

@@ -4,8 +4,12 @@
 #pragma once
 
 #include <array>
+#include <memory>
+#include <string>
+#include <type_traits>
 
 #include "ao/methods/characteristic.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/samples.h"
 #include "ao/simd/screen_space_internal.h"
 
@@ -18,10 +22,33 @@ inline simd::Rotations16 simd_rotations(const std::array<Rotation, 16>& r) {
   return out;
 }
 
-/// The depth plane a depth-buffer characteristic reads, with its projection.
-inline simd::DepthPlane simd_depth_plane(const DepthBufferCharacteristic& ch) {
+/// The depth plane a depth-buffer characteristic reads, with its projection, and its second layer
+/// when `layers` asks for two.
+inline simd::DepthPlane simd_depth_plane(const DepthBufferCharacteristic& ch, const DepthLayers& layers = {}) {
   const ScreenProjection& p = ch.projection;
-  return {ch.depth, p.scale_x, p.scale_y, p.centre_x, p.centre_y, p.width, p.height};
+  const bool two = layers.layers == 2;
+  return {ch.depth, p.scale_x, p.scale_y, p.centre_x, p.centre_y, p.width, p.height, two ? ch.second : nullptr, two ? ch.separation : 0.0f};
+}
+
+/// The depth characteristic of `g` with the layers `d` asks for: its second layer (not copied: `g`
+/// must outlive the result) when d.layers = 2, InputError when `g` has none at the separation in effect.
+inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const DepthLayers& d, float radius, const std::string& method) {
+  if (d.layers < 2) return DepthBufferCharacteristic(g);
+  const float separation = effective_separation(d, radius);
+  if (!has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
+  return DepthBufferCharacteristic(g, std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth), separation);
+}
+
+/// InputError unless `ch` can give what `d` asks for: two layers are the depth buffer's, with its
+/// second layer.
+template <class C>
+void check_layers(const C& ch, const DepthLayers& d, const std::string& method) {
+  if (d.layers < 2) return;
+  if constexpr (std::is_same_v<C, DepthBufferCharacteristic>) {
+    if (!ch.second) throw_missing_second_layer(method, effective_separation(d, 1.0f));
+  } else {
+    throw InputError(method + ": layers=2 is a second layer of the depth buffer; an analytic characteristic function has its own solid");
+  }
 }
 
 /// Test-point offsets (X_i, Y_i, Z_i) as the kernels take them.

@@ -53,7 +53,7 @@ const ParamTable<TransferParams>& transfer_param_table() {
         P::enumeration<TransferReflectance>("reflectance", &TransferParams::reflectance,
                                             {{"albedo", TransferReflectance::Albedo}, {"radiance", TransferReflectance::Radiance}},
                                             "what occluders send back: albedo (eq. 9) or also their direct light (sec. 4.1, needs --sun)")},
-       interleave_params(&TransferParams::interleave)}};
+       interleave_params(&TransferParams::interleave), depth_layer_params(&TransferParams::layers)}};
   return table;
 }
 
@@ -215,6 +215,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
   if (radiance && (g.direct.width() != w || g.direct.height() != h))
     throw InputError("transfer: the G-buffer's direct-light pass must have its size");
+  check_layers(ch, params.layers, "transfer");
   const ContainmentSamples s = make_containment_samples(params.samples, falloff);
   const simd::Rotations16 rotations = simd_rotations(interleave_rotations(seed, params.interleave.interleave));
   const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;  // AT 4.3
@@ -263,7 +264,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rotations, params.bias, true);
       const simd::TransferOutputs o{raw_r, raw_g, raw_b, raw_o, final_rgb};
       if constexpr (kDepthBuffer)
-        simd::transfer_rays(row, simd_depth_plane(ch), simd_points(s), m, far_limit, in, base + t.x0, o);
+        simd::transfer_rays(row, simd_depth_plane(ch, params.layers), simd_points(s), m, far_limit, in, base + t.x0, o);
       else
         transfer_rays(row, ch, projection, s, m, far_limit, albedo, direct, params.albedo_scale, base + t.x0, o);
     }
@@ -301,12 +302,12 @@ TransferImage transfer_ao(const GBuffer& g, const Characteristic& ch, const Imag
 }
 
 TransferImage transfer_ao(const GBuffer& g, const Falloff& falloff, const TransferParams& params, std::uint32_t seed) {
-  return transfer_ao(g, DepthBufferCharacteristic(g), g.albedo, falloff, params, seed);
+  return transfer_ao(g, depth_characteristic(g, params.layers, falloff.radius, "transfer"), g.albedo, falloff, params, seed);
 }
 
 const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, const Falloff& falloff, const TransferParams& params,
                                  std::uint32_t seed) {
-  return transfer_ao(buffers, g, DepthBufferCharacteristic(g), g.albedo, falloff, params, seed);
+  return transfer_ao(buffers, g, depth_characteristic(g, params.layers, falloff.radius, "transfer"), g.albedo, falloff, params, seed);
 }
 
 #define AO_INSTANTIATE_TRANSFER(Characteristic)                                                                                       \

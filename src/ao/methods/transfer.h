@@ -35,6 +35,7 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/interleave.h"
 
 namespace ao {
@@ -54,6 +55,7 @@ struct TransferParams {
   /// "albedo" (default, eq. 9) or "radiance" (reads GBuffer::direct, which must then be there).
   TransferReflectance reflectance = TransferReflectance::Albedo;
   InterleaveOptions interleave;       ///< sec. 4.2 options; the filter runs on W and O alike.
+  DepthLayers layers;                 ///< A second depth layer (deep G-buffer), read from GBuffer::second_depth (depth_layers.h).
 
   /// Throws InputError naming the bad field.
   void validate() const;

@@ -29,7 +29,7 @@ const ParamTable<VolumetricParams>& volumetric_param_table() {
         P::boolean("silhouette_elimination", &VolumetricParams::silhouette_elimination,
                    "AT 4.3 for pipes: a surface more than R in front of a pipe's entry does not occlude it"),
         P::real("bias", &VolumetricParams::bias, Range::at_least(0), "world units", "added to z* - z_entry; 0 = auto (as containment)")},
-       interleave_params(&VolumetricParams::interleave)}};
+       interleave_params(&VolumetricParams::interleave), depth_layer_params(&VolumetricParams::layers)}};
   return table;
 }
 
@@ -88,6 +88,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
   // object and does not occlude (z_entry - z* > R).
   const float far_limit = params.silhouette_elimination ? -R : -kInfinity;
   const simd::Rotations16 rot = simd_rotations(rotations);
+  check_layers(ch, params.layers, "volumetric");
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     simd::CoveredPixels row;
@@ -95,7 +96,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
     for (int y = t.y0; y < t.y1; ++y) {
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rot, params.bias, false);  // no tangent frame: pipes run along the view axis
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>)
-        simd::sum_free_pipes(row, simd_depth_plane(ch), half_r, simd_points(s), far_limit, free_len.data());
+        simd::sum_free_pipes(row, simd_depth_plane(ch, params.layers), half_r, simd_points(s), far_limit, free_len.data());
       else
         sum_free_pipes(row, ch, half_r, s, far_limit, free_len.data());
       for (int k = 0; k < row.count; ++k)
@@ -108,7 +109,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
 }
 
 Image<float> volumetric_ao(const GBuffer& g, float radius, const VolumetricParams& params, std::uint32_t seed) {
-  return volumetric_ao(g, DepthBufferCharacteristic(g), radius, params, seed);
+  return volumetric_ao(g, depth_characteristic(g, params.layers, radius, "volumetric"), radius, params, seed);
 }
 
 template Image<float> volumetric_ao(const GBuffer&, const DepthBufferCharacteristic&, float, const VolumetricParams&, std::uint32_t);

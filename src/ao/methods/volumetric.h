@@ -24,6 +24,7 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/interleave.h"
 
 namespace ao {
@@ -39,6 +40,7 @@ struct VolumetricParams {
   bool silhouette_elimination = true; ///< AT sec. 4.3 applied to pipes: a surface more than R in front of a pipe's entry point does not occlude it.
   float bias = 0.0f;                  ///< Added to z* - z_entry, world units, >= 0; 0 = auto (as containment).
   InterleaveOptions interleave;       ///< sec. 4.2 options (rotation of the disk samples about the view axis).
+  DepthLayers layers;                 ///< A second depth layer (deep G-buffer), read from GBuffer::second_depth (depth_layers.h).
 
   /// Throws InputError naming the bad field.
   void validate() const;

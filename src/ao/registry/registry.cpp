@@ -11,6 +11,7 @@
 #include "ao/bake/raytraced_bake.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
+#include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/alchemy.h"
 #include "ao/methods/characteristic.h"
 #include "ao/methods/cone.h"
@@ -124,10 +125,29 @@ std::string joined_names(const std::vector<std::string>& names) {
 // fn(ch, kernel_elimination): whether the kernel's own silhouette elimination (AT 4.3) is to run.
 // `elimination` is the user's silhouette_elimination; `limit` the distance in front of a sample
 // point beyond which the depth-buffer factor of the product counts as a distant foreground object.
-template <class Fn>
-void with_characteristic(const MethodInput& in, CharacteristicKind kind, std::string_view method, bool elimination, float limit, Fn&& fn) {
+// The second depth layer a method run with `layers` = 2 reads: the G-buffer's own when it has one
+// at the separation in effect, else rendered from the scene for this run.
+std::shared_ptr<const Image<float>> second_layer_for(const MethodInput& in, float separation, std::string_view method) {
   const GBuffer& g = in.gbuffer;
-  if (kind == CharacteristicKind::Depth) return fn(DepthBufferCharacteristic(g), elimination);
+  if (has_second_layer(g, separation)) return {std::shared_ptr<void>(), &g.second_depth};  // not owned: g outlives the run
+  if (!in.scene)
+    throw InputError(std::string(method) + ": layers=2 traces the second depth layer in the scene, and this G-buffer came without " +
+                     "a scene (a G-buffer file or arrays hold one layer): give the scene, or use layers=1");
+  return std::make_shared<const Image<float>>(render_second_layer_depth(*in.scene, g, separation));
+}
+
+template <class Fn>
+void with_characteristic(const MethodInput& in, CharacteristicKind kind, const DepthLayers& layers, std::string_view method, bool elimination,
+                         float limit, Fn&& fn) {
+  const GBuffer& g = in.gbuffer;
+  if (kind == CharacteristicKind::Depth && layers.layers < 2) return fn(DepthBufferCharacteristic(g), elimination);
+  if (kind == CharacteristicKind::Depth) {
+    const float separation = effective_separation(layers, in.falloff.radius);
+    return fn(DepthBufferCharacteristic(g, second_layer_for(in, separation, method), separation), elimination);
+  }
+  if (layers.layers == 2)
+    throw InputError(std::string(method) + ": layers=2 is a second layer of the depth buffer, and characteristic " +
+                     std::string(kCharacteristicNames[static_cast<std::size_t>(kind)]) + " is analytic: use layers=1 with it");
   const bool implicit = kind == CharacteristicKind::Implicit;
   const std::string name(kCharacteristicNames[static_cast<std::size_t>(kind)]);
   const std::string builtins = joined_names(implicit ? builtin_scenes_with_implicit_surface() : builtin_scenes_with_height_field());
@@ -178,7 +198,7 @@ MethodOutput run_containment(const MethodInput& in, const nlohmann::json& j) {
   const auto w = parse(screen_space_table<containment_param_table>(), j);
   MethodOutput out;
   // AT 4.3 tests the sample point itself: a surface more than R in front of it is distant.
-  with_characteristic(in, w.characteristic, "containment", w.method.silhouette_elimination, in.falloff.radius,
+  with_characteristic(in, w.characteristic, w.method.layers, "containment", w.method.silhouette_elimination, in.falloff.radius,
                       [&](const auto& ch, bool kernel_elimination) {
                         ContainmentParams q = w.method;
                         q.silhouette_elimination = kernel_elimination;
@@ -195,7 +215,7 @@ MethodOutput run_volumetric(const MethodInput& in, const nlohmann::json& j) {
   // front of the sphere's centre, where the characteristic is read: a depth-buffer surface more than
   // 1.5 R in front of the centre is distant for every pipe, so the wrapped factor never drops a
   // surface the kernel's per-pipe test would keep.
-  with_characteristic(in, w.characteristic, "volumetric", w.method.silhouette_elimination, 1.5f * in.falloff.radius,
+  with_characteristic(in, w.characteristic, w.method.layers, "volumetric", w.method.silhouette_elimination, 1.5f * in.falloff.radius,
                       [&](const auto& ch, bool kernel_elimination) {
                         VolumetricParams q = w.method;
                         q.silhouette_elimination = kernel_elimination;
@@ -208,7 +228,7 @@ MethodOutput run_volumetric(const MethodInput& in, const nlohmann::json& j) {
 MethodOutput run_transfer(const MethodInput& in, const nlohmann::json& j) {
   const auto w = parse(screen_space_table<transfer_param_table>(), j);
   MethodOutput out;
-  with_characteristic(in, w.characteristic, "transfer", w.method.silhouette_elimination, in.falloff.radius,
+  with_characteristic(in, w.characteristic, w.method.layers, "transfer", w.method.silhouette_elimination, in.falloff.radius,
                       [&](const auto& ch, bool kernel_elimination) {
                         TransferParams q = w.method;
                         q.silhouette_elimination = kernel_elimination;
@@ -246,7 +266,10 @@ MethodOutput run_cone(const MethodInput& in, const nlohmann::json& j) {
 
 MethodOutput run_alchemy(const MethodInput& in, const nlohmann::json& j) {
   const AlchemyParams p = parse(alchemy_param_table(), j);
-  AlchemyImage img = render_alchemy(in.gbuffer, p, in.falloff.radius, in.seed, in.progress);
+  // Two layers: the G-buffer's second layer, or one traced for this run (the separation scales with r).
+  std::shared_ptr<const Image<float>> second;
+  if (p.layers.layers == 2) second = second_layer_for(in, effective_separation(p.layers, alchemy_constants(p, in.falloff.radius).radius), "alchemy");
+  AlchemyImage img = render_alchemy(in.gbuffer, second.get(), p, in.falloff.radius, in.seed, in.progress);
   MethodOutput out;
   out.visibility = std::move(img.visibility);
   if (!img.unfiltered.empty()) out.extras["unfiltered"] = std::move(img.unfiltered);

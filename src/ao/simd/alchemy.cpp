@@ -88,11 +88,14 @@ void alchemy_row_wide(const AlchemyInputs& in, int y, int x0, int x1, float* out
       const float dx = rho * (in.rot_c[ri] * in.ux[i] - in.rot_s[ri] * in.uy[i]), dy = rho * (in.rot_s[ri] * in.ux[i] + in.rot_c[ri] * in.uy[i]);
       const int ix = std::clamp(static_cast<int>(static_cast<float>(x) + 0.5f + kCoordOffset + dx) - static_cast<int>(kCoordOffset), 0, in.width - 1);
       const int iy = std::clamp(static_cast<int>(static_cast<float>(y) + 0.5f + kCoordOffset + dy) - static_cast<int>(kCoordOffset), 0, in.height - 1);
-      const float dp = in.depth[static_cast<std::size_t>(iy) * w + static_cast<std::size_t>(ix)];
-      const float vx = dp * (in.ray_ax * (static_cast<float>(ix) + 0.5f) + in.ray_bx) - cx;
-      const float vy = dp * (in.ray_ay * (static_cast<float>(iy) + 0.5f) + in.ray_by) - cy, vz = -dp - cz;
-      const float vv = vx * vx + vy * vy + vz * vz, vn = vx * nx + vy * ny + vz * nz + cz * in.beta;
-      sum += vv < r2 && vn > 0.0f ? vn / (vv + in.epsilon) : 0.0f;
+      const std::size_t tap = static_cast<std::size_t>(iy) * w + static_cast<std::size_t>(ix);
+      const float rx = in.ray_ax * (static_cast<float>(ix) + 0.5f) + in.ray_bx, ry = in.ray_ay * (static_cast<float>(iy) + 0.5f) + in.ray_by;
+      const auto term = [&](float dp) {
+        const float vx = dp * rx - cx, vy = dp * ry - cy, vz = -dp - cz;
+        const float vv = vx * vx + vy * vy + vz * vz, vn = vx * nx + vy * ny + vz * nz + cz * in.beta;
+        return vv < r2 && vn > 0.0f ? vn / (vv + in.epsilon) : 0.0f;
+      };
+      sum += in.second ? std::max(term(in.depth[tap]), term(std::abs(in.second[tap]))) : term(in.depth[tap]);
     }
     out[x - x0] = std::max(0.0f, 1.0f - in.scale * sum);
   }
@@ -171,7 +174,9 @@ HWY_INLINE void prepare_row(const AlchemyInputs& in, int y, int x0, int n, int e
   }
 }
 
-// Eq. 10's sum over the s samples for every pixel of the prepared row (whole vectors up to `end`).
+// Eq. 10's sum over the s samples for every pixel of the prepared row (whole vectors up to `end`);
+// with kTwoLayers each tap counts the larger term of its two points (AlchemyInputs::second).
+template <bool kTwoLayers>
 HWY_INLINE void add_samples(const AlchemyInputs& in, int y, int end, Row& r) {
   const DF d;
   const DI di;
@@ -195,17 +200,24 @@ HWY_INLINE void add_samples(const AlchemyInputs& in, int y, int end, Row& r) {
       // beyond it) rather than counting as empty space.
       const VI ix = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(hn::Load(d, r.fx0 + j0), dx)), ioffset), izero), max_ix);
       const VI iy = hn::Min(hn::Max(hn::Sub(truncate_in_range(hn::Add(fy0, dy)), ioffset), izero), max_iy);
-      const VF dp = hn::GatherIndex(d, in.depth, hn::Add(hn::Mul(iy, width), ix));
-      const VF vx = hn::Sub(hn::Mul(dp, hn::MulAdd(ax, hn::Add(hn::ConvertTo(d, ix), half), bx)), hn::Load(d, r.cx + j0));
-      const VF vy = hn::Sub(hn::Mul(dp, hn::MulAdd(ay, hn::Add(hn::ConvertTo(d, iy), half), by)), hn::Load(d, r.cy + j0));
-      const VF vz = hn::Sub(hn::Neg(dp), hn::Load(d, r.cz + j0));
-      const VF vv = hn::MulAdd(vz, vz, hn::MulAdd(vy, vy, hn::Mul(vx, vx)));
-      const VF vn = hn::Add(hn::MulAdd(vz, hn::Load(d, r.nz + j0), hn::MulAdd(vy, hn::Load(d, r.ny + j0), hn::Mul(vx, hn::Load(d, r.nx + j0)))),
-                            hn::Load(d, r.bias + j0));
-      // Background samples (depth +inf, so vv is inf or NaN and fails vv < r^2) contribute
-      // nothing: the paper's assumption that unseen space is empty. vv < r^2 is eq. 9's H.
-      const MF use = hn::And(hn::Lt(vv, r2), hn::Gt(vn, zero));
-      hn::Store(hn::Add(hn::Load(d, r.sum + j0), hn::IfThenElseZero(use, hn::Div(vn, hn::Add(vv, eps)))), d, r.sum + j0);
+      const VI tap = hn::Add(hn::Mul(iy, width), ix);
+      const VF rx = hn::MulAdd(ax, hn::Add(hn::ConvertTo(d, ix), half), bx), ry = hn::MulAdd(ay, hn::Add(hn::ConvertTo(d, iy), half), by);
+      // Eq. 10's term of the point at depth dp on the tap pixel's ray.
+      const auto term = [&](VF dp) {
+        const VF vx = hn::Sub(hn::Mul(dp, rx), hn::Load(d, r.cx + j0));
+        const VF vy = hn::Sub(hn::Mul(dp, ry), hn::Load(d, r.cy + j0));
+        const VF vz = hn::Sub(hn::Neg(dp), hn::Load(d, r.cz + j0));
+        const VF vv = hn::MulAdd(vz, vz, hn::MulAdd(vy, vy, hn::Mul(vx, vx)));
+        const VF vn = hn::Add(hn::MulAdd(vz, hn::Load(d, r.nz + j0), hn::MulAdd(vy, hn::Load(d, r.ny + j0), hn::Mul(vx, hn::Load(d, r.nx + j0)))),
+                              hn::Load(d, r.bias + j0));
+        // Background samples (depth +inf, so vv is inf or NaN and fails vv < r^2) contribute
+        // nothing: the paper's assumption that unseen space is empty. vv < r^2 is eq. 9's H.
+        const MF use = hn::And(hn::Lt(vv, r2), hn::Gt(vn, zero));
+        return hn::IfThenElseZero(use, hn::Div(vn, hn::Add(vv, eps)));
+      };
+      VF t = term(hn::GatherIndex(d, in.depth, tap));
+      if constexpr (kTwoLayers) t = hn::Max(t, term(hn::Abs(hn::GatherIndex(d, in.second, tap))));
+      hn::Store(hn::Add(hn::Load(d, r.sum + j0), t), d, r.sum + j0);
     }
   }
 }
@@ -221,7 +233,10 @@ void AlchemyRow(const AlchemyInputs& in, int y, int x0, int x1, float* out) {
   const int end = (n + lanes - 1) / lanes * lanes;
   Row r;
   prepare_row(in, y, x0, n, end, r);
-  add_samples(in, y, end, r);
+  if (in.second)
+    add_samples<true>(in, y, end, r);
+  else
+    add_samples<false>(in, y, end, r);
   const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), scale = hn::Set(d, in.scale);
   HWY_ALIGN float v[kMaxLanes];
   for (int j0 = 0; j0 < n; j0 += lanes) {

@@ -31,13 +31,27 @@ inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f
 
 // The depth plane's constants in vectors, made once per call.
 struct Plane {
-  VF scale_x, scale_y, centre_x, centre_y, max_x, max_y;
+  VF scale_x, scale_y, centre_x, centre_y, max_x, max_y, separation;
   VI width;
   const float* depth;
+  const float* second;
   explicit Plane(const DepthPlane& p)
       : scale_x(hn::Set(DF(), p.scale_x)), scale_y(hn::Set(DF(), p.scale_y)), centre_x(hn::Set(DF(), p.centre_x)),
         centre_y(hn::Set(DF(), p.centre_y)), max_x(hn::Set(DF(), static_cast<float>(p.width - 1))),
-        max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), width(hn::Set(DI(), p.width)), depth(p.depth) {}
+        max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), separation(hn::Set(DF(), p.separation)), width(hn::Set(DI(), p.width)),
+        depth(p.depth), second(p.second) {}
+
+  // Deep G-buffer (DepthPlane::second): where the solid that begins at a pixel's first layer z1
+  // ends, given the pixel's second-layer word s2: s2 itself for a back face (s2 > 0, +infinity
+  // without a surface behind), z1 + separation for a front face.
+  HWY_INLINE VF solid_end(VF z1, VF s2) const { return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), s2, hn::Add(z1, separation)); }
+  // Where the next solid begins: the front face's depth -s2, else +infinity.
+  HWY_INLINE static VF next_solid(VF s2) {
+    return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), hn::Set(DF(), kInfinity), hn::Neg(s2));
+  }
+  // Whether depth z, behind the first layer z1, lies in the solid: before its end or past the next
+  // solid's beginning.
+  HWY_INLINE MF in_solid(VF z, VF z1, VF s2) const { return hn::Or(hn::Lt(z, solid_end(z1, s2)), hn::Gt(z, next_solid(s2))); }
 
   // ScreenProjection::locate, lane-wise: the pixel of camera-space point q (clamp-to-edge: f clamped
   // to [0, size - 1] as floats before the conversion; Max returns its second operand, 0, for a NaN
@@ -199,7 +213,8 @@ void LoadCoveredPixels(CoveredPixels& row, const GBuffer& g, int y, int first, i
   if (frame) rotate_frames(row, end);
 }
 
-void CountOpenRays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, float* open) {
+template <bool kTwoLayers>
+void CountOpenRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, float* open) {
   const DF d;
   const Plane pl(plane);
   const StepOffsets offsets(s, m);
@@ -216,10 +231,14 @@ void CountOpenRays(const CoveredPixels& row, const DepthPlane& plane, const Test
         VF qx, qy, qz;
         e.point(o[0], o[1], o[2], qx, qy, qz);
         // DepthBufferCharacteristic::distance: z* - depth(p), +infinity behind the camera.
-        const VF zs = hn::GatherIndex(d, pl.depth, pl.pixel(qx, qy, qz));
+        const VI pixel = pl.pixel(qx, qy, qz);
+        const VF zs = hn::GatherIndex(d, pl.depth, pixel);
         const VF dist = hn::IfThenElse(hn::Lt(qz, zero), hn::Add(zs, qz), inf);
-        // Occluded: behind the surface by more than the bias, and (AT 4.3) less than R behind it.
-        blocked = hn::Or(blocked, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+        // Occluded: behind the surface by more than the bias, and (AT 4.3) less than R behind it;
+        // with a second layer also inside the solid behind the surface (not past its end).
+        MF occluded = hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far));
+        if constexpr (kTwoLayers) occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), zs, gather_where(occluded, pl.second, pixel)));
+        blocked = hn::Or(blocked, occluded);
       }
       count = hn::Add(count, hn::IfThenZeroElse(blocked, one));
     }
@@ -227,8 +246,9 @@ void CountOpenRays(const CoveredPixels& row, const DepthPlane& plane, const Test
   }
 }
 
-void SumFreePipes(const CoveredPixels& row, const DepthPlane& plane, float half_radius, const TestPoints& disk, float far_limit,
-                  float* free) {
+template <bool kTwoLayers>
+void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float half_radius, const TestPoints& disk, float far_limit,
+                      float* free) {
   const DF d;
   const Plane pl(plane);
   const VF zero = hn::Zero(d), hr = hn::Set(d, half_radius), lim = hn::Set(d, far_limit), inf = hn::Set(d, kInfinity);
@@ -256,12 +276,23 @@ void SumFreePipes(const CoveredPixels& row, const DepthPlane& plane, float half_
       // Clamp-to-edge as Plane::pixel (behind the camera the pixel is any one: the pipe is free).
       const VI ix = truncate_in_range(hn::Min(hn::Max(fx, zero), pl.max_x));
       const VI iy = truncate_in_range(hn::Min(hn::Max(fy, zero), pl.max_y));
-      const VF zs = hn::GatherIndex(d, pl.depth, hn::Add(hn::Mul(iy, pl.width), ix));
+      const VI pixel = hn::Add(hn::Mul(iy, pl.width), ix);
+      const VF zs = hn::GatherIndex(d, pl.depth, pixel);
       // DepthBufferCharacteristic::distance z* - z_c, then z* - z_entry = (z* - z_c) + (R/2) h_i.
       const VF to_surface = hn::Add(hn::Add(hn::IfThenElse(valid, hn::Add(zs, cz), inf), hc), bias);
       // Fig. 7: dz = clamp(z* - z_entry, 0, chord): (a) surface inside: z* - z_entry; (b) behind:
       // the chord; (c) in front: 0. A distant foreground surface (AT 4.3) leaves the pipe free.
-      const VF dz = hn::Min(hn::Max(to_surface, zero), chord);
+      VF dz = hn::Min(hn::Max(to_surface, zero), chord);
+      if constexpr (kTwoLayers) {
+        // The solid in the pipe is [dz, end) and [next, chord) from its entry (depth_layers.h), so
+        // the free length is next - max(0, end - dz), both clamped to the pipe.
+        const MF reaches = hn::And(valid, hn::Lt(to_surface, chord));  // the solid begins inside the pipe
+        const VF s2 = gather_where(reaches, pl.second, pixel);
+        const VF from_entry = hn::Add(cz, hc);  // depth z - z_entry = z + c_z + (R/2) h_i
+        const VF end = hn::Min(hn::Max(hn::Add(pl.solid_end(zs, s2), from_entry), zero), chord);
+        const VF next = hn::Min(hn::Max(hn::Add(Plane::next_solid(s2), from_entry), zero), chord);
+        dz = hn::IfThenElse(reaches, hn::Sub(next, hn::Max(hn::Sub(end, dz), zero)), dz);
+      }
       const MF distant = hn::And(hn::Lt(to_surface, lim), hn::Gt(to_surface, minus_huge));
       acc = hn::Add(acc, hn::IfThenElse(distant, chord, dz));
     }
@@ -286,6 +317,7 @@ HWY_INLINE void blocked_rgb(const float* palette, VI id, MF blocked, const float
 // Ray i of a vector of entries (sec. 4): whether any of its m test points is occluded (`blocked`),
 // and the nearest occluded one's palette index (with `in.packed`) or pixel (`at`). Steps run from
 // the far end inwards, each occluded one overwriting `at`.
+template <bool kTwoLayers>
 HWY_INLINE void nearest_occluder(const Entries& e, const Plane& pl, const StepOffsets& offsets, int i, int m, VF far, const TransferInputs& in,
                                  VI& at, MF& blocked) {
   const DF d;
@@ -302,6 +334,7 @@ HWY_INLINE void nearest_occluder(const Entries& e, const Plane& pl, const StepOf
     const VI pixel = pl.pixel(qx, qy, qz);
     const MF valid = hn::Lt(qz, zero);  // only points behind the camera are free
     VF dist;  // z* - depth(p)
+    VF z1;    // z*, with the packed words within the exactness margin below (used for a front face's solid end)
     VI id = pixel;
     if (in.packed) {
       // One gather brings z* and the pixel's palette index. z* with its low mantissa bits cleared
@@ -312,14 +345,26 @@ HWY_INLINE void nearest_occluder(const Entries& e, const Plane& pl, const StepOf
       const VF z_near = hn::BitCast(d, hn::AndNot(palette_mask, bits));
       dist = hn::Add(z_near, qz);
       const VF margin = hn::Mul(hn::Add(z_near, hn::Abs(qz)), exactness);
-      const MF close = hn::And(valid, hn::Or(hn::Lt(hn::Abs(hn::Sub(dist, minus_bias)), margin), hn::Lt(hn::Abs(hn::Sub(dist, far)), margin)));
-      if (!hn::AllFalse(d, close)) dist = hn::IfThenElse(close, hn::Add(gather_where(close, pl.depth, pixel), qz), dist);
+      MF close = hn::And(valid, hn::Or(hn::Lt(hn::Abs(hn::Sub(dist, minus_bias)), margin), hn::Lt(hn::Abs(hn::Sub(dist, far)), margin)));
+      if constexpr (kTwoLayers) {
+        // A front face's solid ends at z* + separation: that comparison is made exact the same way.
+        const VF end = hn::Add(z_near, pl.separation);
+        close = hn::Or(close, hn::And(valid, hn::Lt(hn::Abs(hn::Add(end, qz)), hn::Mul(hn::Add(end, hn::Abs(qz)), exactness))));
+      }
+      z1 = z_near;
+      if (!hn::AllFalse(d, close)) {
+        z1 = hn::IfThenElse(close, gather_where(close, pl.depth, pixel), z_near);
+        dist = hn::IfThenElse(close, hn::Add(z1, qz), dist);
+      }
       id = hn::BitCast(di, hn::And(bits, palette_mask));
     } else {
-      dist = hn::Add(gather_where(valid, pl.depth, pixel), qz);
+      z1 = gather_where(valid, pl.depth, pixel);
+      dist = hn::Add(z1, qz);
     }
-    // AT 4.3: occluded only when the surface in front is less than R in front.
-    const MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+    // AT 4.3: occluded only when the surface in front is less than R in front; with a second layer
+    // also inside the solid behind the surface.
+    MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+    if constexpr (kTwoLayers) occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), z1, gather_where(occluded, pl.second, pixel)));
     at = hn::IfThenElse(hn::RebindMask(di, occluded), id, at);
     blocked = hn::Or(blocked, occluded);
   }
@@ -366,7 +411,7 @@ HWY_INLINE void store_transfer(const TransferSums& t, float n, const TransferInp
 
 }  // namespace
 
-template <bool kDirect>
+template <bool kDirect, bool kTwoLayers>
 void TransferRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, const TransferInputs& in,
                       std::size_t row_base, const TransferOutputs& out) {
   const DF d;
@@ -379,7 +424,7 @@ void TransferRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const T
     for (int i = 0; i < s.n; ++i) {
       VI at;
       MF blocked;
-      nearest_occluder(e, pl, offsets, i, m, far, in, at, blocked);
+      nearest_occluder<kTwoLayers>(e, pl, offsets, i, m, far, in, at, blocked);
       t.open = hn::IfThenElse(blocked, t.open, hn::Add(t.open, one));
       VF ar, ag, ab;
       blocked_rgb(in.packed ? in.palette : nullptr, at, blocked, in.albedo, ar, ag, ab);
@@ -398,10 +443,27 @@ void TransferRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const T
 
 void TransferRays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, const TransferInputs& in,
                   std::size_t row_base, const TransferOutputs& out) {
+  const bool two = plane.second != nullptr;
   if (in.direct)
-    TransferRaysImpl<true>(row, plane, s, m, far_limit, in, row_base, out);
+    two ? TransferRaysImpl<true, true>(row, plane, s, m, far_limit, in, row_base, out)
+        : TransferRaysImpl<true, false>(row, plane, s, m, far_limit, in, row_base, out);
   else
-    TransferRaysImpl<false>(row, plane, s, m, far_limit, in, row_base, out);
+    two ? TransferRaysImpl<false, true>(row, plane, s, m, far_limit, in, row_base, out)
+        : TransferRaysImpl<false, false>(row, plane, s, m, far_limit, in, row_base, out);
+}
+
+void CountOpenRays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& s, int m, float far_limit, float* open) {
+  if (plane.second)
+    CountOpenRaysImpl<true>(row, plane, s, m, far_limit, open);
+  else
+    CountOpenRaysImpl<false>(row, plane, s, m, far_limit, open);
+}
+
+void SumFreePipes(const CoveredPixels& row, const DepthPlane& plane, float half_radius, const TestPoints& disk, float far_limit, float* free) {
+  if (plane.second)
+    SumFreePipesImpl<true>(row, plane, half_radius, disk, far_limit, free);
+  else
+    SumFreePipesImpl<false>(row, plane, half_radius, disk, far_limit, free);
 }
 
 }  // namespace ao::simd::HWY_NAMESPACE

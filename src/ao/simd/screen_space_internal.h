@@ -47,6 +47,12 @@ struct DepthPlane {
   const float* depth = nullptr;  ///< width * height linear depths.
   float scale_x = 1, scale_y = 1, centre_x = 0, centre_y = 0;
   int width = 0, height = 0;
+  /// A deep G-buffer's second layer (GBuffer::second_depth), or null. With it the solid along a
+  /// pixel's ray is [z*, z2] where the layer holds a back face z2 > 0, [z*, z* + separation] and
+  /// [-z2, infinity) where it holds a front face (z2 < 0), and [z*, infinity) where it holds
+  /// +infinity; without it [z*, infinity) (methods/depth_layers.h).
+  const float* second = nullptr;
+  float separation = 0;
 };
 
 /// Test points in the tangent frame, world units (VAO eq. 5, AT eq. 8): (x[i], y[i], z[i]), n of them.

@@ -7,8 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <map>
-#include <mutex>
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
@@ -242,17 +240,7 @@ ConeSetup derive_cone_setup(const ConeParams& p) {
     s.sphere_radius[k] = d * sa;
     d /= q;
   }
-  {
-    // The point sets depend on n alone; the Lloyd relaxation costs about a millisecond, per frame
-    // otherwise.
-    static std::mutex mutex;
-    static std::map<int, std::vector<ConeSetup::Disk>> cache;
-    const int n_prisms = p.prisms.value_or(6);
-    const std::lock_guard<std::mutex> lock(mutex);
-    auto it = cache.find(n_prisms);
-    if (it == cache.end()) it = cache.emplace(n_prisms, cone_disk_points(n_prisms)).first;
-    s.disk = it->second;
-  }
+  s.disk = cone_disk_points(p.prisms.value_or(6));  // poisson_disk keeps the relaxed sets: a copy of at most 64 points
   return s;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "ao/core/sampling.h"
+#include "ao/methods/samples.h"
 
 namespace ao {
 
@@ -49,48 +50,12 @@ ConePattern make_cone_pattern(const ConeSetup& setup, bool jitter, std::uint32_t
   return pat;
 }
 
-// Poisson-disk points on the unit disk: best-candidate dart throwing (Mitchell 1991) from a fixed
-// hash sequence, relaxed by Lloyd iterations on a fine grid over the disk so that the points are
-// evenly spread and well inside (a sample on the rim has a zero chord and would be wasted).
+// The prisms' points on the sphere's great disk: the methods' one Poisson-disk set of the unit disk
+// (samples.h, Lloyd-relaxed, so evenly spread and inside: a point on the rim would have a zero
+// chord and be wasted), each with its half chord h = sqrt(1 - x^2 - y^2).
 std::vector<ConeSetup::Disk> cone_disk_points(int n) {
-  std::vector<Vec2> pts;
-  auto disk_point = [](std::uint32_t i) {
-    const float r = std::sqrt(to_unit_float(hash32(2 * i + 17))), a = 2.0f * kPi * to_unit_float(hash32(2 * i + 18));
-    return Vec2{r * std::cos(a), r * std::sin(a)};
-  };
-  std::uint32_t next = 0;
-  for (int k = 0; k < n; ++k) {
-    Vec2 best{};
-    float best_d = -1;
-    for (int c = 0; c < 16 * (k + 1); ++c) {
-      const Vec2 q = disk_point(next++);
-      float d = kInfinity;
-      for (const Vec2& o : pts) d = std::min(d, (q.x - o.x) * (q.x - o.x) + (q.y - o.y) * (q.y - o.y));
-      if (d > best_d) best_d = d, best = q;
-    }
-    pts.push_back(best);
-  }
-  constexpr int kGrid = 48, kIterations = 30;
-  for (int it = 0; it < kIterations; ++it) {
-    std::vector<Vec2> sum(n);
-    std::vector<int> count(n, 0);
-    for (int gy = 0; gy < kGrid; ++gy)
-      for (int gx = 0; gx < kGrid; ++gx) {
-        const float x = -1.0f + (gx + 0.5f) * 2.0f / kGrid, y = -1.0f + (gy + 0.5f) * 2.0f / kGrid;
-        if (x * x + y * y > 1.0f) continue;
-        int best = 0;
-        float best_d = kInfinity;
-        for (int k = 0; k < n; ++k) {
-          const float d = (x - pts[k].x) * (x - pts[k].x) + (y - pts[k].y) * (y - pts[k].y);
-          if (d < best_d) best_d = d, best = k;
-        }
-        sum[best].x += x, sum[best].y += y, ++count[best];
-      }
-    for (int k = 0; k < n; ++k)
-      if (count[k] > 0) pts[k] = {sum[k].x / count[k], sum[k].y / count[k]};
-  }
   std::vector<ConeSetup::Disk> out;
-  for (const Vec2& q : pts) out.push_back({q.x, q.y, std::sqrt(std::max(0.0f, 1.0f - q.x * q.x - q.y * q.y))});
+  for (const Vec3& q : poisson_disk(PoissonDomain::Disk, n)) out.push_back({q.x, q.y, std::sqrt(std::max(0.0f, 1.0f - q.x * q.x - q.y * q.y))});
   return out;
 }
 

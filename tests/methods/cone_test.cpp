@@ -118,7 +118,9 @@ TEST(Cone, ThinRoofMissedAt128BitsIsResolvedAt512) {
 // docs/methods/cone.md) plus a margin of 0.03 for the reference's own noise (256 rays, standard
 // error ~0.03 per pixel) and platform differences.
 TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
-  for (const auto& [name, bound] : {std::pair{"sphere-on-plane", 0.08}, std::pair{"default", 0.12}}) {
+  // box-room: a closed box facing in, seen from inside: its solid is outside (parity alone would
+  // fill the room, V = 0: RMSE 0.90).
+  for (const auto& [name, bound] : {std::pair{"sphere-on-plane", 0.08}, std::pair{"default", 0.12}, std::pair{"box-room", 0.08}}) {
     const Scene s = make_builtin_scene(name);
     const RayScene rs(s);
     Camera cam = *s.preferred_view;
@@ -131,6 +133,28 @@ TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
     const ErrorMetrics m = compare_images(r.visibility, ref.visibility, coverage_mask(g));
     EXPECT_LT(m.rmse, bound) << name << ": mean signed error " << m.mean_signed;
   }
+}
+
+// The world grid of a room (a closed box whose faces turn in) with a box inside: the room's inside
+// is empty but for the box, and the walls are solid on their far side, a slab of R_max deep.
+TEST(Cone, ARoomFacingInIsSolidOutsideItsWalls) {
+  const Scene s = scene_of({make_box({-2, 0, -2}, {2, 2, 2}, {0.8f, 0.8f, 0.8f}, 0.0f, true), make_box({-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f})});
+  const std::vector<MeshClosure> closure = analyze_closure(s);
+  EXPECT_EQ(closure[0].orientation, -1) << "the room faces in";
+  EXPECT_EQ(closure[1].orientation, 1);
+  VoxelizeOptions o;
+  o.columns = 64, o.depth_bits = 64, o.slab_thickness = 0.5f;
+  const VoxelGrid g = voxelize_world(s, closure, o);
+  const auto solid = [&](Vec3 p) {
+    const int i = static_cast<int>((p.x - g.origin.x) / g.voxel_size.x), j = static_cast<int>((p.z - g.origin.z) / g.voxel_size.y),
+              k = static_cast<int>((p.y - g.origin.y) / g.voxel_size.z);
+    return g.voxel(i, j, k);
+  };
+  EXPECT_FALSE(solid({1.5f, 1.5f, 1.5f})) << "the room's air";
+  EXPECT_TRUE(solid({0, 0.5f, 0})) << "the box in it";
+  EXPECT_TRUE(solid({2.3f, 1.0f, 0})) << "beyond a wall";
+  EXPECT_TRUE(solid({0, -0.3f, 0})) << "under the floor";
+  EXPECT_LE(g.origin.y, -0.5f + 1e-3f) << "a slab's thickness of solid below the floor";
 }
 
 using test::cut_base;

@@ -47,11 +47,15 @@ const std::vector<MeshClosure>& closure_of(SceneBuffers& sb) {
   return *sb.closure;
 }
 
-// The GPU voxelizes by parity; the CPU's other modes change the solid of open surfaces (slabs) and
-// of holed meshes (winding number).
+// The GPU voxelizes by parity; the CPU's other modes change the solid of open surfaces (slabs),
+// of holed meshes (winding number) and of closed meshes facing in (the complement).
 void check_parity_suffices(const std::vector<MeshClosure>& closure, OpenMeshes mode) {
-  std::size_t open = 0, holed = 0;
-  for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0;
+  std::size_t open = 0, holed = 0, rooms = 0;
+  for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0, rooms += c.closed() && c.orientation < 0 ? 1 : 0;
+  if (rooms > 0 && mode != OpenMeshes::Parity)
+    throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the scene has " + std::to_string(rooms) +
+                     " closed mesh(es) facing in (a room), whose solid is outside: run cone on the CPU (--device cpu), or give "
+                     "-p open_meshes=parity for the paper's voxelization, which fills the room");
   const bool slabs = mode != OpenMeshes::Parity && open > 0, winding = mode == OpenMeshes::Winding && holed > 0;
   if (!slabs && !winding) return;
   const std::string what = slabs ? std::to_string(open) + " open surface(s), which open_meshes=" + (mode == OpenMeshes::Slab ? "slab" : "winding") +

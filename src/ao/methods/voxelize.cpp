@@ -689,6 +689,31 @@ VoxelStats grid_stats(const std::vector<std::vector<GridTri>>& tris, std::span<c
   return s;
 }
 
+// The objects voxelized by parity whose mesh is closed with its fronts facing in (a mirroring
+// instance transform turns them the other way).
+std::size_t inverted_closed_objects(const Scene& scene, std::span<const MeshClosure> closure, std::span<const Treat> treat) {
+  const std::vector<SceneObject> objects = scene.objects();
+  std::size_t n = 0;
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    const MeshClosure& c = closure[objects[o].mesh];
+    if (treat[o] != Treat::Parity || !c.closed()) continue;
+    const bool mirrored = objects[o].instance != SceneObject::kNoInstance && scene.instances[objects[o].instance].object_to_world.determinant() < 0;
+    n += c.orientation * (mirrored ? -1 : 1) < 0 ? 1 : 0;
+  }
+  return n;
+}
+
+// Complements every column's depth_bits voxels (the bits past them stay clear).
+void complement_columns(VoxelGrid& g) {
+  const std::size_t columns = static_cast<std::size_t>(g.nx) * g.ny;
+  const int tail = g.depth_bits % 64;
+  const std::uint64_t last = tail ? (std::uint64_t{1} << tail) - 1 : ~std::uint64_t{0};
+  tbb::parallel_for(std::size_t{0}, columns, [&](std::size_t c) {
+    std::uint64_t* col = &g.bits[c * static_cast<std::size_t>(g.words)];
+    for (int w = 0; w < g.words; ++w) col[w] = ~col[w] & (w == g.words - 1 ? last : ~std::uint64_t{0});
+  });
+}
+
 // Stages 1-4 for any grid whose geometry fields are set; `voxel` is the largest extent of a voxel
 // (world units), `emit` maps one Tri3 into a vector, `voxel_centre(i, j, k)` gives the world point
 // of a voxel's centre.
@@ -734,6 +759,14 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // 3. Toggles -> solid, then the winding-number solid near holes that are not flat.
   const std::size_t odd = scan_columns(g);
   const WalkCount walked = plan.slot_object.empty() ? WalkCount{} : winding_solid(g, hits, slot_winding(scene, closure, plan), voxel_centre);
+
+  // A closed mesh whose fronts face in (a room) encloses empty space: its solid is the complement
+  // of its parity (but for open_meshes=parity, the paper's voxelization of everything as it is). The world grid's columns start outside every mesh, so with an odd number of
+  // them the whole grid is complemented (objects inside the room stay solid: they toggle back). An
+  // eye grid's columns start at the camera, inside the room, where parity is already right.
+  if constexpr (!kPerspective) {
+    if (o.open_meshes != OpenMeshes::Parity && inverted_closed_objects(scene, closure, treat) % 2) complement_columns(g);
+  }
 
   // 4. Slabs of open meshes, ORed after the parity; walls' prisms as the union of the prisms: per
   // column, the voxels where the count of prisms entered minus left is not 0 (prisms overlap
@@ -903,7 +936,17 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
       i = j;
     }
     c.boundary_edges = c.boundary.size();
-    if (!c.boundary.empty()) {
+    if (c.boundary.empty()) {
+      // Closed: the sign of the enclosed volume (divergence theorem, about the box's centre) says
+      // whether the fronts face out of what it encloses or into it (a room).
+      const Vec3 o = m.bounds().center();
+      double volume = 0;
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
+        volume += dot(a, cross(b, d)) / 6.0;
+      }
+      c.orientation = volume < 0 ? -1 : 1;
+    } else {
       // Holes: connected components of the boundary edges over welded vertices (union-find).
       std::vector<std::uint32_t> parent(next + 1);
       for (std::uint32_t v = 0; v <= next; ++v) parent[v] = v;
@@ -941,9 +984,12 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
   // (a ground plane's slab hangs below it, a wall's prism stands behind it), and above when a
-  // slab rises from a face (a roof seen from below, a ceiling seen from the room).
-  const float side = (any_slab(treat.of) ? slab : 0.0f) + v0;
-  const float top = (slab_rises(scene, treat.of) ? slab : 0.0f) + v0;
+  // slab rises from a face (a roof seen from below, a ceiling seen from the room). A room (a
+  // closed mesh facing in) is solid outside: a slab's thickness of it all around, so that a cone
+  // near its walls meets as much solid as behind an open wall.
+  const bool room = o.open_meshes != OpenMeshes::Parity && inverted_closed_objects(scene, closure, treat.of) > 0;
+  const float side = (any_slab(treat.of) || room ? slab : 0.0f) + v0;
+  const float top = (slab_rises(scene, treat.of) || room ? slab : 0.0f) + v0;
   const Vec3 lo = b.lo - Vec3{side, side, side};
   const Vec3 ext = e + Vec3{2 * side, side + top, 2 * side};
   g.origin = lo;

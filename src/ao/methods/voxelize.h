@@ -59,7 +59,9 @@ enum class OpenMeshes {
             ///< outside its shell.
   Slab,     ///< Sheets become slabs behind their fronts (one-sided, whatever side a point is on); solids
             ///< with holes are voxelized as they are (parity).
-  Parity,   ///< Voxelize everything as it is: columns crossing an open mesh end odd (reported), as in the paper.
+  Parity,   ///< Voxelize everything as it is: columns crossing an open mesh end odd (reported), and a
+            ///< closed mesh facing in (a room) is solid inside, as in the paper. The other two modes
+            ///< take a room's outside for its solid (MeshClosure::orientation).
 };
 
 /// What a mesh stands for, decided per mesh by analyze_closure from its boundary edges and its
@@ -123,7 +125,9 @@ struct MeshClosure {
   float enclosure = 1;
   /// Open meshes: +1 when the fronts face out of what the mesh wraps around (the sign of w_rest, or
   /// of the enclosed volume for small holes), -1 when they face in (a solid with holes then has
-  /// w < -1/2 inside: its w is used negated).
+  /// w < -1/2 inside: its w is used negated). Closed meshes: the sign of the enclosed volume; -1
+  /// is a closed surface whose fronts face in, a room seen from inside: what it encloses is empty
+  /// and its solid is outside (the world grid complements its parity).
   int orientation = 1;
   /// Open meshes: every vertex within 1e-5 of the extent of one plane (a ground, a wall): then
   /// `plane` (n.x, n.y, n.z, d; n unit along the vector area) has n.p + d < 0 exactly where w > 0.

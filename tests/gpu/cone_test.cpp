@@ -73,7 +73,7 @@ TEST(GpuVoxelGridLimits, AGridBeyondTheLargestStorageBufferIsAnInputError) {
   const Scene scene = make_builtin_scene("box-room");
   const GpuScene gpu_scene = GpuScene::upload(test::gpu_device(), scene);
   VoxelizeOptions o;
-  o.open_meshes = OpenMeshes::Parity;  // the GPU's voxelization of a room (facing in)
+  o.open_meshes = OpenMeshes::Parity;  // the paper's voxelization, the GPU's
   o.columns = 4096;
   o.depth_bits = 1024;  // 2 GiB of bits
   try {

@@ -244,13 +244,13 @@ TEST(GpuMethods, ConeReusesItsGridWhileTheVoxelizationOptionsStay) {
   const auto run = [&](const nlohmann::json& params) {
     return run_gpu_method(gpu_device(), "cone", GpuMethodInput{g, f.gpu_scene.get(), {Membership::Step, 1.0f}, 1}, params);
   };
-  // box-room's room faces in: the GPU voxelizes it by parity (the paper's), the default refuses.
+  // box-room's camera is inside its room: the GPU voxelizes it by parity (the paper's), the default refuses.
   EXPECT_FALSE(run({{"columns", 64}, {"open_meshes", "parity"}}).output.stats["grid_reused"].get<bool>());
   const GpuMethodOutput again = run({{"columns", 64}, {"preset", "low"}, {"open_meshes", "parity"}});
   EXPECT_TRUE(again.output.stats["grid_reused"].get<bool>());
   EXPECT_FALSE(again.output.stats["gpu_ms"].contains("voxelize"));
   EXPECT_FALSE(run({{"columns", 96}, {"open_meshes", "parity"}}).output.stats["grid_reused"].get<bool>());
-  test::expect_one_line_error<InputError>([&] { run({{"columns", 64}}); }, "facing in", "--device cpu");
+  test::expect_one_line_error<InputError>([&] { run({{"columns", 64}}); }, "a room", "--device cpu");
 }
 
 }  // namespace

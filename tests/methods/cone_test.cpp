@@ -135,26 +135,37 @@ TEST(Cone, CloseToRayTracedReferenceOnBuiltInScenes) {
   }
 }
 
-// The world grid of a room (a closed box whose faces turn in) with a box inside: the room's inside
-// is empty but for the box, and the walls are solid on their far side, a slab of R_max deep.
-TEST(Cone, ARoomFacingInIsSolidOutsideItsWalls) {
-  const Scene s = scene_of({make_box({-2, 0, -2}, {2, 2, 2}, {0.8f, 0.8f, 0.8f}, 0.0f, true), make_box({-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f})});
-  const std::vector<MeshClosure> closure = analyze_closure(s);
-  EXPECT_EQ(closure[0].orientation, -1) << "the room faces in";
-  EXPECT_EQ(closure[1].orientation, 1);
-  VoxelizeOptions o;
-  o.columns = 64, o.depth_bits = 64, o.slab_thickness = 0.5f;
-  const VoxelGrid g = voxelize_world(s, closure, o);
-  const auto solid = [&](Vec3 p) {
-    const int i = static_cast<int>((p.x - g.origin.x) / g.voxel_size.x), j = static_cast<int>((p.z - g.origin.z) / g.voxel_size.y),
-              k = static_cast<int>((p.y - g.origin.y) / g.voxel_size.z);
-    return g.voxel(i, j, k);
-  };
-  EXPECT_FALSE(solid({1.5f, 1.5f, 1.5f})) << "the room's air";
-  EXPECT_TRUE(solid({0, 0.5f, 0})) << "the box in it";
-  EXPECT_TRUE(solid({2.3f, 1.0f, 0})) << "beyond a wall";
-  EXPECT_TRUE(solid({0, -0.3f, 0})) << "under the floor";
-  EXPECT_LE(g.origin.y, -0.5f + 1e-3f) << "a slab's thickness of solid below the floor";
+// A room: a closed box around the camera with a box inside. Its inside is air but for the box, and
+// its walls are solid on their far side, a slab of R_max deep. Which way its faces turn does not
+// matter: seen from outside, the same closed box (faces turned in or out) is a solid.
+TEST(Cone, AClosedMeshAroundTheCameraIsARoom) {
+  for (const bool inward : {true, false}) {
+    const Scene s = scene_of({make_box({-2, 0, -2}, {2, 2, 2}, {0.8f, 0.8f, 0.8f}, 0.0f, inward), make_box({-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f})});
+    const std::vector<MeshClosure> closure = analyze_closure(s);
+    EXPECT_EQ(closed_meshes_around(s, closure, {1.5f, 1.5f, 1.5f}), (std::vector<std::uint8_t>{1, 0})) << "inside the room";
+    EXPECT_TRUE(closed_meshes_around(s, closure, {0, 1, 5}).empty()) << "outside it";
+    EXPECT_EQ(closed_meshes_around(s, closure, {0, 0.5f, 0}), (std::vector<std::uint8_t>{1, 1})) << "inside the box in it";
+    VoxelizeOptions o;
+    o.columns = 64, o.depth_bits = 64, o.slab_thickness = 0.5f;
+    const auto solid_at = [](const VoxelGrid& g, Vec3 p) {
+      const int i = static_cast<int>((p.x - g.origin.x) / g.voxel_size.x), j = static_cast<int>((p.z - g.origin.z) / g.voxel_size.y),
+                k = static_cast<int>((p.y - g.origin.y) / g.voxel_size.z);
+      return g.voxel(i, j, k);
+    };
+    o.rooms = closed_meshes_around(s, closure, {1.5f, 1.5f, 1.5f});
+    const VoxelGrid room = voxelize_world(s, closure, o);
+    EXPECT_FALSE(solid_at(room, {1.5f, 1.5f, 1.5f})) << "the room's air";
+    EXPECT_TRUE(solid_at(room, {0, 0.5f, 0})) << "the box in it";
+    EXPECT_TRUE(solid_at(room, {2.3f, 1.0f, 0})) << "beyond a wall";
+    EXPECT_TRUE(solid_at(room, {0, -0.3f, 0})) << "under the floor";
+    EXPECT_LE(room.origin.y, -0.5f + 1e-3f) << "a slab's thickness of solid below the floor";
+    o.rooms.clear();  // the camera outside: the closed box is a solid, its faces turned in or not
+    const VoxelGrid solid = voxelize_world(s, closure, o);
+    EXPECT_TRUE(solid_at(solid, {1.5f, 1.5f, 1.5f}));
+    o.rooms = closed_meshes_around(s, closure, {1.5f, 1.5f, 1.5f});
+    o.open_meshes = OpenMeshes::Parity;  // the paper's parity of everything fills the room
+    EXPECT_TRUE(solid_at(voxelize_world(s, closure, o), {1.5f, 1.5f, 1.5f}));
+  }
 }
 
 using test::cut_base;

@@ -48,13 +48,15 @@ const std::vector<MeshClosure>& closure_of(SceneBuffers& sb) {
 }
 
 // The GPU voxelizes by parity; the CPU's other modes change the solid of open surfaces (slabs),
-// of holed meshes (winding number) and of closed meshes facing in (the complement).
-void check_parity_suffices(const std::vector<MeshClosure>& closure, OpenMeshes mode) {
-  std::size_t open = 0, holed = 0, rooms = 0;
-  for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0, rooms += c.closed() && c.orientation < 0 ? 1 : 0;
+// of holed meshes (winding number) and of closed meshes around the camera (the complement).
+void check_parity_suffices(const std::vector<MeshClosure>& closure, const VoxelizeOptions& o) {
+  const OpenMeshes mode = o.open_meshes;
+  std::size_t open = 0, holed = 0;
+  for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0;
+  const auto rooms = static_cast<std::size_t>(std::count(o.rooms.begin(), o.rooms.end(), std::uint8_t{1}));
   if (rooms > 0 && mode != OpenMeshes::Parity)
-    throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the scene has " + std::to_string(rooms) +
-                     " closed mesh(es) facing in (a room), whose solid is outside: run cone on the CPU (--device cpu), or give "
+    throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the camera is inside " + std::to_string(rooms) +
+                     " closed mesh(es) (a room), whose solid is outside: run cone on the CPU (--device cpu), or give "
                      "-p open_meshes=parity for the paper's voxelization, which fills the room");
   const bool slabs = mode != OpenMeshes::Parity && open > 0, winding = mode == OpenMeshes::Winding && holed > 0;
   if (!slabs && !winding) return;
@@ -80,7 +82,7 @@ void set_instance(Context& c, Program& p, const Scene& s, const SceneObject& ob)
 void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vector<PassQuery>& passes) {
   o.validate();
   const std::vector<MeshClosure>& closure = closure_of(sb);
-  check_parity_suffices(closure, o.open_meshes);
+  check_parity_suffices(closure, o);
   GridCache& cache = sb.grid;
   cache.valid = false;
   cache.layout = world_layout(*sb.scene, o);
@@ -160,7 +162,7 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
 
 bool grid_is_current(const GridCache& cache, const VoxelizeOptions& o) {
   return cache.valid && cache.options.columns == o.columns && cache.options.depth_bits == o.depth_bits && cache.options.open_meshes == o.open_meshes &&
-         cache.options.slab_thickness == o.slab_thickness;
+         cache.options.slab_thickness == o.slab_thickness && cache.options.rooms == o.rooms;
 }
 
 // The world sampler's constants of cone_world.cpp: per chain sphere its radii in voxels and the
@@ -213,7 +215,8 @@ MethodOutput run_cone(Run& r, SceneBuffers& sb, const Falloff& falloff, const Co
   const float r_max = falloff.radius;
   if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
   if (p.grid == GridSpace::Eye) throw InputError("cone on the GPU traces the world grid only: grid=eye runs on the CPU (--device cpu)");
-  const VoxelizeOptions options = p.voxelize_options(r_max);
+  VoxelizeOptions options = p.voxelize_options(r_max);
+  options.rooms = closed_meshes_around(*sb.scene, closure_of(sb), r.g.camera.eye);
   ConeResult result;
   result.grid_reused = grid_is_current(sb.grid, options);
   if (!result.grid_reused) build_grid(r.c, sb, options, r.passes);

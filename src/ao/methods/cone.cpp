@@ -282,6 +282,7 @@ VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, con
                    std::span<const std::uint8_t> back = {}, const Bounds3& region = {}) {
   VoxelizeOptions o = p.voxelize_options(r_max);
   o.slab_region = region;
+  o.rooms = closed_meshes_around(scene, closure, gb.camera.eye);
   return p.grid == GridSpace::World ? voxelize_world(scene, closure, o, stats, back) : voxelize_eye(scene, closure, gb, o, stats, back);
 }
 
@@ -379,7 +380,7 @@ ConeContext::ConeContext(const Scene& scene) : scene_(scene), closure_(analyze_c
 
 bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const VoxelizeOptions& o) const {
   if (!valid_ || space != space_ || o.columns != options_.columns || o.depth_bits != options_.depth_bits || o.open_meshes != options_.open_meshes ||
-      o.slab_thickness != options_.slab_thickness)
+      o.slab_thickness != options_.slab_thickness || o.rooms != options_.rooms)
     return false;
   if (space == GridSpace::World) return true;
   const Camera& c = gb.camera;
@@ -393,7 +394,8 @@ bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const Voxe
 
 ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams& params, std::uint32_t seed, const ProgressFn& progress) {
   const ConeParams p = checked_resolved(params, r_max);
-  const VoxelizeOptions options = p.voxelize_options(r_max);
+  VoxelizeOptions options = p.voxelize_options(r_max);
+  options.rooms = closed_meshes_around(scene_, closure_, gb.camera.eye);  // a camera that walks out of a room needs another grid
   ConeResult r;
   const int builds_before = builds_;
   if (!grid_is_current(gb, p.grid, options)) {

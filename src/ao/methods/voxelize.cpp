@@ -689,17 +689,11 @@ VoxelStats grid_stats(const std::vector<std::vector<GridTri>>& tris, std::span<c
   return s;
 }
 
-// The objects voxelized by parity whose mesh is closed with its fronts facing in (a mirroring
-// instance transform turns them the other way).
-std::size_t inverted_closed_objects(const Scene& scene, std::span<const MeshClosure> closure, std::span<const Treat> treat) {
-  const std::vector<SceneObject> objects = scene.objects();
+// The rooms among the objects voxelized by parity (VoxelizeOptions::rooms).
+std::size_t rooms_by_parity(const VoxelizeOptions& o, std::span<const Treat> treat) {
+  if (o.open_meshes == OpenMeshes::Parity) return 0;
   std::size_t n = 0;
-  for (std::size_t o = 0; o < objects.size(); ++o) {
-    const MeshClosure& c = closure[objects[o].mesh];
-    if (treat[o] != Treat::Parity || !c.closed()) continue;
-    const bool mirrored = objects[o].instance != SceneObject::kNoInstance && scene.instances[objects[o].instance].object_to_world.determinant() < 0;
-    n += c.orientation * (mirrored ? -1 : 1) < 0 ? 1 : 0;
-  }
+  for (std::size_t k = 0; k < std::min(o.rooms.size(), treat.size()); ++k) n += o.rooms[k] && treat[k] == Treat::Parity ? 1 : 0;
   return n;
 }
 
@@ -760,12 +754,13 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   const std::size_t odd = scan_columns(g);
   const WalkCount walked = plan.slot_object.empty() ? WalkCount{} : winding_solid(g, hits, slot_winding(scene, closure, plan), voxel_centre);
 
-  // A closed mesh whose fronts face in (a room) encloses empty space: its solid is the complement
-  // of its parity (but for open_meshes=parity, the paper's voxelization of everything as it is). The world grid's columns start outside every mesh, so with an odd number of
-  // them the whole grid is complemented (objects inside the room stay solid: they toggle back). An
-  // eye grid's columns start at the camera, inside the room, where parity is already right.
+  // A closed mesh around the camera (a room) encloses air: its solid is the complement of its
+  // parity (but for open_meshes=parity, the paper's voxelization of everything as it is). The
+  // world grid's columns start outside every mesh, so with an odd number of rooms the whole grid
+  // is complemented (objects inside the room stay solid: they toggle back). An eye grid's columns
+  // start at the camera, inside the room, where parity is already right.
   if constexpr (!kPerspective) {
-    if (o.open_meshes != OpenMeshes::Parity && inverted_closed_objects(scene, closure, treat) % 2) complement_columns(g);
+    if (rooms_by_parity(o, treat) % 2) complement_columns(g);
   }
 
   // 4. Slabs of open meshes, ORed after the parity; walls' prisms as the union of the prisms: per
@@ -936,17 +931,7 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
       i = j;
     }
     c.boundary_edges = c.boundary.size();
-    if (c.boundary.empty()) {
-      // Closed: the sign of the enclosed volume (divergence theorem, about the box's centre) says
-      // whether the fronts face out of what it encloses or into it (a room).
-      const Vec3 o = m.bounds().center();
-      double volume = 0;
-      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-        const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
-        volume += dot(a, cross(b, d)) / 6.0;
-      }
-      c.orientation = volume < 0 ? -1 : 1;
-    } else {
+    if (!c.boundary.empty()) {
       // Holes: connected components of the boundary edges over welded vertices (union-find).
       std::vector<std::uint32_t> parent(next + 1);
       for (std::uint32_t v = 0; v <= next; ++v) parent[v] = v;
@@ -968,6 +953,47 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
   return out;
 }
 
+std::vector<std::uint8_t> closed_meshes_around(const Scene& scene, std::span<const MeshClosure> closure, Vec3 eye) {
+  const std::vector<SceneObject> objects = scene.objects();
+  std::vector<std::uint8_t> around(objects.size(), 0);
+  bool any = false;
+  // A direction no axis-aligned or diagonal face contains, so the ray meets no edge of a modelled
+  // room exactly.
+  const Vec3 dir = normalize(Vec3{0.5734f, 0.6321f, 0.5213f});
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const Mesh& m = scene.meshes[objects[k].mesh];
+    if (!closure[objects[k].mesh].closed()) continue;
+    // The eye and the ray in the mesh's own space.
+    Vec3 p = eye, d = dir;
+    if (objects[k].instance != SceneObject::kNoInstance) {
+      const Affine3 to_object = inverse(scene.instances[objects[k].instance].object_to_world);
+      p = to_object.point(eye), d = to_object.vector(dir);
+    }
+    const Bounds3 b = m.bounds();
+    if (p.x < b.lo.x || p.y < b.lo.y || p.z < b.lo.z || p.x > b.hi.x || p.y > b.hi.y || p.z > b.hi.z) continue;
+    std::size_t crossings = 0;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      // Moller-Trumbore: the ray p + s d, s > 0, through the triangle.
+      const Vec3 a = m.positions[m.indices[3 * t]], e1 = m.positions[m.indices[3 * t + 1]] - a, e2 = m.positions[m.indices[3 * t + 2]] - a;
+      const Vec3 h = cross(d, e2);
+      const float det = dot(e1, h);
+      if (det == 0.0f) continue;
+      const float inv = 1.0f / det;
+      const Vec3 q = p - a;
+      const float u = dot(q, h) * inv;
+      if (u < 0.0f || u > 1.0f) continue;
+      const Vec3 r = cross(q, e1);
+      const float v = dot(d, r) * inv;
+      if (v < 0.0f || u + v > 1.0f) continue;
+      crossings += dot(e2, r) * inv > 0.0f ? 1 : 0;
+    }
+    around[k] = crossings % 2;
+    any = any || around[k];
+  }
+  if (!any) around.clear();
+  return around;
+}
+
 VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats,
                          std::span<const std::uint8_t> back) {
   o.validate();
@@ -985,9 +1011,9 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
   // (a ground plane's slab hangs below it, a wall's prism stands behind it), and above when a
   // slab rises from a face (a roof seen from below, a ceiling seen from the room). A room (a
-  // closed mesh facing in) is solid outside: a slab's thickness of it all around, so that a cone
-  // near its walls meets as much solid as behind an open wall.
-  const bool room = o.open_meshes != OpenMeshes::Parity && inverted_closed_objects(scene, closure, treat.of) > 0;
+  // closed mesh around the camera) is solid outside: a slab's thickness of it all around, so that
+  // a cone near its walls meets as much solid as behind an open wall.
+  const bool room = rooms_by_parity(o, treat.of) > 0;
   const float side = (any_slab(treat.of) || room ? slab : 0.0f) + v0;
   const float top = (slab_rises(scene, treat.of) || room ? slab : 0.0f) + v0;
   const Vec3 lo = b.lo - Vec3{side, side, side};

@@ -60,8 +60,8 @@ enum class OpenMeshes {
   Slab,     ///< Sheets become slabs behind their fronts (one-sided, whatever side a point is on); solids
             ///< with holes are voxelized as they are (parity).
   Parity,   ///< Voxelize everything as it is: columns crossing an open mesh end odd (reported), and a
-            ///< closed mesh facing in (a room) is solid inside, as in the paper. The other two modes
-            ///< take a room's outside for its solid (MeshClosure::orientation).
+            ///< closed mesh around the camera (a room) is solid inside, as in the paper. The other two
+            ///< modes take a room's outside for its solid (VoxelizeOptions::rooms).
 };
 
 /// What a mesh stands for, decided per mesh by analyze_closure from its boundary edges and its
@@ -125,9 +125,7 @@ struct MeshClosure {
   float enclosure = 1;
   /// Open meshes: +1 when the fronts face out of what the mesh wraps around (the sign of w_rest, or
   /// of the enclosed volume for small holes), -1 when they face in (a solid with holes then has
-  /// w < -1/2 inside: its w is used negated). Closed meshes: the sign of the enclosed volume; -1
-  /// is a closed surface whose fronts face in, a room seen from inside: what it encloses is empty
-  /// and its solid is outside (the world grid complements its parity).
+  /// w < -1/2 inside: its w is used negated).
   int orientation = 1;
   /// Open meshes: every vertex within 1e-5 of the extent of one plane (a ground, a wall): then
   /// `plane` (n.x, n.y, n.z, d; n unit along the vector area) has n.p + d < 0 exactly where w > 0.
@@ -160,10 +158,20 @@ struct VoxelizeOptions {
   /// holes seen from inside) whose slab cannot reach into it are left out: slabs are a union of
   /// one per face. Closed meshes and fans are always whole (parity needs them whole).
   Bounds3 slab_region;
+  /// Per object (Scene::objects()): 1 for a closed mesh around the camera (closed_meshes_around), a
+  /// room: what it encloses is air, its solid is outside. The world grid complements its parity and
+  /// keeps a slab's thickness of solid around it (not with open_meshes=parity); an eye grid's
+  /// columns start inside it, where parity is already right. Empty: none.
+  std::vector<std::uint8_t> rooms;
 
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+
+/// Which objects of `scene` are closed meshes (closure[mesh].closed()) with `eye` inside them (an
+/// odd number of crossings along a ray from it), per Scene::objects(); empty when there are none.
+/// Whichever way their faces turn, a closed surface around the viewer is a room.
+std::vector<std::uint8_t> closed_meshes_around(const Scene& scene, std::span<const MeshClosure> closure, Vec3 eye);
 
 /// Numbers for --json.
 struct VoxelStats {

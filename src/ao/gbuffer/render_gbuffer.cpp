@@ -1,10 +1,9 @@
 #include "ao/gbuffer/render_gbuffer.h"
 
 #include <algorithm>
-#include <cstddef>
-
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <string>
 
 #include "ao/core/error.h"
@@ -118,7 +117,6 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
     return static_cast<std::size_t>(t.x1 - t.x0) * static_cast<std::size_t>(t.y1 - t.y0);
   });
 }
-
 
 Image<float> render_second_layer_depth(const RayScene& rs, const GBuffer& g, float separation, const ProgressFn& progress) {
   if (!(std::isfinite(separation) && separation > 0.0f))

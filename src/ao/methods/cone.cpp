@@ -278,11 +278,17 @@ ConeParams checked_resolved(const ConeParams& params, float r_max) {
   return p;
 }
 
-VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max, VoxelStats* stats,
-                   std::span<const std::uint8_t> back = {}, const Bounds3& region = {}) {
+// The voxelization options of a render: the parameters' and the rooms around the camera (a camera
+// that walks out of a room needs another grid).
+VoxelizeOptions voxelize_options(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, float r_max) {
   VoxelizeOptions o = p.voxelize_options(r_max);
-  o.slab_region = region;
   o.rooms = closed_meshes_around(scene, closure, gb.camera.eye);
+  return o;
+}
+
+VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, const GBuffer& gb, const ConeParams& p, VoxelizeOptions o,
+                   VoxelStats* stats, std::span<const std::uint8_t> back = {}, const Bounds3& region = {}) {
+  o.slab_region = region;
   return p.grid == GridSpace::World ? voxelize_world(scene, closure, o, stats, back) : voxelize_eye(scene, closure, gb, o, stats, back);
 }
 
@@ -355,14 +361,15 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
   ConeResult r;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<VoxelGrid> grids;
-  grids.push_back(voxelize(scene, closure, gb, p, r_max, &r.voxel_stats));
+  const VoxelizeOptions options = voxelize_options(scene, closure, gb, p, r_max);
+  grids.push_back(voxelize(scene, closure, gb, p, options, &r.voxel_stats));
   const auto t1 = std::chrono::steady_clock::now();
   const cone_internal::PixelSides sides = cone_internal::pixel_sides(
       gb, scene, p.open_meshes == OpenMeshes::Winding ? cone_internal::make_side_setup(scene, closure, r_max) : cone_internal::SideSetup{}, grids[0]);
   const auto t2 = std::chrono::steady_clock::now();
   for (std::size_t k = 1; k < sides.keys.size(); ++k) {
     VoxelStats s;
-    grids.push_back(voxelize(scene, closure, gb, p, r_max, &s, sides.keys[k], side_region(gb, sides, k, r_max)));
+    grids.push_back(voxelize(scene, closure, gb, p, options, &s, sides.keys[k], side_region(gb, sides, k, r_max)));
     add_grid_stats(r, s);
   }
   r.voxelize_ms = ms_between(t0, t1) + ms_between(t2, std::chrono::steady_clock::now());
@@ -394,8 +401,7 @@ bool ConeContext::grid_is_current(const GBuffer& gb, GridSpace space, const Voxe
 
 ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams& params, std::uint32_t seed, const ProgressFn& progress) {
   const ConeParams p = checked_resolved(params, r_max);
-  VoxelizeOptions options = p.voxelize_options(r_max);
-  options.rooms = closed_meshes_around(scene_, closure_, gb.camera.eye);  // a camera that walks out of a room needs another grid
+  const VoxelizeOptions options = voxelize_options(scene_, closure_, gb, p, r_max);
   ConeResult r;
   const int builds_before = builds_;
   if (!grid_is_current(gb, p.grid, options)) {
@@ -420,7 +426,7 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
     if (it == grids_.end()) {
       const auto t = std::chrono::steady_clock::now();
       CachedGrid c;
-      c.grid = voxelize(scene_, closure_, gb, p, r_max, &c.stats, back);
+      c.grid = voxelize(scene_, closure_, gb, p, options_, &c.stats, back);
       it = grids_.emplace(key, std::move(c)).first;
       ++builds_;
       voxelize_ms += ms_between(t, std::chrono::steady_clock::now());

@@ -88,7 +88,7 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
   const float inv_n = 1.0f / static_cast<float>(params.samples);
   const int m = params.ray_steps;
   const simd::Rotations16 rot = simd_rotations(rotations);
-  check_layers(ch, params.layers, "containment");
+  check_layers(ch, params.layers, falloff.radius, "containment");
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     simd::CoveredPixels row;

@@ -40,12 +40,12 @@ inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const De
 }
 
 /// InputError unless `ch` can give what `d` asks for: two layers are the depth buffer's, with its
-/// second layer.
+/// second layer (at the separation in effect for R = `radius`).
 template <class C>
-void check_layers(const C& ch, const DepthLayers& d, const std::string& method) {
+void check_layers(const C& ch, const DepthLayers& d, float radius, const std::string& method) {
   if (d.layers < 2) return;
   if constexpr (std::is_same_v<C, DepthBufferCharacteristic>) {
-    if (!ch.second) throw_missing_second_layer(method, effective_separation(d, 1.0f));
+    if (!ch.second) throw_missing_second_layer(method, effective_separation(d, radius));
   } else {
     throw InputError(method + ": layers=2 is a second layer of the depth buffer; an analytic characteristic function has its own solid");
   }

@@ -215,7 +215,7 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
   if (radiance && (g.direct.width() != w || g.direct.height() != h))
     throw InputError("transfer: the G-buffer's direct-light pass must have its size");
-  check_layers(ch, params.layers, "transfer");
+  check_layers(ch, params.layers, falloff.radius, "transfer");
   const ContainmentSamples s = make_containment_samples(params.samples, falloff);
   const simd::Rotations16 rotations = simd_rotations(interleave_rotations(seed, params.interleave.interleave));
   const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;  // AT 4.3

@@ -88,7 +88,7 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
   // object and does not occlude (z_entry - z* > R).
   const float far_limit = params.silhouette_elimination ? -R : -kInfinity;
   const simd::Rotations16 rot = simd_rotations(rotations);
-  check_layers(ch, params.layers, "volumetric");
+  check_layers(ch, params.layers, radius, "volumetric");
   Image<float> v(w, h, 1.0f);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     simd::CoveredPixels row;

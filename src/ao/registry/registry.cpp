@@ -121,10 +121,6 @@ std::string joined_names(const std::vector<std::string>& names) {
   return s;
 }
 
-// Builds the characteristic function of `kind` in the G-buffer's camera space and calls
-// fn(ch, kernel_elimination): whether the kernel's own silhouette elimination (AT 4.3) is to run.
-// `elimination` is the user's silhouette_elimination; `limit` the distance in front of a sample
-// point beyond which the depth-buffer factor of the product counts as a distant foreground object.
 // The second depth layer a method run with `layers` = 2 reads: the G-buffer's own when it has one
 // at the separation in effect, else rendered from the scene for this run.
 std::shared_ptr<const Image<float>> second_layer_for(const MethodInput& in, float separation, std::string_view method) {
@@ -136,6 +132,10 @@ std::shared_ptr<const Image<float>> second_layer_for(const MethodInput& in, floa
   return std::make_shared<const Image<float>>(render_second_layer_depth(*in.scene, g, separation));
 }
 
+// Builds the characteristic function of `kind` in the G-buffer's camera space and calls
+// fn(ch, kernel_elimination): whether the kernel's own silhouette elimination (AT 4.3) is to run.
+// `elimination` is the user's silhouette_elimination; `limit` the distance in front of a sample
+// point beyond which the depth-buffer factor of the product counts as a distant foreground object.
 template <class Fn>
 void with_characteristic(const MethodInput& in, CharacteristicKind kind, const DepthLayers& layers, std::string_view method, bool elimination,
                          float limit, Fn&& fn) {

@@ -133,20 +133,22 @@ float histogram_pixel_size(const TexelCoverage& coverage, float pixels_per_texel
   return static_cast<float>(std::sqrt(per_texel) / pixels_per_texel);
 }
 
-BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const HistogramParams& params, const ProgressFn& progress) {
-  params.validate();
-  const int width = cov.width, height = cov.height;
+namespace {
+
+// The histogram's sums over every direction (stages 1 and 2), merged over threads.
+struct HistogramSums {
+  std::vector<double> num;          // per texel: sum_d sum_pixels of the weights (eq. 8), pixel units
+  std::vector<std::int64_t> bent;   // 3 per texel, fixed point: the bent normal's unnormalised sum
+  std::uint64_t fragments = 0;
+};
+
+// Stage 1 (rasterise from w_d) and stage 2 (scatter into the texels) for every direction, each
+// thread into its own integer buffers; the merge adds integers, so the order of threads does not
+// matter.
+HistogramSums scatter_directions(const RasterMesh& mesh, const TexelCoverage& cov, const std::vector<Vec3>& dirs, float pixel_size,
+                                 const HistogramParams& params, const ProgressFn& progress) {
   const std::size_t texels = cov.texel_count();
-  const RasterMesh mesh = make_raster_mesh(scene, width, height);
-  const std::vector<Vec3> dirs = sphere_directions(params.direction_set, params.directions, params.seed);
-
-  // The view resolution matches the texel density: an average texel seen face-on spans
-  // pixels_per_texel pixels. Views larger than 8192^2 are coarsened (a tiny UV region on a huge mesh).
-  float pixel_size = histogram_pixel_size(cov, params.pixels_per_texel);
-  pixel_size = std::max(pixel_size, 2.0f * mesh.radius / 8192.0f);
   const bool bent = params.bent_normals;
-  const bool area_norm = params.normalization == BakeNormalization::Area;
-
   tbb::enumerable_thread_specific<ThreadAccum> accum;
   ProgressCounter counter(progress, dirs.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(dirs.size()), 1), [&](const tbb::blocked_range<int>& range) {
@@ -168,7 +170,8 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
       in.ids = acc.target.id.data(), in.px = acc.target.px.data(), in.py = acc.target.py.data();
       in.view_width = view.width, in.view_height = view.height;
       in.indices = mesh.indices.data(), in.has_uv = mesh.has_uv.data(), in.stretch = mesh.stretch.data(), in.uvs = mesh.uvs.data();
-      in.cos_v = acc.cos_v.data(), in.map_width = width, in.map_height = height, in.pixel_size = pixel_size, in.area_norm = area_norm;
+      in.cos_v = acc.cos_v.data(), in.map_width = cov.width, in.map_height = cov.height, in.pixel_size = pixel_size;
+      in.area_norm = params.normalization == BakeNormalization::Area;
       in.max_weight = kMaxWeight, in.fixed_scale = kFixedScale, in.bent = bent;
       in.bx = std::llround(w.x * 1024.0), in.by = std::llround(w.y * 1024.0), in.bz = std::llround(w.z * 1024.0);
       acc.fragments += simd::scatter_histogram(in, acc.sum.data(), bent ? acc.bent.data() : nullptr);
@@ -176,72 +179,72 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
     }
   });
 
-  // Merge: integer sums, so the order of threads does not matter.
-  std::vector<double> num(texels, 0.0);
-  std::vector<std::int64_t> bent_sum(bent ? 3 * texels : 0, 0);
-  BakeResult out;
-  {
-    std::vector<std::uint64_t> total(texels, 0);
-    for (ThreadAccum& acc : accum) {
-      if (acc.sum.empty()) continue;
-      for (std::size_t i = 0; i < texels; ++i) total[i] += acc.sum[i];
-      for (std::size_t i = 0; i < bent_sum.size(); ++i) bent_sum[i] += acc.bent[i];
-      out.fragments += acc.fragments;
-    }
-    for (std::size_t i = 0; i < texels; ++i) num[i] = static_cast<double>(total[i]) / kFixedScale;
+  HistogramSums sums;
+  sums.num.assign(texels, 0.0);
+  sums.bent.assign(bent ? 3 * texels : 0, 0);
+  std::vector<std::uint64_t> total(texels, 0);
+  for (ThreadAccum& acc : accum) {
+    if (acc.sum.empty()) continue;
+    for (std::size_t i = 0; i < texels; ++i) total[i] += acc.sum[i];
+    for (std::size_t i = 0; i < sums.bent.size(); ++i) sums.bent[i] += acc.bent[i];
+    sums.fragments += acc.fragments;
   }
+  for (std::size_t i = 0; i < texels; ++i) sums.num[i] = static_cast<double>(total[i]) / kFixedScale;
+  return sums;
+}
 
-  // Denominator of the area normalisation: A(T) in pixel units (the weights' unit).
-  std::vector<double> den(texels, 0.0);
-  const double pix2 = static_cast<double>(pixel_size) * pixel_size;
-  for (std::size_t i = 0; i < texels; ++i) den[i] = cov.world_area[i] / pix2;
-  if (params.point_size > 1.0f) {
-    // Sec. 3.2: splats of point_size texels = a box convolution of the histogram. The area
-    // normalisation convolves its denominator too, so the result stays a weighted mean of V.
-    const std::vector<double> kw = box_weights(params.point_size);
-    box_filter(num, width, height, kw);
-    box_filter(den, width, height, kw);
-  }
-
-  out.visibility = Image<float>(width, height, 0.0f);
-  out.mask = cov.mask;
-  out.covered_texels = cov.covered_texels;
-  out.directions = params.directions;
-  out.warnings = cov.warnings();
+// Stage 3's normalisation: V per covered texel from the sums and A(T) in pixel units (`den`), by
+// eq. 2 or the paper's max; the bent normals normalised. Returns how many texels the clamp to 1 cut.
+std::size_t normalize_visibility(const HistogramSums& sums, const std::vector<double>& den, const TexelCoverage& cov,
+                                 const HistogramParams& params, BakeResult& out) {
+  const std::size_t texels = cov.texel_count();
+  const bool area_norm = params.normalization == BakeNormalization::Area;
+  out.visibility = Image<float>(cov.width, cov.height, 0.0f);
   double max_num = 0;
   for (std::size_t i = 0; i < texels; ++i)
-    if (cov.mask[i]) max_num = std::max(max_num, num[i]);
+    if (cov.mask[i]) max_num = std::max(max_num, sums.num[i]);
   std::size_t clamped = 0;
   for (std::size_t i = 0; i < texels; ++i) {
     if (!cov.mask[i]) continue;
     double v = 0;
-    if (area_norm) v = den[i] > 0 ? 4.0 / params.directions * num[i] / den[i] : 0.0;  // eq. 2 with (4/D) sum_d
-    else v = max_num > 0 ? num[i] / max_num : 0.0;                              // the paper: max(1 - AO) = 1
+    if (area_norm) v = den[i] > 0 ? 4.0 / params.directions * sums.num[i] / den[i] : 0.0;  // eq. 2 with (4/D) sum_d
+    else v = max_num > 0 ? sums.num[i] / max_num : 0.0;                                   // the paper: max(1 - AO) = 1
     // Monte Carlo noise can exceed 1 on open texels; V is a fraction, so clamp (and count it).
     if (v > 1.0) ++clamped;
     out.visibility[i] = static_cast<float>(std::clamp(v, 0.0, 1.0));
   }
-  if (bent) {
-    out.bent_normal = Image<Vec3>(width, height, Vec3{0, 0, 0});
+  if (params.bent_normals) {
+    out.bent_normal = Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0});
     for (std::size_t i = 0; i < texels; ++i)
       if (cov.mask[i])
-        out.bent_normal[i] = normalize(Vec3{static_cast<float>(bent_sum[3 * i]), static_cast<float>(bent_sum[3 * i + 1]), static_cast<float>(bent_sum[3 * i + 2])});
+        out.bent_normal[i] = normalize(Vec3{static_cast<float>(sums.bent[3 * i]), static_cast<float>(sums.bent[3 * i + 1]),
+                                            static_cast<float>(sums.bent[3 * i + 2])});
   }
-  // Texels that too few pixel samples can reach. A texel's expected number of samples over all
-  // directions is (D/4) A(T)/p^2 (a quarter of its area faces a random direction, in pixels). A
-  // chart that grazes a texel with a sliver of surface (the dragon at 512^2 has thousands with
-  // A(T) < 1e-3 of an average texel's) expects far less than one: no pixel lands in it and the
-  // ratio says V = 0, a black texel on the chart border that is not occlusion at all (and with
-  // a handful of samples the estimate is mostly noise). Such texels are not estimated: they take
-  // the value of the nearest texel that is (below).
-  const double samples_per_pixel_area = static_cast<double>(params.directions) / 4.0;
-  Image<std::uint8_t> reliable(width, height, 0);
+  return clamped;
+}
+
+struct RefillCounts {
   std::size_t unreliable = 0, unfilled = 0;
+};
+
+// Texels that too few pixel samples can reach. A texel's expected number of samples over all
+// directions is (D/4) A(T)/p^2 (a quarter of its area faces a random direction, in pixels). A
+// chart that grazes a texel with a sliver of surface (the dragon at 512^2 has thousands with
+// A(T) < 1e-3 of an average texel's) expects far less than one: no pixel lands in it and the
+// ratio says V = 0, a black texel on the chart border that is not occlusion at all (and with
+// a handful of samples the estimate is mostly noise). Such texels are not estimated: they take
+// the value of the nearest texel that is. With the seam fix, chart-border texels too (sec. 3.3).
+RefillCounts refill_unestimated_texels(const std::vector<double>& num, const std::vector<double>& den, const TexelCoverage& cov,
+                                       const HistogramParams& params, BakeResult& out) {
+  const std::size_t texels = cov.texel_count();
+  const double samples_per_pixel_area = static_cast<double>(params.directions) / 4.0;
+  Image<std::uint8_t> reliable(cov.width, cov.height, 0);
+  RefillCounts counts;
   for (std::size_t i = 0; i < texels; ++i) {
     if (!cov.mask[i]) continue;
     const double expected = samples_per_pixel_area * den[i];  // den: A(T)/p^2, box-filtered with the splats
     reliable[i] = expected >= params.min_samples ? 1 : 0;
-    unreliable += reliable[i] ? 0 : 1;
+    counts.unreliable += reliable[i] ? 0 : 1;
   }
   std::vector<std::uint8_t> refilled(texels, 0);
   auto refill = [&](const Image<std::uint8_t>& keep, int rings, bool only_unreliable) {
@@ -249,7 +252,7 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
     for (std::size_t i = 0; i < texels; ++i) {
       if (!cov.mask[i] || keep[i] || refilled[i] || nearest[i] < 0 || (only_unreliable && reliable[i])) continue;
       out.visibility[i] = out.visibility[static_cast<std::size_t>(nearest[i])];
-      if (bent) out.bent_normal[i] = out.bent_normal[static_cast<std::size_t>(nearest[i])];
+      if (params.bent_normals) out.bent_normal[i] = out.bent_normal[static_cast<std::size_t>(nearest[i])];
       refilled[i] = 1;
     }
   };
@@ -272,18 +275,55 @@ BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const Hi
   refill(reliable, kUnreliableRings, true);
   // Last resort for texels that no pixel reached at all (V = 0/den says nothing): the nearest
   // texel that some pixel reached, if any within kUnreliableRings.
-  Image<std::uint8_t> sampled(width, height, 0);
+  Image<std::uint8_t> sampled(cov.width, cov.height, 0);
   for (std::size_t i = 0; i < texels; ++i) sampled[i] = cov.mask[i] && (num[i] > 0 || refilled[i]) ? 1 : 0;
   for (std::size_t i = 0; i < texels; ++i)
     if (cov.mask[i] && !sampled[i] && reliable[i]) sampled[i] = 1;  // reached by no pixel but expected to be: truly occluded
   refill(sampled, kUnreliableRings, true);
-  for (std::size_t i = 0; i < texels; ++i) unfilled += cov.mask[i] && !reliable[i] && !refilled[i] ? 1 : 0;
+  for (std::size_t i = 0; i < texels; ++i) counts.unfilled += cov.mask[i] && !reliable[i] && !refilled[i] ? 1 : 0;
+  return counts;
+}
+
+}  // namespace
+
+BakeResult bake_histogram(const Scene& scene, const TexelCoverage& cov, const HistogramParams& params, const ProgressFn& progress) {
+  params.validate();
+  const RasterMesh mesh = make_raster_mesh(scene, cov.width, cov.height);
+  const std::vector<Vec3> dirs = sphere_directions(params.direction_set, params.directions, params.seed);
+
+  // The view resolution matches the texel density: an average texel seen face-on spans
+  // pixels_per_texel pixels. Views larger than 8192^2 are coarsened (a tiny UV region on a huge mesh).
+  float pixel_size = histogram_pixel_size(cov, params.pixels_per_texel);
+  pixel_size = std::max(pixel_size, 2.0f * mesh.radius / 8192.0f);
+
+  HistogramSums sums = scatter_directions(mesh, cov, dirs, pixel_size, params, progress);
+
+  // Denominator of the area normalisation: A(T) in pixel units (the weights' unit).
+  std::vector<double> den(cov.texel_count(), 0.0);
+  const double pix2 = static_cast<double>(pixel_size) * pixel_size;
+  for (std::size_t i = 0; i < den.size(); ++i) den[i] = cov.world_area[i] / pix2;
+  if (params.point_size > 1.0f) {
+    // Sec. 3.2: splats of point_size texels = a box convolution of the histogram. The area
+    // normalisation convolves its denominator too, so the result stays a weighted mean of V.
+    const std::vector<double> kw = box_weights(params.point_size);
+    box_filter(sums.num, cov.width, cov.height, kw);
+    box_filter(den, cov.width, cov.height, kw);
+  }
+
+  BakeResult out;
+  out.fragments = sums.fragments;
+  out.mask = cov.mask;
+  out.covered_texels = cov.covered_texels;
+  out.directions = params.directions;
+  out.warnings = cov.warnings();
+  const std::size_t clamped = normalize_visibility(sums, den, cov, params, out);
+  const RefillCounts refills = refill_unestimated_texels(sums.num, den, cov, params, out);
   out.stats = {{"view_size", make_ortho_view(mesh, {0, 0, 1}, pixel_size, {0, 0}).width},
                {"pixel_size", pixel_size},
                {"fragments", out.fragments},
                {"clamped_texels", clamped},
-               {"unreliable_texels", unreliable},
-               {"unreliable_texels_unfilled", unfilled}};
+               {"unreliable_texels", refills.unreliable},
+               {"unreliable_texels_unfilled", refills.unfilled}};
   return out;
 }
 

@@ -138,6 +138,91 @@ GpuGBuffer GpuGBuffer::upload(GpuDevice& device, const GBuffer& g) {
   return GpuGBuffer(std::move(t));
 }
 
+namespace {
+
+// The G-buffer's seven render targets and a depth buffer on one framebuffer, cleared to the
+// background: P, N, albedo, ids, UV 0 and depth +infinity (docs/gbuffer.md); the depth test set
+// for a buffer that holds near / depth (greater is nearer).
+Framebuffer gbuffer_framebuffer(Context& c, const GBufferTextures& t, const Texture& z_buffer) {
+  GLuint fbo_id = 0;
+  c.gl.GenFramebuffers(1, &fbo_id);
+  Framebuffer fbo(c, fbo_id);
+  c.gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_id);
+  const Texture* targets[] = {&t.position, &t.normal, &t.albedo, &t.object, &t.primitive, &t.uv, &t.depth};
+  GLenum draw[7];
+  for (GLuint k = 0; k < 7; ++k) {
+    c.gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, GL_TEXTURE_2D, targets[k]->id(), 0);
+    draw[k] = GL_COLOR_ATTACHMENT0 + k;
+  }
+  c.gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, z_buffer.id(), 0);
+  c.gl.DrawBuffers(7, draw);
+  if (c.gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw SystemError("--device gpu: the G-buffer's render targets are not supported by " + c.renderer);
+  return fbo;
+}
+
+void clear_to_background(Context& c) {
+  const float zero[4] = {0, 0, 0, 0}, infinite[4] = {kInfinity, 0, 0, 0};
+  const GLuint zero_u[4] = {0, 0, 0, 0};
+  for (GLint k : {0, 1, 2, 5}) c.gl.ClearBufferfv(GL_COLOR, k, zero);
+  for (GLint k : {3, 4}) c.gl.ClearBufferuiv(GL_COLOR, k, zero_u);
+  c.gl.ClearBufferfv(GL_COLOR, 6, infinite);
+  const float far_depth[1] = {0.0f};  // the depth buffer holds near / depth: 0 is infinitely far
+  c.gl.ClearBufferfv(GL_DEPTH, 0, far_depth);
+  c.gl.Enable(GL_DEPTH_TEST);
+  c.gl.DepthFunc(GL_GREATER);
+  c.gl.DepthMask(GL_TRUE);
+}
+
+// The camera's uniforms. The near plane: 1e-6 of the farthest depth of the scene's box (clip
+// space needs one; the depth buffer holds near / depth in float, whose relative precision does not
+// depend on it).
+void set_camera(Context& c, Program& p, const Camera& camera, const Bounds3& bounds, const GBufferOptions& options) {
+  const Frame basis = camera.basis();
+  float farthest = 0;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 corner{k & 1 ? bounds.hi.x : bounds.lo.x, k & 2 ? bounds.hi.y : bounds.lo.y, k & 4 ? bounds.hi.z : bounds.lo.z};
+    farthest = std::max(farthest, -basis.to_local(corner - camera.eye).z);
+  }
+  const float near = std::max(1e-6f * farthest, 1e-30f);
+  const float tan_half = camera.tan_half_fov();
+  set_vec3(c, p, "u_eye", camera.eye);
+  set_vec3(c, p, "u_basis_x", basis.t);
+  set_vec3(c, p, "u_basis_y", basis.b);
+  set_vec3(c, p, "u_basis_z", basis.n);
+  c.gl.Uniform3f(c.uniform(p, "u_clip"), 1.0f / (tan_half * camera.aspect()), 1.0f / tan_half, near);
+  c.gl.Uniform2i(c.uniform(p, "u_size"), camera.width, camera.height);
+  c.gl.Uniform2f(c.uniform(p, "u_tan_half"), tan_half, camera.aspect());
+  c.gl.Uniform1i(c.uniform(p, "u_geometric"), options.normal == SurfaceNormal::Geometric ? 1 : 0);
+}
+
+// One draw per object, id o + 1; an instance's transform and its normals' (the cofactor matrix).
+void draw_objects(Context& c, Program& p, const SceneBuffers& sb, const Scene& s) {
+  for (std::size_t o = 0; o < sb.objects.size(); ++o) {
+    const SceneObject& ob = sb.objects[o];
+    const SceneBuffers::MeshBuffers& mb = sb.meshes[ob.mesh];
+    const bool instance = ob.instance != SceneObject::kNoInstance;
+    c.gl.Uniform1i(c.uniform(p, "u_instance"), instance ? 1 : 0);
+    if (instance) {
+      const Affine3& a = s.instances[ob.instance].object_to_world;
+      const Affine3 n = cofactor(a);
+      const float to_world[12] = {a.c0.x, a.c0.y, a.c0.z, a.c1.x, a.c1.y, a.c1.z, a.c2.x, a.c2.y, a.c2.z, a.c3.x, a.c3.y, a.c3.z};
+      const float normal_to_world[9] = {n.c0.x, n.c0.y, n.c0.z, n.c1.x, n.c1.y, n.c1.z, n.c2.x, n.c2.y, n.c2.z};
+      c.gl.Uniform3fv(c.uniform(p, "u_to_world"), 4, to_world);
+      c.gl.Uniform3fv(c.uniform(p, "u_normal_to_world"), 3, normal_to_world);
+    }
+    c.gl.Uniform1ui(c.uniform(p, "u_object"), static_cast<GLuint>(o + 1));
+    const Vec3 albedo = s.meshes[ob.mesh].albedo;
+    set_vec3(c, p, "u_albedo", albedo);
+    c.gl.BindVertexArray(mb.vao.id());
+    if (!mb.has_uv) c.gl.VertexAttrib2f(2, 0.0f, 0.0f);
+    c.gl.DrawElements(GL_TRIANGLES, mb.index_count, GL_UNSIGNED_INT, nullptr);
+  }
+  c.gl.BindVertexArray(0);
+}
+
+}  // namespace
+
 GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const Camera& camera, const GBufferOptions& options) {
   camera.validate();
   Context& c = Access::context(device);
@@ -160,81 +245,16 @@ GpuGBuffer GpuGBuffer::rasterize(GpuDevice& device, const GpuScene& scene, const
   t->has_uv = options.uv;
   t->has_primitive = true;
   Texture z_buffer = make_texture(c, w, h, GL_DEPTH_COMPONENT32F);
-
-  GLuint fbo_id = 0;
-  c.gl.GenFramebuffers(1, &fbo_id);
-  Framebuffer fbo(c, fbo_id);
-  c.gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_id);
-  const Texture* targets[] = {&t->position, &t->normal, &t->albedo, &t->object, &t->primitive, &t->uv, &t->depth};
-  GLenum draw[7];
-  for (GLuint k = 0; k < 7; ++k) {
-    c.gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, GL_TEXTURE_2D, targets[k]->id(), 0);
-    draw[k] = GL_COLOR_ATTACHMENT0 + k;
-  }
-  c.gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, z_buffer.id(), 0);
-  c.gl.DrawBuffers(7, draw);
-  if (c.gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    throw SystemError("--device gpu: the G-buffer's render targets are not supported by " + c.renderer);
+  Framebuffer fbo = gbuffer_framebuffer(c, *t, z_buffer);
 
   Program& p = c.program({"gbuffer.vert", "gbuffer.geom", "gbuffer.frag"});
   std::vector<PassQuery> passes;
   c.begin_pass(passes, "gbuffer");
   c.gl.Viewport(0, 0, w, h);
-  // Background: P, N, albedo, ids, UV 0 and depth +infinity (docs/gbuffer.md).
-  const float zero[4] = {0, 0, 0, 0}, infinite[4] = {kInfinity, 0, 0, 0};
-  const GLuint zero_u[4] = {0, 0, 0, 0};
-  for (GLint k : {0, 1, 2, 5}) c.gl.ClearBufferfv(GL_COLOR, k, zero);
-  for (GLint k : {3, 4}) c.gl.ClearBufferuiv(GL_COLOR, k, zero_u);
-  c.gl.ClearBufferfv(GL_COLOR, 6, infinite);
-  const float far_depth[1] = {0.0f};  // the depth buffer holds near / depth: 0 is infinitely far
-  c.gl.ClearBufferfv(GL_DEPTH, 0, far_depth);
-  c.gl.Enable(GL_DEPTH_TEST);
-  c.gl.DepthFunc(GL_GREATER);
-  c.gl.DepthMask(GL_TRUE);
-
-  // The near plane: 1e-6 of the farthest depth of the scene's box (clip space needs one; the
-  // depth buffer holds near / depth in float, whose relative precision does not depend on it).
-  const Frame basis = camera.basis();
-  const Bounds3 bounds = scene.scene().bounds();
-  float farthest = 0;
-  for (int k = 0; k < 8; ++k) {
-    const Vec3 corner{k & 1 ? bounds.hi.x : bounds.lo.x, k & 2 ? bounds.hi.y : bounds.lo.y, k & 4 ? bounds.hi.z : bounds.lo.z};
-    farthest = std::max(farthest, -basis.to_local(corner - camera.eye).z);
-  }
-  const float near = std::max(1e-6f * farthest, 1e-30f);
-  const float tan_half = camera.tan_half_fov();
-
+  clear_to_background(c);
   c.gl.UseProgram(p.id);
-  set_vec3(c, p, "u_eye", camera.eye);
-  set_vec3(c, p, "u_basis_x", basis.t);
-  set_vec3(c, p, "u_basis_y", basis.b);
-  set_vec3(c, p, "u_basis_z", basis.n);
-  c.gl.Uniform3f(c.uniform(p, "u_clip"), 1.0f / (tan_half * camera.aspect()), 1.0f / tan_half, near);
-  c.gl.Uniform2i(c.uniform(p, "u_size"), w, h);
-  c.gl.Uniform2f(c.uniform(p, "u_tan_half"), tan_half, camera.aspect());
-  c.gl.Uniform1i(c.uniform(p, "u_geometric"), options.normal == SurfaceNormal::Geometric ? 1 : 0);
-  const Scene& s = scene.scene();
-  for (std::size_t o = 0; o < sb.objects.size(); ++o) {
-    const SceneObject& ob = sb.objects[o];
-    const SceneBuffers::MeshBuffers& mb = sb.meshes[ob.mesh];
-    const bool instance = ob.instance != SceneObject::kNoInstance;
-    c.gl.Uniform1i(c.uniform(p, "u_instance"), instance ? 1 : 0);
-    if (instance) {
-      const Affine3& a = s.instances[ob.instance].object_to_world;
-      const Affine3 n = cofactor(a);
-      const float to_world[12] = {a.c0.x, a.c0.y, a.c0.z, a.c1.x, a.c1.y, a.c1.z, a.c2.x, a.c2.y, a.c2.z, a.c3.x, a.c3.y, a.c3.z};
-      const float normal_to_world[9] = {n.c0.x, n.c0.y, n.c0.z, n.c1.x, n.c1.y, n.c1.z, n.c2.x, n.c2.y, n.c2.z};
-      c.gl.Uniform3fv(c.uniform(p, "u_to_world"), 4, to_world);
-      c.gl.Uniform3fv(c.uniform(p, "u_normal_to_world"), 3, normal_to_world);
-    }
-    c.gl.Uniform1ui(c.uniform(p, "u_object"), static_cast<GLuint>(o + 1));
-    const Vec3 albedo = s.meshes[ob.mesh].albedo;
-    set_vec3(c, p, "u_albedo", albedo);
-    c.gl.BindVertexArray(mb.vao.id());
-    if (!mb.has_uv) c.gl.VertexAttrib2f(2, 0.0f, 0.0f);
-    c.gl.DrawElements(GL_TRIANGLES, mb.index_count, GL_UNSIGNED_INT, nullptr);
-  }
-  c.gl.BindVertexArray(0);
+  set_camera(c, p, camera, scene.scene().bounds(), options);
+  draw_objects(c, p, sb, scene.scene());
   c.end_pass(passes);
   c.gl.Disable(GL_DEPTH_TEST);
   c.gl.BindFramebuffer(GL_FRAMEBUFFER, 0);

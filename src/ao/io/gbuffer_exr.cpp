@@ -132,110 +132,102 @@ bool read_camera(const Imf::Header& header, const fs::path& path, const GBufferR
   return placed;
 }
 
-GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
-  Imf::InputFile file(path.c_str());
-  const Imf::Header& header = file.header();
-  const ExrWindows w = exr_windows(header, path);
-  const Imf::ChannelList& channels = header.channels();
+// Every channel at full resolution, and the four no G-buffer can do without.
+void check_channels(const Imf::ChannelList& channels, const fs::path& path) {
   for (auto it = channels.begin(); it != channels.end(); ++it)
     if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
       throw InputError(path.string() + ": channel '" + it.name() + "' is subsampled, which is not supported");
-
-  const auto has = [&](const char* name) { return channels.findChannel(name) != nullptr; };
   std::string missing;
   for (const char* name : {"Z", "N.X", "N.Y", "N.Z"}) {
-    if (has(name)) continue;
+    if (channels.findChannel(name) != nullptr) continue;
     if (!missing.empty()) missing += ' ';
     missing += name;
   }
   if (!missing.empty())
     throw InputError(path.string() + ": missing G-buffer channels " + missing + " (the file has: " + channel_list(channels) +
                      "); at least Z and N.X N.Y N.Z are needed, see docs/gbuffer.md");
+}
 
-  Camera camera;
-  camera.width = w.width;
-  camera.height = w.height;
-  const bool placed = read_camera(header, path, opt, camera);
-  if (opt.world_space && !placed)
-    throw InputError(path.string() + ": world-space passes need the camera placement (ao:eye/target/up or worldToCamera), "
-                     "and the file has none");
+// The planes read from the file, one float or uint per pixel; pixels outside the data window keep
+// their fills (background). The optional passes are empty when the file lacks them.
+struct ExrPlanes {
+  std::vector<float> z, nx, ny, nz, px, py, pz, ar, ag, ab, a, dr, dg, db;
+  std::vector<std::uint32_t> id, primitive;
+  bool has_p = false, has_albedo = false, has_direct = false, has_a = false, has_id = false, has_primitive = false;
+};
 
-  // Planes read from the file. Pixels outside the data window keep these fills: background.
+ExrPlanes read_planes(Imf::InputFile& file, const ExrWindows& w, const fs::path& path) {
+  const Imf::ChannelList& channels = file.header().channels();
+  const auto has = [&](const char* name) { return channels.findChannel(name) != nullptr; };
   const std::size_t n = static_cast<std::size_t>(w.width) * w.height;
-  const bool has_p = has("P.X") && has("P.Y") && has("P.Z");
-  const bool has_albedo = has("albedo.R") && has("albedo.G") && has("albedo.B");
-  const bool has_id = has("id");
-  const bool has_primitive = has("primid");
-  const bool has_a = has("A");
+  ExrPlanes p;
+  p.has_p = has("P.X") && has("P.Y") && has("P.Z");
+  p.has_albedo = has("albedo.R") && has("albedo.G") && has("albedo.B");
+  p.has_id = has("id");
+  p.has_primitive = has("primid");
+  p.has_a = has("A");
   const int direct_channels = int{has("direct.R")} + int{has("direct.G")} + int{has("direct.B")};
   if (direct_channels != 0 && direct_channels != 3)
     throw InputError(path.string() + ": the direct-light pass needs all of direct.R direct.G direct.B (the file has: " + channel_list(channels) + ")");
-  const bool has_direct = direct_channels == 3;
-  std::vector<float> z(n, kInfinity), nx(n, 0.0f), ny(n, 0.0f), nz(n, 0.0f), px, py, pz, ar, ag, ab, a, dr, dg, db;
-  std::vector<std::uint32_t> id, primitive;
-  std::vector<ExrChannelTarget> targets = {{"Z", Imf::FLOAT, z.data()},
-                                           {"N.X", Imf::FLOAT, nx.data()},
-                                           {"N.Y", Imf::FLOAT, ny.data()},
-                                           {"N.Z", Imf::FLOAT, nz.data()}};
+  p.has_direct = direct_channels == 3;
+  p.z.assign(n, kInfinity), p.nx.assign(n, 0.0f), p.ny.assign(n, 0.0f), p.nz.assign(n, 0.0f);
+  std::vector<ExrChannelTarget> targets = {{"Z", Imf::FLOAT, p.z.data()},
+                                           {"N.X", Imf::FLOAT, p.nx.data()},
+                                           {"N.Y", Imf::FLOAT, p.ny.data()},
+                                           {"N.Z", Imf::FLOAT, p.nz.data()}};
   const auto add = [&](const char* name, std::vector<float>& plane) {
     plane.assign(n, 0.0f);
     targets.push_back({name, Imf::FLOAT, plane.data()});
   };
-  if (has_p) {
-    add("P.X", px);
-    add("P.Y", py);
-    add("P.Z", pz);
+  if (p.has_p) add("P.X", p.px), add("P.Y", p.py), add("P.Z", p.pz);
+  if (p.has_albedo) add("albedo.R", p.ar), add("albedo.G", p.ag), add("albedo.B", p.ab);
+  if (p.has_direct) add("direct.R", p.dr), add("direct.G", p.dg), add("direct.B", p.db);
+  if (p.has_a) add("A", p.a);
+  if (p.has_id) {
+    p.id.assign(n, 0u);
+    targets.push_back({"id", Imf::UINT, p.id.data()});
   }
-  if (has_albedo) {
-    add("albedo.R", ar);
-    add("albedo.G", ag);
-    add("albedo.B", ab);
-  }
-  if (has_direct) {
-    add("direct.R", dr);
-    add("direct.G", dg);
-    add("direct.B", db);
-  }
-  if (has_a) add("A", a);
-  if (has_id) {
-    id.assign(n, 0u);
-    targets.push_back({"id", Imf::UINT, id.data()});
-  }
-  if (has_primitive) {
-    primitive.assign(n, 0u);
-    targets.push_back({"primid", Imf::UINT, primitive.data()});
+  if (p.has_primitive) {
+    p.primitive.assign(n, 0u);
+    targets.push_back({"primid", Imf::UINT, p.primitive.data()});
   }
   read_exr_channels(file, w, targets);
+  return p;
+}
 
+// The G-buffer from the planes: covered pixels (A >= 0.5, or a finite depth nearer than the
+// background's) checked and moved to camera space; every other pixel stays background.
+GBuffer gbuffer_from_planes(const ExrPlanes& p, const Camera& camera, const GBufferReadOptions& opt, const fs::path& path) {
   GBuffer g(camera);
-  if (has_direct) g.direct = Image<Vec3>(w.width, w.height);  // 0 where not covered
-  if (has_primitive) g.primitive_id = Image<std::uint32_t>(w.width, w.height, 0u);
+  const int width = camera.width, height = camera.height;
+  if (p.has_direct) g.direct = Image<Vec3>(width, height);  // 0 where not covered
+  if (p.has_primitive) g.primitive_id = Image<std::uint32_t>(width, height, 0u);
   const Frame basis = camera.basis();
-  for (int y = 0; y < w.height; ++y) {
-    for (int x = 0; x < w.width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w.width + x;
-      const float depth = z[i];
-      const bool covered = has_a ? a[i] >= 0.5f : (std::isfinite(depth) && depth > 0.0f && depth < opt.background_depth);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      const float depth = p.z[i];
+      const bool covered = p.has_a ? p.a[i] >= 0.5f : (std::isfinite(depth) && depth > 0.0f && depth < opt.background_depth);
       if (!covered) continue;  // GBuffer(camera) already holds the background values
       if (!(std::isfinite(depth) && depth > 0.0f))
         bad_pixel(path, x, y, "covered (A >= 0.5) but depth Z = " + std::to_string(depth) + " is not finite and positive");
 
-      Vec3 normal{nx[i], ny[i], nz[i]};
-      Vec3 position = has_p ? Vec3{px[i], py[i], pz[i]} : camera.camera_direction(x + 0.5f, y + 0.5f) * depth;
+      Vec3 normal{p.nx[i], p.ny[i], p.nz[i]};
+      Vec3 position = p.has_p ? Vec3{p.px[i], p.py[i], p.pz[i]} : camera.camera_direction(x + 0.5f, y + 0.5f) * depth;
       if (opt.world_space) {
         normal = basis.to_local(normal);
-        if (has_p) position = camera.world_to_camera_point(position);
+        if (p.has_p) position = camera.world_to_camera_point(position);
       }
       if (!is_finite(normal) || length(normal) <= 0.0f) bad_pixel(path, x, y, "normal N = " + format_vec(normal) + " is not a finite, non-zero vector");
       if (!is_finite(position)) bad_pixel(path, x, y, "position P = " + format_vec(position) + " is not finite");
       // The G-buffer's depth is -P.z (GBuffer::depth): the point must be in front of the camera.
       if (!(position.z < 0.0f)) bad_pixel(path, x, y, "position P = " + format_vec(position) + " is not in front of the camera (P.z must be < 0)");
-      const std::uint32_t object = has_id ? id[i] : 1u;
+      const std::uint32_t object = p.has_id ? p.id[i] : 1u;
       if (object == 0) bad_pixel(path, x, y, "covered but its id is 0, which marks background (surfaces have ids >= 1)");
-      const Vec3 albedo = has_albedo ? Vec3{ar[i], ag[i], ab[i]} : Vec3{kDefaultAlbedo, kDefaultAlbedo, kDefaultAlbedo};
+      const Vec3 albedo = p.has_albedo ? Vec3{p.ar[i], p.ag[i], p.ab[i]} : Vec3{kDefaultAlbedo, kDefaultAlbedo, kDefaultAlbedo};
       if (!is_finite(albedo)) bad_pixel(path, x, y, "albedo = " + format_vec(albedo) + " is not finite");
-      if (has_direct) {
-        const Vec3 d{dr[i], dg[i], db[i]};
+      if (p.has_direct) {
+        const Vec3 d{p.dr[i], p.dg[i], p.db[i]};
         if (!is_finite(d) || d.x < 0 || d.y < 0 || d.z < 0)
           bad_pixel(path, x, y, "direct radiance = " + format_vec(d) + " is not finite and >= 0");
         g.direct(x, y) = d;
@@ -245,10 +237,27 @@ GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
       g.normal(x, y) = normalize(normal);  // passes are often filtered or stored as half: renormalise
       g.albedo(x, y) = albedo;
       g.object_id(x, y) = object;
-      if (has_primitive) g.primitive_id(x, y) = primitive[i];
+      if (p.has_primitive) g.primitive_id(x, y) = p.primitive[i];
     }
   }
   return g;
+}
+
+GBuffer read_gbuffer(const fs::path& path, const GBufferReadOptions& opt) {
+  Imf::InputFile file(path.c_str());
+  const Imf::Header& header = file.header();
+  const ExrWindows w = exr_windows(header, path);
+  check_channels(header.channels(), path);
+
+  Camera camera;
+  camera.width = w.width;
+  camera.height = w.height;
+  const bool placed = read_camera(header, path, opt, camera);
+  if (opt.world_space && !placed)
+    throw InputError(path.string() + ": world-space passes need the camera placement (ao:eye/target/up or worldToCamera), "
+                     "and the file has none");
+  const ExrPlanes planes = read_planes(file, w, path);
+  return gbuffer_from_planes(planes, camera, opt, path);
 }
 
 }  // namespace

@@ -191,8 +191,14 @@ bool looks_like_off(std::string_view data) {
   return false;
 }
 
-Scene read_off(const fs::path& path, std::string_view data) {
-  LineReader reader(data);
+struct OffHeader {
+  long long vertex_count = 0, face_count = 0;
+  bool has_normals = false;
+};
+
+/// The keyword line and the counts (on the keyword's line or the next one), checked against the
+/// file's size.
+OffHeader read_off_header(const fs::path& path, std::string_view data, LineReader& reader) {
   std::string_view line;
   if (!reader.next(line)) fail(path, "the file has no OFF header");
   std::vector<std::string_view> tokens = split(line);
@@ -201,7 +207,8 @@ Scene read_off(const fs::path& path, std::string_view data) {
   if (keyword != "OFF" && keyword != "COFF" && keyword != "NOFF" && keyword != "CNOFF")
     fail(path, "unsupported OFF variant " + quote(keyword) + " (supported: OFF, COFF, NOFF, CNOFF)");
   if (tokens.size() > 1 && tokens[1] == "BINARY") fail(path, "binary OFF is not supported, only text OFF");
-  const bool has_normals = keyword.find('N') != std::string::npos;
+  OffHeader header;
+  header.has_normals = keyword.find('N') != std::string::npos;
 
   // Counts may follow the keyword on its line or stand on the next one.
   tokens.erase(tokens.begin());
@@ -225,16 +232,20 @@ Scene read_off(const fs::path& path, std::string_view data) {
   if (vertex_count > max_count || face_count > max_count || 6 * vertex_count + 8 * face_count > static_cast<long long>(data.size()))
     fail(path, "header says " + std::to_string(vertex_count) + " vertices and " + std::to_string(face_count) +
              " faces but the file has only " + std::to_string(data.size()) + " bytes");
+  header.vertex_count = vertex_count, header.face_count = face_count;
+  return header;
+}
 
-  Mesh mesh;
-  mesh.name = path.stem().string();
-  mesh.positions.reserve(static_cast<std::size_t>(vertex_count) + kVertexPadding);  // see kVertexPadding
-  if (has_normals) mesh.normals.reserve(static_cast<std::size_t>(vertex_count));
-  const std::size_t coords_per_vertex = has_normals ? 6 : 3;
-  for (long long v = 0; v < vertex_count; ++v) {
+/// One vertex per line: x y z, then nx ny nz for NOFF (a colour after them is ignored).
+void read_off_vertices(const fs::path& path, LineReader& reader, const OffHeader& header, Mesh& mesh) {
+  mesh.positions.reserve(static_cast<std::size_t>(header.vertex_count) + kVertexPadding);  // see kVertexPadding
+  if (header.has_normals) mesh.normals.reserve(static_cast<std::size_t>(header.vertex_count));
+  const std::size_t coords_per_vertex = header.has_normals ? 6 : 3;
+  std::string_view line;
+  for (long long v = 0; v < header.vertex_count; ++v) {
     if (!reader.next(line))
-      fail(path, "truncated: expected " + std::to_string(vertex_count) + " vertices, found " + std::to_string(v));
-    tokens = split(line);
+      fail(path, "truncated: expected " + std::to_string(header.vertex_count) + " vertices, found " + std::to_string(v));
+    const std::vector<std::string_view> tokens = split(line);
     if (tokens.size() < coords_per_vertex)
       fail(path, "line " + std::to_string(reader.line_number()) + ": vertex " + std::to_string(v) + " has " + std::to_string(tokens.size()) +
                " numbers, expected " + std::to_string(coords_per_vertex));
@@ -246,14 +257,19 @@ Scene read_off(const fs::path& path, std::string_view data) {
         fail(path, "vertex " + std::to_string(v) + " has a non-finite " + (k < 3 ? "coordinate" : "normal") + " (" + quote(tokens[k]) + ")");
     }
     mesh.positions.push_back({c[0], c[1], c[2]});
-    if (has_normals) mesh.normals.push_back({c[3], c[4], c[5]});
+    if (header.has_normals) mesh.normals.push_back({c[3], c[4], c[5]});
   }
+}
 
-  mesh.indices.reserve(static_cast<std::size_t>(face_count) * 3);
+/// One face per line, "n i0 ... in-1" (a colour after them is ignored), fanned into triangles;
+/// nothing may follow the last face.
+void read_off_faces(const fs::path& path, LineReader& reader, const OffHeader& header, Mesh& mesh) {
+  mesh.indices.reserve(static_cast<std::size_t>(header.face_count) * 3);
   std::vector<std::uint32_t> face;
-  for (long long f = 0; f < face_count; ++f) {
-    if (!reader.next(line)) fail(path, "truncated: expected " + std::to_string(face_count) + " faces, found " + std::to_string(f));
-    tokens = split(line);
+  std::string_view line;
+  for (long long f = 0; f < header.face_count; ++f) {
+    if (!reader.next(line)) fail(path, "truncated: expected " + std::to_string(header.face_count) + " faces, found " + std::to_string(f));
+    const std::vector<std::string_view> tokens = split(line);
     const std::string at = "line " + std::to_string(reader.line_number()) + ": face " + std::to_string(f);
     long long n = 0;
     if (!parse_number(tokens[0], n)) fail(path, at + ": " + quote(tokens[0]) + " is not a vertex count");
@@ -265,8 +281,8 @@ Scene read_off(const fs::path& path, std::string_view data) {
       long long index = 0;
       if (!parse_number(tokens[static_cast<std::size_t>(k)], index))
         fail(path, at + ": " + quote(tokens[static_cast<std::size_t>(k)]) + " is not a vertex index");
-      if (index < 0 || index >= vertex_count)
-        fail(path, "face " + std::to_string(f) + " uses vertex " + std::to_string(index) + ", the file has " + std::to_string(vertex_count));
+      if (index < 0 || index >= header.vertex_count)
+        fail(path, "face " + std::to_string(f) + " uses vertex " + std::to_string(index) + ", the file has " + std::to_string(header.vertex_count));
       face.push_back(static_cast<std::uint32_t>(index));
     }
     // Fan triangulation keeps the face's winding; it is exact for the convex faces OFF writers emit.
@@ -279,9 +295,17 @@ Scene read_off(const fs::path& path, std::string_view data) {
   // More after the last face means the header's face count is short: reading only what it says
   // would drop faces without a word.
   if (reader.next(line))
-    fail(path, "the header says " + std::to_string(face_count) + " faces, but line " + std::to_string(reader.line_number()) +
+    fail(path, "the header says " + std::to_string(header.face_count) + " faces, but line " + std::to_string(reader.line_number()) +
                    " after the last of them holds more (" + quote(split(line)[0]) + ")");
+}
 
+Scene read_off(const fs::path& path, std::string_view data) {
+  LineReader reader(data);
+  const OffHeader header = read_off_header(path, data, reader);
+  Mesh mesh;
+  mesh.name = path.stem().string();
+  read_off_vertices(path, reader, header, mesh);
+  read_off_faces(path, reader, header, mesh);
   Scene scene;
   scene.name = path.filename().string();
   scene.meshes.push_back(std::move(mesh));
@@ -541,6 +565,42 @@ void convert_instanced(const aiScene& ai, unsigned uv_set, bool format_has_mater
   }
 }
 
+/// One assimp step (reading or post-processing) with its failures in ao's words: running out of
+/// memory is the machine's limit, anything else the file's fault. `ext`: the file's extension when
+/// the step reads it, empty for a post-processing step.
+template <class Step>
+const aiScene* assimp_step(const fs::path& path, Assimp::Importer& importer, std::string_view ext, Step&& step) {
+  const aiScene* result = nullptr;
+  try {
+    result = step();
+  } catch (const std::bad_alloc&) {
+    out_of_memory(path);
+  } catch (const std::exception& e) {
+    fail(path, explain_assimp_error(e.what()));
+  }
+  if (result != nullptr) return result;
+  const std::string error = importer.GetErrorString();
+  if (assimp_ran_out_of_memory(error)) out_of_memory(path);
+  // "No suitable reader" for a file named like a format assimp reads means damaged content.
+  if (error.find("No suitable reader found") != std::string::npos && !ext.empty() && importer.IsExtensionSupported(std::string(ext)))
+    fail(path, "malformed or truncated " + printable(ext.substr(1)) + " file: its content is not recognised");
+  fail(path, explain_assimp_error(error));
+}
+
+/// The UV set asked for: a set above 0 that no mesh has is a mistake worth stopping on (set 0
+/// missing is the "no UVs" case the callers report in their own terms).
+void check_uv_set(const fs::path& path, const aiScene& ai, int asked) {
+  const auto uv_set = static_cast<unsigned>(asked);
+  if (uv_set == 0) return;
+  unsigned sets = 0;
+  bool found = false;
+  for (unsigned m = 0; m < ai.mNumMeshes; ++m) {
+    sets = std::max(sets, ai.mMeshes[m]->GetNumUVChannels());
+    found = found || (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && ai.mMeshes[m]->HasTextureCoords(uv_set));
+  }
+  if (!found) fail(path, uv_set_error(sets, asked));
+}
+
 Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOptions& options, bool is_gltf) {
   const std::string ext = lower(path.extension().string());
   const bool is_stl = ext == ".stl" || data.starts_with("solid");
@@ -554,22 +614,7 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);
 
   // Read with validation only, check the raw data, then post-process.
-  const aiScene* raw = nullptr;
-  try {
-    raw = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
-  } catch (const std::bad_alloc&) {
-    out_of_memory(path);
-  } catch (const std::exception& e) {
-    fail(path, explain_assimp_error(e.what()));
-  }
-  if (raw == nullptr) {
-    const std::string error = importer.GetErrorString();
-    if (assimp_ran_out_of_memory(error)) out_of_memory(path);
-    // "No suitable reader" for a file named like a format assimp reads means damaged content.
-    if (error.find("No suitable reader found") != std::string::npos && !ext.empty() && importer.IsExtensionSupported(ext))
-      fail(path, "malformed or truncated " + printable(ext.substr(1)) + " file: its content is not recognised");
-    fail(path, explain_assimp_error(error));
-  }
+  const aiScene* raw = assimp_step(path, importer, ext, [&] { return importer.ReadFile(path.string(), aiProcess_ValidateDataStructure); });
   check_raw_meshes(path, *raw, static_cast<unsigned>(options.uv_set));
   if (is_gltf) check_node_transforms(path, *raw);
   // A glTF whose node tree uses a mesh several times keeps the mesh once, with instances
@@ -582,33 +627,10 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   unsigned steps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
   if (!instanced) steps |= aiProcess_PreTransformVertices;
   if (is_stl) steps |= aiProcess_RemoveComponent;
-  const aiScene* ai = nullptr;
-  try {
-    ai = importer.ApplyPostProcessing(steps);
-  } catch (const std::bad_alloc&) {
-    out_of_memory(path);
-  } catch (const std::exception& e) {
-    fail(path, explain_assimp_error(e.what()));
-  }
-  if (ai == nullptr) {
-    const std::string error = importer.GetErrorString();
-    if (assimp_ran_out_of_memory(error)) out_of_memory(path);
-    fail(path, explain_assimp_error(error));
-  }
+  const aiScene* ai = assimp_step(path, importer, {}, [&] { return importer.ApplyPostProcessing(steps); });
+  check_uv_set(path, *ai, options.uv_set);
 
-  // The UV set asked for: a set above 0 that no mesh has is a mistake worth stopping on (set 0
-  // missing is the "no UVs" case the callers report in their own terms).
   const unsigned uv_set = static_cast<unsigned>(options.uv_set);
-  if (uv_set > 0) {
-    unsigned sets = 0;
-    bool found = false;
-    for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
-      sets = std::max(sets, ai->mMeshes[m]->GetNumUVChannels());
-      found = found || (uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS && ai->mMeshes[m]->HasTextureCoords(uv_set));
-    }
-    if (!found) fail(path, uv_set_error(sets, options.uv_set));
-  }
-
   Scene scene;
   scene.name = path.filename().string();
   if (instanced) {

@@ -191,9 +191,8 @@ int quad_start(const Vec3 p[4]) {
   return 0;
 }
 
-}  // namespace
-
-std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data, const LoadOptions& options) {
+/// What one pass over the file collects, in the file's terms.
+struct ObjData {
   std::vector<std::array<float, 3>> positions, normals;
   std::vector<std::array<float, 2>> uvs;
   // Face corners as read (attribute indices resolved to 0-based), 3 or 4 per face.
@@ -204,117 +203,118 @@ std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data
   std::string object_name = "defaultobject", material;
   int object_lines = 0, material_lines = 0;
   Form form = kUnset;
-  const fs::path folder = asset_folder(path, options.asset_root);
 
-  std::size_t pos = 0;
-  while (pos < data.size()) {
-    const char* nl = static_cast<const char*>(std::memchr(data.data() + pos, '\n', data.size() - pos));
-    const std::size_t end = nl ? static_cast<std::size_t>(nl - data.data()) : data.size();
-    std::string_view line = data.substr(pos, end - pos);
-    pos = end + 1;
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    if (!line.empty() && line.back() == '\\') return std::nullopt;  // continued lines: assimp's reading
+  /// An f line's corners, all of one form, 3 or 4; false outside the supported shape.
+  bool read_face(Tokens& t) {
+    std::uint8_t n = 0;
+    for (std::string_view c = t.next(); !c.empty(); c = t.next()) {
+      long long idx[3] = {0, 0, 0};
+      Form f = kUnset;
+      if (n == 4 || !read_corner(c, idx, f)) return false;
+      if (form == kUnset) form = f;
+      if (f != form) return false;
+      const std::size_t counts[3] = {positions.size(), uvs.size(), normals.size()};
+      std::array<std::uint32_t, 3> resolved{0, 0, 0};
+      bool later = false;
+      for (int k = 0; k < 3; ++k) {
+        if (idx[k] == 0) continue;  // absent
+        if (idx[k] < 0) {
+          if (static_cast<unsigned long long>(-idx[k]) > counts[k]) return false;
+          resolved[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(static_cast<long long>(counts[k]) + idx[k]);
+        } else {
+          if (idx[k] > 0xFFFFFFFFll) return false;
+          resolved[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(idx[k] - 1);
+          later = later || static_cast<unsigned long long>(idx[k]) > counts[k];
+        }
+      }
+      if (later) forward.push_back({idx[0], idx[1], idx[2]});
+      corners.push_back(resolved);
+      ++n;
+    }
+    if (n < 3) return false;
+    face_sizes.push_back(n);
+    return true;
+  }
+
+  /// One line (comment removed); false outside the supported shape.
+  bool read_line(const fs::path& path, const fs::path& folder, std::string_view line) {
     Tokens t{line};
     const std::string_view key = t.next();
-    if (key.empty()) continue;
+    if (key.empty()) return true;
     if (key == "v" || key == "vn") {
       std::array<float, 3> v;
       for (float& x : v)
-        if (!read_float(t.next(), x)) return std::nullopt;
-      if (!t.next().empty()) return std::nullopt;  // w or a vertex colour
+        if (!read_float(t.next(), x)) return false;
+      if (!t.next().empty()) return false;  // w or a vertex colour
       (key == "v" ? positions : normals).push_back(v);
     } else if (key == "vt") {
       std::array<float, 2> v;
       for (float& x : v)
-        if (!read_float(t.next(), x)) return std::nullopt;
+        if (!read_float(t.next(), x)) return false;
       const std::string_view w = t.next();
       float ignored = 0;
-      if (!w.empty() && (!read_float(w, ignored) || !t.next().empty())) return std::nullopt;
+      if (!w.empty() && (!read_float(w, ignored) || !t.next().empty())) return false;
       uvs.push_back(v);
     } else if (key == "f") {
-      std::uint8_t n = 0;
-      for (std::string_view c = t.next(); !c.empty(); c = t.next()) {
-        long long idx[3] = {0, 0, 0};
-        Form f = kUnset;
-        if (n == 4 || !read_corner(c, idx, f)) return std::nullopt;
-        if (form == kUnset) form = f;
-        if (f != form) return std::nullopt;
-        const std::size_t counts[3] = {positions.size(), uvs.size(), normals.size()};
-        std::array<std::uint32_t, 3> resolved{0, 0, 0};
-        bool later = false;
-        for (int k = 0; k < 3; ++k) {
-          if (idx[k] == 0) continue;  // absent
-          if (idx[k] < 0) {
-            if (static_cast<unsigned long long>(-idx[k]) > counts[k]) return std::nullopt;
-            resolved[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(static_cast<long long>(counts[k]) + idx[k]);
-          } else {
-            if (idx[k] > 0xFFFFFFFFll) return std::nullopt;
-            resolved[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(idx[k] - 1);
-            later = later || static_cast<unsigned long long>(idx[k]) > counts[k];
-          }
-        }
-        if (later) forward.push_back({idx[0], idx[1], idx[2]});
-        corners.push_back(resolved);
-        ++n;
-      }
-      if (n < 3) return std::nullopt;
-      face_sizes.push_back(n);
+      return read_face(t);
     } else if (key == "o" || key == "g") {
       const std::string_view name = t.next();
-      if (!face_sizes.empty() || ++object_lines > 1 || name.empty() || !t.next().empty()) return std::nullopt;
+      if (!face_sizes.empty() || ++object_lines > 1 || name.empty() || !t.next().empty()) return false;
       object_name = name;
     } else if (key == "usemtl") {
       const std::string_view name = t.next();
-      if (!face_sizes.empty() || ++material_lines > 1 || name.empty() || !t.next().empty()) return std::nullopt;
+      if (!face_sizes.empty() || ++material_lines > 1 || name.empty() || !t.next().empty()) return false;
       material = name;
     } else if (key == "mtllib") {
       const std::string_view name = t.next();
       // assimp looks the material up when it meets usemtl; a name with spaces is its reading too.
-      if (material_lines > 0 || name.empty() || !t.next().empty()) return std::nullopt;
+      if (material_lines > 0 || name.empty() || !t.next().empty()) return false;
       resolve_asset_reference(path, folder, name, "material library");
       libraries.emplace_back(name);
     } else if (key != "s") {
-      return std::nullopt;
+      return false;
     }
+    return true;
   }
-  if (face_sizes.empty()) return std::nullopt;
-  for (const auto& idx : forward)
-    if (static_cast<unsigned long long>(idx[0]) > positions.size() || static_cast<unsigned long long>(idx[1]) > uvs.size() ||
-        static_cast<unsigned long long>(idx[2]) > normals.size())
-      return std::nullopt;
-  Vec3 albedo = Mesh{}.albedo;
-  if (!material.empty() && !material_colour(path, libraries, material, albedo)) return std::nullopt;
 
-  const bool has_uv = form == kVT || form == kVTN, has_normal = form == kVN || form == kVTN;
-  if (options.uv_set > 0)
-    throw InputError(path.string() + ": has " + std::string(has_uv ? "1 UV set" : "0 UV sets") + ", --uv-set " + std::to_string(options.uv_set) +
-                     " asked for");
+  /// Whether every index that pointed forwards lands on an element of the whole file.
+  bool forward_indices_in_range() const {
+    for (const auto& idx : forward)
+      if (static_cast<unsigned long long>(idx[0]) > positions.size() || static_cast<unsigned long long>(idx[1]) > uvs.size() ||
+          static_cast<unsigned long long>(idx[2]) > normals.size())
+        return false;
+    return true;
+  }
+};
 
-  // Weld: equal values share a number, then each distinct triple is a vertex in first-use order.
-  const std::vector<std::uint32_t> pos_id = first_equal(positions);
-  const std::vector<std::uint32_t> uv_id = has_uv ? first_equal(uvs) : std::vector<std::uint32_t>{};
-  const std::vector<std::uint32_t> normal_id = has_normal ? first_equal(normals) : std::vector<std::uint32_t>{};
+/// The mesh assimp would make of it: equal values share a number, then each distinct (position,
+/// UV, normal) triple is a vertex in first-use order; quads split at their concave corner.
+Mesh weld_and_triangulate(const ObjData& d) {
+  const bool has_uv = d.form == kVT || d.form == kVTN, has_normal = d.form == kVN || d.form == kVTN;
+  const std::vector<std::uint32_t> pos_id = first_equal(d.positions);
+  const std::vector<std::uint32_t> uv_id = has_uv ? first_equal(d.uvs) : std::vector<std::uint32_t>{};
+  const std::vector<std::uint32_t> normal_id = has_normal ? first_equal(d.normals) : std::vector<std::uint32_t>{};
   std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, KeyHash> vertex_of;
-  vertex_of.reserve(corners.size());
+  vertex_of.reserve(d.corners.size());
   Mesh mesh;
-  mesh.name = object_name;
-  mesh.albedo = albedo;
-  mesh.positions.reserve(positions.size() + kVertexPadding);  // see kVertexPadding
-  std::vector<std::uint32_t> corner_vertex(corners.size());
-  for (std::size_t c = 0; c < corners.size(); ++c) {
-    const std::array<std::uint32_t, 3> key{pos_id[corners[c][0]], has_uv ? uv_id[corners[c][1]] : 0u, has_normal ? normal_id[corners[c][2]] : 0u};
+  mesh.name = d.object_name;
+  mesh.positions.reserve(d.positions.size() + kVertexPadding);  // see kVertexPadding
+  std::vector<std::uint32_t> corner_vertex(d.corners.size());
+  for (std::size_t c = 0; c < d.corners.size(); ++c) {
+    const auto& corner = d.corners[c];
+    const std::array<std::uint32_t, 3> key{pos_id[corner[0]], has_uv ? uv_id[corner[1]] : 0u, has_normal ? normal_id[corner[2]] : 0u};
     const auto [it, inserted] = vertex_of.try_emplace(key, static_cast<std::uint32_t>(mesh.positions.size()));
     if (inserted) {
-      const auto& p = positions[key[0]];
+      const auto& p = d.positions[key[0]];
       mesh.positions.push_back({p[0], p[1], p[2]});
-      if (has_uv) mesh.uvs.push_back({uvs[key[1]][0], uvs[key[1]][1]});
-      if (has_normal) mesh.normals.push_back({normals[key[2]][0], normals[key[2]][1], normals[key[2]][2]});
+      if (has_uv) mesh.uvs.push_back({d.uvs[key[1]][0], d.uvs[key[1]][1]});
+      if (has_normal) mesh.normals.push_back({d.normals[key[2]][0], d.normals[key[2]][1], d.normals[key[2]][2]});
     }
     corner_vertex[c] = it->second;
   }
-  mesh.indices.reserve(corners.size() * 3 / 2 + 3);
+  mesh.indices.reserve(d.corners.size() * 3 / 2 + 3);
   std::size_t c = 0;
-  for (const std::uint8_t n : face_sizes) {
+  for (const std::uint8_t n : d.face_sizes) {
     const std::uint32_t* v = &corner_vertex[c];
     if (n == 3) {
       mesh.indices.insert(mesh.indices.end(), v, v + 3);
@@ -325,7 +325,34 @@ std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data
     }
     c += n;
   }
+  return mesh;
+}
 
+}  // namespace
+
+std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data, const LoadOptions& options) {
+  ObjData d;
+  const fs::path folder = asset_folder(path, options.asset_root);
+  std::size_t pos = 0;
+  while (pos < data.size()) {
+    const char* nl = static_cast<const char*>(std::memchr(data.data() + pos, '\n', data.size() - pos));
+    const std::size_t end = nl ? static_cast<std::size_t>(nl - data.data()) : data.size();
+    std::string_view line = data.substr(pos, end - pos);
+    pos = end + 1;
+    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    if (!line.empty() && line.back() == '\\') return std::nullopt;  // continued lines: assimp's reading
+    if (!d.read_line(path, folder, line)) return std::nullopt;
+  }
+  if (d.face_sizes.empty() || !d.forward_indices_in_range()) return std::nullopt;
+  Vec3 albedo = Mesh{}.albedo;
+  if (!d.material.empty() && !material_colour(path, d.libraries, d.material, albedo)) return std::nullopt;
+
+  const bool has_uv = d.form == kVT || d.form == kVTN;
+  if (options.uv_set > 0)
+    throw InputError(path.string() + ": has " + std::string(has_uv ? "1 UV set" : "0 UV sets") + ", --uv-set " + std::to_string(options.uv_set) +
+                     " asked for");
+  Mesh mesh = weld_and_triangulate(d);
+  mesh.albedo = albedo;
   Scene scene;
   scene.name = path.filename().string();
   scene.meshes.push_back(std::move(mesh));

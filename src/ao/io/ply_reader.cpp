@@ -334,6 +334,78 @@ bool read_triangles_fast(const Element& e, const Layout& l, const char* p, const
   return ok;
 }
 
+/// The vertex element when no property is a list: only the properties that are used, at their
+/// offsets in the fixed-size record; records are independent, so read in parallel.
+template <bool BigEndian>
+void read_fixed_vertices(const Element& e, const char* first, Builder& out) {
+  struct Field {
+    long long offset;
+    Type type;
+    int slot;
+  };
+  std::vector<Field> fields;
+  long long offset = 0;
+  for (const Property& q : e.properties) {
+    if (q.slot != kSkip) fields.push_back({offset, q.type, q.slot});
+    offset += type_size(q.type);
+  }
+  const long long stride = e.min_bytes;
+  tbb::parallel_for(tbb::blocked_range<long long>(0, e.count, 1 << 15), [&](const tbb::blocked_range<long long>& r) {
+    for (long long i = r.begin(); i < r.end(); ++i) {
+      const char* const record = first + i * stride;
+      for (const Field& f : fields) {
+        float value;
+        if (!BigEndian && f.type == Type::F32) std::memcpy(&value, record + f.offset, 4);  // the common case, without conversion
+        else value = static_cast<float>(load<BigEndian>(record + f.offset, f.type));
+        out.set(i, f.slot, value);
+      }
+    }
+  });
+}
+
+/// An element with list properties, record by record from `p`, every read bounded by `end`;
+/// returns where the element ends.
+template <bool BigEndian>
+const char* read_listed_element(const fs::path& path, const Header& h, const Layout& l, const Element& e, bool is_vertex, bool is_face,
+                                const char* p, const char* const end, Builder& out) {
+  for (long long i = 0; i < e.count; ++i) {
+    for (std::size_t pi = 0; pi < e.properties.size(); ++pi) {
+      const Property& q = e.properties[pi];
+      const int size = type_size(q.type);
+      if (!q.is_list) {
+        if (end - p < size) fail(path, truncated(h, e, i));
+        if (is_vertex && q.slot != kSkip) out.set(i, q.slot, static_cast<float>(load<BigEndian>(p, q.type)));
+        p += size;
+        continue;
+      }
+      const int count_size = type_size(q.count_type);
+      if (end - p < count_size) fail(path, truncated(h, e, i));
+      const double n_value = load<BigEndian>(p, q.count_type);
+      p += count_size;
+      if (n_value < 0) fail(path, "'" + e.name + "' " + std::to_string(i) + " has a negative list count " + std::to_string(static_cast<long long>(n_value)));
+      const auto n = static_cast<long long>(n_value);
+      // The list must fit in what is left: a damaged count cannot make us read past the end.
+      if (n > (end - p) / size) fail(path, truncated(h, e, i));
+      if (is_face && static_cast<int>(pi) == l.face_list) {
+        if (!BigEndian && (q.type == Type::I32 || q.type == Type::U32)) {
+          // The common case, without conversion through double.
+          for (long long k = 0; k < n; ++k, p += 4) {
+            std::uint32_t u;
+            std::memcpy(&u, p, 4);
+            out.corner(i, q.type == Type::I32 ? static_cast<long long>(static_cast<std::int32_t>(u)) : static_cast<long long>(u));
+          }
+        } else {
+          for (long long k = 0; k < n; ++k, p += size) out.corner(i, static_cast<long long>(load<BigEndian>(p, q.type)));
+        }
+      } else {
+        p += n * size;
+      }
+    }
+    if (is_face) out.face_done(i);
+  }
+  return p;
+}
+
 template <bool BigEndian>
 void read_binary(const fs::path& path, const Header& h, const Layout& l, std::string_view body, Builder& out) {
   const char* p = body.data();
@@ -344,78 +416,14 @@ void read_binary(const fs::path& path, const Header& h, const Layout& l, std::st
     const bool fixed = std::none_of(e.properties.begin(), e.properties.end(), [](const Property& q) { return q.is_list; });
     if (fixed) {
       // Fixed-size elements: one bounds check for the whole element (min_bytes is the size here).
+      // The face element has a list, so it is never fixed-size.
       if (e.count * e.min_bytes > end - p) fail(path, truncated(h, e, (end - p) / std::max(1LL, e.min_bytes)));
-      if (is_vertex) {
-        // Only the properties that are used, at their offsets in the fixed-size record.
-        struct Field {
-          long long offset;
-          Type type;
-          int slot;
-        };
-        std::vector<Field> fields;
-        long long offset = 0;
-        for (const Property& q : e.properties) {
-          if (q.slot != kSkip) fields.push_back({offset, q.type, q.slot});
-          offset += type_size(q.type);
-        }
-        // Records are independent: read in parallel.
-        const char* const first = p;
-        const long long stride = e.min_bytes;
-        tbb::parallel_for(tbb::blocked_range<long long>(0, e.count, 1 << 15), [&](const tbb::blocked_range<long long>& r) {
-          for (long long i = r.begin(); i < r.end(); ++i) {
-            const char* const record = first + i * stride;
-            for (const Field& f : fields) {
-              float value;
-              if (!BigEndian && f.type == Type::F32) std::memcpy(&value, record + f.offset, 4);  // the common case, without conversion
-              else value = static_cast<float>(load<BigEndian>(record + f.offset, f.type));
-              out.set(i, f.slot, value);
-            }
-          }
-        });
-        p += e.count * e.min_bytes;
-      } else {
-        p += e.count * e.min_bytes;  // the face element has a list, so it is never fixed-size
-      }
-      continue;
-    }
-    if (is_face && !BigEndian && read_triangles_fast(e, l, p, end, out)) {
+      if (is_vertex) read_fixed_vertices<BigEndian>(e, p, out);
+      p += e.count * e.min_bytes;
+    } else if (is_face && !BigEndian && read_triangles_fast(e, l, p, end, out)) {
       p += e.count * 13;
-      continue;
-    }
-    for (long long i = 0; i < e.count; ++i) {
-      for (std::size_t pi = 0; pi < e.properties.size(); ++pi) {
-        const Property& q = e.properties[pi];
-        const int size = type_size(q.type);
-        if (!q.is_list) {
-          if (end - p < size) fail(path, truncated(h, e, i));
-          if (is_vertex && q.slot != kSkip) out.set(i, q.slot, static_cast<float>(load<BigEndian>(p, q.type)));
-          p += size;
-          continue;
-        }
-        const int count_size = type_size(q.count_type);
-        if (end - p < count_size) fail(path, truncated(h, e, i));
-        const double n_value = load<BigEndian>(p, q.count_type);
-        p += count_size;
-        if (n_value < 0) fail(path, "'" + e.name + "' " + std::to_string(i) + " has a negative list count " + std::to_string(static_cast<long long>(n_value)));
-        const auto n = static_cast<long long>(n_value);
-        // The list must fit in what is left: a damaged count cannot make us read past the end.
-        if (n > (end - p) / size) fail(path, truncated(h, e, i));
-        if (is_face && static_cast<int>(pi) == l.face_list) {
-          if (!BigEndian && (q.type == Type::I32 || q.type == Type::U32)) {
-            // The common case, without conversion through double.
-            for (long long k = 0; k < n; ++k, p += 4) {
-              std::uint32_t u;
-              std::memcpy(&u, p, 4);
-              out.corner(i, q.type == Type::I32 ? static_cast<long long>(static_cast<std::int32_t>(u)) : static_cast<long long>(u));
-            }
-          } else {
-            for (long long k = 0; k < n; ++k, p += size) out.corner(i, static_cast<long long>(load<BigEndian>(p, q.type)));
-          }
-        } else {
-          p += n * size;
-        }
-      }
-      if (is_face) out.face_done(i);
+    } else {
+      p = read_listed_element<BigEndian>(path, h, l, e, is_vertex, is_face, p, end, out);
     }
   }
 }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -18,14 +19,11 @@
 
 namespace ao {
 
-TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s) {
-  const auto start_time = std::chrono::steady_clock::now();
-  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count(); };
-  const MethodInfo& m = find_method(s.method);
-  if (views.empty()) throw InputError("tune: no view to fit on");
-  if (s.parameters.empty()) throw InputError("tune: no parameter to fit");
-  if (!(s.time_budget_s > 0)) throw InputError("tune: the time budget must be > 0 seconds");
-  if (!(s.min_step > 0 && s.min_step < 1)) throw InputError("tune: min_step must be in (0, 1)");
+namespace {
+
+// The search's start: the method's defaults (or the given start), each fitted parameter a number
+// inside its range (integer where the parameter is).
+nlohmann::json tune_start(const MethodInfo& m, const TuneSettings& s) {
   nlohmann::json current = s.start.is_null() ? m.default_params() : s.start;
   // A value a preset leaves unset starts where the method has it (Alchemy's intensity 0.4 at the
   // fitted preset), so the start does not depend on the range asked for.
@@ -42,6 +40,61 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
     if (x < p.lo || x > p.hi) current[p.key] = shortest_floats(nlohmann::json(static_cast<float>(std::clamp(x, p.lo, p.hi))));
     if (p.integer) current[p.key] = static_cast<long long>(std::llround(current.at(p.key).get<double>()));
   }
+  return current;
+}
+
+nlohmann::json tune_value(const TuneParameter& p, double x) {
+  x = std::clamp(x, p.lo, p.hi);
+  return p.integer ? nlohmann::json(static_cast<long long>(std::llround(x))) : shortest_floats(nlohmann::json(static_cast<float>(x)));
+}
+
+// Coordinate search from `current` (error `best`): each parameter in turn steps a quarter of its
+// range up, else down, keeping the first move that lowers the error and halving its step when
+// neither does; until every step is below min_step of its range (half a unit for integers) or the
+// time is up. Leaves the best point in `current` and returns its error.
+double coordinate_search(const TuneSettings& s, nlohmann::json& current, double best,
+                         const std::function<double(const nlohmann::json&)>& evaluate, const std::function<double()>& seconds) {
+  std::vector<double> step;
+  for (const TuneParameter& p : s.parameters) step.push_back((p.hi - p.lo) / 4);
+  bool moving = true;
+  while (moving && seconds() < s.time_budget_s) {
+    moving = false;
+    for (std::size_t i = 0; i < s.parameters.size() && seconds() < s.time_budget_s; ++i) {
+      const TuneParameter& p = s.parameters[i];
+      if (step[i] < s.min_step * (p.hi - p.lo) || (p.integer && step[i] < 0.5)) continue;
+      moving = true;
+      const double x = current.at(p.key).get<double>();
+      bool improved = false;
+      for (double sign : {1.0, -1.0}) {
+        nlohmann::json trial = current;
+        trial[p.key] = tune_value(p, x + sign * step[i]);
+        if (trial[p.key] == current[p.key]) continue;
+        const double e = evaluate(trial);
+        if (e < best) {
+          best = e;
+          current = std::move(trial);
+          improved = true;
+          if (s.log) s.log(p.key + " = " + format_value(current[p.key]) + ": mean RMSE " + std::to_string(best));
+          break;
+        }
+      }
+      if (!improved) step[i] /= 2;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count(); };
+  const MethodInfo& m = find_method(s.method);
+  if (views.empty()) throw InputError("tune: no view to fit on");
+  if (s.parameters.empty()) throw InputError("tune: no parameter to fit");
+  if (!(s.time_budget_s > 0)) throw InputError("tune: the time budget must be > 0 seconds");
+  if (!(s.min_step > 0 && s.min_step < 1)) throw InputError("tune: min_step must be in (0, 1)");
+  nlohmann::json current = tune_start(m, s);
 
   TuneResult r;
   // Mean RMSE over the views; a parameter value the method refuses counts as infinitely bad.
@@ -62,46 +115,14 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
     }
     return sum / static_cast<double>(views.size());
   };
-  auto value_of = [](const TuneParameter& p, double x) {
-    x = std::clamp(x, p.lo, p.hi);
-    return p.integer ? nlohmann::json(static_cast<long long>(std::llround(x))) : shortest_floats(nlohmann::json(static_cast<float>(x)));
-  };
 
-  double best = evaluate(current);
-  r.start_rmse = best;
-  std::vector<double> step;
-  for (const TuneParameter& p : s.parameters) step.push_back((p.hi - p.lo) / 4);
-  bool moving = true;
-  while (moving && seconds() < s.time_budget_s) {
-    moving = false;
-    for (std::size_t i = 0; i < s.parameters.size() && seconds() < s.time_budget_s; ++i) {
-      const TuneParameter& p = s.parameters[i];
-      if (step[i] < s.min_step * (p.hi - p.lo) || (p.integer && step[i] < 0.5)) continue;
-      moving = true;
-      const double x = current.at(p.key).get<double>();
-      bool improved = false;
-      for (double sign : {1.0, -1.0}) {
-        nlohmann::json trial = current;
-        trial[p.key] = value_of(p, x + sign * step[i]);
-        if (trial[p.key] == current[p.key]) continue;
-        const double e = evaluate(trial);
-        if (e < best) {
-          best = e;
-          current = std::move(trial);
-          improved = true;
-          if (s.log) s.log(p.key + " = " + format_value(current[p.key]) + ": mean RMSE " + std::to_string(best));
-          break;
-        }
-      }
-      if (!improved) step[i] /= 2;
-    }
-  }
+  r.start_rmse = evaluate(current);
+  r.best_rmse = coordinate_search(s, current, r.start_rmse, evaluate, seconds);
   r.params = shortest_floats(current);
   for (const TuneParameter& p : s.parameters) {
     const double x = r.params.at(p.key).get<double>();
     if (x <= p.lo || x >= p.hi) r.on_bound.push_back(p.key);
   }
-  r.best_rmse = best;
   r.seconds = seconds();
   return r;
 }

@@ -117,8 +117,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const Image<float>* second_layer, 
 
   // Screen radius of the world disk: both image axes have 0.5 * height / tan(fov/2) pixels per unit
   // of x/(-z) (camera.h's projection), so the disk of radius r at depth z_C projects to a disk of
-  // radius r * that / z_C, and uniform area on it is uniform area on the world disk (sec. 2.3).
-  const float px_per_unit = 0.5f * static_cast<float>(h) / g.camera.tan_half_fov();
+  // radius r * that / z_C, and uniform area on it is uniform area on the world disk (sec. 2.3):
+  // DepthView::px_per_unit.
   // 2 sigma / s: eq. 9's 2 pi u / s (uniform directions, pdf 1/(2 pi)) times the paper's nominal
   // 1/pi (sec. 2.3), with u folded into sigma.
   const float scale = 2.0f * k.sigma / static_cast<float>(s);
@@ -133,12 +133,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const Image<float>* second_layer, 
   const std::array<float, kMaxSamples>&ux = directions.x, &uy = directions.y;
   const RotationTable& rot = rotations();
   simd::AlchemyInputs in;
-  in.depth = depth_image.data(), in.normal = &g.normal.data()->x, in.object_id = g.object_id.data();
-  in.width = w, in.height = h;
-  // camera_direction(px, py) = (ax * px + bx, ay * py + by, -1) for continuous pixel coordinates.
-  in.ray_ax = 2.0f * t * g.camera.aspect() / static_cast<float>(w), in.ray_bx = -t * g.camera.aspect();
-  in.ray_ay = -2.0f * t / static_cast<float>(h), in.ray_by = t;
-  in.radius = k.radius, in.px_per_unit = px_per_unit, in.max_pixel_radius = kMaxPixelRadius;
+  static_cast<simd::DepthView&>(in) = simd::depth_view(depth_image.data(), &g.normal.data()->x, g.object_id.data(), w, h, t, g.camera.aspect());
+  in.radius = k.radius, in.max_pixel_radius = kMaxPixelRadius;
   in.epsilon = k.epsilon, in.beta = k.beta, in.scale = scale, in.samples = s;
   in.ux = ux.data(), in.uy = uy.data(), in.rot_c = rot.c.data(), in.rot_s = rot.s.data(), in.seed = seed;
   if (params.layers.layers == 2) {

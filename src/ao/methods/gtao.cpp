@@ -115,13 +115,9 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   const float t = g.camera.tan_half_fov();
   const Image<float> depth_image = depth_plane(g);  // also the filter's
   simd::GtaoInputs in;
-  in.depth = depth_image.data(), in.normal = &g.normal.data()->x, in.object_id = g.object_id.data();
-  in.width = w, in.height = h;
-  in.ray_ax = 2.0f * t * g.camera.aspect() / static_cast<float>(w), in.ray_bx = -t * g.camera.aspect();
-  in.ray_ay = -2.0f * t / static_cast<float>(h), in.ray_by = t;
-  in.radius = radius;
   // Both image axes have 0.5 h / tan(fov/2) pixels per unit of x/(-z): R at depth z spans R * that / z pixels.
-  in.px_per_unit = 0.5f * static_cast<float>(h) / t;
+  static_cast<simd::DepthView&>(in) = simd::depth_view(depth_image.data(), &g.normal.data()->x, g.object_id.data(), w, h, t, g.camera.aspect());
+  in.radius = radius;
   in.slices = slices, in.steps = steps;
   // The kernel reads each table as one row-major array, [k * 16 + p].
   static_assert(sizeof(tables.dir_c) == sizeof(float) * kMaxSlices * 16 && sizeof(tables.step_t) == sizeof(float) * kMaxSteps * 16);

@@ -200,6 +200,64 @@ bool make_palette(const Image<Vec3>& img, const Image<float>& depth, Image<std::
   }
   return true;
 }
+
+// What transfer reads beyond the G-buffer's depth and normals: the reflectance image at its size,
+// and for reflectance=radiance its direct-light pass.
+void check_transfer_inputs(const GBuffer& g, const Image<Vec3>& indirect, const TransferParams& params) {
+  const int w = g.width(), h = g.height();
+  if (indirect.width() != w || indirect.height() != h) throw InputError("transfer: the indirect reflectance image must have the G-buffer's size");
+  if (params.reflectance != TransferReflectance::Radiance) return;
+  if (g.direct.empty())
+    throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
+  if (g.direct.width() != w || g.direct.height() != h) throw InputError("transfer: the G-buffer's direct-light pass must have its size");
+}
+
+// Where the kernel writes W (R, G, B planes) and O: planar, the filter's input, so its depth tests
+// are shared by all four. Unfiltered, R goes where the luminance will be and O to its final place;
+// when the depth-buffer kernel writes the final images itself, `final_rgb` is W interleaved (and
+// raw_g, raw_b are unused).
+struct RawPlanes {
+  float* r;
+  float* g;
+  float* b;
+  float* o;
+  Vec3* final_rgb;
+};
+
+RawPlanes raw_planes(TransferBuffers& buffers, int w, int h, bool filter, bool kernel_writes_final) {
+  TransferImage& out = buffers.result;
+  out.transfer.resize(w, h), out.obscurance.resize(w, h), out.luminance.resize(w, h);
+  for (Image<float>& p : buffers.scratch) p.resize(w, h);
+  return {filter ? buffers.scratch[0].data() : out.luminance.data(), buffers.scratch[1].data(), buffers.scratch[2].data(),
+          filter ? buffers.scratch[3].data() : out.obscurance.data(), kernel_writes_final ? out.transfer.data() : nullptr};
+}
+
+// Sec. 4.2's filter on W and O alike (filtered R goes where the luminance will be), then W
+// interleaved and its luminance over the R plane in place (each pixel reads R before writing).
+void finish_transfer(TransferBuffers& buffers, const RawPlanes& raw, const GBuffer& g, bool filter, float depth_limit,
+                     const Image<float>* carried_depth) {
+  TransferImage& out = buffers.result;
+  float* fr = raw.r;
+  float* fg = raw.g;
+  float* fb = raw.b;
+  if (filter) {
+    fr = out.luminance.data(), fg = buffers.scratch[4].data(), fb = buffers.scratch[5].data();
+    const std::array<const float*, 4> src{raw.r, raw.g, raw.b, raw.o};
+    const std::array<float*, 4> dst{fr, fg, fb, out.obscurance.data()};
+    depth_aware_box_filter_planes(src, dst, g, depth_limit, carried_depth);
+  }
+  const int w = g.width();
+  parallel_for_tiles(w, g.height(), kTileWidth, [&](const Tile& t) {
+    for (int y = t.y0; y < t.y1; ++y)
+      for (int x = t.x0; x < t.x1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        const Vec3 c{fr[i], fg[i], fb[i]};
+        out.transfer[i] = c;
+        out.luminance[i] = luminance(c);
+      }
+  });
+}
+
 }  // namespace
 
 template <class Characteristic>
@@ -208,14 +266,10 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
   constexpr bool kDepthBuffer = std::is_same_v<Characteristic, DepthBufferCharacteristic>;
   falloff.validate();
   params.validate();
-  const int w = g.width(), h = g.height();
-  if (indirect.width() != w || indirect.height() != h) throw InputError("transfer: the indirect reflectance image must have the G-buffer's size");
-  const bool radiance = params.reflectance == TransferReflectance::Radiance;
-  if (radiance && g.direct.empty())
-    throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
-  if (radiance && (g.direct.width() != w || g.direct.height() != h))
-    throw InputError("transfer: the G-buffer's direct-light pass must have its size");
+  check_transfer_inputs(g, indirect, params);
   check_layers(ch, params.layers, falloff.radius, "transfer");
+  const int w = g.width(), h = g.height();
+  const bool radiance = params.reflectance == TransferReflectance::Radiance;
   const ContainmentSamples s = make_containment_samples(params.samples, falloff);
   const simd::Rotations16 rotations = simd_rotations(interleave_rotations(seed, params.interleave.interleave));
   const float far_limit = params.silhouette_elimination ? -falloff.radius : -kInfinity;  // AT 4.3
@@ -235,62 +289,34 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     if (!radiance && ch.depth == ch.plane->data() && make_palette(indirect, *ch.plane, buffers.depth_and_palette, palette_rgb))
       in.packed = buffers.depth_and_palette.data();
   }
-  TransferImage& out = buffers.result;
-  out.transfer.resize(w, h), out.obscurance.resize(w, h), out.luminance.resize(w, h);
-  for (Image<float>& p : buffers.scratch) p.resize(w, h);
-  // Planar W (R, G, B) and O, the filter's input: its depth tests are then shared by all four.
-  // Unfiltered, R goes where the luminance will be and O to its final place.
-  float* raw_r = filter ? buffers.scratch[0].data() : out.luminance.data();
-  float* raw_g = buffers.scratch[1].data();
-  float* raw_b = buffers.scratch[2].data();
-  float* raw_o = filter ? buffers.scratch[3].data() : out.obscurance.data();
   // Unfiltered, the depth-buffer kernel writes the final images itself (W interleaved, its
-  // luminance where R would go, O), and the interleave pass below is skipped.
+  // luminance where R would go, O), and the interleave pass is skipped.
   const bool kernel_writes_final = !filter && kDepthBuffer;
-  Vec3* final_rgb = kernel_writes_final ? out.transfer.data() : nullptr;
+  const RawPlanes raw = raw_planes(buffers, w, h, filter, kernel_writes_final);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     thread_local simd::CoveredPixels row;  // its arrays kept between tiles: one allocation per thread, not 17 per tile
     for (int y = t.y0; y < t.y1; ++y) {
       const std::size_t base = static_cast<std::size_t>(y) * w;
-      // Uncovered pixels: W = O = 1. Writing the final images, only those (raw_g, raw_b unused).
+      // Uncovered pixels: W = O = 1. Writing the final images, only those (raw.g, raw.b unused).
       const std::size_t first = base + t.x0, end = base + t.x1;
-      if (final_rgb) {
-        std::fill(final_rgb + first, final_rgb + end, Vec3{1, 1, 1});
-        std::fill(raw_r + first, raw_r + end, luminance(Vec3{1, 1, 1}));
-        std::fill(raw_o + first, raw_o + end, 1.0f);
+      if (raw.final_rgb) {
+        std::fill(raw.final_rgb + first, raw.final_rgb + end, Vec3{1, 1, 1});
+        std::fill(raw.r + first, raw.r + end, luminance(Vec3{1, 1, 1}));
+        std::fill(raw.o + first, raw.o + end, 1.0f);
       } else {
-        for (float* plane : {raw_r, raw_g, raw_b, raw_o}) std::fill(plane + first, plane + end, 1.0f);
+        for (float* plane : {raw.r, raw.g, raw.b, raw.o}) std::fill(plane + first, plane + end, 1.0f);
       }
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rotations, params.bias, true);
-      const simd::TransferOutputs o{raw_r, raw_g, raw_b, raw_o, final_rgb};
+      const simd::TransferOutputs o{raw.r, raw.g, raw.b, raw.o, raw.final_rgb};
       if constexpr (kDepthBuffer)
         simd::transfer_rays(row, simd_depth_plane(ch, params.layers), simd_points(s), m, far_limit, in, base + t.x0, o);
       else
         transfer_rays(row, ch, projection, s, m, far_limit, albedo, direct, params.albedo_scale, base + t.x0, o);
     }
   });
-  // Sec. 4.2's filter on W and O alike; filtered R goes where the luminance will be.
-  float* fr = raw_r;
-  float* fg = raw_g;
-  float* fb = raw_b;
-  if (filter) {
-    fr = out.luminance.data(), fg = buffers.scratch[4].data(), fb = buffers.scratch[5].data();
-    const std::array<const float*, 4> src{raw_r, raw_g, raw_b, raw_o};
-    const std::array<float*, 4> dst{fr, fg, fb, out.obscurance.data()};
-    depth_aware_box_filter_planes(src, dst, g, effective_depth_limit(params.interleave, falloff.radius), carried_depth_plane(ch));
-  }
-  if (kernel_writes_final) return out;  // the kernel wrote the final images
-  // Interleave W, and its luminance over the R plane in place (each pixel reads R before writing).
-  parallel_for_tiles(w, h, kTileWidth, [&](const Tile& t) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        const Vec3 c{fr[i], fg[i], fb[i]};
-        out.transfer[i] = c;
-        out.luminance[i] = luminance(c);
-      }
-  });
-  return out;
+  if (!kernel_writes_final)
+    finish_transfer(buffers, raw, g, filter, effective_depth_limit(params.interleave, falloff.radius), carried_depth_plane(ch));
+  return buffers.result;
 }
 
 template <class Characteristic>

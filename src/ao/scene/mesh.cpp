@@ -201,10 +201,8 @@ bool has_area(Vec3 a, Vec3 b, Vec3 c, float scale) {
   return dot(n, n) > 0.0f;
 }
 
-void validate_mesh(const Scene& scene, Mesh& mesh) {
-  const std::string w = where(scene, mesh);
-  if (mesh.indices.size() % 3 != 0) throw InputError(w + ": index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
-  // Every check below runs in parallel and reports the first offender in file order.
+// Vertices and their attributes: finite, in range, one per vertex; the albedo clamped to [0, 1].
+void validate_vertices(const std::string& w, Mesh& mesh) {
   const auto bad_position = [&](std::size_t v) {
     const Vec3 p = mesh.positions[v];
     return !is_finite(p) || std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > kMaxCoordinate;
@@ -226,10 +224,12 @@ void validate_mesh(const Scene& scene, Mesh& mesh) {
   for (float c : {mesh.albedo.x, mesh.albedo.y, mesh.albedo.z})
     if (!std::isfinite(c)) throw InputError(w + ": albedo is not finite");
   mesh.albedo = min(max(mesh.albedo, Vec3{0, 0, 0}), Vec3{1, 1, 1});
+}
 
-  // Triangles, in blocks of kGrain: each block checks its indices and moves the triangles it keeps
-  // to its own front (in place: a kept triangle never moves up); the blocks are then joined in
-  // order, which keeps the file's triangle order.
+// Triangles, in blocks of kGrain: each block checks its indices and moves the triangles it keeps
+// to its own front (in place: a kept triangle never moves up); the blocks are then joined in
+// order, which keeps the file's triangle order.
+void compact_triangles(const std::string& w, Mesh& mesh) {
   const std::size_t vertex_count = mesh.positions.size(), triangle_count = mesh.indices.size() / 3;
   const std::size_t blocks = (triangle_count + kGrain - 1) / kGrain;
   struct Block {
@@ -270,19 +270,29 @@ void validate_mesh(const Scene& scene, Mesh& mesh) {
   // changes no result but spares the ray tracer and the bakers a division by zero. The caller
   // reports how many went.
   mesh.indices.resize(3 * kept);
-  if (!mesh.normals.empty()) {
-    const auto bad_normal = [&](std::size_t v) { return !is_finite(mesh.normals[v]); };
-    if (const std::size_t v = first_where(mesh.normals.size(), bad_normal); v < mesh.normals.size())
-      throw InputError(w + ": normal " + std::to_string(v) + " is not finite");
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.normals.size(), kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t v = r.begin(); v < r.end(); ++v) {
-        const float len = length(mesh.normals[v]);
-        mesh.normals[v] = len > 0 ? mesh.normals[v] / len : Vec3{0, 0, 1};
-      }
-    });
-  } else {
-    generate_normals(mesh);
-  }
+}
+
+// Given normals: finite, made unit length (a zero one becomes +z).
+void normalize_given_normals(const std::string& w, Mesh& mesh) {
+  const auto bad_normal = [&](std::size_t v) { return !is_finite(mesh.normals[v]); };
+  if (const std::size_t v = first_where(mesh.normals.size(), bad_normal); v < mesh.normals.size())
+    throw InputError(w + ": normal " + std::to_string(v) + " is not finite");
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.normals.size(), kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t v = r.begin(); v < r.end(); ++v) {
+      const float len = length(mesh.normals[v]);
+      mesh.normals[v] = len > 0 ? mesh.normals[v] / len : Vec3{0, 0, 1};
+    }
+  });
+}
+
+void validate_mesh(const Scene& scene, Mesh& mesh) {
+  const std::string w = where(scene, mesh);
+  if (mesh.indices.size() % 3 != 0) throw InputError(w + ": index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
+  // Every check below runs in parallel and reports the first offender in file order.
+  validate_vertices(w, mesh);
+  compact_triangles(w, mesh);
+  if (!mesh.normals.empty()) normalize_given_normals(w, mesh);
+  else generate_normals(mesh);
   // Loaders reserve this up front; a reallocation here only happens for meshes built in code.
   if (mesh.positions.capacity() < mesh.positions.size() + kVertexPadding) mesh.positions.reserve(mesh.positions.size() + kVertexPadding);
 }

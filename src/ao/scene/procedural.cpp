@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "ao/core/error.h"
 
@@ -36,6 +37,16 @@ Vec3 rotate_y(Vec3 p, Vec3 pivot, float deg) {
 Mesh named(Mesh m, std::string name) {
   m.name = std::move(name);
   return m;
+}
+
+// A scene's preferred view: from `eye` towards `target`, with the camera's default field of view
+// unless one is given.
+Camera look_at(Vec3 eye, Vec3 target, std::optional<float> vertical_fov_deg = std::nullopt) {
+  Camera view;
+  view.eye = eye;
+  view.target = target;
+  if (vertical_fov_deg) view.vertical_fov_deg = *vertical_fov_deg;
+  return view;
 }
 
 // Axis-aligned rectangle on the ground (y = 0), facing up.
@@ -101,26 +112,24 @@ Scene default_scene() {
     }
   s.meshes.push_back(std::move(cubes));
 
-  Camera view;
-  view.eye = {4.4f, 4.6f, 7.0f};
-  view.target = {-0.2f, 0.1f, -0.9f};
-  view.vertical_fov_deg = 45.0f;
-  s.preferred_view = view;
+  s.preferred_view = look_at({4.4f, 4.6f, 7.0f}, {-0.2f, 0.1f, -0.9f}, 45.0f);
   return s;
+}
+
+// A 40 x 40 ground square at y = 0, named "plane": the open ground of the analytic scenes.
+Mesh open_ground() {
+  Mesh m;
+  m.name = "plane";
+  add_ground_rect(m, -20, -20, 20, 20);
+  return m;
 }
 
 Scene plane_scene() {
   Scene s;
   s.name = "plane";
-  Mesh m;
-  m.name = "plane";
-  add_ground_rect(m, -20, -20, 20, 20);
-  s.meshes.push_back(std::move(m));
+  s.meshes.push_back(open_ground());
   s.analytic.implicit = ImplicitSurface{{ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 1, 0})}};
-  Camera view;
-  view.eye = {0, 6, 10};
-  view.target = {0, 0, 0};
-  s.preferred_view = view;
+  s.preferred_view = look_at({0, 6, 10}, {0, 0, 0});
   return s;
 }
 
@@ -136,29 +145,20 @@ Scene wedge_scene() {
   // Outer region y >= 0 and z >= 0 (the quads end at 100 units; R is far smaller).
   s.analytic.implicit = ImplicitSurface{{ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 1, 0}),
                                          ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 0, 1})}};
-  Camera view;
-  view.eye = {3, 3, 6};
-  view.target = {0, 0.5f, 0.5f};
-  s.preferred_view = view;
+  s.preferred_view = look_at({3, 3, 6}, {0, 0.5f, 0.5f});
   return s;
 }
 
 Scene sphere_on_plane_scene() {
   Scene s;
   s.name = "sphere-on-plane";
-  Mesh ground;
-  ground.name = "plane";
-  add_ground_rect(ground, -20, -20, 20, 20);
-  s.meshes.push_back(std::move(ground));
+  s.meshes.push_back(open_ground());
   s.meshes.push_back(named(make_sphere({0, 1, 0}, 1.0f, 96, 48), "sphere"));
   // The tessellated sphere lies inside the analytic one by at most its sagitta, 1 - cos(pi/96) ~ 5e-4
   // units, far below the depth-test bias at any distance the view shows.
   s.analytic.implicit = ImplicitSurface{{ImplicitSurfacePrimitive::half_space({0, 0, 0}, {0, 1, 0}),
                                          ImplicitSurfacePrimitive::sphere_exterior({0, 1, 0}, 1.0f)}};
-  Camera view;
-  view.eye = {0, 3, 6};
-  view.target = {0, 0.6f, 0};
-  s.preferred_view = view;
+  s.preferred_view = look_at({0, 3, 6}, {0, 0.6f, 0});
   return s;
 }
 
@@ -168,11 +168,7 @@ Scene box_room_scene() {
   s.meshes.push_back(named(make_box({-2, 0, -2.5f}, {2, 3, 2.5f}, {0.8f, 0.8f, 0.8f}, 0.0f, true), "room"));
   s.meshes.push_back(named(make_box({-1.2f, 0, -1.6f}, {-0.2f, 1.0f, -0.6f}, {0.8f, 0.5f, 0.3f}, 20.0f), "box"));
   s.meshes.push_back(named(make_sphere({0.9f, 0.6f, -0.8f}, 0.6f), "sphere"));
-  Camera view;
-  view.eye = {1.7f, 2.4f, 2.2f};
-  view.target = {-0.6f, 0.4f, -1.5f};
-  view.vertical_fov_deg = 70.0f;
-  s.preferred_view = view;
+  s.preferred_view = look_at({1.7f, 2.4f, 2.2f}, {-0.6f, 0.4f, -1.5f}, 70.0f);
   return s;
 }
 
@@ -235,11 +231,8 @@ Scene displaced_scene() {
   // does not know about (VAO fig. 12: "the z-buffer-based classification handles other objects' occlusions").
   s.meshes.push_back(named(make_sphere({-1.3f, 0.8f, 0.3f}, 0.8f, 64, 32, {0.35f, 0.55f, 0.80f}), "sphere"));
   s.meshes.push_back(named(make_box({0.5f, 0.0f, -1.7f}, {1.9f, 1.1f, -0.5f}, {0.80f, 0.45f, 0.30f}, 25.0f), "box"));
-  Camera view;
-  view.eye = {3.0f, 3.0f, 5.2f};  // low enough that the domes hide parts of each other
-  view.target = {0.0f, 0.2f, -0.6f};
-  view.vertical_fov_deg = 45.0f;
-  s.preferred_view = view;
+  // The eye low enough that the domes hide parts of each other.
+  s.preferred_view = look_at({3.0f, 3.0f, 5.2f}, {0.0f, 0.2f, -0.6f}, 45.0f);
   return s;
 }
 

@@ -6,19 +6,14 @@
 
 #include <cstdint>
 
+#include "ao/simd/depth_internal.h"
+
 namespace ao::simd {
 
-/// What the estimator reads: the G-buffer's depth plane, normals and ids, its constants and the
-/// sample pattern.
-struct AlchemyInputs {
-  const float* depth = nullptr;             ///< width * height linear depths, +infinity on background.
-  const float* normal = nullptr;            ///< width * height unit normals, xyz triples, camera space.
-  const std::uint32_t* object_id = nullptr; ///< width * height; 0: uncovered.
-  int width = 0, height = 0;
-  /// Camera rays through pixel centres: ray(x, y) = (ray_ax (x + 1/2) + ray_bx, ray_ay (y + 1/2) + ray_by, -1).
-  float ray_ax = 0, ray_bx = 0, ray_ay = 0, ray_by = 0;
+/// What the estimator reads: the G-buffer's depth plane, normals and ids (DepthView), its constants
+/// and the sample pattern.
+struct AlchemyInputs : DepthView {
   float radius = 1;       ///< r of eq. 9-10, world units.
-  float px_per_unit = 1;  ///< Pixels per unit of x/(-z) on both axes.
   float max_pixel_radius = 16384;  ///< Cap on the disk's screen radius, pixels.
   float epsilon = 0;      ///< epsilon of eq. 10, world units squared.
   float beta = 0;         ///< beta of eq. 10 (multiplies z_C).

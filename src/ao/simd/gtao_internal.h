@@ -7,19 +7,14 @@
 
 #include <cstdint>
 
+#include "ao/simd/depth_internal.h"
+
 namespace ao::simd {
 
-/// What GTAO's kernel reads: the G-buffer's depth plane, normals and ids, and the tables of the 4x4
-/// pattern (entry (y % 4) * 4 + x % 4 of each).
-struct GtaoInputs {
-  const float* depth = nullptr;            ///< width * height linear depths, +infinity on background.
-  const float* normal = nullptr;           ///< width * height unit normals, xyz triples, camera space.
-  const std::uint32_t* object_id = nullptr;///< width * height; 0: uncovered.
-  int width = 0, height = 0;
-  /// Camera rays through pixel centres: ray(x, y) = (ray_ax (x + 1/2) + ray_bx, ray_ay (y + 1/2) + ray_by, -1).
-  float ray_ax = 0, ray_bx = 0, ray_ay = 0, ray_by = 0;
-  float radius = 1;                         ///< R, world units.
-  float px_per_unit = 1;                    ///< Pixels per unit of x/(-z) on both axes.
+/// What GTAO's kernel reads: the G-buffer's depth plane, normals and ids (DepthView), and the
+/// tables of the 4x4 pattern (entry (y % 4) * 4 + x % 4 of each).
+struct GtaoInputs : DepthView {
+  float radius = 1;  ///< R, world units.
   int slices = 1, steps = 1;
   const float* dir_c = nullptr;             ///< slices x 16: cos phi of slice k for pattern entry p, [k * 16 + p].
   const float* dir_s = nullptr;             ///< slices x 16: sin phi (screen y down).

@@ -16,13 +16,22 @@ namespace ao::cli {
 
 namespace {
 
+/// A baker's default of a parameter the command line gives by name, as the baker's table names it.
+template <class T>
+std::string default_name(const ParamTable<T>& table, const char* key) {
+  return table.to_json(T{}).at(key).template get<std::string>();
+}
+
 struct BakeOptions {
   BakeRequest request;  ///< Filled directly where the types allow.
-  std::string method = "raytraced";
+  std::string method{to_string(BakeRequest{}.method)};
   std::string size = "1024";
   std::vector<std::string> groups;  ///< "a,b,c" each.
-  std::string direction_set = "fibonacci", normalization = "area", normal = "shading", membership = "step";
-  std::uint32_t seed = 1;
+  std::string direction_set = default_name(histogram_param_table(), "direction_set");
+  std::string normalization = default_name(histogram_param_table(), "normalization");
+  std::string normal = default_name(raytraced_bake_param_table(), "normal");
+  std::string membership = default_name(raytraced_bake_param_table(), "membership");
+  std::uint32_t seed = RaytracedBakeParams{}.seed;  ///< Both bakers' (the same default).
   bool json = false;
   // Options given that only one baker reads, by name ("--directions", ...).
   std::vector<std::string> histogram_only, raytraced_only;

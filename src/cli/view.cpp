@@ -15,7 +15,7 @@ namespace {
 
 struct ViewOptions {
   std::vector<std::string> scene;
-  std::string method = "containment";
+  std::string method = view::ViewSetup{}.method;
   CameraOptions camera{.request = {.default_width = 960, .default_height = 540}};
   FalloffOptions falloff;
   std::uint32_t seed = 1;

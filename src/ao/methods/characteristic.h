@@ -85,8 +85,10 @@ struct DepthBufferCharacteristic {
   const float* second = nullptr;
   float separation = 0;  ///< The second layer's minimum separation, world units.
 
-  explicit DepthBufferCharacteristic(const GBuffer& g)
-      : projection(ScreenProjection::from_camera(g.camera)), plane(std::make_shared<const Image<float>>(depth_plane(g))), depth(plane->data()) {}
+  explicit DepthBufferCharacteristic(const GBuffer& g) : DepthBufferCharacteristic(g, std::make_shared<const Image<float>>(depth_plane(g))) {}
+  /// On a depth plane built already (`built`: depth_plane(g)), e.g. one a caller keeps between frames.
+  DepthBufferCharacteristic(const GBuffer& g, std::shared_ptr<const Image<float>> built)
+      : projection(ScreenProjection::from_camera(g.camera)), plane(std::move(built)), depth(plane->data()) {}
   /// With a second layer (`layer`: the G-buffer's size, rendered at `separation`).
   DepthBufferCharacteristic(const GBuffer& g, std::shared_ptr<const Image<float>> layer, float layer_separation)
       : DepthBufferCharacteristic(g) {

@@ -32,11 +32,21 @@ inline simd::DepthPlane simd_depth_plane(const DepthBufferCharacteristic& ch, co
 
 /// The depth characteristic of `g` with the layers `d` asks for: its second layer (not copied: `g`
 /// must outlive the result) when d.layers = 2, InputError when `g` has none at the separation in effect.
-inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const DepthLayers& d, float radius, const std::string& method) {
-  if (d.layers < 2) return DepthBufferCharacteristic(g);
-  const float separation = effective_separation(d, radius);
-  if (!has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
-  return DepthBufferCharacteristic(g, std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth), separation);
+/// `built`: g's depth plane built already (depth_plane(g)), or null to build it.
+inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const DepthLayers& d, float radius, const std::string& method,
+                                                      std::shared_ptr<const Image<float>> built = nullptr) {
+  float separation = 0;
+  if (d.layers == 2) {
+    separation = effective_separation(d, radius);
+    if (!has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
+  }
+  DepthBufferCharacteristic ch = built ? DepthBufferCharacteristic(g, std::move(built)) : DepthBufferCharacteristic(g);
+  if (d.layers == 2) {
+    ch.second_plane = std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth);
+    ch.second = ch.second_plane->data();
+    ch.separation = separation;
+  }
+  return ch;
 }
 
 /// InputError unless `ch` can give what `d` asks for: two layers are the depth buffer's, with its

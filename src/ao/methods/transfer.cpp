@@ -297,14 +297,25 @@ const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, con
     thread_local simd::CoveredPixels row;  // its arrays kept between tiles: one allocation per thread, not 17 per tile
     for (int y = t.y0; y < t.y1; ++y) {
       const std::size_t base = static_cast<std::size_t>(y) * w;
-      // Uncovered pixels: W = O = 1. Writing the final images, only those (raw.g, raw.b unused).
-      const std::size_t first = base + t.x0, end = base + t.x1;
-      if (raw.final_rgb) {
-        std::fill(raw.final_rgb + first, raw.final_rgb + end, Vec3{1, 1, 1});
-        std::fill(raw.r + first, raw.r + end, luminance(Vec3{1, 1, 1}));
-        std::fill(raw.o + first, raw.o + end, 1.0f);
-      } else {
-        for (float* plane : {raw.r, raw.g, raw.b, raw.o}) std::fill(plane + first, plane + end, 1.0f);
+      // Uncovered pixels, runs of id 0: W = O = 1 (the kernel writes every covered pixel). Writing
+      // the final images, only those (raw.g, raw.b unused).
+      const std::uint32_t* id = g.object_id.data() + base;
+      for (int x = t.x0; x < t.x1;) {
+        if (id[x] != 0) {
+          ++x;
+          continue;
+        }
+        int e = x + 1;
+        while (e < t.x1 && id[e] == 0) ++e;
+        const std::size_t first = base + x, end = base + e;
+        if (raw.final_rgb) {
+          std::fill(raw.final_rgb + first, raw.final_rgb + end, Vec3{1, 1, 1});
+          std::fill(raw.r + first, raw.r + end, luminance(Vec3{1, 1, 1}));
+          std::fill(raw.o + first, raw.o + end, 1.0f);
+        } else {
+          for (float* plane : {raw.r, raw.g, raw.b, raw.o}) std::fill(plane + first, plane + end, 1.0f);
+        }
+        x = e;
       }
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rotations, params.bias, true);
       const simd::TransferOutputs o{raw.r, raw.g, raw.b, raw.o, raw.final_rgb};
@@ -333,7 +344,9 @@ TransferImage transfer_ao(const GBuffer& g, const Falloff& falloff, const Transf
 
 const TransferImage& transfer_ao(TransferBuffers& buffers, const GBuffer& g, const Falloff& falloff, const TransferParams& params,
                                  std::uint32_t seed) {
-  return transfer_ao(buffers, g, depth_characteristic(g, params.layers, falloff.radius, "transfer"), g.albedo, falloff, params, seed);
+  depth_plane(g, *buffers.depth);  // in the buffers' own pages: no fresh 4 bytes a pixel to fault in each frame
+  return transfer_ao(buffers, g, depth_characteristic(g, params.layers, falloff.radius, "transfer", buffers.depth), g.albedo, falloff, params,
+                     seed);
 }
 
 #define AO_INSTANTIATE_TRANSFER(Characteristic)                                                                                       \

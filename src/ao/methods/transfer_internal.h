@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 
 #include "ao/methods/transfer.h"
 
@@ -16,6 +17,7 @@ struct TransferBuffers {
   TransferImage result;
   std::array<Image<float>, 6> scratch;  ///< Unfiltered W (R, G, B) and O, filtered G and B.
   Image<std::uint32_t> depth_and_palette;  ///< The depth with an albedo index in its low bits (transfer.cpp).
+  std::shared_ptr<Image<float>> depth = std::make_shared<Image<float>>();  ///< The G-buffer's depth plane, rebuilt in place.
 };
 
 /// The same into `buffers` (returns buffers.result), allocating only when the size changes.

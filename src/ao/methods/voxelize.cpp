@@ -193,10 +193,16 @@ bool finish_visible(GridTri& t, int nx, int ny) {
   const float ymin = std::min({t.y[0], t.y[1], t.y[2]}), ymax = std::max({t.y[0], t.y[1], t.y[2]});
   // Column i's centre is i + 0.5: the box covers i in [ceil(min - 0.5), floor(max - 0.5)].
   if (!(xmax >= 0.5f && xmin <= static_cast<float>(nx) - 0.5f)) return false;  // also rejects NaN
-  const float j0 = std::ceil(ymin - 0.5f), j1 = std::floor(ymax - 0.5f);
-  if (j1 < 0 || j0 > static_cast<float>(ny - 1) || j0 > j1) return false;
-  t.j0 = static_cast<int>(std::max(j0, 0.0f));
-  t.j1 = static_cast<int>(std::min(j1, static_cast<float>(ny - 1)));
+  if (!(ymax >= ymin)) return false;                                           // NaN
+  // Rows: the rounding of the ends clamped to [-2, ny + 1] first, where truncation does it (a
+  // baseline x86-64 build has no rounding instruction, and this runs once per triangle); ends
+  // beyond that range are rejected or clamped to the grid alike.
+  const float lo = std::clamp(ymin - 0.5f, -2.0f, static_cast<float>(ny + 1)), hi = std::clamp(ymax - 0.5f, -2.0f, static_cast<float>(ny + 1));
+  const int tl = static_cast<int>(lo), th = static_cast<int>(hi);
+  const int j0 = tl + (static_cast<float>(tl) < lo ? 1 : 0), j1 = th - (static_cast<float>(th) > hi ? 1 : 0);  // ceil, floor
+  if (j1 < 0 || j0 > ny - 1 || j0 > j1) return false;
+  t.j0 = std::max(j0, 0);
+  t.j1 = std::min(j1, ny - 1);
   return true;
 }
 

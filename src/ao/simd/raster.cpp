@@ -74,6 +74,10 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
   const double x0 = t.x[0], y0 = t.y[0];
   const double area2 = (double(t.x[1]) - x0) * (double(t.y[2]) - y0) - (double(t.x[2]) - x0) * (double(t.y[1]) - y0);
   if (area2 == 0) return 0;  // edge-on: no column centre lies inside
+  const float xmin = std::min({t.x[0], t.x[1], t.x[2]}), xmax = std::max({t.x[0], t.x[1], t.x[2]});
+  const int i0 = std::max(0, static_cast<int>(std::ceil(xmin - 0.5f)));
+  const int i1 = std::min(g.nx - 1, static_cast<int>(std::floor(xmax - 0.5f)));
+  if (i0 > i1 || r0 > r1) return 0;  // no column centre in the box (a small triangle between centres)
   Edge e[3] = {{t.x[0], t.y[0], t.x[1], t.y[1]}, {t.x[1], t.y[1], t.x[2], t.y[2]}, {t.x[2], t.y[2], t.x[0], t.y[0]}};
   if (area2 < 0)
     for (Edge& ed : e) ed.negate();  // back faces count as much as front faces (sec. III-B)
@@ -81,14 +85,13 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
   const double da1 = double(t.a[1]) - t.a[0], da2 = double(t.a[2]) - t.a[0];
   const double dadx = (da1 * (double(t.y[2]) - y0) - da2 * (double(t.y[1]) - y0)) / area2;
   const double dady = (da2 * (double(t.x[1]) - x0) - da1 * (double(t.x[2]) - x0)) / area2;
-  const float xmin = std::min({t.x[0], t.x[1], t.x[2]}), xmax = std::max({t.x[0], t.x[1], t.x[2]});
-  const int i0 = std::max(0, static_cast<int>(std::ceil(xmin - 0.5f)));
-  const int i1 = std::min(g.nx - 1, static_cast<int>(std::floor(xmax - 0.5f)));
   const int nbits = g.depth_bits, words = g.words;
-  const double inv_a[3] = {1.0 / e[0].A, 1.0 / e[1].A, 1.0 / e[2].A};
   // A box a few columns wide has no centres to spare worth the spans' arithmetic (most triangles
   // of a detailed mesh at 512 columns).
   const bool narrow = i1 - i0 >= kNarrowColumns;
+  double inv_a[3] = {0, 0, 0};
+  if (narrow)
+    for (int k = 0; k < 3; ++k) inv_a[k] = 1.0 / e[k].A;
   std::size_t fragments = 0;
   for (int j = r0; j <= r1; ++j) {
     const double yc = j + 0.5;

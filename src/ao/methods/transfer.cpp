@@ -248,13 +248,10 @@ void finish_transfer(TransferBuffers& buffers, const RawPlanes& raw, const GBuff
   }
   const int w = g.width();
   parallel_for_tiles(w, g.height(), kTileWidth, [&](const Tile& t) {
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        const Vec3 c{fr[i], fg[i], fb[i]};
-        out.transfer[i] = c;
-        out.luminance[i] = luminance(c);
-      }
+    for (int y = t.y0; y < t.y1; ++y) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + t.x0;
+      simd::interleave_transfer(fr + i, fg + i, fb + i, static_cast<std::size_t>(t.x1 - t.x0), out.transfer.data() + i, out.luminance.data() + i);
+    }
   });
 }
 

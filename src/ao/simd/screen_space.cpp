@@ -466,6 +466,25 @@ void SumFreePipes(const CoveredPixels& row, const DepthPlane& plane, float half_
     SumFreePipesImpl<false>(row, plane, half_radius, disk, far_limit, free);
 }
 
+void InterleaveTransfer(const float* r, const float* g, const float* b, std::size_t n, Vec3* rgb, float* lum) {
+  const DF d;
+  const std::size_t lanes = hn::Lanes(d);
+  const VF kr = hn::Set(d, 0.2126f), kg = hn::Set(d, 0.7152f), kb = hn::Set(d, 0.0722f);
+  float* out = &rgb->x;  // Vec3 is three packed floats
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes) {
+    const VF vr = hn::LoadU(d, r + k), vg = hn::LoadU(d, g + k), vb = hn::LoadU(d, b + k);
+    hn::StoreInterleaved3(vr, vg, vb, d, out + 3 * k);
+    // luminance()'s products and sums in its order: the same bits as the scalar tail.
+    hn::StoreU(hn::Add(hn::Add(hn::Mul(kr, vr), hn::Mul(kg, vg)), hn::Mul(kb, vb)), d, lum + k);
+  }
+  for (; k < n; ++k) {
+    const float vr = r[k], vg = g[k], vb = b[k];
+    rgb[k] = Vec3{vr, vg, vb};
+    lum[k] = luminance(vr, vg, vb);
+  }
+}
+
 }  // namespace ao::simd::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -473,6 +492,7 @@ HWY_AFTER_NAMESPACE();
 namespace ao::simd {
 
 HWY_EXPORT(LoadCoveredPixels);
+HWY_EXPORT(InterleaveTransfer);
 HWY_EXPORT(CountOpenRays);
 HWY_EXPORT(SumFreePipes);
 HWY_EXPORT(TransferRays);
@@ -494,6 +514,10 @@ void sum_free_pipes(const CoveredPixels& row, const DepthPlane& plane, float hal
 void transfer_rays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& samples, int m, float far_limit,
                    const TransferInputs& in, std::size_t row_base, const TransferOutputs& out) {
   HWY_DYNAMIC_DISPATCH(TransferRays)(row, plane, samples, m, far_limit, in, row_base, out);
+}
+
+void interleave_transfer(const float* r, const float* g, const float* b, std::size_t n, Vec3* rgb, float* lum) {
+  HWY_DYNAMIC_DISPATCH(InterleaveTransfer)(r, g, b, n, rgb, lum);
 }
 
 }  // namespace ao::simd

@@ -107,4 +107,8 @@ struct TransferOutputs {
 void transfer_rays(const CoveredPixels& row, const DepthPlane& plane, const TestPoints& samples, int m, float far_limit,
                    const TransferInputs& in, std::size_t row_base, const TransferOutputs& out);
 
+/// Transfer's last pass over filtered planes: rgb[k] = (r[k], g[k], b[k]) (W interleaved) and lum[k]
+/// its Rec. 709 luminance for k < n. `lum` may be `r` (each value is read before it is written).
+void interleave_transfer(const float* r, const float* g, const float* b, std::size_t n, Vec3* rgb, float* lum);
+
 }  // namespace ao::simd

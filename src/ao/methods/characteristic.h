@@ -92,6 +92,10 @@ struct DepthBufferCharacteristic {
   /// With a second layer (`layer`: the G-buffer's size, rendered at `separation`).
   DepthBufferCharacteristic(const GBuffer& g, std::shared_ptr<const Image<float>> layer, float layer_separation)
       : DepthBufferCharacteristic(g) {
+    add_second_layer(std::move(layer), layer_separation);
+  }
+  /// Reads `layer` (the G-buffer's size, rendered at `layer_separation`) as the second layer too.
+  void add_second_layer(std::shared_ptr<const Image<float>> layer, float layer_separation) {
     second_plane = std::move(layer);
     second = second_plane->data();
     separation = layer_separation;

@@ -41,11 +41,7 @@ inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const De
     if (!has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
   }
   DepthBufferCharacteristic ch = built ? DepthBufferCharacteristic(g, std::move(built)) : DepthBufferCharacteristic(g);
-  if (d.layers == 2) {
-    ch.second_plane = std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth);
-    ch.second = ch.second_plane->data();
-    ch.separation = separation;
-  }
+  if (d.layers == 2) ch.add_second_layer(std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth), separation);
   return ch;
 }
 

@@ -20,6 +20,7 @@
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/bilateral.h"
 #include "ao/methods/interleave.h"
+#include "ao/reference/raytraced.h"
 #include "ao/registry/registry.h"
 #include "ao/scene/procedural.h"
 #include "ao/simd/target.h"
@@ -179,7 +180,9 @@ TEST(SimdTargets, FiltersAgreeBetweenTargets) {
 
 // The G-buffer's and the outside-in baker's kernels are scalar code compiled once per target
 // without contraction (ao/simd/gbuffer.cpp, histogram.cpp): every target gives the same bits.
-TEST(SimdTargets, GBufferAndHistogramBakeAreTheSameBitsOnEveryTarget) {
+// The G-buffer's rays, the reference's directions (no fused multiply-add in either) and the
+// histogram bake's integer counts: the same bits on every target, with or without FMA.
+TEST(SimdTargets, GBufferReferenceAndHistogramBakeAreTheSameBitsOnEveryTarget) {
   const TargetGuard guard;
   Scene scene = make_builtin_scene("default");
   // Planar UVs from x and z over the scene's box (overlapping charts: the baker only warns).
@@ -198,6 +201,8 @@ TEST(SimdTargets, GBufferAndHistogramBakeAreTheSameBitsOnEveryTarget) {
   set_simd_target(targets.front());
   const GBuffer best = render_gbuffer(rays, c);
   const BakeResult best_bake = bake_histogram(scene, coverage, {.directions = 24});
+  const Falloff falloff{Membership::Step, 0.1f * length(size)};
+  const RaytracedImage best_reference = render_raytraced(rays, best, falloff, {.samples = 24}, 7);
   ASSERT_GT(best_bake.fragments, 1000u) << "the bake sees the scene";
   ASSERT_GT(std::count(best.object_id.data(), best.object_id.data() + best.object_id.size(), 0u), 0) << "background too";
   for (std::size_t k = 1; k < targets.size(); ++k) {
@@ -206,6 +211,9 @@ TEST(SimdTargets, GBufferAndHistogramBakeAreTheSameBitsOnEveryTarget) {
     EXPECT_TRUE(same(g.position, best.position) && same(g.normal, best.normal) && same(g.albedo, best.albedo) && same(g.uv, best.uv) &&
                 same(g.object_id, best.object_id) && same(g.primitive_id, best.primitive_id))
         << "G-buffer on " << targets[k];
+    const RaytracedImage reference = render_raytraced(rays, best, falloff, {.samples = 24}, 7);
+    EXPECT_TRUE(same(reference.visibility, best_reference.visibility) && same(reference.std_error, best_reference.std_error))
+        << "reference on " << targets[k];
     EXPECT_TRUE(same(bake_histogram(scene, coverage, {.directions = 24}).visibility, best_bake.visibility)) << "histogram bake on " << targets[k];
   }
 }

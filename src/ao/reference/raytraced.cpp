@@ -10,6 +10,7 @@
 #include "ao/reference/gbuffer_rays_internal.h"
 #include "ao/reference/pixel_loop_internal.h"
 #include "ao/reference/ray_offset.h"
+#include "ao/simd/sampling_internal.h"
 
 namespace ao {
 
@@ -91,34 +92,17 @@ PointSetup setup_point(Vec3 p, Vec3 n, Vec3 ng, float offset, std::uint32_t key)
 
 using detail::MeanAccumulator;
 
-// Directions of samples [first, first + N) of point `s` into the packet, with valid[k] = -1 for
-// the lanes to trace: inside the sample count and above the geometric tangent plane. A direction
-// below it (possible about a shading normal) enters the surface at once: occluded, mu = 0,
-// counted without a ray. Branch-free so the compiler vectorises it across lanes.
+// Directions of samples [first, first + N) of point `s` into the packet (the kernel layer's
+// cosine_directions), with valid[k] = -1 for the lanes to trace: inside the sample count and above
+// the geometric tangent plane. A direction below it (possible about a shading normal) enters the
+// surface at once: occluded, mu = 0, counted without a ray.
 template <int N>
-int fill_directions(const SampleTable& tbl, const PointSetup& s, int first, int end, float* __restrict dir_x, float* __restrict dir_y,
-                    float* __restrict dir_z, int* __restrict valid) {
-  const float* __restrict u0 = tbl.u0.data() + first;
-  const float* __restrict cp = tbl.cos_phi.data() + first;
-  const float* __restrict sp = tbl.sin_phi.data() + first;
-  int live = 0;
-  for (int k = 0; k < N; ++k) {
-    float u = u0[k] + s.shift;
-    u = u >= 1.0f ? u - 1.0f : u;
-    const float r = std::sqrt(u), z = std::sqrt(std::max(0.0f, 1.0f - u));
-    const float x = r * cp[k], y = r * sp[k];
-    const float dx = s.t.x * x + s.b.x * y + s.n.x * z;
-    const float dy = s.t.y * x + s.b.y * y + s.n.y * z;
-    const float dz = s.t.z * x + s.b.z * y + s.n.z * z;
-    dir_x[k] = dx;
-    dir_y[k] = dy;
-    dir_z[k] = dz;
-    const bool above = dx * s.ng.x + dy * s.ng.y + dz * s.ng.z > 0.0f;
-    const bool on = first + k < end && above;
-    valid[k] = on ? -1 : 0;
-    live += on;
-  }
-  return live;
+int fill_directions(const SampleTable& tbl, const PointSetup& s, int first, int end, float* dir_x, float* dir_y, float* dir_z, int* valid) {
+  const auto at = static_cast<std::size_t>(first);
+  const simd::CosineSamples samples{tbl.u0.data() + at,     tbl.cos_phi.data() + at, tbl.sin_phi.data() + at,
+                                    {s.t.x, s.t.y, s.t.z}, {s.b.x, s.b.y, s.b.z},   {s.n.x, s.n.y, s.n.z},
+                                    {s.ng.x, s.ng.y, s.ng.z}, s.shift};
+  return simd::cosine_directions(samples, N, end - first, dir_x, dir_y, dir_z, valid);
 }
 
 // Traces samples [first, end) of one point, at most N, and adds their mu to acc.

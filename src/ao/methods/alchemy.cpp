@@ -112,7 +112,8 @@ AlchemyImage render_alchemy(const GBuffer& g, const Image<float>* second_layer, 
   const AlchemyConstants k = alchemy_constants(params, default_radius);
   if (params.layers.layers == 2 && !second_layer) throw_missing_second_layer("alchemy", effective_separation(params.layers, k.radius));
   const int w = g.width(), h = g.height(), s = params.samples;
-  AlchemyImage out{Image<float>(w, h, 1.0f)};
+  AlchemyImage out;
+  out.visibility.resize(w, h);  // every pixel written by alchemy_row (1 where not covered), in parallel
   const auto t0 = std::chrono::steady_clock::now();
 
   // Screen radius of the world disk: both image axes have 0.5 * height / tan(fov/2) pixels per unit

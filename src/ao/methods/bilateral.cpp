@@ -81,7 +81,8 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
   const float t = g.camera.tan_half_fov(), aspect = g.camera.aspect();
   const Rays rays{2.0f * t * aspect / static_cast<float>(w), -t * aspect, -2.0f * t / static_cast<float>(h), t};
 
-  Image<float> tmp(w, h);
+  Image<float> tmp;
+  tmp.resize(w, h);  // every pixel written by the horizontal pass, in parallel
   // Horizontal pass: each row segment's depths and values are copied with `half` pixels of margin
   // on both sides (depth +inf beyond the image), so every tap is a plain shifted load.
   tbb::parallel_for(

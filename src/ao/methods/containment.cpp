@@ -89,11 +89,15 @@ Image<float> containment_ao(const GBuffer& g, const Characteristic& ch, const Fa
   const int m = params.ray_steps;
   const simd::Rotations16 rot = simd_rotations(rotations);
   check_layers(ch, params.layers, falloff.radius, "containment");
-  Image<float> v(w, h, 1.0f);
+  // V = 1 where nothing is covered: each tile fills its own rows, so the image's fresh pages are
+  // first touched in parallel.
+  Image<float> v;
+  v.resize(w, h);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& t) {
     simd::CoveredPixels row;
     simd::AlignedVector<float> open(static_cast<std::size_t>(simd::padded(t.x1 - t.x0)));
     for (int y = t.y0; y < t.y1; ++y) {
+      std::fill_n(&v(t.x0, y), t.x1 - t.x0, 1.0f);
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rot, params.bias, true);
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>)
         simd::count_open_rays(row, simd_depth_plane(ch, params.layers), simd_points(s), m, far_limit, open.data());

@@ -123,9 +123,14 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   static_assert(sizeof(tables.dir_c) == sizeof(float) * kMaxSlices * 16 && sizeof(tables.step_t) == sizeof(float) * kMaxSteps * 16);
   in.dir_c = tables.dir_c[0].data(), in.dir_s = tables.dir_s[0].data(), in.step_t = tables.step_t[0].data();
 
-  Image<float> v(w, h, 1.0f);
+  // V = 1 where nothing is covered: each tile fills its own rows (fresh pages touched in parallel).
+  Image<float> v;
+  v.resize(w, h);
   parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& tile) {
-    for (int y = tile.y0; y < tile.y1; ++y) simd::gtao_row(in, y, tile.x0, tile.x1, &v(tile.x0, y));
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      std::fill_n(&v(tile.x0, y), tile.x1 - tile.x0, 1.0f);
+      simd::gtao_row(in, y, tile.x0, tile.x1, &v(tile.x0, y));
+    }
   });
   if (params.interleave.interleave && params.interleave.filter) v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius), &depth_image);
   GtaoImage out;

@@ -40,7 +40,8 @@ void check_size(const GBuffer& g, int w, int h) {
 
 Image<float> depth_aware_box_filter(const Image<float>& image, const GBuffer& g, float depth_limit, const Image<float>* depth) {
   check_size(g, image.width(), image.height());
-  Image<float> out(image.width(), image.height());
+  Image<float> out;
+  out.resize(image.width(), image.height());  // every pixel written by the filter's rows, in parallel
   const float* src[] = {image.data()};
   float* dst[] = {out.data()};
   box_filter(src, dst, 1, g, depth_limit, depth);
@@ -51,7 +52,8 @@ Image<Vec3> depth_aware_box_filter(const Image<Vec3>& image, const GBuffer& g, f
   check_size(g, image.width(), image.height());
   // Interleaved RGB lanes directly (3 lanes per pixel, one depth test per lane), no planar copies.
   static_assert(sizeof(Vec3) == 3 * sizeof(float));
-  Image<Vec3> out(image.width(), image.height());
+  Image<Vec3> out;
+  out.resize(image.width(), image.height());
   const float* src[] = {&image.data()->x};
   float* dst[] = {&out.data()->x};
   box_filter(src, dst, 3, g, depth_limit, depth);
@@ -74,7 +76,7 @@ void depth_aware_box_filter_planes(std::span<Image<float>* const> planes, const 
     std::array<const float*, 4> src{};
     std::array<float*, 4> dst{};
     for (std::size_t c = 0; c < k; ++c) {
-      out[c] = Image<float>(g.width(), g.height());
+      out[c].resize(g.width(), g.height());
       src[c] = planes[done + c]->data(), dst[c] = out[c].data();
     }
     depth_aware_box_filter_planes(std::span(src.data(), k), std::span(dst.data(), k), g, depth_limit, depth);

@@ -89,11 +89,15 @@ Image<float> volumetric_ao(const GBuffer& g, const Characteristic& ch, float rad
   const float far_limit = params.silhouette_elimination ? -R : -kInfinity;
   const simd::Rotations16 rot = simd_rotations(rotations);
   check_layers(ch, params.layers, radius, "volumetric");
-  Image<float> v(w, h, 1.0f);
+  // V = 1 where nothing is covered: each tile fills its own rows, so the image's fresh pages are
+  // first touched in parallel.
+  Image<float> v;
+  v.resize(w, h);
   parallel_for_tiles(w, h, kTile, [&](const Tile& t) {
     simd::CoveredPixels row;
     simd::AlignedVector<float> free_len(static_cast<std::size_t>(simd::padded(t.x1 - t.x0)));
     for (int y = t.y0; y < t.y1; ++y) {
+      std::fill_n(&v(t.x0, y), t.x1 - t.x0, 1.0f);
       simd::load_covered_pixels(row, g, y, t.x0, t.x1, rot, params.bias, false);  // no tangent frame: pipes run along the view axis
       if constexpr (std::is_same_v<Characteristic, DepthBufferCharacteristic>)
         simd::sum_free_pipes(row, simd_depth_plane(ch, params.layers), half_r, simd_points(s), far_limit, free_len.data());

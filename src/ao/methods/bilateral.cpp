@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "ao/core/error.h"
 #include "ao/core/math.h"
 #include "ao/core/parallel.h"
@@ -83,13 +85,15 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
 
   Image<float> tmp;
   tmp.resize(w, h);  // every pixel written by the horizontal pass, in parallel
+  // A row segment's centres, one set per thread for both passes (not allocated per tile).
+  tbb::enumerable_thread_specific<simd::BilateralCentres> centres;
   // Horizontal pass: each row segment's depths and values are copied with `half` pixels of margin
   // on both sides (depth +inf beyond the image), so every tap is a plain shifted load.
   tbb::parallel_for(
       tbb::blocked_range2d<int>(0, h, kTileHeight, 0, w, kTileWidth),
       [&](const tbb::blocked_range2d<int>& r) {
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
-        simd::BilateralCentres c;
+        simd::BilateralCentres& c = centres.local();
         alignas(64) std::array<float, kTileWidth + 2 * kMaxTaps> rx, rd, rv;
         for (int k = 0; k < n + 2 * half; ++k) rx[k] = rays.x(static_cast<float>(x0 - half + k) + 0.5f);
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
@@ -112,7 +116,7 @@ void filter(const GBuffer& g, const float* depth, Image<float>& values, const Bi
       tbb::blocked_range2d<int>(0, h, kTileHeight, 0, w, kTileWidth),
       [&](const tbb::blocked_range2d<int>& r) {
         const int x0 = r.cols().begin(), x1 = r.cols().end(), n = x1 - x0;
-        simd::BilateralCentres c;
+        simd::BilateralCentres& c = centres.local();
         for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
           load_centres(g, depth, rays, y, x0, x1, params.plane_sigma, true, c);
           std::array<const float*, kMaxTaps> tt, td, tv;

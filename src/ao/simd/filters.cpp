@@ -81,16 +81,21 @@ HWY_INLINE void box_block(const BoxFilterImage& im, const RgbSpread& rgb, const 
   for (int dy = dy_lo; dy <= dy_hi; ++dy) {
     const float* dn = im.depth + static_cast<std::size_t>(y + dy) * im.width + p;
     const std::size_t nrow = static_cast<std::size_t>(y + dy) * lanes + static_cast<std::size_t>(S) * p;
-    for (int dx = -2; dx <= 1; ++dx)
+    HWY_UNROLL(4)
+    for (int dx = -2; dx <= 1; ++dx) {
+      HWY_UNROLL(2)
       for (int u = 0; u < V; ++u) {
         const hn::Mask<DB> m = hn::Le(hn::Abs(hn::Sub(hn::LoadU(d, dn + dx + n * u), dc[u])), lim);
         count[u] = hn::Add(count[u], hn::IfThenElseZero(m, one));
         const std::array<VB, S> e = spread<S>(rgb, hn::VecFromMask(d, m));
+        HWY_UNROLL(4)
         for (int c = 0; c < N; ++c) {
           const float* v = im.src[c] + nrow + S * (dx + n * u);
+          HWY_UNROLL(3)
           for (int k = 0; k < S; ++k) sum[u][c * S + k] = hn::Add(sum[u][c * S + k], hn::And(e[static_cast<std::size_t>(k)], hn::LoadU(d, v + n * k)));
         }
       }
+    }
   }
   const std::size_t row = static_cast<std::size_t>(y) * lanes;
   for (int u = 0; u < V; ++u) {

@@ -8,8 +8,8 @@
 #include <tbb/global_control.h>
 
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/methods/alchemy.h"
-#include "ao/methods/bilateral.h"
+#include "ao/methods/alchemy/alchemy.h"
+#include "ao/methods/filters/bilateral.h"
 #include "ao/reference/ray_scene.h"
 #include "bench_scenes.h"
 

@@ -9,8 +9,8 @@
 
 #include "ao/eval/metrics.h"
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/methods/bilateral.h"
-#include "ao/methods/cone.h"
+#include "ao/methods/filters/bilateral.h"
+#include "ao/methods/cone/cone.h"
 #include "ao/reference/raytraced.h"
 #include "bench_scenes.h"
 #include "support/open_sheets.h"

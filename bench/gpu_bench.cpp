@@ -18,8 +18,8 @@
 #include <string>
 
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/gpu/methods.h"
-#include "ao/gpu/voxelize.h"
+#include "ao/registry/methods_gpu.h"
+#include "ao/methods/cone/voxelize_gpu.h"
 #include "ao/registry/registry.h"
 #include "bench_scenes.h"
 
@@ -81,12 +81,12 @@ void pixels_rate(benchmark::State& state) {
 void gpu_method(benchmark::State& state, const std::string& method) {
   Fixture& f = fixture(method);
   if (!f.device) return state.SkipWithError(f.error.c_str());
-  const nlohmann::json params = defaults(method);
+  const MethodParams params = find_method(method).decode(defaults(method));
   const GpuMethodInput in{*f.gpu_g, &*f.gpu_scene, {Membership::Step, f.radius}, 1};
   std::map<std::string, double> ms;
-  run_gpu_method(*f.device, method, in, params);  // compiles the shaders (llvmpipe: tens of ms), untimed
+  run_gpu_method(*f.device, in, params);  // compiles the shaders (llvmpipe: tens of ms), untimed
   for (auto _ : state) {
-    const GpuMethodOutput out = run_gpu_method(*f.device, method, in, params);
+    const GpuMethodOutput out = run_gpu_method(*f.device, in, params);
     for (const GpuPassTime& p : out.passes) ms[p.name] += p.ms;
     benchmark::DoNotOptimize(out.output.visibility.data());
   }
@@ -97,11 +97,10 @@ void gpu_method(benchmark::State& state, const std::string& method) {
 
 void cpu_method(benchmark::State& state, const std::string& method) {
   Fixture& f = fixture(method);
-  const MethodInfo& m = find_method(method);
-  const nlohmann::json params = defaults(method);
+  const MethodParams params = find_method(method).decode(defaults(method));
   MethodCache cache;  // cone keeps its grid, as the GPU does between calls
   for (auto _ : state) {
-    const MethodOutput out = m.run({f.g, &f.rays, {Membership::Step, f.radius}, 1, {}, nullptr, &cache}, params);
+    const MethodOutput out = run_method({f.g, &f.rays, {Membership::Step, f.radius}, 1, {}, nullptr, &cache}, params);
     benchmark::DoNotOptimize(out.visibility.data());
   }
   pixels_rate(state);

@@ -17,14 +17,16 @@
 
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/methods/characteristic.h"
-#include "ao/methods/containment.h"
-#include "ao/methods/gtao.h"
-#include "ao/methods/interleave.h"
+#include "ao/methods/containment/containment.h"
+#include "ao/methods/containment/containment_kernel_internal.h"
+#include "ao/methods/gtao/gtao.h"
+#include "ao/methods/filters/interleave.h"
 #include "ao/methods/screen_space_internal.h"
-#include "ao/methods/transfer.h"
-#include "ao/methods/transfer_internal.h"
-#include "ao/methods/volumetric.h"
+#include "ao/methods/transfer/transfer.h"
+#include "ao/methods/transfer/transfer_internal.h"
+#include "ao/methods/volumetric/volumetric.h"
 #include "ao/reference/direct_light.h"
+#include "ao/simd/depth_plane.h"
 #include "bench_scenes.h"
 
 namespace ao::bench {

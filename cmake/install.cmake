@@ -17,7 +17,7 @@ endif()
 # The GPU backend's shaders as readable files (docs/gpu.md), for engines that take one: the library
 # itself carries them embedded and never reads these.
 if(AO_GPU)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/ao/gpu/shaders/ DESTINATION ${CMAKE_INSTALL_DATADIR}/ao/shaders)
+  install(FILES ${AO_GPU_SHADERS} DESTINATION ${CMAKE_INSTALL_DATADIR}/ao/shaders)
 endif()
 # Apache-2.0 section 4: a redistribution carries the licence and the NOTICE file.
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/NOTICE DESTINATION ${CMAKE_INSTALL_DOCDIR})

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include <ao/core/gbuffer.h>
-#include <ao/methods/volumetric.h>
+#include <ao/methods/volumetric/volumetric.h>
 
 int main() {
   // 1. The camera the buffers were rendered with: its field of view and size (camera space looks down -z).

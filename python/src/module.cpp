@@ -13,6 +13,7 @@
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
 #include "ao/registry/registry.h"
+#include "ao/simd/depth_plane.h"
 #include "ao/version.h"
 #include "call.h"
 #include "convert.h"

@@ -10,8 +10,8 @@
 //   const ao::Scene scene = ao::load_scene_file("bunny.obj");
 //   const ao::RayScene rays(scene);
 //   const ao::GBuffer g = ao::render_gbuffer(rays, ao::frame_bounds(scene.bounds(), {0.55f, 0.5f, 1}, 40, 640, 360));
-//   const ao::MethodInfo& m = ao::find_method("volumetric");
-//   const ao::MethodOutput out = m.run({g, &rays, {ao::Membership::Step, 0.1f * scene.bounds().diagonal()}, 1}, m.default_params());
+//   const ao::MethodParams p = ao::find_method("volumetric").decode({{"samples", 16}});
+//   const ao::MethodOutput out = ao::run_method({g, &rays, {ao::Membership::Step, 0.1f * scene.bounds().diagonal()}, 1}, p);
 //   ao::write_image("ao.exr", out.visibility);
 #pragma once
 
@@ -33,6 +33,8 @@
 #include "ao/core/sampling.h"
 #include "ao/core/stopwatch.h"
 #include "ao/core/texture.h"
+#include "ao/core/typed_slots.h"
+#include "ao/simd/depth_plane.h"
 #include "ao/simd/target.h"  // which SIMD instruction set the kernels run with
 
 // scene: meshes, scenes, built-in and analytic scenes.
@@ -46,25 +48,27 @@
 #include "ao/reference/ray_offset.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
+#include "ao/reference/raytraced_method.h"
 #include "ao/reference/reference.h"
 #include "ao/reference/tangent_sphere.h"
 #include "ao/reference/transfer_reference.h"
 
 // methods: one paper per header, and the registry that runs any of them by name.
-#include "ao/methods/alchemy.h"
-#include "ao/methods/bilateral.h"
+#include "ao/methods/alchemy/alchemy.h"
+#include "ao/methods/filters/bilateral.h"
 #include "ao/methods/characteristic.h"
-#include "ao/methods/cone.h"
-#include "ao/methods/containment.h"
+#include "ao/methods/cone/cone.h"
+#include "ao/methods/containment/containment.h"
 #include "ao/methods/depth_layers.h"
-#include "ao/methods/gtao.h"
-#include "ao/methods/interleave.h"
+#include "ao/methods/gtao/gtao.h"
+#include "ao/methods/filters/interleave.h"
+#include "ao/methods/method.h"
 #include "ao/registry/registry.h"
 #include "ao/methods/samples.h"
-#include "ao/methods/transfer.h"
-#include "ao/methods/volumetric.h"
-#include "ao/methods/voxelize.h"
-#include "ao/methods/winding_number.h"
+#include "ao/methods/transfer/transfer.h"
+#include "ao/methods/volumetric/volumetric.h"
+#include "ao/methods/cone/voxelize.h"
+#include "ao/methods/cone/winding_number.h"
 
 // bake: AO maps (outside-in histogram, inside-out ray-traced), denoising, padding, per-vertex AO,
 // high to low, bake groups, UDIM tiles.
@@ -84,8 +88,8 @@
 // gpu: the methods as OpenGL compute shaders (docs/gpu.md); without AO_GPU, opening a device says so.
 #include "ao/gpu/device.h"
 #include "ao/gpu/gbuffer.h"
-#include "ao/gpu/methods.h"
-#include "ao/gpu/voxelize.h"
+#include "ao/registry/methods_gpu.h"
+#include "ao/methods/cone/voxelize_gpu.h"
 
 // eval: error metrics against a reference, display shading.
 #include "ao/eval/metrics.h"

@@ -219,8 +219,8 @@ class Viewer final : public ViewerControls {
   void run_method(StageTimes& times) {
     const Clock::time_point t = Clock::now();
     const MethodInfo& m = method();
-    const nlohmann::json params = state_.params();
-    result_ = m.ground_truth ? MethodOutput{} : frames_.run(m, params, state_.falloff, state_.seed);
+    const MethodParams params = m.decode(state_.params());
+    result_ = m.ground_truth ? MethodOutput{} : frames_.run(params, state_.falloff, state_.seed);
     times.method = ms_since(t);
     add_gpu_passes(frames_.gpu_passes());
     if (result_.stats.contains("filter_ms")) {
@@ -232,7 +232,7 @@ class Viewer final : public ViewerControls {
     if (s_.benchmark) {  // a moving camera: nothing to accumulate
       progressive_.stop();
     } else {
-      progressive_.restart({frames_.shared_gbuffer(), frames_.scene().rays.get(), m.reference(state_.falloff, params), state_.seed});
+      progressive_.restart({frames_.shared_gbuffer(), frames_.scene().rays.get(), matched_reference(state_.falloff, params), state_.seed});
     }
     error_.clear();
   }

@@ -19,6 +19,7 @@
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
 #include "ao/scene/procedural.h"
+#include "ao/simd/sampling_internal.h"
 
 namespace ao {
 namespace {

@@ -1,6 +1,7 @@
 // GBuffer's derived channels: linear depth is -position.z and coverage is object_id != 0, per
 // pixel and as the planes kernels and metrics read.
 #include "ao/core/gbuffer.h"
+#include "ao/simd/depth_plane.h"
 
 #include <gtest/gtest.h>
 

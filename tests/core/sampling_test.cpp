@@ -1,4 +1,5 @@
 #include "ao/core/sampling.h"
+#include "ao/simd/sampling_internal.h"
 
 #include <gtest/gtest.h>
 

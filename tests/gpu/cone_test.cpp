@@ -6,7 +6,7 @@
 #include <string>
 
 #include "ao/core/error.h"
-#include "ao/gpu/voxelize.h"
+#include "ao/methods/cone/voxelize_gpu.h"
 #include "ao/io/mesh_io.h"
 #include "gpu/gpu_support.h"
 

@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "ao/core/error.h"
-#include "ao/gpu/methods.h"
+#include "ao/registry/methods_gpu.h"
 #include "gpu/gpu_support.h"
 
 namespace ao {
@@ -57,10 +57,10 @@ TEST(GpuDevice, BorrowsTheCurrentContextAndComputesTheSame) {
   // gpu_device()'s context is current on this thread since it was last used: borrow it, as a
   // viewer lends its window's context.
   const MethodInput in{f.g, f.rays.get(), {Membership::Step, 1.0f}, 4};
-  const Image<float> own = run_gpu_method(gpu_device(), "volumetric", in, nlohmann::json::object()).output.visibility;
+  const Image<float> own = run_gpu_method(gpu_device(), in, find_method("volumetric").decode(nlohmann::json::object())).output.visibility;
   GpuDevice borrowed = GpuDevice::from_current_context(egl_loader);
   EXPECT_EQ(borrowed.renderer(), gpu_device().renderer());
-  const Image<float> lent = run_gpu_method(borrowed, "volumetric", in, nlohmann::json::object()).output.visibility;
+  const Image<float> lent = run_gpu_method(borrowed, in, find_method("volumetric").decode(nlohmann::json::object())).output.visibility;
   EXPECT_TRUE(std::equal(own.pixels().begin(), own.pixels().end(), lent.pixels().begin()));
 }
 
@@ -81,7 +81,7 @@ TEST(GpuDevice, AGBufferOfAnotherDeviceIsRefused) {
   const test::GpuFixture f = test::gpu_fixture("sphere-on-plane", 16, 16);
   const GpuGBuffer g = GpuGBuffer::upload(gpu_device(), f.g);
   GpuDevice other = GpuDevice::from_current_context(egl_loader);
-  EXPECT_THROW(run_gpu_method(other, "gtao", GpuMethodInput{g, nullptr, {Membership::Step, 1.0f}, 1}, nlohmann::json::object()), InputError);
+  EXPECT_THROW(run_gpu_method(other, GpuMethodInput{g, nullptr, {Membership::Step, 1.0f}, 1}, find_method("gtao").decode(nlohmann::json::object())), InputError);
 }
 
 }  // namespace

@@ -25,7 +25,7 @@
 
 #include "ao/core/error.h"
 #include "ao/eval/metrics.h"
-#include "ao/gpu/methods.h"
+#include "ao/registry/methods_gpu.h"
 #include "ao/reference/direct_light.h"
 #include "ao/reference/reference.h"
 #include "gpu/gpu_support.h"
@@ -72,8 +72,8 @@ TEST_P(GpuMethodAgreement, AgreesWithTheCpuKernelOnTheSameGBuffer) {
   const test::GpuFixture f = gpu_fixture(scene, 96, 64);
   const nlohmann::json params = gpu_params(method);
   const MethodInput in{f.g, f.rays.get(), {Membership::Linear, 0.5f * f.radius}, 7, {}, &f.scene.analytic};
-  const MethodOutput cpu = find_method(method).run(in, params);
-  const GpuMethodOutput gpu = run_gpu_method(gpu_device(), method, in, params);
+  const MethodOutput cpu = run_method(in, find_method(method).decode(params));
+  const GpuMethodOutput gpu = run_gpu_method(gpu_device(), in, find_method(method).decode(params));
   expect_agreement(gpu.output.visibility, cpu.visibility, method + " on " + scene);
   ASSERT_EQ(gpu.output.color.empty(), cpu.color.empty());
   for (const auto& [name, image] : cpu.extras) {
@@ -117,8 +117,8 @@ TEST_P(GpuMethodVariants, AgreeWithTheCpuKernel) {
   nlohmann::json params = gpu_params(v.method);
   params.update(v.params);
   const MethodInput in{f.g, f.rays.get(), {v.membership, 0.5f * f.radius}, 11, {}, &f.scene.analytic};
-  const MethodOutput cpu = find_method(v.method).run(in, params);
-  const GpuMethodOutput gpu = run_gpu_method(gpu_device(), v.method, in, params);
+  const MethodOutput cpu = run_method(in, find_method(v.method).decode(params));
+  const GpuMethodOutput gpu = run_gpu_method(gpu_device(), in, find_method(v.method).decode(params));
   expect_agreement(gpu.output.visibility, cpu.visibility, v.method + " " + v.params.dump());
   ASSERT_EQ(gpu.output.color.size(), cpu.color.size());
   for (int c = 0; c < 3 && !cpu.color.empty(); ++c) {
@@ -145,8 +145,8 @@ TEST(GpuMethods, TransferRadianceModeReadsTheDirectLightPass) {
   nlohmann::json params = gpu_params("transfer");
   params["reflectance"] = "radiance";
   const MethodInput in{f.g, f.rays.get(), {Membership::Step, 0.5f * f.radius}, 3, {}, &f.scene.analytic};
-  const MethodOutput cpu = find_method("transfer").run(in, params);
-  const GpuMethodOutput gpu = run_gpu_method(gpu_device(), "transfer", in, params);
+  const MethodOutput cpu = run_method(in, find_method("transfer").decode(params));
+  const GpuMethodOutput gpu = run_gpu_method(gpu_device(), in, find_method("transfer").decode(params));
   expect_agreement(gpu.output.visibility, cpu.visibility, "transfer radiance");
   // Sunlit occluders send more light than the sky they hide somewhere: the mode did something.
   EXPECT_GT(*std::max_element(gpu.output.visibility.pixels().begin(), gpu.output.visibility.pixels().end()), 1.0f);
@@ -154,12 +154,12 @@ TEST(GpuMethods, TransferRadianceModeReadsTheDirectLightPass) {
 
 TEST(GpuMethods, OpenPlaneIsFullyVisible) {
   const test::GpuFixture f = gpu_fixture("plane", 64, 40);
-  for (std::string_view method : gpu_method_names()) {
+  for (const MethodInfo& info : all_methods()) {
     // Not cone: the GPU voxelizes by parity, which fills everything above an open plane (each
     // column crosses it once; the paper's voxelization needs closed meshes).
-    if (method == "cone") continue;
-    const std::string m(method);
-    const GpuMethodOutput out = run_gpu_method(gpu_device(), m, MethodInput{f.g, f.rays.get(), {Membership::Step, 2.0f}, 1}, gpu_params(m));
+    if (!info.gpu || info.name == "cone") continue;
+    const std::string m(info.name);
+    const GpuMethodOutput out = run_gpu_method(gpu_device(), MethodInput{f.g, f.rays.get(), {Membership::Step, 2.0f}, 1}, find_method(m).decode(gpu_params(m)));
     // As AllMethods.OpenPlaneIsFullyVisible: volumetric's pipes run along the camera's z and read
     // z* along the view ray through their middle, an error of order R / depth (below 0.01 here).
     for (std::size_t i = 0; i < out.output.visibility.size(); ++i) {
@@ -173,7 +173,7 @@ TEST(GpuMethods, SameSeedSameImageAndAnotherSeedAnother) {
   const test::GpuFixture f = gpu_fixture("default", 64, 40);
   for (const char* m : {"containment", "alchemy", "cone"}) {
     const auto run = [&](std::uint32_t seed) {
-      return run_gpu_method(gpu_device(), m, MethodInput{f.g, f.rays.get(), {Membership::Linear, 0.5f * f.radius}, seed}, gpu_params(m)).output.visibility;
+      return run_gpu_method(gpu_device(), MethodInput{f.g, f.rays.get(), {Membership::Linear, 0.5f * f.radius}, seed}, find_method(m).decode(gpu_params(m))).output.visibility;
     };
     const Image<float> a = run(5), b = run(5), c = run(6);
     EXPECT_TRUE(std::equal(a.pixels().begin(), a.pixels().end(), b.pixels().begin())) << m;
@@ -199,14 +199,14 @@ TEST_P(GpuMethodRmse, WithinTwoThousandthsOfTheCpuBackend) {
   RaytracedParams rp;
   rp.samples = 64;  // the same reference image for both backends: its noise cancels in the difference
   const auto rmse = [&](const GBuffer& g, const Image<float>& v) {
-    const ReferenceImage ref = render_reference(*f.rays, g, m.reference(requested, params), rp, 1);
+    const ReferenceImage ref = render_reference(*f.rays, g, matched_reference(requested, m.decode(params)), rp, 1);
     return compare_images(v, ref.scalar.visibility, coverage_mask(g)).rmse;
   };
-  const double cpu = rmse(f.g, m.run({f.g, f.rays.get(), requested, 9, {}, &f.scene.analytic}, params).visibility);
-  const double gpu = rmse(f.g, run_gpu_method(gpu_device(), method, MethodInput{f.g, f.rays.get(), requested, 9}, params).output.visibility);
+  const double cpu = rmse(f.g, run_method({f.g, f.rays.get(), requested, 9, {}, &f.scene.analytic}, m.decode(params)).visibility);
+  const double gpu = rmse(f.g, run_gpu_method(gpu_device(), MethodInput{f.g, f.rays.get(), requested, 9}, find_method(method).decode(params)).output.visibility);
   EXPECT_NEAR(gpu, cpu, 0.002) << method;
   const GpuGBuffer raster = GpuGBuffer::rasterize(gpu_device(), *f.gpu_scene, f.g.camera);
-  const GpuMethodOutput whole = run_gpu_method(gpu_device(), method, GpuMethodInput{raster, f.gpu_scene.get(), requested, 9}, params);
+  const GpuMethodOutput whole = run_gpu_method(gpu_device(), GpuMethodInput{raster, f.gpu_scene.get(), requested, 9}, find_method(method).decode(params));
   const double rasterized = rmse(raster.download(), whole.output.visibility);
   EXPECT_NEAR(rasterized, cpu, 0.002) << method << " on the rasterized G-buffer";
   std::printf("%s: RMSE against its reference %.5f (CPU), %.5f (GPU, same G-buffer), %.5f (GPU, rasterized G-buffer)\n", method.c_str(), cpu, gpu,
@@ -219,7 +219,7 @@ TEST(GpuMethods, WhatTheGpuDoesNotImplementIsAOneLineInputError) {
   const test::GpuFixture f = gpu_fixture("sphere-on-plane", 32, 20);
   const MethodInput in{f.g, f.rays.get(), {Membership::Step, 1.0f}, 1, {}, &f.scene.analytic};
   const auto fails = [&](const std::string& method, const nlohmann::json& params, const std::string& problem) {
-    test::expect_one_line_error<InputError>([&] { run_gpu_method(gpu_device(), method, in, params); }, method, problem);
+    test::expect_one_line_error<InputError>([&] { run_gpu_method(gpu_device(), in, find_method(method).decode(params)); }, method, problem);
   };
   fails("containment", {{"characteristic", "implicit"}}, "depth buffer only");
   fails("volumetric", {{"characteristic", "nonsense"}}, "characteristic must be one of");
@@ -234,7 +234,7 @@ TEST(GpuMethods, WhatTheGpuDoesNotImplementIsAOneLineInputError) {
 TEST(GpuMethods, ConeWithoutASceneIsRefused) {
   const test::GpuFixture f = gpu_fixture("box-room", 32, 20);
   const GpuGBuffer g = GpuGBuffer::upload(gpu_device(), f.g);
-  test::expect_one_line_error<InputError>([&] { run_gpu_method(gpu_device(), "cone", GpuMethodInput{g, nullptr, {Membership::Step, 1.0f}, 1}, nlohmann::json::object()); },
+  test::expect_one_line_error<InputError>([&] { run_gpu_method(gpu_device(), GpuMethodInput{g, nullptr, {Membership::Step, 1.0f}, 1}, find_method("cone").decode(nlohmann::json::object())); },
                                           "cone", "voxelizes the scene");
 }
 
@@ -242,7 +242,7 @@ TEST(GpuMethods, ConeReusesItsGridWhileTheVoxelizationOptionsStay) {
   const test::GpuFixture f = gpu_fixture("box-room", 48, 32);
   const GpuGBuffer g = GpuGBuffer::upload(gpu_device(), f.g);
   const auto run = [&](const nlohmann::json& params) {
-    return run_gpu_method(gpu_device(), "cone", GpuMethodInput{g, f.gpu_scene.get(), {Membership::Step, 1.0f}, 1}, params);
+    return run_gpu_method(gpu_device(), GpuMethodInput{g, f.gpu_scene.get(), {Membership::Step, 1.0f}, 1}, find_method("cone").decode(params));
   };
   // box-room's camera is inside its room: the GPU voxelizes it by parity (the paper's), the default refuses.
   EXPECT_FALSE(run({{"columns", 64}, {"open_meshes", "parity"}}).output.stats["grid_reused"].get<bool>());

@@ -1,10 +1,12 @@
-// The shaders as an engine takes them (src/ao/gpu/shaders/, installed to share/ao/shaders/): each
+// The shaders as an engine takes them (src/ao/gpu/shaders/ and each method's folder, installed to
+// share/ao/shaders/): each
 // file is the one the library embeds, says in its comments what it computes, and documents every
 // uniform it declares; every one compiles on the device.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -17,7 +19,19 @@
 namespace ao {
 namespace {
 
-const std::filesystem::path kShaders = std::filesystem::path(AO_TESTS_DIR) / ".." / "src" / "ao" / "gpu" / "shaders";
+const std::filesystem::path kSources = std::filesystem::path(AO_TESTS_DIR) / ".." / "src" / "ao";
+
+// Every shader file under src/ao (the extensions the build embeds), by file name (names are unique).
+std::map<std::string, std::filesystem::path> shader_files() {
+  static const std::set<std::string> kExtensions{".comp", ".glsl", ".vert", ".geom", ".frag"};
+  std::map<std::string, std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(kSources))
+    if (kExtensions.contains(entry.path().extension().string())) {
+      const bool unique = files.emplace(entry.path().filename().string(), entry.path()).second;
+      EXPECT_TRUE(unique) << entry.path() << ": a second shader of this name (the loader finds shaders by name)";
+    }
+  return files;
+}
 
 std::string read(const std::filesystem::path& p) {
   std::ifstream in(p);
@@ -30,21 +44,22 @@ TEST(GpuShaders, EveryFileIsEmbeddedAsItIs) {
   std::set<std::string> embedded;
   for (const gpu_detail::EmbeddedShader& s : gpu_detail::embedded_shaders()) {
     embedded.insert(s.name);
-    EXPECT_EQ(std::string(s.text), read(kShaders / s.name)) << s.name;
+    const auto files = shader_files();
+    ASSERT_TRUE(files.contains(s.name)) << s.name << " is embedded and not in the sources";
+    EXPECT_EQ(std::string(s.text), read(files.at(s.name))) << s.name;
   }
-  for (const auto& entry : std::filesystem::directory_iterator(kShaders))
-    EXPECT_TRUE(embedded.contains(entry.path().filename().string())) << entry.path();
+  for (const auto& [name, path] : shader_files()) EXPECT_TRUE(embedded.contains(name)) << path;
 }
 
 TEST(GpuShaders, EveryUniformIsDocumentedInItsFile) {
   const std::regex uniform(R"(^\s*uniform\s+\w+\s+(u_\w+))");
-  for (const auto& entry : std::filesystem::directory_iterator(kShaders)) {
-    const std::string text = read(entry.path());
+  for (const auto& [name, path] : shader_files()) {
+    const std::string text = read(path);
     std::string comments;
     std::istringstream lines(text);
     for (std::string line; std::getline(lines, line);)
       if (const std::size_t at = line.find("//"); at != std::string::npos) comments += line.substr(at) + "\n";
-    EXPECT_NE(comments.find("//"), std::string::npos) << entry.path() << " has no comment";
+    EXPECT_NE(comments.find("//"), std::string::npos) << path << " has no comment";
     std::istringstream again(text);
     for (std::string line; std::getline(again, line);) {
       std::smatch m;
@@ -54,7 +69,7 @@ TEST(GpuShaders, EveryUniformIsDocumentedInItsFile) {
       const std::string name = m[1];
       const std::string stem = name.substr(0, name.find_last_of('_'));
       EXPECT_TRUE(comments.find(name) != std::string::npos || comments.find(stem + "_x/y/z") != std::string::npos)
-          << entry.path().filename() << ": uniform " << name << " is not documented in its comments";
+          << name << ": uniform " << name << " is not documented in its comments";
     }
   }
 }
@@ -63,9 +78,8 @@ TEST(GpuShaders, EveryShaderCompilesOnTheDevice) {
   // The loader's include expansion and defines, as the methods use them.
   gpu_detail::Context& c = gpu_detail::Access::context(test::gpu_device());
   c.make_current();
-  for (const auto& entry : std::filesystem::directory_iterator(kShaders)) {
-    const std::string name = entry.path().filename().string();
-    if (entry.path().extension() != ".comp") continue;
+  for (const auto& [name, path] : shader_files()) {
+    if (path.extension() != ".comp") continue;
     if (name == "box_filter.comp") {
       EXPECT_NO_THROW(c.program({name}, "#define CHANNELS 1\n")) << name;
       EXPECT_NO_THROW(c.program({name}, "#define CHANNELS 4\n")) << name;

@@ -281,8 +281,8 @@ TEST(GltfInstances, EveryScreenSpaceMethodAndConeMatchTheFlattenedScene) {
   for (const MethodInfo& m : all_methods()) {
     if (m.needs_scene && m.name != "cone") continue;  // raytraced: the test above
     SCOPED_TRACE(std::string(m.name));
-    const MethodOutput oa = m.run(MethodInput{a.g, a.rays.get(), falloff, 5, {}, &inst.analytic}, m.default_params());
-    const MethodOutput ob = m.run(MethodInput{b.g, b.rays.get(), falloff, 5, {}, &copies.analytic}, m.default_params());
+    const MethodOutput oa = run_method(MethodInput{a.g, a.rays.get(), falloff, 5, {}, &inst.analytic}, m.decode(m.default_params()));
+    const MethodOutput ob = run_method(MethodInput{b.g, b.rays.get(), falloff, 5, {}, &copies.analytic}, m.decode(m.default_params()));
     // The inputs differ by float rounding (positions 1e-5 relative at most, above) and at the
     // rare edge pixels; the methods are continuous in them but for thresholds (a sample just in
     // front of or behind a depth), so: a small mean difference, and few pixels that differ at all.

@@ -21,7 +21,7 @@ TEST(Tune, FindsAKnownOptimum) {
   const MethodInfo& m = find_method("transfer");
   nlohmann::json target = m.default_params();
   target["albedo_scale"] = 0.4;
-  TuneView view{s.rays.get(), &s.g, &s.scene.analytic, f, m.run(MethodInput{s.g, s.rays.get(), f, 1}, target).visibility};
+  TuneView view{s.rays.get(), &s.g, &s.scene.analytic, f, run_method(MethodInput{s.g, s.rays.get(), f, 1}, m.decode(target)).visibility};
   TuneSettings settings{.method = "transfer", .parameters = {{"albedo_scale", 0.0, 1.0}}, .time_budget_s = 120};
   const TuneResult r = tune_method({view}, settings);
   EXPECT_NEAR(r.params.at("albedo_scale").get<double>(), 0.4, 2e-3);
@@ -39,7 +39,7 @@ TEST(Tune, AlchemyIntensityImprovesAndIsDeterministic) {
   for (const auto* s : {&a, &b}) {
     const Falloff f{Membership::Step, 0.8f};
     views.push_back({s->rays.get(), &s->g, nullptr, f,
-                     render_reference(*s->rays, s->g, m.reference(f, m.default_params()), {.samples = 64}, 2).scalar.visibility});
+                     render_reference(*s->rays, s->g, matched_reference(f, m.decode(m.default_params())), {.samples = 64}, 2).scalar.visibility});
   }
   TuneSettings settings{.method = "alchemy", .parameters = {{"intensity", 0.05, 2.0}}, .time_budget_s = 60, .min_step = 1e-2};
   const TuneResult r1 = tune_method(views, settings), r2 = tune_method(views, settings);
@@ -78,7 +78,7 @@ TEST(Tune, SaysWhenTheResultIsAtAnEndOfItsRange) {
   const MethodInfo& m = find_method("transfer");
   nlohmann::json target = m.default_params();
   target["albedo_scale"] = 0.4;
-  TuneView view{s.rays.get(), &s.g, &s.scene.analytic, f, m.run(MethodInput{s.g, s.rays.get(), f, 1}, target).visibility};
+  TuneView view{s.rays.get(), &s.g, &s.scene.analytic, f, run_method(MethodInput{s.g, s.rays.get(), f, 1}, m.decode(target)).visibility};
   const TuneResult below = tune_method({view}, {.method = "transfer", .parameters = {{"albedo_scale", 0.6, 1.0}}, .time_budget_s = 120});
   EXPECT_DOUBLE_EQ(below.params.at("albedo_scale").get<double>(), 0.6);
   EXPECT_EQ(below.on_bound, std::vector<std::string>{"albedo_scale"});

@@ -1,7 +1,7 @@
 // Alchemy AO (eq. 10) against known answers: the open plane, the 90-degree wedge against an
 // independent quadrature of the integral the screen-space estimator converges to
 // (docs/methods/alchemy.md), its ray-traced reference, and properties.
-#include "ao/methods/alchemy.h"
+#include "ao/methods/alchemy/alchemy.h"
 
 #include <gtest/gtest.h>
 
@@ -183,8 +183,8 @@ TEST(Alchemy, ReferenceIsStepObscuranceWithinRAtAnyIntensity) {
   const MethodInfo& m = find_method("alchemy");
   nlohmann::json off = m.default_params();
   off["intensity"] = 0;  // AO switched off is judged against the same step reference
-  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, off).key(), m.reference({Membership::Step, 2.0f}, m.default_params()).key());
-  EXPECT_EQ(m.reference({Membership::Step, 2.0f}, off).falloff.membership, Membership::Step);
+  EXPECT_EQ(matched_reference({Membership::Step, 2.0f}, m.decode(off)).key(), matched_reference({Membership::Step, 2.0f}, m.decode(m.default_params())).key());
+  EXPECT_EQ(matched_reference({Membership::Step, 2.0f}, m.decode(off)).falloff.membership, Membership::Step);
 }
 
 TEST(Alchemy, RejectsBadParameters) {

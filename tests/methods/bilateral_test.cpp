@@ -1,6 +1,6 @@
 // The cross-bilateral filter on synthetic G-buffers with known answers: constants stay constant,
 // depth discontinuities are not crossed, noise on a plane falls, and bad parameters are refused.
-#include "ao/methods/bilateral.h"
+#include "ao/methods/filters/bilateral.h"
 
 #include <gtest/gtest.h>
 

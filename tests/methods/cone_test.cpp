@@ -1,6 +1,6 @@
 // Voxel cone traced AO: configurations with known answers, the depth-resolution limitation the
 // paper names (sec. IV-A) and its fix, the ray-traced reference, properties, bad parameters.
-#include "ao/methods/cone.h"
+#include "ao/methods/cone/cone.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Containment-test AO (VAO eq. 5) on known answers, against its reference, and its properties.
-#include "ao/methods/containment.h"
+#include "ao/methods/containment/containment.h"
 
 #include <gtest/gtest.h>
 

@@ -11,7 +11,7 @@
 
 #include "ao/core/gbuffer.h"
 #include "ao/simd/aligned_internal.h"
-#include "ao/simd/screen_space_internal.h"
+#include "ao/methods/screen_space_kernel_internal.h"
 
 namespace ao {
 namespace {

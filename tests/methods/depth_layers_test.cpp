@@ -14,11 +14,11 @@
 #include "ao/registry/registry.h"
 
 #include "ao/core/error.h"
-#include "ao/methods/alchemy.h"
+#include "ao/methods/alchemy/alchemy.h"
 #include "ao/methods/characteristic.h"
-#include "ao/methods/containment.h"
-#include "ao/methods/transfer.h"
-#include "ao/methods/volumetric.h"
+#include "ao/methods/containment/containment.h"
+#include "ao/methods/transfer/transfer.h"
+#include "ao/methods/volumetric/volumetric.h"
 #include "screen_space_fixtures.h"
 
 namespace ao {
@@ -154,13 +154,13 @@ TEST(DepthLayers, TheRegistryTracesTheLayerFromTheSceneOrRefuses) {
   for (const char* name : {"containment", "volumetric", "transfer", "alchemy"}) {
     const MethodInfo& m = find_method(name);
     const nlohmann::json params = m.canonical_params({{"layers", 2}});
-    const Image<float> via_registry = m.run(MethodInput{s.g, s.rays.get(), falloff, 7}, params).visibility;
+    const Image<float> via_registry = run_method(MethodInput{s.g, s.rays.get(), falloff, 7}, m.decode(params)).visibility;
     GBuffer g = s.g;
     render_second_layer(*s.rays, g, effective_separation(DepthLayers{2, 0}, falloff.radius));
-    const Image<float> direct = m.run(MethodInput{g, nullptr, falloff, 7}, params).visibility;
+    const Image<float> direct = run_method(MethodInput{g, nullptr, falloff, 7}, m.decode(params)).visibility;
     ASSERT_EQ(via_registry.size(), direct.size());
     for (std::size_t i = 0; i < direct.size(); ++i) ASSERT_EQ(via_registry[i], direct[i]) << name << ", pixel " << i;
-    EXPECT_THROW(m.run(MethodInput{s.g, nullptr, falloff, 7}, params), InputError) << name << ": no scene, no second layer";
+    EXPECT_THROW(run_method(MethodInput{s.g, nullptr, falloff, 7}, m.decode(params)), InputError) << name << ": no scene, no second layer";
   }
 }
 

@@ -1,6 +1,6 @@
 // GTAO (Jimenez et al. 2016) on known answers, against its reference (step obscurance with R), and
 // its properties.
-#include "ao/methods/gtao.h"
+#include "ao/methods/gtao/gtao.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // The 4x4 depth-aware box filter of interleaved sampling (VAO and AT sec. 4.2).
-#include "ao/methods/interleave.h"
+#include "ao/methods/filters/interleave.h"
 
 #include <gtest/gtest.h>
 

@@ -18,8 +18,8 @@
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/error.h"
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/methods/bilateral.h"
-#include "ao/methods/interleave.h"
+#include "ao/methods/filters/bilateral.h"
+#include "ao/methods/filters/interleave.h"
 #include "ao/reference/raytraced.h"
 #include "ao/registry/registry.h"
 #include "ao/scene/procedural.h"
@@ -113,7 +113,7 @@ TEST(SimdTargets, MethodImagesAgreeBetweenTargets) {
     for (const nlohmann::json& params : variants) {
     auto run = [&](const std::string& target) {
       set_simd_target(target);
-      return m.run(MethodInput{g, &rays, falloff, 5, {}, &scene.analytic}, params).visibility;
+      return run_method(MethodInput{g, &rays, falloff, 5, {}, &scene.analytic}, m.decode(params)).visibility;
     };
     std::map<bool, Image<float>> first;  // the first image of each group: with FMA, without
     const Image<float> best = run(targets.front());
@@ -179,7 +179,7 @@ TEST(SimdTargets, FiltersAgreeBetweenTargets) {
 }
 
 // The G-buffer's and the outside-in baker's kernels are scalar code compiled once per target
-// without contraction (ao/simd/gbuffer.cpp, histogram.cpp): every target gives the same bits.
+// without contraction (ao/gbuffer/gbuffer_kernel.cpp, histogram.cpp): every target gives the same bits.
 // The G-buffer's rays, the reference's directions (no fused multiply-add in either) and the
 // histogram bake's integer counts: the same bits on every target, with or without FMA.
 TEST(SimdTargets, GBufferReferenceAndHistogramBakeAreTheSameBitsOnEveryTarget) {

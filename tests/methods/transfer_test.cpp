@@ -1,13 +1,14 @@
 // Ambient transfer (AT eq. 6, 9): its relation to obscurance and known answers.
-#include "ao/methods/transfer.h"
+#include "ao/methods/transfer/transfer.h"
 
 #include <gtest/gtest.h>
 
 
 #include "ao/core/error.h"
 #include "ao/methods/characteristic.h"
-#include "ao/methods/containment.h"
+#include "ao/methods/containment/containment.h"
 #include "ao/reference/direct_light.h"
+#include "ao/simd/depth_plane.h"
 #include "screen_space_fixtures.h"
 
 namespace ao {

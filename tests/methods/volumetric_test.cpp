@@ -2,7 +2,7 @@
 // and the paper's claims measured on the default scene. The claims test prints the table that
 // docs/methods/volumetric.md reproduces:
 //   ./build/tests/ao_tests --gtest_filter='Volumetric.PaperClaims*'
-#include "ao/methods/volumetric.h"
+#include "ao/methods/volumetric/volumetric.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 
 #include "ao/core/error.h"
 #include "ao/methods/characteristic.h"
-#include "ao/methods/containment.h"
+#include "ao/methods/containment/containment.h"
 #include "screen_space_fixtures.h"
 
 namespace ao {

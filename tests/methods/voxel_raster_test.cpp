@@ -11,8 +11,8 @@
 #include <random>
 #include <vector>
 
-#include "ao/methods/voxelize.h"
-#include "ao/simd/raster_internal.h"
+#include "ao/methods/cone/voxelize.h"
+#include "ao/methods/cone/raster_kernel_internal.h"
 
 namespace ao {
 namespace {

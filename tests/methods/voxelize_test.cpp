@@ -1,6 +1,6 @@
 // Parity voxelization against sets with exact answers: a voxel is solid exactly when its centre
 // is inside a closed mesh, so an axis-aligned box gives an exact count.
-#include "ao/methods/voxelize.h"
+#include "ao/methods/cone/voxelize.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 
 #include "ao/core/sampling.h"
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/methods/winding_number.h"
+#include "ao/methods/cone/winding_number.h"
 #include "ao/scene/procedural.h"
 
 #include "support/open_sheets.h"

@@ -1,7 +1,7 @@
 // Generalized winding numbers: known answers (a closed mesh, a flat sheet, a sphere with a cap cut
 // off, seen from its centre), the jump across a surface, and the fast hierarchy against the exact
 // sum.
-#include "ao/methods/winding_number.h"
+#include "ao/methods/cone/winding_number.h"
 
 #include <gtest/gtest.h>
 

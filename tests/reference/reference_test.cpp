@@ -13,7 +13,7 @@ namespace {
 
 ReferenceSpec matched(const char* method, const Falloff& f) {
   const MethodInfo& m = find_method(method);
-  return m.reference(f, m.default_params());
+  return matched_reference(f, m.decode(m.default_params()));
 }
 
 TEST(Reference, EachMethodIsJudgedAgainstWhatItEstimates) {
@@ -33,16 +33,16 @@ TEST(Reference, EachMethodIsJudgedAgainstWhatItEstimates) {
 TEST(Reference, OldReferencesRemainAvailableByName) {
   const Falloff f{Membership::Step, 2.0f};
   const MethodInfo& v = find_method("volumetric");
-  EXPECT_EQ(choose_reference(v, "obscurance", f, v.default_params()).label(), "cubic obscurance");
-  EXPECT_EQ(choose_reference(v, "matched", f, v.default_params()).label(), "tangent sphere");
+  EXPECT_EQ(choose_reference("obscurance", f, v.decode(v.default_params())).label(), "cubic obscurance");
+  EXPECT_EQ(choose_reference("matched", f, v.decode(v.default_params())).label(), "tangent sphere");
   const MethodInfo& t = find_method("transfer");
-  EXPECT_EQ(choose_reference(t, "obscurance", f, t.default_params()).label(), "step obscurance");
+  EXPECT_EQ(choose_reference("obscurance", f, t.decode(t.default_params())).label(), "step obscurance");
   nlohmann::json p = t.default_params();
   p["albedo_scale"] = 0.5;
-  EXPECT_EQ(choose_reference(t, "transfer", f, p).albedo_scale, 0.5f);
+  EXPECT_EQ(choose_reference("transfer", f, t.decode(p)).albedo_scale, 0.5f);
   const MethodInfo& c = find_method("containment");
-  EXPECT_EQ(choose_reference(c, "tangent-sphere", f, c.default_params()).kind, ReferenceKind::TangentSphere);
-  EXPECT_THROW(choose_reference(c, "cubic", f, c.default_params()), InputError);
+  EXPECT_EQ(choose_reference("tangent-sphere", f, c.decode(c.default_params())).kind, ReferenceKind::TangentSphere);
+  EXPECT_THROW(choose_reference("cubic", f, c.decode(c.default_params())), InputError);
 }
 
 TEST(Reference, NamesRoundTrip) {
@@ -67,7 +67,7 @@ TEST(Reference, RaytracedRendersEachKindByParameter) {
     nlohmann::json p = m.default_params();
     p[kReferenceParam] = kind;
     p["samples"] = 8;
-    const MethodOutput out = m.run(MethodInput{s.g, s.rays.get(), f, 1}, p);
+    const MethodOutput out = run_method(MethodInput{s.g, s.rays.get(), f, 1}, m.decode(p));
     const RaytracedImage direct = render_reference(*s.rays, s.g, {*parse_reference_kind(kind), f}, {.samples = 8}, 1).scalar;
     for (std::size_t i = 0; i < direct.visibility.size(); ++i) ASSERT_EQ(out.visibility[i], direct.visibility[i]) << kind << ", pixel " << i;
     EXPECT_EQ(!out.color.empty(), std::string(kind) == "transfer") << kind;
@@ -75,9 +75,9 @@ TEST(Reference, RaytracedRendersEachKindByParameter) {
   }
   nlohmann::json bad = m.default_params();
   bad[kReferenceParam] = "cubic";
-  EXPECT_THROW(m.run(MethodInput{s.g, s.rays.get(), f, 1}, bad), InputError);
+  EXPECT_THROW(run_method(MethodInput{s.g, s.rays.get(), f, 1}, m.decode(bad)), InputError);
   bad[kReferenceParam] = 3;
-  EXPECT_THROW(m.run(MethodInput{s.g, s.rays.get(), f, 1}, bad), InputError);
+  EXPECT_THROW(run_method(MethodInput{s.g, s.rays.get(), f, 1}, m.decode(bad)), InputError);
 }
 
 }  // namespace

@@ -116,11 +116,11 @@ TEST(TangentSphere, VolumetricWithExactSolidMatchesItOnTheWedge) {
   p["bias"] = 1e-6;
   p["filter"] = false;
   p["interleave"] = false;
-  const MethodOutput out = m.run(MethodInput{s.g, s.rays.get(), f, 1, {}, &s.scene.analytic}, p);
-  const ReferenceSpec spec = m.reference(f, p);
+  const MethodOutput out = run_method(MethodInput{s.g, s.rays.get(), f, 1, {}, &s.scene.analytic}, m.decode(p));
+  const ReferenceSpec spec = matched_reference(f, m.decode(p));
   ASSERT_EQ(spec.kind, ReferenceKind::TangentSphere);
   const Image<float> sphere = render_reference(*s.rays, s.g, spec, {.samples = 1024}, 2).scalar.visibility;
-  const Image<float> cubic = render_reference(*s.rays, s.g, choose_reference(m, "obscurance", f, p), {.samples = 1024}, 2).scalar.visibility;
+  const Image<float> cubic = render_reference(*s.rays, s.g, choose_reference("obscurance", f, m.decode(p)), {.samples = 1024}, 2).scalar.visibility;
   const double e_sphere = test::rmse_against(out.visibility, sphere, s.g), e_cubic = test::rmse_against(out.visibility, cubic, s.g);
   std::printf("wedge, R = 0.5, volumetric (implicit, 256 pipes): RMSE %.4f against the tangent sphere, %.4f against cubic obscurance\n",
               e_sphere, e_cubic);

@@ -40,7 +40,7 @@ Fixture fixture(const char* name) {
 }
 
 MethodOutput run(const MethodInfo& m, const Fixture& f, const Falloff& falloff, std::uint32_t seed = 3) {
-  return m.run(MethodInput{f.g, f.rays.get(), falloff, seed, {}, &f.scene.analytic}, m.default_params());
+  return run_method(MethodInput{f.g, f.rays.get(), falloff, seed, {}, &f.scene.analytic}, m.decode(m.default_params()));
 }
 
 class AllMethods : public ::testing::TestWithParam<std::string> {
@@ -156,23 +156,23 @@ TEST_P(AllMethods, NoEstimatorParameterMovesTheReference) {
   const MethodInfo& m = method();
   const nlohmann::json defaults = m.default_params();
   for (const Falloff requested : {Falloff{Membership::Step, 1.5f}, Falloff{Membership::Linear, 0.7f}}) {
-    const std::string matched = m.reference(requested, defaults).key();
-    const std::string obscurance = choose_reference(m, "obscurance", requested, defaults).key();
+    const std::string matched = matched_reference(requested, m.decode(defaults)).key();
+    const std::string obscurance = choose_reference("obscurance", requested, m.decode(defaults)).key();
     for (const ParamSpec& s : m.params().specs()) {
       const bool quantity = std::find(m.quantity_params.begin(), m.quantity_params.end(), s.name) != m.quantity_params.end();
       nlohmann::json j = defaults;
       j[s.name] = other_value(s);
-      const std::string moved = m.reference(requested, m.canonical_params(j)).key();
+      const std::string moved = matched_reference(requested, m.decode(m.canonical_params(j))).key();
       if (quantity) continue;  // it chooses the quantity: its reference may differ
       EXPECT_EQ(moved, matched) << m.name << ": " << s.name << " = " << j[s.name] << " moved the reference";
-      EXPECT_EQ(choose_reference(m, "obscurance", requested, m.canonical_params(j)).key(), obscurance) << m.name << ": " << s.name;
+      EXPECT_EQ(choose_reference("obscurance", requested, m.decode(m.canonical_params(j))).key(), obscurance) << m.name << ": " << s.name;
     }
     // Alchemy's intensity in particular, over its range, 0 included (V = 1 everywhere).
     if (m.params().find("intensity"))
       for (double sigma : {0.0, 0.1, 0.4, 1.0, 3.0}) {
         nlohmann::json j = defaults;
         j["intensity"] = sigma;
-        EXPECT_EQ(m.reference(requested, m.canonical_params(j)).key(), matched) << "intensity " << sigma;
+        EXPECT_EQ(matched_reference(requested, m.decode(m.canonical_params(j))).key(), matched) << "intensity " << sigma;
       }
   }
 }

@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "ao/core/error.h"
-#include "ao/methods/containment.h"
-#include "ao/methods/transfer.h"
-#include "ao/methods/volumetric.h"
+#include "ao/methods/containment/containment.h"
+#include "ao/methods/transfer/transfer.h"
+#include "ao/methods/volumetric/volumetric.h"
 #include "methods/screen_space_fixtures.h"
 
 namespace ao {
@@ -28,7 +28,7 @@ MethodOutput run(const test::SceneGBuffer& s, const char* method, const Falloff&
   const MethodInfo& m = find_method(method);
   nlohmann::json p = m.default_params();
   for (const auto& [k, v] : overrides.items()) p[k] = v;
-  return m.run(MethodInput{s.g, s.rays.get(), f, seed, {}, surfaces}, p);
+  return run_method(MethodInput{s.g, s.rays.get(), f, seed, {}, surfaces}, m.decode(p));
 }
 MethodOutput run(const test::SceneGBuffer& s, const char* method, const Falloff& f, const char* characteristic) {
   return run(s, method, f, {{"characteristic", characteristic}}, &s.scene.analytic);
@@ -43,7 +43,7 @@ const Image<float>& compared(const MethodOutput& out, const char* method) {
 // The obscurance each method approximates (`ao compare --reference obscurance`).
 Falloff reference_falloff(const char* method, const Falloff& requested) {
   const MethodInfo& m = find_method(method);
-  return m.obscurance_falloff(requested, m.default_params());
+  return obscurance_falloff(requested, m.decode(m.default_params()));
 }
 
 double covered_mean(const Image<float>& v, const GBuffer& g) {
@@ -60,12 +60,12 @@ double covered_mean(const Image<float>& v, const GBuffer& g) {
 TEST(Registry, GtaoWithMultiBounceIsJudgedAgainstAmbientTransfer) {
   const MethodInfo& m = find_method("gtao");
   nlohmann::json p = m.default_params();
-  const ReferenceSpec plain = m.reference({Membership::Linear, 1.5f}, p);
+  const ReferenceSpec plain = matched_reference({Membership::Linear, 1.5f}, m.decode(p));
   EXPECT_EQ(plain.kind, ReferenceKind::Obscurance);
   EXPECT_EQ(plain.falloff.membership, Membership::Step);
   EXPECT_EQ(plain.falloff.radius, 1.5f);
   p["multi_bounce"] = true;
-  const ReferenceSpec bounced = m.reference({Membership::Linear, 1.5f}, m.canonical_params(p));
+  const ReferenceSpec bounced = matched_reference({Membership::Linear, 1.5f}, m.decode(m.canonical_params(p)));
   EXPECT_EQ(bounced.kind, ReferenceKind::Transfer);
   EXPECT_EQ(bounced.falloff.membership, Membership::Step);
   EXPECT_EQ(bounced.falloff.radius, 1.5f);
@@ -111,8 +111,8 @@ TEST(Registry, MethodCacheGivesTheSameImagesAsNoCache) {
     for (std::uint32_t seed : {3u, 8u}) {
       const MethodInfo& m = find_method(method);
       const nlohmann::json p = m.default_params();
-      const MethodOutput plain = m.run(MethodInput{s.g, s.rays.get(), f, seed, {}, &s.scene.analytic}, p);
-      const MethodOutput cached = m.run(MethodInput{s.g, s.rays.get(), f, seed, {}, &s.scene.analytic, &cache}, p);
+      const MethodOutput plain = run_method(MethodInput{s.g, s.rays.get(), f, seed, {}, &s.scene.analytic}, m.decode(p));
+      const MethodOutput cached = run_method(MethodInput{s.g, s.rays.get(), f, seed, {}, &s.scene.analytic, &cache}, m.decode(p));
       ASSERT_EQ(plain.visibility.size(), cached.visibility.size());
       for (std::size_t i = 0; i < plain.visibility.size(); ++i) ASSERT_EQ(plain.visibility[i], cached.visibility[i]) << method << " pixel " << i;
       for (std::size_t i = 0; i < plain.color.size(); ++i) ASSERT_EQ(plain.color[i], cached.color[i]) << method << " pixel " << i;
@@ -120,8 +120,8 @@ TEST(Registry, MethodCacheGivesTheSameImagesAsNoCache) {
   // The same cache handed another scene: cone voxelizes that scene, not the kept grid.
   const auto other = test::builtin_gbuffer("sphere-on-plane");
   const MethodInfo& cone = find_method("cone");
-  const MethodOutput plain = cone.run(MethodInput{other.g, other.rays.get(), f, 3, {}, &other.scene.analytic}, cone.default_params());
-  const MethodOutput cached = cone.run(MethodInput{other.g, other.rays.get(), f, 3, {}, &other.scene.analytic, &cache}, cone.default_params());
+  const MethodOutput plain = run_method(MethodInput{other.g, other.rays.get(), f, 3, {}, &other.scene.analytic}, cone.decode(cone.default_params()));
+  const MethodOutput cached = run_method(MethodInput{other.g, other.rays.get(), f, 3, {}, &other.scene.analytic, &cache}, cone.decode(cone.default_params()));
   for (std::size_t i = 0; i < plain.visibility.size(); ++i) ASSERT_EQ(plain.visibility[i], cached.visibility[i]) << "pixel " << i;
 }
 

@@ -6,7 +6,7 @@
 //    culling (ortho_raster.cpp, simd::rasterize_front_faces). For each visible pixel the fragment
 //    program outputs (u, v) and (w . n)|J|, with n the interpolated normal and |J| =
 //    |det d(u,v)/d(x_w,y_w)| (eq. 9). We recompute (u, v) and (w . n) from the pixel's barycentrics
-//    in the scatter (simd::scatter_histogram, src/ao/simd/histogram.cpp); |J| of an
+//    in the scatter (simd::scatter_histogram, src/ao/bake/histogram_kernel.cpp); |J| of an
 //    affine map is the ratio of the triangle's UV area to its image area, exactly what the paper's
 //    dFdx/dFdy estimate (they are exact for linear interpolation).
 //  - Stage 2, "sum over pixels": the histogram scatter of eq. 7-8, each pixel adding (w . n)|J| to
@@ -41,7 +41,7 @@
 #include "ao/bake/padding.h"
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
-#include "ao/simd/histogram_internal.h"
+#include "ao/bake/histogram_kernel_internal.h"
 
 namespace ao {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "ao/bake/texel_coverage.h"
-#include "ao/simd/histogram_internal.h"
+#include "ao/bake/histogram_kernel_internal.h"
 
 namespace ao {
 

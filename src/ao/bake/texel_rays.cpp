@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "ao/reference/ray_offset.h"
+#include "ao/simd/sampling_internal.h"
 
 namespace ao::detail {
 

@@ -2,6 +2,8 @@
 // the image; pixel (0,0) is the top-left corner of the image and pixel centres sit at +0.5.
 #pragma once
 
+#include <algorithm>
+
 #include "ao/core/math.h"
 
 namespace ao {
@@ -45,5 +47,35 @@ struct Camera {
 /// Camera that frames the bounds: looks at their centre from `direction` (world, need not be unit)
 /// at the distance where the bounding sphere fills the smaller field of view.
 Camera frame_bounds(const Bounds3& bounds, Vec3 direction, float vertical_fov_deg, int width, int height);
+
+/// Camera-space point -> pixel index of the G-buffer, with the arithmetic of Camera::project
+/// folded into four constants.
+struct ScreenProjection {
+  float scale_x = 1, scale_y = 1;   ///< Pixels per unit of x/(-z) and y/(-z).
+  float centre_x = 0, centre_y = 0; ///< Pixel coordinate of the optical axis.
+  int width = 0, height = 0;
+
+  static ScreenProjection from_camera(const Camera& c) {
+    const float t = c.tan_half_fov();
+    return {0.5f * static_cast<float>(c.width) / (t * c.aspect()), 0.5f * static_cast<float>(c.height) / t,
+            0.5f * static_cast<float>(c.width), 0.5f * static_cast<float>(c.height), c.width, c.height};
+  }
+  /// Sets `index` to y * width + x of the pixel containing p's projection, clamped to the image
+  /// (a point projecting outside it reads the nearest border pixel: clamp-to-edge), and returns
+  /// true; sets it to 0 and returns false when p is not in front of the camera. Branch-free, so
+  /// loops over it vectorise (with gathers).
+  bool locate(float x, float y, float z, int& index) const {
+    const float inv = -1.0f / z;
+    const bool valid = z < 0.0f;
+    // Clamped as floats, before the conversion (which is undefined out of int's range); a NaN
+    // (z = 0) is replaced by 0 first.
+    const float fx = valid ? x * inv * scale_x + centre_x : 0.0f;
+    const float fy = valid ? centre_y - y * inv * scale_y : 0.0f;
+    const int ix = static_cast<int>(std::min(std::max(fx, 0.0f), static_cast<float>(width - 1)));
+    const int iy = static_cast<int>(std::min(std::max(fy, 0.0f), static_cast<float>(height - 1)));
+    index = iy * width + ix;
+    return valid;
+  }
+};
 
 }  // namespace ao

@@ -2,7 +2,7 @@
 // (right-handed, looking down -z; see camera.h). Linear depth and coverage are not stored: they
 // follow from the position and the object id (GBuffer::depth, GBuffer::covered), so rendering a
 // G-buffer writes fewer bytes a pixel; kernels that gather depths build a contiguous plane with
-// depth_plane().
+// depth_plane() (simd/depth_plane.h).
 #pragma once
 
 #include <cstdint>
@@ -69,11 +69,19 @@ struct GBuffer {
   float depth(std::size_t i) const { return covered(i) ? -position[i].z : kInfinity; }
 };
 
-/// GBuffer::depth of every pixel as one contiguous image (width x height, reusing `out`'s storage),
-/// for kernels that gather depths (the screen-space methods, their filters). Computed in parallel.
-void depth_plane(const GBuffer& g, Image<float>& out);
-/// The same as a new image.
-Image<float> depth_plane(const GBuffer& g);
+/// What a G-buffer renderer puts in the G-buffer (render_gbuffer: gbuffer/render_gbuffer.h;
+/// GpuGBuffer::rasterize: gpu/gbuffer.h).
+struct GBufferOptions {
+  /// Which normal `normal` holds (and so which hemisphere every method integrates over). Default:
+  /// shading, the smooth surface scanned and modelled meshes stand for (docs/methods/raytraced.md).
+  SurfaceNormal normal = SurfaceNormal::Shading;
+  /// Fill `albedo`. False leaves it empty, for passes that never read it (the ray-traced
+  /// references take albedos from the scene): 12 bytes a pixel less to write. Default true.
+  bool albedo = true;
+  /// Fill `uv`. False leaves it empty: only sampling a baked map at the pixels reads it (`ao
+  /// render --ao-map`). Default true.
+  bool uv = true;
+};
 
 /// 1 where covered, 0 elsewhere: the mask the metrics (eval/metrics.h) take.
 Image<std::uint8_t> coverage_mask(const GBuffer& g);

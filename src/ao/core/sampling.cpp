@@ -4,7 +4,6 @@
 #include <cmath>
 #include <initializer_list>
 
-#include "ao/simd/sampling_internal.h"
 
 namespace ao {
 
@@ -91,19 +90,18 @@ Vec2 sobol_owen_2d(std::uint32_t index, std::uint32_t seed) {
 
 std::array<float, 4> sobol_owen_4d(std::uint32_t index, std::uint32_t seed) {
   // Dimension 0 is the bit reversal of the index, which cancels the scramble's inner reversal.
-  const std::uint32_t d0 = reverse_bits(laine_karras(index, hash_combine(seed, 0x50b01u)));
-  const std::uint32_t d1 = reverse_bits(laine_karras(reverse_bits(kSobolDim1(index)), hash_combine(seed, 0x50b02u)));
-  const std::uint32_t d2 = reverse_bits(laine_karras(reverse_bits(kSobolDim2(index)), hash_combine(seed, 0x50b03u)));
-  const std::uint32_t d3 = reverse_bits(laine_karras(reverse_bits(kSobolDim3(index)), hash_combine(seed, 0x50b04u)));
+  const std::array<std::uint32_t, 4> key = sobol_owen_4d_keys(seed);
+  const std::uint32_t d0 = reverse_bits(laine_karras(index, key[0]));
+  const std::uint32_t d1 = reverse_bits(laine_karras(reverse_bits(kSobolDim1(index)), key[1]));
+  const std::uint32_t d2 = reverse_bits(laine_karras(reverse_bits(kSobolDim2(index)), key[2]));
+  const std::uint32_t d3 = reverse_bits(laine_karras(reverse_bits(kSobolDim3(index)), key[3]));
   return {to_unit_float(d0), to_unit_float(d1), to_unit_float(d2), to_unit_float(d3)};
 }
 
-void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, float (&out)[4][16]) {
-  const std::uint32_t key[4] = {hash_combine(seed, 0x50b01u), hash_combine(seed, 0x50b02u), hash_combine(seed, 0x50b03u), hash_combine(seed, 0x50b04u)};
-  // The unscrambled points, bit-reversed (the scramble's inner reversal); dimension 0's reversal
-  // is the index itself. A Sobol dimension is linear over GF(2), and so is the reversal: for first
-  // a multiple of 16 and k < 16 (disjoint bits), point first + k is point first XOR point k, so
-  // one table lookup per dimension serves all 16 lanes.
+void sobol_reversed_4d_batch(std::uint32_t first, int count, std::uint32_t (&r)[4][16]) {
+  // Dimension 0's reversal is the index itself. A Sobol dimension is linear over GF(2), and so is
+  // the reversal: for first a multiple of 16 and k < 16 (disjoint bits), point first + k is point
+  // first XOR point k, so one table lookup per dimension serves all 16 lanes.
   static constexpr auto kLow = [] {
     std::array<std::array<std::uint32_t, 16>, 3> t{};
     for (std::uint32_t k = 0; k < 16; ++k) {
@@ -113,7 +111,6 @@ void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, flo
     }
     return t;
   }();
-  alignas(64) std::uint32_t r[4][16] = {};
   if (first % 16 == 0) {
     const std::uint32_t high[3] = {reverse_bits(kSobolDim1(first)), reverse_bits(kSobolDim2(first)), reverse_bits(kSobolDim3(first))};
     for (int k = 0; k < 16; ++k) {
@@ -129,8 +126,10 @@ void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, flo
       r[3][k] = reverse_bits(kSobolDim3(i));
     }
   }
-  // Hash and outer reversal: shifts, masks and multiplies, 16 lanes at once in the SIMD kernel layer.
-  simd::owen_scramble_4x16(r, key, out);
+}
+
+std::array<std::uint32_t, 4> sobol_owen_4d_keys(std::uint32_t seed) {
+  return {hash_combine(seed, 0x50b01u), hash_combine(seed, 0x50b02u), hash_combine(seed, 0x50b03u), hash_combine(seed, 0x50b04u)};
 }
 
 Vec3 cosine_hemisphere(Vec2 u) {

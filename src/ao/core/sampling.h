@@ -41,11 +41,14 @@ Vec2 sobol_owen_2d(std::uint32_t index, std::uint32_t seed);
 /// 0 and 1 and is a net of the four dimensions jointly; different seeds give independent sets.
 std::array<float, 4> sobol_owen_4d(std::uint32_t index, std::uint32_t seed);
 
-/// Points first .. first + count - 1 of sobol_owen_4d(., seed), count in [0, 16]: dimension d of
-/// point first + k in out[d][k], bit-identical to sobol_owen_4d. The per-dimension keys are
-/// hashed once and the scramble runs over the 16 lanes in SIMD registers (the inside-out baker's
-/// rays of one packet).
-void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, float (&out)[4][16]);
+/// The per-dimension scrambling keys sobol_owen_4d derives from `seed`.
+std::array<std::uint32_t, 4> sobol_owen_4d_keys(std::uint32_t seed);
+
+/// Points first .. first + count - 1 (count in [0, 16]) of sobol_owen_4d's sequence before
+/// scrambling, into r[d][k]: dimension 0 the index, dimensions 1-3 bit-reversed (the inner
+/// reversal of nested uniform scrambling); entries k >= count are left as they are. The SIMD
+/// kernel layer scrambles a batch of them (simd/sampling_internal.h: sobol_owen_4d_batch).
+void sobol_reversed_4d_batch(std::uint32_t first, int count, std::uint32_t (&r)[4][16]);
 
 /// Cosine-weighted direction on the hemisphere about +z from u in [0,1)^2: Shirley-Chiu concentric
 /// disk mapping, lifted to the hemisphere (Malley's method). pdf = cos(theta) / pi.

@@ -9,7 +9,7 @@
 #include "ao/core/error.h"
 #include "ao/reference/packets_internal.h"
 #include "ao/reference/ray_tiles_internal.h"
-#include "ao/simd/gbuffer_internal.h"
+#include "ao/gbuffer/gbuffer_kernel_internal.h"
 
 namespace ao {
 

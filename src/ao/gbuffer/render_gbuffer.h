@@ -7,19 +7,6 @@
 
 namespace ao {
 
-/// What render_gbuffer puts in the G-buffer.
-struct GBufferOptions {
-  /// Which normal `normal` holds (and so which hemisphere every method integrates over). Default:
-  /// shading, the smooth surface scanned and modelled meshes stand for (docs/methods/raytraced.md).
-  SurfaceNormal normal = SurfaceNormal::Shading;
-  /// Fill `albedo`. False leaves it empty, for passes that never read it (the ray-traced
-  /// references take albedos from the scene): 12 bytes a pixel less to write. Default true.
-  bool albedo = true;
-  /// Fill `uv`. False leaves it empty: only sampling a baked map at the pixels reads it (`ao
-  /// render --ao-map`). Default true.
-  bool uv = true;
-};
-
 /// Traces one primary ray through each pixel centre of `camera` (which must validate) and fills
 /// the G-buffer: camera-space position interpolated on the hit triangle (linear depth and coverage
 /// follow from it and the id: GBuffer::depth, ::covered), the normal

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "ao/core/gbuffer.h"
-#include "ao/gbuffer/render_gbuffer.h"
 #include "ao/gpu/device.h"
 #include "ao/scene/mesh.h"
 

@@ -2,24 +2,14 @@
 #pragma once
 
 #include <memory>
-#include <optional>
 #include <vector>
 
 #include "ao/core/camera.h"
 #include "ao/gpu/gbuffer.h"
 #include "ao/gpu/gl_internal.h"
-#include "ao/methods/voxelize.h"
+#include "ao/core/typed_slots.h"
 
 namespace ao::gpu_detail {
-
-/// A world voxel grid built on the GPU (cone.cpp) and what it was built from, kept with its scene.
-struct GridCache {
-  bool valid = false;
-  VoxelizeOptions options;
-  VoxelGrid layout;    ///< nx, ny, depth_bits, words, origin, voxel_size (bits stay on the GPU).
-  Buffer bits;         ///< The columns as 32-bit words: column c's word w at c * (depth_bits / 32) + w.
-  VoxelStats stats;
-};
 
 struct SceneBuffers {
   std::shared_ptr<Context> context;
@@ -32,9 +22,8 @@ struct SceneBuffers {
   };
   std::vector<MeshBuffers> meshes;
   std::vector<SceneObject> objects;
-  /// analyze_closure of the scene, computed on first use (cone checks for open meshes).
-  std::optional<std::vector<MeshClosure>> closure;
-  GridCache grid;
+  /// What methods keep with the scene on the device (cone: its mesh closure and world voxel grid).
+  TypedSlots state;
 };
 
 struct GBufferTextures {

@@ -18,6 +18,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/exr_common_internal.h"
+#include "ao/simd/depth_plane.h"
 
 namespace ao {
 

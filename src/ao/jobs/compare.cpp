@@ -118,7 +118,7 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
       }
     }
     s.params[name] = shortest_floats(p);
-    choose_reference(m, reference_name(s, name), s.falloff, s.params[name]);  // throws for unknown names
+    choose_reference(reference_name(s, name), s.falloff, m.decode(s.params[name]));  // throws for unknown names
   }
   for (const auto& [name, ref] : in.references)
     if (!name.empty() && !s.params.count(name)) throw InputError("--reference: method '" + name + "' is not among --methods");
@@ -166,9 +166,9 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
     result.references.push_back({spec, std::move(img.scalar.visibility), elapsed_ms(start), img.scalar.mean_std_error});
     return result.references.size() - 1;
   };
-  auto run_method = [&](const MethodInfo& m, const nlohmann::json& p, double& ms) {
+  auto run_timed = [&](const MethodParams& p, double& ms) {
     const auto start = std::chrono::steady_clock::now();
-    MethodOutput out = m.run(MethodInput{g, &scene, s.falloff, s.seed, stage(s, std::string(m.name)), surfaces}, p);
+    MethodOutput out = run_method(MethodInput{g, &scene, s.falloff, s.seed, stage(s, std::string(method_of(p).name)), surfaces}, p);
     ms = elapsed_ms(start);
     return out;
   };
@@ -180,20 +180,20 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
   };
   for (const std::string& name : s.methods) {
     const MethodInfo& m = find_method(name);
-    const nlohmann::json& p = s.params.at(name);
+    const MethodParams p = m.decode(s.params.at(name));
     CompareRow row;
     row.method = name;
-    row.params = p;
+    row.params = s.params.at(name);
     row.defaults = shortest_floats(m.default_params());
-    row.reference = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
-    MethodOutput out = run_method(m, p, row.ms);
+    row.reference = reference_for(choose_reference(reference_name(s, name), s.falloff, p));
+    MethodOutput out = run_timed(p, row.ms);
     const Image<float>& ref = result.references[row.reference].visibility;
     row.metrics = compare_images(out.visibility, ref, covered);
     row.heat = signed_error_heat_map(out.visibility, ref, covered, kCompareHeatRange);
     row.common = against_common(out.visibility);
     row.stats = out.stats;
     row.visibility = std::move(out.visibility);
-    if (gpu_column) row.gpu = gpu_column->run(name, p, s.falloff, s.seed, ref, row.visibility, covered, true);
+    if (gpu_column) row.gpu = gpu_column->run(p, s.falloff, s.seed, ref, row.visibility, covered, true);
     result.rows.push_back(std::move(row));
   }
 
@@ -202,15 +202,16 @@ CompareResult compare_methods(const RayScene& scene, const GBuffer& g, const Ana
       if (!s.params.at(name).contains(s.sweep_key)) continue;
       const MethodInfo& m = find_method(name);
       for (const nlohmann::json& v : s.sweep_values) {
-        nlohmann::json p = s.params.at(name);
-        p[s.sweep_key] = v;
-        const std::size_t r = reference_for(choose_reference(m, reference_name(s, name), s.falloff, p));
+        nlohmann::json j = s.params.at(name);
+        j[s.sweep_key] = v;
+        const MethodParams p = m.decode(j);
+        const std::size_t r = reference_for(choose_reference(reference_name(s, name), s.falloff, p));
         double ms = 0;
-        const MethodOutput out = run_method(m, p, ms);
+        const MethodOutput out = run_timed(p, ms);
         const Image<float>& ref = result.references[r].visibility;
         const ErrorMetrics e = compare_images(out.visibility, ref, covered);
         result.sweep.push_back({name, v, e.rmse, against_common(out.visibility).rmse, ms, {}});
-        if (gpu_column) result.sweep.back().gpu = gpu_column->run(name, p, s.falloff, s.seed, ref, out.visibility, covered, false);
+        if (gpu_column) result.sweep.back().gpu = gpu_column->run(p, s.falloff, s.seed, ref, out.visibility, covered, false);
       }
     }
   return result;

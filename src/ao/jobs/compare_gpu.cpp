@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "ao/core/error.h"
-#include "ao/gpu/methods.h"
+#include "ao/registry/methods_gpu.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao {
@@ -36,14 +36,14 @@ double CompareGpuColumn::upload_ms() const {
   return ms;
 }
 
-CompareGpuRun CompareGpuColumn::run(const std::string& method, const nlohmann::json& params, const Falloff& falloff, std::uint32_t seed,
+CompareGpuRun CompareGpuColumn::run(const MethodParams& params, const Falloff& falloff, std::uint32_t seed,
                                     const Image<float>& reference, const Image<float>& cpu, const Image<std::uint8_t>& covered, bool keep_images) {
   CompareGpuRun out;
   try {
-    check_gpu_method(method, params);
-    if (method == "cone" && !gpu_scene_) gpu_scene_ = GpuScene::upload(device_, scene_.scene());
+    check_gpu_method(params);
+    if (method_of(params).needs_scene && !gpu_scene_) gpu_scene_ = GpuScene::upload(device_, scene_.scene());
     const auto start = std::chrono::steady_clock::now();
-    GpuMethodOutput g = run_gpu_method(device_, method, GpuMethodInput{gbuffer_, gpu_scene_ ? &*gpu_scene_ : nullptr, falloff, seed}, params);
+    GpuMethodOutput g = run_gpu_method(device_, GpuMethodInput{gbuffer_, gpu_scene_ ? &*gpu_scene_ : nullptr, falloff, seed}, params);
     out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     out.passes = std::move(g.passes);
     out.stats = std::move(g.output.stats);

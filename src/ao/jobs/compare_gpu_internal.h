@@ -13,6 +13,7 @@
 #include "ao/core/membership.h"
 #include "ao/gpu/gbuffer.h"
 #include "ao/jobs/compare.h"
+#include "ao/registry/registry.h"
 
 namespace ao {
 
@@ -26,11 +27,11 @@ class CompareGpuColumn {
   /// GPU time of the G-buffer's upload.
   double upload_ms() const;
 
-  /// `method` with canonical `params` on the GPU, judged against `reference` over `covered` and
+  /// The method of `params` on the GPU, judged against `reference` over `covered` and
   /// measured against the CPU's V `cpu`. What the GPU backend does not run (an InputError: a CPU
   /// only method, a characteristic function, cone's open-mesh modes) comes back as `skipped`.
   /// `keep_images`: keep V and the heat map (the table's rows; a sweep needs only the numbers).
-  CompareGpuRun run(const std::string& method, const nlohmann::json& params, const Falloff& falloff, std::uint32_t seed,
+  CompareGpuRun run(const MethodParams& params, const Falloff& falloff, std::uint32_t seed,
                     const Image<float>& reference, const Image<float>& cpu, const Image<std::uint8_t>& covered, bool keep_images);
 
  private:
@@ -38,7 +39,7 @@ class CompareGpuColumn {
   GpuDevice& device_;
   const RayScene& scene_;
   GpuGBuffer gbuffer_;
-  std::optional<GpuScene> gpu_scene_;  ///< Uploaded when cone first runs.
+  std::optional<GpuScene> gpu_scene_;  ///< Uploaded when a method that needs the scene (cone) first runs.
 };
 
 /// A row's "gpu" object in table.json (compare_table_json).

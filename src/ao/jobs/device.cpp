@@ -3,7 +3,6 @@
 #include <cstdio>
 
 #include "ao/core/error.h"
-#include "ao/gpu/methods.h"
 
 namespace ao {
 
@@ -15,8 +14,8 @@ Device device_from_name(const std::string& name) {
   throw InputError("--device: cpu or gpu, got '" + name + "'");
 }
 
-void check_device(Device device, const MethodInfo& method, const nlohmann::json& params) {
-  if (device == Device::Gpu) check_gpu_method(method.name, params);
+void check_device(Device device, const MethodParams& params) {
+  if (device == Device::Gpu) check_gpu_method(params);
 }
 
 std::string describe_gpu_passes(std::span<const GpuPassTime> passes) {

@@ -25,10 +25,11 @@ const char* to_string(Device device);
 /// The device called `name` ("cpu" or "gpu"); InputError "--device: cpu or gpu, got 'x'" otherwise.
 Device device_from_name(const std::string& name);
 
-/// The checks of running `method` with canonical `params` on `device` that need no scene and no
-/// device: nothing for the CPU; for the GPU, check_gpu_method (InputError naming what the GPU
-/// backend does not run and the way out, --device cpu; SystemError in a library built without it).
-void check_device(Device device, const MethodInfo& method, const nlohmann::json& params);
+/// The checks of running the method of `params` on `device` that need no scene and no device:
+/// nothing for the CPU; for the GPU, check_gpu_method (InputError naming what the GPU backend does
+/// not run and the way out, --device cpu). A library built without the backend says so when the
+/// device is opened.
+void check_device(Device device, const MethodParams& params);
 
 /// The GPU passes as people read them, in the order they ran: "upload 0.41 ms, volumetric 32.6 ms,
 /// filter 25.4 ms" (three significant digits).

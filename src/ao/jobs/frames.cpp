@@ -1,7 +1,7 @@
 #include "ao/jobs/frames.h"
 
 #include "ao/core/error.h"
-#include "ao/gpu/methods.h"
+#include "ao/registry/methods_gpu.h"
 #include "ao/jobs/render.h"
 #include "ao/reference/ray_scene.h"
 
@@ -18,12 +18,11 @@ const GBuffer& FrameRenderer::render_gbuffer(const Camera& camera, const GBuffer
   return *gbuffer_;
 }
 
-MethodOutput FrameRenderer::run(const MethodInfo& method, const nlohmann::json& params, const Falloff& falloff, std::uint32_t seed,
-                                const ProgressFn& progress) {
+MethodOutput FrameRenderer::run(const MethodParams& params, const Falloff& falloff, std::uint32_t seed, const ProgressFn& progress) {
   if (!gbuffer_) throw std::logic_error("FrameRenderer::run before render_gbuffer");
   gpu_passes_.clear();
-  if (device_ == Device::Gpu) return run_on_gpu(method, params, falloff, seed);
-  return run_method(method, params, *gbuffer_, &scene_, falloff, seed, &cache_, progress);
+  if (device_ == Device::Gpu) return run_on_gpu(params, falloff, seed);
+  return run_on_scene(params, *gbuffer_, &scene_, falloff, seed, &cache_, progress);
 }
 
 void FrameRenderer::set_device(Device device, GpuDevice* gpu) {
@@ -33,11 +32,11 @@ void FrameRenderer::set_device(Device device, GpuDevice* gpu) {
   gpu_ = device == Device::Gpu ? gpu : nullptr;
 }
 
-MethodOutput FrameRenderer::run_on_gpu(const MethodInfo& method, const nlohmann::json& params, const Falloff& falloff, std::uint32_t seed) {
-  check_gpu_method(method.name, params);
+MethodOutput FrameRenderer::run_on_gpu(const MethodParams& params, const Falloff& falloff, std::uint32_t seed) {
+  check_gpu_method(params);
   const GpuGBuffer g = GpuGBuffer::upload(*gpu_, *gbuffer_);
-  if (method.name == "cone" && !gpu_scene_) gpu_scene_.emplace(GpuScene::upload(*gpu_, *scene_.scene));
-  GpuMethodOutput out = run_gpu_method(*gpu_, method.name, GpuMethodInput{g, gpu_scene_ ? &*gpu_scene_ : nullptr, falloff, seed}, params);
+  if (method_of(params).needs_scene && !gpu_scene_) gpu_scene_.emplace(GpuScene::upload(*gpu_, *scene_.scene));
+  GpuMethodOutput out = run_gpu_method(*gpu_, GpuMethodInput{g, gpu_scene_ ? &*gpu_scene_ : nullptr, falloff, seed}, params);
   gpu_passes_ = g.passes();
   gpu_passes_.insert(gpu_passes_.end(), out.passes.begin(), out.passes.end());
   return std::move(out.output);

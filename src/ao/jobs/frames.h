@@ -38,10 +38,11 @@ class FrameRenderer {
   /// the next render_gbuffer then makes a new one unless the consumer has let go.
   std::shared_ptr<const GBuffer> shared_gbuffer() const { return gbuffer_; }
 
-  /// `method` with canonical `params` on the last G-buffer, with the cache of this scene. On the
-  /// GPU: run_gpu_method on the G-buffer uploaded (InputError, one line, for what the GPU backend
-  /// does not run), the scene uploaded when cone first runs; gpu_passes() then has its times.
-  MethodOutput run(const MethodInfo& method, const nlohmann::json& params, const Falloff& falloff, std::uint32_t seed, const ProgressFn& progress = {});
+  /// The method of `params` on the last G-buffer, with the cache of this scene. On the GPU:
+  /// run_gpu_method on the G-buffer uploaded (InputError, one line, for what the GPU backend does
+  /// not run), the scene uploaded when a method that needs it first runs; gpu_passes() then has
+  /// its times.
+  MethodOutput run(const MethodParams& params, const Falloff& falloff, std::uint32_t seed, const ProgressFn& progress = {});
 
   /// Where run() computes: the CPU (default, `gpu` ignored), or the GPU backend on `gpu`, which
   /// must outlive this renderer's runs on it (a viewer's window context, GpuDevice::from_current_context).
@@ -52,14 +53,14 @@ class FrameRenderer {
   const std::vector<GpuPassTime>& gpu_passes() const { return gpu_passes_; }
 
  private:
-  MethodOutput run_on_gpu(const MethodInfo& method, const nlohmann::json& params, const Falloff& falloff, std::uint32_t seed);
+  MethodOutput run_on_gpu(const MethodParams& params, const Falloff& falloff, std::uint32_t seed);
 
   PreparedScene scene_;
   std::shared_ptr<GBuffer> gbuffer_;
   MethodCache cache_;
   Device device_ = Device::Cpu;
   GpuDevice* gpu_ = nullptr;
-  std::optional<GpuScene> gpu_scene_;  ///< Uploaded when cone first runs on the GPU; keeps cone's grid between runs.
+  std::optional<GpuScene> gpu_scene_;  ///< Uploaded when a method that needs the scene (cone) first runs on the GPU; keeps its grid between runs.
   std::vector<GpuPassTime> gpu_passes_;
 };
 

@@ -7,7 +7,7 @@
 #include "ao/core/memory.h"
 #include "ao/eval/shading.h"
 #include "ao/gbuffer/render_gbuffer.h"
-#include "ao/gpu/methods.h"
+#include "ao/registry/methods_gpu.h"
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
 #include "ao/io/output_set.h"
@@ -25,8 +25,9 @@ constexpr const char* kAoMapMethod = "ao-map";
 bool has_gbuffer_input(const RenderRequest& r) { return r.gbuffer || !r.gbuffer_file.empty(); }
 
 // The parameters of the run: the method's, or none when an AO map is shown instead.
-nlohmann::json request_params(const RenderRequest& r, const MethodInfo& m) {
-  return r.ao_map.empty() ? method_params(m, r.params, r.samples, r.target_error) : nlohmann::json::object();
+std::optional<MethodParams> request_params(const RenderRequest& r, const MethodInfo& m) {
+  if (!r.ao_map.empty()) return std::nullopt;
+  return method_params(m, r.params, r.samples, r.target_error);
 }
 
 void check_outputs(const RenderOutputs& o) {
@@ -57,10 +58,10 @@ void declare_outputs(OutputSet& set, const RenderRequest& r, const MethodInfo& m
     for (std::string_view name : m.extras) set.add_output(extra_path(o.visibility, name), "--extras");
 }
 
-void check_memory_of(const RenderRequest& r, const MethodInfo& m, const nlohmann::json& params) {
+void check_memory_of(const RenderRequest& r, const std::optional<MethodParams>& params) {
   if (has_gbuffer_input(r)) return;
   const int width = r.camera.width.value_or(r.camera.default_width), height = r.camera.height.value_or(r.camera.default_height);
-  const MethodMemory extra = r.ao_map.empty() && m.memory ? m.memory(params) : MethodMemory{};
+  const MethodMemory extra = params ? extra_memory(*params) : MethodMemory{};
   check_memory(estimate_render_memory({.width = width, .height = height, .sun = r.sun.has_value(), .shaded = !r.outputs.shaded.empty(),
                                        .gbuffer_out = !r.outputs.gbuffer.empty()}) +
                    extra.bytes,
@@ -117,9 +118,9 @@ bool is_exr(const fs::path& path) {
 }
 
 // The method on the GPU, on the G-buffer the render made (uploaded, with the scene for cone).
-void run_on_gpu(GpuDevice& device, const MethodInfo& m, const Loaded& in, std::uint32_t seed, RenderResult& out) {
+void run_on_gpu(GpuDevice& device, const MethodParams& params, const Loaded& in, std::uint32_t seed, RenderResult& out) {
   const RayScene* rays = in.scene ? in.scene->rays.get() : nullptr;
-  GpuMethodOutput g = run_gpu_method(device, m.name, MethodInput{in.gbuffer, rays, out.falloff, seed}, out.params);
+  GpuMethodOutput g = run_gpu_method(device, MethodInput{in.gbuffer, rays, out.falloff, seed}, params);
   out.output = std::move(g.output);
   out.gpu_passes = std::move(g.passes);
   out.gl_renderer = std::move(g.renderer);
@@ -192,8 +193,8 @@ nlohmann::json summary_of(const RenderRequest& r, const RenderResult& out, const
 
 }  // namespace
 
-nlohmann::json method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples,
-                             std::optional<float> target_error) {
+MethodParams method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples,
+                           std::optional<float> target_error) {
   nlohmann::json params = nlohmann::json::object();
   if (samples) {
     if (method.samples_param.empty()) throw InputError("--spp: method " + std::string(method.name) + " has no sample count");
@@ -207,7 +208,7 @@ nlohmann::json method_params(const MethodInfo& method, const nlohmann::json& ove
     if (!overrides.is_object()) throw InputError(std::string(method.name) + ": parameters must be a JSON object, got " + overrides.dump());
     for (const auto& [key, value] : overrides.items()) params[key] = value;
   }
-  return method.canonical_params(params);
+  return method.decode(params);
 }
 
 GBufferOptions gbuffer_options_for(const MethodInfo& method, SurfaceNormal normal, bool albedo_for_outputs, bool uv) {
@@ -223,9 +224,9 @@ GBuffer render_view_gbuffer(const PreparedScene& scene, const Camera& camera, co
   return g;
 }
 
-MethodOutput run_method(const MethodInfo& method, const nlohmann::json& params, const GBuffer& gbuffer, const PreparedScene* scene,
-                        const Falloff& falloff, std::uint32_t seed, MethodCache* cache, const ProgressFn& progress) {
-  return method.run(MethodInput{gbuffer, scene ? scene->rays.get() : nullptr, falloff, seed, progress, scene ? &scene->scene->analytic : nullptr, cache},
+MethodOutput run_on_scene(const MethodParams& params, const GBuffer& gbuffer, const PreparedScene* scene, const Falloff& falloff,
+                          std::uint32_t seed, MethodCache* cache, const ProgressFn& progress) {
+  return run_method(MethodInput{gbuffer, scene ? scene->rays.get() : nullptr, falloff, seed, progress, scene ? &scene->scene->analytic : nullptr, cache},
                     params);
 }
 
@@ -241,17 +242,17 @@ void check_render_request(const RenderRequest& r) {
     throw InputError("method " + std::string(m.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
   r.camera.validate();
   r.falloff.validate();
-  const nlohmann::json params = request_params(r, m);
+  const std::optional<MethodParams> params = request_params(r, m);
   if (r.device == Device::Gpu && !r.ao_map.empty())
     throw InputError("--ao-map shows a baked map instead of running a method: --device gpu does not apply");
-  if (r.ao_map.empty()) check_device(r.device, m, params);
+  if (params) check_device(r.device, *params);
   if (r.normal && gbuffer_input)
     throw InputError("--normal chooses the normal a scene's G-buffer is rendered with; a --gbuffer-in file brings its own N");
   if (r.sun) r.sun->validate();
   if (r.sun && gbuffer_input)
     throw InputError("--sun traces shadow rays in the scene, and --gbuffer-in gives only a G-buffer: give a scene, or a G-buffer EXR with "
                      "direct.R direct.G direct.B channels");
-  if (r.ao_map.empty() && m.reads_direct_light && m.reads_direct_light(params) && !r.sun && !gbuffer_input)
+  if (params && reads_direct_light(*params) && !r.sun && !gbuffer_input)
     throw InputError("-p reflectance=radiance reads the occluders' direct light: give a sun with --sun DX,DY,DZ[,E] (or --gbuffer-in "
                      "with direct.R direct.G direct.B channels)");
 }
@@ -269,10 +270,11 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   const MethodInfo& m = find_method(r.method);
   RenderResult out;
   out.method = r.ao_map.empty() ? std::string(m.name) : kAoMapMethod;
-  out.params = request_params(r, m);
+  const std::optional<MethodParams> params = request_params(r, m);
+  out.params = params ? params_json(*params) : nlohmann::json::object();
   OutputSet outputs;
   declare_outputs(outputs, r, m);
-  check_memory_of(r, m, out.params);
+  check_memory_of(r, params);
   std::optional<GpuDevice> gpu;
   if (r.device == Device::Gpu) {  // before anything is loaded: without a usable OpenGL the run stops here
     gpu = GpuDevice::open();
@@ -281,7 +283,7 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
 
   Loaded in = load_inputs(r, m, reporter, timings, clock);
   const bool gbuffer_input = !in.scene;
-  if (r.ao_map.empty() && m.reads_direct_light && m.reads_direct_light(out.params) && in.gbuffer.direct.empty())
+  if (params && reads_direct_light(*params) && in.gbuffer.direct.empty())
     throw InputError(r.gbuffer_file.string() + ": -p reflectance=radiance reads the occluders' direct light, and the file has no direct.R direct.G "
                      "direct.B channels (docs/gbuffer.md)");
   out.falloff = choose_falloff(r.falloff, in.diagonal);
@@ -290,9 +292,9 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
     out.output.stats = {{"ao_map", r.ao_map.string()}, {"map_width", in.ao_map.width()}, {"map_height", in.ao_map.height()}};
   } else if (gpu) {
     reporter.start(out.method + " (gpu)");
-    run_on_gpu(*gpu, m, in, r.seed, out);
+    run_on_gpu(*gpu, *params, in, r.seed, out);
   } else {
-    out.output = run_method(m, out.params, in.gbuffer, in.scene ? &*in.scene : nullptr, out.falloff, r.seed, nullptr, reporter.start(out.method));
+    out.output = run_on_scene(*params, in.gbuffer, in.scene ? &*in.scene : nullptr, out.falloff, r.seed, nullptr, reporter.start(out.method));
   }
   out.device = gpu ? Device::Gpu : Device::Cpu;
   out.method_ms = clock.lap_ms();

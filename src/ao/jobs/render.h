@@ -97,10 +97,11 @@ RenderResult run_render(const RenderRequest& request, const JobReporter& reporte
 
 // ---- One view of a prepared scene: what run_render does after loading, and the viewer per frame.
 
-/// The method's parameters: its defaults, then `samples` and `target_error` where the method has
-/// them (InputError where it has not), then `overrides`; complete and checked.
-nlohmann::json method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples = {},
-                             std::optional<float> target_error = {});
+/// The method's parameters, decoded once: its defaults, then `samples` and `target_error` where
+/// the method has them (InputError where it has not), then `overrides`; checked by its table.
+/// params_json (registry.h) gives them back complete, for an echo.
+MethodParams method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples = {},
+                           std::optional<float> target_error = {});
 
 /// The G-buffer channels a render needs: albedo for screen-space methods (and the sun pass, a
 /// shaded picture, a G-buffer file), UVs for an AO map.
@@ -110,9 +111,9 @@ GBufferOptions gbuffer_options_for(const MethodInfo& method, SurfaceNormal norma
 GBuffer render_view_gbuffer(const PreparedScene& scene, const Camera& camera, const GBufferOptions& options, const std::optional<Sun>& sun,
                             const JobReporter& reporter = {});
 
-/// `method` with canonical `params` on `gbuffer` (rendered from `scene`, or from a file when
-/// `scene` is null). `cache`: null, or what the method keeps between frames of this scene.
-MethodOutput run_method(const MethodInfo& method, const nlohmann::json& params, const GBuffer& gbuffer, const PreparedScene* scene,
-                        const Falloff& falloff, std::uint32_t seed, MethodCache* cache = nullptr, const ProgressFn& progress = {});
+/// The method of `params` on `gbuffer` (rendered from `scene`, or from a file when `scene` is
+/// null). `cache`: null, or what the method keeps between frames of this scene.
+MethodOutput run_on_scene(const MethodParams& params, const GBuffer& gbuffer, const PreparedScene* scene, const Falloff& falloff,
+                          std::uint32_t seed, MethodCache* cache = nullptr, const ProgressFn& progress = {});
 
 }  // namespace ao

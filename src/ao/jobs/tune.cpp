@@ -27,7 +27,7 @@ nlohmann::json tune_start(const MethodInfo& m, const TuneSettings& s) {
   nlohmann::json current = s.start.is_null() ? m.default_params() : s.start;
   // A value a preset leaves unset starts where the method has it (Alchemy's intensity 0.4 at the
   // fitted preset), so the start does not depend on the range asked for.
-  const nlohmann::json resolved = m.resolve_presets ? m.resolve_presets(current) : current;
+  const nlohmann::json resolved = params_json(with_presets_resolved(m.decode(current)));
   for (const TuneParameter& p : s.parameters) {
     if (!current.contains(p.key)) throw InputError("tune: method " + s.method + " has no parameter '" + p.key + "'");
     if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
@@ -107,7 +107,7 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
       const TuneView& v = views[i];
       MethodOutput out;
       try {
-        out = m.run(MethodInput{*v.gbuffer, v.scene, v.falloff, s.seed, {}, v.surfaces}, params);
+        out = run_method(MethodInput{*v.gbuffer, v.scene, v.falloff, s.seed, {}, v.surfaces}, m.decode(params));
       } catch (const InputError&) {
         return std::numeric_limits<double>::infinity();
       }
@@ -191,7 +191,7 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
     const Scene& scene = *l->scene->scene;
     l->g = render_gbuffer(*l->scene->rays, choose_camera(scene, r.camera), GBufferOptions{.normal = r.normal});
     const Falloff f = choose_falloff(r.falloff, interest_diagonal(scene));  // R as ao render and ao compare choose it
-    Image<float> ref = render_reference(*l->scene->rays, l->g, m.reference(f, start), {.samples = r.spp_reference}, r.seed + 1,
+    Image<float> ref = render_reference(*l->scene->rays, l->g, matched_reference(f, m.decode(start)), {.samples = r.spp_reference}, r.seed + 1,
                                         reporter.start("reference (" + name + ")"))
                            .scalar.visibility;
     views.push_back({l->scene->rays.get(), &l->g, &scene.analytic, f, std::move(ref)});

@@ -45,7 +45,7 @@ struct TuneView {
 struct TuneSettings {
   std::string method;                    ///< Registry name.
   /// Complete parameters to start from (default_params() when null). A fitted value left null
-  /// starts where the method's preset puts it (MethodInfo::resolve_presets), else mid-range; a
+  /// starts where the method's preset puts it (with_presets_resolved, registry.h), else mid-range; a
   /// start outside [lo, hi] at its nearest end.
   nlohmann::json start;
   std::vector<TuneParameter> parameters; ///< At least one; keys the method has, numeric values.

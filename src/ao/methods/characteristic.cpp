@@ -1,5 +1,6 @@
 #include "ao/methods/characteristic.h"
 
+#include <array>
 #include <string>
 
 #include "ao/core/error.h"
@@ -42,5 +43,12 @@ HeightFieldCharacteristic height_field_characteristic(const HeightFieldSurface& 
   ch.amplitude = surface.amplitude;
   return ch;
 }
+
+namespace {
+constexpr std::array<std::string_view, 4> kCharacteristicNames{"depth", "implicit", "height-field", "depth*height-field"};
+}  // namespace
+
+std::span<const std::string_view> characteristic_names() { return kCharacteristicNames; }
+std::string_view to_string(CharacteristicKind kind) { return kCharacteristicNames[static_cast<std::size_t>(kind)]; }
 
 }  // namespace ao

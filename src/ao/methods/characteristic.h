@@ -31,45 +31,22 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <span>
+#include <string>
+#include <string_view>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "ao/core/camera.h"
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
 #include "ao/core/math.h"
+#include "ao/core/params.h"
 #include "ao/scene/analytic.h"
+#include "ao/simd/depth_plane.h"
 
 namespace ao {
-
-/// Camera-space point -> pixel index of the G-buffer, with the arithmetic of Camera::project
-/// folded into four constants.
-struct ScreenProjection {
-  float scale_x = 1, scale_y = 1;   ///< Pixels per unit of x/(-z) and y/(-z).
-  float centre_x = 0, centre_y = 0; ///< Pixel coordinate of the optical axis.
-  int width = 0, height = 0;
-
-  static ScreenProjection from_camera(const Camera& c) {
-    const float t = c.tan_half_fov();
-    return {0.5f * static_cast<float>(c.width) / (t * c.aspect()), 0.5f * static_cast<float>(c.height) / t,
-            0.5f * static_cast<float>(c.width), 0.5f * static_cast<float>(c.height), c.width, c.height};
-  }
-  /// Sets `index` to y * width + x of the pixel containing p's projection, clamped to the image
-  /// (a point projecting outside it reads the nearest border pixel: clamp-to-edge), and returns
-  /// true; sets it to 0 and returns false when p is not in front of the camera. Branch-free, so
-  /// loops over it vectorise (with gathers).
-  bool locate(float x, float y, float z, int& index) const {
-    const float inv = -1.0f / z;
-    const bool valid = z < 0.0f;
-    // Clamped as floats, before the conversion (which is undefined out of int's range); a NaN
-    // (z = 0) is replaced by 0 first.
-    const float fx = valid ? x * inv * scale_x + centre_x : 0.0f;
-    const float fy = valid ? centre_y - y * inv * scale_y : 0.0f;
-    const int ix = static_cast<int>(std::min(std::max(fx, 0.0f), static_cast<float>(width - 1)));
-    const int iy = static_cast<int>(std::min(std::max(fy, 0.0f), static_cast<float>(height - 1)));
-    index = iy * width + ix;
-    return valid;
-  }
-};
 
 /// VAO fig. 2c: the z-buffer separates inner from outer. z* is the linear depth stored at p's pixel
 /// (nearest pixel, clamped to the image); background pixels hold +infinity, so they are free.
@@ -255,5 +232,32 @@ ImplicitCharacteristic implicit_characteristic(const ImplicitSurface& surface, c
 /// copied: `surface.map` must outlive the result. InputError for an empty map, a non-positive or
 /// non-finite period, or a frame that is not orthonormal.
 HeightFieldCharacteristic height_field_characteristic(const HeightFieldSurface& surface, const Camera& camera);
+
+/// Which characteristic function I(p) containment, volumetric and transfer read (their parameter
+/// `characteristic`; VAO fig. 2 and 12). The method's run builds it in the G-buffer's camera space
+/// (screen_space_method_internal.h).
+enum class CharacteristicKind {
+  Depth,                  ///< "depth": the G-buffer's depth buffer (fig. 2c), with AT 4.3's silhouette elimination as asked.
+  Implicit,               ///< "implicit": the scene's half-spaces and sphere exteriors (fig. 2a); no silhouette elimination.
+  HeightField,            ///< "height-field": the scene's displacement map over its macro plane (fig. 2b), alone.
+  DepthTimesHeightField,  ///< "depth*height-field": their product (fig. 12); elimination applies to the depth factor only.
+};
+/// The parameter of containment, volumetric and transfer that holds their CharacteristicKind.
+inline constexpr const char* kCharacteristicParam = "characteristic";
+/// The names of CharacteristicKind's values, in its order: "depth", "implicit", "height-field",
+/// "depth*height-field".
+std::span<const std::string_view> characteristic_names();
+/// The name of `kind`.
+std::string_view to_string(CharacteristicKind kind);
+
+/// The `characteristic` row of a screen-space method's parameter table, for member `member`.
+template <class P>
+Param<P> characteristic_param(CharacteristicKind P::*member) {
+  std::vector<std::pair<std::string, CharacteristicKind>> names;
+  for (std::size_t k = 0; k < characteristic_names().size(); ++k)
+    names.emplace_back(characteristic_names()[k], static_cast<CharacteristicKind>(k));
+  return Param<P>::enumeration(kCharacteristicParam, member, std::move(names),
+                               "the characteristic function I(p): depth buffer, the scene's implicit surface or height field, or depth x height field");
+}
 
 }  // namespace ao

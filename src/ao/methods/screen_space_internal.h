@@ -1,5 +1,5 @@
 // Internals of the screen-space methods (containment, volumetric, transfer), not installed: their
-// inputs in the form of the SIMD kernel layer (src/ao/simd/screen_space_internal.h), which takes a
+// inputs in the form of the SIMD kernel layer (src/ao/methods/screen_space_kernel_internal.h), which takes a
 // row's covered pixels as structure-of-arrays and runs the loops over samples across pixels.
 #pragma once
 
@@ -11,7 +11,7 @@
 #include "ao/methods/characteristic.h"
 #include "ao/methods/depth_layers.h"
 #include "ao/methods/samples.h"
-#include "ao/simd/screen_space_internal.h"
+#include "ao/methods/screen_space_kernel_internal.h"
 
 namespace ao {
 

@@ -1,14 +1,24 @@
 // Kernels of the sample points, written once for every SIMD target (sampling.cpp):
-//  - the scrambled Sobol points the bakers' rays are made from (core/sampling.h:
-//    sobol_owen_4d_batch): Owen scrambling in bit-reversed order (Laine and Karras 2011, Burley
-//    2020's constants) and the outer reversal, 16 points of 4 dimensions at a time. Integer
-//    arithmetic: every target gives the same bits.
+//  - the scrambled Sobol points the bakers' rays are made from (sobol_owen_4d_batch below, over
+//    core/sampling.h's sobol_reversed_4d_batch): Owen scrambling in bit-reversed order (Laine and
+//    Karras 2011, Burley 2020's constants) and the outer reversal, 16 points of 4 dimensions at a
+//    time. Integer arithmetic: every target gives the same bits.
 //  - the ray-traced reference's directions about a point (reference/raytraced.cpp): its Sobol
 //    table, shifted and mapped to the cosine-weighted hemisphere, one packet at a time. Products and
 //    sums in one order, none fused: every target gives the same bits.
 #pragma once
 
 #include <cstdint>
+
+namespace ao {
+
+/// Points first .. first + count - 1 of sobol_owen_4d(., seed) (core/sampling.h), count in [0, 16]:
+/// dimension d of point first + k in out[d][k], bit-identical to sobol_owen_4d. The per-dimension
+/// keys are hashed once and the scramble runs over the 16 lanes in SIMD registers (the inside-out
+/// baker's rays of one packet).
+void sobol_owen_4d_batch(std::uint32_t first, int count, std::uint32_t seed, float (&out)[4][16]);
+
+}  // namespace ao
 
 namespace ao::simd {
 

@@ -1,0 +1,15 @@
+// Alchemy's GPU path (alchemy_gpu.cpp: alchemy.comp, then the bilateral filter), not installed: what the registry's
+// run_gpu_method calls for its parameters (methods/method.h).
+#pragma once
+
+#include "ao/gpu/run_internal.h"
+#include "ao/methods/method.h"
+#include "ao/methods/alchemy/alchemy.h"
+
+namespace ao::gpu_detail {
+
+/// The method on the device with the CPU kernel's sample sets and rotations; the output as run()'s
+/// (up to float rounding: tests/gpu). Parameters are checked by the caller's decode and check_gpu.
+MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const AlchemyParams& params);
+
+}  // namespace ao::gpu_detail

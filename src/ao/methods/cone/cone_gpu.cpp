@@ -1,0 +1,341 @@
+// Voxel cone tracing on the GPU (Dalla Favera & Celes 2012): the world voxel grid built by
+// rasterization, each fragment XOR-ing its depth-slab mask into its column
+// (cone_voxelize.vert, .geom, .frag; statistics: cone_count.comp), the cones of spheres and the
+// prisms' bit counts in a compute shader (cone_trace.comp), and the cross-bilateral filter
+// (filters_gpu.cpp). The sampling tables are the CPU kernel's
+// (derive_cone_setup, make_cone_pattern), uploaded.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/gpu/run_internal.h"
+#include "ao/methods/cone/cone_gpu_internal.h"
+#include "ao/methods/filters/filters_gpu_internal.h"
+#include "ao/methods/cone/voxelize_gpu.h"
+#include "ao/methods/cone/cone_pattern_internal.h"
+
+namespace ao {
+
+namespace gpu_detail {
+
+namespace {
+
+// A world voxel grid built on the GPU and what it was built from.
+struct GridCache {
+  bool valid = false;
+  VoxelizeOptions options;
+  VoxelGrid layout;    // nx, ny, depth_bits, words, origin, voxel_size (bits stay on the GPU).
+  Buffer bits;         // The columns as 32-bit words: column c's word w at c * (depth_bits / 32) + w.
+  VoxelStats stats;
+};
+
+// What cone keeps with a scene on the device (SceneBuffers::state): the closure of its meshes
+// (analyze_closure, computed on first use: cone checks for open meshes) and the last world grid.
+struct ConeGpuState {
+  std::optional<std::vector<MeshClosure>> closure;
+  GridCache grid;
+};
+
+ConeGpuState& state_of(SceneBuffers& sb) {
+  return sb.state.get<ConeGpuState>([] { return std::make_unique<ConeGpuState>(); });
+}
+
+// voxelize_world's layout of the world grid (voxelize.cpp) when nothing is voxelized as a slab:
+// the scene's bounds (every axis at least 1e-4 of the diagonal, so that a flat scene's voxels have
+// size) padded by one voxel v0 on every side and one more on top.
+VoxelGrid world_layout(const Scene& scene, const VoxelizeOptions& o) {
+  VoxelGrid g;
+  g.space = GridSpace::World;
+  g.nx = g.ny = o.columns;
+  g.depth_bits = o.depth_bits;
+  g.words = (o.depth_bits + 63) / 64;
+  const Bounds3 b = scene.bounds();
+  if (b.empty()) throw InputError(scene.name + ": cannot voxelize an empty scene");
+  const float floor_extent = std::max(1e-4f * b.diagonal(), 1e-6f);
+  const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
+  const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
+  const float side = v0;  // the CPU adds the slab thickness here when it makes slabs
+  const Vec3 lo = b.lo - Vec3{side, side, side};
+  const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
+  g.origin = lo;
+  g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
+  return g;
+}
+
+const std::vector<MeshClosure>& closure_of(SceneBuffers& sb) {
+  std::optional<std::vector<MeshClosure>>& closure = state_of(sb).closure;
+  if (!closure) closure = analyze_closure(*sb.scene);
+  return *closure;
+}
+
+// The GPU voxelizes by parity; the CPU's other modes change the solid of open surfaces (slabs),
+// of holed meshes (winding number) and of closed meshes around the camera (the complement).
+void check_parity_suffices(const std::vector<MeshClosure>& closure, const VoxelizeOptions& o) {
+  const OpenMeshes mode = o.open_meshes;
+  std::size_t open = 0, holed = 0;
+  for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0;
+  const auto rooms = static_cast<std::size_t>(std::count(o.rooms.begin(), o.rooms.end(), std::uint8_t{1}));
+  if (rooms > 0 && mode != OpenMeshes::Parity)
+    throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the camera is inside " + std::to_string(rooms) +
+                     " closed mesh(es) (a room), whose solid is outside: run cone on the CPU (--device cpu), or give "
+                     "-p open_meshes=parity for the paper's voxelization, which fills the room");
+  const bool slabs = mode != OpenMeshes::Parity && open > 0, winding = mode == OpenMeshes::Winding && holed > 0;
+  if (!slabs && !winding) return;
+  const std::string what = slabs ? std::to_string(open) + " open surface(s), which open_meshes=" + (mode == OpenMeshes::Slab ? "slab" : "winding") +
+                                       " thickens into slabs"
+                                 : std::to_string(holed) + " mesh(es) with holes, which open_meshes=winding closes";
+  throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the scene has " + what +
+                   ": run cone on the CPU (--device cpu), or give -p open_meshes=parity for the paper's voxelization, which fills the "
+                   "space beyond an open surface");
+}
+
+void set_instance(Context& c, Program& p, const Scene& s, const SceneObject& ob) {
+  const bool instance = ob.instance != SceneObject::kNoInstance;
+  c.gl.Uniform1i(c.uniform(p, "u_instance"), instance ? 1 : 0);
+  if (!instance) return;
+  const Affine3& a = s.instances[ob.instance].object_to_world;
+  const float to_world[12] = {a.c0.x, a.c0.y, a.c0.z, a.c1.x, a.c1.y, a.c1.z, a.c2.x, a.c2.y, a.c2.z, a.c3.x, a.c3.y, a.c3.z};
+  c.gl.Uniform3fv(c.uniform(p, "u_to_world"), 4, to_world);
+}
+
+// Builds state_of(sb).grid for `o` on the GPU, as the passes "voxelize" (the XOR rasterization) and
+// "count" (its statistics).
+void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vector<PassQuery>& passes) {
+  o.validate();
+  const std::vector<MeshClosure>& closure = closure_of(sb);
+  check_parity_suffices(closure, o);
+  GridCache& cache = state_of(sb).grid;
+  cache.valid = false;
+  cache.layout = world_layout(*sb.scene, o);
+  const VoxelGrid& g = cache.layout;
+  if (g.nx > c.max_texture_size)
+    throw InputError("cone: " + std::to_string(g.nx) + " columns exceed this GPU's largest framebuffer (" + std::to_string(c.max_texture_size) + ")");
+
+  Program& raster = c.program({"cone_voxelize.vert", "cone_voxelize.geom", "cone_voxelize.frag"},
+                              c.geometry_storage ? "" : "#define NO_GEOMETRY_COUNTER\n");
+  Program& count = c.program({"cone_count.comp"});
+  const std::size_t words = static_cast<std::size_t>(g.nx) * g.ny * (g.depth_bits / 32);
+  if (static_cast<double>(words) * 4 > static_cast<double>(c.max_storage_block))
+    throw InputError("cone: a " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.depth_bits) + " voxel grid (" +
+                     std::to_string(words * 4 >> 20) + " MiB) exceeds this GPU's largest storage buffer (" +
+                     std::to_string(c.max_storage_block >> 20) + " MiB, " + c.renderer + "): fewer columns or depth_bits");
+  const GLuint zero[4] = {0, 0, 0, 0};
+  Buffer counters = make_buffer(c, sizeof zero, zero);
+  cache.bits = make_buffer(c, words * sizeof(std::uint32_t), nullptr);
+  // A framebuffer without attachments, nx x ny: the fragments write the grid's buffer only.
+  GLuint fbo_id = 0;
+  c.gl.GenFramebuffers(1, &fbo_id);
+  Framebuffer fbo(c, fbo_id);
+  c.gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_id);
+  c.gl.FramebufferParameteri(GL_FRAMEBUFFER, GL_FRAMEBUFFER_DEFAULT_WIDTH, g.nx);
+  c.gl.FramebufferParameteri(GL_FRAMEBUFFER, GL_FRAMEBUFFER_DEFAULT_HEIGHT, g.ny);
+  if (c.gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw SystemError("--device gpu: a framebuffer without attachments is not supported by " + c.renderer);
+  c.check("allocating the voxel grid");
+
+  c.begin_pass(passes, "voxelize");
+  c.gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, cache.bits.id());
+  c.gl.ClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, zero);
+  c.gl.Viewport(0, 0, g.nx, g.ny);
+  c.gl.Disable(GL_DEPTH_TEST);
+  c.gl.UseProgram(raster.id);
+  const Vec3 inv{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z};
+  c.gl.Uniform3f(c.uniform(raster, "u_origin"), g.origin.x, g.origin.y, g.origin.z);
+  c.gl.Uniform3f(c.uniform(raster, "u_inv_size"), inv.x, inv.y, inv.z);
+  c.gl.Uniform2i(c.uniform(raster, "u_columns"), g.nx, g.ny);
+  c.gl.Uniform1i(c.uniform(raster, "u_depth_bits"), g.depth_bits);
+  c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, cache.bits.id());
+  c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counters.id());
+  for (const SceneObject& ob : sb.objects) {
+    set_instance(c, raster, *sb.scene, ob);
+    const SceneBuffers::MeshBuffers& mb = sb.meshes[ob.mesh];
+    c.gl.BindVertexArray(mb.vao.id());
+    c.gl.DrawElements(GL_TRIANGLES, mb.index_count, GL_UNSIGNED_INT, nullptr);
+  }
+  c.gl.BindVertexArray(0);
+  c.gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  c.gl.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  c.end_pass(passes);
+
+  c.begin_pass(passes, "count");
+  c.gl.UseProgram(count.id);
+  c.gl.Uniform2i(c.uniform(count, "u_columns"), g.nx, g.ny);
+  c.gl.Uniform1i(c.uniform(count, "u_depth_bits"), g.depth_bits);
+  dispatch_2d(c, g.nx, g.ny);
+  c.end_pass(passes);
+  c.check("voxelizing the scene");
+
+  GLuint counts[4] = {0, 0, 0, 0};
+  c.gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, counters.id());
+  c.gl.GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof counts, counts);
+  VoxelStats& s = cache.stats;
+  s = {};
+  s.triangles = counts[0], s.fragments = counts[1], s.set_voxels = counts[2], s.odd_columns = counts[3];
+  for (const MeshClosure& m : closure) {
+    s.open_meshes += m.open_surface() ? 1 : 0;
+    s.holed_meshes += m.holed() ? 1 : 0;
+    s.holes += m.holed() ? m.holes : 0;
+    s.boundary_edges += m.boundary_edges;
+  }
+  cache.options = o;
+  cache.valid = true;
+}
+
+bool grid_is_current(const GridCache& cache, const VoxelizeOptions& o) {
+  return cache.valid && cache.options.columns == o.columns && cache.options.depth_bits == o.depth_bits && cache.options.open_meshes == o.open_meshes &&
+         cache.options.slab_thickness == o.slab_thickness && cache.options.rooms == o.rooms;
+}
+
+// The world sampler's constants of cone_world.cpp: per chain sphere its radii in voxels and the
+// sum of its prisms' chords, per prism the disk point and per sphere its half chord; per sphere
+// slot of a cone the affine forms of its distance, radius scale and "is sampled" test in the chain
+// scale s (ConeLanes).
+struct TraceTables {
+  std::vector<float> spheres, prisms, lanes;
+};
+
+TraceTables trace_tables(const ConeSetup& setup, const VoxelGrid& g, float r_max) {
+  TraceTables t;
+  const Vec3 inv{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z};
+  const int np = static_cast<int>(setup.disk.size()), ns = static_cast<int>(setup.sphere_radius.size());
+  for (const ConeSetup::Disk& d : setup.disk) t.prisms.insert(t.prisms.end(), {d.u, d.v});
+  for (int k = 0; k < ns; ++k) {
+    const float r = setup.sphere_radius[static_cast<std::size_t>(k)] * r_max;
+    const float rz = r * inv.z;
+    float chord = 0;
+    for (int s = 0; s < np; ++s) {
+      const float h = setup.disk[static_cast<std::size_t>(s)].half_chord * rz;
+      t.prisms.push_back(h);
+      chord += 2.0f * h;
+    }
+    t.spheres.insert(t.spheres.end(), {r * inv.x, r * inv.y, rz, chord});
+  }
+  // Spheres that start nearer the apex than 1.5 voxels are skipped (the surface's own voxels).
+  const float near = 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z});
+  const float inv_last_radius = 1.0f / setup.sphere_radius.back();
+  for (int j = 0; j <= ns; ++j) {
+    const float k = static_cast<float>(std::min(j, ns - 1));
+    if (j < ns) {
+      const auto js = static_cast<std::size_t>(j);
+      t.lanes.insert(t.lanes.end(), {setup.sphere_distance[js] * r_max, 0.0f, 1.0f, 0.0f,
+                                     (setup.sphere_distance[js] - setup.sphere_radius[js]) * r_max, -near, k, 0.0f});
+    } else {
+      // The filler sphere, inscribed in [s R_max, R_max] along the axis (cone.cpp chain_spheres).
+      t.lanes.insert(t.lanes.end(), {0.5f * r_max, 0.5f * r_max, -0.5f * inv_last_radius, 0.5f * inv_last_radius, -0.5f * inv_last_radius,
+                                     0.5f * inv_last_radius - 1e-3f, k, 0.0f});
+    }
+  }
+  return t;
+}
+
+}  // namespace
+
+MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params) {
+  if (!in.scene) throw InputError("method cone voxelizes the scene, and a G-buffer file has none: give a scene instead of --gbuffer-in");
+  if (Access::buffers(*in.scene).context != Access::textures(in.gbuffer).context)
+    throw InputError("--device gpu: the scene was uploaded to another device");
+  SceneBuffers& sb = Access::buffers(*in.scene);
+  const std::uint32_t seed = in.seed;
+  const ConeParams p = params.resolved();
+  p.validate();
+  check_gpu(p);
+  const float r_max = in.falloff.radius;
+  if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
+  // The CPU method's own timings in --json, from the GPU passes that do their work.
+  r.report_ms("voxelize_ms", {"voxelize", "count"});
+  r.report_ms("trace_ms", {"cone"});
+  r.report_ms("filter_ms", {"filter"});
+  VoxelizeOptions options = p.voxelize_options(r_max);
+  options.rooms = closed_meshes_around(*sb.scene, closure_of(sb), r.g.camera.eye);
+  ConeResult result;
+  result.grid_reused = grid_is_current(state_of(sb).grid, options);
+  if (!result.grid_reused) build_grid(r.c, sb, options, r.passes);
+  const VoxelGrid& g = state_of(sb).grid.layout;
+  const ConeSetup setup = derive_cone_setup(p);
+  const ConePattern pattern = make_cone_pattern(setup, p.jitter, seed);
+  const TraceTables tables = trace_tables(setup, g, r_max);
+  std::vector<float> pattern_table;
+  const int slots = pattern.period * pattern.period;
+  for (int s = 0; s < slots; ++s) {
+    pattern_table.insert(pattern_table.end(), {pattern.rot[2 * static_cast<std::size_t>(s)], pattern.rot[2 * static_cast<std::size_t>(s) + 1], 0.0f, 0.0f});
+    for (int c = 0; c < pattern.cones; ++c) {
+      const ConePattern::Cone& k = pattern.cone[static_cast<std::size_t>(s) * pattern.cones + c];
+      pattern_table.insert(pattern_table.end(), {k.x, k.y, k.z, k.scale});
+    }
+  }
+  const Buffer pattern_buffer = make_buffer(r.c, std::span<const float>(pattern_table));
+  const Buffer lane_buffer = make_buffer(r.c, std::span<const float>(tables.lanes));
+  const Buffer sphere_buffer = make_buffer(r.c, std::span<const float>(tables.spheres));
+  const Buffer prism_buffer = make_buffer(r.c, std::span<const float>(tables.prisms));
+
+  Texture raw = r.image(GL_R32F);
+  Program& prog = r.begin("cone_trace.comp", "cone");
+  const Camera& cam = r.g.camera;
+  const Frame basis = cam.basis();
+  r.set(prog, "u_eye", cam.eye);
+  r.set(prog, "u_basis_x", basis.t);
+  r.set(prog, "u_basis_y", basis.b);
+  r.set(prog, "u_basis_z", basis.n);
+  r.set(prog, "u_origin", g.origin);
+  r.set(prog, "u_inv_size", Vec3{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z});
+  r.c.gl.Uniform2i(r.c.uniform(prog, "u_columns"), g.nx, g.ny);
+  r.set(prog, "u_depth_bits", g.depth_bits);
+  r.set(prog, "u_cones", pattern.cones);
+  r.set(prog, "u_per_cone", static_cast<int>(setup.sphere_distance.size()) + 1);
+  r.set(prog, "u_prisms", static_cast<int>(setup.disk.size()));
+  r.set(prog, "u_period", pattern.period);
+  r.bind(0, state_of(sb).grid.bits);
+  r.bind(2, pattern_buffer);
+  r.bind(3, lane_buffer);
+  r.bind(4, sphere_buffer);
+  r.bind(5, prism_buffer);
+  r.finish(raw);
+
+  MethodOutput out;
+  if (p.filter_taps > 1) {
+    BilateralParams f;
+    f.taps = p.filter_taps;
+    out.visibility = read_float(r.c, bilateral_filter(r, raw, f, "filter"));
+  } else {
+    out.visibility = read_float(r.c, raw);
+  }
+  result.voxel_stats = state_of(sb).grid.stats;
+  result.grid_nx = g.nx;
+  result.grid_ny = g.ny;
+  out.stats = cone_stats(result);  // the timings are the passes' GPU times (stats "gpu_ms")
+  return out;
+}
+
+}  // namespace gpu_detail
+
+VoxelGrid gpu_voxelize_world(GpuDevice& device, const GpuScene& scene, const VoxelizeOptions& options, VoxelStats* stats) {
+  using namespace gpu_detail;
+  Context& c = Access::context(device);
+  c.make_current();
+  SceneBuffers& sb = Access::buffers(scene);
+  if (sb.context.get() != &c) throw InputError("--device gpu: the scene was uploaded to another device");
+  std::vector<PassQuery> passes;
+  build_grid(c, sb, options, passes);
+  c.resolve(passes);
+  VoxelGrid g = state_of(sb).grid.layout;
+  const std::size_t words32 = static_cast<std::size_t>(g.nx) * g.ny * (g.depth_bits / 32);
+  std::vector<std::uint32_t> w(words32);
+  c.gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, state_of(sb).grid.bits.id());
+  c.gl.GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(words32 * sizeof(std::uint32_t)), w.data());
+  c.check("reading the voxel grid back");
+  // 32-bit words to the CPU grid's 64-bit ones: bit b of a column is bit b % 64 of word b / 64, and
+  // the high half of a last word past depth_bits stays zero.
+  const int per_column = g.depth_bits / 32;
+  g.bits.assign(static_cast<std::size_t>(g.nx) * g.ny * g.words, 0);
+  for (std::size_t col = 0; col < static_cast<std::size_t>(g.nx) * g.ny; ++col)
+    for (int k = 0; k < per_column; ++k)
+      g.bits[col * g.words + static_cast<std::size_t>(k / 2)] |= static_cast<std::uint64_t>(w[col * per_column + static_cast<std::size_t>(k)]) << (32 * (k % 2));
+  if (stats) *stats = state_of(sb).grid.stats;
+  return g;
+}
+
+}  // namespace ao

@@ -1,0 +1,329 @@
+// Which side of each open mesh a pixel's point lies on (cone_sides_internal.h).
+#include "ao/methods/cone/cone_sides_internal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <tbb/parallel_for.h>
+
+#include "ao/core/affine.h"
+#include "ao/methods/cone/winding_number.h"
+
+namespace ao::cone_internal {
+
+namespace {
+
+// Within this much of the threshold of w the hierarchy cannot tell the side (its truncation error
+// is 0.005 at worst on the test meshes, winding_number_test.cpp). For a sheet that is where a
+// point sees as much of its fronts as of its backs (beside the foot of an arch standing on the
+// ground: the arch's near wall from outside, its far wall from inside behind it), and the side of
+// the part of the sheet nearest to the point decides. Inside a solid with holes (w near 1/2 in
+// the mouth of a hole) the point is taken as outside.
+constexpr double kUndecided = 0.01;
+// Lattice (SideSetup::Open::lattice): points R_max / 2 apart (farther apart for a lattice of more
+// than 2^15 points); corners whose w is within 0.05 of the threshold leave the decision to the
+// point itself.
+constexpr double kLatticePoints = 32768;
+constexpr float kLatticeMargin = 0.05f;
+
+Bounds3 object_bounds(const Scene& scene, const SceneObject& ob) {
+  const Bounds3 b = scene.meshes[ob.mesh].bounds();
+  return ob.instance == SceneObject::kNoInstance ? b : transform_bounds(scene.instances[ob.instance].object_to_world, b);
+}
+
+bool overlap(const Bounds3& a, const Bounds3& b) {
+  return !(a.hi.x < b.lo.x || b.hi.x < a.lo.x || a.hi.y < b.lo.y || b.hi.y < a.lo.y || a.hi.z < b.lo.z || b.hi.z < a.lo.z);
+}
+
+bool contains(const Bounds3& b, Vec3 p) {
+  return p.x >= b.lo.x && p.x <= b.hi.x && p.y >= b.lo.y && p.y <= b.hi.y && p.z >= b.lo.z && p.z <= b.hi.z;
+}
+
+// The side of the nearest triangle of sheet `o` (0 in its plane).
+int nearest_side(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
+  ++evaluations;
+  const double d = o.sign * o.closure->winding.get().signed_distance(o.instanced ? o.to_object.point(world) : world);
+  return d > 0 ? 1 : d < 0 ? -1 : 0;
+}
+
+// +1 behind open object `o` (sign x w > threshold), -1 in front, 0 on it. Counts evaluations of w.
+int side_of(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
+  const Vec3 p = o.instanced ? o.to_object.point(world) : world;
+  const MeshClosure& c = *o.closure;
+  if (c.flat) {
+    // A flat sheet's w has the sign of -(n.p + d) (voxelize.h, MeshClosure::plane).
+    const double d = double(c.plane[0]) * p.x + double(c.plane[1]) * p.y + double(c.plane[2]) * p.z + c.plane[3];
+    return d == 0 ? 0 : (o.sign * -d > 0 ? 1 : -1);
+  }
+  ++evaluations;
+  const double v = o.sign * c.winding.get()(p) - o.threshold;
+  if (std::abs(v) >= kUndecided) return v > 0 ? 1 : -1;
+  return c.holed() ? -1 : nearest_side(o, world, evaluations);
+}
+
+// The side of `o` that its lattice gives for p: +1 / -1 when the corners of p's cell agree, else 0;
+// `crossed` when they do not agree but all lie at least 0.25 from the threshold: the mesh itself
+// passes through the cell, not the surface beyond its rim where w meets the threshold smoothly.
+int lattice_side(const SideSetup::Open& o, Vec3 p, bool& crossed) {
+  crossed = false;
+  if (o.lattice.empty()) return 0;
+  const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
+  const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
+            z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
+  int behind = 0, front = 0, strong = 0;
+  for (int k = 0; k < 8; ++k) {
+    const float v = o.lattice[(static_cast<std::size_t>(z + (k >> 2)) * o.ly + y + ((k >> 1) & 1)) * o.lx + x + (k & 1)];
+    behind += v >= kLatticeMargin, front += v <= -kLatticeMargin, strong += std::abs(v) >= 0.25f;
+  }
+  crossed = strong == 8;
+  return behind == 8 ? 1 : front == 8 ? -1 : 0;
+}
+
+// How far along its normal a surface point must go to be clear of its own surface's voxels: 1.5
+// voxels, as the kernel's near limit (cone.cpp, cone_world.cpp).
+float clearance(const VoxelGrid& g, Vec3 p) {
+  if (g.space == GridSpace::World) return 1.5f * std::max({g.voxel_size.x, g.voxel_size.y, g.voxel_size.z});
+  const Vec3 c = g.camera.world_to_camera_point(p);
+  const float depth = -c.z;
+  if (!(depth > 0)) return 0.0f;  // not in front of the camera: not a pixel's point
+  const Vec2 pix = g.camera.project(c);
+  const int i = std::clamp(static_cast<int>(pix.x / g.pixels_per_column_x), 0, g.nx - 1);
+  const int j = std::clamp(static_cast<int>(pix.y / g.pixels_per_column_y), 0, g.ny - 1);
+  const float width = 2.0f * g.camera.tan_half_fov() * depth / static_cast<float>(g.ny);
+  return 1.5f * std::max(1.0f / g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i], width);
+}
+
+// The voxel of `g` at world point p (false outside the grid).
+bool solid_at(const VoxelGrid& g, Vec3 p) {
+  float fx, fy, fk;
+  std::size_t col;
+  if (g.space == GridSpace::World) {
+    fx = (p.x - g.origin.x) / g.voxel_size.x, fy = (p.z - g.origin.z) / g.voxel_size.y, fk = (p.y - g.origin.y) / g.voxel_size.z;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < float(g.nx) && fy < float(g.ny))) return false;
+    col = static_cast<std::size_t>(fy) * g.nx + static_cast<std::size_t>(fx);
+  } else {
+    const Vec3 c = g.camera.world_to_camera_point(p);
+    const float depth = -c.z;
+    if (!(depth > 0)) return false;
+    const Vec2 pix = g.camera.project(c);
+    fx = pix.x / g.pixels_per_column_x, fy = pix.y / g.pixels_per_column_y;
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < float(g.nx) && fy < float(g.ny))) return false;
+    col = static_cast<std::size_t>(fy) * g.nx + static_cast<std::size_t>(fx);
+    fk = (depth - g.z_near[col]) * g.voxels_per_unit[col];
+  }
+  if (!(fk >= 0.0f && fk < float(g.depth_bits))) return false;
+  const int k = static_cast<int>(fk);
+  return (g.bits[col * g.words + (k >> 6)] >> (k & 63)) & 1u;
+}
+
+// Open object `oi` of the scene (not closed): where it is, how to test a point, its triangles'
+// world normals.
+SideSetup::Open open_object(const Scene& scene, const SceneObject& ob, std::uint32_t oi, const MeshClosure& c, const Bounds3& bounds, float r_max) {
+  SideSetup::Open o;
+  o.object = oi;
+  o.closure = &c;
+  int det_sign = 1;
+  const Affine3* tf = ob.instance == SceneObject::kNoInstance ? nullptr : &scene.instances[ob.instance].object_to_world;
+  if (tf) {
+    o.instanced = true;
+    o.to_object = inverse(*tf);
+    det_sign = tf->determinant() < 0 ? -1 : 1;  // a mirror turns fronts into backs
+  }
+  // A sheet's slab reaches R_max past it, and a point's cones R_max further: only points within
+  // 2 R_max of it can tell its sides apart. A solid with holes is entered only inside its box.
+  const float pad = c.open_surface() ? 2.0f * r_max : 0.0f;
+  o.reach = bounds;
+  o.reach.lo -= Vec3{pad, pad, pad};
+  o.reach.hi += Vec3{pad, pad, pad};
+  o.sign = det_sign * (c.holed() ? c.orientation : 1);
+  o.threshold = c.holed() ? 0.5 : 0.0;
+  const Mesh& m = scene.meshes[ob.mesh];
+  o.face.resize(m.triangle_count());
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    Vec3 v[3] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+    if (tf)
+      for (Vec3& vk : v) vk = tf->point(vk);
+    o.face[t] = cross(v[1] - v[0], v[2] - v[0]);
+  }
+  return o;
+}
+
+// How an object with box `b` within reach of open object `o` votes: entirely on one side of a flat
+// sheet (its box's corners), that side; any other object is tested per pixel (Mixed: its vertices
+// are too sparse a sample, a ground quad has four, none under a sheet that stands on it).
+SideSetup::Vote vote_of(const SideSetup::Open& o, const Bounds3& b, std::size_t& evaluations) {
+  if (!o.closure->flat) return SideSetup::Mixed;
+  int behind = 0, front = 0;
+  for (int k = 0; k < 8; ++k) {
+    const int side = side_of(o, {k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z}, evaluations);
+    behind += side > 0, front += side < 0;
+  }
+  return behind == 0 ? SideSetup::Front : front == 0 ? SideSetup::Back : SideSetup::Mixed;
+}
+
+// The lattice of sign x w - threshold over o's reach (SideSetup::Open::lattice).
+void fill_lattice(SideSetup::Open& o, float r_max) {
+  const Vec3 e = o.reach.extent();
+  const double cells = (double(e.x) / (0.5 * r_max) + 1) * (double(e.y) / (0.5 * r_max) + 1) * (double(e.z) / (0.5 * r_max) + 1);
+  o.lattice_step = 0.5f * r_max * static_cast<float>(std::max(1.0, std::cbrt(cells / kLatticePoints)));
+  o.lattice_lo = o.reach.lo;
+  // At least one cell along each axis (a box flat along one).
+  o.lx = std::max(2, static_cast<int>(std::ceil(e.x / o.lattice_step)) + 1);
+  o.ly = std::max(2, static_cast<int>(std::ceil(e.y / o.lattice_step)) + 1);
+  o.lz = std::max(2, static_cast<int>(std::ceil(e.z / o.lattice_step)) + 1);
+  o.lattice.resize(static_cast<std::size_t>(o.lx) * o.ly * o.lz);
+  tbb::parallel_for(0, o.lz, [&](int z) {
+    for (int y = 0; y < o.ly; ++y)
+      for (int x = 0; x < o.lx; ++x) {
+        const Vec3 p = o.lattice_lo + Vec3{float(x), float(y), float(z)} * o.lattice_step;
+        o.lattice[(static_cast<std::size_t>(z) * o.ly + y) * o.lx + x] =
+            static_cast<float>(o.sign * o.closure->winding.get()(o.instanced ? o.to_object.point(p) : p) - o.threshold);
+      }
+  });
+}
+
+// Whether a pixel of open object `o` itself, at p with normal n, sees its back side.
+// `camera_behind`: the camera is behind `o` (for a flat sheet); `offset` as in pixel_sides.
+bool own_behind(const GBuffer& gb, int x, int y, const SideSetup::Open& o, bool camera_behind, Vec3 p, Vec3 n, float offset, std::size_t& evaluations) {
+  // A flat sheet is seen from the camera's side of its plane, at every pixel.
+  if (o.closure->flat) return camera_behind;
+  if (!gb.primitive_id.empty() && gb.primitive_id(x, y) < o.face.size()) {
+    // The side of its own triangle the camera sees (world winding, mirrors included).
+    const bool sees_back = dot(o.face[gb.primitive_id(x, y)], n) < 0;
+    // A sheet's back is its triangles' back; a solid's inside is its outside's back.
+    // (o.sign < 0: the world fronts of the solid face in, mirrors and orientation included.)
+    return o.closure->holed() ? sees_back != (o.sign < 0) : sees_back;
+  }
+  return side_of(o, p + n * offset, evaluations) > 0;
+}
+
+// Whether a point p (normal n) of another object lies behind open object `o`, on which its object
+// votes `vote`.
+bool voted_behind(const SideSetup& setup, const SideSetup::Open& o, SideSetup::Vote vote, const VoxelGrid& front, Vec3 p, Vec3 n,
+                  std::size_t& evaluations) {
+  if (vote != SideSetup::Mixed || !contains(o.reach, p)) return vote == SideSetup::Back;
+  bool crossed;
+  const int side = lattice_side(o, p, crossed);
+  if (side != 0) return side > 0;
+  // Where the lattice cannot tell, the point lies within a cell's diagonal of the mesh or of where
+  // w crosses its threshold. With cells R_max / 2 wide that is within 0.87 R_max: inside a solid
+  // with holes, or behind a sheet that crosses its cell, its front is solid in the all-front grid
+  // (the solid holds its inside; the sheet's slab is R_max thick), so only such points need w.
+  // Elsewhere (beside a sheet's rim, under a hole in it) the side of the sheet's nearest triangle
+  // decides: the side of the part of it that the point's cones reach, the same whichever way its
+  // triangles face.
+  const bool pretest = o.lattice_step * 1.7320508f < setup.r_max && (o.closure->holed() || crossed);
+  if (pretest && !solid_at(front, p + n * clearance(front, p))) return false;
+  return (o.closure->holed() ? side_of(o, p, evaluations) : nearest_side(o, p, evaluations)) > 0;
+}
+
+// A pixel whose point is behind some open objects: those objects (indices into SideSetup::open).
+struct Flagged {
+  std::size_t pixel;
+  std::vector<std::uint32_t> back;
+};
+
+// Groups the flagged pixels (per row) by their sides: the largest groups get the grids
+// (kMaxSideGrids, kMinSidePixels), the others are counted as unresolved.
+void group_by_side(const GBuffer& gb, const SideSetup& setup, std::size_t objects, std::vector<std::vector<Flagged>>& rows, PixelSides& out) {
+  std::map<std::vector<std::uint32_t>, std::size_t> count;
+  for (auto& row : rows)
+    for (Flagged& f : row) {
+      std::sort(f.back.begin(), f.back.end());
+      ++count[f.back];
+    }
+  std::vector<std::pair<std::size_t, const std::vector<std::uint32_t>*>> by_size;
+  for (const auto& [back, n] : count) by_size.push_back({n, &back});
+  std::stable_sort(by_size.begin(), by_size.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < out.key_of.size(); ++i) covered += gb.covered(i) ? 1 : 0;
+  const std::size_t least = std::min(kMinSidePixels, covered / 1000);
+  std::map<std::vector<std::uint32_t>, std::uint8_t> index;
+  for (const auto& [n, back] : by_size) {
+    if (static_cast<int>(out.keys.size()) >= kMaxSideGrids || n < least) break;
+    std::vector<std::uint8_t> key(objects, 0);
+    for (std::uint32_t q : *back) key[setup.open[q].object] = 1;
+    index.emplace(*back, static_cast<std::uint8_t>(out.keys.size()));
+    out.keys.push_back(std::move(key));
+  }
+  for (const auto& row : rows)
+    for (const Flagged& f : row) {
+      const auto it = index.find(f.back);
+      if (it == index.end()) ++out.unresolved;
+      else out.key_of[f.pixel] = it->second;
+    }
+}
+
+}  // namespace
+
+SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closure, float r_max) {
+  SideSetup s;
+  s.r_max = r_max;
+  const std::vector<SceneObject> objects = scene.objects();
+  s.votes.resize(objects.size());
+  std::vector<Bounds3> bounds;
+  for (const SceneObject& ob : objects) bounds.push_back(object_bounds(scene, ob));
+  for (std::size_t oi = 0; oi < objects.size(); ++oi) {
+    const MeshClosure& c = closure[objects[oi].mesh];
+    if (!c.closed()) s.open.push_back(open_object(scene, objects[oi], static_cast<std::uint32_t>(oi), c, bounds[oi], r_max));
+  }
+  for (std::uint32_t q = 0; q < s.open.size(); ++q)
+    for (std::size_t a = 0; a < objects.size(); ++a) {
+      if (a == s.open[q].object || !overlap(bounds[a], s.open[q].reach)) continue;
+      const SideSetup::Vote vote = vote_of(s.open[q], bounds[a], s.evaluations);
+      if (vote != SideSetup::Front) s.votes[a].push_back({q, vote});
+    }
+  // Lattices for the open meshes that some object votes Mixed on.
+  std::vector<std::uint8_t> mixed(s.open.size(), 0);
+  for (const auto& list : s.votes)
+    for (const auto& [q, vote] : list) mixed[q] |= vote == SideSetup::Mixed && !s.open[q].closure->flat;
+  for (std::uint32_t q = 0; q < s.open.size(); ++q)
+    if (mixed[q]) {
+      fill_lattice(s.open[q], r_max);
+      s.evaluations += s.open[q].lattice.size();
+    }
+  return s;
+}
+
+PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& setup, const VoxelGrid& front) {
+  PixelSides out;
+  const std::vector<SceneObject> objects = scene.objects();
+  out.keys.push_back({});
+  out.key_of.assign(static_cast<std::size_t>(gb.width()) * gb.height(), 0);
+  if (setup.open.empty()) return out;
+  std::vector<int> open_of(objects.size(), -1);
+  for (std::uint32_t q = 0; q < setup.open.size(); ++q) open_of[setup.open[q].object] = static_cast<int>(q);
+  const Frame basis = gb.camera.basis();
+  const Vec3 eye = gb.camera.eye;
+  // A point just off the surface on the camera's side, to test a pixel of an open object whose
+  // triangle is not known (a G-buffer built by hand): 1e-3 R_max, far below any feature the grid
+  // resolves and far above the float error of the position.
+  const float offset = 1e-3f * setup.r_max;
+  std::vector<std::uint8_t> camera_behind(setup.open.size(), 0);
+  std::size_t unused = 0;
+  for (std::size_t q = 0; q < setup.open.size(); ++q) camera_behind[q] = setup.open[q].closure->flat && side_of(setup.open[q], eye, unused) > 0;
+  // Rows in parallel; each pixel's back flags (open objects, in `open` order) go to its row's list.
+  std::vector<std::vector<Flagged>> rows(gb.height());
+  std::vector<std::size_t> evaluations(gb.height(), 0);
+  tbb::parallel_for(0, gb.height(), [&](int y) {
+    for (int x = 0; x < gb.width(); ++x) {
+      if (!gb.covered(x, y)) continue;
+      const std::uint32_t a = gb.object_id(x, y) - 1;
+      if (a >= objects.size()) continue;
+      const int own = open_of[a];
+      if (own < 0 && setup.votes[a].empty()) continue;
+      const Vec3 p = basis.to_world(gb.position(x, y)) + eye, n = basis.to_world(gb.normal(x, y));
+      std::vector<std::uint32_t> back;
+      if (own >= 0 && own_behind(gb, x, y, setup.open[own], camera_behind[own], p, n, offset, evaluations[y])) back.push_back(static_cast<std::uint32_t>(own));
+      for (const auto& [q, vote] : setup.votes[a])
+        if (voted_behind(setup, setup.open[q], vote, front, p, n, evaluations[y])) back.push_back(q);
+      if (!back.empty()) rows[y].push_back({static_cast<std::size_t>(y) * gb.width() + x, std::move(back)});
+    }
+  });
+  for (std::size_t e : evaluations) out.evaluations += e;
+  group_by_side(gb, setup, objects.size(), rows, out);
+  return out;
+}
+
+}  // namespace ao::cone_internal

@@ -1,0 +1,161 @@
+#include "ao/methods/gtao/gtao.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "ao/core/error.h"
+#include "ao/core/parallel.h"
+#include "ao/core/sampling.h"
+#include "ao/methods/gtao/gtao_internal.h"
+#include "ao/methods/gtao/gtao_kernel_internal.h"
+#include "ao/simd/depth_plane.h"
+
+namespace ao {
+
+namespace {
+
+using gtao_internal::kMaxSlices;
+using gtao_internal::kMaxSteps;
+// Tiles of 128 x 16 pixels, as the other screen-space kernels: long row segments for the SIMD
+// loops over pixels, few rows per tile.
+constexpr int kTileWidth = 128, kTileHeight = 16;
+static_assert(kTileWidth <= simd::kMaxGtaoSegment);
+
+// The 4x4 pattern (the paper's spatial noise, undone by its 4x4 denoiser): per pattern entry p, the
+// rotation of the slice set (a fraction of pi / slices) and the offset of the samples along a slice
+// (a fraction of one step). Both stratified over the 16 entries with independent seeded
+// permutations and jitter, so a 4x4 block holds 16 distinct rotations and offsets; without
+// interleaving every entry is the same seeded value.
+struct Pattern {
+  std::array<float, 16> rotation, offset;
+};
+
+Pattern make_pattern(std::uint32_t seed, bool interleave) {
+  Pattern p;
+  auto permutation = [&](std::uint32_t salt) {
+    std::array<int, 16> perm;
+    for (int k = 0; k < 16; ++k) perm[static_cast<std::size_t>(k)] = k;
+    // Fisher-Yates with hashed choices: depends only on the seed.
+    for (int k = 15; k > 0; --k) {
+      const int j = static_cast<int>(hash_combine(hash_combine(seed, salt), static_cast<std::uint32_t>(k)) % static_cast<std::uint32_t>(k + 1));
+      std::swap(perm[static_cast<std::size_t>(k)], perm[static_cast<std::size_t>(j)]);
+    }
+    return perm;
+  };
+  const std::array<int, 16> pr = permutation(0x51u), po = permutation(0xA7u);
+  for (int k = 0; k < 16; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const float jr = to_unit_float(hash_combine(hash_combine(seed, 0x1Du), static_cast<std::uint32_t>(k)));
+    const float jo = to_unit_float(hash_combine(hash_combine(seed, 0x2Eu), static_cast<std::uint32_t>(k)));
+    p.rotation[i] = interleave ? (static_cast<float>(pr[i]) + jr) / 16.0f : to_unit_float(hash_combine(seed, 0x3Fu));
+    p.offset[i] = interleave ? (static_cast<float>(po[i]) + jo) / 16.0f : to_unit_float(hash_combine(seed, 0x40u));
+  }
+  return p;
+}
+
+}  // namespace
+
+const ParamTable<GtaoParams>& gtao_param_table() {
+  using P = Param<GtaoParams>;
+  static const ParamTable<GtaoParams> table{
+      "gtao",
+      {{P::integer("slices", &GtaoParams::slices, Range::closed(1, kMaxSlices), "", "slice directions per pixel (the outer integral over phi)"),
+        P::integer("steps", &GtaoParams::steps, Range::closed(1, kMaxSteps), "", "depth-buffer samples on each side of a slice (the horizon search)"),
+        P::real("step_power", &GtaoParams::step_power, Range::closed(1, 4), "", "samples at ((j + u) / steps)^step_power of the screen radius"),
+        P::boolean("multi_bounce", &GtaoParams::multi_bounce, "the multi-bounce fit with the G-buffer albedo")},
+       interleave_params(&GtaoParams::interleave)}};
+  return table;
+}
+
+namespace gtao_internal {
+
+Tables make_tables(const GtaoParams& params, std::uint32_t seed) {
+  const int slices = params.slices, steps = params.steps;
+  const Pattern pattern = make_pattern(seed, params.interleave.interleave);
+  Tables t;
+  // Slice k of pattern entry p has screen angle phi = pi (k + rotation_p) / slices: the slices
+  // split the half circle evenly (a slice covers both of its sides), rotated per pixel.
+  for (int k = 0; k < slices; ++k)
+    for (int p = 0; p < 16; ++p) {
+      const double phi = kPi * (k + pattern.rotation[static_cast<std::size_t>(p)]) / slices;
+      t.dir_c[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::cos(phi));
+      t.dir_s[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::sin(phi));
+    }
+  // Step j of pattern entry p lies at t = ((j + offset_p) / steps)^step_power of the screen radius.
+  for (int j = 0; j < steps; ++j)
+    for (int p = 0; p < 16; ++p)
+      t.step_t[static_cast<std::size_t>(j)][static_cast<std::size_t>(p)] =
+          std::pow((static_cast<float>(j) + pattern.offset[static_cast<std::size_t>(p)]) / static_cast<float>(steps), params.step_power);
+  return t;
+}
+
+}  // namespace gtao_internal
+
+void GtaoParams::validate() const { gtao_param_table().validate(*this); }
+void to_json(nlohmann::json& j, const GtaoParams& p) { j = gtao_param_table().to_json(p); }
+void from_json(const nlohmann::json& j, GtaoParams& p) { gtao_param_table().from_json(j, p); }
+
+float gtao_multi_bounce(float v, float rho) {
+  // The paper's cubic fit of path-traced multi-bounce AO against single-bounce V, per albedo rho.
+  const float a = 2.0404f * rho - 0.3324f, b = -4.7951f * rho + 0.6417f, c = 2.7552f * rho + 0.6903f;
+  return std::max(v, ((a * v + b) * v + c) * v);
+}
+
+GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std::uint32_t seed) {
+  params.validate();
+  if (!(radius > 0.0f) || !std::isfinite(radius)) throw InputError("gtao: radius R must be a positive number of world units");
+  const int w = g.width(), h = g.height();
+  const int slices = params.slices, steps = params.steps;
+  const gtao_internal::Tables tables = gtao_internal::make_tables(params, seed);
+
+  // Camera rays through pixel centres: ray(x, y) = (ax (x + 0.5) + bx, ay (y + 0.5) + by, -1), so a
+  // sample's camera-space point is depth * ray (one 4-byte gather per sample).
+  const float t = g.camera.tan_half_fov();
+  const Image<float> depth_image = depth_plane(g);  // also the filter's
+  simd::GtaoInputs in;
+  // Both image axes have 0.5 h / tan(fov/2) pixels per unit of x/(-z): R at depth z spans R * that / z pixels.
+  static_cast<simd::DepthView&>(in) = simd::depth_view(depth_image.data(), &g.normal.data()->x, g.object_id.data(), w, h, t, g.camera.aspect());
+  in.radius = radius;
+  in.slices = slices, in.steps = steps;
+  // The kernel reads each table as one row-major array, [k * 16 + p].
+  static_assert(sizeof(tables.dir_c) == sizeof(float) * kMaxSlices * 16 && sizeof(tables.step_t) == sizeof(float) * kMaxSteps * 16);
+  in.dir_c = tables.dir_c[0].data(), in.dir_s = tables.dir_s[0].data(), in.step_t = tables.step_t[0].data();
+
+  // V = 1 where nothing is covered: each tile fills its own rows (fresh pages touched in parallel).
+  Image<float> v;
+  v.resize(w, h);
+  parallel_for_tiles(w, h, kTileWidth, kTileHeight, [&](const Tile& tile) {
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      std::fill_n(&v(tile.x0, y), tile.x1 - tile.x0, 1.0f);
+      simd::gtao_row(in, y, tile.x0, tile.x1, &v(tile.x0, y));
+    }
+  });
+  if (params.interleave.interleave && params.interleave.filter) v = depth_aware_box_filter(v, g, effective_depth_limit(params.interleave, radius), &depth_image);
+  GtaoImage out;
+  if (params.multi_bounce) {
+    out.color = Image<Vec3>(w, h, Vec3{1, 1, 1});
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (!g.covered(x, y)) continue;
+        const Vec3 a = g.albedo(x, y);
+        const float vis = v(x, y);
+        out.color(x, y) = {gtao_multi_bounce(vis, a.x), gtao_multi_bounce(vis, a.y), gtao_multi_bounce(vis, a.z)};
+        v(x, y) = gtao_multi_bounce(vis, 0.2126f * a.x + 0.7152f * a.y + 0.0722f * a.z);  // Rec. 709 luminance
+      }
+  }
+  out.visibility = std::move(v);
+  return out;
+}
+
+MethodOutput run(const MethodInput& in, const GtaoParams& params) {
+  GtaoImage img = gtao_ao(in.gbuffer, in.falloff.radius, params, in.seed);
+  MethodOutput out;
+  out.visibility = std::move(img.visibility);
+  out.color = std::move(img.color);
+  return out;
+}
+
+}  // namespace ao

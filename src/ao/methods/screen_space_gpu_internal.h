@@ -1,0 +1,24 @@
+// What the screen-space methods' GPU runs share (containment_gpu.cpp, volumetric_gpu.cpp,
+// transfer_gpu.cpp), not installed: the uniforms of their sampling, containment's test offsets as
+// a buffer, and the filter after an interleaved pass.
+#pragma once
+
+#include <cstdint>
+
+#include "ao/core/membership.h"
+#include "ao/gpu/run_internal.h"
+#include "ao/methods/filters/interleave.h"
+
+namespace ao::gpu_detail {
+
+/// The uniforms containment, transfer and volumetric share: the depth-test bias, the 4x4
+/// rotations, the sample count and the silhouette elimination's limit (AT 4.3: a surface more than
+/// R in front of the test point, or of the pipe's entry, does not occlude it).
+void set_sampling(Run& r, Program& p, int samples, float bias, bool silhouette_elimination, float radius, const InterleaveOptions& interleave,
+                  std::uint32_t seed);
+/// The containment-test offsets (X, Y, Z, r) of make_containment_samples, as vec4s.
+Buffer containment_offsets(Run& r, int n, const Falloff& falloff);
+/// `raw` through the box filter when the options ask for it (interleaving and filtering on).
+Texture filtered(Run& r, Texture raw, int channels, const InterleaveOptions& o, float radius);
+
+}  // namespace ao::gpu_detail

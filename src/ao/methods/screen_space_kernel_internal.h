@@ -1,0 +1,67 @@
+// What the kernels of the depth-buffer screen-space methods share (containment and volumetric AO:
+// Szirmay-Kalos et al., "Volumetric Ambient Occlusion for Real-Time Rendering and Games", eq. 5-7;
+// ambient transfer: Szirmay-Kalos et al., "Ambient Transfer", eq. 8-9 and sec. 4; each kernel in its
+// method's folder): a row's covered pixels in the lanes of vectors (the row loader,
+// screen_space_kernel.cpp), the depth plane and the test points. Each kernel runs all samples of a
+// vector of pixels with its per-pixel values and sums in registers, one depth gather per test
+// point. The methods derive the samples and constants from the papers and hand them over; what the
+// kernels compute is stated in their headers in the papers' terms.
+#pragma once
+
+#include <cstdint>
+
+#include "ao/core/gbuffer.h"
+#include "ao/simd/aligned_internal.h"
+
+namespace ao::simd {
+
+/// The 16 rotations of the 4x4 interleaving pattern (VAO and AT sec. 4.2): entry (y % 4) * 4 + x % 4.
+struct Rotations16 {
+  float c[16], s[16];  ///< cos and sin of the angle.
+};
+
+/// The covered pixels of a row segment [x0, x0 + ...), compacted, structure of arrays: entry k < count
+/// is pixel x0 + index[k]. Every array holds padded(count) entries; those past `count` are a
+/// harmless point (one unit in front of the camera, facing it) whose results are never read.
+struct CoveredPixels {
+  int y = 0, x0 = 0, count = 0;
+  AlignedVector<int> index;
+  AlignedVector<float> px, py, pz;  ///< Camera-space position of the shaded point x.
+  AlignedVector<float> nx, ny, nz;  ///< Unit normal N.
+  AlignedVector<float> tx, ty, tz;  ///< Tangent T rotated by the pixel's interleaving angle about N (with `frame`).
+  AlignedVector<float> bx, by, bz;  ///< Binormal B = N x T, rotated likewise (with `frame`).
+  AlignedVector<float> rc, rs;      ///< The pixel's rotation (cos, sin).
+  AlignedVector<float> bias;        ///< Depth-test bias, world units.
+};
+
+/// Fills `row` with the covered pixels of [x0, x1) of row y of `g`. The depth bias is `bias_world`
+/// when > 0, else one pixel footprint at the pixel's depth times (1 + tan theta_v), theta_v the
+/// angle between N and the view ray (tan clamped to 8): the most a nearest-pixel depth lookup on the
+/// same surface can be off by. With `frame` false the rotated frame (tx..bz) is left unset.
+void load_covered_pixels(CoveredPixels& row, const GBuffer& g, int y, int x0, int x1, const Rotations16& rotations, float bias_world,
+                         bool frame);
+
+/// The depth plane (VAO fig. 2c) and the projection onto it (ScreenProjection's constants):
+/// pixel (ix, iy) of camera-space p = (scale_x x / -z + centre_x, centre_y - scale_y y / -z),
+/// clamped to the image; +infinity on background.
+struct DepthPlane {
+  const float* depth = nullptr;  ///< width * height linear depths.
+  float scale_x = 1, scale_y = 1, centre_x = 0, centre_y = 0;
+  int width = 0, height = 0;
+  /// A deep G-buffer's second layer (GBuffer::second_depth), or null. With it the solid along a
+  /// pixel's ray is [z*, z2] where the layer holds a back face z2 > 0, [z*, z* + separation] and
+  /// [-z2, infinity) where it holds a front face (z2 < 0), and [z*, infinity) where it holds
+  /// +infinity; without it [z*, infinity) (methods/depth_layers.h).
+  const float* second = nullptr;
+  float separation = 0;
+};
+
+/// Test points in the tangent frame, world units (VAO eq. 5, AT eq. 8): (x[i], y[i], z[i]), n of them.
+struct TestPoints {
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+  int n = 0;
+};
+
+}  // namespace ao::simd

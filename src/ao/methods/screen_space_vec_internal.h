@@ -1,0 +1,104 @@
+// What the screen-space methods' kernels share (containment, volumetric and transfer: each
+// method's folder holds its kernel), included by each of their sources once per target (Highway's
+// "-inl.h" convention, as simd/vec_internal.h): the depth plane in vectors, a vector of a row's
+// covered pixels, and the test points' offsets. Include it after simd/vec_internal.h, inside no
+// namespace.
+#if defined(AO_METHODS_SCREEN_SPACE_VEC_INTERNAL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef AO_METHODS_SCREEN_SPACE_VEC_INTERNAL_H_
+#undef AO_METHODS_SCREEN_SPACE_VEC_INTERNAL_H_
+#else
+#define AO_METHODS_SCREEN_SPACE_VEC_INTERNAL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "ao/methods/screen_space_kernel_internal.h"
+#include "ao/simd/vec_internal.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace ao::simd::HWY_NAMESPACE {
+namespace screen_space {
+
+constexpr int kMaxSteps = 8;            // m: test points per ray (the methods' parameter range)
+constexpr int kMaxSamples = 256;        // n: rays per pixel (kMaxScreenSpaceSamples)
+
+// The depth plane's constants in vectors, made once per call.
+struct Plane {
+  VF scale_x, scale_y, centre_x, centre_y, max_x, max_y, separation;
+  VI width;
+  const float* depth;
+  const float* second;
+  explicit Plane(const DepthPlane& p)
+      : scale_x(hn::Set(DF(), p.scale_x)), scale_y(hn::Set(DF(), p.scale_y)), centre_x(hn::Set(DF(), p.centre_x)),
+        centre_y(hn::Set(DF(), p.centre_y)), max_x(hn::Set(DF(), static_cast<float>(p.width - 1))),
+        max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), separation(hn::Set(DF(), p.separation)), width(hn::Set(DI(), p.width)),
+        depth(p.depth), second(p.second) {}
+
+  // Deep G-buffer (DepthPlane::second): where the solid that begins at a pixel's first layer z1
+  // ends, given the pixel's second-layer word s2: s2 itself for a back face (s2 > 0, +infinity
+  // without a surface behind), z1 + separation for a front face.
+  HWY_INLINE VF solid_end(VF z1, VF s2) const { return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), s2, hn::Add(z1, separation)); }
+  // Where the next solid begins: the front face's depth -s2, else +infinity.
+  HWY_INLINE static VF next_solid(VF s2) {
+    return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), hn::Set(DF(), kInfinity), hn::Neg(s2));
+  }
+  // Whether depth z, behind the first layer z1, lies in the solid: before its end or past the next
+  // solid's beginning.
+  HWY_INLINE MF in_solid(VF z, VF z1, VF s2) const { return hn::Or(hn::Lt(z, solid_end(z1, s2)), hn::Gt(z, next_solid(s2))); }
+
+  // ScreenProjection::locate, lane-wise: the pixel of camera-space point q (clamp-to-edge: f clamped
+  // to [0, size - 1] as floats before the conversion; Max returns its second operand, 0, for a NaN
+  // first one on every target). `valid`: q is in front of the camera (else the pixel is meaningless).
+  VI pixel(VF qx, VF qy, VF qz) const {
+    const VF zero = hn::Zero(DF());
+    const VF inv = hn::Div(hn::Set(DF(), -1.0f), qz);
+    const VF fx = hn::MulAdd(hn::Mul(qx, inv), scale_x, centre_x);
+    const VF fy = hn::NegMulAdd(hn::Mul(qy, inv), scale_y, centre_y);
+    const VI ix = truncate_in_range(hn::Min(hn::Max(fx, zero), max_x));
+    const VI iy = truncate_in_range(hn::Min(hn::Max(fy, zero), max_y));
+    return hn::Add(hn::Mul(iy, width), ix);
+  }
+};
+
+// A vector of CoveredPixels entries from k0: position, rotated frame, normal, bias.
+struct Entries {
+  VF px, py, pz, tx, ty, tz, bx, by, bz, nx, ny, nz, bias;
+  Entries(const CoveredPixels& row, int k0) {
+    const DF d;
+    px = hn::Load(d, row.px.data() + k0), py = hn::Load(d, row.py.data() + k0), pz = hn::Load(d, row.pz.data() + k0);
+    tx = hn::Load(d, row.tx.data() + k0), ty = hn::Load(d, row.ty.data() + k0), tz = hn::Load(d, row.tz.data() + k0);
+    bx = hn::Load(d, row.bx.data() + k0), by = hn::Load(d, row.by.data() + k0), bz = hn::Load(d, row.bz.data() + k0);
+    nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);
+    bias = hn::Load(d, row.bias.data() + k0);
+  }
+  // VAO eq. 5 / AT eq. 8: the test point x + X T + Y B + Z N for the offset (X, Y, Z).
+  void point(float X, float Y, float Z, VF& qx, VF& qy, VF& qz) const {
+    const DF d;
+    const VF vx = hn::Set(d, X), vy = hn::Set(d, Y), vz = hn::Set(d, Z);
+    qx = hn::MulAdd(vz, nx, hn::MulAdd(vy, bx, hn::MulAdd(vx, tx, px)));
+    qy = hn::MulAdd(vz, ny, hn::MulAdd(vy, by, hn::MulAdd(vx, ty, py)));
+    qz = hn::MulAdd(vz, nz, hn::MulAdd(vy, bz, hn::MulAdd(vx, tz, pz)));
+  }
+};
+
+// The offsets of every test point, (j/m)(X_i, Y_i, Z_i) for step j of ray i, scaled once per call.
+struct StepOffsets {
+  float xyz[3 * kMaxSamples * kMaxSteps];
+  StepOffsets(const TestPoints& s, int m) {
+    const float inv_m = 1.0f / static_cast<float>(m);
+    for (int i = 0; i < s.n; ++i)
+      for (int j = 1; j <= m; ++j) {
+        const float f = static_cast<float>(j) * inv_m;
+        float* o = at(i, j);
+        o[0] = f * s.x[i], o[1] = f * s.y[i], o[2] = f * s.z[i];
+      }
+  }
+  float* at(int i, int j) { return &xyz[3 * (i * kMaxSteps + j - 1)]; }
+  const float* at(int i, int j) const { return &xyz[3 * (i * kMaxSteps + j - 1)]; }
+};
+
+}  // namespace screen_space
+}  // namespace ao::simd::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // AO_METHODS_SCREEN_SPACE_VEC_INTERNAL_H_

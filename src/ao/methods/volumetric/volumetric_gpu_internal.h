@@ -1,0 +1,15 @@
+// Volumetric's GPU path (volumetric_gpu.cpp: volumetric.comp), not installed: what the registry's
+// run_gpu_method calls for its parameters (methods/method.h).
+#pragma once
+
+#include "ao/gpu/run_internal.h"
+#include "ao/methods/method.h"
+#include "ao/methods/volumetric/volumetric.h"
+
+namespace ao::gpu_detail {
+
+/// The method on the device with the CPU kernel's sample sets and rotations; the output as run()'s
+/// (up to float rounding: tests/gpu). Parameters are checked by the caller's decode and check_gpu.
+MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const VolumetricParams& params);
+
+}  // namespace ao::gpu_detail

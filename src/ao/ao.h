@@ -21,7 +21,9 @@
 // tiles, parameter tables, memory estimates, stopwatch, errors.
 #include "ao/core/affine.h"
 #include "ao/core/camera.h"
+#include "ao/core/color_shared.h"
 #include "ao/core/error.h"
+#include "ao/core/hash_shared.h"
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
 #include "ao/core/math.h"
@@ -31,6 +33,7 @@
 #include "ao/core/params.h"
 #include "ao/core/progress.h"
 #include "ao/core/sampling.h"
+#include "ao/core/shared.h"  // the prelude of the *_shared.h headers, which C++ and the GPU shaders both read
 #include "ao/core/stopwatch.h"
 #include "ao/core/texture.h"
 #include "ao/core/typed_slots.h"
@@ -55,16 +58,20 @@
 
 // methods: one paper per header, and the registry that runs any of them by name.
 #include "ao/methods/alchemy/alchemy.h"
+#include "ao/methods/alchemy/alchemy_shared.h"
 #include "ao/methods/filters/bilateral.h"
 #include "ao/methods/characteristic.h"
 #include "ao/methods/cone/cone.h"
+#include "ao/methods/cone/cone_shared.h"
 #include "ao/methods/containment/containment.h"
 #include "ao/methods/depth_layers.h"
 #include "ao/methods/gtao/gtao.h"
+#include "ao/methods/gtao/gtao_shared.h"
 #include "ao/methods/filters/interleave.h"
 #include "ao/methods/method.h"
 #include "ao/registry/registry.h"
 #include "ao/methods/samples.h"
+#include "ao/methods/screen_space_shared.h"
 #include "ao/methods/transfer/transfer.h"
 #include "ao/methods/volumetric/volumetric.h"
 #include "ao/methods/cone/voxelize.h"

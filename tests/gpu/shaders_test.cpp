@@ -21,12 +21,17 @@ namespace {
 
 const std::filesystem::path kSources = std::filesystem::path(AO_TESTS_DIR) / ".." / "src" / "ao";
 
-// Every shader file under src/ao (the extensions the build embeds), by file name (names are unique).
+// Every shader file under src/ao (the files the build embeds: the extensions of shader stages and
+// GLSL, and the headers C++ and GLSL share), by file name (names are unique).
 std::map<std::string, std::filesystem::path> shader_files() {
   static const std::set<std::string> kExtensions{".comp", ".glsl", ".vert", ".geom", ".frag"};
+  const auto embedded = [](const std::filesystem::path& p) {
+    const std::string name = p.filename().string();
+    return kExtensions.contains(p.extension().string()) || name == "shared.h" || name.ends_with("_shared.h");
+  };
   std::map<std::string, std::filesystem::path> files;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(kSources))
-    if (kExtensions.contains(entry.path().extension().string())) {
+    if (embedded(entry.path())) {
       const bool unique = files.emplace(entry.path().filename().string(), entry.path()).second;
       EXPECT_TRUE(unique) << entry.path() << ": a second shader of this name (the loader finds shaders by name)";
     }
@@ -89,6 +94,32 @@ TEST(GpuShaders, EveryShaderCompilesOnTheDevice) {
   }
   EXPECT_NO_THROW(c.program({"gbuffer.vert", "gbuffer.geom", "gbuffer.frag"}));
   EXPECT_NO_THROW(c.program({"cone_voxelize.vert", "cone_voxelize.geom", "cone_voxelize.frag"}));
+}
+
+// A constant the shared headers define (AO_CONST name = literal, core/shared.h) is read from them:
+// no shader types its value again (outside comments), where it could drift from the C++ kernels'.
+TEST(GpuShaders, NoShaderTypesASharedConstantAgain) {
+  const std::regex constant(R"(AO_CONST\s+\w+\s+(\w+)\s*=\s*([^;]+);)");
+  std::vector<std::pair<std::string, std::string>> literals;  // name, literal without its suffix
+  for (const auto& [name, path] : shader_files()) {
+    if (!name.ends_with("_shared.h")) continue;
+    const std::string text = read(path);
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), constant); it != std::sregex_iterator(); ++it) {
+      std::string literal = (*it)[2];
+      if (!literal.empty() && (literal.back() == 'f' || literal.back() == 'u')) literal.pop_back();
+      literals.emplace_back((*it)[1], literal);
+    }
+  }
+  ASSERT_GT(literals.size(), 10u) << "the shared headers' constants were not found";
+  for (const auto& [name, path] : shader_files()) {
+    if (name.ends_with(".h")) continue;
+    std::istringstream lines(read(path));
+    for (std::string line; std::getline(lines, line);) {
+      const std::string code = line.substr(0, line.find("//"));
+      for (const auto& [constant_name, literal] : literals)
+        EXPECT_EQ(code.find(literal), std::string::npos) << name << " types " << constant_name << " (" << literal << ") again: " << line;
+    }
+  }
 }
 
 }  // namespace

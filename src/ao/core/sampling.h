@@ -5,28 +5,15 @@
 #include <array>
 #include <cstdint>
 
+#include "ao/core/hash_shared.h"  // hash32, hash_combine, pixel_seed, to_unit_float (shared with the GPU shaders)
 #include "ao/core/math.h"
 
 namespace ao {
 
-/// 32-bit integer finaliser with good avalanche (the "lowbias32" constants).
-constexpr std::uint32_t hash32(std::uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352du;
-  x ^= x >> 15;
-  x *= 0x846ca68bu;
-  x ^= x >> 16;
-  return x;
-}
-constexpr std::uint32_t hash_combine(std::uint32_t seed, std::uint32_t v) { return hash32(seed ^ (v + 0x9e3779b9u + (seed << 6) + (seed >> 2))); }
-
-/// Seed for one pixel of one image: mixes the user's seed with the pixel coordinates.
-constexpr std::uint32_t pixel_seed(std::uint32_t seed, int x, int y) {
-  return hash_combine(hash_combine(hash32(seed), static_cast<std::uint32_t>(x)), static_cast<std::uint32_t>(y));
-}
-
-/// Maps 32 random bits to a float in [0, 1).
-constexpr float to_unit_float(std::uint32_t bits) { return static_cast<float>(bits >> 8) * 0x1.0p-24f; }
+using shared::hash32;
+using shared::hash_combine;
+using shared::pixel_seed;
+using shared::to_unit_float;
 
 /// Point `index` of the 2-D Sobol sequence with hash-based nested uniform (Owen) scrambling and
 /// index shuffling keyed by `seed` (Burley 2020, "Practical hash-based Owen scrambling").

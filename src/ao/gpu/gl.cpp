@@ -95,7 +95,9 @@ const char* find_embedded(std::string_view name) {
   throw SystemError("gpu: no embedded shader '" + std::string(name) + "'");
 }
 
-// `text` with its #include "file" lines expanded (each file once: the includes have no guards).
+// `text` with its #include "file" lines expanded, each file once (the GLSL files have no guards).
+// A file is found by its name: `#include "ao/core/hash_shared.h"`, the path a C++ compiler takes
+// in a header both read, names the embedded hash_shared.h.
 void expand(std::string_view text, std::set<std::string, std::less<>>& seen, std::string& out) {
   std::istringstream in{std::string(text)};
   std::string line;
@@ -103,7 +105,8 @@ void expand(std::string_view text, std::set<std::string, std::less<>>& seen, std
     const std::size_t at = line.find("#include \"");
     if (at != std::string::npos && line.find_first_not_of(' ') == at) {
       const std::size_t end = line.find('"', at + 10);
-      const std::string file = line.substr(at + 10, end - at - 10);
+      const std::string path = line.substr(at + 10, end - at - 10);
+      const std::string file = path.substr(path.rfind('/') + 1);  // npos + 1 = 0: a bare name
       if (seen.insert(file).second) expand(find_embedded(file), seen, out);
       continue;
     }
@@ -114,10 +117,12 @@ void expand(std::string_view text, std::set<std::string, std::less<>>& seen, std
 
 }  // namespace
 
-std::string shader_source(std::string_view name) {
+std::string shader_source(std::string_view name) { return expand_includes(find_embedded(name)); }
+
+std::string expand_includes(std::string_view text) {
   std::set<std::string, std::less<>> seen;
   std::string out;
-  expand(find_embedded(name), seen, out);
+  expand(text, seen, out);
   return out;
 }
 

@@ -166,11 +166,15 @@ class Context {
   std::map<std::string, Program, std::less<>> programs_;
 };
 
-/// The embedded text of shader file `name` (src/ao/gpu/shaders/), with every `#include "file"`
-/// line replaced by that file's text (once per file and program); SystemError for an unknown name.
+/// The embedded text of shader file `name`, with every `#include "file"` line replaced by that
+/// file's text (once per file and program; a file is found by its name, whatever folders its path
+/// names); SystemError for an unknown name.
 std::string shader_source(std::string_view name);
+/// `text` with its includes expanded as shader_source expands a file's.
+std::string expand_includes(std::string_view text);
 
-/// The embedded shader files, by name (generated from src/ao/gpu/shaders/ at build time).
+/// The embedded shader files, by name (generated at build time from the shaders under src/ao/ and
+/// the *_shared.h headers they include).
 struct EmbeddedShader {
   const char* name;
   const char* text;

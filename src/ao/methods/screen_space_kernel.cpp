@@ -11,6 +11,7 @@
 #include <hwy/highway.h>
 
 #include "ao/methods/screen_space_kernel_internal.h"
+#include "ao/methods/screen_space_shared.h"
 #include "ao/simd/vec_internal.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -87,7 +88,7 @@ void set_bias(CoveredPixels& row, const GBuffer& g, int end, float bias_world) {
   }
   // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
   const VF footprint = hn::Set(d, 2.0f * g.camera.tan_half_fov() / static_cast<float>(g.height()));
-  const VF one = hn::Set(d, 1.0f), zero = hn::Zero(d), min_cos = hn::Set(d, 0.124f);  // cos 82.9 deg: tan <= 8
+  const VF one = hn::Set(d, 1.0f), zero = hn::Zero(d), min_cos = hn::Set(d, shared::kMinViewCosine);
   for (int k0 = 0; k0 < end; k0 += static_cast<int>(hn::Lanes(d))) {
     const VF px = hn::Load(d, row.px.data() + k0), py = hn::Load(d, row.py.data() + k0), pz = hn::Load(d, row.pz.data() + k0);
     const VF nx = hn::Load(d, row.nx.data() + k0), ny = hn::Load(d, row.ny.data() + k0), nz = hn::Load(d, row.nz.data() + k0);

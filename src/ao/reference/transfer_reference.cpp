@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "ao/core/color_shared.h"
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/pixel_loop_internal.h"
@@ -13,7 +14,7 @@ namespace ao {
 
 namespace {
 
-constexpr Vec3 kLuminance{0.2126f, 0.7152f, 0.0722f};  // Rec. 709, as the method's luminance
+constexpr Vec3 kLuminance{shared::kLuminanceR, shared::kLuminanceG, shared::kLuminanceB};  // Rec. 709, as the method's luminance
 
 // Running sums of o_i and, per channel, of the denominators' samples q_i = 1 - l_i, for the ratio
 // W = sum o / sum q and its delta-method variance (1/n) var(o - W q) / mean(q)^2.

@@ -1,5 +1,5 @@
-// Shared by the GPU backend's compute shaders (src/ao/gpu/shaders/): the G-buffer's bindings and
-// conventions, the integer hashes of src/ao/core/sampling.h, and small helpers every method uses.
+// Shared by the GPU backend's compute shaders (each method's, in its folder): the G-buffer's bindings
+// and conventions, the integer hashes of src/ao/core/sampling.h, and small helpers every method uses.
 // A shader that includes this file (`#include "common.glsl"`, expanded by the loader in
 // src/ao/gpu/gl.cpp) can be used elsewhere by pasting the file in place of that line.
 //
@@ -28,18 +28,9 @@ const float kInfinity = uintBitsToFloat(0x7f800000u);
 float depth_at(ivec2 p) { return texelFetch(u_depth, p, 0).r; }
 bool covered(ivec2 p) { return texelFetch(u_object, p, 0).r != 0u; }
 
-// sampling.h: the "lowbias32" finaliser, hash_combine, pixel_seed and to_unit_float, bit for bit.
-uint hash32(uint x) {
-  x ^= x >> 16;
-  x *= 0x7feb352du;
-  x ^= x >> 15;
-  x *= 0x846ca68bu;
-  x ^= x >> 16;
-  return x;
-}
-uint hash_combine(uint seed, uint v) { return hash32(seed ^ (v + 0x9e3779b9u + (seed << 6) + (seed >> 2))); }
-uint pixel_seed(uint seed, int x, int y) { return hash_combine(hash_combine(hash32(seed), uint(x)), uint(y)); }
-float to_unit_float(uint bits) { return float(bits >> 8) * (1.0 / 16777216.0); }
+// sampling.h: the "lowbias32" finaliser, hash_combine, pixel_seed and to_unit_float, the same
+// definitions the C++ compiler reads.
+#include "ao/core/hash_shared.h"
 
 // math.h Frame::from_normal (Duff et al. 2017): tangent and bitangent of a unit normal. The sign is
 // that of n.z's sign bit, as std::copysign(1, n.z) (-0 counts as negative).
@@ -62,17 +53,4 @@ ivec2 locate(vec3 q, out bool valid) {
   const float fx = valid ? q.x * inv * u_projection.x + u_projection.z : 0.0;
   const float fy = valid ? u_projection.w - q.y * inv * u_projection.y : 0.0;
   return ivec2(int(min(max(fx, 0.0), float(u_size.x - 1))), int(min(max(fy, 0.0), float(u_size.y - 1))));
-}
-
-// The automatic depth-test bias of the screen-space methods (screen_space_internal.h PixelRow):
-// one pixel's footprint at the point's depth times (1 + tan theta_v), theta_v the angle between
-// the normal and the view ray, clamped at tan = 8 (cos 0.124): the most a nearest-pixel depth
-// lookup on the same surface can be off by. `bias_world` > 0 replaces it.
-float depth_bias(vec3 p, vec3 n, float bias_world, float footprint) {
-  if (bias_world > 0.0) return bias_world;
-  const float len = sqrt(dot(p, p));
-  const vec3 u = len > 0.0 ? p / len : p;
-  const float cos_v = max(abs(dot(n, u)), 0.124);
-  const float tan_v = sqrt(1.0 - cos_v * cos_v) / cos_v;
-  return footprint * (-p.z) * (1.0 + tan_v);
 }

@@ -29,6 +29,7 @@
 // Buffers: binding 0 the 1024 rotations (cos, sin); binding 1 the sample directions (cos, sin of
 // i times the golden angle); both alchemy_internal.h's tables.
 #include "common.glsl"
+#include "alchemy_shared.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, r32f) uniform writeonly image2D o_visibility;
@@ -45,13 +46,11 @@ uniform float u_beta;
 uniform float u_contrast;
 uniform vec4 u_rays;
 
-const float kMaxPixelRadius = 16384.0;  // a disk covering the image gains nothing from a larger one
-const float kCoordOffset = 65536.0;     // keeps pixel coordinates positive: truncation is floor
 
 // sqrt(x) for x in [0, 1] as the CPU kernel computes it: the reciprocal square root bit trick and
 // two Newton steps (relative error < 5e-6), so both backends place the samples alike.
 float sqrt_unit(float x) {
-  float r = uintBitsToFloat(0x5f3759dfu - (floatBitsToUint(x) >> 1));
+  float r = uintBitsToFloat(kInvSqrtMagic - (floatBitsToUint(x) >> 1));
   r = r * (1.5 - 0.5 * x * r * r);
   r = r * (1.5 - 0.5 * x * r * r);
   return x * r;
@@ -72,18 +71,18 @@ void main() {
   const vec3 c = position_at(pix, d), n = texelFetch(u_normal, pix, 0).xyz;
   // Eq. 10's z_C beta: z_C < 0, so this lowers v.n and drops samples nearly in the tangent plane.
   const float bias = c.z * u_beta;
-  const float radius_px = min(kMaxPixelRadius, u_radius_px / d);
+  const float radius_px = min(kAlchemyMaxPixelRadius, u_radius_px / d);
   const uint hs = pixel_seed(u_seed, pix.x, pix.y);
   const float jitter = to_unit_float(hs);
   const vec2 rot = u_rotations[hash32(hs) & 1023u];
-  const float fx0 = float(pix.x) + 0.5 + kCoordOffset, fy0 = float(pix.y) + 0.5 + kCoordOffset;
+  const float fx0 = float(pix.x) + 0.5 + kAlchemyCoordOffset, fy0 = float(pix.y) + 0.5 + kAlchemyCoordOffset;
   const float inv_s = 1.0 / float(u_samples);
   float sum = 0.0;
   for (int i = 0; i < u_samples; ++i) {
     const vec2 u = u_directions[i];
     const float rho = radius_px * sqrt_unit((float(i) + jitter) * inv_s);
     const float dx = rho * (rot.x * u.x - rot.y * u.y), dy = rho * (rot.y * u.x + rot.x * u.y);
-    const ivec2 q = clamp(ivec2(int(fx0 + dx), int(fy0 + dy)) - ivec2(int(kCoordOffset)), ivec2(0), u_size - 1);
+    const ivec2 q = clamp(ivec2(int(fx0 + dx), int(fy0 + dy)) - ivec2(int(kAlchemyCoordOffset)), ivec2(0), u_size - 1);
     const vec3 v = position_at(q, depth_at(q)) - c;
     const float vv = v.x * v.x + v.y * v.y + v.z * v.z;
     const float vn = v.x * n.x + v.y * n.y + v.z * n.z + bias;

@@ -4,13 +4,14 @@
 
 #include <array>
 
+#include "ao/methods/alchemy/alchemy_shared.h"
+
 namespace ao::alchemy_internal {
 
 inline constexpr int kMaxSamples = 1024;
-// The disk's screen radius is capped (a pixel whose disk covers the whole image gains nothing from a
-// larger one) so that pixel coordinates stay below kCoordOffset and truncation acts as floor.
-inline constexpr float kMaxPixelRadius = 16384.0f;
-inline constexpr float kCoordOffset = 65536.0f;
+// The disk's screen radius cap and the coordinate offset (alchemy_shared.h, read by the shader too).
+inline constexpr float kMaxPixelRadius = shared::kAlchemyMaxPixelRadius;
+inline constexpr float kCoordOffset = shared::kAlchemyCoordOffset;
 // Per-pixel rotations of the sample pattern come from a table of this many angles (no trig per
 // pixel); 1024 steps of 0.35 degrees are far finer than any sample spacing.
 inline constexpr int kRotations = 1024;

@@ -26,21 +26,21 @@ namespace {
 
 // Pixel coordinates are offset by this so they stay positive and truncation acts as floor (the
 // disk's screen radius is capped below it).
-constexpr float kCoordOffset = 65536.0f;
+constexpr float kCoordOffset = shared::kAlchemyCoordOffset;
 constexpr std::uint32_t kRotationMask = 1023;  // the rotation table holds 1024 angles
 
 // hash32 and hash_combine of core/sampling.h, lane-wise.
 HWY_INLINE VU hash32(VU x) {
   const DU du;
   x = hn::Xor(x, hn::ShiftRight<16>(x));
-  x = hn::Mul(x, hn::Set(du, 0x7feb352du));
+  x = hn::Mul(x, hn::Set(du, shared::kHashMultiplier1));
   x = hn::Xor(x, hn::ShiftRight<15>(x));
-  x = hn::Mul(x, hn::Set(du, 0x846ca68bu));
+  x = hn::Mul(x, hn::Set(du, shared::kHashMultiplier2));
   return hn::Xor(x, hn::ShiftRight<16>(x));
 }
 HWY_INLINE VU hash_combine(VU seed, VU v) {
   const DU du;
-  return hash32(hn::Xor(seed, hn::Add(hn::Add(hn::Add(v, hn::Set(du, 0x9e3779b9u)), hn::ShiftLeft<6>(seed)), hn::ShiftRight<2>(seed))));
+  return hash32(hn::Xor(seed, hn::Add(hn::Add(hn::Add(v, hn::Set(du, shared::kHashGolden)), hn::ShiftLeft<6>(seed)), hn::ShiftRight<2>(seed))));
 }
 
 // sqrt(x) for x in [0, 1] by the reciprocal square root bit trick and two Newton steps, relative
@@ -49,7 +49,7 @@ HWY_INLINE VF sqrt_unit(VF x) {
   const DF d;
   const DU du;
   const VF half = hn::Set(d, 0.5f), three_halves = hn::Set(d, 1.5f);
-  VF r = hn::BitCast(d, hn::Sub(hn::Set(du, 0x5f3759dfu), hn::ShiftRight<1>(hn::BitCast(du, x))));
+  VF r = hn::BitCast(d, hn::Sub(hn::Set(du, shared::kInvSqrtMagic), hn::ShiftRight<1>(hn::BitCast(du, x))));
   const VF hx = hn::Mul(half, x);
   r = hn::Mul(r, hn::NegMulAdd(hn::Mul(hx, r), r, three_halves));
   r = hn::Mul(r, hn::NegMulAdd(hn::Mul(hx, r), r, three_halves));
@@ -57,7 +57,7 @@ HWY_INLINE VF sqrt_unit(VF x) {
 }
 
 HWY_INLINE float sqrt_unit(float x) {
-  float r = std::bit_cast<float>(0x5f3759dfu - (std::bit_cast<std::uint32_t>(x) >> 1));
+  float r = std::bit_cast<float>(shared::kInvSqrtMagic - (std::bit_cast<std::uint32_t>(x) >> 1));
   r = r * (1.5f - 0.5f * x * r * r);
   r = r * (1.5f - 0.5f * x * r * r);
   return x * r;

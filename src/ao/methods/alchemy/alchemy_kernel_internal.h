@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "ao/methods/alchemy/alchemy_shared.h"
 #include "ao/simd/depth_internal.h"
 
 namespace ao::simd {
@@ -14,7 +15,7 @@ namespace ao::simd {
 /// and the sample pattern.
 struct AlchemyInputs : DepthView {
   float radius = 1;       ///< r of eq. 9-10, world units.
-  float max_pixel_radius = 16384;  ///< Cap on the disk's screen radius, pixels.
+  float max_pixel_radius = shared::kAlchemyMaxPixelRadius;  ///< Cap on the disk's screen radius, pixels.
   float epsilon = 0;      ///< epsilon of eq. 10, world units squared.
   float beta = 0;         ///< beta of eq. 10 (multiplies z_C).
   float scale = 0;        ///< 2 sigma / s: the factor of eq. 10's sum.

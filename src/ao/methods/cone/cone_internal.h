@@ -10,13 +10,13 @@
 #include "ao/core/progress.h"
 #include "ao/methods/cone/cone.h"
 #include "ao/methods/cone/cone_pattern_internal.h"
+#include "ao/methods/cone/cone_shared.h"
 
 namespace ao::cone_internal {
 
 constexpr int kTile = 16;
-// A cone stops once its transmittance T <= kOpaque: its remaining spheres can lower T by at most
-// kOpaque, so V (the mean over cones) by at most kOpaque = 1e-4, far below an 8-bit step (1/255).
-constexpr float kOpaque = 1e-4f;
+// A cone stops once its transmittance T <= kOpaque (cone_shared.h, read by the shader too).
+constexpr float kOpaque = shared::kConeOpaque;
 
 // Length of [zlo, zhi) (voxel units along the column) covered by solid voxels, counting the two
 // end voxels by the part of them inside the range. The paper counts whole bits (Fig. 7); the

@@ -35,6 +35,7 @@
 //   4  per chain sphere k: (rx, ry, rz in voxels, sum of its prisms' chords in voxels)
 //   5  per prism s: (u, v) on the unit disk, then per chain sphere k the prisms' half chords in voxels
 #include "common.glsl"
+#include "cone_shared.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, r32f) uniform writeonly image2D o_visibility;
@@ -49,8 +50,6 @@ uniform vec3 u_origin, u_inv_size;
 uniform ivec2 u_columns;
 uniform int u_depth_bits;
 uniform int u_cones, u_per_cone, u_prisms, u_period;
-
-const float kOpaque = 1e-4;
 
 uint bit(uint base, int k) { return (u_words[base + uint(k >> 5)] >> uint(k & 31)) & 1u; }
 
@@ -103,7 +102,7 @@ void main() {
     const vec3 axis = vec3(w.x * u_inv_size.x, w.z * u_inv_size.y, w.y * u_inv_size.z);
     const float s = cone.w;
     float tr = 1.0;
-    for (int j = 0; j < u_per_cone && tr > kOpaque; ++j) {
+    for (int j = 0; j < u_per_cone && tr > kConeOpaque; ++j) {
       const vec4 la = u_lanes[2 * j], lb = u_lanes[2 * j + 1];
       if (!(fma(lb.x, s, lb.y) >= 0.0)) continue;  // a sphere too near the apex, or a filler of no size
       const float d = fma(la.x, s, la.y);

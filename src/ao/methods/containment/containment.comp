@@ -20,11 +20,12 @@
 //   u_ray_steps     m, [1, 8]
 //   u_far_limit     -R with silhouette elimination, -infinity without (a test is occluded when
 //                   -bias > distance > u_far_limit)
-//   u_bias          depth-test bias, world units; 0 = automatic (common.glsl depth_bias)
+//   u_bias          depth-test bias, world units; 0 = automatic (screen_space.glsl depth_bias)
 //   u_footprint     one pixel's footprint at unit depth, 2 tan(fov/2) / height
 //   u_rotation[16]  (cos, sin) of the 4x4 pattern's angles, entry (y % 4) * 4 + x % 4 (samples.h)
 // Buffers: binding 0, the sample offsets (X_i, Y_i, Z_i, r_i) of make_containment_samples, world units.
 #include "common.glsl"
+#include "screen_space.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, r32f) uniform writeonly image2D o_visibility;

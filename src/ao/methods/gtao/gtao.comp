@@ -32,6 +32,7 @@
 // Buffers (gtao_internal.h's tables, entry [k][pattern] at k * 16 + pattern): binding 0 the slice
 // directions (cos, sin) per slice k; binding 1 the step fractions per step j.
 #include "common.glsl"
+#include "gtao_shared.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, r32f) uniform writeonly image2D o_visibility;
@@ -47,17 +48,17 @@ uniform vec4 u_rays;
 const float kPi = 3.14159265358979323846;
 const float kHalfPi = 0.5 * kPi;
 
-// acos on [-1, 1] by Abramowitz & Stegun 4.4.46 (|error| <= 2.2e-8 rad), as the CPU kernel.
+// acos on [-1, 1] by Abramowitz & Stegun 4.4.46 (gtao_shared.h), as the CPU kernel.
 float fast_acos(float x) {
   const float a = min(abs(x), 1.0);
-  float p = -0.0012624911;
-  p = p * a + 0.0066700901;
-  p = p * a - 0.0170881256;
-  p = p * a + 0.0308918810;
-  p = p * a - 0.0501743046;
-  p = p * a + 0.0889789874;
-  p = p * a - 0.2145988016;
-  p = p * a + 1.5707963050;
+  float p = kAcosFit7;
+  p = p * a + kAcosFit6;
+  p = p * a + kAcosFit5;
+  p = p * a + kAcosFit4;
+  p = p * a + kAcosFit3;
+  p = p * a + kAcosFit2;
+  p = p * a + kAcosFit1;
+  p = p * a + kAcosFit0;
   const float r = p * sqrt(1.0 - a);
   return x < 0.0 ? kPi - r : r;
 }

@@ -8,9 +8,11 @@
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
+#include "ao/core/color_shared.h"
 #include "ao/core/sampling.h"
 #include "ao/methods/gtao/gtao_internal.h"
 #include "ao/methods/gtao/gtao_kernel_internal.h"
+#include "ao/methods/gtao/gtao_shared.h"
 #include "ao/simd/depth_plane.h"
 
 namespace ao {
@@ -99,9 +101,7 @@ void to_json(nlohmann::json& j, const GtaoParams& p) { j = gtao_param_table().to
 void from_json(const nlohmann::json& j, GtaoParams& p) { gtao_param_table().from_json(j, p); }
 
 float gtao_multi_bounce(float v, float rho) {
-  // The paper's cubic fit of path-traced multi-bounce AO against single-bounce V, per albedo rho.
-  const float a = 2.0404f * rho - 0.3324f, b = -4.7951f * rho + 0.6417f, c = 2.7552f * rho + 0.6903f;
-  return std::max(v, ((a * v + b) * v + c) * v);
+  return shared::multi_bounce_fit(v, rho);
 }
 
 GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std::uint32_t seed) {
@@ -143,7 +143,7 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
         const Vec3 a = g.albedo(x, y);
         const float vis = v(x, y);
         out.color(x, y) = {gtao_multi_bounce(vis, a.x), gtao_multi_bounce(vis, a.y), gtao_multi_bounce(vis, a.z)};
-        v(x, y) = gtao_multi_bounce(vis, 0.2126f * a.x + 0.7152f * a.y + 0.0722f * a.z);  // Rec. 709 luminance
+        v(x, y) = gtao_multi_bounce(vis, shared::luminance(a.x, a.y, a.z));
       }
   }
   out.visibility = std::move(v);

@@ -14,6 +14,7 @@
 #include "ao/core/math.h"
 #include "ao/simd/aligned_internal.h"
 #include "ao/methods/gtao/gtao_kernel_internal.h"
+#include "ao/methods/gtao/gtao_shared.h"
 #include "ao/simd/vec_internal.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -23,13 +24,12 @@ namespace {
 
 constexpr float kHalfPi = 0.5f * kPi;
 
-// acos on [-1, 1] by Abramowitz & Stegun 4.4.46 (|error| <= 2.2e-8 rad, below float resolution
-// near pi/2), branch-free.
+// acos on [-1, 1] by Abramowitz & Stegun 4.4.46 (gtao_shared.h), branch-free.
 HWY_INLINE VF fast_acos(VF x) {
   const DF d;
   const VF a = hn::Min(hn::Abs(x), hn::Set(d, 1.0f));
-  VF p = hn::Set(d, -0.0012624911f);
-  for (float c : {0.0066700901f, -0.0170881256f, 0.0308918810f, -0.0501743046f, 0.0889789874f, -0.2145988016f, 1.5707963050f})
+  VF p = hn::Set(d, shared::kAcosFit7);
+  for (float c : {shared::kAcosFit6, shared::kAcosFit5, shared::kAcosFit4, shared::kAcosFit3, shared::kAcosFit2, shared::kAcosFit1, shared::kAcosFit0})
     p = hn::MulAdd(p, a, hn::Set(d, c));
   const VF r = hn::Mul(p, hn::Sqrt(hn::Sub(hn::Set(d, 1.0f), a)));
   return hn::IfThenElse(hn::Lt(x, hn::Zero(d)), hn::Sub(hn::Set(d, kPi), r), r);

@@ -29,6 +29,7 @@
 //   u_rotation[16] the 4x4 pattern's (cos, sin) about N
 // Buffers: binding 0, the sample offsets (X_i, Y_i, Z_i, r_i), world units.
 #include "common.glsl"
+#include "screen_space.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba32f) uniform writeonly image2D o_transfer;

@@ -19,6 +19,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "ao/core/color_shared.h"
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/methods/characteristic.h"
@@ -41,7 +42,7 @@ constexpr int kPaletteSize = 32;                  // distinct reflectances a pac
 constexpr std::uint32_t kPaletteMask = 0x1F;      // its index's bits in a packed depth word (simd::TransferInputs)
 
 // Rec. 709 luminance of W: the method's scalar visibility.
-inline float luminance(Vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+inline float luminance(Vec3 c) { return shared::luminance(c.x, c.y, c.z); }
 }
 
 const ParamTable<TransferParams>& transfer_param_table() {

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 
+#include "ao/core/color_shared.h"
+
 #include <hwy/highway.h>
 
 #include "ao/methods/transfer/transfer_kernel_internal.h"
@@ -21,9 +23,6 @@ namespace ao::simd::HWY_NAMESPACE {
 using namespace screen_space;  // NOLINT(google-build-using-namespace): the shared per-target vocabulary
 
 constexpr std::uint32_t kPaletteMask = 0x1F;  // a palette index's bits in a packed depth word
-
-// Rec. 709 luminance of W: the method's scalar visibility.
-inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
 namespace {
 
@@ -127,7 +126,7 @@ HWY_INLINE void store_transfer(const TransferSums& t, float n, const TransferInp
   for (int k = 0; k < std::min(lanes, row.count - k0); ++k) {
     const std::size_t at_pixel = row_base + static_cast<std::size_t>(row.index[static_cast<std::size_t>(k0 + k)]);
     if (out.rgb) {  // the final images directly: W interleaved, its luminance in out.r
-      out.rgb[at_pixel] = Vec3{wr[k], wg[k], wb[k]}, out.r[at_pixel] = luminance(wr[k], wg[k], wb[k]), out.o[at_pixel] = wo[k];
+      out.rgb[at_pixel] = Vec3{wr[k], wg[k], wb[k]}, out.r[at_pixel] = shared::luminance(wr[k], wg[k], wb[k]), out.o[at_pixel] = wo[k];
     } else {
       out.r[at_pixel] = wr[k], out.g[at_pixel] = wg[k], out.b[at_pixel] = wb[k], out.o[at_pixel] = wo[k];
     }
@@ -180,19 +179,20 @@ void TransferRays(const CoveredPixels& row, const DepthPlane& plane, const TestP
 void InterleaveTransfer(const float* r, const float* g, const float* b, std::size_t n, Vec3* rgb, float* lum) {
   const DF d;
   const std::size_t lanes = hn::Lanes(d);
-  const VF kr = hn::Set(d, 0.2126f), kg = hn::Set(d, 0.7152f), kb = hn::Set(d, 0.0722f);
+  const VF kr = hn::Set(d, shared::kLuminanceR), kg = hn::Set(d, shared::kLuminanceG), kb = hn::Set(d, shared::kLuminanceB);
   float* out = &rgb->x;  // Vec3 is three packed floats
   std::size_t k = 0;
   for (; k + lanes <= n; k += lanes) {
     const VF vr = hn::LoadU(d, r + k), vg = hn::LoadU(d, g + k), vb = hn::LoadU(d, b + k);
     hn::StoreInterleaved3(vr, vg, vb, d, out + 3 * k);
-    // luminance()'s products and sums in its order: the same bits as the scalar tail.
+    // shared::luminance's products and sums in its order (W's Rec. 709 luminance, the method's
+    // scalar visibility): the same bits as the scalar tail.
     hn::StoreU(hn::Add(hn::Add(hn::Mul(kr, vr), hn::Mul(kg, vg)), hn::Mul(kb, vb)), d, lum + k);
   }
   for (; k < n; ++k) {
     const float vr = r[k], vg = g[k], vb = b[k];
     rgb[k] = Vec3{vr, vg, vb};
-    lum[k] = luminance(vr, vg, vb);
+    lum[k] = shared::luminance(vr, vg, vb);
   }
 }
 

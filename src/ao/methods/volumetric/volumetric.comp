@@ -25,11 +25,12 @@
 //   u_half_radius R / 2, world units
 //   u_far_limit   -R with silhouette elimination, -infinity without
 //   u_inv_f       1 / F
-//   u_bias        added to z* - z_entry, world units; 0 = automatic (common.glsl depth_bias)
+//   u_bias        added to z* - z_entry, world units; 0 = automatic (screen_space.glsl depth_bias)
 //   u_footprint   one pixel's footprint at unit depth
 //   u_rotation[16] the 4x4 pattern's (cos, sin) about the view axis
 // Buffers: binding 0, the disk points (x_i, y_i, h_i, 0) of make_disk_samples (unit disk).
 #include "common.glsl"
+#include "screen_space.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, r32f) uniform writeonly image2D o_visibility;

@@ -1,4 +1,4 @@
-// The voxelizer's raster stage (simd/raster.cpp) tests only the column centres of each row's span
+// The voxelizer's raster stage (methods/cone/raster_kernel.cpp) tests only the column centres of each row's span
 // between the triangle's edges (widened by a column), not the whole bounding box. Its grid must be
 // the one a test of every centre of the box gives: the same edge functions and tie rule, evaluated
 // here over the whole box, on triangles that stress the span's arithmetic (huge and tiny, far

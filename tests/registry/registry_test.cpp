@@ -266,5 +266,19 @@ TEST(Registry, ImplicitSurfaceWithTooManyPrimitivesIsAnInputError) {
   expect_input_error([&] { run(s, "containment", {Membership::Step, 1.0f}, {{"characteristic", "implicit"}}, &surfaces); }, {"5 primitives", "1 to 4"});
 }
 
+// A row's decode makes its own alternative of MethodParams (the rows are in the variant's order),
+// and params_json gives back the table's complete JSON: what --json echoes is what was decoded.
+TEST(Registry, DecodeGivesTheRowsOwnStruct) {
+  for (const MethodInfo& m : all_methods()) {
+    const MethodParams p = m.decode(m.default_params());
+    EXPECT_EQ(&method_of(p), &m) << m.name;
+    EXPECT_EQ(params_json(p), m.default_params()) << m.name;
+    const MethodParams overridden = m.decode(nlohmann::json::object());
+    EXPECT_EQ(params_json(overridden), m.default_params()) << m.name << ": no overrides decode to the defaults";
+  }
+  EXPECT_THROW(find_method("gtao").decode({{"slices", 0}}), InputError);
+  EXPECT_THROW(find_method("gtao").decode({{"no_such_parameter", 1}}), InputError);
+}
+
 }  // namespace
 }  // namespace ao

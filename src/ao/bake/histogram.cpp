@@ -165,7 +165,7 @@ HistogramSums scatter_directions(const RasterMesh& mesh, const TexelCoverage& co
       const OrthoView view = make_ortho_view(mesh, w, pixel_size, jitter);
       rasterize(mesh, view, acc.target);  // stage 1
       for (std::size_t i = 0; i < mesh.normals.size(); ++i) acc.cos_v[i] = dot(w, mesh.normals[i]);
-      // Stage 2: the histogram scatter, eq. 8, in the SIMD kernel layer (compiled for every x86-64 target).
+      // Stage 2: the histogram scatter, eq. 8, in its SIMD kernel (histogram_kernel.cpp, compiled for every x86-64 target).
       simd::ScatterInput in;
       in.ids = acc.target.id.data(), in.px = acc.target.px.data(), in.py = acc.target.py.data();
       in.view_width = view.width, in.view_height = view.height;

@@ -68,7 +68,7 @@ void rasterize(const RasterMesh& mesh, const OrthoView& view, RasterTarget& targ
     target.depth = Image<float>(w, h);
     target.id = Image<std::uint32_t>(w, h);
   }
-  // The rasteriser itself runs in the SIMD kernel layer, compiled for every x86-64 target.
+  // The rasteriser itself runs in a SIMD kernel (histogram_kernel.cpp), compiled for every x86-64 target.
   const simd::RasterInput in{mesh.positions.data(), nv, mesh.indices.data(), mesh.triangle_count(), view.frame, view.origin, view.pixel_size, w, h};
   simd::rasterize_front_faces(in, target.px.data(), target.py.data(), target.pz.data(), target.depth.data(), target.id.data());
 }

@@ -34,7 +34,7 @@ std::array<std::uint32_t, 4> sobol_owen_4d_keys(std::uint32_t seed);
 /// Points first .. first + count - 1 (count in [0, 16]) of sobol_owen_4d's sequence before
 /// scrambling, into r[d][k]: dimension 0 the index, dimensions 1-3 bit-reversed (the inner
 /// reversal of nested uniform scrambling); entries k >= count are left as they are. The SIMD
-/// kernel layer scrambles a batch of them (simd/sampling_internal.h: sobol_owen_4d_batch).
+/// kernels scramble a batch of them (simd/sampling_internal.h: sobol_owen_4d_batch).
 void sobol_reversed_4d_batch(std::uint32_t first, int count, std::uint32_t (&r)[4][16]);
 
 /// Cosine-weighted direction on the hemisphere about +z from u in [0,1)^2: Shirley-Chiu concentric

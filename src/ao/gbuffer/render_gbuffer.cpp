@@ -106,7 +106,7 @@ void render_gbuffer(const RayScene& rs, const Camera& camera, const GBufferOptio
   g.direct = Image<Vec3>();  // belongs to the lighting of the previous view: render_direct_light makes a new one
   g.second_depth = Image<float>(), g.second_separation = 0;  // belongs to the previous view: render_second_layer
   const Frame basis = camera.basis();
-  // Each tile is traced and written by the SIMD kernel layer (simd::render_gbuffer_tile).
+  // Each tile is traced and written by the SIMD kernel (gbuffer_kernel.cpp: simd::render_gbuffer_tile).
   const simd::GBufferTileJob job{&rs, &camera, basis, simd::RayGenerator(camera, basis), options.normal, &g};
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);  // a primary ray per pixel
   // Primary rays of neighbouring pixels are coherent; every tile costs about the same, so TBB

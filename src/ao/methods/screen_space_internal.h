@@ -1,5 +1,5 @@
 // Internals of the screen-space methods (containment, volumetric, transfer), not installed: their
-// inputs in the form of the SIMD kernel layer (src/ao/methods/screen_space_kernel_internal.h), which takes a
+// inputs in the form of their SIMD kernels (screen_space_kernel_internal.h), which take a
 // row's covered pixels as structure-of-arrays and runs the loops over samples across pixels.
 #pragma once
 

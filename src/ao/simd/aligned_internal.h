@@ -1,4 +1,4 @@
-// Storage the SIMD kernels (src/ao/simd/) read and write: arrays on 64-byte boundaries, so that a
+// Storage the SIMD kernels (*_kernel.cpp) read and write: arrays on 64-byte boundaries, so that a
 // vector of any target is one aligned load, sized in whole vectors of the widest target.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The G-buffer's depth as one contiguous plane, built by the SIMD kernel layer (depth_kernel.cpp):
+// The G-buffer's depth as one contiguous plane, built by a SIMD kernel (depth_kernel.cpp):
 // the form every kernel that gathers depths reads (the screen-space methods, their filters).
 #pragma once
 

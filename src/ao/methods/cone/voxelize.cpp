@@ -256,7 +256,7 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
 
 // Prefix XOR along every column: bit k becomes the XOR of toggles 0..k. Returns odd columns.
 // Two passes per row of columns (the row stays in L1): the prefix XOR inside every word, a flat
-// pass over the row's words in the SIMD layer (simd::prefix_xor_in_words), then the carry between
+// pass over the row's words in a SIMD kernel (simd::prefix_xor_in_words, simd/bits_kernel.cpp), then the carry between
 // the words of each column (the top bit of a word is the parity of the column so far).
 std::size_t scan_columns(VoxelGrid& g) {
   const int words = g.words, nbits = g.depth_bits;

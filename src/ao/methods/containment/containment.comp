@@ -14,7 +14,7 @@
 // elimination (AT 4.3), by less than R. The pixel's tangent frame (T, B) is turned by its 4x4
 // interleaving angle about N (VAO and AT sec. 4.2); box_filter.comp then averages the 4x4 blocks.
 //
-// Uniforms (set from ContainmentParams and the Falloff; src/ao/gpu/screen_space.cpp):
+// Uniforms (set from ContainmentParams and the Falloff; containment_gpu.cpp):
 //   u_size, u_projection   common.glsl
 //   u_samples       n, [1, 256]
 //   u_ray_steps     m, [1, 8]

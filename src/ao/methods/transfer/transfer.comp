@@ -19,7 +19,7 @@
 // Output o_transfer: (W_r, W_g, W_b, O), 1 where not covered; box_filter.comp filters all four,
 // transfer_finish.comp takes the Rec. 709 luminance of W as the visibility.
 //
-// Uniforms (TransferParams and the Falloff; src/ao/gpu/screen_space.cpp):
+// Uniforms (TransferParams and the Falloff; transfer_gpu.cpp):
 //   u_size, u_projection  common.glsl
 //   u_samples, u_ray_steps  n in [1, 256], m in [1, 8]
 //   u_far_limit    -R with silhouette elimination (AT 4.3), -infinity without

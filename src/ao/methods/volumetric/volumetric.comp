@@ -19,7 +19,7 @@
 // The pixel position of a pipe's point (c_x + o_x, c_y + o_y, c_z) is affine in the disk point, as
 // the CPU kernel folds it: f_x = f_x0 + x_i a_x - y_i b_x, f_y = f_y0 - x_i a_y - y_i b_y.
 //
-// Uniforms (VolumetricParams and R; src/ao/gpu/screen_space.cpp):
+// Uniforms (VolumetricParams and R; volumetric_gpu.cpp):
 //   u_size, u_projection  common.glsl
 //   u_samples     n, [1, 256]
 //   u_half_radius R / 2, world units

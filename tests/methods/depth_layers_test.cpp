@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 
-// The registry first: its CharacteristicKind::DepthTimesHeightField would shadow characteristic.h's type of that name.
+// The registry first: its CharacteristicKind::DepthTimesHeight would shadow characteristic.h's type of that name.
 #include "ao/registry/registry.h"
 
 #include "ao/core/error.h"

@@ -240,7 +240,7 @@ enum class CharacteristicKind {
   Depth,                  ///< "depth": the G-buffer's depth buffer (fig. 2c), with AT 4.3's silhouette elimination as asked.
   Implicit,               ///< "implicit": the scene's half-spaces and sphere exteriors (fig. 2a); no silhouette elimination.
   HeightField,            ///< "height-field": the scene's displacement map over its macro plane (fig. 2b), alone.
-  DepthTimesHeightField,  ///< "depth*height-field": their product (fig. 12); elimination applies to the depth factor only.
+  DepthTimesHeight,       ///< "depth*height-field": their product (fig. 12); elimination applies to the depth factor only.
 };
 /// The parameter of containment, volumetric and transfer that holds their CharacteristicKind.
 inline constexpr const char* kCharacteristicParam = "characteristic";

@@ -55,7 +55,7 @@ void check_gpu_screen_space(std::string_view method, CharacteristicKind kind, co
 void add_characteristic_stats(MethodOutput& out, CharacteristicKind kind, bool elimination) {
   if (kind == CharacteristicKind::Depth) return;
   out.stats["characteristic"] = to_string(kind);
-  out.stats["silhouette_elimination"] = kind == CharacteristicKind::DepthTimesHeightField && elimination ? "depth-buffer factor only" : "off";
+  out.stats["silhouette_elimination"] = kind == CharacteristicKind::DepthTimesHeight && elimination ? "depth-buffer factor only" : "off";
 }
 
 }  // namespace ao::detail

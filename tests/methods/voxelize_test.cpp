@@ -116,7 +116,7 @@ TEST(Voxelize, OnlyOpenSurfacesBecomeSlabs) {
   EXPECT_TRUE(c[1].open_surface());
 }
 
-// What each open mesh is taken for, by its enclosure (voxelize.h, kSolidEnclosure): sheets (a flat
+// What each open mesh is taken for, by its enclosure (mesh_closure.h, kSolidEnclosure): sheets (a flat
 // quad, a bent sheet with holes) and meshes that wrap around a volume (an open container, a sphere
 // with a hole), whatever way their triangles face.
 TEST(Voxelize, OpenMeshesAreClassifiedByTheirWindingNumber) {

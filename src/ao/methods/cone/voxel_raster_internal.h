@@ -1,6 +1,6 @@
 // The voxelizer's triangles in grid space and what their rasterisation writes besides the grid's
-// bits, shared by the voxelizer (voxelize.cpp: projection, bands, the winding number's walk) and its
-// raster kernel (raster_kernel.cpp), not installed.
+// bits, shared by the voxelizer (voxelize.cpp: projection, bands; winding_solid_internal.h: the
+// winding number's walk) and its raster kernel (raster_kernel.cpp), not installed.
 #pragma once
 
 #include <algorithm>

@@ -6,31 +6,42 @@
 //  2. the rows of columns are split into bands; triangles are bucketed by band (counting sort per
 //     chunk); each band rasterises the triangles that overlap it at the column centres and toggles
 //     one bit per fragment (no atomics: bands are disjoint);
-//  3. one prefix-XOR scan per column turns toggles into "XOR from the fragment to the far end";
-//  4. coarse occupancy (blocks and windowed cell masks, voxelize.h) for empty-space skipping.
+//  3. one prefix-XOR scan per column turns toggles into "XOR from the fragment to the far end"
+//     (voxel_grid.cpp), and next to holes that are not flat the winding-number solid
+//     (winding_solid.cpp);
+//  4. slabs of open meshes, then coarse occupancy (blocks and windowed cell masks, voxelize.h) for
+//     empty-space skipping (voxel_grid.cpp).
+// What each mesh stands for (closed, a solid with holes, a sheet) is decided in mesh_closure.cpp.
 #include "ao/methods/cone/voxelize.h"
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
-#include <mutex>
 #include <tuple>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "ao/core/error.h"
-#include "ao/methods/cone/voxel_raster_internal.h"
-#include "ao/simd/bits_internal.h"
 #include "ao/methods/cone/raster_kernel_internal.h"
+#include "ao/methods/cone/voxel_grid_internal.h"
+#include "ao/methods/cone/voxel_raster_internal.h"
+#include "ao/methods/cone/winding_solid_internal.h"
 
 namespace ao {
 
+using voxel_internal::build_coarse;
 using voxel_internal::ColumnHit;
+using voxel_internal::fan_winding;
 using voxel_internal::GridTri;
+using voxel_internal::hole_centroids;
+using voxel_internal::Holes;
+using voxel_internal::object_space;
 using voxel_internal::PrismCounts;
+using voxel_internal::scan_columns;
+using voxel_internal::SlotWinding;
+using voxel_internal::WalkCount;
+using voxel_internal::winding_solid;
 
 namespace {
 
@@ -45,99 +56,6 @@ struct Tri3 {
   int fan = -1;  // kind 0: slot of the solid with holes whose non-flat hole this fan triangle closes,
                  // or near which this triangle of it lies (Holes::near)
 };
-
-// The centroid of each hole's boundary vertices (each boundary edge contributes its two ends), and
-// whether the hole is flat to the grid: its boundary within `flat` (world units: two voxels) of the
-// plane through the centroid normal to the fan's vector area. Off a flat fan |w_fan| < 1/2
-// (voxelize_world), so the parity of the mesh with its fans is its winding-number solid there;
-// within two voxels of a plane, the pocket between the fan and the surface w = 1/2 that spans the
-// hole lies in a sliver of that thickness along the plane (a scan's base cut through its
-// triangles zigzags by a triangle's height), which is left to parity.
-// `near` marks the mesh's triangles near the rim of a hole that is not flat: where the pocket
-// between that hole's fan and its spanning surface can meet the mesh.
-struct Holes {
-  std::vector<Vec3> centre;
-  std::vector<std::uint8_t> flat;
-  std::vector<std::uint8_t> near;  // per triangle
-};
-Holes hole_centroids(const Mesh& m, const MeshClosure& c, float flat) {
-  Holes h{std::vector<Vec3>(c.holes, Vec3{0, 0, 0}), std::vector<std::uint8_t>(c.holes, 1), std::vector<std::uint8_t>(m.triangle_count(), 0)};
-  std::vector<float> n(c.holes, 0.0f);
-  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    h.centre[c.hole[e]] += m.positions[c.boundary[e][0]] + m.positions[c.boundary[e][1]];
-    n[c.hole[e]] += 2.0f;
-  }
-  for (std::uint32_t k = 0; k < c.holes; ++k) h.centre[k] = h.centre[k] * (1.0f / n[k]);
-  std::vector<Vec3> area(c.holes, Vec3{0, 0, 0});
-  std::vector<Bounds3> box(c.holes);
-  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    const Vec3 o = h.centre[c.hole[e]];
-    area[c.hole[e]] += cross(m.positions[c.boundary[e][1]] - o, m.positions[c.boundary[e][0]] - o);
-    box[c.hole[e]].extend(m.positions[c.boundary[e][0]]);
-  }
-  const float extent = m.bounds().diagonal(), tol = flat, pad = 0.01f * extent;
-  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    const std::uint32_t k = c.hole[e];
-    const Vec3 nk = normalize(area[k]);
-    for (int end = 0; end < 2; ++end)
-      if (!(std::abs(dot(nk, m.positions[c.boundary[e][end]] - h.centre[k])) <= tol)) h.flat[k] = 0;
-  }
-  // Near a hole: within its rim's deviation from its plane (how far the pocket reaches from the
-  // rim) plus 1% of the mesh's extent of one of its rim vertices.
-  std::vector<float> deviation(c.holes, 0.0f);
-  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    const std::uint32_t k = c.hole[e];
-    deviation[k] = std::max(deviation[k], std::abs(dot(normalize(area[k]), m.positions[c.boundary[e][0]] - h.centre[k])));
-  }
-  for (std::uint32_t k = 0; k < c.holes; ++k) {
-    if (h.flat[k]) continue;
-    const float reach = deviation[k] + pad;
-    const Vec3 lo = box[k].lo - Vec3{reach, reach, reach}, hi = box[k].hi + Vec3{reach, reach, reach};
-    for (std::size_t t = 0; t < m.triangle_count(); ++t)
-      for (int v = 0; v < 3 && !h.near[t]; ++v) {
-        const Vec3 p = m.positions[m.indices[3 * t + v]];
-        if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
-        for (std::size_t e = 0; e < c.boundary.size() && !h.near[t]; ++e)
-          if (c.hole[e] == k && length(p - m.positions[c.boundary[e][0]]) <= reach) h.near[t] = 1;
-      }
-  }
-  return h;
-}
-
-// The winding number w_C of one mesh's fans (the triangles (b, a, centroid) over its boundary
-// edges a -> b), summed exactly with Van Oosterom and Strackee's formula (winding_number.h): fan
-// triangles are slivers from the rim to the centroid, which a hierarchy cannot group. The rim's
-// vertices are shared by two edges each, so their offsets and lengths are computed once per point.
-struct FanWinding {
-  std::vector<Vec3> vertex;                      // rim vertices, then the holes' centroids
-  std::vector<std::array<std::uint32_t, 3>> tri;  // (b, a, centroid) into `vertex`
-  double operator()(Vec3 q, std::vector<Vec3>& r, std::vector<float>& len) const {
-    r.resize(vertex.size());
-    len.resize(vertex.size());
-    for (std::size_t v = 0; v < vertex.size(); ++v) r[v] = vertex[v] - q, len[v] = length(r[v]);
-    double sum = 0;
-    for (const auto& [b, a, c] : tri) {
-      const float det = dot(r[b], cross(r[a], r[c]));
-      if (det == 0.0f) continue;  // q in the triangle's plane: 0 (winding_number.cpp)
-      const float den = len[b] * len[a] * len[c] + dot(r[b], r[a]) * len[c] + dot(r[b], r[c]) * len[a] + dot(r[a], r[c]) * len[b];
-      sum += std::atan2(det, den);
-    }
-    return sum * (2.0 / (4.0 * 3.14159265358979323846));
-  }
-};
-FanWinding fan_winding(const Mesh& m, const MeshClosure& c, const Holes& h) {
-  FanWinding f;
-  std::vector<std::uint32_t> slot(m.positions.size(), ~0u);
-  const auto at = [&](std::uint32_t v) {
-    if (slot[v] == ~0u) slot[v] = static_cast<std::uint32_t>(f.vertex.size()), f.vertex.push_back(m.positions[v]);
-    return slot[v];
-  };
-  for (std::size_t e = 0; e < c.boundary.size(); ++e) f.tri.push_back({at(c.boundary[e][1]), at(c.boundary[e][0]), 0});
-  const std::uint32_t first_centre = static_cast<std::uint32_t>(f.vertex.size());
-  f.vertex.insert(f.vertex.end(), h.centre.begin(), h.centre.end());
-  for (std::size_t e = 0; e < c.boundary.size(); ++e) f.tri[e][2] = first_centre + c.hole[e];
-  return f;
-}
 
 Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
   const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], c = m.positions[m.indices[3 * t + 2]];
@@ -254,122 +172,6 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
   }
 }
 
-// Prefix XOR along every column: bit k becomes the XOR of toggles 0..k. Returns odd columns.
-// Two passes per row of columns (the row stays in L1): the prefix XOR inside every word, a flat
-// pass over the row's words in a SIMD kernel (simd::prefix_xor_in_words, simd/bits_kernel.cpp), then the carry between
-// the words of each column (the top bit of a word is the parity of the column so far).
-std::size_t scan_columns(VoxelGrid& g) {
-  const int words = g.words, nbits = g.depth_bits;
-  const int last_bits = nbits - 64 * (words - 1);
-  const std::uint64_t last_mask = last_bits == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << last_bits) - 1;
-  std::vector<std::size_t> odd_per_row(g.ny, 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, g.ny, 8), [&](const tbb::blocked_range<int>& r) {
-    const std::size_t row_words = static_cast<std::size_t>(g.nx) * words;
-    for (int j = r.begin(); j < r.end(); ++j) {
-      std::uint64_t* row = g.bits.data() + static_cast<std::size_t>(j) * row_words;
-      simd::prefix_xor_in_words(row, row_words);
-      std::size_t odd = 0;
-      for (int i = 0; i < g.nx; ++i) {
-        std::uint64_t* col = row + static_cast<std::size_t>(i) * words;
-        std::uint64_t carry = 0;  // all ones when the previous words left the column inside
-        for (int w = 0; w < words; ++w) {
-          const std::uint64_t x = col[w] ^ carry;
-          carry = static_cast<std::uint64_t>(static_cast<std::int64_t>(x) >> 63);
-          col[w] = x;
-        }
-        std::uint64_t& last = col[words - 1];
-        odd += (last >> (last_bits - 1)) & 1u;
-        last &= last_mask;  // keep the unused high bits of the last word zero for popcount
-      }
-      odd_per_row[j] = odd;
-    }
-  });
-  std::size_t odd = 0;
-  for (std::size_t o : odd_per_row) odd += o;
-  return odd;
-}
-
-// Coarse occupancy for empty-space skipping, in one pass over the grid: the OR of each cell of
-// kCellXY x kCellXY columns (all words), from which the blocks (2 x 2 cells, all words) and the
-// cells' 64-bit masks along the column (one bit per cell_bits voxels), ORed over the square
-// windows of 1..kWindowCap + 1 cells anchored at each cell. Returns the number of solid voxels.
-std::size_t build_coarse(VoxelGrid& g) {
-  constexpr int C = VoxelGrid::kCellXY, B = VoxelGrid::kBlock;
-  static_assert(B == 2 * C);
-  const int words = g.words;
-  int cb = 1;
-  while (cb * 64 < g.depth_bits) cb *= 2;
-  g.cell_bits = cb;
-  g.cell_shift = std::countr_zero(static_cast<unsigned>(cb));
-  g.dnx = (g.nx + C - 1) / C;
-  g.dny = (g.ny + C - 1) / C;
-  g.bnx = (g.nx + B - 1) / B;
-  g.bny = (g.ny + B - 1) / B;
-  const int dnx = g.dnx, dny = g.dny;
-  const std::size_t cells = static_cast<std::size_t>(dnx) * dny;
-  std::vector<std::uint64_t> cell_words(cells * words, 0);
-  constexpr int L = VoxelGrid::kWindowCap + 1;
-  std::vector<std::uint64_t> level(cells * L);  // window w at [w * cells, (w + 1) * cells), then interleaved
-  std::uint64_t* m0 = level.data();
-  std::vector<std::size_t> set_per_row(dny, 0);
-  tbb::parallel_for(0, dny, [&](int cj) {
-    const std::size_t row_words = static_cast<std::size_t>(g.nx) * words;
-    std::vector<std::uint64_t> acc(row_words, 0);
-    std::size_t set = 0;
-    for (int j = cj * C; j < std::min(g.ny, (cj + 1) * C); ++j) {
-      set += simd::or_into_and_count(acc.data(), g.column(0, j), row_words);
-    }
-    set_per_row[cj] = set;
-    for (int ci = 0; ci < dnx; ++ci) {
-      std::uint64_t* out = cell_words.data() + (static_cast<std::size_t>(cj) * dnx + ci) * words;
-      for (int i = ci * C; i < std::min(g.nx, (ci + 1) * C); ++i)
-        for (int w = 0; w < words; ++w) out[w] |= acc[static_cast<std::size_t>(i) * words + w];
-      std::uint64_t m = 0;
-      if (cb == 1) {
-        m = out[0];
-      } else {
-        const int per_word = 64 / cb;
-        for (int w = 0; w < words; ++w) {
-          std::uint64_t x = out[w];
-          for (int f = 1; f < cb; f <<= 1) x |= x >> f;  // bit q * cb: OR of its cell's voxels
-          for (int q = 0; q < per_word; ++q) m |= ((x >> (q * cb)) & 1u) << (w * per_word + q);
-        }
-      }
-      m0[static_cast<std::size_t>(cj) * dnx + ci] = m;
-    }
-  });
-  g.block_bits.assign(static_cast<std::size_t>(g.bnx) * g.bny * words, 0);
-  for (int cj = 0; cj < dny; ++cj)
-    for (int ci = 0; ci < dnx; ++ci) {
-      std::uint64_t* blk = g.block_bits.data() + (static_cast<std::size_t>(cj / 2) * g.bnx + ci / 2) * words;
-      const std::uint64_t* cw = cell_words.data() + (static_cast<std::size_t>(cj) * dnx + ci) * words;
-      for (int w = 0; w < words; ++w) blk[w] |= cw[w];
-    }
-  // Windows of w + 1 cells: the OR along i of cells ci..ci + w (row w = row w - 1 | cell ci + w),
-  // then the OR of those over the rows cj..cj + w.
-  std::vector<std::uint64_t> rows(cells * L);
-  for (std::size_t c = 0; c < cells; ++c) rows[c] = m0[c];
-  for (int w = 1; w < L; ++w)
-    for (int cj = 0; cj < dny; ++cj)
-      for (int ci = 0; ci < dnx; ++ci) {
-        const std::size_t c = static_cast<std::size_t>(cj) * dnx + ci;
-        rows[w * cells + c] = rows[(w - 1) * cells + c] | (ci + w < dnx ? m0[c + w] : 0);
-      }
-  for (int w = 1; w < L; ++w)
-    for (int cj = 0; cj < dny; ++cj)
-      for (int ci = 0; ci < dnx; ++ci) {
-        std::uint64_t m = 0;
-        for (int j = cj; j <= std::min(cj + w, dny - 1); ++j) m |= rows[w * cells + static_cast<std::size_t>(j) * dnx + ci];
-        level[w * cells + static_cast<std::size_t>(cj) * dnx + ci] = m;
-      }
-  g.window.resize(cells * L);
-  for (std::size_t c = 0; c < cells; ++c)
-    for (int w = 0; w < L; ++w) g.window[c * L + w] = level[w * cells + c];
-  std::size_t set = 0;
-  for (std::size_t n : set_per_row) set += n;
-  return set;
-}
-
 // How one object is voxelized (voxelize.h: OpenMeshes, and the `back` side of a grid).
 enum class Treat : std::uint8_t {
   Parity,       // as it is
@@ -431,20 +233,6 @@ bool slab_rises(const Scene& scene, std::span<const Treat> t) {
     }
   }
   return false;
-}
-
-// Object space of an object: the inverse of its instance's map (identity for a world-space mesh),
-// and the sign of its determinant (a mirror turns fronts into backs: w changes sign).
-struct ObjectSpace {
-  bool instanced = false;
-  Affine3 to_object;
-  int sign = 1;
-  Vec3 operator()(Vec3 p) const { return instanced ? to_object.point(p) : p; }
-};
-ObjectSpace object_space(const Scene& scene, const SceneObject& ob) {
-  if (ob.instance == SceneObject::kNoInstance) return {};
-  const Affine3& m = scene.instances[ob.instance].object_to_world;
-  return {true, inverse(m), m.determinant() < 0 ? -1 : 1};
 }
 
 // Row bands of the raster stage (kBands, fewer for a short grid) and the band of each row.
@@ -594,14 +382,7 @@ std::size_t raster_band(VoxelGrid& g, const Bands& bands, int b, int fill_kind, 
   return f;
 }
 
-// Per slot of a solid with holes (ObjectPlan): object space, sigma (orientation, mirrors
-// included) and the winding number of its fans alone (w_C needs no triangle near the point but
-// the fans' own, unlike w of the mesh).
-struct SlotWinding {
-  std::vector<ObjectSpace> space;
-  std::vector<int> sign;
-  std::vector<FanWinding> fans;
-};
+// The winding numbers of the slots of solids with holes (SlotWinding) of a plan.
 SlotWinding slot_winding(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan) {
   SlotWinding s;
   for (std::size_t oi : plan.slot_object) {
@@ -611,75 +392,6 @@ SlotWinding slot_winding(const Scene& scene, std::span<const MeshClosure> closur
     s.fans.push_back(fan_winding(scene.meshes[mi], closure[mi], plan.holes[mi]));
   }
   return s;
-}
-
-// Voxels where w was evaluated, and of those, where it changed the parity's answer; and one
-// band's scratch space.
-struct WalkCount {
-  std::size_t evaluated = 0, changed = 0;
-};
-struct WalkScratch {
-  std::vector<std::uint64_t> chi, seen;
-  std::vector<Vec3> r;
-  std::vector<float> len;
-};
-
-// Walks the column of list[q] from each of its fragments of the same slot (sorted together),
-// both ways, setting each voxel to [sigma w(centre) > 1/2] until that agrees with parity (see
-// winding_solid). chi is the column as parity left it, so each voxel is decided once however many
-// walks reach it. Returns the index past those fragments.
-template <class Centre>
-std::size_t walk_column(VoxelGrid& g, const std::vector<ColumnHit>& list, std::size_t q, const SlotWinding& sw, Centre& voxel_centre, WalkScratch& sc,
-                        WalkCount& n) {
-  std::vector<std::uint64_t>& chi = sc.chi;
-  std::vector<std::uint64_t>& seen = sc.seen;
-  const ColumnHit& at = list[q];
-  std::uint64_t* col = g.bits.data() + (static_cast<std::size_t>(at.j) * g.nx + at.i) * g.words;
-  chi.assign(col, col + g.words);
-  seen.assign(g.words, 0);
-  const int s = at.tag;
-  for (; q < list.size() && list[q].i == at.i && list[q].j == at.j && list[q].tag == s; ++q)
-    for (int dir : {1, -1})
-      for (int k = dir > 0 ? list[q].k : list[q].k - 1; k >= 0 && k < g.depth_bits; k += dir) {
-        const std::uint64_t bit = std::uint64_t{1} << (k & 63);
-        const bool parity = (chi[k >> 6] & bit) != 0;
-        bool solid;
-        if (seen[k >> 6] & bit) {
-          solid = (col[k >> 6] & bit) != 0;
-        } else {
-          // w = chi - w_C: solid where sigma w = chi - sigma w_C > 1/2.
-          solid = (parity ? 1.0 : 0.0) - sw.sign[s] * sw.fans[s](sw.space[s](voxel_centre(at.i, at.j, k)), sc.r, sc.len) > 0.5;
-          seen[k >> 6] |= bit;
-          ++n.evaluated;
-          if (solid != parity) col[k >> 6] ^= bit, ++n.changed;
-        }
-        if (solid == parity) break;
-      }
-  return q;
-}
-
-// The winding-number solid near holes that are not flat. Parity with the fans is the solid chi
-// of the mesh plus its fans C; the mesh's own winding number is w = chi - w_C (w is a sum over
-// triangles; sigma w with sigma the orientation, voxelize.h), and the solid is w > 1/2. The two
-// differ only where |w_C| >= 1/2, which is next to a fan that is not flat: in the pocket between
-// the fan and the surface w = 1/2 that spans the hole, which the mesh itself can also cut near
-// the hole's rim. Along a column the pocket is entered through the fan or through the mesh near
-// the hole (it is bounded by them and that surface), so from each such fragment (`hits`, per
-// band) we walk the column both ways and stop at the first voxel where w agrees with parity: the
-// pocket's end. (A column that crossed the spanning surface twice and neither the fan nor the
-// mesh would be missed.)
-template <class Centre>
-WalkCount winding_solid(VoxelGrid& g, std::vector<std::vector<ColumnHit>>& hits, const SlotWinding& sw, Centre& voxel_centre) {
-  std::vector<WalkCount> in(hits.size());
-  tbb::parallel_for(0, static_cast<int>(hits.size()), [&](int b) {
-    std::vector<ColumnHit>& list = hits[b];
-    std::sort(list.begin(), list.end(), [](const ColumnHit& x, const ColumnHit& y) { return std::tie(x.j, x.i, x.tag, x.k) < std::tie(y.j, y.i, y.tag, y.k); });
-    WalkScratch scratch;
-    for (std::size_t q = 0; q < list.size();) q = walk_column(g, list, q, sw, voxel_centre, scratch, in[b]);
-  });
-  WalkCount n;
-  for (const WalkCount& w : in) n.evaluated += w.evaluated, n.changed += w.changed;
-  return n;
 }
 
 VoxelStats grid_stats(const std::vector<std::vector<GridTri>>& tris, std::span<const std::size_t> fragments, std::span<const MeshClosure> closure) {
@@ -790,214 +502,13 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
 
 }  // namespace
 
+
 void VoxelizeOptions::validate() const {
   if (columns < 8 || columns > 4096) throw InputError("cone: columns must be in [8, 4096], got " + std::to_string(columns));
   if (depth_bits < 32 || depth_bits > 1024 || depth_bits % 32 != 0)
     throw InputError("cone: depth_bits must be a multiple of 32 in [32, 1024], got " + std::to_string(depth_bits));
   if (!(slab_thickness >= 0.0f) || !std::isfinite(slab_thickness))
     throw InputError("cone: slab thickness must be a finite number >= 0, got " + std::to_string(slab_thickness));
-}
-
-std::size_t VoxelGrid::count_set() const {
-  return simd::count_set_bits(bits.data(), bits.size());
-}
-
-namespace {
-
-// Sheet or solid with holes, from the winding number of the mesh itself (voxelize.h, MeshKind).
-// Just in front of and just behind a triangle's centroid c, w(c + n d) + w(c - n d) = 2 w_rest(c):
-// the triangle's own solid angles cancel (mirror images), leaving twice the winding number of
-// the rest of the mesh at c. A closed mesh has w_rest = 1/2 everywhere (the rest subtends the
-// whole half-space behind the face), a flat sheet 0. `enclosure` is the magnitude of 2 w_rest
-// averaged over the area (at every (n / kEnclosureSamples)-th triangle), `orientation` its sign.
-void classify_open_mesh(const Mesh& m, MeshClosure& c) {
-  c.winding = MeshWinding(m);
-  const std::size_t nt = m.triangle_count();
-  // Small holes (kSmallHoles): each hole's vector area from its boundary edges (about any point,
-  // here its first vertex), the orientation from the sign of the enclosed volume (about the box's
-  // centre; the holes change it little).
-  {
-    std::vector<Vec3> hole_area(c.holes, Vec3{0, 0, 0}), origin(c.holes, Vec3{0, 0, 0});
-    std::vector<std::uint8_t> has(c.holes, 0);
-    for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-      const std::uint32_t h = c.hole[e];
-      if (!has[h]) origin[h] = m.positions[c.boundary[e][0]], has[h] = 1;
-      hole_area[h] += cross(m.positions[c.boundary[e][0]] - origin[h], m.positions[c.boundary[e][1]] - origin[h]) * 0.5f;
-    }
-    double holes = 0, area = 0, volume = 0;
-    for (const Vec3& a : hole_area) holes += length(a);
-    const Vec3 o = m.bounds().center();
-    for (std::size_t t = 0; t < nt; ++t) {
-      const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
-      area += 0.5 * length(cross(b - a, d - a));
-      volume += dot(a, cross(b, d)) / 6.0;
-    }
-    if (area > 0 && holes < kSmallHoles * area) {
-      c.kind = MeshKind::SolidWithHoles;
-      c.enclosure = static_cast<float>(1.0 - holes / area);
-      c.orientation = volume < 0 ? -1 : 1;
-      return;
-    }
-  }
-  const std::size_t step = std::max<std::size_t>(1, nt / kEnclosureSamples);
-  double sum = 0, area = 0;
-  Vec3 vector_area{0, 0, 0};
-  for (std::size_t t = 0; t < nt; ++t) {
-    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
-    vector_area += cross(b - a, d - a) * 0.5f;
-  }
-  for (std::size_t t = 0; t < nt; t += step) {
-    const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
-    const Vec3 n2 = cross(b - a, d - a);
-    const float len = length(n2);
-    if (!(len > 0.0f)) continue;
-    const float at = 0.5f * len;
-    // 1% of the inradius (2 area / perimeter): far closer to c than any other triangle is.
-    const float delta = 0.01f * 2.0f * at / (length(b - a) + length(d - b) + length(a - d));
-    const Vec3 centre = (a + b + d) * (1.0f / 3.0f), n = n2 / len;
-    sum += at * (c.winding.get()(centre + n * delta) + c.winding.get()(centre - n * delta));
-    area += at;
-  }
-  const double mean = area > 0 ? sum / area : 0.0;
-  c.enclosure = static_cast<float>(std::min(1.0, std::abs(mean)));
-  c.orientation = mean < 0 ? -1 : 1;
-  c.kind = c.enclosure >= kSolidEnclosure ? MeshKind::SolidWithHoles : MeshKind::Sheet;
-  // A flat sheet (a ground, a wall): every vertex within 1e-5 of its extent of one plane. Its
-  // winding number then has the sign of the side of that plane everywhere.
-  const float len = length(vector_area);
-  if (len > 0.0f) {
-    const Vec3 n = vector_area / len;
-    const Bounds3 box = m.bounds();
-    const float tol = 1e-5f * box.diagonal();
-    const float offset = dot(n, m.positions[m.indices[0]]);
-    bool flat = true;
-    for (std::uint32_t i : m.indices) flat = flat && std::abs(dot(n, m.positions[i]) - offset) <= tol;
-    if (flat) c.plane = {n.x, n.y, n.z, -offset};
-    c.flat = flat;
-  }
-}
-
-}  // namespace
-
-struct MeshWinding::State {
-  const Mesh* mesh = nullptr;
-  std::once_flag once;
-  std::unique_ptr<WindingNumber> field;
-};
-
-MeshWinding::MeshWinding(const Mesh& mesh) : state_(std::make_shared<State>()) { state_->mesh = &mesh; }
-
-const WindingNumber& MeshWinding::get() const {
-  static const WindingNumber empty;
-  if (!state_) return empty;
-  std::call_once(state_->once, [&] { state_->field = std::make_unique<WindingNumber>(state_->mesh->positions, state_->mesh->indices); });
-  return *state_->field;
-}
-
-std::vector<MeshClosure> analyze_closure(const Scene& scene) {
-  std::vector<MeshClosure> out;
-  out.reserve(scene.meshes.size());
-  for (const Mesh& m : scene.meshes) {
-    // Weld vertices by exact position, then count each undirected edge; an edge used an odd
-    // number of times is a boundary (a closed 2-manifold uses each edge twice).
-    const std::size_t nv = m.positions.size();
-    std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> keyed(nv);
-    for (std::size_t v = 0; v < nv; ++v) {
-      std::array<std::uint32_t, 3> k;
-      const float c[3] = {m.positions[v].x + 0.0f, m.positions[v].y + 0.0f, m.positions[v].z + 0.0f};  // + 0 turns -0 into +0
-      std::memcpy(k.data(), c, sizeof c);
-      keyed[v] = {k, static_cast<std::uint32_t>(v)};
-    }
-    std::sort(keyed.begin(), keyed.end());
-    std::vector<std::uint32_t> id(nv);
-    std::uint32_t next = 0;
-    for (std::size_t v = 0; v < nv; ++v) {
-      if (v > 0 && keyed[v].first != keyed[v - 1].first) ++next;
-      id[keyed[v].second] = next;
-    }
-    // (undirected key, directed edge index 3 t + e) so that a boundary edge keeps its direction.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;
-    edges.reserve(m.indices.size());
-    for (std::size_t t = 0; t < m.triangle_count(); ++t)
-      for (int e = 0; e < 3; ++e) {
-        std::uint64_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
-        if (a > b) std::swap(a, b);
-        edges.push_back({a << 32 | b, static_cast<std::uint32_t>(3 * t + e)});
-      }
-    std::sort(edges.begin(), edges.end());
-    MeshClosure c;
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-      if ((j - i) % 2) {
-        const std::uint32_t de = edges[i].second, t = de / 3, e = de % 3;
-        c.boundary.push_back({m.indices[3 * t + e], m.indices[3 * t + (e + 1) % 3]});
-      }
-      ++c.edges;
-      i = j;
-    }
-    c.boundary_edges = c.boundary.size();
-    if (!c.boundary.empty()) {
-      // Holes: connected components of the boundary edges over welded vertices (union-find).
-      std::vector<std::uint32_t> parent(next + 1);
-      for (std::uint32_t v = 0; v <= next; ++v) parent[v] = v;
-      const auto find = [&](std::uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-      };
-      for (const auto& [a, b] : c.boundary) parent[find(id[a])] = find(id[b]);
-      std::vector<std::uint32_t> number(next + 1, ~0u);
-      for (const auto& [a, b] : c.boundary) {
-        std::uint32_t& n = number[find(id[a])];
-        if (n == ~0u) n = c.holes++;
-        c.hole.push_back(n);
-      }
-      classify_open_mesh(m, c);
-    }
-    out.push_back(std::move(c));
-  }
-  return out;
-}
-
-std::vector<std::uint8_t> closed_meshes_around(const Scene& scene, std::span<const MeshClosure> closure, Vec3 eye) {
-  const std::vector<SceneObject> objects = scene.objects();
-  std::vector<std::uint8_t> around(objects.size(), 0);
-  bool any = false;
-  // A direction no axis-aligned or diagonal face contains, so the ray meets no edge of a modelled
-  // room exactly.
-  const Vec3 dir = normalize(Vec3{0.5734f, 0.6321f, 0.5213f});
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    const Mesh& m = scene.meshes[objects[k].mesh];
-    if (!closure[objects[k].mesh].closed()) continue;
-    // The eye and the ray in the mesh's own space.
-    Vec3 p = eye, d = dir;
-    if (objects[k].instance != SceneObject::kNoInstance) {
-      const Affine3 to_object = inverse(scene.instances[objects[k].instance].object_to_world);
-      p = to_object.point(eye), d = to_object.vector(dir);
-    }
-    const Bounds3 b = m.bounds();
-    if (p.x < b.lo.x || p.y < b.lo.y || p.z < b.lo.z || p.x > b.hi.x || p.y > b.hi.y || p.z > b.hi.z) continue;
-    std::size_t crossings = 0;
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      // Moller-Trumbore: the ray p + s d, s > 0, through the triangle.
-      const Vec3 a = m.positions[m.indices[3 * t]], e1 = m.positions[m.indices[3 * t + 1]] - a, e2 = m.positions[m.indices[3 * t + 2]] - a;
-      const Vec3 h = cross(d, e2);
-      const float det = dot(e1, h);
-      if (det == 0.0f) continue;
-      const float inv = 1.0f / det;
-      const Vec3 q = p - a;
-      const float u = dot(q, h) * inv;
-      if (u < 0.0f || u > 1.0f) continue;
-      const Vec3 r = cross(q, e1);
-      const float v = dot(d, r) * inv;
-      if (v < 0.0f || u + v > 1.0f) continue;
-      crossings += dot(e2, r) * inv > 0.0f ? 1 : 0;
-    }
-    around[k] = crossings % 2;
-    any = any || around[k];
-  }
-  if (!any) around.clear();
-  return around;
 }
 
 VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats,

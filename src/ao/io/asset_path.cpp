@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 
 namespace ao {
 
@@ -12,11 +13,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// Text of a reference for a message: printable and short, whatever the file holds.
-std::string printable(std::string_view s) {
-  std::string out;
-  for (char c : s.substr(0, 80)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return s.size() > 80 ? out + "..." : out;
-}
+std::string printable(std::string_view s) { return io_detail::printable(s, 80); }
 
 }  // namespace
 

@@ -14,29 +14,6 @@ namespace ao::io_detail {
 
 namespace fs = std::filesystem;
 
-std::string one_line(std::string_view message) {
-  std::string out;
-  out.reserve(message.size());
-  bool pending_separator = false;
-  for (const char c : message) {
-    if (c == '\n' || c == '\r') {
-      pending_separator = !out.empty();
-      continue;
-    }
-    if ((c == ' ' || c == '\t') && (out.empty() || out.back() == ' ')) continue;
-    if (pending_separator) {
-      while (!out.empty() && out.back() == ' ') out.pop_back();
-      if (!out.empty() && out.back() != '.' && out.back() != ';') out += ';';
-      out += ' ';
-      pending_separator = false;
-      if (c == ' ' || c == '\t') continue;
-    }
-    out += (c == '\t') ? ' ' : c;
-  }
-  while (!out.empty() && (out.back() == ' ' || out.back() == ';')) out.pop_back();
-  return out;
-}
-
 void require_input_file(const fs::path& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);

@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 
 namespace ao::io_detail {
 
@@ -24,10 +25,6 @@ namespace ao::io_detail {
 inline constexpr std::int64_t kMaxImageSide = 32768;
 /// Largest accepted pixel count (2^28, 1 GiB per float channel), checked before allocating.
 inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 28;
-
-/// Library messages may span lines; errors must be one line. Newlines become "; ", runs of
-/// blanks collapse, and the result is trimmed.
-std::string one_line(std::string_view message);
 
 /// Throws InputError naming `path` unless it is an existing, non-empty regular file.
 void require_input_file(const std::filesystem::path& path);

@@ -27,6 +27,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/asset_path.h"
+#include "ao/io/io_error_internal.h"
 
 namespace ao {
 namespace {
@@ -34,13 +35,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
-
-std::string one_line(std::string_view s) {
-  std::string out;
-  for (char c : s.substr(0, 160)) out += std::isprint(static_cast<unsigned char>(c)) ? c : ' ';
-  return s.size() > 160 ? out + "..." : out;
-}
+using io_detail::fail;
+using io_detail::one_line;
 
 std::uint32_t read_u32(const char* p) {
   const auto* b = reinterpret_cast<const unsigned char*>(p);

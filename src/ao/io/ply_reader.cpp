@@ -23,6 +23,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 #include "ao/io/number_text.h"
 
 namespace ao {
@@ -30,19 +31,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
-
-std::string printable(std::string_view token) {
-  std::string out;
-  for (char c : token.substr(0, 24)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return token.size() > 24 ? out + "..." : out;
-}
-std::string quote(std::string_view token) {
-  std::string out(1, '\'');
-  out += printable(token);
-  out += '\'';
-  return out;
-}
+using io_detail::fail;
+using io_detail::printable;
+using io_detail::quote;
 
 std::string_view next_token(std::string_view line, std::size_t& pos) {
   while (pos < line.size() && std::isspace(static_cast<unsigned char>(line[pos]))) ++pos;

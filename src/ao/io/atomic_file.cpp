@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/random.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
@@ -11,6 +12,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <random>
 #include <string>
 #include <system_error>
 
@@ -22,10 +24,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// "the file size limit (ulimit -f) of N bytes is reached": what a write past RLIMIT_FSIZE says.
+std::string file_size_limit_text() {
+  struct rlimit limit {};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    return "the file size limit (ulimit -f) of " + std::to_string(limit.rlim_cur) + " bytes is reached";
+  return "the file size limit (ulimit -f) is reached";
+}
+
 std::string errno_text(int err) {
   // The message a user can act on: strerror's "No space left on device" names no remedy.
   if (err == ENOSPC || err == EDQUOT) return "the disk is full";
-  if (err == EFBIG) return "the file is larger than the file size limit allows";
+  if (err == EFBIG) return file_size_limit_text();
   return std::generic_category().message(err);
 }
 
@@ -75,14 +85,26 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
   ::raise(sig);
 }
 
-// Unique within the process (the counter) and across processes (the pid), so concurrent writers
-// of the same destination never share a temporary file.
+/// 64 random bits as 16 hex digits: from the kernel (getrandom), else std::random_device.
+std::string random_hex() {
+  std::uint64_t bits = 0;
+  if (::getrandom(&bits, sizeof bits, 0) != static_cast<ssize_t>(sizeof bits)) {
+    std::random_device device;
+    bits = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(bits));
+  return text;
+}
+
+// The pid names the process that made the file (remove_stale_temporaries reads it back); the
+// random part makes the name unguessable, so nobody can plant a file or a symbolic link under it
+// beforehand, and unique across processes and calls.
 fs::path temp_path_for(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
   // Built by appending: GCC 12 warns falsely (-Wrestrict) about "literal" + std::string here.
   std::string name = ".";
   name += target.stem().string();
-  name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+  name += ".tmp-" + std::to_string(::getpid()) + "-" + random_hex();
   name += target.extension().string();
   return target.parent_path() / name;
 }
@@ -94,10 +116,12 @@ long temporary_pid(const std::string& name, const fs::path& destination) {
   prefix += ".tmp-";
   const std::string ext = destination.extension().string();
   if (!name.starts_with(prefix) || !name.ends_with(ext) || name.size() <= prefix.size() + ext.size()) return -1;
-  const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - ext.size());  // "<pid>-<counter>"
+  const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - ext.size());  // "<pid>-<hex>"
   const std::size_t dash = middle.find('-');
   if (dash == 0 || dash == std::string::npos || dash + 1 == middle.size()) return -1;
-  if (middle.find_first_not_of("0123456789-") != std::string::npos || middle.find('-', dash + 1) != std::string::npos) return -1;
+  if (middle.substr(0, dash).find_first_not_of("0123456789") != std::string::npos ||
+      middle.substr(dash + 1).find_first_not_of("0123456789abcdef") != std::string::npos)
+    return -1;
   try {
     return std::stol(middle.substr(0, dash));
   } catch (const std::exception&) {
@@ -115,7 +139,7 @@ std::string storage_failure(const fs::path& temp, const fs::path& dir) {
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(temp, ec);
   if (!ec && ::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && size >= limit.rlim_cur)
-    return "the file reached the file size limit (ulimit -f) of " + std::to_string(limit.rlim_cur) + " bytes";
+    return file_size_limit_text();
   return {};
 }
 
@@ -133,7 +157,7 @@ const char* file_type_name(fs::file_type t) {
 // Flushes the file's data to disk before the rename, so that after a crash the destination holds
 // either the old file or the complete new one, never a renamed but empty file.
 void sync_file(const fs::path& file, const fs::path& reported) {
-  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0) throw SystemError(reported.string() + ": cannot reopen the temporary file: " + errno_text(errno));
   const int rc = ::fsync(fd);
   const int err = errno;
@@ -162,11 +186,49 @@ TemporaryRegistration& TemporaryRegistration::operator=(TemporaryRegistration&& 
   return *this;
 }
 
-ScratchFile::ScratchFile(fs::path path) : path_(std::move(path)), registration_(path_) {}
+void ignore_file_size_signal() {
+  struct sigaction action {};
+  action.sa_handler = SIG_IGN;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGXFSZ, &action, nullptr);
+}
 
-ScratchFile::~ScratchFile() {
-  std::error_code ec;
-  fs::remove(path_, ec);
+int open_temporary_descriptor(const fs::path& temp, const fs::path& reported) {
+  // No O_CREAT: the file write_file_atomically created exclusively must still be there, and a
+  // symbolic link put in its place is not followed.
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) throw SystemError(reported.string() + ": cannot open the temporary file for writing: " + errno_text(errno));
+  return fd;
+}
+
+std::FILE* open_temporary(const fs::path& temp, const fs::path& reported) {
+  const int fd = open_temporary_descriptor(temp, reported);
+  std::FILE* f = ::fdopen(fd, "wb");
+  if (f == nullptr) {
+    const int err = errno;
+    ::close(fd);
+    throw SystemError(reported.string() + ": cannot open the temporary file for writing: " + errno_text(err));
+  }
+  return f;
+}
+
+void close_temporary(std::FILE* file, const fs::path& reported) {
+  const bool flushed = std::fflush(file) == 0 && std::ferror(file) == 0;
+  const int err = errno;
+  if (std::fclose(file) != 0 || !flushed) throw SystemError(reported.string() + ": cannot write: " + errno_text(flushed ? errno : err));
+}
+
+void write_bytes_atomically(const fs::path& path, std::string_view bytes) {
+  write_file_atomically(path, [&](const fs::path& temp) {
+    std::FILE* f = open_temporary(temp, path);
+    const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const int err = errno;
+    if (!written) {
+      std::fclose(f);
+      throw SystemError(path.string() + ": cannot write: " + errno_text(err));
+    }
+    close_temporary(f, path);
+  });
 }
 
 void remove_temporaries_on_signals() {
@@ -269,7 +331,7 @@ void write_file_atomically(const fs::path& path, const std::function<void(const 
   // point after the open finds it.
   const fs::path temp = temp_path_for(target);
   TemporaryRegistration registration(temp);
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) {
     const int err = errno;
     throw SystemError(path.string() + ": cannot create a file in '" + dir.string() + "': " + errno_text(err));

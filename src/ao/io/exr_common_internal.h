@@ -67,8 +67,14 @@ void read_exr_channels(Imf::InputFile& file, const ExrWindows& windows, std::spa
 /// of one line naming `path`; the errors of write_file_atomically pass through.
 void write_exr_atomically(const std::filesystem::path& path, const Imf::Header& header, const Imf::FrameBuffer& frame);
 
+/// OpenEXR's message `message` about the file `path` in ao's words: the problems OpenEXR reports
+/// most (a file cut short, a damaged header or offset table, missing attributes) as one phrase
+/// each; anything else as OpenEXR's text on one line, without the file name it repeats (the
+/// message already starts with it).
+std::string exr_words(std::string_view message, const std::filesystem::path& path);
+
 /// Runs `body`, turning OpenEXR's exceptions (Iex, derived from std::exception) into InputError
-/// "<path>: <what>: <library message>" on one line. InputError and SystemError pass unchanged.
+/// "<path>: <what>: <exr_words>" on one line. InputError and SystemError pass unchanged.
 template <class Body>
 auto with_exr_errors(const std::filesystem::path& path, std::string_view what, Body&& body) -> decltype(body()) {
   try {
@@ -80,7 +86,7 @@ auto with_exr_errors(const std::filesystem::path& path, std::string_view what, B
   } catch (const std::bad_alloc&) {
     throw SystemError(path.string() + ": out of memory while reading");
   } catch (const std::exception& e) {
-    throw InputError(path.string() + ": " + std::string(what) + ": " + one_line(e.what()));
+    throw InputError(path.string() + ": " + std::string(what) + ": " + exr_words(e.what(), path));
   }
 }
 

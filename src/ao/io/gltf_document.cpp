@@ -520,12 +520,7 @@ std::vector<std::string> GltfDocument::save_glb(const fs::path& path) {
   writer.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &nowhere});
   if (!writer.WriteGltfSceneToStream(&d.model, glb, false, true)) throw SystemError(path.string() + ": cannot serialise the glTF document");
   const std::string bytes = glb.str();
-  write_file_atomically(path, [&](const fs::path& temp) {
-    std::ofstream f(temp, std::ios::binary);
-    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    f.close();
-    if (!f) throw SystemError(path.string() + ": cannot write");
-  });
+  write_bytes_atomically(path, bytes);
   std::vector<std::string> w = std::move(d.save_warnings);
   d.save_warnings.clear();
   return w;

@@ -52,13 +52,7 @@ void write_vertex_ao_ply(const std::filesystem::path& path, const Scene& scene, 
                              "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
                              "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float quality\n"
                              "element face " + std::to_string(scene.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
-  write_file_atomically(path, [&](const std::filesystem::path& temp) {
-    std::ofstream f(temp, std::ios::binary);
-    f.write(header.data(), static_cast<std::streamsize>(header.size()));
-    f.write(body.data(), static_cast<std::streamsize>(body.size()));
-    f.close();
-    if (!f) throw SystemError(path.string() + ": cannot write");
-  });
+  write_bytes_atomically(path, header + body);
 }
 
 }  // namespace ao

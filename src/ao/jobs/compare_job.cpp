@@ -26,14 +26,7 @@ std::string fixed4(double v) {
   return buf;
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  write_file_atomically(path, [&](const fs::path& temp) {
-    std::ofstream out(temp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw SystemError(path.string() + ": cannot write");
-  });
-}
+void write_text(const fs::path& path, const std::string& text) { write_bytes_atomically(path, text); }
 
 // The sheet's columns: the method's V, its reference's V and the heat map; with the GPU backend
 // the method's V and heat map once per backend. Titles are pieces wrapped between, never inside,

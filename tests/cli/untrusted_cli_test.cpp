@@ -1,0 +1,148 @@
+// Issue 41's reproducers, end to end: hostile files, parameters and environments that crashed `ao`,
+// made it write where it should not, or gave a wrong result with exit 0. Each test runs the
+// built binary (AO_CLI_PATH), so a crash shows as a failed expectation, not as a crash of the
+// test program.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "support/gltf_docs.h"
+#include "support/run.h"
+
+namespace ao::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// `depth` arrays nested in one another: "[[[...]]]".
+std::string nested_arrays(int depth) { return std::string(static_cast<std::size_t>(depth), '[') + std::string(static_cast<std::size_t>(depth), ']'); }
+
+// A unit square with UVs on a floor, as OBJ: something to bake.
+constexpr const char* kQuadObj = "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 4/4 3/3 2/2\n";
+
+// `args` run by a shell that first runs `setup` and then replaces itself by ao: $$ in `setup` is
+// the pid ao will have.
+RunResult run_ao_after(const std::string& setup, const std::string& args, const fs::path& dir) {
+  std::string quoted;
+  for (char c : setup) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return run_ao_under("bash -c '" + quoted + " && exec \"$0\" \"$@\"'", args, dir);
+}
+
+// --- no shared temporary (item 1) ---------------------------------------------------------------
+
+// `bake --gltf` staged its embedded map at $TMPDIR/ao-bake-<pid>.png and wrote through a symbolic
+// link planted there. Now nothing is written in $TMPDIR: the link's target keeps its content and
+// the folder holds only what was planted.
+TEST(UntrustedCli, BakeGltfWritesNothingInTheTemporaryFolder) {
+  TempDir dir, tmp, elsewhere;
+  dir.write("quad.obj", kQuadObj);
+  const fs::path victim = elsewhere.write("victim.txt", "precious");
+  const std::string plant = "ln -s " + victim.string() + " " + (tmp / "ao-bake-").string() + "$$.png";
+  // A map that is not a PNG: the glTF's PNG was the staged scratch file.
+  const RunResult r = run_ao_after("export TMPDIR=" + tmp.path().string() + " && " + plant, "bake quad.obj -o m.exr --gltf out.glb -s 32 --spp 4 -q", dir.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_text(victim), "precious");
+  EXPECT_EQ(tmp.file_count(), 1);
+  // The GLB carries the map as its occlusion texture.
+  const GlbFile glb = parse_glb_file(read_text(dir / "out.glb"));
+  ASSERT_EQ(glb.json["images"].size(), 1u);
+  EXPECT_EQ(glb_view(glb, glb.json["images"][0]["bufferView"].get<int>()).substr(0, 4), "\x89PNG");
+}
+
+// Temporary names were the pid and a counter from 0: files or links planted under them made the
+// run fail ("cannot create a file"). Now names are random: the run writes, the links stay unused.
+TEST(UntrustedCli, PlantedTemporaryNamesAreNeitherInTheWayNorFollowed) {
+  TempDir dir, elsewhere;
+  const fs::path victim = elsewhere.write("victim.png", "precious");
+  const std::string plant = "for n in 0 1 2 3 4 5 6 7; do ln -s " + victim.string() + " .v.tmp-$$-$n.png; done";
+  const RunResult r = run_ao_after(plant, "render plane -o v.png --width 16 --height 16 --spp 1 -q", dir.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_text(victim), "precious");
+  EXPECT_EQ(read_text(dir / "v.png").substr(0, 4), "\x89PNG");
+}
+
+// --- JSON limits (item 2) -----------------------------------------------------------------------
+
+// A camera file whose eye is 100,000 nested arrays (200 KB) crashed render on a stack overflow;
+// 50,000 gave a 100 KB error line. Now one short line naming the file, for camera and parameter
+// files alike, at any depth past the limit.
+TEST(UntrustedCli, DeeplyNestedJsonIsOneShortLine) {
+  TempDir dir;
+  for (int depth : {65, 50000, 100000}) {
+    SCOPED_TRACE(depth);
+    dir.write("c.json", R"({"eye": )" + nested_arrays(depth) + R"(, "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40})");
+    dir.write("p.json", R"({"intensity": )" + nested_arrays(depth) + "}");
+    std::vector<std::string> commands = {"render plane --camera c.json -o v.png", "render plane -m alchemy -p @p.json -o v.png"};
+    // On the command line too, within the 128 KiB a single argument (the shell's command) may have.
+    if (depth <= 50000) commands.push_back("render plane -m alchemy -p intensity=" + nested_arrays(depth) + " -o v.png");
+    for (const std::string& args : commands) {
+      const RunResult r = run_ao(args, dir.path());
+      expect_one_line_error(r, "nests deeper than 64 levels");
+      EXPECT_LT(r.err.size(), 200u);
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir / "v.png"));
+}
+
+// A value that is long but shallow is quoted in a message only in part.
+TEST(UntrustedCli, LongJsonValuesAreNotEchoed) {
+  TempDir dir;
+  std::string many = "[1";
+  for (int k = 0; k < 50000; ++k) many += ",1";
+  many += "]";
+  dir.write("c.json", R"({"eye": )" + many + R"(, "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40})");
+  dir.write("p.json", R"({"intensity": )" + many + "}");
+  RunResult r = run_ao("render plane --camera c.json -o v.png", dir.path());
+  expect_one_line_error(r, "c.json: camera 'eye' must be an array of three numbers");
+  EXPECT_LT(r.err.size(), 200u);
+  r = run_ao("render plane -m alchemy -p @p.json -o v.png", dir.path());
+  expect_one_line_error(r, "intensity must be");
+  EXPECT_LT(r.err.size(), 300u);
+}
+
+// --- file size limit (item 5) -------------------------------------------------------------------
+
+// Under `ulimit -f` every writer died of SIGXFSZ (exit 153, no message, a temporary file left).
+// Now "cannot write: the file size limit ...", exit 3, nothing left, in every image format.
+TEST(UntrustedCli, FileSizeLimitIsAnErrorThatLeavesNothing) {
+  TempDir dir;
+  for (const std::string out : {"v.png", "v.exr", "v.tif", "v.jpg"}) {
+    SCOPED_TRACE(out);
+    const RunResult r = run_ao_after("ulimit -f 16", "render displaced -o " + out + " --width 512 --height 512 --spp 1 -q", dir.path());
+    expect_one_line_error(r, out + ": cannot write: the file size limit (ulimit -f) of 16384 bytes is reached", 3);
+    EXPECT_EQ(dir.file_count(), 0);
+  }
+}
+
+// --- ao tune -o (item 6) ------------------------------------------------------------------------
+
+// `ao tune -o` replaced its own inputs with JSON (exit 0). Now it is checked as render's outputs
+// are: a .json name that is none of the files the run reads, refused before any work.
+TEST(UntrustedCli, TuneOutputIsCheckedAgainstItsInputsAndExtension) {
+  TempDir dir;
+  const std::string mesh = "OFF\n4 2 0\n-1 0 -1\n1 0 -1\n1 0 1\n-1 0 1\n3 0 3 2\n3 0 2 1\n";
+  dir.write("m.off", mesh);
+  dir.write("c.json", R"({"eye": [0, 2, 2], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40})");
+  dir.write("p.json", R"({"intensity": 0.7})");
+  const std::string tune = "tune -m alchemy --fit intensity=0.5:1 --budget 1 ";
+  expect_one_line_error(run_ao(tune + "--scenes m.off -o m.off", dir.path()), "m.off: -o writes the parameter file as JSON; give it a .json name");
+  expect_one_line_error(run_ao(tune + "--scenes m.off -o m.json.txt", dir.path()), ".json name");
+  expect_one_line_error(run_ao(tune + "--scenes plane --camera c.json -o c.json", dir.path()), "c.json: the output of -o is the input of --camera");
+  expect_one_line_error(run_ao(tune + "--scenes plane -p @p.json -o p.json", dir.path()), "p.json: the output of -o is the input of -p @p.json");
+  fs::create_directory(dir / "d.json");
+  expect_one_line_error(run_ao(tune + "--scenes plane -o d.json", dir.path()), "d.json: -o names a directory");
+  EXPECT_EQ(read_text(dir / "m.off"), mesh);
+  EXPECT_EQ(read_text(dir / "c.json"), R"({"eye": [0, 2, 2], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40})");
+  EXPECT_EQ(read_text(dir / "p.json"), R"({"intensity": 0.7})");
+  EXPECT_EQ(dir.file_count(), 4);
+}
+
+}  // namespace
+}  // namespace ao::test

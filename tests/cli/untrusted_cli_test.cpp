@@ -68,6 +68,42 @@ TEST(UntrustedCli, PlantedTemporaryNamesAreNeitherInTheWayNorFollowed) {
   EXPECT_EQ(read_text(dir / "v.png").substr(0, 4), "\x89PNG");
 }
 
+// --- bake --gltf without its texture (item 7) ---------------------------------------------------
+
+// When the map staged for the GLB could not be read back (EACCES, EIO, EMFILE), bake --gltf wrote
+// the GLB without its occlusion texture and exited 0. With a failed open at each of the last
+// steps of the run (strace's fault injection), the run now either fails cleanly, leaving nothing,
+// or writes the map and a GLB that embeds it.
+TEST(UntrustedCli, BakeGltfWithAFailedOpenAtEachStepFailsCleanlyOrEmbedsTheMap) {
+  if (std::system("strace -o /dev/null true >/dev/null 2>&1") != 0) GTEST_SKIP() << "strace cannot trace here (not installed, or ptrace is not permitted)";
+  TempDir dir;
+  dir.write("quad.obj", kQuadObj);
+  const std::string bake = "bake quad.obj -o m.png --gltf m.glb -s 16 --spp 2 -q";
+  // How many files a successful run opens.
+  ASSERT_EQ(run_ao_under("strace -f -qq -o opens.txt -e trace=openat", bake, dir.path()).exit_code, 0);
+  const std::string trace = read_text(dir / "opens.txt");
+  int opens = 0;
+  for (std::size_t at = 0; (at = trace.find("openat(", at)) != std::string::npos; ++at) ++opens;
+  ASSERT_GT(opens, 8);
+  for (const char* f : {"opens.txt", "m.png", "m.glb"}) fs::remove(dir / f);
+  // The writes come last: fail each of the last 12 opens in turn.
+  for (int k = opens - 11; k <= opens; ++k) {
+    SCOPED_TRACE("open " + std::to_string(k) + " of " + std::to_string(opens) + " fails");
+    const RunResult r = run_ao_under("strace -f -qq -o /dev/null -e trace=openat -e inject=openat:error=EACCES:when=" + std::to_string(k), bake, dir.path());
+    if (r.exit_code != 0) {
+      EXPECT_TRUE(r.exit_code == 1 || r.exit_code == 3) << r.err;
+      EXPECT_EQ(dir.file_count(), 1) << r.err;  // quad.obj only
+      continue;
+    }
+    const GlbFile glb = parse_glb_file(read_text(dir / "m.glb"));
+    ASSERT_TRUE(glb.json.contains("images")) << "exit 0, and the GLB has no occlusion texture";
+    EXPECT_EQ(glb_view(glb, glb.json["images"][0]["bufferView"].get<int>()), read_text(dir / "m.png"));
+    fs::remove(dir / "m.png");
+    fs::remove(dir / "m.glb");
+    EXPECT_EQ(dir.file_count(), 1);
+  }
+}
+
 // --- JSON limits (item 2) -----------------------------------------------------------------------
 
 // A camera file whose eye is 100,000 nested arrays (200 KB) crashed render on a stack overflow;

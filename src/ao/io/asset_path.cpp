@@ -17,6 +17,19 @@ std::string printable(std::string_view s) { return io_detail::printable(s, 80); 
 
 }  // namespace
 
+std::string percent_decode(std::string_view s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) && std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
+      out += static_cast<char>(std::stoi(std::string(s.substr(i + 1, 2)), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
 fs::path resolved_path(const fs::path& p) {
   std::error_code ec;
   fs::path abs = fs::absolute(p, ec);

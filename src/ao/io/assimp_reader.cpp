@@ -8,6 +8,7 @@
 // The raw data assimp returns is checked here (non-finite data, index ranges, empty faces, node
 // transforms) before post-processing can merge, hide or trip over it; validate_and_prepare then
 // runs on the Scene.
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/io/asset_path.h"
 #include "ao/io/assimp_internal.h"
 #include "ao/io/io_error_internal.h"
 #include "ao/io/ply_reader.h"
@@ -134,10 +136,7 @@ void check_node_transforms(const fs::path& path, const aiScene& scene) {
     std::string name;
     for (char c : std::string_view(u.node->mName.C_Str()).substr(0, 64)) name += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
     const std::string label = name.empty() ? "a node" : "node '" + name + "'";
-    const Affine3 t = to_affine(u.world);
-    if (!t.is_finite()) fail(path, label + " has a non-finite transform");
-    const double det = t.determinant();
-    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) fail(path, label + " has a transform with determinant 0 (it flattens the mesh)");
+    if (const std::string problem = transform_problem(to_affine(u.world)); !problem.empty()) fail(path, label + " " + problem);
   }
 }
 
@@ -224,6 +223,26 @@ const aiScene* assimp_step(const fs::path& path, Assimp::Importer& importer, std
   fail(path, explain_assimp_error(error));
 }
 
+/// assimp's file system for a glTF: the files it references are named by URIs, percent-encoded
+/// ("m%2Ebin" is m.bin; glTF 2.0 spec, "URIs"), which assimp 5.2 opens as written. The part of a
+/// name after the model's folder is decoded (check_gltf has checked that the decoded file lies in
+/// the asset's folder); the model itself and names elsewhere are opened as given.
+class GltfUriFileSystem : public Assimp::DefaultIOSystem {
+ public:
+  explicit GltfUriFileSystem(const fs::path& model) : model_(model.string()), folder_(model.parent_path().string()) {}
+  bool Exists(const char* file) const override { return DefaultIOSystem::Exists(decoded(file).c_str()); }
+  Assimp::IOStream* Open(const char* file, const char* mode) override { return DefaultIOSystem::Open(decoded(file).c_str(), mode); }
+
+ private:
+  std::string decoded(const char* file) const {
+    const std::string name(file);
+    if (name == model_) return name;
+    const std::size_t from = !folder_.empty() && name.starts_with(folder_) ? folder_.size() : 0;
+    return name.substr(0, from) + percent_decode(std::string_view(name).substr(from));
+  }
+  std::string model_, folder_;
+};
+
 /// The UV set asked for: a set above 0 that no mesh has is a mistake worth stopping on (set 0
 /// missing is the "no UVs" case the callers report in their own terms).
 void check_uv_set(const fs::path& path, const aiScene& ai, int asked) {
@@ -246,6 +265,7 @@ Scene read_with_assimp(const fs::path& path, std::string_view data, const LoadOp
   const bool format_has_materials = !(is_stl || looks_like_ply(data));
 
   Assimp::Importer importer;
+  if (is_gltf) importer.SetIOHandler(new GltfUriFileSystem(path));  // the importer owns it
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   // STL stores one normal per facet, which would keep every triangle's corners apart; dropping them
   // lets JoinIdenticalVertices weld the soup, and validate_and_prepare makes smooth normals.

@@ -8,6 +8,7 @@
 #include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include <system_error>
 
 #include "ao/core/error.h"
+#include "ao/io/commit_journal.h"
 
 namespace ao {
 
@@ -248,6 +250,8 @@ namespace detail {
 
 fs::path temporary_path_for(const fs::path& destination) { return temp_path_for(destination); }
 
+std::string random_suffix() { return random_hex(); }
+
 DeferredRenames::DeferredRenames(Keep keep) : keep_(std::move(keep)), outer_(t_deferred) { t_deferred = this; }
 DeferredRenames::~DeferredRenames() { t_deferred = outer_; }
 DeferredRenames* DeferredRenames::current() { return t_deferred; }
@@ -258,6 +262,13 @@ void DeferredRenames::keep(const fs::path& temp, const fs::path& destination, Te
 }  // namespace detail
 
 void check_output_destination(const fs::path& path, const std::string& what) {
+  // A line break in a name would break every one-line message and summary that names the file.
+  const std::string name = path.string();
+  if (std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; })) {
+    std::string shown;
+    for (char c : name.substr(0, 80)) shown += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+    throw InputError("'" + shown + "': " + what + " has a line break or another control character in its name; ao writes no such names");
+  }
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);  // follows symbolic links
   if (ec || !fs::exists(st) || fs::is_regular_file(st)) return;
@@ -271,7 +282,7 @@ namespace {
 
 // Removes the temporary files of other processes beside `destination` (write_file_atomically's
 // names) that `abandoned` accepts.
-int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned) {
+int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned, bool any_process) {
   std::error_code ec;
   fs::path target = destination;
   if (fs::is_symlink(destination, ec)) {
@@ -279,6 +290,9 @@ int remove_temporaries_of(const fs::path& destination, const std::function<bool(
     if (!ec) target = resolved;
   }
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  // A killed run's commit first: its journal names the staged files and links it needs to roll
+  // back, which the loop below would otherwise remove as stale.
+  detail::recover_interrupted_commits(dir, any_process);
   int removed = 0;
   fs::directory_iterator it(dir, ec);
   for (; !ec && it != fs::directory_iterator(); it.increment(ec)) {
@@ -300,11 +314,11 @@ int remove_stale_temporaries(const fs::path& destination) {
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) return false;
     std::error_code ec;
     return file.last_write_time(ec) < g_process_start && !ec;
-  });
+  }, false);
 }
 
 int remove_abandoned_temporaries(const fs::path& destination) {
-  return remove_temporaries_of(destination, [](long, const fs::directory_entry&) { return true; });
+  return remove_temporaries_of(destination, [](long, const fs::directory_entry&) { return true; }, true);
 }
 
 void write_file_atomically(const fs::path& path, const std::function<void(const fs::path& temp)>& write) {

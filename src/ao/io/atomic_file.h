@@ -56,6 +56,8 @@ void close_temporary(std::FILE* file, const std::filesystem::path& reported);
 /// exists, following symbolic links, and is not a regular file: replacing it by a regular file
 /// would break a pipe another program reads, or, through a symbolic link, a device node. A new
 /// path, a regular file and a symbolic link to either pass. `what` names the option ("-o").
+/// Also InputError for a name with a line break or another control character, which would break
+/// every one-line message and summary naming the file.
 void check_output_destination(const std::filesystem::path& path, const std::string& what = "the output");
 
 /// Removes the temporary files that runs of ao killed before they could clean up (SIGKILL, a
@@ -114,6 +116,9 @@ namespace detail {
 /// A fresh temporary name for `destination` as write_file_atomically makes them (hidden, in the
 /// same folder, unique per process and call); nothing is created.
 std::filesystem::path temporary_path_for(const std::filesystem::path& destination);
+
+/// 64 random bits as 16 hex digits (getrandom): the unguessable part of temporary names.
+std::string random_suffix();
 
 /// While alive, write_file_atomically on this thread does not rename its complete temporary file:
 /// it calls `keep(temp, destination, registration)` and leaves the file to the callee (OutputSet).

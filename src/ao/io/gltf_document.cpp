@@ -163,9 +163,9 @@ struct __attribute__((visibility("hidden"))) GltfDocument::Impl {
   std::string plain_name(int mesh) const { return io_detail::gltf_plain_name(model, mesh); }
   int map_sampler = -1;  ///< The sampler of the AO maps, added with the first.
 
-  /// A node that places triangles needs a finite transform that does not flatten them: with
-  /// determinant 0 every triangle is degenerate (the same rule as validate_and_prepare's for
-  /// instances, and load_scene_file's for every glTF node).
+  /// A node that places triangles needs a transform ao can trace (transform_problem: finite, not
+  /// flattening, not squashing beyond kMaxSquashRatio), the rule of validate_and_prepare for
+  /// instances and of load_scene_file for every glTF node.
   void check_transform(int node, int mesh, const Mat4& world) const {
     bool triangles = false;
     for (const tinygltf::Primitive& p : model.meshes[static_cast<std::size_t>(mesh)].primitives) triangles = triangles || is_triangles(p);
@@ -174,9 +174,10 @@ struct __attribute__((visibility("hidden"))) GltfDocument::Impl {
     const std::string label = n.name.empty() ? "node " + std::to_string(node) : "node '" + one_line(n.name.substr(0, 64)) + "'";
     for (double v : world)
       if (!std::isfinite(v)) fail(path, label + " has a non-finite transform");
-    double det = 0;
-    normal_matrix(world, det);
-    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) fail(path, label + " has a transform with determinant 0 (it flattens the mesh)");
+    // The rule of every loader (transform_problem), on the float matrix the scene will carry.
+    const auto f = [&](int i) { return static_cast<float>(world[static_cast<std::size_t>(i)]); };
+    const Affine3 t{{f(0), f(1), f(2)}, {f(4), f(5), f(6)}, {f(8), f(9), f(10)}, {f(12), f(13), f(14)}};
+    if (const std::string problem = transform_problem(t); !problem.empty()) fail(path, label + " " + problem);
   }
 
   void collect_instances() {
@@ -319,10 +320,6 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set, const fs::path& ass
     }
   }
   if (!ok) fail(path, "malformed glTF (" + one_line(err.empty() ? warn : err) + ")");
-  // Compressed geometry lives in the extension, not in the accessors this reads.
-  for (const std::string& e : d.model.extensionsRequired)
-    if (e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression")
-      fail(path, "its geometry is compressed with " + e + ", which ao cannot decode; export it uncompressed to bake it");
   // Indices this code follows (check_gltf covers the node graph, buffers, views and accessors).
   for (std::size_t m = 0; m < d.model.meshes.size(); ++m)
     for (std::size_t p = 0; p < d.model.meshes[m].primitives.size(); ++p) {

@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 
@@ -52,7 +53,15 @@ void write_vertex_ao_ply(const std::filesystem::path& path, const Scene& scene, 
                              "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
                              "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float quality\n"
                              "element face " + std::to_string(scene.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
-  write_bytes_atomically(path, header + body);
+  write_file_atomically(path, [&](const std::filesystem::path& temp) {
+    std::FILE* f = open_temporary(temp, path);
+    const bool written = std::fwrite(header.data(), 1, header.size(), f) == header.size() && std::fwrite(body.data(), 1, body.size(), f) == body.size();
+    if (!written) {
+      std::fclose(f);
+      throw SystemError(path.string() + ": cannot write");
+    }
+    close_temporary(f, path);
+  });
 }
 
 }  // namespace ao

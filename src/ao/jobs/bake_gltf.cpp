@@ -50,6 +50,7 @@ struct RoundTrip {
   Stopwatch clock;
 
   void add_occluders(GltfWorldScene& ws) {
+    check_traceable_size(ws.scene);  // every world scene of the round trip passes here
     for (const std::string& w : ws.scene.warnings) reporter.warn(input.string() + ": " + w);
     if (!occluders) occluders = load_occluders(plan, ws.scene, nullptr, reporter);
     for (const Mesh& m : *occluders) ws.scene.meshes.push_back(m);

@@ -328,6 +328,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
   Stopwatch clock;
   Scene scene = load_scene_file(input, {.uv_set = plan.r.uv_set, .flatten_instances = true});
   for (const std::string& w : scene.warnings) reporter.warn(w);  // the loader names the file
+  check_traceable_size(scene);  // the histogram baker traces no ray: checked here for both
   MeshJob job{plan, input, reporter, scene};
   job.clock = clock;
   job.timings["load_ms"] = job.clock.lap_ms();
@@ -338,6 +339,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
 }
 
 MeshBake bake_scene(const Plan& plan, const Scene& scene, const JobReporter& reporter) {
+  check_traceable_size(scene);
   MeshJob job{plan, scene.name, reporter, scene};
   job.summary = {{"input", scene.name}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   if (plan.high_to_low()) job.high = load_high_scene(plan.r.high, reporter);

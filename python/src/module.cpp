@@ -188,14 +188,7 @@ void bind_files(py::module_& m) {
       py::arg("path"), py::arg("camera"));
   m.def(
       "write_text",
-      [](const std::filesystem::path& path, const std::string& text) {
-        write_file_atomically(path, [&](const std::filesystem::path& temp) {
-          std::FILE* f = std::fopen(temp.c_str(), "wb");
-          const bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
-          if (f && std::fclose(f) != 0) throw SystemError(path.string() + ": cannot write");
-          if (!ok) throw SystemError(path.string() + ": cannot write");
-        });
-      },
+      [](const std::filesystem::path& path, const std::string& text) { write_bytes_atomically(path, text); },
       py::arg("path"), py::arg("text"), "Writes `text` to `path` atomically (a temporary file beside it, renamed into place).");
   m.def(
       "read_image", [](const std::filesystem::path& path) { return to_array(read_image(path)); }, py::arg("path"),

@@ -116,6 +116,7 @@
 #include "ao/io/number_text.h"
 #include "ao/io/obj_check.h"
 #include "ao/io/obj_reader.h"
+#include "ao/io/off_reader.h"
 #include "ao/io/output_set.h"
 #include "ao/io/ply_export.h"
 #include "ao/io/ply_reader.h"

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ao/core/error.h"
+#include "ao/io/json_text.h"
 #include "ao/jobs/progress_meter.h"
 
 namespace ao::cli {
@@ -80,9 +82,7 @@ Vec3 parse_vec3(const std::string& text, const char* option) {
 
 // A parameter file: {"parameters": {...}} (as ao tune writes) or the object itself, as key=value pairs.
 std::vector<std::string> parameter_file_pairs(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the parameter file");
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  nlohmann::json j = read_json_file(path, "an object of parameters");
   if (j.is_object() && j.contains("parameters")) j = j["parameters"];
   if (!j.is_object()) throw InputError(path + ": not a JSON object of parameters");
   std::vector<std::string> pairs;
@@ -92,18 +92,25 @@ std::vector<std::string> parameter_file_pairs(const std::string& path) {
 
 namespace {
 
+// Text of a parameter file or an option for a message: printable, at most 40 characters.
+std::string shown(std::string_view text) {
+  std::string out;
+  for (char c : text.substr(0, 40)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+  return text.size() > 40 ? out + "..." : out;
+}
+
 // An integer parameter gets a whole number that fits its 32-bit field, checked here before the
 // method narrows it (a double beyond the int range converts to garbage); the method's own range is
 // checked by its table.
 nlohmann::json whole_number(const nlohmann::json& parsed, const std::string& key, const std::string& value, std::string_view method) {
   const bool whole = parsed.is_number_integer() ||
                      (parsed.is_number_float() && std::isfinite(parsed.get<double>()) && std::trunc(parsed.get<double>()) == parsed.get<double>());
-  if (!whole) throw InputError("--param " + key + "=" + value + ": " + key + " of method " + std::string(method) + " is a whole number");
+  if (!whole) throw InputError("--param " + key + "=" + shown(value) + ": " + key + " of method " + std::string(method) + " is a whole number");
   const double d = parsed.get<double>();
   if (d < static_cast<double>(std::numeric_limits<int>::min()) || d > static_cast<double>(std::numeric_limits<int>::max()))
-    throw InputError("--param " + key + "=" + value + ": " + key + " of method " + std::string(method) + " must be a whole number in [" +
+    throw InputError("--param " + key + "=" + shown(value) + ": " + key + " of method " + std::string(method) + " must be a whole number in [" +
                      std::to_string(std::numeric_limits<int>::min()) + ", " + std::to_string(std::numeric_limits<int>::max()) +
-                     "] (the method's own range is narrower: see --json), got " + value);
+                     "] (the method's own range is narrower: see --json), got " + shown(value));
   return static_cast<std::int64_t>(d);
 }
 
@@ -117,16 +124,16 @@ void apply_param_overrides(nlohmann::json& params, const std::vector<std::string
       continue;
     }
     const auto eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) throw InputError("--param: expected key=value, got '" + kv + "'");
+    if (eq == std::string::npos || eq == 0) throw InputError("--param: expected key=value, got '" + shown(kv) + "'");
     const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
     if (!known.contains(key)) {
       std::string names;
       for (const auto& [k, v] : known.items()) names += (names.empty() ? "" : ", ") + k;
-      throw InputError("--param: method " + std::string(method) + " has no parameter '" + key + "' (it has: " + names + ")");
+      throw InputError("--param: method " + std::string(method) + " has no parameter '" + shown(key) + "' (it has: " + names + ")");
     }
-    nlohmann::json parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
-    if (known[key].is_number_integer() && !parsed.is_discarded()) parsed = whole_number(parsed, key, value, method);
-    params[key] = parsed.is_discarded() ? nlohmann::json(value) : parsed;
+    std::optional<nlohmann::json> parsed = parse_json_limited(value, "--param " + key);
+    if (known[key].is_number_integer() && parsed) parsed = whole_number(*parsed, key, value, method);
+    params[key] = parsed ? std::move(*parsed) : nlohmann::json(value);
   }
 }
 

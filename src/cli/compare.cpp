@@ -10,6 +10,7 @@
 #include "ao/core/error.h"
 #include "ao/jobs/compare.h"
 #include "ao/io/text.h"
+#include "ao/io/json_text.h"
 #include "ao/registry/registry.h"
 #include "common.h"
 #include "subcommands.h"
@@ -96,8 +97,8 @@ CompareRequest make_request(const CompareOptions& o) {
     if (eq == std::string::npos || eq == 0) throw InputError("--sweep: expected key=v1,v2,..., got '" + o.sweep + "'");
     settings.sweep_key = o.sweep.substr(0, eq);
     for (const std::string& v : split(o.sweep.substr(eq + 1), ',')) {
-      nlohmann::json parsed = nlohmann::json::parse(v, nullptr, false);
-      settings.sweep_values.push_back(parsed.is_discarded() ? nlohmann::json(v) : parsed);
+      std::optional<nlohmann::json> parsed = parse_json_limited(v, "--sweep " + settings.sweep_key);
+      settings.sweep_values.push_back(parsed ? std::move(*parsed) : nlohmann::json(v));
     }
   }
   r.scene.args = o.scene;

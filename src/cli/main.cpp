@@ -22,8 +22,10 @@ int main(int argc, char** argv) {
   std::function<int()> action;
   ao::cli::add_ao_commands(app, global, action);
 
-  // Interrupted runs remove their temporary files (atomic_file.h).
+  // Interrupted runs remove their temporary files, and a file size limit is an error like a full
+  // disk (atomic_file.h).
   ao::remove_temporaries_on_signals();
+  ao::ignore_file_size_signal();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -31,11 +31,7 @@ void add_params_command(CLI::App& app, const GlobalOptions& global, std::functio
       }
       for (const ParamTableInfo& t : all_param_tables()) {
         const std::filesystem::path path = std::filesystem::path(*dir) / (std::string(t.name) + ".md");
-        write_file_atomically(path, [&](const std::filesystem::path& temp) {
-          std::ofstream out(temp, std::ios::binary);
-          out << params_markdown(t.schema().specs());
-          if (!out.flush()) throw SystemError(path.string() + ": cannot write");
-        });
+        write_bytes_atomically(path, params_markdown(t.schema().specs()));
       }
       return 0;
     };

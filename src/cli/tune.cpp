@@ -48,6 +48,8 @@ int run(const TuneOptions& o, const GlobalOptions& global) {
   TuneRequest r = o.request;
   const MethodInfo& m = find_method(r.method);
   apply_param_overrides(r.params, o.params, m.name, m.default_params());
+  for (const std::string& p : o.params)
+    if (p.starts_with("@")) r.parameter_files.emplace_back(p.substr(1));
   for (const std::string& f : o.fit) r.fit.push_back(parse_fit(f));
   r.scenes = split(o.scenes, ',');
   r.camera = camera_request(o.camera);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/io/json_text.h"
 #include "ao/registry/registry.h"
 
 namespace ao::view {
@@ -66,8 +67,8 @@ void set_parameter(const std::string& key, const std::string& value, ViewerState
     for (const auto& [k, v] : params.items()) known += ", " + k;
     throw InputError("--set: unknown key '" + key + "' (viewer settings and parameters of " + state.method + ": " + known + ")");
   }
-  const nlohmann::json parsed = nlohmann::json::parse(value, nullptr, /*allow_exceptions=*/false);
-  params[key] = parsed.is_discarded() ? nlohmann::json(value) : parsed;
+  std::optional<nlohmann::json> parsed = parse_json_limited(value, "--set " + key);
+  params[key] = parsed ? std::move(*parsed) : nlohmann::json(value);
   state.dirty_method = true;
 }
 

@@ -160,16 +160,6 @@ void expect_signal_removes_temporaries(int sig) {
 TEST(OutputSet, SigtermRemovesTheTemporaryFiles) { expect_signal_removes_temporaries(SIGTERM); }
 TEST(OutputSet, SigintRemovesTheTemporaryFiles) { expect_signal_removes_temporaries(SIGINT); }
 
-TEST(ScratchFile, IsRemovedWithItsOwner) {
-  TempDir dir;
-  {
-    const ScratchFile scratch(dir / "s.png");
-    write_text(scratch.path(), "x");
-    EXPECT_TRUE(fs::exists(dir / "s.png"));
-  }
-  EXPECT_EQ(dir.file_count(), 0);
-}
-
 /// The pid of a process that has ended (a child that exited and was reaped).
 pid_t dead_pid() {
   const pid_t child = ::fork();

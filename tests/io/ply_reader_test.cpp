@@ -250,5 +250,36 @@ TEST(PlyReader, CountsAreCheckedAgainstTheFileBeforeAllocating) {
   EXPECT_READ_ERROR(many, "face 0 has 0 vertices");
 }
 
+// Issue 41: a header declaring one face fewer than the data holds dropped the last face with exit
+// 0 (OFF already refused it). Data after the last declared element, other than blank space, is
+// refused in every encoding; a trailing line end is not data.
+TEST(PlyReader, DataBeyondTheDeclaredElementsIsRefused) {
+  const std::string ascii_body = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+  const auto ascii = [&](int faces) {
+    return "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(faces) +
+           "\nproperty list uchar int vertex_indices\nend_header\n" + ascii_body;
+  };
+  EXPECT_EQ(read_ply("t.ply", ascii(2)).meshes[0].triangle_count(), 2u);
+  EXPECT_EQ(read_ply("t.ply", ascii(2) + "\n \n").meshes[0].triangle_count(), 2u);
+  EXPECT_READ_ERROR(ascii(1), "the header declares 4 x 'vertex', 1 x 'face' elements, but the data holds more after the last of them");
+  // Binary: the square's face list, then one more face the header does not declare.
+  std::string binary = binary_square(false);
+  EXPECT_NO_THROW(read_ply("t.ply", binary + "\n"));
+  put<std::uint8_t>(binary, 3);
+  for (int i : {0, 1, 2}) put<std::int32_t>(binary, i);
+  EXPECT_READ_ERROR(binary, "but the data holds more after the last of them (13 more bytes)");
+}
+
+// Issue 41: a header with a 100 KB comment line was "no end_header line" (only the first 64 KiB
+// were searched). Lines are read whole, and "end_header" inside a comment ends nothing.
+TEST(PlyReader, LongCommentsAreReadAndEndHeaderInsideOneEndsNothing) {
+  const std::string body = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string long_comment = "comment " + std::string(100000, 'x') + " end_header\n";
+  const Scene s = read_ply("t.ply", "ply\n" + long_comment + body.substr(4));
+  EXPECT_EQ(s.meshes[0].triangle_count(), 1u);
+  EXPECT_EQ(read_ply("t.ply", "ply\ncomment see end_header below\n" + body.substr(4)).meshes[0].triangle_count(), 1u);
+}
+
 }  // namespace
 }  // namespace ao

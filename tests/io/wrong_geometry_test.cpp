@@ -181,5 +181,74 @@ TEST(WrongGeometry, DenormalAndUnderflowingCoordinatesReadTheSameInEveryFormat) 
   EXPECT_NE(test::load_error(dir.write("big.obj", "v 0 0 1e39\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).find("non-finite"), std::string::npos);
 }
 
+// Issue 41: a node scaled 1e-20 along one axis (determinant 1e-20, not 0) aborted render and
+// compare on an Embree assertion (rays in the mesh's space too long) and baked with exit 0. A
+// transform that squashes its mesh beyond kMaxSquashRatio is refused wherever it is loaded, as a
+// flattening one is; a strong but traceable squash (1e-5) is a valid placement.
+TEST(WrongGeometry, SquashedNodeTransformsAreRefusedEverywhere) {
+  TempDir dir;
+  const std::vector<std::pair<std::string, json>> cases = {
+      {"squash-once.gltf", json::array({{{"name", "thin"}, {"mesh", 0}, {"scale", {1e-20, 1, 1}}}})},
+      {"squash-twice.gltf", json::array({{{"name", "ok"}, {"mesh", 0}}, {{"name", "thin"}, {"mesh", 0}, {"scale", {1e-20, 1, 1}}, {"translation", {2, 0, 0}}}})},
+      {"squash-matrix.gltf", json::array({{{"name", "ok"}, {"mesh", 0}},
+                                          {{"name", "thin"}, {"mesh", 0}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1e-9, 0, 2, 0, 0, 1}}}})},
+  };
+  const std::string needle = "node 'thin' has a transform that squashes the mesh";
+  for (const auto& [name, nodes] : cases) {
+    SCOPED_TRACE(name);
+    const fs::path file = dir.write(name, gltf_with_nodes(nodes).dump());
+    for (bool flatten : {false, true}) {
+      try {
+        load_scene_file(file, {.flatten_instances = flatten});
+        ADD_FAILURE() << "loaded, flatten_instances " << flatten;
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+      }
+    }
+    try {
+      GltfDocument doc(file, 0);
+      ADD_FAILURE() << "GltfDocument loaded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+    expect_cli_refuses(dir.path(), name, needle);
+    const test::RunResult r = test::run_ao("compare " + name + " --methods gtao --width 16 --height 16 --reference-samples 4 -q", dir.path());
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+  }
+  const json thin = json::array({{{"mesh", 0}}, {{"mesh", 0}, {"scale", {1e-5, 1, 1}}, {"translation", {2, 0, 0}}}});
+  EXPECT_EQ(load_scene_file(dir.write("thin.gltf", gltf_with_nodes(thin).dump())).instances.size(), 2u);
+  EXPECT_EQ(test::run_ao("render thin.gltf -o out.png --width 16 --height 16 --spp 2 -q", dir.path()).exit_code, 0);
+}
+
+// Issue 41: a model scaled to 1e-14 rendered an empty image and baked V = 1 with exit 0 (1e-8
+// was already visibly wrong); at 1e-25 the message named no file. A scene smaller than
+// kMinSceneExtent loads (its normals are right) but is refused, naming the file, by everything
+// that traces it; the smallest accepted size traces like the model at unit size.
+TEST(WrongGeometry, TooSmallScenesAreRefusedWhereTheyAreTraced) {
+  TempDir dir;
+  const Mesh torus = make_torus({0.3f, -0.2f, 0.1f}, 1.0f, 0.35f, 48, 16);  // 2.7 units across
+  for (const char* scale : {"1e-9", "1e-14", "1e-25"}) {
+    SCOPED_TRACE(scale);
+    const std::string name = std::string("tiny") + scale + ".off";
+    dir.write(name, off_text(torus, std::stof(scale)));
+    EXPECT_GT(load_scene_file(dir / name).triangle_count(), 0u);
+    expect_cli_refuses(dir.path(), name, name + ": the scene is ");
+    const test::RunResult r = test::run_ao("bake " + name + " -m histogram --per-vertex pv.ply -q", dir.path());
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out.png") || fs::exists(dir / "pv.ply"));
+  // Just above the limit the image is the unit-size one: mean V equal to 2 decimals (the run at
+  // unit size and at 4e-7 differ only by rounding of the coordinates).
+  dir.write("unit.off", off_text(torus, 1.0f));
+  dir.write("small.off", off_text(torus, 4e-7f));
+  const auto mean_v = [&](const std::string& file) {
+    const test::RunResult r = test::run_ao("render " + file + " -o " + file + ".png --width 48 --height 32 --spp 16 --json -q", dir.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return json::parse(r.out).at("mean_visibility").get<double>();
+  };
+  EXPECT_NEAR(mean_v("small.off"), mean_v("unit.off"), 0.005);
+}
+
 }  // namespace
 }  // namespace ao

@@ -51,6 +51,31 @@ inline Affine3 inverse(const Affine3& m) {
   return r;
 }
 
+/// How much more m's linear part L stretches space along one direction than along another: the
+/// condition number ||L||_F ||L^-1||_F (Frobenius norms, in double; ||L^-1||_F = ||cof(L)||_F /
+/// |det L|), which is at least the ratio of L's largest to its smallest singular value and at most
+/// 3 times it. 1 for a rotation or a uniform scale, about 1.4e20 for a scale of (1e-20, 1, 1);
+/// +infinity when L is singular or not finite.
+inline double squash_ratio(const Affine3& m) {
+  const auto norm2 = [](const Affine3& a) {
+    double s = 0;
+    for (const Vec3& c : {a.c0, a.c1, a.c2})
+      for (const float v : {c.x, c.y, c.z}) s += static_cast<double>(v) * static_cast<double>(v);
+    return s;
+  };
+  // The cofactors in double: in float the products of tiny entries underflow.
+  const auto d = [](float v) { return static_cast<double>(v); };
+  const Vec3 &a = m.c0, &b = m.c1, &c = m.c2;
+  const double cof[9] = {d(b.y) * d(c.z) - d(b.z) * d(c.y), d(b.z) * d(c.x) - d(b.x) * d(c.z), d(b.x) * d(c.y) - d(b.y) * d(c.x),
+                         d(c.y) * d(a.z) - d(c.z) * d(a.y), d(c.z) * d(a.x) - d(c.x) * d(a.z), d(c.x) * d(a.y) - d(c.y) * d(a.x),
+                         d(a.y) * d(b.z) - d(a.z) * d(b.y), d(a.z) * d(b.x) - d(a.x) * d(b.z), d(a.x) * d(b.y) - d(a.y) * d(b.x)};
+  double cof2 = 0;
+  for (const double v : cof) cof2 += v * v;
+  const double det = std::abs(m.determinant());
+  const double ratio = std::sqrt(norm2(m)) * std::sqrt(cof2) / det;
+  return std::isfinite(ratio) && det > 0 ? ratio : HUGE_VAL;
+}
+
 /// The axis-aligned box of m applied to the corners of b (an empty box stays empty).
 inline Bounds3 transform_bounds(const Affine3& m, const Bounds3& b) {
   Bounds3 out;

@@ -24,6 +24,19 @@ struct RenderMemoryInput {
 /// of the registry's methods), and the encoded outputs, plus a fixed 64 MiB for the process.
 std::uint64_t estimate_render_memory(const RenderMemoryInput& in);
 
+/// What `ao compare` allocates that grows with the image.
+struct CompareMemoryInput {
+  int width = 0, height = 0;  ///< Pixels.
+  int methods = 0;            ///< Methods compared (rows of the table and the sheet).
+  int references = 0;         ///< Distinct references rendered.
+  int sheet_columns = 3;      ///< Images per row of the contact sheet (V, reference, heat map; 5 with the GPU).
+};
+/// Peak bytes of a comparison's images: the G-buffer, the scratch of the method that runs (the
+/// largest of the registry's), each method's V and heat map and each reference's V (kept for the
+/// table and the sheet), and the contact sheet (its rows, then the joined sheet, and its
+/// encoding), plus a fixed 64 MiB for the process.
+std::uint64_t estimate_compare_memory(const CompareMemoryInput& in);
+
 /// Peak bytes of cone tracing's voxel grid of columns x columns x depth_bits voxels (ConeParams;
 /// the eye grid has at most that many): the bit grid, its coarser levels and the voxelizer's
 /// scratch, about twice the grid's bits, plus 16 bytes of masks per column. Arguments are clamped

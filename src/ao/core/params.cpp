@@ -75,10 +75,24 @@ nlohmann::json float_json(float v) {
 
 std::string json_text(const nlohmann::json& j) { return j.is_string() ? j.get<std::string>() : j.dump(); }
 
+namespace {
+
+/// A value for a message: its JSON text, at most 40 characters (a value may be any JSON, as large
+/// as the file or the option that gave it).
+std::string excerpt(const nlohmann::json& j) {
+  std::string text = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (text.size() > 40) text = text.substr(0, 40) + "...";
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  return text;
+}
+
+}  // namespace
+
 namespace params_detail {
 
 void throw_bad_value(std::string_view owner, const ParamSpec& spec, const nlohmann::json& got) {
-  std::string value = got.dump();
+  std::string value = excerpt(got);
   if (got.is_number_float()) value = float_text(got.get<float>());
   throw InputError(std::string(owner) + ": " + spec.name + " must be " + spec.valid_text() + ", got " + value);
 }
@@ -93,7 +107,7 @@ void throw_unknown_key(std::string_view owner, std::string_view key, const std::
 }
 
 void throw_not_object(std::string_view owner, const nlohmann::json& got) {
-  throw InputError(std::string(owner) + ": parameters must be a JSON object, got " + got.dump());
+  throw InputError(std::string(owner) + ": parameters must be a JSON object, got " + excerpt(got));
 }
 
 bool type_matches(const ParamSpec& spec, const nlohmann::json& j) {

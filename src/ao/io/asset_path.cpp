@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 
 namespace ao {
 
@@ -12,13 +13,22 @@ namespace fs = std::filesystem;
 namespace {
 
 /// Text of a reference for a message: printable and short, whatever the file holds.
-std::string printable(std::string_view s) {
-  std::string out;
-  for (char c : s.substr(0, 80)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return s.size() > 80 ? out + "..." : out;
-}
+std::string printable(std::string_view s) { return io_detail::printable(s, 80); }
 
 }  // namespace
+
+std::string percent_decode(std::string_view s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) && std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
+      out += static_cast<char>(std::stoi(std::string(s.substr(i + 1, 2)), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
 
 fs::path resolved_path(const fs::path& p) {
   std::error_code ec;

@@ -23,6 +23,10 @@ std::filesystem::path asset_folder(const std::filesystem::path& model, const std
 /// path below it. `folder` as asset_folder returns it.
 bool inside_folder(const std::filesystem::path& file, const std::filesystem::path& folder);
 
+/// A glTF URI's percent-encoded octets decoded (RFC 3986, as glTF requires URIs to be written):
+/// "m%2Ebin" is the file "m.bin". A '%' not followed by two hex digits stays as it is.
+std::string percent_decode(std::string_view uri);
+
 /// The file a reference of `model` names: `reference` (a relative path, or an absolute one) taken
 /// from the folder of `model`. InputError "<model>: <what> '<reference>' lies outside the asset's
 /// folder '<folder>'; an asset may reference files only in its own folder or below it" when it

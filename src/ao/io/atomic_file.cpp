@@ -2,19 +2,23 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/random.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <random>
 #include <string>
 #include <system_error>
 
 #include "ao/core/error.h"
+#include "ao/io/commit_journal.h"
 
 namespace ao {
 
@@ -22,10 +26,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// "the file size limit (ulimit -f) of N bytes is reached": what a write past RLIMIT_FSIZE says.
+std::string file_size_limit_text() {
+  struct rlimit limit {};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    return "the file size limit (ulimit -f) of " + std::to_string(limit.rlim_cur) + " bytes is reached";
+  return "the file size limit (ulimit -f) is reached";
+}
+
 std::string errno_text(int err) {
   // The message a user can act on: strerror's "No space left on device" names no remedy.
   if (err == ENOSPC || err == EDQUOT) return "the disk is full";
-  if (err == EFBIG) return "the file is larger than the file size limit allows";
+  if (err == EFBIG) return file_size_limit_text();
   return std::generic_category().message(err);
 }
 
@@ -75,14 +87,26 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
   ::raise(sig);
 }
 
-// Unique within the process (the counter) and across processes (the pid), so concurrent writers
-// of the same destination never share a temporary file.
+/// 64 random bits as 16 hex digits: from the kernel (getrandom), else std::random_device.
+std::string random_hex() {
+  std::uint64_t bits = 0;
+  if (::getrandom(&bits, sizeof bits, 0) != static_cast<ssize_t>(sizeof bits)) {
+    std::random_device device;
+    bits = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(bits));
+  return text;
+}
+
+// The pid names the process that made the file (remove_stale_temporaries reads it back); the
+// random part makes the name unguessable, so nobody can plant a file or a symbolic link under it
+// beforehand, and unique across processes and calls.
 fs::path temp_path_for(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
   // Built by appending: GCC 12 warns falsely (-Wrestrict) about "literal" + std::string here.
   std::string name = ".";
   name += target.stem().string();
-  name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+  name += ".tmp-" + std::to_string(::getpid()) + "-" + random_hex();
   name += target.extension().string();
   return target.parent_path() / name;
 }
@@ -94,10 +118,12 @@ long temporary_pid(const std::string& name, const fs::path& destination) {
   prefix += ".tmp-";
   const std::string ext = destination.extension().string();
   if (!name.starts_with(prefix) || !name.ends_with(ext) || name.size() <= prefix.size() + ext.size()) return -1;
-  const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - ext.size());  // "<pid>-<counter>"
+  const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - ext.size());  // "<pid>-<hex>"
   const std::size_t dash = middle.find('-');
   if (dash == 0 || dash == std::string::npos || dash + 1 == middle.size()) return -1;
-  if (middle.find_first_not_of("0123456789-") != std::string::npos || middle.find('-', dash + 1) != std::string::npos) return -1;
+  if (middle.substr(0, dash).find_first_not_of("0123456789") != std::string::npos ||
+      middle.substr(dash + 1).find_first_not_of("0123456789abcdef") != std::string::npos)
+    return -1;
   try {
     return std::stol(middle.substr(0, dash));
   } catch (const std::exception&) {
@@ -115,7 +141,7 @@ std::string storage_failure(const fs::path& temp, const fs::path& dir) {
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(temp, ec);
   if (!ec && ::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && size >= limit.rlim_cur)
-    return "the file reached the file size limit (ulimit -f) of " + std::to_string(limit.rlim_cur) + " bytes";
+    return file_size_limit_text();
   return {};
 }
 
@@ -133,7 +159,7 @@ const char* file_type_name(fs::file_type t) {
 // Flushes the file's data to disk before the rename, so that after a crash the destination holds
 // either the old file or the complete new one, never a renamed but empty file.
 void sync_file(const fs::path& file, const fs::path& reported) {
-  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0) throw SystemError(reported.string() + ": cannot reopen the temporary file: " + errno_text(errno));
   const int rc = ::fsync(fd);
   const int err = errno;
@@ -162,11 +188,49 @@ TemporaryRegistration& TemporaryRegistration::operator=(TemporaryRegistration&& 
   return *this;
 }
 
-ScratchFile::ScratchFile(fs::path path) : path_(std::move(path)), registration_(path_) {}
+void ignore_file_size_signal() {
+  struct sigaction action {};
+  action.sa_handler = SIG_IGN;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGXFSZ, &action, nullptr);
+}
 
-ScratchFile::~ScratchFile() {
-  std::error_code ec;
-  fs::remove(path_, ec);
+int open_temporary_descriptor(const fs::path& temp, const fs::path& reported) {
+  // No O_CREAT: the file write_file_atomically created exclusively must still be there, and a
+  // symbolic link put in its place is not followed.
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) throw SystemError(reported.string() + ": cannot open the temporary file for writing: " + errno_text(errno));
+  return fd;
+}
+
+std::FILE* open_temporary(const fs::path& temp, const fs::path& reported) {
+  const int fd = open_temporary_descriptor(temp, reported);
+  std::FILE* f = ::fdopen(fd, "wb");
+  if (f == nullptr) {
+    const int err = errno;
+    ::close(fd);
+    throw SystemError(reported.string() + ": cannot open the temporary file for writing: " + errno_text(err));
+  }
+  return f;
+}
+
+void close_temporary(std::FILE* file, const fs::path& reported) {
+  const bool flushed = std::fflush(file) == 0 && std::ferror(file) == 0;
+  const int err = errno;
+  if (std::fclose(file) != 0 || !flushed) throw SystemError(reported.string() + ": cannot write: " + errno_text(flushed ? errno : err));
+}
+
+void write_bytes_atomically(const fs::path& path, std::string_view bytes) {
+  write_file_atomically(path, [&](const fs::path& temp) {
+    std::FILE* f = open_temporary(temp, path);
+    const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const int err = errno;
+    if (!written) {
+      std::fclose(f);
+      throw SystemError(path.string() + ": cannot write: " + errno_text(err));
+    }
+    close_temporary(f, path);
+  });
 }
 
 void remove_temporaries_on_signals() {
@@ -186,6 +250,8 @@ namespace detail {
 
 fs::path temporary_path_for(const fs::path& destination) { return temp_path_for(destination); }
 
+std::string random_suffix() { return random_hex(); }
+
 DeferredRenames::DeferredRenames(Keep keep) : keep_(std::move(keep)), outer_(t_deferred) { t_deferred = this; }
 DeferredRenames::~DeferredRenames() { t_deferred = outer_; }
 DeferredRenames* DeferredRenames::current() { return t_deferred; }
@@ -196,6 +262,13 @@ void DeferredRenames::keep(const fs::path& temp, const fs::path& destination, Te
 }  // namespace detail
 
 void check_output_destination(const fs::path& path, const std::string& what) {
+  // A line break in a name would break every one-line message and summary that names the file.
+  const std::string name = path.string();
+  if (std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; })) {
+    std::string shown;
+    for (char c : name.substr(0, 80)) shown += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+    throw InputError("'" + shown + "': " + what + " has a line break or another control character in its name; ao writes no such names");
+  }
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);  // follows symbolic links
   if (ec || !fs::exists(st) || fs::is_regular_file(st)) return;
@@ -209,7 +282,7 @@ namespace {
 
 // Removes the temporary files of other processes beside `destination` (write_file_atomically's
 // names) that `abandoned` accepts.
-int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned) {
+int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned, bool any_process) {
   std::error_code ec;
   fs::path target = destination;
   if (fs::is_symlink(destination, ec)) {
@@ -217,6 +290,9 @@ int remove_temporaries_of(const fs::path& destination, const std::function<bool(
     if (!ec) target = resolved;
   }
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  // A killed run's commit first: its journal names the staged files and links it needs to roll
+  // back, which the loop below would otherwise remove as stale.
+  detail::recover_interrupted_commits(dir, any_process);
   int removed = 0;
   fs::directory_iterator it(dir, ec);
   for (; !ec && it != fs::directory_iterator(); it.increment(ec)) {
@@ -238,11 +314,11 @@ int remove_stale_temporaries(const fs::path& destination) {
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) return false;
     std::error_code ec;
     return file.last_write_time(ec) < g_process_start && !ec;
-  });
+  }, false);
 }
 
 int remove_abandoned_temporaries(const fs::path& destination) {
-  return remove_temporaries_of(destination, [](long, const fs::directory_entry&) { return true; });
+  return remove_temporaries_of(destination, [](long, const fs::directory_entry&) { return true; }, true);
 }
 
 void write_file_atomically(const fs::path& path, const std::function<void(const fs::path& temp)>& write) {
@@ -269,7 +345,7 @@ void write_file_atomically(const fs::path& path, const std::function<void(const 
   // point after the open finds it.
   const fs::path temp = temp_path_for(target);
   TemporaryRegistration registration(temp);
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) {
     const int err = errno;
     throw SystemError(path.string() + ": cannot create a file in '" + dir.string() + "': " + errno_text(err));

@@ -6,15 +6,20 @@
 // Runs with several outputs group their writes with OutputSet (output_set.h).
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <string_view>
 
 namespace ao {
 
 /// Writes `path` atomically. `write` receives the path of a temporary file in the same directory
-/// (named `.<stem>.tmp-<pid>-<counter><extension>`: hidden, unique per process and call, and
-/// keeping the real extension last for libraries that choose a format by extension). The temporary
-/// file already exists, empty; `write` must fill it and close it before returning. Then the
+/// (named `.<stem>.tmp-<pid>-<16 random hex digits><extension>`: hidden, unguessable, unique per
+/// process and call, and keeping the real extension last for libraries that choose a format by
+/// extension). The temporary file already exists, empty: it is created with O_EXCL and
+/// O_NOFOLLOW, so neither a file nor a symbolic link planted beforehand is written through. `write`
+/// must fill it, opening it with open_temporary (which follows no symbolic link either), and close
+/// it before returning. Nothing is ever written to a shared temporary folder ($TMPDIR). Then the
 /// temporary file is flushed to disk and renamed over `path`, which is replaced in one step
 /// (a symbolic link at `path` is followed, so the file it names is replaced and the link kept).
 /// Inside OutputSet::write the rename is left to OutputSet::commit.
@@ -25,15 +30,34 @@ namespace ao {
 /// Errors of its own are one line naming `path`: InputError when the destination cannot be used
 /// (its directory does not exist, it is a directory, a FIFO, a device or a socket), SystemError
 /// when the environment fails (no permission to create the temporary file, cannot flush or
-/// rename; a full disk says "the disk is full").
+/// rename; a full disk says "cannot write: the disk is full", a file size limit "cannot write: the
+/// file size limit (ulimit -f) of N bytes is reached").
 void write_file_atomically(const std::filesystem::path& path,
                            const std::function<void(const std::filesystem::path& temp)>& write);
+
+/// write_file_atomically with `bytes` as the file's whole content.
+void write_bytes_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+/// Opens `temp`, a temporary file write_file_atomically made, for writing from its start: with
+/// O_NOFOLLOW and without O_CREAT, so the file it created is the one written, never a symbolic
+/// link or a new file put in its place. SystemError naming `reported` (the destination) when it
+/// cannot be opened. Close it with close_temporary.
+std::FILE* open_temporary(const std::filesystem::path& temp, const std::filesystem::path& reported);
+
+/// open_temporary as a file descriptor (for libraries that take one); the caller closes it.
+int open_temporary_descriptor(const std::filesystem::path& temp, const std::filesystem::path& reported);
+
+/// Flushes and closes a file of open_temporary; SystemError naming `reported` when a write failed
+/// ("cannot write: the disk is full", "... the file size limit ... is reached").
+void close_temporary(std::FILE* file, const std::filesystem::path& reported);
 
 /// InputError "<path>: <what> is a FIFO (named pipe), not a regular file; ao writes only regular
 /// files or new paths" (likewise a character or block device, a socket, a directory) when `path`
 /// exists, following symbolic links, and is not a regular file: replacing it by a regular file
 /// would break a pipe another program reads, or, through a symbolic link, a device node. A new
 /// path, a regular file and a symbolic link to either pass. `what` names the option ("-o").
+/// Also InputError for a name with a line break or another control character, which would break
+/// every one-line message and summary naming the file.
 void check_output_destination(const std::filesystem::path& path, const std::string& what = "the output");
 
 /// Removes the temporary files that runs of ao killed before they could clean up (SIGKILL, a
@@ -54,8 +78,15 @@ int remove_stale_temporaries(const std::filesystem::path& destination);
 /// this process started). Returns how many it removed; never throws.
 int remove_abandoned_temporaries(const std::filesystem::path& destination);
 
+/// Ignores SIGXFSZ, so that a write beyond the file size limit (ulimit -f, RLIMIT_FSIZE) fails with
+/// EFBIG, which the writers report as "cannot write: the file size limit ... is reached" and clean
+/// up after, instead of the signal's default action killing the process with no message and its
+/// temporary files left. For programs (the CLI calls it first thing; Python ignores SIGXFSZ
+/// itself); the library never changes a signal's disposition by itself. Idempotent.
+void ignore_file_size_signal();
+
 /// Installs handlers of SIGINT, SIGTERM and SIGHUP that remove every registered temporary file
-/// (those of write_file_atomically, OutputSet and ScratchFile not yet renamed or removed) and the
+/// (those of write_file_atomically and OutputSet not yet renamed or removed) and the
 /// empty folders an OutputSet created, then end the process by the same signal with its default
 /// action, so the parent sees the signal as usual. For programs (the CLI calls it first thing);
 /// the library never installs a handler by itself. Idempotent.
@@ -80,26 +111,14 @@ class TemporaryRegistration {
   int slot_ = -1;
 };
 
-/// A scratch file that is nobody's output (e.g. an intermediate encoding): removed by the
-/// destructor, and by the signal handlers while it lives. The file is not created here.
-class ScratchFile {
- public:
-  explicit ScratchFile(std::filesystem::path path);
-  ~ScratchFile();
-  ScratchFile(const ScratchFile&) = delete;
-  ScratchFile& operator=(const ScratchFile&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-  TemporaryRegistration registration_;
-};
-
 namespace detail {
 
 /// A fresh temporary name for `destination` as write_file_atomically makes them (hidden, in the
 /// same folder, unique per process and call); nothing is created.
 std::filesystem::path temporary_path_for(const std::filesystem::path& destination);
+
+/// 64 random bits as 16 hex digits (getrandom): the unguessable part of temporary names.
+std::string random_suffix();
 
 /// While alive, write_file_atomically on this thread does not rename its complete temporary file:
 /// it calls `keep(temp, destination, registration)` and leaves the file to the callee (OutputSet).

@@ -1,10 +1,9 @@
 #include "ao/io/camera_json.h"
 
-#include <fstream>
-#include <sstream>
-
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
+#include "ao/io/io_error_internal.h"
+#include "ao/io/json_text.h"
 
 namespace ao {
 
@@ -15,7 +14,7 @@ nlohmann::json vec_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z});
 Vec3 read_vec(const nlohmann::json& j, const char* key, const std::string& source) {
   const nlohmann::json& v = j.at(key);
   if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
-    throw InputError(source + ": camera '" + key + "' must be an array of three numbers, got " + v.dump());
+    throw InputError(source + ": camera '" + key + "' must be an array of three numbers, got " + json_excerpt(v));
   return {v[0].get<float>(), v[1].get<float>(), v[2].get<float>()};
 }
 
@@ -32,18 +31,18 @@ Camera camera_from_json(const nlohmann::json& j, const Camera& defaults, const s
     if (!j.contains(key)) throw InputError(source + ": camera has no '" + key + "' (needs eye, target, up, fov; width, height optional)");
   for (const auto& [key, value] : j.items())
     if (key != "eye" && key != "target" && key != "up" && key != "fov" && key != "width" && key != "height")
-      throw InputError(source + ": unknown camera field '" + key + "' (known: eye, target, up, fov, width, height)");
+      throw InputError(source + ": unknown camera field '" + io_detail::printable(key, 40) + "' (known: eye, target, up, fov, width, height)");
   Camera c = defaults;
   c.eye = read_vec(j, "eye", source);
   c.target = read_vec(j, "target", source);
   c.up = read_vec(j, "up", source);
-  if (!j["fov"].is_number()) throw InputError(source + ": camera 'fov' must be a number of degrees, got " + j["fov"].dump());
+  if (!j["fov"].is_number()) throw InputError(source + ": camera 'fov' must be a number of degrees, got " + json_excerpt(j["fov"]));
   c.vertical_fov_deg = j["fov"].get<float>();
   for (const char* key : {"width", "height"}) {
     if (!j.contains(key)) continue;
     const nlohmann::json& v = j[key];
     if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 65536)
-      throw InputError(source + ": camera '" + key + "' must be a whole number of pixels in [1, 65536], got " + v.dump());
+      throw InputError(source + ": camera '" + key + "' must be a whole number of pixels in [1, 65536], got " + json_excerpt(v));
     (key[0] == 'w' ? c.width : c.height) = v.get<int>();
   }
   try {
@@ -55,22 +54,11 @@ Camera camera_from_json(const nlohmann::json& j, const Camera& defaults, const s
 }
 
 Camera read_camera_file(const std::filesystem::path& path, const Camera& defaults) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open the camera file");
-  std::stringstream text;
-  text << in.rdbuf();
-  const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) throw InputError(path.string() + ": not valid JSON (expected a camera: eye, target, up, fov)");
-  return camera_from_json(j, defaults, path.string());
+  return camera_from_json(read_json_file(path, "a camera: eye, target, up, fov"), defaults, path.string());
 }
 
 void write_camera_file(const std::filesystem::path& path, const Camera& camera) {
-  write_file_atomically(path, [&](const std::filesystem::path& temp) {
-    std::ofstream out(temp, std::ios::binary);
-    out << camera_to_json(camera).dump(2) << "\n";
-    out.close();
-    if (!out) throw SystemError(path.string() + ": cannot write");
-  });
+  write_bytes_atomically(path, camera_to_json(camera).dump(2) + "\n");
 }
 
 }  // namespace ao

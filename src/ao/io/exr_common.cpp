@@ -3,6 +3,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStdIO.h>
 
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <vector>
@@ -14,27 +15,49 @@ namespace ao::io_detail {
 
 namespace fs = std::filesystem;
 
-std::string one_line(std::string_view message) {
-  std::string out;
-  out.reserve(message.size());
-  bool pending_separator = false;
-  for (const char c : message) {
-    if (c == '\n' || c == '\r') {
-      pending_separator = !out.empty();
-      continue;
-    }
-    if ((c == ' ' || c == '\t') && (out.empty() || out.back() == ' ')) continue;
-    if (pending_separator) {
-      while (!out.empty() && out.back() == ' ') out.pop_back();
-      if (!out.empty() && out.back() != '.' && out.back() != ';') out += ';';
-      out += ' ';
-      pending_separator = false;
-      if (c == ' ' || c == '\t') continue;
-    }
-    out += (c == '\t') ? ' ' : c;
-  }
-  while (!out.empty() && (out.back() == ' ' || out.back() == ';')) out.pop_back();
-  return out;
+namespace {
+
+/// OpenEXR's details (what follows the file name in its messages), as ao says them.
+struct ExrWords {
+  std::string_view needle, words;
+};
+constexpr ExrWords kExrWords[] = {
+    {"Early end of file", "truncated: the file ends before its data does"},
+    {"Unexpected data block", "damaged pixel data: a block lies at the wrong place"},
+    {"decompression", "damaged pixel data: a block does not decompress"},
+    {"Missing or empty channel list", "its header lists no channels"},
+    {"Unexpected type for image attribute", "damaged header: an attribute has the wrong type"},
+    {"Invalid size field", "damaged header: an attribute's size is wrong"},
+    {"unrecognized flags", "damaged header: unknown format flags"},
+    {"Invalid line order", "damaged header: unknown line order"},
+    {"not a multiple of the", "damaged header: the data window does not fit the channels' subsampling"},
+    {"Cannot read scan line offsets", "damaged offset table"},
+    {"Invalid data window", "damaged header: invalid data window"},
+    {"Invalid display window", "damaged header: invalid display window"},
+    {"Invalid compression", "damaged header: unknown compression"},
+    {"does not appear to be an OpenEXR file", "not an OpenEXR file"},
+    {"magic number", "not an OpenEXR file"},
+    {"No space left", "the disk is full"},
+    {"File too large", "the file size limit (ulimit -f) is reached"},
+};
+
+}  // namespace
+
+std::string exr_words(std::string_view message, const fs::path& path) {
+  for (const ExrWords& w : kExrWords)
+    if (message.find(w.needle) != std::string_view::npos) return std::string(w.words);
+  // OpenEXR's messages name the file ("Cannot read image file \"g.exr\". <detail>"); ours already
+  // start with it. Without a known detail: what part of the file failed, in general words.
+  if (message.find("pixel data") != std::string_view::npos || message.find("tile") != std::string_view::npos)
+    return "damaged pixel data";
+  if (message.find("Cannot read") != std::string_view::npos || message.find("header") != std::string_view::npos) return "damaged header";
+  std::string text(message);
+  // Appended piecewise: "literal" + std::string trips GCC 12's false -Wrestrict here.
+  std::string quoted(1, '"');
+  quoted += path.string();
+  quoted += '"';
+  for (std::size_t at; (at = text.find(quoted)) != std::string::npos;) text.erase(at, quoted.size());
+  return one_line(text);
 }
 
 void require_input_file(const fs::path& path) {
@@ -126,24 +149,40 @@ void read_exr_channels(Imf::InputFile& file, const ExrWindows& w, std::span<cons
   }
 }
 
+namespace {
+
+/// OpenEXR's output stream over a stdio file (the temporary file open_temporary opened). Write
+/// errors are remembered rather than thrown: close_temporary reports them in ao's words.
+class StdioOStream : public Imf::OStream {
+ public:
+  StdioOStream(std::FILE* file, const char* name) : Imf::OStream(name), file_(file) {}
+  void write(const char c[], int n) override { std::fwrite(c, 1, static_cast<std::size_t>(n), file_); }
+  std::uint64_t tellp() override { return static_cast<std::uint64_t>(::ftello(file_)); }
+  void seekp(std::uint64_t pos) override { ::fseeko(file_, static_cast<off_t>(pos), SEEK_SET); }
+
+ private:
+  std::FILE* file_;
+};
+
+}  // namespace
+
 void write_exr_atomically(const fs::path& path, const Imf::Header& header, const Imf::FrameBuffer& frame) {
   write_file_atomically(path, [&](const fs::path& temp) {
     // Our own stream rather than a file name: OutputFile's destructor writes the line-offset
-    // table and swallows any error, so only the stream's state after closing tells us whether
-    // the whole file reached the disk (a full disk shows up here).
-    std::ofstream os(temp, std::ios::binary | std::ios::trunc);
-    if (!os) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+    // table and swallows any error, so only the file's state after closing tells us whether the
+    // whole file reached the disk (a full disk, a file size limit show up there).
+    std::FILE* file = open_temporary(temp, path);
     try {
-      Imf::StdOFStream stream(os, path.c_str());  // the name OpenEXR's messages give: the user's, not the temporary one
+      StdioOStream stream(file, path.c_str());  // the name OpenEXR's messages give: the user's, not the temporary one
       Imf::OutputFile out(stream, header);
       out.setFrameBuffer(frame);
       const Imath::Box2i& data = header.dataWindow();
       out.writePixels(data.max.y - data.min.y + 1);
     } catch (const std::exception& e) {
-      throw SystemError(path.string() + ": cannot write OpenEXR file: " + one_line(e.what()));
+      std::fclose(file);
+      throw SystemError(path.string() + ": cannot write OpenEXR file: " + exr_words(e.what(), path));
     }
-    os.close();
-    if (!os) throw SystemError(path.string() + ": write failed (disk full?)");
+    close_temporary(file, path);
   });
 }
 

@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 
 namespace ao::io_detail {
 
@@ -24,10 +25,6 @@ namespace ao::io_detail {
 inline constexpr std::int64_t kMaxImageSide = 32768;
 /// Largest accepted pixel count (2^28, 1 GiB per float channel), checked before allocating.
 inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 28;
-
-/// Library messages may span lines; errors must be one line. Newlines become "; ", runs of
-/// blanks collapse, and the result is trimmed.
-std::string one_line(std::string_view message);
 
 /// Throws InputError naming `path` unless it is an existing, non-empty regular file.
 void require_input_file(const std::filesystem::path& path);
@@ -70,8 +67,14 @@ void read_exr_channels(Imf::InputFile& file, const ExrWindows& windows, std::spa
 /// of one line naming `path`; the errors of write_file_atomically pass through.
 void write_exr_atomically(const std::filesystem::path& path, const Imf::Header& header, const Imf::FrameBuffer& frame);
 
+/// OpenEXR's message `message` about the file `path` in ao's words: the problems OpenEXR reports
+/// most (a file cut short, a damaged header or offset table, missing attributes) as one phrase
+/// each; anything else as OpenEXR's text on one line, without the file name it repeats (the
+/// message already starts with it).
+std::string exr_words(std::string_view message, const std::filesystem::path& path);
+
 /// Runs `body`, turning OpenEXR's exceptions (Iex, derived from std::exception) into InputError
-/// "<path>: <what>: <library message>" on one line. InputError and SystemError pass unchanged.
+/// "<path>: <what>: <exr_words>" on one line. InputError and SystemError pass unchanged.
 template <class Body>
 auto with_exr_errors(const std::filesystem::path& path, std::string_view what, Body&& body) -> decltype(body()) {
   try {
@@ -83,7 +86,7 @@ auto with_exr_errors(const std::filesystem::path& path, std::string_view what, B
   } catch (const std::bad_alloc&) {
     throw SystemError(path.string() + ": out of memory while reading");
   } catch (const std::exception& e) {
-    throw InputError(path.string() + ": " + std::string(what) + ": " + one_line(e.what()));
+    throw InputError(path.string() + ": " + std::string(what) + ": " + exr_words(e.what(), path));
   }
 }
 

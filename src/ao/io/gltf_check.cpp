@@ -27,6 +27,8 @@
 
 #include "ao/core/error.h"
 #include "ao/io/asset_path.h"
+#include "ao/io/io_error_internal.h"
+#include "ao/io/json_text.h"
 
 namespace ao {
 namespace {
@@ -34,13 +36,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
-
-std::string one_line(std::string_view s) {
-  std::string out;
-  for (char c : s.substr(0, 160)) out += std::isprint(static_cast<unsigned char>(c)) ? c : ' ';
-  return s.size() > 160 ? out + "..." : out;
-}
+using io_detail::fail;
+using io_detail::one_line;
 
 std::uint32_t read_u32(const char* p) {
   const auto* b = reinterpret_cast<const unsigned char*>(p);
@@ -57,13 +54,15 @@ struct GlbChunks {
   std::optional<std::string_view> bin;
 };
 
-/// GLB 2: a 12-byte header (magic, version, total length), then chunks of (length, type, data).
-/// Every length is checked against what the file holds before anything uses it.
+/// GLB 2: a 12-byte header (magic, version, total length), then chunks of (length, type, data):
+/// JSON first, then at most one BIN, then chunks of other types, which are ignored (glTF 2.0
+/// spec, "Binary glTF Layout"). Every length is checked against what the file holds before
+/// anything uses it, and the chunks must fill the file exactly, as the header's length says.
 GlbChunks split_glb(const fs::path& path, std::string_view data) {
   if (data.size() < 12) fail(path, "truncated GLB: " + std::to_string(data.size()) + " bytes, the header alone takes 12");
   const std::uint32_t version = read_u32(data.data() + 4), length = read_u32(data.data() + 8);
   if (version != 2) fail(path, "GLB version " + std::to_string(version) + " is not supported, only version 2 (glTF 2.0)");
-  if (length > data.size())
+  if (length != data.size())
     fail(path, "GLB header says the file has " + std::to_string(length) + " bytes, it has " + std::to_string(data.size()));
   const std::string_view all = data.substr(0, length);
   if (all.size() < 20) fail(path, "truncated GLB: no JSON chunk");
@@ -72,27 +71,26 @@ GlbChunks split_glb(const fs::path& path, std::string_view data) {
   if (json_length > all.size() - 20)
     fail(path, "GLB JSON chunk says " + std::to_string(json_length) + " bytes, only " + std::to_string(all.size() - 20) + " follow");
   GlbChunks chunks{all.substr(20, json_length), std::nullopt};
-  const std::size_t pos = 20 + static_cast<std::size_t>(json_length);
-  if (all.size() - pos >= 8) {
-    const std::uint32_t bin_length = read_u32(all.data() + pos), bin_type = read_u32(all.data() + pos + 4);
-    if (bin_length > all.size() - pos - 8)
-      fail(path, "GLB chunk 1 says " + std::to_string(bin_length) + " bytes, only " + std::to_string(all.size() - pos - 8) + " follow");
-    // Chunks of unknown type are to be ignored (glTF 2.0 spec, GLB file format).
-    if (bin_type == kChunkBin) chunks.bin = all.substr(pos + 8, bin_length);
+  std::size_t pos = 20 + static_cast<std::size_t>(json_length);
+  for (int k = 1; pos < all.size(); ++k) {
+    if (all.size() - pos < 8)
+      fail(path, "GLB has " + std::to_string(all.size() - pos) + " bytes after chunk " + std::to_string(k - 1) + ", too few for another chunk's 8-byte header");
+    const std::uint32_t chunk_length = read_u32(all.data() + pos), type = read_u32(all.data() + pos + 4);
+    if (chunk_length > all.size() - pos - 8)
+      fail(path, "GLB chunk " + std::to_string(k) + " says " + std::to_string(chunk_length) + " bytes, only " + std::to_string(all.size() - pos - 8) + " follow");
+    if (type == kChunkBin) {
+      if (k != 1) fail(path, "GLB chunk " + std::to_string(k) + " is a second binary chunk or follows another chunk; only chunk 1 may be BIN");
+      chunks.bin = all.substr(pos + 8, chunk_length);
+    }
+    pos += 8 + static_cast<std::size_t>(chunk_length);
   }
   return chunks;
 }
 
-struct TooDeep {};
-
 json parse_json(const fs::path& path, std::string_view text) {
   try {
-    // The callback sees each value's depth before the parser descends into it.
-    return json::parse(text.begin(), text.end(), [](int depth, json::parse_event_t, json&) {
-      if (depth > kMaxGltfJsonDepth) throw TooDeep{};
-      return true;
-    });
-  } catch (const TooDeep&) {
+    return parse_json_with_depth_limit(text, kMaxGltfJsonDepth);  // linear in the text, the depth checked as it opens
+  } catch (const JsonTooDeep&) {
     fail(path, "glTF JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) + " levels");
   } catch (const json::parse_error& e) {
     // nlohmann's text names its own grammar; the byte where it stopped, and the text there, is
@@ -135,19 +133,6 @@ std::optional<std::string> decode_base64(std::string_view in) {
   return out;
 }
 
-std::string percent_decode(std::string_view s) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) && std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
-      out += static_cast<char>(std::stoi(std::string(s.substr(i + 1, 2)), nullptr, 16));
-      i += 2;
-    } else {
-      out += s[i];
-    }
-  }
-  return out;
-}
-
 struct Accessor {
   std::uint64_t count = 0;
   int components = 0;
@@ -171,6 +156,7 @@ class Checker {
   void run() {
     if (!root_.is_object()) fail(path_, "glTF JSON is not an object");
     check_version();
+    check_required_extensions();
     read_buffers();
     check_images();
     read_views();
@@ -291,6 +277,23 @@ class Checker {
     if (version == asset->end() || !version->is_string()) bad("glTF asset has no version");
     const std::string v = version->get<std::string>();
     if (!v.starts_with("2.")) bad("glTF version '" + one_line(v.substr(0, 16)) + "' is not supported, only 2.0");
+  }
+
+  /// A reader must refuse a file that requires an extension it does not implement (glTF 2.0 spec,
+  /// "Specifying Extensions"). ao reads geometry, node transforms, UVs and the base colour:
+  /// extensions about materials, textures' images and sampling, lights and metadata leave those
+  /// as they are; the others (compressed or quantized geometry, GPU instancing, unknown ones)
+  /// would be misread.
+  void check_required_extensions() {
+    for (const json& e : array(root_, "extensionsRequired", "glTF")) {
+      if (!e.is_string()) bad("extensionsRequired holds a value that is not an extension name");
+      const std::string& name = e.get_ref<const std::string&>();
+      if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression")
+        bad("its geometry is compressed with " + name + ", which ao cannot decode; export it uncompressed");
+      const bool harmless = name.starts_with("KHR_materials_") || name == "KHR_texture_transform" || name == "KHR_texture_basisu" ||
+                            name == "EXT_texture_webp" || name == "EXT_texture_avif" || name == "KHR_lights_punctual" || name == "KHR_xmp_json_ld";
+      if (!harmless) bad("it requires the glTF extension '" + one_line(name, 64) + "', which ao does not read");
+    }
   }
 
   void read_buffers() {

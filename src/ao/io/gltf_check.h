@@ -33,7 +33,11 @@ struct GltfSize {
 };
 
 /// Checks `data`, the whole content of `path`, as glTF 2.0 JSON or GLB, without allocating more
-/// than a small multiple of its size: GLB chunk lengths against the file size; JSON nesting depth
+/// than a small multiple of its size: GLB chunk lengths against the file size (the chunks must fill
+/// the file exactly, JSON first, at most one BIN, second); extensionsRequired (only extensions that
+/// leave geometry, transforms, UVs and base colour as ao reads them: KHR_materials_*,
+/// KHR_texture_transform, KHR_texture_basisu, EXT_texture_webp, EXT_texture_avif,
+/// KHR_lights_punctual, KHR_xmp_json_ld; compressed geometry says so); JSON nesting depth
 /// (kMaxGltfJsonDepth); the node graph (indices in range, one parent per node, no cycle, depth at
 /// most kMaxGltfNodeDepth); buffers (GLB BIN chunk, base64 data URI or a file beside `path`)
 /// against their byteLength; file URIs of buffers and images inside `asset_root` (empty, the

@@ -22,6 +22,8 @@
 #include "ao/io/asset_path.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/gltf_check.h"
+#include "ao/io/gltf_document_internal.h"
+#include "ao/io/io_error_internal.h"
 #include "ao/io/tiny_gltf_internal.h"
 
 namespace ao {
@@ -30,15 +32,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
-
-/// tinygltf's messages are several lines: one line, printable, short.
-std::string one_line(const std::string& s) {
-  std::string out;
-  for (char c : s.substr(0, 240)) out += std::isspace(static_cast<unsigned char>(c)) ? ' ' : std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  while (!out.empty() && (out.back() == ' ' || out.back() == '.')) out.pop_back();
-  return s.size() > 240 ? out + "..." : out;
-}
+using io_detail::fail;
+using io_detail::one_line;  // tinygltf's messages are several lines
 
 // --- tinygltf's file system: the input's folder, read only ------------------------------------
 
@@ -161,166 +156,16 @@ struct __attribute__((visibility("hidden"))) GltfDocument::Impl {
   std::vector<std::string> save_warnings;
 
   std::string uv_attribute() const { return "TEXCOORD_" + std::to_string(uv_set); }
-  static bool is_triangles(const tinygltf::Primitive& p) { return p.mode == -1 || (p.mode >= TINYGLTF_MODE_TRIANGLES && p.mode <= TINYGLTF_MODE_TRIANGLE_FAN); }
+  static bool is_triangles(const tinygltf::Primitive& p) { return io_detail::gltf_is_triangles(p); }
   bool bakes(const tinygltf::Primitive& p) const { return is_triangles(p) && p.attributes.count("POSITION") && p.attributes.count(uv_attribute()); }
 
-  std::string label(int mesh) const {
-    const std::string& n = model.meshes[static_cast<std::size_t>(mesh)].name;
-    return n.empty() ? "mesh " + std::to_string(mesh) : "'" + n + "'";
-  }
-  /// The mesh's name, or "mesh N", for names of what is added for it.
-  std::string plain_name(int mesh) const {
-    const std::string& n = model.meshes[static_cast<std::size_t>(mesh)].name;
-    return n.empty() ? "mesh " + std::to_string(mesh) : n;
-  }
+  std::string label(int mesh) const { return io_detail::gltf_mesh_label(model, mesh); }
+  std::string plain_name(int mesh) const { return io_detail::gltf_plain_name(model, mesh); }
   int map_sampler = -1;  ///< The sampler of the AO maps, added with the first.
 
-  // Reads accessor `index` as `comps` floats per element. Integer components count as glTF
-  // specifies: normalized ones scaled to [0, 1] or [-1, 1], others as their value. Sparse values
-  // are applied; an accessor without a bufferView starts as zeros.
-  std::vector<float> read_floats(int index, int comps, const std::string& what) const {
-    const tinygltf::Accessor& a = accessor(index, what);
-    if (tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type)) != comps)
-      fail(path, what + ": accessor " + std::to_string(index) + " has " + std::to_string(tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type))) +
-                     " components, " + std::to_string(comps) + " expected");
-    std::vector<float> out(a.count * static_cast<std::size_t>(comps), 0.0f);
-    auto convert = [&](const unsigned char* src, int type, float* dst, int n) {
-      for (int k = 0; k < n; ++k) {
-        float v = 0;
-        switch (type) {
-          case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&v, src + 4 * k, 4); break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = src[k]; if (a.normalized) v /= 255.0f; break;
-          case TINYGLTF_COMPONENT_TYPE_BYTE: v = static_cast<float>(static_cast<std::int8_t>(src[k])); if (a.normalized) v = std::max(v / 127.0f, -1.0f); break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, src + 2 * k, 2); v = u; if (a.normalized) v /= 65535.0f; break; }
-          case TINYGLTF_COMPONENT_TYPE_SHORT: { std::int16_t s; std::memcpy(&s, src + 2 * k, 2); v = s; if (a.normalized) v = std::max(v / 32767.0f, -1.0f); break; }
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, src + 4 * k, 4); v = static_cast<float>(u); break; }
-          default: fail(path, what + ": accessor " + std::to_string(index) + " has component type " + std::to_string(type) + ", not a vertex attribute type");
-        }
-        dst[k] = v;
-      }
-    };
-    const std::size_t elem = static_cast<std::size_t>(comps) * component_size(a.componentType, index, what);
-    if (a.bufferView >= 0) {
-      const auto [data, stride] = view_range(a, index, elem, what);
-      for (std::size_t i = 0; i < a.count; ++i) convert(data + i * stride, a.componentType, &out[i * static_cast<std::size_t>(comps)], comps);
-    }
-    if (a.sparse.isSparse && a.sparse.count > 0) {
-      const std::size_t n = static_cast<std::size_t>(a.sparse.count);
-      const std::vector<std::uint32_t> at = read_indices_raw(a.sparse.indices.bufferView, static_cast<std::size_t>(a.sparse.indices.byteOffset), a.sparse.indices.componentType, n, index, what);
-      const unsigned char* values = raw_view(a.sparse.values.bufferView, static_cast<std::size_t>(a.sparse.values.byteOffset), n * elem, index, what);
-      for (std::size_t k = 0; k < n; ++k) {
-        if (at[k] >= a.count) fail(path, what + ": sparse index " + std::to_string(at[k]) + " of accessor " + std::to_string(index) + " is past its " + std::to_string(a.count) + " elements");
-        convert(values + k * elem, a.componentType, &out[at[k] * static_cast<std::size_t>(comps)], comps);
-      }
-    }
-    return out;
-  }
-
-  std::vector<std::uint32_t> read_indices(int index, const std::string& what) const {
-    const tinygltf::Accessor& a = accessor(index, what);
-    if (a.type != TINYGLTF_TYPE_SCALAR) fail(path, what + ": index accessor " + std::to_string(index) + " is not SCALAR");
-    if (a.sparse.isSparse) fail(path, what + ": sparse index accessor " + std::to_string(index) + " is not supported");
-    if (a.bufferView < 0) return std::vector<std::uint32_t>(a.count, 0);
-    const std::size_t elem = component_size(a.componentType, index, what);
-    const auto [data, stride] = view_range(a, index, elem, what);
-    std::vector<std::uint32_t> out(a.count);
-    for (std::size_t i = 0; i < a.count; ++i) out[i] = load_index(data + i * stride, a.componentType, index, what);
-    return out;
-  }
-
-  const tinygltf::Accessor& accessor(int index, const std::string& what) const {
-    if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size()) fail(path, what + " uses accessor " + std::to_string(index) + ", the file has " + std::to_string(model.accessors.size()));
-    return model.accessors[static_cast<std::size_t>(index)];
-  }
-  std::size_t component_size(int type, int index, const std::string& what) const {
-    const int s = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(type));
-    if (s <= 0 || s > 4) fail(path, what + ": accessor " + std::to_string(index) + " has an unsupported component type " + std::to_string(type));
-    return static_cast<std::size_t>(s);
-  }
-  std::uint32_t load_index(const unsigned char* p, int type, int index, const std::string& what) const {
-    switch (type) {
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); return u; }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); return u; }
-      default: fail(path, what + ": index accessor " + std::to_string(index) + " is not unsigned byte, short or int");
-    }
-  }
-  /// `bytes` bytes at `offset` in buffer view `view`, checked against the view and its buffer.
-  const unsigned char* raw_view(int view, std::size_t offset, std::size_t bytes, int index, const std::string& what) const {
-    if (view < 0 || static_cast<std::size_t>(view) >= model.bufferViews.size()) fail(path, what + ": accessor " + std::to_string(index) + " uses a missing bufferView");
-    const tinygltf::BufferView& v = model.bufferViews[static_cast<std::size_t>(view)];
-    if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= model.buffers.size()) fail(path, what + ": bufferView " + std::to_string(view) + " uses a missing buffer");
-    const std::size_t size = model.buffers[static_cast<std::size_t>(v.buffer)].data.size();
-    if (v.byteOffset > size || v.byteLength > size - v.byteOffset || offset > v.byteLength || bytes > v.byteLength - offset)
-      fail(path, what + ": accessor " + std::to_string(index) + " reads past the end of bufferView " + std::to_string(view));
-    return model.buffers[static_cast<std::size_t>(v.buffer)].data.data() + v.byteOffset + offset;
-  }
-  std::pair<const unsigned char*, std::size_t> view_range(const tinygltf::Accessor& a, int index, std::size_t elem, const std::string& what) const {
-    if (static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size()) fail(path, what + ": accessor " + std::to_string(index) + " uses a missing bufferView");
-    const std::size_t stride = model.bufferViews[static_cast<std::size_t>(a.bufferView)].byteStride ? model.bufferViews[static_cast<std::size_t>(a.bufferView)].byteStride : elem;
-    if (stride < elem) fail(path, what + ": accessor " + std::to_string(index) + " has a byteStride smaller than its elements");
-    if (a.count == 0) return {nullptr, stride};
-    if (a.count - 1 > (std::numeric_limits<std::size_t>::max() - elem) / stride) fail(path, what + ": accessor " + std::to_string(index) + " is too long");
-    return {raw_view(a.bufferView, a.byteOffset, (a.count - 1) * stride + elem, index, what), stride};
-  }
-  std::vector<std::uint32_t> read_indices_raw(int view, std::size_t offset, int type, std::size_t n, int index, const std::string& what) const {
-    const std::size_t elem = component_size(type, index, what);
-    const unsigned char* p = raw_view(view, offset, n * elem, index, what);
-    std::vector<std::uint32_t> out(n);
-    for (std::size_t i = 0; i < n; ++i) out[i] = load_index(p + i * elem, type, index, what);
-    return out;
-  }
-
-  /// One primitive as a Mesh in the mesh's own space: positions, normals (when given), the UV
-  /// set (when `with_uv` and given; v flipped to the loader's v-up convention), triangle indices
-  /// (strips and fans triangulated as the spec orders them).
-  Mesh primitive_mesh(int mesh, int prim, bool with_uv) const {
-    const tinygltf::Primitive& p = model.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
-    const std::string what = "mesh " + label(mesh) + " primitive " + std::to_string(prim);
-    Mesh m;
-    m.name = model.meshes[static_cast<std::size_t>(mesh)].name;
-    const std::vector<float> pos = read_floats(p.attributes.at("POSITION"), 3, what + " POSITION");
-    const std::size_t n = pos.size() / 3;
-    m.positions.reserve(n + kVertexPadding);  // see kVertexPadding
-    for (std::size_t v = 0; v < n; ++v) m.positions.push_back({pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]});
-    if (const auto it = p.attributes.find("NORMAL"); it != p.attributes.end()) {
-      const std::vector<float> nor = read_floats(it->second, 3, what + " NORMAL");
-      if (nor.size() != pos.size()) fail(path, what + ": NORMAL and POSITION have different counts");
-      m.normals.reserve(n);
-      for (std::size_t v = 0; v < n; ++v) m.normals.push_back({nor[3 * v], nor[3 * v + 1], nor[3 * v + 2]});
-    }
-    if (const auto it = p.attributes.find(uv_attribute()); with_uv && it != p.attributes.end()) {
-      const std::vector<float> uv = read_floats(it->second, 2, what + " " + uv_attribute());
-      if (uv.size() / 2 != n) fail(path, what + ": " + uv_attribute() + " and POSITION have different counts");
-      m.uvs.reserve(n);
-      for (std::size_t v = 0; v < n; ++v) m.uvs.push_back({uv[2 * v], 1.0f - uv[2 * v + 1]});  // glTF's v runs down the image
-    }
-    std::vector<std::uint32_t> idx;
-    if (p.indices >= 0) {
-      idx = read_indices(p.indices, what + " indices");
-    } else {
-      idx.resize(n);
-      for (std::size_t v = 0; v < n; ++v) idx[v] = static_cast<std::uint32_t>(v);
-    }
-    for (std::uint32_t i : idx)
-      if (i >= n) fail(path, what + " uses vertex " + std::to_string(i) + ", it has " + std::to_string(n));
-    if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-      for (std::size_t k = 0; k + 2 < idx.size(); ++k) {
-        const bool odd = k % 2;  // every other strip triangle is listed clockwise
-        m.indices.insert(m.indices.end(), {idx[k + (odd ? 1 : 0)], idx[k + (odd ? 0 : 1)], idx[k + 2]});
-      }
-    } else if (p.mode == TINYGLTF_MODE_TRIANGLE_FAN) {
-      for (std::size_t k = 1; k + 1 < idx.size(); ++k) m.indices.insert(m.indices.end(), {idx[k], idx[k + 1], idx[0]});
-    } else {
-      idx.resize(idx.size() / 3 * 3);
-      m.indices = std::move(idx);
-    }
-    return m;
-  }
-
-  /// A node that places triangles needs a finite transform that does not flatten them: with
-  /// determinant 0 every triangle is degenerate (the same rule as validate_and_prepare's for
-  /// instances, and load_scene_file's for every glTF node).
+  /// A node that places triangles needs a transform ao can trace (transform_problem: finite, not
+  /// flattening, not squashing beyond kMaxSquashRatio), the rule of validate_and_prepare for
+  /// instances and of load_scene_file for every glTF node.
   void check_transform(int node, int mesh, const Mat4& world) const {
     bool triangles = false;
     for (const tinygltf::Primitive& p : model.meshes[static_cast<std::size_t>(mesh)].primitives) triangles = triangles || is_triangles(p);
@@ -329,9 +174,10 @@ struct __attribute__((visibility("hidden"))) GltfDocument::Impl {
     const std::string label = n.name.empty() ? "node " + std::to_string(node) : "node '" + one_line(n.name.substr(0, 64)) + "'";
     for (double v : world)
       if (!std::isfinite(v)) fail(path, label + " has a non-finite transform");
-    double det = 0;
-    normal_matrix(world, det);
-    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) fail(path, label + " has a transform with determinant 0 (it flattens the mesh)");
+    // The rule of every loader (transform_problem), on the float matrix the scene will carry.
+    const auto f = [&](int i) { return static_cast<float>(world[static_cast<std::size_t>(i)]); };
+    const Affine3 t{{f(0), f(1), f(2)}, {f(4), f(5), f(6)}, {f(8), f(9), f(10)}, {f(12), f(13), f(14)}};
+    if (const std::string problem = transform_problem(t); !problem.empty()) fail(path, label + " " + problem);
   }
 
   void collect_instances() {
@@ -433,59 +279,7 @@ struct __attribute__((visibility("hidden"))) GltfDocument::Impl {
   void assign_materials() {
     if (materials_done || map_texture.empty()) return;
     materials_done = true;
-    // What each material is asked to carry: the map of a mesh (>= 0) or no change (-1), per primitive.
-    std::map<int, std::set<int>> uses;  // material -> the maps (or -1) its primitives need
-    auto map_of = [&](int mesh, const tinygltf::Primitive& p) {
-      const auto it = map_texture.find(mesh);
-      return it != map_texture.end() && bakes(p) ? it->first : -1;
-    };
-    for (std::size_t m = 0; m < model.meshes.size(); ++m)
-      for (const tinygltf::Primitive& p : model.meshes[m].primitives)
-        if (p.material >= 0) uses[p.material].insert(map_of(static_cast<int>(m), p));
-    std::map<std::pair<int, int>, int> material_for;  // (material or -1, map mesh) -> material index
-    std::set<int> replaced;
-    for (std::size_t m = 0; m < model.meshes.size(); ++m)
-      for (tinygltf::Primitive& p : model.meshes[m].primitives) {
-        const int map_mesh = map_of(static_cast<int>(m), p);
-        if (map_mesh < 0) continue;
-        const auto key = std::make_pair(p.material, map_mesh);
-        auto it = material_for.find(key);
-        if (it == material_for.end()) {
-          int target = -1;
-          if (p.material < 0) {
-            // glTF's default material (white, metallic 1, roughness 1), named for the map.
-            tinygltf::Material fresh;
-            fresh.name = "ao " + plain_name(static_cast<int>(m));
-            model.materials.push_back(fresh);
-            target = static_cast<int>(model.materials.size() - 1);
-          } else {
-            const std::set<int>& u = uses[p.material];
-            // In place when this map is its only use, or the first map of a material that every
-            // user needs changed; otherwise a clone for this mesh's primitives.
-            const bool first_taker = !u.count(-1) && std::none_of(material_for.begin(), material_for.end(), [&](const auto& e) { return e.first.first == p.material; });
-            if (u.size() == 1 || first_taker) {
-              target = p.material;
-            } else {
-              tinygltf::Material clone = model.materials[static_cast<std::size_t>(p.material)];
-              clone.name += (clone.name.empty() ? "" : " ") + std::string("(ao ") + plain_name(map_mesh) + ")";
-              model.materials.push_back(std::move(clone));
-              target = static_cast<int>(model.materials.size() - 1);
-            }
-            if (model.materials[static_cast<std::size_t>(target)].occlusionTexture.index >= 0) replaced.insert(p.material);
-          }
-          tinygltf::OcclusionTextureInfo& o = model.materials[static_cast<std::size_t>(target)].occlusionTexture;
-          o = tinygltf::OcclusionTextureInfo();
-          o.index = map_texture.at(map_mesh);
-          o.texCoord = uv_set;
-          o.strength = 1.0;
-          it = material_for.emplace(key, target).first;
-        }
-        p.material = it->second;
-      }
-    for (int m : replaced) {
-      const std::string& n = model.materials[static_cast<std::size_t>(m)].name;
-      save_warnings.push_back("material " + (n.empty() ? std::to_string(m) : "'" + n + "'") + ": its occlusion texture is replaced by the baked map");
-    }
+    io_detail::assign_occlusion_maps(model, map_texture, uv_set, save_warnings);
   }
 };
 
@@ -526,10 +320,6 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set, const fs::path& ass
     }
   }
   if (!ok) fail(path, "malformed glTF (" + one_line(err.empty() ? warn : err) + ")");
-  // Compressed geometry lives in the extension, not in the accessors this reads.
-  for (const std::string& e : d.model.extensionsRequired)
-    if (e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression")
-      fail(path, "its geometry is compressed with " + e + ", which ao cannot decode; export it uncompressed to bake it");
   // Indices this code follows (check_gltf covers the node graph, buffers, views and accessors).
   for (std::size_t m = 0; m < d.model.meshes.size(); ++m)
     for (std::size_t p = 0; p < d.model.meshes[m].primitives.size(); ++p) {
@@ -626,7 +416,7 @@ GltfWorldScene GltfDocument::world_scene(int baked_mesh) const {
       if (!Impl::is_triangles(p) || !p.attributes.count("POSITION")) continue;
       const auto key = std::make_pair(inst.mesh, static_cast<int>(pi));
       auto it = local.find(key);
-      if (it == local.end()) it = local.emplace(key, d.primitive_mesh(inst.mesh, static_cast<int>(pi), inst.mesh == baked_mesh)).first;
+      if (it == local.end()) it = local.emplace(key, io_detail::read_gltf_primitive(d.model, d.path, inst.mesh, static_cast<int>(pi), inst.mesh == baked_mesh ? d.uv_attribute() : std::string())).first;
       Mesh m;
       m.name = it->second.name;
       m.positions.reserve(it->second.positions.size() + kVertexPadding);
@@ -727,12 +517,7 @@ std::vector<std::string> GltfDocument::save_glb(const fs::path& path) {
   writer.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &nowhere});
   if (!writer.WriteGltfSceneToStream(&d.model, glb, false, true)) throw SystemError(path.string() + ": cannot serialise the glTF document");
   const std::string bytes = glb.str();
-  write_file_atomically(path, [&](const fs::path& temp) {
-    std::ofstream f(temp, std::ios::binary);
-    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    f.close();
-    if (!f) throw SystemError(path.string() + ": cannot write");
-  });
+  write_bytes_atomically(path, bytes);
   std::vector<std::string> w = std::move(d.save_warnings);
   d.save_warnings.clear();
   return w;

@@ -185,12 +185,7 @@ void write_ao_glb(const std::filesystem::path& path, const Scene& scene, const s
     first_vertex += m.positions.size();
   }
   const std::string out = glb.glb();
-  write_file_atomically(path, [&](const std::filesystem::path& temp) {
-    std::ofstream f(temp, std::ios::binary);
-    f.write(out.data(), static_cast<std::streamsize>(out.size()));
-    f.close();
-    if (!f) throw SystemError(path.string() + ": cannot write");
-  });
+  write_bytes_atomically(path, out);
 }
 
 }  // namespace ao

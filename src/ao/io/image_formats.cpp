@@ -17,9 +17,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+
+#include <unistd.h>
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/io/atomic_file.h"
 #include "ao/io/exr_common_internal.h"
 
 namespace ao::io_detail {
@@ -42,10 +45,7 @@ std::vector<unsigned char> to_bytes(std::size_t count, const float* samples, boo
   return out;
 }
 
-void close_checked(FilePtr& fp, const fs::path& path) {
-  const bool flushed = std::fflush(fp.get()) == 0 && std::ferror(fp.get()) == 0;
-  if (std::fclose(fp.release()) != 0 || !flushed) throw SystemError(path.string() + ": write failed (disk full?)");
-}
+void close_checked(FilePtr& fp, const fs::path& path) { close_temporary(fp.release(), path); }
 
 // --- JPEG ---------------------------------------------------------------------------------------
 // libjpeg reports errors through error_exit, which must not return: it longjmps back here. As for
@@ -126,8 +126,7 @@ void write_tga_file(const fs::path& path, const fs::path& temp, int width, int h
   header[15] = static_cast<unsigned char>(height >> 8);
   header[16] = static_cast<unsigned char>(8 * channels);  // bits per pixel
   header[17] = 0x20;                                      // origin top-left, no alpha bits
-  FilePtr fp(std::fopen(temp.c_str(), "wb"));
-  if (!fp) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+  FilePtr fp(open_temporary(temp, path));
   std::fwrite(header, 1, sizeof header, fp.get());
   if (channels == 1) {
     std::fwrite(bytes.data(), 1, bytes.size(), fp.get());
@@ -149,7 +148,11 @@ void write_tiff_file(const fs::path& path, const fs::path& temp, int width, int 
   if (!opts) throw SystemError(path.string() + ": out of memory");
   TIFFOpenOptionsSetErrorHandlerExtR(opts.get(), on_tiff_error, &message);
   TIFFOpenOptionsSetWarningHandlerExtR(opts.get(), on_tiff_warning, nullptr);
-  std::unique_ptr<TIFF, void (*)(TIFF*)> tif(TIFFOpenExt(temp.c_str(), "w", opts.get()), TIFFClose);
+  // TIFF gets the descriptor of the temporary file (open_temporary: no symbolic link followed);
+  // TIFFClose closes it.
+  const int fd = open_temporary_descriptor(temp, path);
+  std::unique_ptr<TIFF, void (*)(TIFF*)> tif(TIFFFdOpenExt(fd, temp.c_str(), "w", opts.get()), TIFFClose);
+  if (!tif) ::close(fd);
   if (!tif) throw SystemError(path.string() + ": cannot open the temporary file for writing" + (message.text.empty() ? "" : ": " + one_line(message.text)));
   constexpr std::uint32_t kRowsPerStrip = 64;
   TIFF* t = tif.get();
@@ -190,8 +193,7 @@ void write_tiff_file(const fs::path& path, const fs::path& temp, int width, int 
 
 void write_jpeg_file(const fs::path& path, const fs::path& temp, int width, int height, int channels, const float* samples, int quality, bool srgb) {
   const std::vector<unsigned char> bytes = to_bytes(static_cast<std::size_t>(width) * height * channels, samples, srgb);
-  FilePtr fp(std::fopen(temp.c_str(), "wb"));
-  if (!fp) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+  FilePtr fp(open_temporary(temp, path));
   JpegError err;
   if (!write_jpeg_stream(fp.get(), bytes.data(), width, height, channels, quality, err)) throw SystemError(path.string() + ": cannot write JPEG: " + one_line(err.text));
   close_checked(fp, path);

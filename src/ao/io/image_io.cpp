@@ -169,8 +169,8 @@ struct FileCloser {
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
-// Quantises samples (channels per pixel: 1 or 3) to PNG and writes atomically.
-void write_png(const fs::path& path, int width, int height, int channels, const float* samples, const ImageWriteOptions& opt) {
+// Samples (channels per pixel: 1 or 3) quantised to PNG's 8 or 16 bits.
+PngPixels quantised_pixels(int width, int height, int channels, const float* samples, const ImageWriteOptions& opt) {
   PngPixels pixels;
   pixels.width = static_cast<png_uint_32>(width);
   pixels.height = static_cast<png_uint_32>(height);
@@ -189,16 +189,34 @@ void write_png(const fs::path& path, int width, int height, int channels, const 
     }
   }
   pixels.point_rows();
+  return pixels;
+}
 
+// Writes `pixels` as the PNG `path`, atomically.
+void write_png_file(const fs::path& path, PngPixels& pixels, bool srgb) {
   write_file_atomically(path, [&](const fs::path& temp) {
-    FilePtr fp(std::fopen(temp.c_str(), "wb"));
-    if (!fp) throw SystemError(path.string() + ": cannot open the temporary file for writing");
+    FilePtr fp(open_temporary(temp, path));
     PngMessage message;
-    if (!write_png_stream(fp.get(), pixels, opt.srgb, message))
+    if (!write_png_stream(fp.get(), pixels, srgb, message))
       throw SystemError(path.string() + ": cannot write PNG: " + one_line(message.text[0] ? message.text : "out of memory"));
-    const bool flushed = std::fflush(fp.get()) == 0 && std::ferror(fp.get()) == 0;
-    if (std::fclose(fp.release()) != 0 || !flushed) throw SystemError(path.string() + ": write failed (disk full?)");
+    close_temporary(fp.release(), path);
   });
+}
+
+// The PNG write_png_file would write, in memory (a stdio stream over a growing buffer, so the
+// encoder and its settings are the same).
+std::string encode_png_bytes(PngPixels& pixels, bool srgb) {
+  char* buffer = nullptr;
+  std::size_t size = 0;
+  std::FILE* stream = ::open_memstream(&buffer, &size);
+  if (stream == nullptr) throw std::bad_alloc();
+  PngMessage message;
+  const bool written = write_png_stream(stream, pixels, srgb, message);
+  const bool closed = std::fclose(stream) == 0;
+  std::string bytes = written && closed ? std::string(buffer, size) : std::string();
+  std::free(buffer);
+  if (!written || !closed) throw std::bad_alloc();  // a stream in memory fails only for want of it
+  return bytes;
 }
 
 PngPixels read_png(const fs::path& path, bool keep_alpha = false) {
@@ -311,7 +329,10 @@ Format input_format(const fs::path& path) {
 
 // PNG here; TGA, TIFF and JPEG in image_formats.cpp.
 void write_8_or_16_bit(const fs::path& path, Format format, int width, int height, int channels, const float* samples, const ImageWriteOptions& opt) {
-  if (format == Format::Png) return write_png(path, width, height, channels, samples, opt);
+  if (format == Format::Png) {
+    PngPixels pixels = quantised_pixels(width, height, channels, samples, opt);
+    return write_png_file(path, pixels, opt.srgb);
+  }
   // The formats' own limits: 16-bit sizes in the TGA header, JPEG_MAX_DIMENSION in libjpeg.
   const int max_side = format == Format::Tga ? 65535 : format == Format::Jpeg ? 65500 : 1 << 30;
   if (width > max_side || height > max_side)
@@ -410,13 +431,15 @@ StoredPng read_stored_png(const fs::path& path) {
   return out;
 }
 
-void write_stored_png(const fs::path& path, const StoredPng& image) {
+namespace {
+
+// A StoredPng's layout checked (InputError naming `path`) and its samples as PNG rows.
+PngPixels stored_pixels(const fs::path& path, const StoredPng& image) {
   const bool layout_ok = image.width >= 1 && image.height >= 1 && image.channels >= 1 && image.channels <= 4 && (image.bits == 8 || image.bits == 16) &&
                          image.samples.size() == static_cast<std::size_t>(image.width) * image.height * static_cast<std::size_t>(image.channels);
   if (!layout_ok) throw InputError(path.string() + ": cannot write a PNG of " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
                                    std::to_string(image.channels) + " channels, " + std::to_string(image.bits) + " bits from " +
                                    std::to_string(image.samples.size()) + " samples");
-  if (lower_extension(path) != ".png") throw InputError(path.string() + ": this image is written as PNG; give it a .png name");
   PngPixels pixels;
   pixels.width = static_cast<png_uint_32>(image.width);
   pixels.height = static_cast<png_uint_32>(image.height);
@@ -432,15 +455,27 @@ void write_stored_png(const fs::path& path, const StoredPng& image) {
     }
   }
   pixels.point_rows();
-  write_file_atomically(path, [&](const fs::path& temp) {
-    FilePtr fp(std::fopen(temp.c_str(), "wb"));
-    if (!fp) throw SystemError(path.string() + ": cannot open the temporary file for writing");
-    PngMessage message;
-    if (!write_png_stream(fp.get(), pixels, false, message))
-      throw SystemError(path.string() + ": cannot write PNG: " + one_line(message.text[0] ? message.text : "out of memory"));
-    const bool flushed = std::fflush(fp.get()) == 0 && std::ferror(fp.get()) == 0;
-    if (std::fclose(fp.release()) != 0 || !flushed) throw SystemError(path.string() + ": write failed (disk full?)");
-  });
+  return pixels;
+}
+
+}  // namespace
+
+void write_stored_png(const fs::path& path, const StoredPng& image) {
+  PngPixels pixels = stored_pixels(path, image);
+  if (lower_extension(path) != ".png") throw InputError(path.string() + ": this image is written as PNG; give it a .png name");
+  write_png_file(path, pixels, false);
+}
+
+std::string encode_stored_png(const StoredPng& image) {
+  PngPixels pixels = stored_pixels("the PNG", image);
+  return encode_png_bytes(pixels, false);
+}
+
+std::string encode_png(const Image<float>& image, const ImageWriteOptions& opt) {
+  opt.validate();
+  if (image.width() < 1 || image.height() < 1) throw InputError("encode_png: the image is empty");
+  PngPixels pixels = quantised_pixels(image.width(), image.height(), 1, image.data(), opt);
+  return encode_png_bytes(pixels, opt.srgb);
 }
 
 void replace_channel(StoredPng& image, int channel, const Image<float>& values) {

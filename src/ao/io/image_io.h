@@ -88,6 +88,15 @@ StoredPng read_stored_png(const std::filesystem::path& path);
 /// InputError when the samples do not match the layout or the name does not end in .png.
 void write_stored_png(const std::filesystem::path& path, const StoredPng& image);
 
+/// The bytes write_stored_png writes, encoded in memory. InputError when the samples do not match
+/// the layout.
+std::string encode_stored_png(const StoredPng& image);
+
+/// The bytes write_image writes for a .png name (same encoder, same settings: `opt.png_bits`,
+/// `opt.srgb`), encoded in memory: for a PNG embedded in another file (a glTF's occlusion
+/// texture), with no file of its own. InputError for an empty image or invalid options.
+std::string encode_png(const Image<float>& image, const ImageWriteOptions& opt = {});
+
 /// Replaces channel `channel` of every pixel with `values` (linear, clamped to [0,1], NaN -> 0,
 /// rounded to the image's depth). InputError when the channel or the size does not match.
 void replace_channel(StoredPng& image, int channel, const Image<float>& values);

@@ -1,5 +1,5 @@
 // Mesh files -> Scene. OFF, PLY and one-mesh OBJ files are read by our own strict readers; other
-// OBJ files, STL and glTF/GLB go through assimp, after checks of our own (see mesh_io.cpp for why).
+// OBJ files, STL and glTF/GLB go through assimp, after checks of our own (see assimp_reader.cpp for why).
 #pragma once
 
 #include <filesystem>

@@ -13,6 +13,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/asset_path.h"
+#include "ao/io/io_error_internal.h"
 #include "ao/io/number_text.h"
 
 namespace ao {
@@ -28,11 +29,7 @@ std::string_view next_token(std::string_view line, std::size_t& pos) {
   return line.substr(start, pos - start);
 }
 
-std::string printable(std::string_view token) {
-  std::string out;
-  for (char c : token.substr(0, 24)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return token.size() > 24 ? out + "..." : out;
-}
+using io_detail::printable;
 
 struct Lines {
   std::string_view text;

@@ -13,7 +13,7 @@
 //    it has one (the angles at a corner to the diagonal and the two edges sum above pi), else 0;
 //    the test below is assimp's, in float.
 //  - The mesh is named after the object ("o name") or group ("g name") line, "defaultobject"
-//    without one; the albedo is the material's Kd (material_albedo in mesh_io.cpp).
+//    without one; the albedo is the material's Kd (material_albedo in assimp_reader.cpp).
 // Numbers are read by from_chars, correctly rounded; assimp's fast_atof can differ in the last bit.
 #include "ao/io/obj_reader.h"
 

@@ -1,14 +1,18 @@
 #include "ao/io/output_set.h"
 
+#include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <optional>
 #include <system_error>
 #include <utility>
 
 #include "ao/core/error.h"
 #include "ao/io/asset_path.h"
+#include "ao/io/commit_journal.h"
 
 namespace ao {
 
@@ -134,25 +138,53 @@ fs::path OutputSet::staged(const fs::path& path) const {
   throw InputError(path.string() + ": nothing was written for this output yet");
 }
 
+namespace {
+
+/// SIGINT, SIGTERM and SIGHUP held back while it lives (delivered when it ends): their handlers
+/// remove registered temporary files, which in the middle of a commit include the links that keep
+/// the previous outputs. The commit completes or rolls back first; then the signal ends the run.
+class HeldSignals {
+ public:
+  HeldSignals() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, sig);
+    ::pthread_sigmask(SIG_BLOCK, &set, &old_);
+  }
+  ~HeldSignals() { ::pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
+  HeldSignals(const HeldSignals&) = delete;
+  HeldSignals& operator=(const HeldSignals&) = delete;
+
+ private:
+  sigset_t old_;
+};
+
+}  // namespace
+
 void OutputSet::commit() {
   // Each destination that holds a file keeps it under a hidden name (a hard link: the same file,
   // no copy; a copy where the file system has no hard links) until every rename succeeded, so a
-  // rename that fails puts back the files already replaced and removes the new ones.
+  // rename that fails puts back the files already replaced and removes the new ones. With two
+  // outputs or more, a journal listing them all is on disk before the first rename, so that a run
+  // killed between two renames is rolled back by the next run (commit_journal.h).
+  const HeldSignals held;
   struct Replaced {
     fs::path destination, backup;  ///< backup empty: there was no file before
     TemporaryRegistration registration;
   };
-  std::vector<Replaced> replaced;
+  std::vector<Replaced> backups;
   std::error_code ec;
+  std::size_t renamed = 0;
   const auto undo = [&] {
-    for (auto it = replaced.rbegin(); it != replaced.rend(); ++it) {
-      if (it->backup.empty()) fs::remove(it->destination, ec);
-      else fs::rename(it->backup, it->destination, ec);
+    for (std::size_t k = renamed; k-- > 0;) {
+      if (backups[k].backup.empty()) fs::remove(backups[k].destination, ec);
+      else fs::rename(backups[k].backup, backups[k].destination, ec);
     }
+    for (const Replaced& r : backups)
+      if (!r.backup.empty()) fs::remove(r.backup, ec);
     for (const Staged& s : staged_) fs::remove(s.temp, ec);
   };
-  for (std::size_t i = 0; i < staged_.size(); ++i) {
-    Staged& s = staged_[i];
+  for (const Staged& s : staged_) {
     Replaced r{s.destination, {}, {}};
     if (fs::is_regular_file(fs::symlink_status(s.destination, ec))) {
       r.backup = detail::temporary_path_for(s.destination);
@@ -160,26 +192,42 @@ void OutputSet::commit() {
       if (::link(s.destination.c_str(), r.backup.c_str()) != 0) {
         std::error_code copy_ec;
         if (!fs::copy_file(s.destination, r.backup, fs::copy_options::overwrite_existing, copy_ec)) {
+          backups.push_back(std::move(r));
           undo();
           throw SystemError(s.destination.string() + ": cannot keep the previous file while the outputs are renamed: " + copy_ec.message() +
                             "; no output was replaced");
         }
       }
     }
+    backups.push_back(std::move(r));
+  }
+  std::optional<detail::CommitJournal> journal;
+  if (staged_.size() > 1) {
+    std::vector<detail::JournalEntry> entries;
+    for (std::size_t i = 0; i < staged_.size(); ++i) entries.push_back({staged_[i].destination, staged_[i].temp, backups[i].backup});
+    try {
+      journal.emplace(entries);
+    } catch (...) {
+      undo();
+      throw;
+    }
+  }
+  for (std::size_t i = 0; i < staged_.size(); ++i) {
+    Staged& s = staged_[i];
     const int injected = detail::commit_rename_fault(i);
     if (injected != 0) ec = std::error_code(injected, std::generic_category());
     else fs::rename(s.temp, s.destination, ec);
     if (ec) {
       const std::string why = ec == std::errc::no_space_on_device ? "the disk is full" : ec.message();
-      if (!r.backup.empty()) fs::remove(r.backup, ec);
       undo();
       throw SystemError(s.destination.string() + ": cannot rename the temporary file into place: " + why + "; no output was replaced");
     }
     s.registration = TemporaryRegistration();
-    replaced.push_back(std::move(r));
+    ++renamed;
   }
-  for (const Replaced& r : replaced)
+  for (const Replaced& r : backups)
     if (!r.backup.empty()) fs::remove(r.backup, ec);
+  if (journal) journal->remove();
   for (Directory& d : directories_) d.registration = TemporaryRegistration();
   committed_ = true;
 }

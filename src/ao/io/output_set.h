@@ -63,7 +63,11 @@ class OutputSet {
   /// or a copy) until all renames succeeded. When a rename fails (a broken or full file system, a
   /// destination turned into a directory meanwhile), the destinations already replaced get their
   /// previous files back, the new ones are removed, and a SystemError names the file that failed:
-  /// every output is then as it was before the run.
+  /// every output is then as it was before the run. With two outputs or more, a journal listing
+  /// them is on disk before the first rename (commit_journal.h): a run killed by SIGKILL or a power
+  /// cut between two renames is rolled back by the next run that writes into one of their folders
+  /// (remove_stale_temporaries), so no folder keeps new and old outputs mixed. SIGINT, SIGTERM and
+  /// SIGHUP are held back while the outputs are renamed and take effect after.
   void commit();
 
   /// Paths of the declared outputs, in declaration order.

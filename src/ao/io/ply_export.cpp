@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 
@@ -53,11 +54,13 @@ void write_vertex_ao_ply(const std::filesystem::path& path, const Scene& scene, 
                              "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float quality\n"
                              "element face " + std::to_string(scene.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
   write_file_atomically(path, [&](const std::filesystem::path& temp) {
-    std::ofstream f(temp, std::ios::binary);
-    f.write(header.data(), static_cast<std::streamsize>(header.size()));
-    f.write(body.data(), static_cast<std::streamsize>(body.size()));
-    f.close();
-    if (!f) throw SystemError(path.string() + ": cannot write");
+    std::FILE* f = open_temporary(temp, path);
+    const bool written = std::fwrite(header.data(), 1, header.size(), f) == header.size() && std::fwrite(body.data(), 1, body.size(), f) == body.size();
+    if (!written) {
+      std::fclose(f);
+      throw SystemError(path.string() + ": cannot write");
+    }
+    close_temporary(f, path);
   });
 }
 

@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -23,6 +24,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 #include "ao/io/number_text.h"
 
 namespace ao {
@@ -30,19 +32,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const fs::path& path, const std::string& problem) { throw InputError(path.string() + ": " + problem); }
-
-std::string printable(std::string_view token) {
-  std::string out;
-  for (char c : token.substr(0, 24)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return token.size() > 24 ? out + "..." : out;
-}
-std::string quote(std::string_view token) {
-  std::string out(1, '\'');
-  out += printable(token);
-  out += '\'';
-  return out;
-}
+using io_detail::fail;
+using io_detail::printable;
+using io_detail::quote;
 
 std::string_view next_token(std::string_view line, std::size_t& pos) {
   while (pos < line.size() && std::isspace(static_cast<unsigned char>(line[pos]))) ++pos;
@@ -124,9 +116,22 @@ struct Header {
   std::size_t body_start = 0;
 };
 
+/// Where the line "end_header" starts and where the body after it starts; npos when there is no
+/// such line. Lines are read whole, so a long comment (exporters write whole licences there) is
+/// one line, and "end_header" inside a comment ends nothing. Linear in the header's length.
+std::pair<std::size_t, std::size_t> find_end_header(std::string_view data) {
+  for (std::size_t pos = 0; pos < data.size();) {
+    const std::size_t end = std::min(data.find('\n', pos), data.size());
+    std::size_t token = pos;
+    const std::string_view key = next_token(data.substr(0, end), token);
+    if (key == "end_header") return {pos, std::min(end + 1, data.size())};
+    pos = end + 1;
+  }
+  return {std::string_view::npos, std::string_view::npos};
+}
+
 Header parse_header(const fs::path& path, std::string_view data) {
-  // A PLY header is a few hundred bytes; looking at the first 64 KiB bounds the work on garbage.
-  const std::size_t header_end = data.substr(0, 1 << 16).find("end_header");
+  const auto [header_end, body_start] = find_end_header(data);
   if (header_end == std::string_view::npos) fail(path, "truncated or malformed PLY header: no end_header line");
   Header h;
   std::string_view head = data.substr(0, header_end);
@@ -177,7 +182,7 @@ Header parse_header(const fs::path& path, std::string_view data) {
   }
   if (h.format != "ascii" && h.format != "binary_little_endian" && h.format != "binary_big_endian")
     fail(path, "PLY header has no valid format line");
-  h.body_start = std::min(data.find('\n', header_end), data.size() - 1) + 1;
+  h.body_start = body_start;
   return h;
 }
 
@@ -292,10 +297,21 @@ class Builder {
   std::uint32_t first_ = 0, previous_ = 0;
 };
 
-std::string truncated(const Header& h, const Element& e, long long i) {
+std::string element_summary(const Header& h) {
   std::string summary;
   for (const Element& el : h.elements) summary += (summary.empty() ? "" : ", ") + std::to_string(el.count) + " x '" + el.name + "'";
-  return "truncated: header declares " + summary + " elements, the data ends in '" + e.name + "' " + std::to_string(i);
+  return summary;
+}
+
+std::string truncated(const Header& h, const Element& e, long long i) {
+  return "truncated: header declares " + element_summary(h) + " elements, the data ends in '" + e.name + "' " + std::to_string(i);
+}
+
+/// Data after the last element the header declares, other than blank space, means the header's
+/// counts are short: reading only what they say would drop elements (faces) without a word.
+void check_nothing_after(const fs::path& path, const Header& h, std::string_view rest, const std::string& where) {
+  if (rest.find_first_not_of(" \t\r\n") == std::string_view::npos) return;
+  fail(path, "the header declares " + element_summary(h) + " elements, but the data holds more after the last of them (" + where + ")");
 }
 
 /// The usual binary little-endian face element, a byte count and three 32-bit indices per face
@@ -426,6 +442,7 @@ void read_binary(const fs::path& path, const Header& h, const Layout& l, std::st
       p = read_listed_element<BigEndian>(path, h, l, e, is_vertex, is_face, p, end, out);
     }
   }
+  check_nothing_after(path, h, std::string_view(p, static_cast<std::size_t>(end - p)), std::to_string(end - p) + " more bytes");
 }
 
 void read_ascii(const fs::path& path, const Header& h, const Layout& l, std::string_view body, Builder& out) {
@@ -482,6 +499,7 @@ void read_ascii(const fs::path& path, const Header& h, const Layout& l, std::str
       if (is_face) out.face_done(i);
     }
   }
+  check_nothing_after(path, h, body.substr(std::min(pos, body.size())), "after data line " + std::to_string(line_number));
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "ao/core/error.h"
+#include "ao/io/io_error_internal.h"
 #include "ao/io/number_text.h"
 
 namespace ao {
@@ -16,11 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string printable(std::string_view token) {
-  std::string out;
-  for (char c : token.substr(0, 24)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return token.size() > 24 ? out + "..." : out;
-}
+using io_detail::printable;
 
 class Tokens {
  public:

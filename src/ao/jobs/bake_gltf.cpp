@@ -2,11 +2,8 @@
 // per-vertex .glb) keeps its document (gltf_document.h). Each glTF mesh with the UV set is baked
 // once, into a map of its own, at its first instance with every other instance and mesh occluding;
 // per-vertex AO becomes each primitive's COLOR_0.
-#include <unistd.h>
 
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 
 #include "ao/bake/padding.h"
 #include "ao/bake/udim.h"
@@ -22,18 +19,6 @@
 namespace ao::bake_job {
 
 namespace {
-
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
-// The map as PNG bytes (8 or 16 bit: glTF allows both), through a scratch file of write_image.
-std::string encode_png(const Image<float>& map, int bits) {
-  const ScratchFile tmp(fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png"));
-  write_image(tmp.path(), map, {.png_bits = bits});
-  return read_all(tmp.path());
-}
 
 // The options that do not apply to a document kept as it is.
 void check_round_trip_options(const Plan& plan, const fs::path& input) {
@@ -65,6 +50,7 @@ struct RoundTrip {
   Stopwatch clock;
 
   void add_occluders(GltfWorldScene& ws) {
+    check_traceable_size(ws.scene);  // every world scene of the round trip passes here
     for (const std::string& w : ws.scene.warnings) reporter.warn(input.string() + ": " + w);
     if (!occluders) occluders = load_occluders(plan, ws.scene, nullptr, reporter);
     for (const Mesh& m : *occluders) ws.scene.meshes.push_back(m);
@@ -115,7 +101,8 @@ void bake_round_trip_maps(RoundTrip& job, const std::vector<int>& targets, const
     BakeResult r = bake_map_plain(plan, ws.scene, cov, job.reporter.start("bake " + job.input.filename().string() + " " + label));
     const double mean = covered_mean(r);
     if (plan.r.padding > 0) pad(r.visibility, nearest_valid_texel(r.mask, plan.r.padding));
-    job.doc.add_occlusion_map(t, encode_png(r.visibility, plan.png_bits));
+    // The map as PNG bytes (8 or 16 bit: glTF allows both), encoded in memory: no file to read back.
+    job.doc.add_occlusion_map(t, encode_png(r.visibility, {.png_bits = plan.png_bits}));
     if (!map.empty()) {
       job.outputs.write(map, [&] { write_image(map, r.visibility, {.png_bits = plan.png_bits}); });
       job.reporter.tell("wrote " + map.string() + ": the map of mesh " + label);

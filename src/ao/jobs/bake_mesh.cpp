@@ -3,10 +3,7 @@
 // a mesh that fails half-way leaves no partial set of outputs behind.
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 
-#include <unistd.h>
 
 #include "ao/bake/bake_groups.h"
 #include "ao/bake/padding.h"
@@ -233,21 +230,18 @@ std::vector<float> bake_vertex_ao(MeshJob& job) {
   return v;
 }
 
-std::string read_bytes(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // The map file, the miss mask, the bent normals and the glTF, staged in `outputs`.
 void write_map_outputs(MeshJob& job, const BakeResult& r, const MeshOutputs& outs, const std::vector<float>& vertex_ao, OutputSet& outputs) {
   const Plan& plan = job.plan;
   const bool write_map = plan.writes_map_file();
+  // The glTF embeds the map file's own bytes when the map is a PNG, else the map as a PNG of the
+  // same bit depth (glTF allows 16-bit PNG); encoded in memory either way, so nothing is read back.
+  std::string png;
   if (write_map && !plan.r.orm.empty()) {
     // The ORM texture with V in its red channel (glTF's occlusion channel); G, B, A and the depth as they were.
     StoredPng packed = read_stored_png(plan.r.orm);
     replace_channel(packed, 0, r.visibility);
+    if (!outs.gltf.empty()) png = encode_stored_png(packed);
     outputs.write(outs.map, [&] { write_stored_png(outs.map, packed); });
   } else if (write_map) {
     outputs.write(outs.map, [&] { write_image(outs.map, r.visibility, {.png_bits = plan.png_bits}); });
@@ -264,15 +258,7 @@ void write_map_outputs(MeshJob& job, const BakeResult& r, const MeshOutputs& out
     outputs.write(outs.bent, [&] { write_rgb_image(outs.bent, enc, {.png_bits = plan.png_bits}); });
   }
   if (!outs.gltf.empty()) {
-    std::string png;
-    if (write_map && (outs.map.extension() == ".png" || outs.map.extension() == ".PNG")) {
-      png = read_bytes(outputs.staged(outs.map));
-    } else {
-      // The bit depth applies to the embedded map too (glTF allows 16-bit PNG).
-      const ScratchFile tmp(fs::temp_directory_path() / ("ao-bake-" + std::to_string(::getpid()) + ".png"));
-      write_image(tmp.path(), r.visibility, {.png_bits = plan.png_bits});
-      png = read_bytes(tmp.path());
-    }
+    if (png.empty()) png = encode_png(r.visibility, {.png_bits = plan.png_bits});
     outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, job.scene, png, vertex_ao.empty() ? nullptr : &vertex_ao); });
     job.summary["gltf_output"] = outs.gltf.string();
   }
@@ -342,6 +328,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
   Stopwatch clock;
   Scene scene = load_scene_file(input, {.uv_set = plan.r.uv_set, .flatten_instances = true});
   for (const std::string& w : scene.warnings) reporter.warn(w);  // the loader names the file
+  check_traceable_size(scene);  // the histogram baker traces no ray: checked here for both
   MeshJob job{plan, input, reporter, scene};
   job.clock = clock;
   job.timings["load_ms"] = job.clock.lap_ms();
@@ -352,6 +339,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
 }
 
 MeshBake bake_scene(const Plan& plan, const Scene& scene, const JobReporter& reporter) {
+  check_traceable_size(scene);
   MeshJob job{plan, scene.name, reporter, scene};
   job.summary = {{"input", scene.name}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   if (plan.high_to_low()) job.high = load_high_scene(plan.r.high, reporter);

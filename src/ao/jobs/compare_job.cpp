@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "ao/core/error.h"
+#include "ao/core/memory.h"
 #include "ao/core/stopwatch.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
@@ -13,6 +14,7 @@
 #include "ao/jobs/compare.h"
 #include "ao/jobs/contact_sheet.h"
 #include "ao/reference/ray_scene.h"
+#include "ao/registry/registry.h"
 
 namespace ao {
 
@@ -26,14 +28,7 @@ std::string fixed4(double v) {
   return buf;
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  write_file_atomically(path, [&](const fs::path& temp) {
-    std::ofstream out(temp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw SystemError(path.string() + ": cannot write");
-  });
-}
+void write_text(const fs::path& path, const std::string& text) { write_bytes_atomically(path, text); }
 
 // The sheet's columns: the method's V, its reference's V and the heat map; with the GPU backend
 // the method's V and heat map once per backend. Titles are pieces wrapped between, never inside,
@@ -96,6 +91,28 @@ void write_outputs(OutputSet& outputs, const fs::path& dir, CompareJobResult& ou
 
 }  // namespace
 
+namespace {
+
+// The images of the run against the memory available, before the scene is loaded: methods and
+// references at their largest count (one reference per method, and the common one), and the
+// largest method scratch of the registry counted once (estimate_compare_memory) plus the methods'
+// own extra memory.
+void check_compare_memory(const CompareRequest& request, const CompareSettings& settings) {
+  const int width = request.camera.width.value_or(request.camera.default_width), height = request.camera.height.value_or(request.camera.default_height);
+  const int methods = static_cast<int>(settings.methods.size());
+  std::uint64_t extra = 0;
+  for (const std::string& name : settings.methods) {
+    const MethodInfo& m = find_method(name);
+    const auto it = settings.params.find(name);
+    if (m.memory) extra = std::max(extra, m.memory(m.canonical_params(it != settings.params.end() ? it->second : m.default_params())).bytes);
+  }
+  const std::uint64_t bytes = estimate_compare_memory({.width = width, .height = height, .methods = methods, .references = methods + 1,
+                                                        .sheet_columns = static_cast<int>(sheet_columns(settings.device == Device::Gpu).size())}) + extra;
+  check_memory(bytes, "ao compare: " + std::to_string(methods) + (methods == 1 ? " method at " : " methods at ") + std::to_string(width) + "x" + std::to_string(height) + " pixels");
+}
+
+}  // namespace
+
 fs::path default_compare_dir(const CompareRequest& request) { return "compare-" + fs::path(request.scene.name()).stem().string(); }
 
 CompareJobResult run_compare(const CompareRequest& request, const JobReporter& reporter) {
@@ -110,6 +127,7 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
     for (const std::string& f : output_files(!settings.sweep_key.empty())) outputs.add_output(request.out_dir / f, "--out-dir");
   }
 
+  check_compare_memory(request, settings);
   Stopwatch clock;
   std::optional<GpuDevice> gpu;
   if (settings.device == Device::Gpu) gpu = GpuDevice::open();  // before anything is loaded: without a usable OpenGL the run stops here

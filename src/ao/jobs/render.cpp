@@ -10,6 +10,7 @@
 #include "ao/registry/methods_gpu.h"
 #include "ao/io/gbuffer_exr.h"
 #include "ao/io/image_io.h"
+#include "ao/io/json_text.h"
 #include "ao/io/output_set.h"
 #include "ao/core/stopwatch.h"
 #include "ao/reference/ray_scene.h"
@@ -205,7 +206,7 @@ MethodParams method_params(const MethodInfo& method, const nlohmann::json& overr
     params[std::string(method.target_error_param)] = *target_error;
   }
   if (!overrides.is_null()) {
-    if (!overrides.is_object()) throw InputError(std::string(method.name) + ": parameters must be a JSON object, got " + overrides.dump());
+    if (!overrides.is_object()) throw InputError(std::string(method.name) + ": parameters must be a JSON object, got " + json_excerpt(overrides));
     for (const auto& [key, value] : overrides.items()) params[key] = value;
   }
   return method.decode(params);

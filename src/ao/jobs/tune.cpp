@@ -1,6 +1,7 @@
 #include "ao/jobs/tune.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include "ao/core/error.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
+#include "ao/io/output_set.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/reference.h"
 #include "ao/jobs/compare.h"
@@ -141,6 +143,19 @@ std::string number(double v) {
   return s.str();
 }
 
+// The parameter file as render's outputs are checked, before any work: a .json name that names
+// none of the files the run reads (its scenes, camera file, parameter files) and no folder.
+void declare_output(const TuneRequest& r, OutputSet& outputs) {
+  if (r.output.empty()) return;
+  std::string ext = r.output.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".json") throw InputError(r.output.string() + ": -o writes the parameter file as JSON; give it a .json name");
+  for (const std::string& scene : r.scenes) SceneSource{.args = {scene}}.declare_inputs(outputs);
+  if (r.camera.file) outputs.add_input(*r.camera.file, "--camera");
+  for (const std::filesystem::path& p : r.parameter_files) outputs.add_input(p, "-p @" + p.string());
+  outputs.add_output(r.output, "-o");
+}
+
 }  // namespace
 
 std::vector<TuneParameter> tune_parameters(const MethodInfo& m, const std::vector<TuneFit>& fit) {
@@ -177,6 +192,8 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
   if (r.scenes.empty()) throw InputError("--scenes: no scene named");
   r.camera.validate();
   r.falloff.validate();
+  OutputSet outputs;
+  declare_output(r, outputs);
 
   // Each view keeps its scene, BVH and G-buffer alive while tuning runs.
   struct Loaded {
@@ -210,13 +227,10 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
   out.file = {{"method", r.method},       {"parameters", out.tune.params}, {"start_rmse", out.tune.start_rmse}, {"best_rmse", out.tune.best_rmse},
               {"evaluations", out.tune.evaluations}, {"seconds", out.tune.seconds}, {"scenes", r.scenes},
               {"width", width},           {"height", height}, {"on_bound", out.tune.on_bound}};
-  if (!r.output.empty())
-    write_file_atomically(r.output, [&](const std::filesystem::path& temp) {
-      std::ofstream file(temp, std::ios::binary);
-      file << out.file.dump(2) << "\n";
-      file.close();
-      if (!file) throw SystemError(r.output.string() + ": cannot write");
-    });
+  if (!r.output.empty()) {
+    outputs.write(r.output, [&] { write_bytes_atomically(r.output, out.file.dump(2) + "\n"); });
+    outputs.commit();
+  }
   return out;
 }
 

@@ -91,7 +91,9 @@ struct TuneRequest {
   FalloffRequest falloff;
   SurfaceNormal normal = SurfaceNormal::Shading;  ///< The G-buffer's N, for the method and its reference.
   std::uint32_t seed = 1;
-  std::filesystem::path output;                    ///< The parameter file (JSON; `ao render -p @FILE`); empty: not written.
+  std::filesystem::path output;                    ///< The parameter file (.json; `ao render -p @FILE`); empty: not written.
+  /// Files the starting parameters were read from (`-p @FILE`): `output` may not name one.
+  std::vector<std::filesystem::path> parameter_files;
 };
 
 struct TuneJobResult {
@@ -106,7 +108,8 @@ std::vector<TuneParameter> tune_parameters(const MethodInfo& method, const std::
 
 /// Loads each scene, renders its G-buffer and its matched reference (for the starting
 /// parameters), runs tune_method and writes the parameter file. Each accepted improvement is told
-/// to the reporter as a note.
+/// to the reporter as a note. Before any work, InputError when `output` does not end in .json or
+/// names a scene file, the camera file, a parameter file or a folder (as render's outputs).
 TuneJobResult run_tune(const TuneRequest& request, const JobReporter& reporter = {});
 
 }  // namespace ao

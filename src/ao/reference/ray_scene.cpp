@@ -80,6 +80,7 @@ std::string embree_error_text(int code) {
 
 RayScene::RayScene(const Scene& scene, const BvhOptions& options)
     : source_(scene), bounds_(scene.bounds()), handles_(std::make_unique<Handles>()) {
+  check_traceable_size(scene);
   RTCDevice& device = handles_->device;
   RTCScene& bvh = handles_->scene;
   device = rtcNewDevice(nullptr);

@@ -46,7 +46,8 @@ class RayScene {
   /// references through its transform (one BVH over the instances on top, not a copy per
   /// instance). Embree reads the meshes' positions and indices in place (no copy) when the
   /// positions have the spare capacity validate_and_prepare reserves (kVertexPadding); otherwise it
-  /// copies them. Throws SystemError when Embree fails.
+  /// copies them. Throws InputError for a scene smaller than kMinSceneExtent (check_traceable_size),
+  /// SystemError when Embree fails.
   explicit RayScene(const Scene& scene, const BvhOptions& options = {});
   ~RayScene();
   RayScene(const RayScene&) = delete;

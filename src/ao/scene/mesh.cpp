@@ -310,7 +310,7 @@ std::string instance_label(const Scene& scene, std::size_t k) {
   return "node '" + name + (in.name.size() > 64 ? "...'" : "'");
 }
 
-// Transforms: finite, invertible, and keeping their mesh inside +-kMaxCoordinate. The box test
+// Transforms: finite, invertible, not squashed beyond kMaxSquashRatio, and keeping their mesh inside +-kMaxCoordinate. The box test
 // first (8 corners); only a transform whose box leaves the range has its vertices checked one by
 // one, since a rotated box can stick out where no vertex does.
 void validate_instances(const Scene& scene) {
@@ -320,11 +320,7 @@ void validate_instances(const Scene& scene) {
     const Instance& in = scene.instances[k];
     const std::string w = scene.name + ": " + instance_label(scene, k);
     const Affine3& t = in.object_to_world;
-    if (!t.is_finite()) throw InputError(w + " has a non-finite transform");
-    // A zero determinant flattens the mesh onto a plane or a line: every triangle would be
-    // degenerate, and the ray tracer needs the inverse.
-    const double det = t.determinant();
-    if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) throw InputError(w + " has a transform with determinant 0 (it flattens the mesh)");
+    if (const std::string problem = transform_problem(t); !problem.empty()) throw InputError(w + " " + problem);
     if (!have[in.mesh]) mesh_bounds[in.mesh] = scene.meshes[in.mesh].bounds(), have[in.mesh] = 1;
     const Bounds3 b = transform_bounds(t, mesh_bounds[in.mesh]);
     const auto too_far = [](Vec3 p) { return !is_finite(p) || std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > kMaxCoordinate; };
@@ -340,6 +336,33 @@ void validate_instances(const Scene& scene) {
 }
 
 }  // namespace
+
+std::string transform_problem(const Affine3& t) {
+  if (!t.is_finite()) return "has a non-finite transform";
+  // A zero determinant flattens the mesh onto a plane or a line: every triangle would be
+  // degenerate, and the ray tracer needs the inverse.
+  const double det = t.determinant();
+  if (!(std::abs(det) > 0) || !std::isfinite(1.0 / det)) return "has a transform with determinant 0 (it flattens the mesh)";
+  // Nearly flat is flat in float, and rays in the mesh's own space become too long for Embree.
+  const double ratio = squash_ratio(t);
+  if (ratio > kMaxSquashRatio) {
+    char text[160];
+    std::snprintf(text, sizeof text, "has a transform that squashes the mesh: it scales one direction %.2g times more than another, ao traces at most %.0e",
+                  ratio, kMaxSquashRatio);
+    return text;
+  }
+  return {};
+}
+
+void check_traceable_size(const Scene& scene) {
+  const Bounds3 b = scene.bounds();
+  if (b.empty()) return;
+  const Vec3 size = b.hi - b.lo;
+  const float extent = std::max({size.x, size.y, size.z});
+  if (extent < kMinSceneExtent)
+    throw InputError(scene.name + ": the scene is " + format_magnitude(extent) + " units across, less than the " + format_magnitude(kMinSceneExtent) +
+                     " ao traces correctly (scale it up)");
+}
 
 void validate_and_prepare(Scene& scene) {
   if (scene.meshes.empty()) throw InputError(scene.name + ": the scene has no meshes");

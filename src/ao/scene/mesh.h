@@ -20,6 +20,24 @@ namespace ao {
 /// from 1e13 and aborts on an assertion from about 2e18. 1e9 keeps a margin below the first failure.
 inline constexpr float kMaxCoordinate = 1e9f;
 
+/// Smallest extent (the longest side of the bounding box, world units) of a scene ao traces
+/// correctly: RayScene refuses smaller ones. Measured (docs/assets.md, "Tiny and squashed
+/// models"): a hand model renders the same mean V (to 1e-5) at sizes 1e8 down to 1e-7, a visibly
+/// wrong one at 1e-8 (0.85 for 0.95) and 1e-9 (0.15); 1e-6 keeps a margin of 10 above the last
+/// good size. (Loading accepts smaller meshes: their normals and areas are computed at unit scale.)
+inline constexpr float kMinSceneExtent = 1e-6f;
+
+/// Largest squash_ratio (affine.h) of a transform that places a mesh: beyond about 2^23 (8.4e6)
+/// the squashed axis is below the float spacing of the others, and from about 1e16 Embree's ray
+/// validity check aborts the process (a glTF node scaled 1e-20 along one axis).
+inline constexpr double kMaxSquashRatio = 1e7;
+
+/// Why the transform `t` cannot place a mesh ao traces, as the end of a sentence that starts with
+/// the node's name ("has a non-finite transform", "has a transform with determinant 0 (it flattens
+/// the mesh)", "has a transform that squashes the mesh: it scales one direction 1.4e+20 times more
+/// than another, ao traces at most 1e+07"); empty when it can.
+std::string transform_problem(const Affine3& t);
+
 /// Spare elements of capacity that validate_and_prepare keeps behind Mesh::positions, so that a ray
 /// tracer may share the array and read 16 bytes from the last vertex (Embree's SIMD loads read 4
 /// bytes past its end; two Vec3 are 24 bytes).
@@ -106,5 +124,10 @@ void generate_normals(Mesh& mesh);
 /// with their count, and generates normals where missing (unit length is restored where loaded
 /// normals are not).
 void validate_and_prepare(Scene& scene);
+
+/// InputError "<scene>: the scene is X units across, less than the 1e-06 ao traces correctly
+/// (scale it up)" when the scene's bounds are smaller than kMinSceneExtent on their longest side.
+/// RayScene and the bakers call it; loading does not (a tiny mesh loads and gets its normals).
+void check_traceable_size(const Scene& scene);
 
 }  // namespace ao

@@ -60,7 +60,10 @@ struct BakeOutputs {
   std::filesystem::path per_vertex;    ///< Per-vertex AO: .ply (colour + float quality) or .glb (COLOR_0).
   std::filesystem::path gltf;          ///< A .glb of the mesh with the map as its occlusion texture.
   std::filesystem::path miss_mask;     ///< High to low: 1 where every cage ray of a texel missed.
-  std::optional<int> png_bits;         ///< 8 or 16 (default 8; an --orm texture keeps its own).
+  std::optional<int> png_bits;         ///< 8 or 16 (default 8; an ORM texture keeps its own).
+  /// Also write each output's record beside it, <output>.ao.json (jobs/provenance.h): ao's version,
+  /// the inputs' SHA-256, every setting; in the mesh's transaction, renamed after its outputs.
+  bool provenance = false;
 };
 
 struct BakeRequest {
@@ -115,6 +118,14 @@ struct BakeBatchResult {
 /// The checks that need no mesh (option values, combinations, output names, memory), with the
 /// defaults resolved: what run_bake bakes. InputError with one line naming the option.
 BakeRequest resolve_bake_request(const BakeRequest& request);
+
+/// The provenance record (jobs/provenance.h) of the outputs `request` writes for `mesh`, without
+/// the per-file "output": the mesh (and a .gltf's buffers), high meshes, cage, occluders, ORM
+/// texture and reference map as inputs (hashed when `hash_inputs`; otherwise each input has its
+/// role and path only), and as settings every resolved field that changes an output (the baker
+/// and its parameters, size, UV set, padding, denoise, high-to-low reach, groups, floor, PNG bits,
+/// which outputs). Checks the request first (resolve_bake_request).
+nlohmann::json bake_provenance(const BakeRequest& request, const std::filesystem::path& mesh, bool hash_inputs = true);
 
 /// Bakes every mesh of `request` and writes its outputs, each mesh's as one transaction. In a
 /// batch a mesh that fails (InputError, SystemError) is reported through `reporter` and in its

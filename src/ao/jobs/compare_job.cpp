@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "ao/core/error.h"
+#include "ao/jobs/fields.h"
 #include "ao/core/stopwatch.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
@@ -106,8 +107,8 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   OutputSet outputs;
   request.scene.declare_inputs(outputs);
   if (!request.out_dir.empty()) {
-    outputs.add_directory(request.out_dir, "--out-dir");
-    for (const std::string& f : output_files(!settings.sweep_key.empty())) outputs.add_output(request.out_dir / f, "--out-dir");
+    outputs.add_directory(request.out_dir, field(fields::kCompareOutDir));
+    for (const std::string& f : output_files(!settings.sweep_key.empty())) outputs.add_output(request.out_dir / f, field(fields::kCompareOutDir));
   }
 
   Stopwatch clock;

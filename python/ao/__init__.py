@@ -112,11 +112,6 @@ def _scene_arg(scene, name="scene"):
     raise TypeError(f"{name}: expected a mesh file, a built-in scene name, a list of mesh files or an ao.Scene, got {type(scene).__name__}")
 
 
-def _params(params):
-    """The method's parameters by name, as given (their table checks them); a name must be a str."""
-    return dict(params)
-
-
 def _run(job, progress, *args):
     """The compiled `job` with the caller's progress (ao._progress), its display ended afterwards."""
     fn, done = _reporter(_check.progress("progress", progress))
@@ -197,7 +192,7 @@ def _falloff(radius, radius_fraction, membership, tau):
 def _render_request(method, params, *, spp, target_error, seed, radius, radius_fraction, membership, tau, normal, camera, output,
                     shaded, gbuffer_output, png_bits, extras, provenance):
     """The job layer's request for render() (and ao.batch's records), every argument checked."""
-    request = {"method": _check.text("method", method), "params": _params(params), "samples": _check.integer("spp", spp, optional=True),
+    request = {"method": _check.text("method", method), "params": dict(params), "samples": _check.integer("spp", spp, optional=True),
                "target_error": _check.number("target_error", target_error, optional=True), "seed": _check.seed("seed", seed),
                **_falloff(radius, radius_fraction, membership, tau), "normal": _check.text("normal", normal, optional=True),
                "camera": _camera_dict(camera), "output": _check.path("output", output), "shaded": _check.path("shaded", shaded),
@@ -289,7 +284,7 @@ def _mesh_arg(mesh):
 def _bake_request(*, size, method, uv_set, padding, vertex_resolution, seed, params, map, per_vertex, output, per_vertex_output,
                   bent_normals_output, gltf_output, png_bits, provenance):
     """The job layer's request for bake() (and ao.batch's records), every argument checked."""
-    params = _params(params)
+    params = dict(params)
     if seed is not None:
         params["seed"] = _check.seed("seed", seed)
     if size is not None and not isinstance(size, str):

@@ -87,13 +87,11 @@ def changes(expected, found):
     for key in sorted(set(new) | set(old)):
         if new.get(key) != old.get(key):
             out.append(f"{key} {_short(old.get(key))} -> {_short(new.get(key))}")
-    mine = [(i["role"], i["sha256"]) for i in expected.get("inputs", [])]
-    theirs = [(i.get("role"), i.get("sha256")) for i in found.get("inputs", []) if isinstance(i, dict)]
-    if mine != theirs:
-        named = {i.get("role"): os.path.basename(i.get("path", "")) for i in expected.get("inputs", [])}
-        changed = sorted({os.path.basename(i["path"]) for i, t in zip(expected["inputs"], theirs + [None] * len(mine))
-                          if t is None or (i["role"], i["sha256"]) != t}) or sorted(named.values())
-        out.append("input " + ", ".join(changed) + " changed")
+    found_inputs = [i for i in found.get("inputs", []) if isinstance(i, dict)]
+    if [(i["role"], i["sha256"]) for i in expected["inputs"]] != [(i.get("role"), i.get("sha256")) for i in found_inputs]:
+        before = {(i.get("role"), i.get("path")): i.get("sha256") for i in found_inputs}
+        changed = [os.path.basename(i["path"]) for i in expected["inputs"] if before.get((i["role"], i["path"])) != i["sha256"]]
+        out.append("input " + ", ".join(changed) + " changed" if changed else "the list of inputs changed")
     return out
 
 

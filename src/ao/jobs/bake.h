@@ -109,10 +109,21 @@ struct MeshBake {
   nlohmann::json summary;          ///< What `ao bake --json` prints for it.
 };
 
+/// What run_bake returns. Keep it in a variable, or take what you need with mesh(): a reference
+/// into a temporary result, such as `const BakeResult& map = run_bake(r).meshes.at(0).map;`,
+/// dangles at the end of the statement (the vector is freed with the result).
 struct BakeBatchResult {
   std::vector<MeshBake> meshes;  ///< In input order (folders sorted by name).
   int failed = 0;                ///< Meshes with an error.
   bool batch = false;            ///< Several meshes or a folder were asked for (outputs named <stem>-<name>).
+
+  /// The first mesh's outcome (the only one of a single mesh). On a result held in a variable, a
+  /// reference into it; on a temporary, the outcome moved out of it, so that
+  /// `const MeshBake& m = run_bake(r).mesh();` and `const BakeResult& map = run_bake(r).mesh().map;`
+  /// keep it alive (a reference bound to a temporary, or to a member of one, extends its life).
+  /// std::out_of_range when there is none.
+  const MeshBake& mesh() const& { return meshes.at(0); }
+  MeshBake mesh() && { return std::move(meshes.at(0)); }
 };
 
 /// The checks that need no mesh (option values, combinations, output names, memory), with the

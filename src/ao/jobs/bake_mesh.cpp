@@ -151,7 +151,7 @@ void bake_udim_tiles(MeshJob& job, const fs::path& pattern, OutputSet& outputs) 
   const Plan& plan = job.plan;
   const std::vector<UdimTile> tiles = udim_tiles(job.scene);
   for (const UdimTile& t : tiles)  // tile 1001 of "ao.1001.png" is the pattern itself, already declared
-    if (udim_tile_path(pattern, t.number()) != pattern) outputs.add_output(udim_tile_path(pattern, t.number()), "tile " + std::to_string(t.number()) + " of -o");
+    if (udim_tile_path(pattern, t.number()) != pattern) outputs.add_output(udim_tile_path(pattern, t.number()), "tile " + std::to_string(t.number()) + " of " + field(fields::kBakeMap));
   nlohmann::json tile_summary = nlohmann::json::array();
   std::size_t covered = 0;
   for (const UdimTile& t : tiles) {

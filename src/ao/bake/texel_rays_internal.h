@@ -17,6 +17,7 @@
 #include "ao/core/sampling.h"
 #include "ao/reference/embree_scene_internal.h"
 #include "ao/reference/packets_internal.h"
+#include "ao/reference/ray_offset.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/ray_tiles_internal.h"
 
@@ -184,6 +185,16 @@ void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& tab
 /// the surface itself, mu = 0, no ray); lanes from count on are not valid.
 void make_hemisphere_rays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, TexelRayBatch& out);
 
+/// Where the search for the next hit starts along ray o + t d after a face hit at t with normal
+/// n (any length): past the face's plane by the ray-offset distance of the hit point's coordinates
+/// (ray_offset.h), measured along the ray. Embree's t is known to a few float spacings of those
+/// coordinates, not of t, so starting one spacing of t beyond it can find the same face again.
+inline float beyond_face(Vec3 o, Vec3 d, float t, Vec3 n) {
+  const float cos = std::abs(dot(n, d)) / std::sqrt(dot(n, n) * dot(d, d));
+  // The cosine's floor keeps a grazing ray's step under 1000 offsets (0.8% of the coordinates' magnitude).
+  return t + ray_offset_distance(max_abs_coordinate(o + d * t)) / std::max(cos, 1e-3f);
+}
+
 /// Traces AO rays and returns mu(D) per ray, optionally passing through back faces.
 struct Tracer {
   const RayScene& rs;
@@ -202,8 +213,9 @@ struct Tracer {
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(embree_scene(rs), &ctx, &rh);
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 1.0f;
-      if (!ignore_back || dot(hit_face_normal(rs, normals, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v), d) <= 0) return falloff.mu(rh.ray.tfar);
-      tnear = std::nextafter(rh.ray.tfar, kInfinity);  // a back face: look beyond it
+      const Vec3 n = hit_face_normal(rs, normals, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v);
+      if (!ignore_back || dot(n, d) <= 0) return falloff.mu(rh.ray.tfar);
+      tnear = beyond_face(o, d, rh.ray.tfar, n);  // a back face: look beyond it
     }
     return 0.0f;
   }
@@ -241,7 +253,7 @@ struct Tracer {
           if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
             mu[k] = 1.0f;
           } else if (ignore_back && dot(hit_face_normal(rs, normals, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]), dir[k]) > 0) {
-            mu[k] = trace1(ctx, org[k], dir[k], std::nextafter(rh.ray.tfar[k], kInfinity));
+            mu[k] = trace1(ctx, org[k], dir[k], beyond_face(org[k], dir[k], rh.ray.tfar[k], hit_face_normal(rs, normals, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k])));
           } else {
             mu[k] = falloff.mu(rh.ray.tfar[k]);
           }

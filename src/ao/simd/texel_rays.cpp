@@ -124,17 +124,29 @@ namespace ao::simd {
 HWY_EXPORT(MakeTexelRays);
 HWY_EXPORT(MakeHemisphereRays);
 
+// Dispatched from the namespace of HWY_EXPORT: with a single static target (AO_NATIVE=ON)
+// HWY_DYNAMIC_DISPATCH(F) is F of that target's namespace, named relative to the calling scope.
+namespace {
+void dispatch_texel_rays(const std::vector<detail::PatchPiece>& patch, const detail::PatchTable& table, const float (&u)[4][16], int count,
+                         bool geometric, detail::TexelRayBatch& out) {
+  HWY_DYNAMIC_DISPATCH(MakeTexelRays)(patch, table, u, count, geometric, out);
+}
+void dispatch_hemisphere_rays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, detail::TexelRayBatch& out) {
+  HWY_DYNAMIC_DISPATCH(MakeHemisphereRays)(origin, n, ng, u, count, out);
+}
+}  // namespace
+
 }  // namespace ao::simd
 
 namespace ao::detail {
 
 void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& table, const float (&u)[4][16], int count, bool geometric,
                      TexelRayBatch& out) {
-  HWY_DYNAMIC_DISPATCH(simd::MakeTexelRays)(patch, table, u, count, geometric, out);
+  simd::dispatch_texel_rays(patch, table, u, count, geometric, out);
 }
 
 void make_hemisphere_rays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, TexelRayBatch& out) {
-  HWY_DYNAMIC_DISPATCH(simd::MakeHemisphereRays)(origin, n, ng, u, count, out);
+  simd::dispatch_hemisphere_rays(origin, n, ng, u, count, out);
 }
 
 }  // namespace ao::detail

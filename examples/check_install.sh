@@ -61,7 +61,10 @@ echo "== examples/ as a separate project (find_package(ao 0.2 REQUIRED)), under 
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 sanitize="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-cmake -S "$src" -B "$tmp/examples" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_PREFIX_PATH="$prefix" "${launcher[@]}" \
+# Release (no -g) and CCACHE_BASEDIR: ccache then finds the objects of an earlier run, whose
+# temporary folder differed.
+export CCACHE_BASEDIR="$tmp"
+cmake -S "$src" -B "$tmp/examples" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" "${launcher[@]}" \
   -DCMAKE_CXX_FLAGS="$sanitize" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" >/dev/null
 cmake --build "$tmp/examples" >/dev/null
 # Any ASan report ends the program with an error; leaks inside the libraries ao uses are listed in

@@ -39,10 +39,10 @@ install(FILES ${PROJECT_BINARY_DIR}/aoConfig.cmake ${PROJECT_BINARY_DIR}/aoConfi
 # libraries it uses inside (Embree has no .pc file in Debian, hence -lembree3).
 set(AO_PC_REQUIRES "tbb nlohmann_json")
 if(BUILD_SHARED_LIBS)
-  set(AO_PC_REQUIRES_PRIVATE "libhwy assimp OpenEXR libpng libtiff-4 libjpeg freetype2")
+  set(AO_PC_REQUIRES_PRIVATE "libhwy assimp OpenEXR libpng libtiff-4 libjpeg freetype2 libcrypto")
   set(AO_PC_LIBS "")
 else()
-  set(AO_PC_REQUIRES "${AO_PC_REQUIRES} libhwy assimp OpenEXR libpng libtiff-4 libjpeg freetype2")
+  set(AO_PC_REQUIRES "${AO_PC_REQUIRES} libhwy assimp OpenEXR libpng libtiff-4 libjpeg freetype2 libcrypto")
   set(AO_PC_REQUIRES_PRIVATE "")
   set(AO_PC_LIBS "-lembree3 -pthread")
   if(AO_GPU AND CMAKE_DL_LIBS)

@@ -17,12 +17,15 @@ int main(int argc, char** argv) try {
   low.high = {argv[2]};
   low.outputs.map = "low_ao.png";
   if (argc > 3) low.size = ao::parse_map_size(argv[3]);
-  const ao::BakeResult& map = ao::run_bake(low).meshes.at(0).map;
+  // mesh() on the temporary result moves the mesh's outcome out of it: `map` stays valid.
+  const ao::MeshBake baked = ao::run_bake(low).mesh();
+  const ao::BakeResult& map = baked.map;
 
   ao::BakeRequest high;
   high.inputs = {argv[2]};
   high.outputs.per_vertex = "high_ao.ply";
-  const std::vector<float>& vertex_ao = ao::run_bake(high).meshes.at(0).vertex_ao;
+  const ao::BakeBatchResult per_vertex = ao::run_bake(high);  // or keep the whole result
+  const std::vector<float>& vertex_ao = per_vertex.mesh().vertex_ao;
   double mean = 0;
   for (float v : vertex_ao) mean += v / static_cast<double>(vertex_ao.size());
   std::printf("low_ao.png: %zu texels from the high mesh; high_ao.ply: %zu vertices, mean V %.3f\n", map.covered_texels, vertex_ao.size(), mean);

@@ -8,23 +8,35 @@ and `ao compare` run, so an array from here equals the CLI's output for the same
     m = ao.bake(ao.Scene.from_arrays(vertices, faces, uvs=uvs), size=256)        # the AO map
     rows = ao.compare("sphere-on-plane", methods=["alchemy", "gtao"])             # list of dicts
 
-Values: V in [0, 1] per pixel or texel, 1 = fully open, 0 = fully occluded; 0 where nothing is
-covered (background pixels, texels outside the charts; see `mask`).
+Values: V in [0, 1] per pixel, texel or point, 1 = fully open, 0 = fully occluded. Background
+pixels of a render, where no surface is seen (the G-buffer's object_id is 0), hold 1; texels of a
+map beyond the charts and their padding hold 0 (bake(full=True) gives the `mask` of covered texels).
 
-Errors: a bad parameter value or a bad file raises ao.InputError (a ValueError subclass) with the
-one line `ao` prints after "ao: error: "; an I/O failure (disk full, permissions) raises OSError;
-Ctrl-C raises KeyboardInterrupt within a fraction of a second. The GIL is released while the job
-computes, so other Python threads run meanwhile. Warnings of the job (e.g. degenerate triangles
-dropped) are issued with warnings.warn.
+    >>> v = ao.render("plane", ao.Camera(eye=(0, 1, 3), target=(0, 1, 4), width=4, height=4), "volumetric")
+    >>> float(v.min()), float(v.max())   # looking away from the plane: background only
+    (1.0, 1.0)
+
+Errors: an argument of the wrong type raises TypeError; a bad value or a bad file raises
+ao.InputError (a ValueError subclass) with one line naming the argument or file ("padding must be
+in [0, 1024] texels, got 2000"), the line `ao` prints after "ao: error: " with its options named
+as keyword arguments; an I/O failure (disk full, permissions) raises OSError; Ctrl-C raises
+KeyboardInterrupt within a fraction of a second. The GIL is released while the job computes, so
+other Python threads run meanwhile. Warnings of the job (e.g. degenerate triangles dropped) are
+issued with warnings.warn.
+
+Progress: the long calls take progress=True (a tqdm bar per stage when tqdm is installed, a line
+on stderr every few seconds otherwise) or a callable(stage, done, total).
 """
 
 import os as _os
 
 from . import _ao
+from . import _arguments as _check
 from ._ao import GBuffer, InputError, Scene, read_image, __version__
+from ._progress import reporter as _reporter
 
 __all__ = ["Camera", "GBuffer", "InputError", "Scene", "bake", "compare", "gbuffer", "gbuffer_from_arrays", "methods",
-           "read_image", "render", "set_threads", "__version__"]
+           "occlusion", "read_image", "render", "set_threads", "__version__"]
 
 
 class Camera:
@@ -41,7 +53,12 @@ class Camera:
     _fields = ("eye", "target", "up", "fov", "width", "height")
 
     def __init__(self, eye=None, target=None, up=None, fov=None, width=None, height=None):
-        self.eye, self.target, self.up, self.fov, self.width, self.height = eye, target, up, fov, width, height
+        self.eye = _check.vector3("camera.eye", eye)
+        self.target = _check.vector3("camera.target", target)
+        self.up = _check.vector3("camera.up", up)
+        self.fov = _check.number("camera.fov", fov, optional=True)
+        self.width = _check.integer("camera.width", width, optional=True)
+        self.height = _check.integer("camera.height", height, optional=True)
 
     @classmethod
     def read(cls, path):
@@ -51,10 +68,12 @@ class Camera:
     @classmethod
     def from_dict(cls, d):
         """Camera.from_dict({"eye": [..], "target": [..], "up": [..], "fov": 45, "width": .., "height": ..})."""
+        if not isinstance(d, dict):
+            raise TypeError(f"camera: expected a dict of camera fields, got {type(d).__name__}")
         unknown = set(d) - set(cls._fields)
         if unknown:
             raise InputError("camera: unknown field(s) " + ", ".join(sorted(unknown)) + "; the fields are " + ", ".join(cls._fields))
-        return cls(**d)
+        return cls(**{str(k): v for k, v in d.items()})
 
     def to_dict(self):
         """The fields that are set, as the camera JSON names them."""
@@ -80,19 +99,26 @@ def _camera_dict(camera):
         return Camera.from_dict(camera).to_dict()
     if isinstance(camera, (str, _os.PathLike)):
         return Camera.read(camera).to_dict()
-    raise InputError(f"camera: expected an ao.Camera, a dict or a camera JSON file, got {type(camera).__name__}")
+    raise TypeError(f"camera: expected an ao.Camera, a dict or a camera JSON file, got {type(camera).__name__}")
 
 
-def _scene_arg(scene):
+def _scene_arg(scene, name="scene"):
+    if scene is None or isinstance(scene, (Scene, str)):
+        return scene
     if isinstance(scene, _os.PathLike):
         return _os.fspath(scene)
-    if isinstance(scene, (list, tuple)):
-        return [_os.fspath(s) for s in scene]
-    return scene
+    if isinstance(scene, (list, tuple)) and scene:
+        return [_check.path(f"{name}[{k}]", s, optional=False) for k, s in enumerate(scene)]
+    raise TypeError(f"{name}: expected a mesh file, a built-in scene name, a list of mesh files or an ao.Scene, got {type(scene).__name__}")
 
 
-def _path(p):
-    return None if p is None else _os.fspath(p)
+def _run(job, progress, *args):
+    """The compiled `job` with the caller's progress (ao._progress), its display ended afterwards."""
+    fn, done = _reporter(_check.progress("progress", progress))
+    try:
+        return job(*args, fn)
+    finally:
+        done()
 
 
 def methods():
@@ -108,16 +134,17 @@ def methods():
 def set_threads(threads):
     """set_threads(threads): worker threads for the calls that follow (as --threads); 0 = all cores.
     Results do not depend on it."""
-    _ao.set_threads(threads)
+    _ao.set_threads(_check.integer("threads", threads))
 
 
 def render(scene=None, camera=None, method="raytraced", *, gbuffer=None, spp=None, target_error=None, seed=1, radius=None,
            radius_fraction=None, membership=None, tau=None, normal=None, output=None, shaded=None, gbuffer_output=None,
-           png_bits=8, extras=False, full=False, **params):
+           png_bits=8, extras=False, provenance=False, full=False, progress=None, **params):
     """render(scene=None, camera=None, method="raytraced", *, gbuffer=None, spp=None, target_error=None,
            seed=1, radius=None, radius_fraction=None, membership=None, tau=None, normal=None,
-           output=None, shaded=None, gbuffer_output=None, png_bits=8, extras=False, full=False,
-           **params) -> numpy.ndarray  (H x W float32, V per pixel)
+           output=None, shaded=None, gbuffer_output=None, png_bits=8, extras=False,
+           provenance=False, full=False, progress=None, **params)
+       -> numpy.ndarray  (H x W float32, V per pixel; 1 where no surface is seen)
 
     Renders the AO of a scene as `ao render` does.
 
@@ -138,28 +165,52 @@ def render(scene=None, camera=None, method="raytraced", *, gbuffer=None, spp=Non
     output, shaded, gbuffer_output, png_bits, extras
                     files to write as `ao render -o, --shaded, --gbuffer-out, --png-bits, --extras`
                     write them (one atomic transaction)
+    provenance      also write each file's record beside it, FILE.ao.json (`--provenance`)
     full            return a dict instead: {"visibility", "std_error" (raytraced: the standard
                     error of V per pixel), "color" (RGB methods), "extras" {name: array},
                     "summary" (what `ao render --json` prints), "gbuffer" (ao.GBuffer)}
+    progress        True (a bar) or a callable(stage, done, total) (module docstring)
     **params        the method's parameters by name (`ao render -p key=value`), checked against its
                     table (listed below); a bad one raises ao.InputError (a ValueError)
     """
-    request = {"method": method, "params": params, "samples": spp, "target_error": target_error, "seed": seed,
-               "radius": radius, "radius_fraction": radius_fraction, "membership": membership, "tau": tau, "normal": normal,
-               "camera": _camera_dict(camera), "output": _path(output), "shaded": _path(shaded),
-               "gbuffer_output": _path(gbuffer_output), "png_bits": png_bits, "extras": extras, "return_gbuffer": full}
-    out = _ao.render(_scene_arg(scene), gbuffer, {k: v for k, v in request.items() if v is not None})
+    if gbuffer is not None and not isinstance(gbuffer, GBuffer):
+        raise TypeError(f"gbuffer: expected an ao.GBuffer (ao.gbuffer, ao.gbuffer_from_arrays), got {type(gbuffer).__name__}")
+    request = _render_request(method, params, spp=spp, target_error=target_error, seed=seed, radius=radius, radius_fraction=radius_fraction,
+                              membership=membership, tau=tau, normal=normal, camera=camera, output=output, shaded=shaded,
+                              gbuffer_output=gbuffer_output, png_bits=png_bits, extras=extras, provenance=provenance)
+    request["return_gbuffer"] = _check.flag("full", full)
+    out = _run(_ao.render, progress, _scene_arg(scene), gbuffer, request)
     return out if full else out["visibility"]
 
 
-def gbuffer(scene=None, camera=None, *, normal="shading", albedo=True, uv=False):
-    """gbuffer(scene=None, camera=None, *, normal="shading", albedo=True, uv=False) -> ao.GBuffer
+def _falloff(radius, radius_fraction, membership, tau):
+    return {"radius": _check.number("radius", radius, optional=True),
+            "radius_fraction": _check.number("radius_fraction", radius_fraction, optional=True),
+            "membership": _check.text("membership", membership, optional=True), "tau": _check.number("tau", tau, optional=True)}
+
+
+def _render_request(method, params, *, spp, target_error, seed, radius, radius_fraction, membership, tau, normal, camera, output,
+                    shaded, gbuffer_output, png_bits, extras, provenance):
+    """The job layer's request for render() (and ao.batch's records), every argument checked."""
+    request = {"method": _check.text("method", method), "params": dict(params), "samples": _check.integer("spp", spp, optional=True),
+               "target_error": _check.number("target_error", target_error, optional=True), "seed": _check.seed("seed", seed),
+               **_falloff(radius, radius_fraction, membership, tau), "normal": _check.text("normal", normal, optional=True),
+               "camera": _camera_dict(camera), "output": _check.path("output", output), "shaded": _check.path("shaded", shaded),
+               "gbuffer_output": _check.path("gbuffer_output", gbuffer_output), "png_bits": _check.integer("png_bits", png_bits),
+               "extras": _check.flag("extras", extras), "provenance": _check.flag("provenance", provenance)}
+    return {k: v for k, v in request.items() if v is not None}
+
+
+def gbuffer(scene=None, camera=None, *, normal="shading", albedo=True, uv=False, progress=None):
+    """gbuffer(scene=None, camera=None, *, normal="shading", albedo=True, uv=False, progress=None) -> ao.GBuffer
 
     The G-buffer `ao render` renders for a scene and camera (docs/gbuffer.md): camera-space
     positions, unit normals, albedo, object ids, the camera. Pass it to render(gbuffer=...) to run
     several screen-space methods on one G-buffer.
     """
-    return _ao.gbuffer(_scene_arg(scene), {"camera": _camera_dict(camera), "normal": normal, "albedo": albedo, "uv": uv})
+    request = {"camera": _camera_dict(camera), "normal": _check.text("normal", normal), "albedo": _check.flag("albedo", albedo),
+               "uv": _check.flag("uv", uv)}
+    return _run(_ao.gbuffer, progress, _scene_arg(scene), {k: v for k, v in request.items() if v is not None})
 
 
 def gbuffer_from_arrays(normal, *, depth=None, position=None, albedo=None, object_id=None, camera):
@@ -184,51 +235,113 @@ def gbuffer_from_arrays(normal, *, depth=None, position=None, albedo=None, objec
 
 def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=True, per_vertex=False, seed=None,
          vertex_resolution=None, output=None, per_vertex_output=None, bent_normals_output=None, gltf_output=None, png_bits=None,
-         full=False, **params):
+         provenance=False, full=False, progress=None, **params):
     """bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=16, map=True, per_vertex=False,
          seed=1, output=None, per_vertex_output=None, bent_normals_output=None, gltf_output=None,
-         png_bits=None, full=False, **params) -> numpy.ndarray
+         png_bits=None, provenance=False, full=False, progress=None, **params) -> numpy.ndarray
 
     Bakes AO into a mesh's UV space as `ao bake` does (one mesh; a folder: python3 -m ao.batch).
 
-    mesh        a mesh file with UVs, or an ao.Scene (Scene.from_arrays(..., uvs=...))
+    mesh        a mesh file with UVs, or an ao.Scene (Scene.from_arrays(..., uvs=...)); per-vertex
+                AO (map=False, per_vertex=True) needs no UVs
     size        texels per side: N, "N" or "WIDTHxHEIGHT" (default 1024)
     method      "raytraced" (default) or "histogram"
     uv_set      the UV set to bake into (glTF TEXCOORD_n)
-    padding     texels filled outside the charts (default 16)
+    padding     texels filled outside the charts (default 16); beyond them the map holds 0
     map         bake the map (H x W float32; row 0 is the top row of the image file)
     per_vertex  bake per-vertex AO (1-D float32, one value per vertex of the mesh as loaded)
     seed        seed of the sample sets (default 1)
     output, per_vertex_output, bent_normals_output, gltf_output, png_bits
                 files to write (mesh files only) as `ao bake -o, --per-vertex, --bent-normals,
                 --gltf, --png-bits`
+    provenance  also write each file's record beside it, FILE.ao.json (`--provenance`)
     full        return {"map", "mask" (1 where a texel is covered), "per_vertex", "summary"}
+    progress    True (a bar) or a callable(stage, done, total) (module docstring)
     **params    the baker's parameters (`ao bake --help`): samples, denoise, max_distance,
                 membership, offset, normal, ignore_back_faces; histogram: directions, ...
 
     Returns the map; only per-vertex values when map=False; (map, per_vertex) when both.
     """
-    if seed is not None:
-        params["seed"] = seed
-    request = {"method": method, "size": size, "uv_set": uv_set, "padding": padding, "vertex_resolution": vertex_resolution,
-               "params": params, "map": map, "per_vertex": per_vertex, "output": _path(output),
-               "per_vertex_output": _path(per_vertex_output), "bent_normals_output": _path(bent_normals_output),
-               "gltf_output": _path(gltf_output), "png_bits": png_bits}
-    out = _ao.bake(_scene_arg(mesh), {k: v for k, v in request.items() if v is not None})
-    if full:
+    map_ = _check.flag("map", map)
+    per_vertex = _check.flag("per_vertex", per_vertex)
+    request = _bake_request(size=size, method=method, uv_set=uv_set, padding=padding, vertex_resolution=vertex_resolution, seed=seed,
+                            params=params, map=map_, per_vertex=per_vertex, output=output, per_vertex_output=per_vertex_output,
+                            bent_normals_output=bent_normals_output, gltf_output=gltf_output, png_bits=png_bits, provenance=provenance)
+    out = _run(_ao.bake, progress, _mesh_arg(mesh), request)
+    if _check.flag("full", full):
         return out
-    if map and per_vertex:
+    if map_ and per_vertex:
         return out.get("map"), out.get("per_vertex")
-    return out.get("map") if map else out.get("per_vertex")
+    return out.get("map") if map_ else out.get("per_vertex")
+
+
+def _mesh_arg(mesh):
+    if isinstance(mesh, Scene):
+        return mesh
+    return _check.path("mesh", mesh, optional=False)
+
+
+def _bake_request(*, size, method, uv_set, padding, vertex_resolution, seed, params, map, per_vertex, output, per_vertex_output,
+                  bent_normals_output, gltf_output, png_bits, provenance):
+    """The job layer's request for bake() (and ao.batch's records), every argument checked."""
+    params = dict(params)
+    if seed is not None:
+        params["seed"] = _check.seed("seed", seed)
+    if size is not None and not isinstance(size, str):
+        size = _check.integer("size", size)
+    request = {"method": _check.text("method", method), "size": size, "uv_set": _check.integer("uv_set", uv_set),
+               "padding": _check.integer("padding", padding, optional=True),
+               "vertex_resolution": _check.integer("vertex_resolution", vertex_resolution, optional=True), "params": params, "map": map,
+               "per_vertex": per_vertex, "output": _check.path("output", output), "per_vertex_output": _check.path("per_vertex_output", per_vertex_output),
+               "bent_normals_output": _check.path("bent_normals_output", bent_normals_output),
+               "gltf_output": _check.path("gltf_output", gltf_output), "png_bits": _check.integer("png_bits", png_bits, optional=True),
+               "provenance": _check.flag("provenance", provenance)}
+    return {k: v for k, v in request.items() if v is not None}
+
+
+def occlusion(scene, points, normals, *, samples=256, radius=None, radius_fraction=None, membership=None, tau=None, target_error=None,
+              offset=None, seed=1, full=False, progress=None):
+    """occlusion(scene, points, normals, *, samples=256, radius=None, radius_fraction=None,
+              membership=None, tau=None, target_error=None, offset=None, seed=1, full=False,
+              progress=None) -> numpy.ndarray  (N float32: V per point)
+
+    AO at points you choose (what libigl's ambient_occlusion gives), estimated as the ray-traced
+    reference of `ao render` estimates each pixel: cosine-weighted directions about the normal,
+    V = the mean of mu(D) over `samples` rays from the point, with its standard error.
+
+    scene       a mesh file, a list of them, a built-in name or an ao.Scene
+    points      N x 3 world-space points (on or just above the surface)
+    normals     N x 3 normals, one per point (normalised; not zero)
+    samples     rays per point, [1, 1048576]; the standard error falls as 1/sqrt(samples)
+    radius, radius_fraction, membership, tau
+                the falloff as for render(): R in world units (default 0.1 x the objects'
+                diagonal), mu(d) step (default), linear, sqrt, cubic, exp
+    target_error, offset, seed
+                adaptive stop per point, ray origin offset (world units; 0: scale-free), and the
+                seed: point i uses the sample set keyed by (seed, i)
+    full        return {"visibility", "std_error", "summary"} instead
+
+        >>> v = ao.occlusion("plane", [[0, 0, 0]], [[0, 1, 0]], samples=16)
+        >>> float(v[0])   # nothing above an open plane
+        1.0
+    """
+    params = {"samples": _check.integer("samples", samples)}
+    if target_error is not None:
+        params["target_error"] = _check.number("target_error", target_error)
+    if offset is not None:
+        params["offset"] = _check.number("offset", offset)
+    request = {**_falloff(radius, radius_fraction, membership, tau), "params": params, "seed": _check.seed("seed", seed)}
+    out = _run(_ao.occlusion, progress, _scene_arg(scene), points, normals, {k: v for k, v in request.items() if v is not None})
+    return out if _check.flag("full", full) else out["visibility"]
 
 
 def compare(scene=None, camera=None, methods=None, *, reference=None, common_reference=None, spp_reference=None, seed=1,
             radius=None, radius_fraction=None, membership=None, tau=None, normal="shading", params=None, sweep=None, out_dir=None,
-            full=False, images=False):
+            full=False, images=False, progress=None):
     """compare(scene=None, camera=None, methods=None, *, reference=None, common_reference="obscurance",
             spp_reference=256, seed=1,
             radius=None, radius_fraction=None, membership=None, tau=None, normal="shading",
-            params=None, sweep=None, out_dir=None, full=False, images=False) -> list of dict
+            params=None, sweep=None, out_dir=None, full=False, images=False, progress=None) -> list of dict
 
     Compares methods with the ray-traced reference as `ao compare` does; one dict per method:
     {"method", "parameters", "reference" {kind, label, ...}, "rmse", "psnr_db", "ssim",
@@ -248,13 +361,22 @@ def compare(scene=None, camera=None, methods=None, *, reference=None, common_ref
     full        return {"table" (table.json's content), "markdown" (table.md)}
     images      with full: also "images", per row {"method", "visibility", "reference"} arrays
     camera      as for render; default 640 x 360
+    progress    True (a bar) or a callable(stage, done, total) (module docstring)
     """
-    request = {"methods": methods, "reference": reference, "common_reference": common_reference, "spp_reference": spp_reference,
-               "seed": seed, "radius": radius,
-               "radius_fraction": radius_fraction, "membership": membership, "tau": tau, "normal": normal, "params": params,
-               "sweep": sweep, "out_dir": _path(out_dir), "camera": _camera_dict(camera), "images": images}
-    out = _ao.compare(_scene_arg(scene), {k: v for k, v in request.items() if v is not None})
-    return out if full else out["table"]["rows"]
+    if isinstance(methods, str):
+        methods = [methods]
+    if methods is not None and (not isinstance(methods, (list, tuple)) or not all(isinstance(m, str) for m in methods)):
+        raise TypeError(f"methods: expected a list of method names, got {type(methods).__name__}")
+    if params is not None and not isinstance(params, dict):
+        raise TypeError(f"params: expected a dict {{method: {{parameter: value}}}}, got {type(params).__name__}")
+    if sweep is not None and not isinstance(sweep, dict):
+        raise TypeError(f"sweep: expected a dict {{parameter: [values]}}, got {type(sweep).__name__}")
+    request = {"methods": methods, "reference": reference, "common_reference": _check.text("common_reference", common_reference, optional=True),
+               "spp_reference": _check.integer("spp_reference", spp_reference, optional=True), "seed": _check.seed("seed", seed),
+               **_falloff(radius, radius_fraction, membership, tau), "normal": _check.text("normal", normal), "params": params,
+               "sweep": sweep, "out_dir": _check.path("out_dir", out_dir), "camera": _camera_dict(camera), "images": _check.flag("images", images)}
+    out = _run(_ao.compare, progress, _scene_arg(scene), {k: v for k, v in request.items() if v is not None})
+    return out if _check.flag("full", full) else out["table"]["rows"]
 
 
 def _parameter_help():

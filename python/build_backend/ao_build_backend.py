@@ -4,7 +4,10 @@
 with CMake (AO_PYTHON=ON, the interpreter running pip as Python_EXECUTABLE, so a virtual
 environment's module matches its Python), installs the `python` component into a staging folder
 and packs that folder as a wheel. No setuptools, no network: only the standard library, cmake and
-the compiler. Editable installs and source distributions are not offered (build from the tree).
+the compiler. `pip install -e .` (build_editable, PEP 660) builds the module the same way and
+installs a path file naming the build folder's python/ (its ao/ holds the compiled module and
+symbolic links to python/ao/*.py), so edits to the Python files are live and a change to the C++
+takes a rebuild (`cmake --build BUILD --target ao_python`). Source distributions are not offered.
 
 Settings (pip --config-settings KEY=VALUE, or the environment variable in brackets):
   build-dir   [AO_PIP_BUILD_DIR]  the CMake build folder; default build-pip/ in the source tree.
@@ -69,8 +72,13 @@ def _run(cmd):
     subprocess.run(cmd, check=True, stdout=sys.stderr)
 
 
-def _build(config_settings, stage):
-    build_dir = os.path.abspath(_setting(config_settings, "build-dir", "AO_PIP_BUILD_DIR") or os.path.join(_ROOT, "build-pip"))
+def _build_dir(config_settings):
+    return os.path.abspath(_setting(config_settings, "build-dir", "AO_PIP_BUILD_DIR") or os.path.join(_ROOT, "build-pip"))
+
+
+def _compile(config_settings):
+    """Configures (once) and builds the module and the package folder; returns the build folder."""
+    build_dir = _build_dir(config_settings)
     jobs = _setting(config_settings, "jobs", "AO_PIP_JOBS") or str(os.cpu_count() or 1)
     if not os.path.exists(os.path.join(build_dir, "CMakeCache.txt")):
         cmd = ["cmake", "-S", _ROOT, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release", "-DAO_PYTHON=ON",
@@ -81,12 +89,50 @@ def _build(config_settings, stage):
             cmd += ["-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"]
         _run(cmd)
     _run(["cmake", "--build", build_dir, "-j", jobs, "--target", "ao_python"])
-    _run(["cmake", "--install", build_dir, "--component", "python", "--prefix", stage])
+    return build_dir
+
+
+def _build(config_settings, stage):
+    _run(["cmake", "--install", _compile(config_settings), "--component", "python", "--prefix", stage])
 
 
 def _record_line(path, data):
     digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
     return f"{path},sha256={digest},{len(data)}"
+
+
+def _write_wheel(wheel_directory, version, files):
+    """A wheel of `files` ({path in the wheel: bytes}) with its metadata and record."""
+    info = f"ao-{version}.dist-info"
+    files = dict(files)
+    files[f"{info}/METADATA"] = _metadata(version).encode()
+    files[f"{info}/WHEEL"] = (f"Wheel-Version: 1.0\nGenerator: ao_build_backend\nRoot-Is-Purelib: false\nTag: {_tag()}\n").encode()
+    record = [_record_line(p, d) for p, d in files.items()] + [f"{info}/RECORD,,"]
+    files[f"{info}/RECORD"] = ("\n".join(record) + "\n").encode()
+    wheel = f"ao-{version}-{_tag()}.whl"
+    with zipfile.ZipFile(os.path.join(wheel_directory, wheel), "w", zipfile.ZIP_DEFLATED) as z:
+        for path, data in files.items():
+            entry = zipfile.ZipInfo(path, date_time=(1980, 1, 1, 0, 0, 0))
+            entry.external_attr = (0o755 if path.endswith(".so") else 0o644) << 16
+            z.writestr(entry, data, zipfile.ZIP_DEFLATED)
+    return wheel
+
+
+def get_requires_for_build_editable(config_settings=None):
+    return []
+
+
+def prepare_metadata_for_build_editable(metadata_directory, config_settings=None):
+    return prepare_metadata_for_build_wheel(metadata_directory, config_settings)
+
+
+def build_editable(wheel_directory, config_settings=None, metadata_directory=None):
+    """PEP 660: a wheel holding only ao-editable.pth, the build folder's python/ on sys.path."""
+    build_dir = _compile(config_settings)
+    package = os.path.join(build_dir, "python")
+    if not os.path.isfile(os.path.join(package, "ao", "__init__.py")):
+        raise RuntimeError(f"ao_build_backend: {package}/ao has no __init__.py after the build")
+    return _write_wheel(wheel_directory, _version(), {"ao-editable.pth": (package + "\n").encode()})
 
 
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
@@ -99,21 +145,10 @@ def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
                 package = dirpath
         if package is None:
             raise RuntimeError("ao_build_backend: cmake --install put no package ao into the staging folder")
-        info = f"ao-{version}.dist-info"
         files = {}
         for name in sorted(os.listdir(package)):
             if name == "__pycache__":
                 continue
             with open(os.path.join(package, name), "rb") as f:
                 files[f"ao/{name}"] = f.read()
-        files[f"{info}/METADATA"] = _metadata(version).encode()
-        files[f"{info}/WHEEL"] = (f"Wheel-Version: 1.0\nGenerator: ao_build_backend\nRoot-Is-Purelib: false\nTag: {_tag()}\n").encode()
-        record = [_record_line(p, d) for p, d in files.items()] + [f"{info}/RECORD,,"]
-        files[f"{info}/RECORD"] = ("\n".join(record) + "\n").encode()
-        wheel = f"ao-{version}-{_tag()}.whl"
-        with zipfile.ZipFile(os.path.join(wheel_directory, wheel), "w", zipfile.ZIP_DEFLATED) as z:
-            for path, data in files.items():
-                entry = zipfile.ZipInfo(path, date_time=(1980, 1, 1, 0, 0, 0))
-                entry.external_attr = (0o755 if path.endswith(".so") else 0o644) << 16
-                z.writestr(entry, data, zipfile.ZIP_DEFLATED)
-    return wheel
+        return _write_wheel(wheel_directory, version, files)

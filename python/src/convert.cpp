@@ -53,9 +53,9 @@ py::array read_only(const Image<T>& image, py::handle owner) {
 
 Vec3 vec3_of(const nlohmann::json& j, const std::string& what) {
   if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
-    throw InputError(what + ": expected three numbers x, y, z, got " + j.dump());
+    throw InputError(what + ": expected three numbers x, y, z");
   const Vec3 v{j[0].get<float>(), j[1].get<float>(), j[2].get<float>()};
-  if (!is_finite(v)) throw InputError(what + ": expected three finite numbers, got " + j.dump());
+  if (!is_finite(v)) throw InputError(what + ": expected three finite numbers x, y, z");
   return v;
 }
 
@@ -63,16 +63,36 @@ Vec3 vec3_of(const nlohmann::json& j, const std::string& what) {
 // (when > 0); InputError naming `what` and the shape otherwise.
 template <class T>
 py::array_t<T, py::array::c_style | py::array::forcecast> shaped(py::handle array, int rank, py::ssize_t last, const std::string& what) {
+  if (array.is_none()) throw py::type_error(what + ": expected an array, got None");
   auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(array);
-  if (!a) throw InputError(what + ": expected a numeric array, got " + type_name(array));
-  if (a.ndim() != rank || (last > 0 && a.shape(rank - 1) != last))
+  if (!a) throw py::type_error(what + ": expected an array of numbers, got " + type_name(array));
+  if (a.ndim() != rank || (last > 0 && a.shape(rank - 1) != last)) {
+    std::string got;
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) got += (k ? " x " : "") + std::to_string(a.shape(k));
     throw InputError(what + ": expected an array of shape " + std::string(rank == 2 ? "N" : "H x W") + (last > 0 ? " x " + std::to_string(last) : "") +
-                     ", got " + py::str(py::tuple(py::cast(std::vector<py::ssize_t>(a.shape(), a.shape() + a.ndim())))).cast<std::string>());
+                     ", got " + (a.ndim() == 0 ? std::string("a single value") : got));
+  }
   return a;
+}
+
+// The numpy kind of `array`'s elements ('i', 'u', 'f', 'b', ...); 0 when it is not an array.
+char kind_of(py::handle array) {
+  const py::array a = py::array::ensure(array);
+  return a ? a.dtype().kind() : 0;
+}
+
+// Numbers only: integers and floats, not None, booleans, complex numbers, strings or objects.
+void require_numbers(py::handle array, const std::string& what) {
+  if (array.is_none()) throw py::type_error(what + ": expected an array, got None");
+  const char k = kind_of(array);
+  if (k == 'i' || k == 'u' || k == 'f') return;
+  const std::string got = k == 'b' ? "booleans" : k == 'c' ? "complex numbers" : k == 'U' || k == 'S' ? "strings" : "values of type " + type_name(array);
+  throw py::type_error(what + ": expected an array of numbers, got " + got);
 }
 
 template <class V, int N>
 std::vector<V> rows_of(py::handle array, std::size_t count, const std::string& what) {
+  require_numbers(array, what);
   const auto a = shaped<float>(array, 2, N, what);
   if (count != static_cast<std::size_t>(-1) && static_cast<std::size_t>(a.shape(0)) != count)
     throw InputError(what + ": expected one row per vertex (" + std::to_string(count) + "), got " + std::to_string(a.shape(0)));
@@ -83,7 +103,19 @@ std::vector<V> rows_of(py::handle array, std::size_t count, const std::string& w
 
 }  // namespace
 
-nlohmann::json to_json(py::handle o, const std::string& what) {
+namespace {
+
+// The name of `key` inside the value named `what`: the request's own keys and the method
+// parameters are the keyword arguments themselves ("slices", "camera.eye").
+std::string member_name(const std::string& what, const std::string& key) {
+  return what.empty() || what == "params" ? key : what + "." + key;
+}
+
+nlohmann::json json_of(py::handle o, const std::string& what, int depth) {
+  // Deeper than any value ao reads (a camera's vector is two levels, a compare's parameters three);
+  // a list or dict that contains itself ends here too, instead of recursing until the stack ends.
+  if (depth > kMaxNesting)
+    throw InputError(what + ": nested deeper than " + std::to_string(kMaxNesting) + " levels (a list or dict that contains itself?)");
   if (o.is_none()) return nullptr;
   if (py::isinstance<py::bool_>(o)) return o.cast<bool>();
   if (PyLong_Check(o.ptr())) {
@@ -96,25 +128,83 @@ nlohmann::json to_json(py::handle o, const std::string& what) {
   }
   if (PyFloat_Check(o.ptr())) return o.cast<double>();
   if (py::isinstance<py::str>(o)) return o.cast<std::string>();
-  if (py::hasattr(o, "__fspath__")) return py::module_::import("os").attr("fspath")(o).cast<std::string>();
+  if (py::hasattr(o, "__fspath__")) {
+    const py::object p = py::module_::import("os").attr("fspath")(o);
+    if (!py::isinstance<py::str>(p)) throw py::type_error(what + ": expected a str file name, got " + type_name(p));
+    return p.cast<std::string>();
+  }
   const py::module_ np = py::module_::import("numpy");
-  if (py::isinstance(o, np.attr("generic"))) return to_json(o.attr("item")(), what);
-  if (py::isinstance(o, np.attr("ndarray"))) return to_json(o.attr("tolist")(), what);
+  if (py::isinstance(o, np.attr("generic"))) return json_of(o.attr("item")(), what, depth + 1);
+  if (py::isinstance(o, np.attr("ndarray"))) return json_of(o.attr("tolist")(), what, depth + 1);
   if (py::isinstance<py::dict>(o)) {
     nlohmann::json j = nlohmann::json::object();
     for (const auto& [k, v] : o.cast<py::dict>()) {
-      if (!py::isinstance<py::str>(k)) throw InputError(what + ": keys must be strings, got " + type_name(k));
+      if (!py::isinstance<py::str>(k)) throw py::type_error(what + ": keys must be strings, got " + type_name(k));
       const std::string key = k.cast<std::string>();
-      j[key] = to_json(v, what + "." + key);
+      j[key] = json_of(v, member_name(what, key), depth + 1);
     }
     return j;
   }
   if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o)) {
     nlohmann::json j = nlohmann::json::array();
-    for (py::handle item : o) j.push_back(to_json(item, what));
+    for (py::handle item : o) j.push_back(json_of(item, what, depth + 1));
     return j;
   }
-  throw InputError(what + ": a value of type " + type_name(o) + " is not a number, string, bool, list or dict");
+  throw py::type_error(what + ": a value of type " + type_name(o) + " is not a number, string, bool, list or dict");
+}
+
+}  // namespace
+
+nlohmann::json to_json(py::handle o, const std::string& what) { return json_of(o, what, 0); }
+
+namespace {
+
+const nlohmann::json* set_value(const nlohmann::json& request, const char* key) {
+  const auto it = request.find(key);
+  return it == request.end() || it->is_null() ? nullptr : &*it;
+}
+
+std::string json_type(const nlohmann::json& j) {
+  if (j.is_string()) return "str";
+  if (j.is_boolean()) return "bool";
+  if (j.is_number_integer()) return "int";
+  if (j.is_number()) return "float";
+  return j.is_array() ? "list" : "dict";
+}
+
+}  // namespace
+
+std::optional<int> int_of(const nlohmann::json& request, const char* key, const std::string& name) {
+  const nlohmann::json* v = set_value(request, key);
+  if (!v) return std::nullopt;
+  if (!v->is_number_integer()) throw py::type_error(name + ": expected an integer, got " + json_type(*v));
+  const std::int64_t i = v->get<std::int64_t>();
+  if (i < std::numeric_limits<int>::min() || i > std::numeric_limits<int>::max())
+    throw InputError(name + ": " + std::to_string(i) + " is out of range");
+  return static_cast<int>(i);
+}
+
+std::optional<float> float_of(const nlohmann::json& request, const char* key, const std::string& name) {
+  const nlohmann::json* v = set_value(request, key);
+  if (!v) return std::nullopt;
+  if (!v->is_number() || v->is_boolean()) throw py::type_error(name + ": expected a number, got " + json_type(*v));
+  const double d = v->get<double>();
+  if (!std::isfinite(d) || std::abs(d) > std::numeric_limits<float>::max()) throw InputError(name + ": expected a finite number, got " + v->dump());
+  return static_cast<float>(d);
+}
+
+std::optional<std::string> string_of(const nlohmann::json& request, const char* key, const std::string& name) {
+  const nlohmann::json* v = set_value(request, key);
+  if (!v) return std::nullopt;
+  if (!v->is_string()) throw py::type_error(name + ": expected a string, got " + json_type(*v));
+  return v->get<std::string>();
+}
+
+std::optional<bool> bool_of(const nlohmann::json& request, const char* key, const std::string& name) {
+  const nlohmann::json* v = set_value(request, key);
+  if (!v) return std::nullopt;
+  if (!v->is_boolean()) throw py::type_error(name + ": expected True or False, got " + json_type(*v));
+  return v->get<bool>();
 }
 
 py::object from_json(const nlohmann::json& j) {
@@ -140,6 +230,12 @@ py::object from_json(const nlohmann::json& j) {
 }
 
 py::array to_array(Image<float>&& image) { return owned_array(std::move(image)); }
+py::array to_array(std::vector<float>&& values) {
+  auto* held = new std::vector<float>(std::move(values));
+  return py::array_t<float>({static_cast<py::ssize_t>(held->size())}, {static_cast<py::ssize_t>(sizeof(float))}, held->data(),
+                            py::capsule(held, [](void* p) { delete static_cast<std::vector<float>*>(p); }));
+}
+std::vector<Vec3> rows_of_vec3(py::handle array, const std::string& what) { return rows_of<Vec3, 3>(array, static_cast<std::size_t>(-1), what); }
 py::array to_array(Image<Vec3>&& image) { return owned_array(std::move(image)); }
 py::array to_array(Image<Vec2>&& image) { return owned_array(std::move(image)); }
 py::array to_array(Image<std::uint32_t>&& image) { return owned_array(std::move(image)); }
@@ -174,19 +270,19 @@ CameraRequest camera_request(const nlohmann::json& request, CameraRequest camera
   if (set("eye")) camera.eye = vec3_of(c["eye"], "camera.eye");
   if (set("target")) camera.target = vec3_of(c["target"], "camera.target");
   if (set("up")) camera.up = vec3_of(c["up"], "camera.up");
-  if (set("fov")) camera.fov = c["fov"].get<float>();
-  if (set("width")) camera.width = c["width"].get<int>();
-  if (set("height")) camera.height = c["height"].get<int>();
+  if (const auto fov = float_of(c, "fov", "camera.fov")) camera.fov = *fov;
+  if (const auto width = int_of(c, "width", "camera.width")) camera.width = *width;
+  if (const auto height = int_of(c, "height", "camera.height")) camera.height = *height;
   camera.validate();
   return camera;
 }
 
 FalloffRequest falloff_request(const nlohmann::json& request) {
   FalloffRequest f;
-  f.membership = membership_from_name(request.value("membership", std::string("step")));
-  if (request.contains("radius") && !request["radius"].is_null()) f.radius = request["radius"].get<float>();
-  f.radius_fraction = request.value("radius_fraction", f.radius_fraction);
-  f.tau = request.value("tau", f.tau);
+  f.membership = membership_from_name(string_of(request, "membership", "membership").value_or("step"));
+  f.radius = float_of(request, "radius", "radius");
+  f.radius_fraction = float_of(request, "radius_fraction", "radius_fraction").value_or(f.radius_fraction);
+  f.tau = float_of(request, "tau", "tau").value_or(f.tau);
   f.validate();
   return f;
 }
@@ -195,16 +291,24 @@ std::shared_ptr<const Scene> scene_from_arrays(py::handle vertices, py::handle f
   Mesh mesh;
   mesh.name = name;
   mesh.positions = rows_of<Vec3, 3>(vertices, static_cast<std::size_t>(-1), name + ": vertices");
-  const auto f = shaped<std::int64_t>(faces, 2, 3, name + ": faces");
+  // Indices are whole numbers: integers, or floats that hold them (3.0); 0.5 is not vertex 0.
+  require_numbers(faces, name + ": faces");
+  const auto f = shaped<double>(faces, 2, 3, name + ": faces");
   mesh.indices.resize(static_cast<std::size_t>(f.size()));
   for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
-    const std::int64_t v = f.data()[i];
-    if (v < 0 || v >= static_cast<std::int64_t>(mesh.positions.size()))
-      throw InputError(name + ": face " + std::to_string(i / 3) + " uses vertex " + std::to_string(v) + ", the mesh has " +
-                       std::to_string(mesh.positions.size()));
+    const double v = f.data()[i];
+    const std::string face = name + ": face " + std::to_string(i / 3);
+    if (!(v == std::floor(v))) throw InputError(face + " has the index " + py::str(py::float_(v)).cast<std::string>() + ", not a whole number");
+    if (v < 0 || v >= static_cast<double>(mesh.positions.size()))
+      throw InputError(face + " uses vertex " + std::to_string(static_cast<long long>(v)) + ", the mesh has " + std::to_string(mesh.positions.size()));
     mesh.indices[i] = static_cast<std::uint32_t>(v);
   }
-  if (!normals.is_none()) mesh.normals = rows_of<Vec3, 3>(normals, mesh.positions.size(), name + ": normals");
+  if (!normals.is_none()) {
+    mesh.normals = rows_of<Vec3, 3>(normals, mesh.positions.size(), name + ": normals");
+    for (std::size_t v = 0; v < mesh.normals.size(); ++v)
+      if (!is_finite(mesh.normals[v]) || !(length(mesh.normals[v]) > 0))
+        throw InputError(name + ": normals: row " + std::to_string(v) + " is not a finite non-zero vector (give unit normals, or none)");
+  }
   if (!uvs.is_none()) mesh.uvs = rows_of<Vec2, 2>(uvs, mesh.positions.size(), name + ": uvs");
   auto scene = std::make_shared<Scene>();
   scene->name = name;
@@ -215,6 +319,12 @@ std::shared_ptr<const Scene> scene_from_arrays(py::handle vertices, py::handle f
 
 std::shared_ptr<const GBuffer> gbuffer_from_arrays(py::handle normal, py::handle depth, py::handle position, py::handle albedo,
                                                    py::handle object_id, const Camera& camera) {
+  require_numbers(normal, "normal");
+  if (!depth.is_none()) require_numbers(depth, "depth");
+  if (!position.is_none()) require_numbers(position, "position");
+  if (!albedo.is_none()) require_numbers(albedo, "albedo");
+  if (!object_id.is_none() && kind_of(object_id) != 'i' && kind_of(object_id) != 'u')
+    throw py::type_error("object_id: expected an array of integers (0 = background)");
   const auto n = shaped<float>(normal, 3, 3, "normal");
   const int h = static_cast<int>(n.shape(0)), w = static_cast<int>(n.shape(1));
   if (camera.width != w || camera.height != h)
@@ -229,7 +339,13 @@ std::shared_ptr<const GBuffer> gbuffer_from_arrays(py::handle normal, py::handle
   if (!depth.is_none()) expect_size(*(z = shaped<float>(depth, 2, 0, "depth")), "depth");
   if (!position.is_none()) expect_size(*(p = shaped<float>(position, 3, 3, "position")), "position");
   if (!albedo.is_none()) expect_size(*(a = shaped<float>(albedo, 3, 3, "albedo")), "albedo");
-  if (!object_id.is_none()) expect_size(*(id = shaped<std::uint32_t>(object_id, 2, 0, "object_id")), "object_id");
+  if (!object_id.is_none()) {
+    const auto wide = shaped<std::int64_t>(object_id, 2, 0, "object_id");
+    for (py::ssize_t i = 0; i < wide.size(); ++i)
+      if (wide.data()[i] < 0 || wide.data()[i] > std::numeric_limits<std::uint32_t>::max())
+        throw InputError("object_id: " + std::to_string(wide.data()[i]) + " is not an id in [0, 4294967295]");
+    expect_size(*(id = shaped<std::uint32_t>(object_id, 2, 0, "object_id")), "object_id");
+  }
 
   auto g = std::make_shared<GBuffer>();
   g->camera = camera;

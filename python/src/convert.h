@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <pybind11/numpy.h>
@@ -20,11 +21,30 @@ namespace ao::python {
 
 namespace py = pybind11;
 
+/// Levels of lists and dicts to_json follows.
+inline constexpr int kMaxNesting = 32;
+
 /// A Python object (None, bool, int, float, str, os.PathLike, list, tuple, dict, numpy scalars and
-/// arrays) as JSON. Anything else is an InputError naming `what` and the type.
+/// arrays) as JSON. Another type is a TypeError naming `what` (a dict's entries are named
+/// what.key, or key alone at the top, where `what` is empty, and in "params"); an integer beyond
+/// 64 bits or nesting deeper than kMaxNesting (a list that contains itself) an InputError.
 nlohmann::json to_json(py::handle object, const std::string& what);
+/// `request[key]` when it is set (present and not None) as an int, a finite float, a str or a
+/// bool; a TypeError naming `name` for another type, an InputError for an integer beyond int or a
+/// float that is not finite.
+std::optional<int> int_of(const nlohmann::json& request, const char* key, const std::string& name);
+std::optional<float> float_of(const nlohmann::json& request, const char* key, const std::string& name);
+std::optional<std::string> string_of(const nlohmann::json& request, const char* key, const std::string& name);
+std::optional<bool> bool_of(const nlohmann::json& request, const char* key, const std::string& name);
+
 /// JSON as plain Python objects.
 py::object from_json(const nlohmann::json& j);
+
+/// A 1-D float32 array that owns `values` (moved, not copied).
+py::array to_array(std::vector<float>&& values);
+/// An N x 3 array of numbers as N vectors (TypeError for what is not numbers, InputError naming
+/// `what` for another shape).
+std::vector<Vec3> rows_of_vec3(py::handle array, const std::string& what);
 
 /// The images as numpy arrays that own them: the pixels are moved into the array's base object,
 /// not copied. float32 H x W; Vec3 images H x W x 3; Vec2 H x W x 2; uint32 and uint8 H x W.

@@ -3,12 +3,14 @@
 // warnings), and hands the images back as numpy arrays that own them.
 #include "jobs.h"
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "ao/core/error.h"
 #include "ao/io/mesh_io.h"
 #include "ao/jobs/bake.h"
 #include "ao/jobs/compare.h"
+#include "ao/jobs/points.h"
 #include "ao/jobs/render.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/registry/registry.h"
@@ -21,20 +23,19 @@ namespace {
 
 nlohmann::json object_of(const nlohmann::json& request, const char* key) {
   const nlohmann::json v = request.value(key, nlohmann::json::object());
-  if (!v.is_object()) throw InputError(std::string(key) + ": expected a dict, got " + v.dump());
+  if (!v.is_object()) throw py::type_error(std::string(key) + ": expected a dict");
   return v;
 }
 
 std::uint32_t seed_of(const nlohmann::json& request) {
   const nlohmann::json s = request.value("seed", nlohmann::json(1));
-  if (!s.is_number_integer() || s.get<std::int64_t>() < 0 || s.get<std::int64_t>() > 4294967295LL)
-    throw InputError("--seed: expected an integer in [0, 4294967295], got " + s.dump());
+  if (!s.is_number_integer()) throw py::type_error("seed: expected an integer");
+  if (s.get<std::int64_t>() < 0 || s.get<std::int64_t>() > 4294967295LL) throw InputError("seed: expected an integer in [0, 4294967295], got " + s.dump());
   return static_cast<std::uint32_t>(s.get<std::int64_t>());
 }
 
 std::filesystem::path path_of(const nlohmann::json& request, const char* key) {
-  const nlohmann::json v = request.value(key, nlohmann::json());
-  return v.is_string() ? std::filesystem::path(v.get<std::string>()) : std::filesystem::path();
+  return std::filesystem::path(string_of(request, key, key).value_or(std::string()));
 }
 
 // The keyword parameters' names against the method's table, with the line `ao render -p` prints
@@ -49,7 +50,7 @@ void check_param_names(const std::string& method, const nlohmann::json& params) 
     if (known.contains(key)) continue;
     std::string names;
     for (const auto& [k, v] : known.items()) names += (names.empty() ? "" : ", ") + k;
-    throw InputError("--param: method " + method + " has no parameter '" + key + "' (it has: " + names + ")");
+    throw InputError("method " + method + " has no parameter '" + key + "' (it has: " + names + ")");
   }
 }
 
@@ -57,29 +58,30 @@ RenderRequest render_request(py::handle scene, py::handle gbuffer, const nlohman
   RenderRequest r;
   if (!gbuffer.is_none()) r.gbuffer = gbuffer.cast<const GBufferHandle&>().gbuffer;
   else r.scene = scene_source(scene);
-  r.method = q.value("method", std::string("raytraced"));
+  r.method = string_of(q, "method", "method").value_or("raytraced");
   r.params = object_of(q, "params");
   check_param_names(r.method, r.params);
-  if (q.contains("samples") && !q["samples"].is_null()) r.samples = q["samples"].get<int>();
-  if (q.contains("target_error") && !q["target_error"].is_null()) r.target_error = q["target_error"].get<float>();
+  r.samples = int_of(q, "samples", "spp");
+  r.target_error = float_of(q, "target_error", "target_error");
   r.camera = camera_request(q, r.camera);
   r.falloff = falloff_request(q);
-  if (q.contains("normal") && !q["normal"].is_null()) r.normal = surface_normal_from_name(q["normal"].get<std::string>());
+  if (const auto normal = string_of(q, "normal", "normal")) r.normal = surface_normal_from_name(*normal);
   r.seed = seed_of(q);
   r.outputs.visibility = path_of(q, "output");
   r.outputs.shaded = path_of(q, "shaded");
   r.outputs.gbuffer = path_of(q, "gbuffer_output");
-  r.outputs.png_bits = q.value("png_bits", 8);
-  r.outputs.extras = q.value("extras", false);
+  r.outputs.png_bits = int_of(q, "png_bits", "png_bits").value_or(8);
+  r.outputs.extras = bool_of(q, "extras", "extras").value_or(false);
+  r.outputs.provenance = bool_of(q, "provenance", "provenance").value_or(false);
   return r;
 }
 
 }  // namespace
 
-py::dict render(py::handle scene, py::handle gbuffer, py::handle request) {
-  const nlohmann::json q = to_json(request, "request");
+py::dict render(py::handle scene, py::handle gbuffer, py::handle request, py::object progress) {
+  const nlohmann::json q = to_json(request, "");
   const RenderRequest r = render_request(scene, gbuffer, q);
-  Call call;
+  Call call(std::move(progress));
   RenderResult out = call.run([&] { return run_render(r, call.reporter()); });
   py::dict d;
   d["visibility"] = to_array(std::move(out.output.visibility));
@@ -89,17 +91,22 @@ py::dict render(py::handle scene, py::handle gbuffer, py::handle request) {
   for (auto& [name, image] : out.output.extras) extras[py::str(name)] = to_array(std::move(image));
   d["extras"] = extras;
   d["summary"] = from_json(out.summary);
-  if (q.value("return_gbuffer", false)) d["gbuffer"] = GBufferHandle{std::make_shared<const GBuffer>(std::move(out.gbuffer))};
+  if (bool_of(q, "return_gbuffer", "full").value_or(false)) d["gbuffer"] = GBufferHandle{std::make_shared<const GBuffer>(std::move(out.gbuffer))};
   return d;
 }
 
-GBufferHandle gbuffer(py::handle scene, py::handle request) {
-  const nlohmann::json q = to_json(request, "request");
+py::dict render_record(py::handle scene, py::handle gbuffer, py::handle request) {
+  const RenderRequest r = render_request(scene, gbuffer, to_json(request, ""));
+  return from_json(render_provenance(r, /*hash_inputs=*/false));
+}
+
+GBufferHandle gbuffer(py::handle scene, py::handle request, py::object progress) {
+  const nlohmann::json q = to_json(request, "");
   const SceneSource source = scene_source(scene);
   const CameraRequest camera = camera_request(q, CameraRequest{});
-  const GBufferOptions options{.normal = surface_normal_from_name(q.value("normal", std::string("shading"))), .albedo = q.value("albedo", true),
-                               .uv = q.value("uv", false)};
-  Call call;
+  const GBufferOptions options{.normal = surface_normal_from_name(string_of(q, "normal", "normal").value_or("shading")),
+                               .albedo = bool_of(q, "albedo", "albedo").value_or(true), .uv = bool_of(q, "uv", "uv").value_or(false)};
+  Call call(std::move(progress));
   return call.run([&] {
     const std::shared_ptr<const Scene> s = source.load();
     for (const std::string& w : s->warnings) call.reporter().warn(w);
@@ -114,8 +121,7 @@ namespace {
 // The baker's parameters (its table's names), with denoise a setting of the request.
 void bake_params(BakeRequest& r, nlohmann::json params) {
   if (params.contains("denoise")) {
-    if (!params["denoise"].is_number()) throw InputError("--denoise: expected a number of texels, got " + params["denoise"].dump());
-    r.denoise = params["denoise"].get<float>();
+    r.denoise = float_of(params, "denoise", "denoise");
     params.erase("denoise");
   }
   if (r.method == Baker::Histogram) histogram_param_table().from_json(params, r.histogram);
@@ -126,24 +132,28 @@ void bake_params(BakeRequest& r, nlohmann::json params) {
 // `ao bake` bakes it, outputs included).
 BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, bool& files) {
   BakeRequest r;
-  r.method = baker_from_name(q.value("method", std::string("raytraced")));
-  if (q.contains("size") && !q["size"].is_null()) r.size = parse_map_size(q["size"].is_string() ? q["size"].get<std::string>() : q["size"].dump());
-  r.uv_set = q.value("uv_set", 0);
-  r.padding = q.value("padding", r.padding);
-  r.vertex_resolution = q.value("vertex_resolution", r.vertex_resolution);
+  r.method = baker_from_name(string_of(q, "method", "method").value_or("raytraced"));
+  if (q.contains("size") && !q["size"].is_null()) {
+    if (!q["size"].is_string() && !q["size"].is_number_integer()) throw py::type_error("size: expected an integer or a string 'WIDTHxHEIGHT'");
+    r.size = parse_map_size(q["size"].is_string() ? q["size"].get<std::string>() : q["size"].dump());
+  }
+  r.uv_set = int_of(q, "uv_set", "uv_set").value_or(0);
+  r.padding = int_of(q, "padding", "padding").value_or(r.padding);
+  r.vertex_resolution = int_of(q, "vertex_resolution", "vertex_resolution").value_or(r.vertex_resolution);
   bake_params(r, object_of(q, "params"));
   r.outputs.map = path_of(q, "output");
   r.outputs.per_vertex = path_of(q, "per_vertex_output");
   r.outputs.bent_normals = path_of(q, "bent_normals_output");
   r.outputs.gltf = path_of(q, "gltf_output");
-  if (q.contains("png_bits") && !q["png_bits"].is_null()) r.outputs.png_bits = q["png_bits"].get<int>();
+  r.outputs.png_bits = int_of(q, "png_bits", "png_bits");
+  r.outputs.provenance = bool_of(q, "provenance", "provenance").value_or(false);
   files = !r.outputs.map.empty() || !r.outputs.per_vertex.empty() || !r.outputs.bent_normals.empty() || !r.outputs.gltf.empty();
   if (py::isinstance<SceneHandle>(mesh)) {
     if (files) throw InputError("ao.bake: outputs are written for mesh files; bake a mesh made from arrays and save the arrays");
     r.scene = mesh.cast<const SceneHandle&>().scene;
   } else {
     const nlohmann::json path = to_json(mesh, "mesh");
-    if (!path.is_string()) throw InputError("mesh: expected a mesh file or an ao.Scene, got " + path.dump());
+    if (!path.is_string()) throw py::type_error("mesh: expected a mesh file or an ao.Scene");
     r.inputs = {path.get<std::string>()};
     if (std::filesystem::is_directory(r.inputs.front()))
       throw InputError(r.inputs.front().string() + ": ao.bake bakes one mesh; bake a folder with python3 -m ao.batch bake");
@@ -151,8 +161,8 @@ BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, bool& files) 
   // Without files, what to compute: the job bakes a map unless only per-vertex AO is named, and
   // writes nothing for a mesh in memory (these names only say what to bake).
   if (!files) {
-    if (q.value("map", true)) r.outputs.map = "map.png";
-    if (q.value("per_vertex", false)) r.outputs.per_vertex = "per-vertex.ply";
+    if (bool_of(q, "map", "map").value_or(true)) r.outputs.map = "map.png";
+    if (bool_of(q, "per_vertex", "per_vertex").value_or(false)) r.outputs.per_vertex = "per-vertex.ply";
     if (r.outputs.map.empty() && r.outputs.per_vertex.empty()) throw InputError("ao.bake: nothing to bake: ask for the map or per_vertex");
   }
   return r;
@@ -160,11 +170,18 @@ BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, bool& files) 
 
 }  // namespace
 
-py::dict bake(py::handle mesh, py::handle request) {
-  const nlohmann::json q = to_json(request, "request");
+py::dict bake_record(py::handle mesh, py::handle request) {
+  bool files = false;
+  const BakeRequest r = bake_request(mesh, to_json(request, ""), files);
+  if (r.inputs.size() != 1) throw InputError("provenance: a record describes the outputs of one mesh file");
+  return from_json(bake_provenance(r, r.inputs.front(), /*hash_inputs=*/false));
+}
+
+py::dict bake(py::handle mesh, py::handle request, py::object progress) {
+  const nlohmann::json q = to_json(request, "");
   bool files = false;
   BakeRequest r = bake_request(mesh, q, files);
-  Call call;
+  Call call(std::move(progress));
   BakeBatchResult out = call.run([&] {
     // A mesh file baked without files to write is loaded as `ao bake` loads it and baked in memory.
     if (!r.scene && !files) {
@@ -182,12 +199,26 @@ py::dict bake(py::handle mesh, py::handle request) {
     d["map"] = to_array(std::move(m.map.visibility));
     d["mask"] = to_array(std::move(m.map.mask));
   }
-  if (!m.vertex_ao.empty()) {
-    auto* held = new std::vector<float>(std::move(m.vertex_ao));
-    d["per_vertex"] = py::array_t<float>({static_cast<py::ssize_t>(held->size())}, {static_cast<py::ssize_t>(sizeof(float))}, held->data(),
-                                         py::capsule(held, [](void* p) { delete static_cast<std::vector<float>*>(p); }));
-  }
+  if (!m.vertex_ao.empty()) d["per_vertex"] = to_array(std::move(m.vertex_ao));
   d["summary"] = from_json(m.summary);
+  return d;
+}
+
+py::dict occlusion(py::handle scene, py::handle points, py::handle normals, py::handle request, py::object progress) {
+  const nlohmann::json q = to_json(request, "");
+  PointsRequest r;
+  r.scene = scene_source(scene);
+  r.points = rows_of_vec3(points, "points");
+  r.normals = rows_of_vec3(normals, "normals");
+  r.falloff = falloff_request(q);
+  raytraced_param_table().from_json(object_of(q, "params"), r.params);
+  r.seed = seed_of(q);
+  Call call(std::move(progress));
+  PointsResult out = call.run([&] { return run_points(r, call.reporter()); });
+  py::dict d;
+  d["visibility"] = to_array(std::move(out.visibility));
+  d["std_error"] = to_array(std::move(out.std_error));
+  d["summary"] = from_json(out.summary);
   return d;
 }
 
@@ -198,30 +229,43 @@ CompareRequest compare_request(py::handle scene, const nlohmann::json& q) {
   r.scene = scene_source(scene);
   r.camera = camera_request(q, r.camera);
   r.falloff = falloff_request(q);
-  r.normal = surface_normal_from_name(q.value("normal", std::string("shading")));
+  r.normal = surface_normal_from_name(string_of(q, "normal", "normal").value_or("shading"));
   CompareSettings& s = r.settings;
-  if (q.contains("methods") && !q["methods"].is_null()) s.methods = q["methods"].get<std::vector<std::string>>();
+  if (q.contains("methods") && !q["methods"].is_null()) {
+    const nlohmann::json& m = q["methods"];
+    if (!m.is_array() || !std::all_of(m.begin(), m.end(), [](const nlohmann::json& v) { return v.is_string(); }))
+      throw py::type_error("methods: expected a list of method names");
+    s.methods = m.get<std::vector<std::string>>();
+  }
   // Each method's overrides over its defaults, as `ao compare -p method.key=value` sets them.
   const nlohmann::json per_method = object_of(q, "params");
   for (const auto& [name, overrides] : per_method.items()) {
     nlohmann::json p = find_method(name).default_params();
-    if (!overrides.is_object()) throw InputError("params." + name + ": expected a dict of parameters, got " + overrides.dump());
+    if (!overrides.is_object()) throw py::type_error("params['" + name + "']: expected a dict of parameters");
     check_param_names(name, overrides);
     for (const auto& [k, v] : overrides.items()) p[k] = v;
     s.params[name] = p;
   }
   const nlohmann::json ref = q.value("reference", nlohmann::json());
-  if (ref.is_string()) s.references[""] = ref.get<std::string>();
-  else if (ref.is_object()) s.references = ref.get<std::map<std::string, std::string>>();
-  s.common_reference = q.value("common_reference", s.common_reference);
-  s.spp_reference = q.value("spp_reference", s.spp_reference);
+  if (ref.is_string()) {
+    s.references[""] = ref.get<std::string>();
+  } else if (ref.is_object()) {
+    for (const auto& [method, name] : ref.items()) {
+      if (!name.is_string()) throw py::type_error("reference['" + method + "']: expected a reference name");
+      s.references[method] = name.get<std::string>();
+    }
+  } else if (!ref.is_null()) {
+    throw py::type_error("reference: expected a reference name or a dict {method: reference}");
+  }
+  s.common_reference = string_of(q, "common_reference", "common_reference").value_or(s.common_reference);
+  s.spp_reference = int_of(q, "spp_reference", "spp_reference").value_or(s.spp_reference);
   s.seed = seed_of(q);
   const nlohmann::json sweep = q.value("sweep", nlohmann::json());
-  if (sweep.is_object() && sweep.size() == 1) {
+  if (sweep.is_object() && sweep.size() == 1 && sweep.begin().value().is_array()) {
     s.sweep_key = sweep.begin().key();
     s.sweep_values = sweep.begin().value().get<std::vector<nlohmann::json>>();
   } else if (!sweep.is_null()) {
-    throw InputError("sweep: expected {key: [values]} for one parameter, got " + sweep.dump());
+    throw InputError("sweep: expected {key: [values]} for one parameter");
   }
   r.out_dir = path_of(q, "out_dir");
   // The sheet's font as `ao compare` finds it: $AO_FONT when set, else DejaVu Sans.
@@ -231,15 +275,15 @@ CompareRequest compare_request(py::handle scene, const nlohmann::json& q) {
 
 }  // namespace
 
-py::dict compare(py::handle scene, py::handle request) {
-  const nlohmann::json q = to_json(request, "request");
+py::dict compare(py::handle scene, py::handle request, py::object progress) {
+  const nlohmann::json q = to_json(request, "");
   const CompareRequest r = compare_request(scene, q);
-  Call call;
+  Call call(std::move(progress));
   CompareJobResult out = call.run([&] { return run_compare(r, call.reporter()); });
   py::dict d;
   d["table"] = from_json(out.table);
   d["markdown"] = out.markdown;
-  if (q.value("images", false)) {
+  if (bool_of(q, "images", "images").value_or(false)) {
     py::list images;
     for (CompareRow& row : out.result.rows) {
       py::dict i;

@@ -8,13 +8,21 @@
 
 namespace ao::python {
 
+// `progress`: None or a callable(stage, done, total) (Call).
+
 /// run_render: {"visibility", "std_error" (raytraced), "color", "extras", "summary", "gbuffer"}.
-py::dict render(py::handle scene, py::handle gbuffer, py::handle request);
+py::dict render(py::handle scene, py::handle gbuffer, py::handle request, py::object progress);
+/// render_provenance of the request, inputs not hashed: what ao.batch compares with a record on disk.
+py::dict render_record(py::handle scene, py::handle gbuffer, py::handle request);
 /// The G-buffer of a scene and camera, rendered as run_render renders it.
-GBufferHandle gbuffer(py::handle scene, py::handle request);
+GBufferHandle gbuffer(py::handle scene, py::handle request, py::object progress);
 /// run_bake of one mesh: {"map", "mask", "per_vertex", "summary"}.
-py::dict bake(py::handle mesh, py::handle request);
+py::dict bake(py::handle mesh, py::handle request, py::object progress);
+/// bake_provenance of the request for its one mesh file, inputs not hashed.
+py::dict bake_record(py::handle mesh, py::handle request);
+/// run_points: {"visibility", "std_error" (1-D float32, one per point), "summary"}.
+py::dict occlusion(py::handle scene, py::handle points, py::handle normals, py::handle request, py::object progress);
 /// run_compare: {"table" (table.json), "markdown", "images"}.
-py::dict compare(py::handle scene, py::handle request);
+py::dict compare(py::handle scene, py::handle request, py::object progress);
 
 }  // namespace ao::python

@@ -12,11 +12,14 @@
 #include "ao/io/atomic_file.h"
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 #include "ao/registry/registry.h"
 #include "ao/simd/depth_plane.h"
 #include "ao/version.h"
 #include "call.h"
 #include "convert.h"
+#include "field_names.h"
 #include "jobs.h"
 
 namespace ao::python {
@@ -71,6 +74,7 @@ py::list methods() {
     d["summary"] = std::string(m.summary);
     d["ground_truth"] = m.ground_truth;
     d["needs_scene"] = m.needs_scene;
+    d["extras"] = list_of(m.extras, [](std::string_view e) { return std::string(e); });
     d["params"] = list_of(m.params().specs(), spec_dict);
     return d;
   });
@@ -88,7 +92,7 @@ py::list param_tables() {
 // TBB's worker count for the calls that follow; 0 restores all cores.
 void set_threads(int threads) {
   static std::unique_ptr<tbb::global_control> limit;
-  if (threads < 0 || threads > 1024) throw InputError("--threads: expected an integer in [0, 1024], got " + std::to_string(threads));
+  if (threads < 0 || threads > 1024) throw InputError("threads: expected an integer in [0, 1024], got " + std::to_string(threads));
   limit.reset();
   if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
 }
@@ -99,8 +103,9 @@ Camera camera_for_arrays(const nlohmann::json& c, py::handle normal) {
   Camera cam;
   cam.height = static_cast<int>(n.shape(0));
   cam.width = static_cast<int>(n.shape(1));
-  if (!c.contains("fov") || !c["fov"].is_number()) throw InputError("fov: the vertical field of view (degrees) the buffers were rendered with is needed");
-  cam.vertical_fov_deg = c["fov"].get<float>();
+  const std::optional<float> fov = c.is_object() ? float_of(c, "fov", "camera.fov") : std::nullopt;
+  if (!fov) throw InputError("camera.fov: the vertical field of view (degrees) the buffers were rendered with is needed");
+  cam.vertical_fov_deg = *fov;
   nlohmann::json placed = camera_to_json(cam);
   for (const char* key : {"eye", "target", "up", "width", "height"})
     if (c.contains(key) && !c[key].is_null()) placed[key] = c[key];
@@ -212,18 +217,35 @@ PYBIND11_MODULE(_ao, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const ao::InputError& e) {
-      PyErr_SetString(input_error.ptr(), e.what());
+      // The job layer names request fields ("BakeRequest::padding"); Python names its keywords.
+      PyErr_SetString(input_error.ptr(), e.message(keyword_name).c_str());
     } catch (const ao::SystemError& e) {
       PyErr_SetString(PyExc_OSError, e.what());
+    } catch (const nlohmann::json::exception&) {
+      // The conversions check every type they read (convert.h); should one slip through, the JSON
+      // library's text stays out of the message.
+      PyErr_SetString(PyExc_TypeError, "ao: an argument has the wrong type for the library (expected numbers, strings, lists or dicts as documented)");
     }
   });
   bind_scene(m);
   bind_gbuffer(m);
   bind_files(m);
-  m.def("render", &render, py::arg("scene"), py::arg("gbuffer"), py::arg("request"));
-  m.def("gbuffer", &gbuffer, py::arg("scene"), py::arg("request"));
-  m.def("bake", &bake, py::arg("mesh"), py::arg("request"));
-  m.def("compare", &compare, py::arg("scene"), py::arg("request"));
+  m.def("render", &render, py::arg("scene"), py::arg("gbuffer"), py::arg("request"), py::arg("progress") = py::none());
+  m.def("render_record", &render_record, py::arg("scene"), py::arg("gbuffer"), py::arg("request"),
+        "The provenance record the request's outputs would get (inputs by role and path, not hashed): what ao.batch compares.");
+  m.def("bake_record", &bake_record, py::arg("mesh"), py::arg("request"),
+        "The provenance record the request's outputs would get for its one mesh file (inputs not hashed).");
+  m.def("gbuffer", &gbuffer, py::arg("scene"), py::arg("request"), py::arg("progress") = py::none());
+  m.def("bake", &bake, py::arg("mesh"), py::arg("request"), py::arg("progress") = py::none());
+  m.def("occlusion", &occlusion, py::arg("scene"), py::arg("points"), py::arg("normals"), py::arg("request"), py::arg("progress") = py::none());
+  m.def("compare", &compare, py::arg("scene"), py::arg("request"), py::arg("progress") = py::none());
+  m.def("build_info", [] { return from_json(ao::build_info()); }, "{'version', 'simd_target'}: what every JSON output of ao names as 'ao'.");
+  m.def("keyword_table", &keyword_table, "[(request field, keyword)]: the names ao's errors give the job layer's request fields.");
+  m.def("request_fields", [] {
+    std::vector<std::string> out;
+    for (std::string_view f : ao::fields::kAll) out.emplace_back(f);
+    return out;
+  });
   m.def("methods", &methods);
   m.def("param_tables", &param_tables);
   m.def("set_threads", &set_threads, py::arg("threads"));

@@ -124,14 +124,18 @@
 #include "ao/io/text.h"
 
 // jobs: render, bake, compare and tune as library calls, with the ao command's defaults; what
-// every job starts from (scene, camera, falloff), frame-after-frame rendering, progress reports.
+// every job starts from (scene, camera, falloff), frame-after-frame rendering, progress reports;
+// AO at given points; the request fields errors name; the provenance records of outputs.
 #include "ao/jobs/bake.h"
 #include "ao/jobs/compare.h"
 #include "ao/jobs/contact_sheet.h"
 #include "ao/jobs/device.h"
+#include "ao/jobs/fields.h"
 #include "ao/jobs/frames.h"
 #include "ao/jobs/inputs.h"
+#include "ao/jobs/points.h"
 #include "ao/jobs/progress_meter.h"
+#include "ao/jobs/provenance.h"
 #include "ao/jobs/render.h"
 #include "ao/jobs/reporter.h"
 #include "ao/jobs/tune.h"

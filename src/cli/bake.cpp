@@ -129,6 +129,9 @@ void add_output_options(CLI::App& cmd, BakeOptions& o) {
                  "or .1001. writes one map per UDIM tile (ao.<UDIM>.png -> ao.1001.png, ao.1002.png, ...). Default <mesh>-ao.png; in a batch, <mesh>-<name>");
   cmd.add_option("--out-dir", r.out_dir, "Folder for the outputs of a batch (default: beside each mesh)");
   cmd.add_option("--png-bits", r.outputs.png_bits, "PNG and TIFF bit depth, 8 or 16 (TGA and JPEG are 8-bit)")->default_str("8");
+  cmd.add_flag("--provenance", r.outputs.provenance,
+               "Also write beside each output FILE its record FILE.ao.json: ao's version and SIMD target, the inputs' SHA-256, every setting "
+               "(docs/cluster.md, \"Provenance\")");
   cmd.add_option("--orm", r.orm,
                  "Write the map into the red channel of this ORM texture (PNG, RGB/RGBA, 8/16 bit): -o gets a copy with AO in R and G, B, A, depth "
                  "as they were; the map takes its size")

@@ -14,6 +14,7 @@
 #include "ao/core/error.h"
 #include "ao/io/json_text.h"
 #include "ao/jobs/progress_meter.h"
+#include "field_names.h"
 
 namespace ao::cli {
 
@@ -166,11 +167,11 @@ StderrReporter::StderrReporter(const GlobalOptions& global, bool json) : state_(
   };
   reporter_.warning = [s = state_](const std::string& line) {
     s->end();
-    std::fprintf(stderr, "warning: %s\n", line.c_str());
+    std::fprintf(stderr, "warning: %s\n", in_option_words(line).c_str());
   };
   reporter_.error = [s = state_](const std::string& line) {
     s->end();
-    std::fprintf(stderr, "ao: error: %s\n", line.c_str());
+    std::fprintf(stderr, "ao: error: %s\n", in_option_words(line).c_str());
   };
   // In a log (stderr not a terminal, so no progress bars) a batch says where it is, line by line.
   if (!global.quiet && !stderr_is_terminal())
@@ -178,7 +179,7 @@ StderrReporter::StderrReporter(const GlobalOptions& global, bool json) : state_(
   reporter_.note = [s = state_](const std::string& line) {
     if (!s->notes) return;
     s->end();
-    std::fprintf(stderr, "%s\n", line.c_str());
+    std::fprintf(stderr, "%s\n", in_option_words(line).c_str());
   };
 }
 

@@ -14,6 +14,7 @@
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
 #include "app.h"
+#include "field_names.h"
 #include "parse_errors.h"
 
 int main(int argc, char** argv) {
@@ -39,7 +40,8 @@ int main(int argc, char** argv) {
   try {
     return action ? action() : 0;
   } catch (const ao::InputError& e) {
-    std::fprintf(stderr, "ao: error: %s\n", e.what());
+    // The job layer names request fields ("BakeRequest::padding"); the command line names its options.
+    std::fprintf(stderr, "ao: error: %s\n", e.message(ao::cli::option_name).c_str());
     return 1;
   } catch (const ao::SystemError& e) {
     std::fprintf(stderr, "ao: error: %s\n", e.what());

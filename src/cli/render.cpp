@@ -151,6 +151,9 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
   cmd->add_flag("--extras", o->request.outputs.extras,
                 "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");
   cmd->add_flag("--json", o->json, "Print a JSON summary (parameters, timings, rays/s, mean V, errors) on stdout");
+  cmd->add_flag("--provenance", o->request.outputs.provenance,
+                "Also write beside each output FILE its record FILE.ao.json: ao's version and SIMD target, the inputs' SHA-256, every setting "
+                "(docs/cluster.md, \"Provenance\")");
   cmd->callback([o, &global, &action] { action = [o, &global] { return run(*o, global); }; });
 }
 

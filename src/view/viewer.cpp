@@ -22,6 +22,7 @@
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
 #include "ao/jobs/frames.h"
+#include "ao/jobs/provenance.h"
 #include "ao/registry/registry.h"
 #include "view/display.h"
 #include "view/hud.h"
@@ -337,6 +338,7 @@ class Viewer final : public ViewerControls {
 
   nlohmann::json summary() const {
     nlohmann::json j = stats_.json();
+    j["ao"] = build_info();
     j["method"] = state_.method;
     j["parameters"] = state_.params();
     j["membership"] = to_string(state_.falloff.membership);

@@ -144,7 +144,7 @@ TEST(BakeFormats, OrmMisuseIsAOneLineErrorAndWritesNothing) {
   write_stored_png(dir / "orm.png", orm_texture(16, 8, 3, 8));
   write_stored_png(dir / "grey.png", orm_texture(16, 8, 1, 8));
   const std::string before = read_text(dir / "orm.png");
-  expect_one_line_error(run_ao("bake quad.obj --orm orm.png -s 16 -o out.png" + kRays, dir.path()), "give -s 16x8 or leave -s out");
+  expect_one_line_error(run_ao("bake quad.obj --orm orm.png -s 16 -o out.png" + kRays, dir.path()), "give --size 16x8 or leave it unset");
   expect_one_line_error(run_ao("bake quad.obj --orm grey.png -o out.png" + kRays, dir.path()), "greyscale");
   expect_one_line_error(run_ao("bake quad.obj --orm orm.png -o out.exr" + kRays, dir.path()), ".png");
   expect_one_line_error(run_ao("bake quad.obj --orm orm.png --png-bits 16 -o out.png" + kRays, dir.path()), "--png-bits");

@@ -39,11 +39,17 @@ def test_per_vertex_equals_cli(ao_binary, grid_obj, tmp_path):
 
 
 def test_bake_errors_match_cli(ao_binary, grid_obj, tmp_path):
-    for kwargs, args in [(dict(samples=0), ["--spp", 0]), (dict(denoise=9), ["--denoise", 9]), (dict(size="0"), ["-s", 0]),
-                         (dict(method="sideways"), ["-m", "sideways"])]:
+    # The same line, each naming the field its own way: the parameter table's name in both, the
+    # request field as the keyword argument in Python and as the option on the command line.
+    for kwargs, args, keyword, option in [(dict(samples=0), ["--spp", 0], "", ""), (dict(denoise=9), ["--denoise", 9], "", ""),
+                                          (dict(size="0"), ["-s", 0], "size:", "--size:"),
+                                          (dict(method="sideways"), ["-m", "sideways"], "method:", "--method:"),
+                                          (dict(padding=2000), ["--padding", 2000], "padding must", "--padding must")]:
         with pytest.raises(ValueError) as e:
             ao.bake(grid_obj, **kwargs)
-        assert str(e.value) == cli_error(ao_binary, "bake", grid_obj, *args, "-o", tmp_path / "unused.png")
+        cli = cli_error(ao_binary, "bake", grid_obj, *args, "-o", tmp_path / "unused.png")
+        assert cli.startswith(option) and str(e.value).startswith(keyword), (cli, str(e.value))
+        assert str(e.value) == keyword + cli[len(option):]
     with pytest.raises(ao.InputError, match="missing.obj"):
         ao.bake(tmp_path / "missing.obj")
 
@@ -74,5 +80,5 @@ def _same_except_ms(a, b):
 def test_compare_errors_match_cli(ao_binary, tmp_path):
     with pytest.raises(ValueError) as e:
         ao.compare("wedge", methods=["alchemy"], params={"alchemy": {"nosuch": 1}})
-    assert str(e.value) == cli_error(ao_binary, "compare", "wedge", "--methods", "alchemy", "-p", "alchemy.nosuch=1", "--out-dir",
-                                     tmp_path / "c")
+    cli = cli_error(ao_binary, "compare", "wedge", "--methods", "alchemy", "-p", "alchemy.nosuch=1", "--out-dir", tmp_path / "c")
+    assert cli.startswith("--param: ") and str(e.value) == cli[len("--param: "):]

@@ -46,9 +46,10 @@ def test_cluster_section_runs(tmp_path):
         assert cmd[0] == "/usr/bin/python3"
         p = subprocess.run([sys.executable, *cmd[1:]], cwd=tmp_path, capture_output=True, text=True, timeout=300)
         assert p.returncode == 0, line + "\n" + p.stdout + p.stderr
-        assert p.stdout.splitlines()[-1].endswith("failed 0, skipped 0 (already present)"), p.stdout
-    assert sorted(os.listdir(tmp_path / "maps")) == ["grid0-ao.png", "grid1-ao.png"]
-    assert sorted(os.listdir(tmp_path / "frames")) == [f"wedge-{k:04d}.exr" for k in range(4)]
+        assert p.stdout.splitlines()[-1].endswith("failed 0, skipped 0 (already made with these settings)"), p.stdout
+    with_records = lambda names: sorted(names + [n + ".ao.json" for n in names])  # noqa: E731
+    assert sorted(os.listdir(tmp_path / "maps")) == with_records(["grid0-ao.png", "grid1-ao.png"])
+    assert sorted(os.listdir(tmp_path / "frames")) == with_records([f"wedge-{k:04d}.exr" for k in range(4)])
     with open(tmp_path / "cmp" / "table.json") as f:
         rows = json.load(f)["rows"]
     assert sorted((r["mesh"], r["method"]) for r in rows) == [(m, a) for m in ("grid0.obj", "grid1.obj") for a in ("alchemy", "gtao")]

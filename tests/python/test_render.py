@@ -94,18 +94,21 @@ def test_own_depth_buffer_agrees_with_positions():
 
 
 def test_bad_parameters_raise_value_error_with_the_cli_text(ao_binary):
+    # The CLI's line, with its option named as the keyword argument where the line names one.
     cases = [
-        (dict(method="alchemy", foo=1), ["wedge", "-m", "alchemy", "-p", "foo=1"]),
-        (dict(method="gtao", slices=0), ["wedge", "-m", "gtao", "-p", "slices=0"]),
-        (dict(spp=0), ["wedge", "--spp", 0]),
-        (dict(method="nosuch"), ["wedge", "-m", "nosuch"]),
-        (dict(membership="cubicle"), ["wedge", "--membership", "cubicle"]),
+        (dict(method="alchemy", foo=1), ["wedge", "-m", "alchemy", "-p", "foo=1"], "", "--param: "),
+        (dict(method="gtao", slices=0), ["wedge", "-m", "gtao", "-p", "slices=0"], "", ""),
+        (dict(spp=0), ["wedge", "--spp", 0], "", ""),
+        (dict(method="nosuch"), ["wedge", "-m", "nosuch"], "", ""),
+        (dict(membership="cubicle"), ["wedge", "--membership", "cubicle"], "membership:", "--membership:"),
+        (dict(radius=-1.0), ["wedge", "--radius", -1], "radius must", "--radius must"),
     ]
-    for kwargs, args in cases:
+    for kwargs, args, keyword, option in cases:
         with pytest.raises(ValueError) as e:
             ao.render("wedge", ao.Camera(**SIZE), **kwargs)
         assert isinstance(e.value, ao.InputError)
-        assert str(e.value) == cli_error(ao_binary, "render", *args, "-o", "unused.exr")
+        cli = cli_error(ao_binary, "render", *args, "-o", "unused.exr")
+        assert cli.startswith(option) and str(e.value) == keyword + cli[len(option):], (str(e.value), cli)
 
 
 def test_bad_files_raise_input_error_naming_the_file(ao_binary, tmp_path):

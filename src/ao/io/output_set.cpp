@@ -131,6 +131,12 @@ void OutputSet::write(const fs::path& path, const std::function<void()>& write, 
   write();
 }
 
+std::vector<fs::path> OutputSet::written() const {
+  std::vector<fs::path> out;
+  for (const Staged& s : staged_) out.push_back(s.destination);
+  return out;
+}
+
 fs::path OutputSet::staged(const fs::path& path) const {
   const fs::path resolved = resolve(path);
   for (const Staged& s : staged_)

@@ -72,6 +72,8 @@ class OutputSet {
 
   /// Paths of the declared outputs, in declaration order.
   std::vector<std::filesystem::path> outputs() const;
+  /// Destinations write() has staged so far, in write order (each once).
+  std::vector<std::filesystem::path> written() const;
 
  private:
   struct Named {

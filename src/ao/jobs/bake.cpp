@@ -18,6 +18,8 @@
 #include "ao/core/stopwatch.h"
 #include "ao/io/image_io.h"
 #include "ao/jobs/bake_internal.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao {
@@ -27,7 +29,7 @@ std::string_view to_string(Baker baker) { return baker == Baker::Histogram ? "hi
 Baker baker_from_name(const std::string& name) {
   if (name == "raytraced") return Baker::Raytraced;
   if (name == "histogram") return Baker::Histogram;
-  throw InputError("--method: expected histogram or raytraced, got '" + name + "'");
+  throw InputError(field(fields::kBakeMethod) + ": expected histogram or raytraced, got '" + name + "'");
 }
 
 MapSize parse_map_size(const std::string& text) {
@@ -41,7 +43,7 @@ MapSize parse_map_size(const std::string& text) {
   const auto w = side(text.substr(0, x));
   const auto h = x == std::string::npos ? w : side(text.substr(x + 1));
   if (!w || !h)
-    throw InputError("--size: expected N or WIDTHxHEIGHT (2048x1024), each in [1, " + std::to_string(kMaxMapSide) + "] texels, got '" + text + "'");
+    throw InputError(field(fields::kBakeSize) + ": expected N or WIDTHxHEIGHT (2048x1024), each in [1, " + std::to_string(kMaxMapSide) + "] texels, got '" + text + "'");
   return {*w, *h};
 }
 
@@ -82,12 +84,13 @@ fs::path batch_path(const fs::path& in, const fs::path& given, const Plan& plan,
 // Bake groups, occluders and high to low: one way of forming groups; what each needs.
 void check_grouping(const BakeRequest& r) {
   const int grouping = (r.match_by_name ? 1 : 0) + (r.groups.empty() ? 0 : 1) + (r.self_occlusion ? 1 : 0);
-  if (grouping > 1) throw InputError("--match-by-name, --group and --self-occlusion: give one way of forming bake groups");
-  if (r.match_by_name && r.high.empty()) throw InputError("--match-by-name needs --high: it pairs low meshes NAME_low with high meshes NAME_high");
+  if (grouping > 1) throw InputError(field(fields::kBakeMatchByName) + ", " + field(fields::kBakeGroups) + " and " + field(fields::kBakeSelfOcclusion) +
+                                     ": give one way of forming bake groups");
+  if (r.match_by_name && r.high.empty()) throw InputError(field(fields::kBakeMatchByName) + " needs " + field(fields::kBakeHigh) + ": it pairs low meshes NAME_low with high meshes NAME_high");
   if (grouping > 0 && !r.outputs.per_vertex.empty())
-    throw InputError("--per-vertex with bake groups: per-vertex AO is baked with every mesh occluding; drop the grouping");
+    throw InputError(field(fields::kBakePerVertex) + " with bake groups: per-vertex AO is baked with every mesh occluding; drop the grouping");
   if (r.floor && r.method == Baker::Histogram)
-    throw InputError("--floor needs --method raytraced: the histogram baker renders views covering the whole scene, and a floor 20 model diagonals "
+    throw InputError(field(fields::kBakeFloor) + " needs " + field(fields::kBakeMethod) + " raytraced: the histogram baker renders views covering the whole scene, and a floor 20 model diagonals "
                      "wide would make each view's pixels 400 times as many");
 }
 
@@ -96,18 +99,21 @@ void check_high_to_low(const BakeRequest& r) {
   const HighToLowParams& h = r.high_to_low;
   if (r.high.empty()) {
     if (!r.cage.empty() || h.cage_extrusion || h.max_front || h.max_back || !r.outputs.miss_mask.empty())
-      throw InputError("--cage, --cage-extrusion, --max-front, --max-back and --miss-mask need --high (the high-poly mesh to bake from)");
+      throw InputError(field(fields::kBakeCage) + ", " + field(fields::kBakeCageExtrusion) + ", " + field(fields::kBakeMaxFront) + ", " + field(fields::kBakeMaxBack) +
+                       " and " + field(fields::kBakeMissMask) + " need " + field(fields::kBakeHigh) + " (the high-poly mesh to bake from)");
     h.validate();  // every value in its range even where it is not used (--cage-points 0)
     return;
   }
   if (r.method == Baker::Histogram)
     throw InputError(
-        "--high needs --method raytraced: the histogram baker scatters each view's pixels into the texels of the surface it sees, "
+        field(fields::kBakeHigh) + " needs " + field(fields::kBakeMethod) +
+        " raytraced: the histogram baker scatters each view's pixels into the texels of the surface it sees, "
         "and pixels of the high mesh have no texel in the low mesh's map without a cage ray per pixel, which is the ray-traced baker");
   if (!r.outputs.per_vertex.empty())
-    throw InputError("--per-vertex with --high: per-vertex AO is baked from the mesh itself; bake the high mesh's map, or drop --high");
+    throw InputError(field(fields::kBakePerVertex) + " with " + field(fields::kBakeHigh) + ": per-vertex AO is baked from the mesh itself; bake the high mesh's map, or drop " +
+                     field(fields::kBakeHigh));
   if (!r.cage.empty() && h.cage_extrusion)
-    throw InputError("--cage and --cage-extrusion: give one (an explicit cage, or the low mesh pushed out by a distance)");
+    throw InputError(field(fields::kBakeCage) + " and " + field(fields::kBakeCageExtrusion) + ": give one (an explicit cage, or the low mesh pushed out by a distance)");
   if (!r.outputs.miss_mask.empty() && !is_supported_image_path(r.outputs.miss_mask))
     throw InputError(r.outputs.miss_mask.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
   h.validate();
@@ -116,14 +122,14 @@ void check_high_to_low(const BakeRequest& r) {
 // The settings of both bakers and the map's layout.
 void check_settings(const BakeRequest& r) {
   if (r.raytraced.membership != Membership::Step && !r.raytraced.max_distance)
-    throw InputError("--membership needs --max-distance: with unlimited distance every occluder counts fully (there is no falloff)");
+    throw InputError(field(fields::kBakeMembership) + " needs " + field(fields::kBakeMaxDistance) + ": with unlimited distance every occluder counts fully (there is no falloff)");
   if (r.raytraced.max_distance && r.raytraced.membership == Membership::Exp)
-    throw InputError("--membership: use step, linear, sqrt or cubic for baking, got 'exp'");
-  if (r.uv_set < 0 || r.uv_set > 7) throw InputError("--uv-set must be in [0, 7] (UV sets count from 0)");
-  if (r.outputs.png_bits && *r.outputs.png_bits != 8 && *r.outputs.png_bits != 16) throw InputError("--png-bits must be 8 or 16");
-  if (r.padding < 0 || r.padding > 1024) throw InputError("--padding must be in [0, 1024] texels");
+    throw InputError(field(fields::kBakeMembership) + ": use step, linear, sqrt or cubic for baking, got 'exp'");
+  if (r.uv_set < 0 || r.uv_set > 7) throw InputError(field(fields::kBakeUvSet) + " must be in [0, 7] (UV sets count from 0), got " + std::to_string(r.uv_set));
+  if (r.outputs.png_bits && *r.outputs.png_bits != 8 && *r.outputs.png_bits != 16) throw InputError(field(fields::kBakePngBits) + " must be 8 or 16, got " + std::to_string(*r.outputs.png_bits));
+  if (r.padding < 0 || r.padding > 1024) throw InputError(field(fields::kBakePadding) + " must be in [0, 1024] texels, got " + std::to_string(r.padding));
   if (r.size && (r.size->width < 1 || r.size->height < 1 || r.size->width > kMaxMapSide || r.size->height > kMaxMapSide))
-    throw InputError("--size: each side must be in [1, " + std::to_string(kMaxMapSide) + "] texels");
+    throw InputError(field(fields::kBakeSize) + ": each side must be in [1, " + std::to_string(kMaxMapSide) + "] texels");
   VertexHistogramParams{.resolution = r.vertex_resolution}.validate();
 }
 
@@ -135,16 +141,16 @@ void check_output_names(const Plan& plan) {
     if (!img.empty() && !is_supported_image_path(img))
       throw InputError(img.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
   if (!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".ply" && lower_extension(o.per_vertex) != ".glb")
-    throw InputError(o.per_vertex.string() + ": --per-vertex writes PLY or binary glTF (COLOR_0), give it a .ply or .glb name");
-  if (!o.gltf.empty() && lower_extension(o.gltf) != ".glb") throw InputError(o.gltf.string() + ": --gltf writes binary glTF, give it a .glb name");
+    throw InputError(o.per_vertex.string() + ": " + field(fields::kBakePerVertex) + " writes PLY or binary glTF (COLOR_0), give it a .ply or .glb name");
+  if (!o.gltf.empty() && lower_extension(o.gltf) != ".glb") throw InputError(o.gltf.string() + ": " + field(fields::kBakeGltf) + " writes binary glTF, give it a .glb name");
   if (!plan.r.out_dir.empty()) {
     // Created when missing (asked for by name); an existing file of that name is an error.
     std::error_code ec;
     if (!fs::is_directory(plan.r.out_dir) && !fs::create_directories(plan.r.out_dir, ec))
-      throw InputError("--out-dir: cannot create folder " + plan.r.out_dir.string() +
+      throw InputError(field(fields::kBakeOutDir) + ": cannot create folder " + plan.r.out_dir.string() +
                        (ec ? ": " + ec.message() : std::string(" (a file has that name)")));
   }
-  if (plan.batch) return;  // outputs go to --out-dir or beside each mesh
+  if (plan.batch) return;  // outputs go to out_dir or beside each mesh
   for (const fs::path& out : {o.map, o.bent_normals, o.per_vertex, o.gltf}) {
     if (out.empty()) continue;
     const fs::path parent = out.parent_path();
@@ -156,33 +162,34 @@ void check_output_names(const Plan& plan) {
 // unless one is given (then they must agree) and its bit depth (so --png-bits does not apply).
 void check_orm(Plan& plan) {
   const BakeRequest& r = plan.r;
-  if (plan.batch) throw InputError("--orm packs the map of one mesh into one texture: give one mesh, not several or a folder");
+  if (plan.batch) throw InputError(field(fields::kBakeOrm) + " packs the map of one mesh into one texture: give one mesh, not several or a folder");
   if (!plan.wants_map() || !plan.writes_map_file())
-    throw InputError("--orm writes the map file: give -o out.png (it is not written with only --gltf, --bent-normals or --per-vertex)");
+    throw InputError(field(fields::kBakeOrm) + " writes the map file: give " + field(fields::kBakeMap) + " a .png name (it is not written with only " +
+                     field(fields::kBakeGltf) + ", " + field(fields::kBakeBentNormals) + " or " + field(fields::kBakePerVertex) + ")");
   if (!r.outputs.map.empty() && lower_extension(r.outputs.map) != ".png")
-    throw InputError(r.outputs.map.string() + ": with --orm the map is the ORM texture with AO in red, a PNG; give -o a .png name");
-  if (r.outputs.png_bits) throw InputError("--png-bits with --orm: the output keeps the ORM texture's own bit depth; drop --png-bits");
+    throw InputError(r.outputs.map.string() + ": with " + field(fields::kBakeOrm) + " the map is the ORM texture with AO in red, a PNG; give " + field(fields::kBakeMap) + " a .png name");
+  if (r.outputs.png_bits) throw InputError(field(fields::kBakePngBits) + " with " + field(fields::kBakeOrm) + ": the output keeps the ORM texture's own bit depth; drop " + field(fields::kBakePngBits));
   const StoredPng orm = read_stored_png(r.orm);
   if (orm.channels < 3)
-    throw InputError(r.orm.string() + ": --orm needs an RGB or RGBA texture (occlusion, roughness, metalness in R, G, B); this one is greyscale");
+    throw InputError(r.orm.string() + ": " + field(fields::kBakeOrm) + " needs an RGB or RGBA texture (occlusion, roughness, metalness in R, G, B); this one is greyscale");
   if (!r.size) {
     plan.width = orm.width;
     plan.height = orm.height;
   } else if (orm.width != plan.width || orm.height != plan.height) {
     const std::string orm_size = std::to_string(orm.width) + "x" + std::to_string(orm.height);
-    throw InputError(r.orm.string() + ": the ORM texture is " + orm_size + " and the map -s " + std::to_string(plan.width) + "x" +
-                     std::to_string(plan.height) + "; give -s " + orm_size + " or leave -s out");
+    throw InputError(r.orm.string() + ": the ORM texture is " + orm_size + " and the map " + field(fields::kBakeSize) + " " + std::to_string(plan.width) +
+                     "x" + std::to_string(plan.height) + "; give " + field(fields::kBakeSize) + " " + orm_size + " or leave it unset");
   }
 }
 
 void check_udim(const Plan& plan) {
   const BakeRequest& r = plan.r;
   if (!is_udim_pattern(r.outputs.map)) return;
-  const std::pair<bool, const char*> single_map_options[] = {{!r.outputs.gltf.empty(), "--gltf (a material takes one occlusion texture)"},
-                                                            {!r.outputs.bent_normals.empty(), "--bent-normals"},
-                                                            {!r.outputs.miss_mask.empty(), "--miss-mask"},
-                                                            {!r.orm.empty(), "--orm"},
-                                                            {!r.reference.empty(), "--reference"}};
+  const std::pair<bool, std::string> single_map_options[] = {{!r.outputs.gltf.empty(), field(fields::kBakeGltf) + " (a material takes one occlusion texture)"},
+                                                            {!r.outputs.bent_normals.empty(), field(fields::kBakeBentNormals)},
+                                                            {!r.outputs.miss_mask.empty(), field(fields::kBakeMissMask)},
+                                                            {!r.orm.empty(), field(fields::kBakeOrm)},
+                                                            {!r.reference.empty(), field(fields::kBakeReference)}};
   for (const auto& [given, what] : single_map_options)
     if (given)
       throw InputError(r.outputs.map.string() + ": UDIM tiles are written for the map only; " + what + " needs a single map, drop it or the tile pattern");
@@ -192,10 +199,10 @@ void check_udim(const Plan& plan) {
 // included: docs/methods/bake.md, "Denoising"), bent normals when their output is named.
 void resolve_baker_settings(Plan& plan) {
   BakeRequest& r = plan.r;
-  if (r.denoise && !plan.wants_map()) throw InputError("--denoise filters maps; per-vertex AO is not filtered, so drop --denoise");
+  if (r.denoise && !plan.wants_map()) throw InputError(field(fields::kBakeDenoise) + " filters maps; per-vertex AO is not filtered, so drop " + field(fields::kBakeDenoise));
   r.raytraced.denoise = plan.wants_map() ? r.denoise.value_or(kDefaultBakeDenoise) : 0.0f;
   r.raytraced.bent_normals = r.histogram.bent_normals = !r.outputs.bent_normals.empty();
-  r.raytraced.validate();  // before any mesh is loaded: --samples, --offset, --denoise
+  r.raytraced.validate();  // before any mesh is loaded: samples, offset, denoise
   r.histogram.validate();
 }
 
@@ -236,7 +243,7 @@ Plan plan_bake(const BakeRequest& request) {
     plan.batch = plan.inputs.size() > 1 || fs::is_directory(request.inputs.front());
   }
   if (plan.batch && plan.high_to_low())
-    throw InputError("--high bakes one low mesh: give one low-poly mesh file, not " + std::to_string(plan.inputs.size()) + " or a folder");
+    throw InputError(field(fields::kBakeHigh) + " bakes one low mesh: give one low-poly mesh file, not " + std::to_string(plan.inputs.size()) + " or a folder");
   check_output_names(plan);
   if (!request.orm.empty()) check_orm(plan);
   check_udim(plan);
@@ -254,24 +261,54 @@ MeshOutputs outputs_of(const fs::path& input, const Plan& plan) {
   MeshOutputs out;
   if (plan.wants_map()) {
     out.map = batch_path(input, o.map, plan, "-ao.png");
-    if (plan.writes_map_file()) out.files.emplace_back(out.map, o.map.empty() ? "the default map output" : "-o");
-    if (!o.miss_mask.empty()) out.files.emplace_back(out.miss = batch_path(input, o.miss_mask, plan, "-miss.png"), "--miss-mask");
-    if (!o.bent_normals.empty()) out.files.emplace_back(out.bent = batch_path(input, o.bent_normals, plan, "-bent.png"), "--bent-normals");
-    if (!o.gltf.empty()) out.files.emplace_back(out.gltf = batch_path(input, o.gltf, plan, "-ao.glb"), "--gltf");
+    if (plan.writes_map_file()) out.files.emplace_back(out.map, o.map.empty() ? "the default map output" : field(fields::kBakeMap));
+    if (!o.miss_mask.empty()) out.files.emplace_back(out.miss = batch_path(input, o.miss_mask, plan, "-miss.png"), field(fields::kBakeMissMask));
+    if (!o.bent_normals.empty()) out.files.emplace_back(out.bent = batch_path(input, o.bent_normals, plan, "-bent.png"), field(fields::kBakeBentNormals));
+    if (!o.gltf.empty()) out.files.emplace_back(out.gltf = batch_path(input, o.gltf, plan, "-ao.glb"), field(fields::kBakeGltf));
   }
-  if (!o.per_vertex.empty()) out.files.emplace_back(out.per_vertex = batch_path(input, o.per_vertex, plan, "-ao.ply"), "--per-vertex");
+  if (!o.per_vertex.empty()) out.files.emplace_back(out.per_vertex = batch_path(input, o.per_vertex, plan, "-ao.ply"), field(fields::kBakePerVertex));
   return out;
+}
+
+nlohmann::json bake_record(const Plan& plan, const fs::path& input, bool hash_inputs) {
+  const BakeRequest& r = plan.r;
+  std::vector<ProvenanceInput> inputs;
+  if (!input.empty())
+    for (const fs::path& f : files_read_by(input)) inputs.push_back({"mesh", f});
+  for (const fs::path& f : r.high) inputs.push_back({"high", f});
+  if (!r.cage.empty()) inputs.push_back({"cage", r.cage});
+  for (const fs::path& f : r.occluders) inputs.push_back({"occluder", f});
+  if (!r.orm.empty()) inputs.push_back({"orm", r.orm});
+  if (!r.reference.empty()) inputs.push_back({"reference", r.reference});
+  nlohmann::json s = {{"method", to_string(r.method)}, {"width", plan.width},   {"height", plan.height}, {"uv_set", r.uv_set},
+                      {"padding", r.padding},          {"png_bits", plan.png_bits}, {"floor", r.floor},      {"groups", r.groups},
+                      {"self_occlusion", r.self_occlusion}, {"match_by_name", r.match_by_name}};
+  if (r.method == Baker::Histogram) {
+    s["parameters"] = r.histogram;
+    if (!r.outputs.per_vertex.empty()) s["vertex_resolution"] = r.vertex_resolution;
+  } else {
+    s["parameters"] = r.raytraced;  // its denoise and bent normals resolved by the plan
+  }
+  if (plan.high_to_low()) s["high_to_low"] = r.high_to_low;
+  // Which outputs, by kind and format: a map written as EXR is not the PNG of the same bake.
+  const BakeOutputs& o = r.outputs;
+  const auto kind = [](const fs::path& p) { return p.empty() ? nlohmann::json() : nlohmann::json(lower_extension(p)); };
+  s["outputs"] = {{"map", plan.wants_map() && plan.writes_map_file() ? kind(o.map.empty() ? fs::path("default.png") : o.map) : nlohmann::json()},
+                  {"bent_normals", kind(o.bent_normals)}, {"per_vertex", kind(o.per_vertex)}, {"gltf", kind(o.gltf)}, {"miss_mask", kind(o.miss_mask)}};
+  return provenance_record("bake", inputs, s, hash_inputs);
 }
 
 void declare(OutputSet& set, const fs::path& input, const Plan& plan, const MeshOutputs& outs, bool of_mesh) {
   const BakeRequest& r = plan.r;
   set.add_input(input, "the mesh " + input.string());
-  set.add_input(r.reference, "--reference");
-  set.add_input(r.cage, "--cage");
-  set.add_input(r.orm, "--orm");
-  for (const fs::path& f : r.high) set.add_input(f, "--high");
-  for (const fs::path& f : r.occluders) set.add_input(f, "--occluder");
+  set.add_input(r.reference, field(fields::kBakeReference));
+  set.add_input(r.cage, field(fields::kBakeCage));
+  set.add_input(r.orm, field(fields::kBakeOrm));
+  for (const fs::path& f : r.high) set.add_input(f, field(fields::kBakeHigh));
+  for (const fs::path& f : r.occluders) set.add_input(f, field(fields::kBakeOccluders));
   for (const auto& [path, what] : outs.files) set.add_output(path, of_mesh ? what + " of " + input.string() : what);
+  if (plan.r.outputs.provenance)
+    for (const auto& [path, what] : outs.files) set.add_output(provenance_path(path), field(fields::kBakeProvenance) + " of " + path.string());
 }
 
 std::vector<Mesh> load_occluders(const Plan& plan, const Scene& scene, const Scene* high, const JobReporter& reporter) {
@@ -325,6 +362,13 @@ double covered_mean(const BakeResult& map) {
 
 }  // namespace bake_job
 
+BakeRequest resolve_bake_request(const BakeRequest& request) { return bake_job::plan_bake(request).r; }
+
+nlohmann::json bake_provenance(const BakeRequest& request, const std::filesystem::path& mesh, bool hash_inputs) {
+  const bake_job::Plan plan = bake_job::plan_bake(request);
+  return bake_job::bake_record(plan, mesh, hash_inputs);
+}
+
 BakeBatchResult run_bake(const BakeRequest& request, const JobReporter& reporter, const std::function<void(const MeshBake&)>& on_mesh) {
   using namespace bake_job;
   const Plan plan = plan_bake(request);
@@ -347,9 +391,10 @@ BakeBatchResult run_bake(const BakeRequest& request, const JobReporter& reporter
         if (!dynamic_cast<const InputError*>(&e) && !dynamic_cast<const SystemError*>(&e)) throw;
         mesh.input = in;
         mesh.error = e.what();
-        mesh.summary = {{"input", in.string()}, {"error", mesh.error}};
+        mesh.summary = {{"ao", build_info()}, {"input", in.string()}, {"error", mesh.error}};
         ++result.failed;
-        reporter.fail(mesh.error);
+        const auto* input_error = dynamic_cast<const InputError*>(&e);
+        reporter.fail(input_error ? input_error->marked() : mesh.error);  // the reporter names the fields its own way
       }
       char seconds[32];
       std::snprintf(seconds, sizeof seconds, "%.1f", clock.lap_ms() / 1000.0);

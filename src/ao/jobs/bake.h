@@ -60,7 +60,10 @@ struct BakeOutputs {
   std::filesystem::path per_vertex;    ///< Per-vertex AO: .ply (colour + float quality) or .glb (COLOR_0).
   std::filesystem::path gltf;          ///< A .glb of the mesh with the map as its occlusion texture.
   std::filesystem::path miss_mask;     ///< High to low: 1 where every cage ray of a texel missed.
-  std::optional<int> png_bits;         ///< 8 or 16 (default 8; an --orm texture keeps its own).
+  std::optional<int> png_bits;         ///< 8 or 16 (default 8; an ORM texture keeps its own).
+  /// Also write each output's record beside it, <output>.ao.json (jobs/provenance.h): ao's version,
+  /// the inputs' SHA-256, every setting; in the mesh's transaction, renamed after its outputs.
+  bool provenance = false;
 };
 
 struct BakeRequest {
@@ -106,15 +109,34 @@ struct MeshBake {
   nlohmann::json summary;          ///< What `ao bake --json` prints for it.
 };
 
+/// What run_bake returns. Keep it in a variable, or take what you need with mesh(): a reference
+/// into a temporary result, such as `const BakeResult& map = run_bake(r).meshes.at(0).map;`,
+/// dangles at the end of the statement (the vector is freed with the result).
 struct BakeBatchResult {
   std::vector<MeshBake> meshes;  ///< In input order (folders sorted by name).
   int failed = 0;                ///< Meshes with an error.
   bool batch = false;            ///< Several meshes or a folder were asked for (outputs named <stem>-<name>).
+
+  /// The first mesh's outcome (the only one of a single mesh). On a result held in a variable, a
+  /// reference into it; on a temporary, the outcome moved out of it, so that
+  /// `const MeshBake& m = run_bake(r).mesh();` and `const BakeResult& map = run_bake(r).mesh().map;`
+  /// keep it alive (a reference bound to a temporary, or to a member of one, extends its life).
+  /// std::out_of_range when there is none.
+  const MeshBake& mesh() const& { return meshes.at(0); }
+  MeshBake mesh() && { return std::move(meshes.at(0)); }
 };
 
 /// The checks that need no mesh (option values, combinations, output names, memory), with the
 /// defaults resolved: what run_bake bakes. InputError with one line naming the option.
 BakeRequest resolve_bake_request(const BakeRequest& request);
+
+/// The provenance record (jobs/provenance.h) of the outputs `request` writes for `mesh`, without
+/// the per-file "output": the mesh (and a .gltf's buffers), high meshes, cage, occluders, ORM
+/// texture and reference map as inputs (hashed when `hash_inputs`; otherwise each input has its
+/// role and path only), and as settings every resolved field that changes an output (the baker
+/// and its parameters, size, UV set, padding, denoise, high-to-low reach, groups, floor, PNG bits,
+/// which outputs). Checks the request first (resolve_bake_request).
+nlohmann::json bake_provenance(const BakeRequest& request, const std::filesystem::path& mesh, bool hash_inputs = true);
 
 /// Bakes every mesh of `request` and writes its outputs, each mesh's as one transaction. In a
 /// batch a mesh that fails (InputError, SystemError) is reported through `reporter` and in its

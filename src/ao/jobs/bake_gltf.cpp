@@ -15,6 +15,8 @@
 #include "ao/io/gltf_export.h"
 #include "ao/io/image_io.h"
 #include "ao/jobs/bake_internal.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 
 namespace ao::bake_job {
 
@@ -23,17 +25,18 @@ namespace {
 // The options that do not apply to a document kept as it is.
 void check_round_trip_options(const Plan& plan, const fs::path& input) {
   const BakeRequest& r = plan.r;
-  const std::pair<bool, const char*> unsupported[] = {{plan.high_to_low(), "--high"},
-                                                      {!r.groups.empty() || r.self_occlusion || r.match_by_name, "bake groups"},
-                                                      {!r.outputs.bent_normals.empty(), "--bent-normals"},
-                                                      {!r.orm.empty(), "--orm"},
-                                                      {!r.reference.empty(), "--reference"},
-                                                      {!r.outputs.per_vertex.empty() && lower_extension(r.outputs.per_vertex) != ".glb", "--per-vertex .ply"},
-                                                      {is_udim_pattern(r.outputs.map), "UDIM tiles"}};
+  const std::pair<bool, std::string> unsupported[] = {
+      {plan.high_to_low(), field(fields::kBakeHigh)},
+      {!r.groups.empty() || r.self_occlusion || r.match_by_name, "bake groups"},
+      {!r.outputs.bent_normals.empty(), field(fields::kBakeBentNormals)},
+      {!r.orm.empty(), field(fields::kBakeOrm)},
+      {!r.reference.empty(), field(fields::kBakeReference)},
+      {!r.outputs.per_vertex.empty() && lower_extension(r.outputs.per_vertex) != ".glb", field(fields::kBakePerVertex) + " .ply"},
+      {is_udim_pattern(r.outputs.map), "UDIM tiles"}};
   for (const auto& [given, what] : unsupported)
     if (given)
-      throw InputError(input.string() + ": a glTF input baked to a .glb keeps its document, one map per glTF mesh; " + what +
-                       " does not apply to it (bake without --gltf/--per-vertex .glb for the flattened scene)");
+      throw InputError(input.string() + ": a glTF input baked to a .glb keeps its document, one map per glTF mesh; " + what + " does not apply to it (bake without " +
+                       field(fields::kBakeGltf) + "/" + field(fields::kBakePerVertex) + " .glb for the flattened scene)");
 }
 
 // What one round trip carries between its steps.
@@ -131,6 +134,7 @@ bool is_gltf_round_trip(const fs::path& input, const Plan& plan) {
 
 MeshBake bake_gltf_input(const Plan& plan, const fs::path& input, const MeshOutputs& outs, OutputSet& outputs, const JobReporter& reporter) {
   check_round_trip_options(plan, input);
+  const nlohmann::json record = plan.r.outputs.provenance ? bake_record(plan, input) : nlohmann::json();  // before the file is read
   RoundTrip job{plan, input, outs, outputs, reporter, GltfDocument(input, plan.r.uv_set)};
   const std::string in = input.string();
   for (const std::string& w : job.doc.warnings()) reporter.warn(in + ": " + w);
@@ -139,14 +143,14 @@ MeshBake bake_gltf_input(const Plan& plan, const fs::path& input, const MeshOutp
   const std::vector<int> targets = want_map ? job.doc.instanced_meshes(true) : std::vector<int>{};
   if (want_map && targets.empty())
     throw InputError(in + ": no mesh of the scene has UV set " + std::to_string(plan.r.uv_set) + " (TEXCOORD_" + std::to_string(plan.r.uv_set) +
-                     "), so it cannot be baked to a texture; use --per-vertex out.glb for per-vertex AO");
+                     "), so it cannot be baked to a texture; use " + field(fields::kBakePerVertex) + " out.glb for per-vertex AO");
   if (!map.empty() && targets.size() > 1)
-    throw InputError(map.string() + ": -o names one map, but " + in + " bakes " + std::to_string(targets.size()) +
-                     " meshes, each into its own map (embedded in the --gltf output); drop -o");
+    throw InputError(map.string() + ": " + field(fields::kBakeMap) + " names one map, but " + in + " bakes " + std::to_string(targets.size()) +
+                     " meshes, each into its own map (embedded in the " + field(fields::kBakeGltf) + " output); drop " + field(fields::kBakeMap));
   check_memory(estimate_ray_scene_memory(job.doc.world_triangle_count(), job.doc.world_vertex_count()),
                in + ": the BVH of every instance, " + std::to_string(job.doc.world_triangle_count()) + " triangles");
   job.timings["load_ms"] = job.clock.lap_ms();
-  job.summary = {{"input", in}, {"gltf_round_trip", true}, {"world_triangles", job.doc.world_triangle_count()}};
+  job.summary = {{"ao", build_info()}, {"input", in}, {"gltf_round_trip", true}, {"world_triangles", job.doc.world_triangle_count()}};
   if (!outs.per_vertex.empty()) bake_round_trip_vertices(job);
   if (want_map) {
     bake_round_trip_maps(job, targets, map);
@@ -159,6 +163,7 @@ MeshBake bake_gltf_input(const Plan& plan, const fs::path& input, const MeshOutp
   job.timings["write_ms"] = job.clock.lap_ms();
   job.summary["timings"] = job.timings;
   job.summary["method"] = to_string(plan.r.method);
+  if (plan.r.outputs.provenance) stage_provenance(outputs, record);
   outputs.commit();
   MeshBake out;
   out.input = input;

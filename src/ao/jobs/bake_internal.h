@@ -66,6 +66,9 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
 /// A mesh the caller made (BakeRequest::scene): baked, not written.
 MeshBake bake_scene(const Plan& plan, const Scene& scene, const JobReporter& reporter);
 
+/// The provenance record of `input`'s outputs (bake_provenance), inputs hashed now.
+nlohmann::json bake_record(const Plan& plan, const fs::path& input, bool hash_inputs = true);
+
 /// A glTF input baked to a .glb keeps its document (bake_gltf.cpp).
 bool is_gltf_round_trip(const fs::path& input, const Plan& plan);
 MeshBake bake_gltf_input(const Plan& plan, const fs::path& input, const MeshOutputs& outs, OutputSet& outputs, const JobReporter& reporter);

@@ -18,6 +18,8 @@
 #include "ao/io/image_io.h"
 #include "ao/io/ply_export.h"
 #include "ao/jobs/bake_internal.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao::bake_job {
@@ -36,6 +38,7 @@ struct MeshJob {
   nlohmann::json timings;
   Stopwatch clock;
   std::unique_ptr<RayScene> rays;  ///< Of the scene alone, built once for the map and per-vertex AO.
+  nlohmann::json record;           ///< The provenance record of the outputs, when asked for (inputs hashed before loading).
 
   const Scene* high_scene() const { return high ? &*high : nullptr; }
   std::string label() const { return input.filename().string(); }
@@ -50,10 +53,10 @@ struct MeshJob {
   }
 };
 
-// The high meshes of --high, one scene (their UVs are not used).
+// The high meshes (BakeRequest::high), one scene (their UVs are not used).
 Scene load_high_scene(const std::vector<fs::path>& files, const JobReporter& reporter) {
   Scene high;
-  high.name = files.size() == 1 ? files.front().string() : "--high meshes";
+  high.name = files.size() == 1 ? files.front().string() : "the high meshes";
   for (const fs::path& f : files) {
     Scene s = load_scene_file(f, kBakeLoad);
     for (const std::string& w : s.warnings) reporter.warn(w);  // the loader names the file
@@ -69,7 +72,7 @@ std::vector<BakeGroup> make_groups(const MeshJob& job, const Scene& scene) {
   if (r.match_by_name) {
     std::vector<std::string> unused;
     groups = groups_by_name(scene, *job.high, &unused);
-    for (const std::string& n : unused) job.reporter.warn("--match-by-name: high mesh '" + n + "' matches no low mesh and is not used");
+    for (const std::string& n : unused) job.reporter.warn(field(fields::kBakeMatchByName) + ": high mesh '" + n + "' matches no low mesh and is not used");
     return groups;
   }
   if (!r.groups.empty()) {
@@ -134,8 +137,8 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
     job.summary["parameters"] = p;
     if (r.missed_texels > 0)
       job.reporter.warn(job.input.string() + ": " + std::to_string(r.missed_texels) + " of " + std::to_string(r.covered_texels) +
-                        " texels: every cage ray missed the high mesh; filled from their neighbours (raise --cage-extrusion or --max-back" +
-                        (plan.r.outputs.miss_mask.empty() ? "; --miss-mask shows where)" : ")"));
+                        " texels: every cage ray missed the high mesh; filled from their neighbours (raise " + field(fields::kBakeCageExtrusion) + " or " +
+                        field(fields::kBakeMaxBack) + (plan.r.outputs.miss_mask.empty() ? "; " + field(fields::kBakeMissMask) + " shows where)" : std::string(")")));
   }
   return r;
 }
@@ -145,7 +148,7 @@ void bake_udim_tiles(MeshJob& job, const fs::path& pattern, OutputSet& outputs) 
   const Plan& plan = job.plan;
   const std::vector<UdimTile> tiles = udim_tiles(job.scene);
   for (const UdimTile& t : tiles)  // tile 1001 of "ao.1001.png" is the pattern itself, already declared
-    if (udim_tile_path(pattern, t.number()) != pattern) outputs.add_output(udim_tile_path(pattern, t.number()), "tile " + std::to_string(t.number()) + " of -o");
+    if (udim_tile_path(pattern, t.number()) != pattern) outputs.add_output(udim_tile_path(pattern, t.number()), "tile " + std::to_string(t.number()) + " of " + field(fields::kBakeMap));
   nlohmann::json tile_summary = nlohmann::json::array();
   std::size_t covered = 0;
   for (const UdimTile& t : tiles) {
@@ -292,7 +295,7 @@ void tell_written(const MeshJob& job, const MeshBake& out, const MeshOutputs& ou
 MeshBake bake_and_write(MeshJob& job, const MeshOutputs& outs, OutputSet* outputs) {
   const Plan& plan = job.plan;
   if (plan.wants_map() && !std::any_of(job.scene.meshes.begin(), job.scene.meshes.end(), [](const Mesh& m) { return !m.uvs.empty(); }))
-    throw InputError(job.input.string() + ": the mesh has no UV coordinates, so it cannot be baked to a texture; use --per-vertex out.ply for per-vertex AO");
+    throw InputError(job.input.string() + ": the mesh has no UV coordinates, so it cannot be baked to a texture; use " + field(fields::kBakePerVertex) + " out.ply for per-vertex AO");
   MeshBake out;
   out.input = job.input;
   const bool udim = outputs && plan.wants_map() && plan.writes_map_file() && is_udim_pattern(outs.map);
@@ -309,6 +312,7 @@ MeshBake bake_and_write(MeshJob& job, const MeshOutputs& outs, OutputSet* output
       });
       job.summary["per_vertex_output"] = outs.per_vertex.string();
     }
+    if (plan.r.outputs.provenance) stage_provenance(*outputs, job.record);
     outputs->commit();
     tell_written(job, out, outs, udim);
   }
@@ -326,13 +330,15 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
   declare(outputs, input, plan, outs);
   if (is_gltf_round_trip(input, plan)) return bake_gltf_input(plan, input, outs, outputs, reporter);
   Stopwatch clock;
+  nlohmann::json record = plan.r.outputs.provenance ? bake_record(plan, input) : nlohmann::json();
   Scene scene = load_scene_file(input, {.uv_set = plan.r.uv_set, .flatten_instances = true});
   for (const std::string& w : scene.warnings) reporter.warn(w);  // the loader names the file
   check_traceable_size(scene);  // the histogram baker traces no ray: checked here for both
   MeshJob job{plan, input, reporter, scene};
   job.clock = clock;
+  job.record = std::move(record);
   job.timings["load_ms"] = job.clock.lap_ms();
-  job.summary = {{"input", input.string()}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
+  job.summary = {{"ao", build_info()}, {"input", input.string()}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   if (plan.high_to_low()) job.high = load_high_scene(plan.r.high, reporter);
   job.occluders = load_occluders(plan, scene, job.high_scene(), reporter);
   return bake_and_write(job, outs, &outputs);
@@ -341,7 +347,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
 MeshBake bake_scene(const Plan& plan, const Scene& scene, const JobReporter& reporter) {
   check_traceable_size(scene);
   MeshJob job{plan, scene.name, reporter, scene};
-  job.summary = {{"input", scene.name}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
+  job.summary = {{"ao", build_info()}, {"input", scene.name}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   if (plan.high_to_low()) job.high = load_high_scene(plan.r.high, reporter);
   job.occluders = load_occluders(plan, scene, job.high_scene(), reporter);
   return bake_and_write(job, MeshOutputs{}, nullptr);

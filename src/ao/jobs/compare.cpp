@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 #include "ao/jobs/compare_gpu_internal.h"
 #include "ao/registry/registry.h"
 #include "ao/reference/ray_scene.h"
@@ -93,27 +95,27 @@ std::string format_value(const nlohmann::json& v) {
 
 CompareSettings resolve_compare_settings(const CompareSettings& in) {
   CompareSettings s = in;
-  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError("--reference-samples must be in [1, 1048576]");
+  if (s.spp_reference < 1 || s.spp_reference > kMaxReferenceSpp) throw InputError(field(fields::kCompareSppReference) + " must be in [1, 1048576], got " + std::to_string(s.spp_reference));
   s.falloff.validate();
   if (s.methods.empty()) {
     // Every approximate method (the reference itself is not compared with itself).
     for (const MethodInfo& m : all_methods())
       if (!m.ground_truth) s.methods.emplace_back(m.name);
-    if (s.methods.empty()) throw InputError("--methods: the registry has no approximate methods");
+    if (s.methods.empty()) throw InputError(field(fields::kCompareMethods) + ": the registry has no approximate methods");
   }
   for (const auto& [name, p] : in.params) {
     bool chosen = false;
     for (const std::string& m : s.methods) chosen = chosen || m == name;
-    if (!chosen) throw InputError("--param: method '" + name + "' is not among --methods");
+    if (!chosen) throw InputError(field(fields::kCompareParams) + ": method '" + name + "' is not among " + field(fields::kCompareMethods));
   }
   s.params.clear();
   for (const std::string& name : s.methods) {
     const MethodInfo& m = find_method(name);
     nlohmann::json p = m.default_params();
     if (auto it = in.params.find(name); it != in.params.end()) {
-      if (!it->second.is_object()) throw InputError("--param: parameters of " + name + " must be a JSON object");
+      if (!it->second.is_object()) throw InputError(field(fields::kCompareParams) + ": parameters of " + name + " must be a JSON object");
       for (const auto& [k, v] : it->second.items()) {
-        if (!p.contains(k)) throw InputError("--param: " + name + " has no parameter '" + k + "'");
+        if (!p.contains(k)) throw InputError(field(fields::kCompareParams) + ": " + name + " has no parameter '" + k + "'");
         p[k] = v;
       }
     }
@@ -121,13 +123,13 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
     choose_reference(reference_name(s, name), s.falloff, m.decode(s.params[name]));  // throws for unknown names
   }
   for (const auto& [name, ref] : in.references)
-    if (!name.empty() && !s.params.count(name)) throw InputError("--reference: method '" + name + "' is not among --methods");
+    if (!name.empty() && !s.params.count(name)) throw InputError(field(fields::kCompareReferences) + ": method '" + name + "' is not among " + field(fields::kCompareMethods));
   common_reference_spec(s);  // throws for unknown names
   if (!s.sweep_key.empty()) {
-    if (s.sweep_values.empty()) throw InputError("--sweep: no values given for '" + s.sweep_key + "'");
+    if (s.sweep_values.empty()) throw InputError(field(fields::kCompareSweep) + ": no values given for '" + s.sweep_key + "'");
     bool any = false;
     for (const auto& [name, p] : s.params) any = any || p.contains(s.sweep_key);
-    if (!any) throw InputError("--sweep: no chosen method has a parameter '" + s.sweep_key + "'");
+    if (!any) throw InputError(field(fields::kCompareSweep) + ": no chosen method has a parameter '" + s.sweep_key + "'");
   }
   return s;
 }
@@ -135,7 +137,7 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
 std::optional<ReferenceSpec> common_reference_spec(const CompareSettings& s) {
   if (s.common_reference == "none") return std::nullopt;
   const std::optional<ReferenceKind> kind = parse_reference_kind(s.common_reference);
-  if (!kind) throw InputError("--common-reference: unknown reference '" + s.common_reference + "' (known: " + reference_kind_names() + ", none)");
+  if (!kind) throw InputError(field(fields::kCompareCommonReference) + ": unknown reference '" + s.common_reference + "' (known: " + reference_kind_names() + ", none)");
   switch (*kind) {
     case ReferenceKind::TangentSphere: return ReferenceSpec{ReferenceKind::TangentSphere, {Membership::Cubic, s.falloff.radius}};
     case ReferenceKind::Transfer: return ReferenceSpec{ReferenceKind::Transfer, s.falloff};
@@ -229,7 +231,7 @@ nlohmann::json compare_table_json(const CompareResult& r) {
     if (row.gpu) j["gpu"] = gpu_run_json(*row.gpu);
     rows.push_back(std::move(j));
   }
-  nlohmann::json table = {{"width", r.width},        {"height", r.height},
+  nlohmann::json table = {{"ao", build_info()},      {"width", r.width},        {"height", r.height},
                           {"membership", to_string(r.falloff.membership)}, {"radius", r.falloff.radius},
                           {"seed", r.seed},          {"spp_reference", r.spp_reference}};
   if (r.common) table["common_reference"] = reference_json(r.references[*r.common], r.spp_reference);
@@ -304,7 +306,7 @@ nlohmann::json compare_sweep_json(const CompareResult& r) {
     if (s.gpu) row["gpu"] = s.gpu->skipped.empty() ? nlohmann::json{{"rmse", s.gpu->metrics.rmse}, {"ms", s.gpu->ms}} : gpu_run_json(*s.gpu);
     rows.push_back(std::move(row));
   }
-  return {{"key", r.sweep_key}, {"rows", rows}};
+  return {{"ao", build_info()}, {"key", r.sweep_key}, {"rows", rows}};
 }
 
 std::string compare_sweep_markdown(const CompareResult& r) {

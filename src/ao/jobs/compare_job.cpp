@@ -5,6 +5,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
+#include "ao/jobs/fields.h"
 #include "ao/core/stopwatch.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
@@ -104,7 +105,7 @@ void check_compare_memory(const CompareRequest& request, const CompareSettings& 
   for (const std::string& name : settings.methods) {
     const MethodInfo& m = find_method(name);
     const auto it = settings.params.find(name);
-    if (m.memory) extra = std::max(extra, m.memory(m.canonical_params(it != settings.params.end() ? it->second : m.default_params())).bytes);
+    extra = std::max(extra, extra_memory(m.decode(it != settings.params.end() ? it->second : nlohmann::json::object())).bytes);
   }
   const std::uint64_t bytes = estimate_compare_memory({.width = width, .height = height, .methods = methods, .references = methods + 1,
                                                         .sheet_columns = static_cast<int>(sheet_columns(settings.device == Device::Gpu).size())}) + extra;
@@ -123,8 +124,8 @@ CompareJobResult run_compare(const CompareRequest& request, const JobReporter& r
   OutputSet outputs;
   request.scene.declare_inputs(outputs);
   if (!request.out_dir.empty()) {
-    outputs.add_directory(request.out_dir, "--out-dir");
-    for (const std::string& f : output_files(!settings.sweep_key.empty())) outputs.add_output(request.out_dir / f, "--out-dir");
+    outputs.add_directory(request.out_dir, field(fields::kCompareOutDir));
+    for (const std::string& f : output_files(!settings.sweep_key.empty())) outputs.add_output(request.out_dir / f, field(fields::kCompareOutDir));
   }
 
   check_compare_memory(request, settings);

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "ao/core/error.h"
+#include "ao/jobs/fields.h"
 
 namespace ao {
 
@@ -11,7 +12,7 @@ const char* to_string(Device device) { return device == Device::Gpu ? "gpu" : "c
 Device device_from_name(const std::string& name) {
   if (name == "cpu") return Device::Cpu;
   if (name == "gpu") return Device::Gpu;
-  throw InputError("--device: cpu or gpu, got '" + name + "'");
+  throw InputError(field(fields::kDevice) + ": cpu or gpu, got '" + name + "'");
 }
 
 void check_device(Device device, const MethodParams& params) {

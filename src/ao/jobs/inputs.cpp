@@ -7,6 +7,7 @@
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/io/camera_json.h"
+#include "ao/jobs/fields.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/scene/procedural.h"
 
@@ -205,6 +206,11 @@ std::string SceneSource::name() const {
   return joined;
 }
 
+std::vector<std::string> SceneSource::files() const {
+  if (scene || args.empty() || names_builtin_scene(args)) return {};
+  return args;
+}
+
 void SceneSource::declare_inputs(OutputSet& outputs) const {
   if (scene || args.empty() || names_builtin_scene(args)) return;
   for (const std::string& a : args) outputs.add_input(a, "the scene " + a);
@@ -250,16 +256,17 @@ PreparedScene& PreparedScene::operator=(PreparedScene&&) noexcept = default;
 PreparedScene::~PreparedScene() = default;
 
 void CameraRequest::validate() const {
-  const auto side = [](const std::optional<int>& v, const char* option) {
+  const auto side = [](const std::optional<int>& v, std::string_view name) {
     if (v && (*v < 1 || *v > kMaxImageSide))
-      throw InputError(std::string(option) + " must be in [1, " + std::to_string(kMaxImageSide) + "] pixels, got " + std::to_string(*v));
+      throw InputError(field(name) + " must be in [1, " + std::to_string(kMaxImageSide) + "] pixels, got " + std::to_string(*v));
   };
-  side(width, "--width");
-  side(height, "--height");
-  if (fov && !(*fov > 0.0f && *fov < 180.0f)) throw InputError("--fov must be in (0, 180) degrees, got " + number(*fov));
-  const std::pair<const std::optional<Vec3>*, const char*> points[] = {{&eye, "--eye"}, {&target, "--target"}, {&up, "--up"}};
-  for (const auto& [p, option] : points)
-    if (*p && !is_finite(**p)) throw InputError(std::string(option) + ": expected three finite numbers as x,y,z");
+  side(width, fields::kCameraWidth);
+  side(height, fields::kCameraHeight);
+  if (fov && !(*fov > 0.0f && *fov < 180.0f)) throw InputError(field(fields::kCameraFov) + " must be in (0, 180) degrees, got " + number(*fov));
+  const std::pair<const std::optional<Vec3>*, std::string_view> points[] = {
+      {&eye, fields::kCameraEye}, {&target, fields::kCameraTarget}, {&up, fields::kCameraUp}};
+  for (const auto& [p, name] : points)
+    if (*p && !is_finite(**p)) throw InputError(field(name) + ": expected three finite numbers as x,y,z");
 }
 
 Camera choose_camera(const Scene& scene, const CameraRequest& request) {
@@ -294,10 +301,10 @@ Camera choose_camera(const Scene& scene, const CameraRequest& request) {
 
 void FalloffRequest::validate() const {
   if (radius && !(*radius > 0.0f && std::isfinite(*radius)))
-    throw InputError("--radius must be a positive finite number of world units, got " + std::to_string(*radius));
+    throw InputError(field(fields::kFalloffRadius) + " must be a positive finite number of world units, got " + std::to_string(*radius));
   if (!radius && !(radius_fraction > 0.0f && radius_fraction <= 10.0f))
-    throw InputError("--radius-fraction must be in (0, 10], got " + std::to_string(radius_fraction));
-  if (!(tau >= 0.0f && std::isfinite(tau))) throw InputError("--tau must be >= 0 (0 selects 3/R), got " + std::to_string(tau));
+    throw InputError(field(fields::kFalloffRadiusFraction) + " must be in (0, 10], got " + std::to_string(radius_fraction));
+  if (!(tau >= 0.0f && std::isfinite(tau))) throw InputError(field(fields::kFalloffTau) + " must be >= 0 (0 selects 3/R), got " + std::to_string(tau));
 }
 
 Falloff choose_falloff(const FalloffRequest& request, float diagonal) {
@@ -309,14 +316,14 @@ Falloff choose_falloff(const FalloffRequest& request, float diagonal) {
 
 Membership membership_from_name(const std::string& name) {
   const auto m = parse_membership(name);
-  if (!m) throw InputError("--membership: unknown '" + name + "' (known: " + membership_names() + ")");
+  if (!m) throw InputError(field(fields::kFalloffMembership) + ": unknown '" + name + "' (known: " + membership_names() + ")");
   return *m;
 }
 
 SurfaceNormal surface_normal_from_name(const std::string& name) {
   if (name == "shading") return SurfaceNormal::Shading;
   if (name == "geometric") return SurfaceNormal::Geometric;
-  throw InputError("--normal: expected shading or geometric, got '" + name + "'");
+  throw InputError(field(fields::kNormal) + ": expected shading or geometric, got '" + name + "'");
 }
 
 const char* to_string(SurfaceNormal normal) { return normal == SurfaceNormal::Geometric ? "geometric" : "shading"; }

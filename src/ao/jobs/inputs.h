@@ -35,6 +35,8 @@ struct SceneSource {
   /// The scene's name, known before loading: the built-in name, the files' names joined by '+', or
   /// the caller's scene's name.
   std::string name() const;
+  /// The mesh files it names: none for the caller's scene or a built-in one.
+  std::vector<std::string> files() const;
   /// Declares the mesh files as inputs of `outputs`, so that no output may overwrite them.
   void declare_inputs(OutputSet& outputs) const;
   /// The scene: the caller's, or the files loaded and merged (InputError naming a bad file). Its

@@ -12,6 +12,8 @@
 #include "ao/io/image_io.h"
 #include "ao/io/json_text.h"
 #include "ao/io/output_set.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 #include "ao/core/stopwatch.h"
 #include "ao/reference/ray_scene.h"
 
@@ -32,12 +34,12 @@ std::optional<MethodParams> request_params(const RenderRequest& r, const MethodI
 }
 
 void check_outputs(const RenderOutputs& o) {
-  if (o.png_bits != 8 && o.png_bits != 16) throw InputError("--png-bits must be 8 or 16, got " + std::to_string(o.png_bits));
+  if (o.png_bits != 8 && o.png_bits != 16) throw InputError(field(fields::kRenderPngBits) + " must be 8 or 16, got " + std::to_string(o.png_bits));
   for (const fs::path& out : {o.visibility, o.shaded})
     if (!out.empty() && !is_supported_image_path(out))
       throw InputError(out.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
   if (!o.gbuffer.empty() && o.gbuffer.extension() != ".exr")
-    throw InputError(o.gbuffer.string() + ": --gbuffer-out writes OpenEXR, give it a .exr name");
+    throw InputError(o.gbuffer.string() + ": " + field(fields::kRenderGBufferOut) + " writes OpenEXR, give it a .exr name");
 }
 
 // <output-stem>-<name><ext>, beside the output.
@@ -49,14 +51,46 @@ fs::path extra_path(const fs::path& output, std::string_view name) {
 // refused now, and they are renamed into place together at the end.
 void declare_outputs(OutputSet& set, const RenderRequest& r, const MethodInfo& m) {
   r.scene.declare_inputs(set);
-  set.add_input(r.gbuffer_file, "--gbuffer-in");
-  set.add_input(r.ao_map, "--ao-map");
+  set.add_input(r.gbuffer_file, field(fields::kRenderGBufferFile));
+  set.add_input(r.ao_map, field(fields::kRenderAoMap));
   const RenderOutputs& o = r.outputs;
-  if (!o.visibility.empty()) set.add_output(o.visibility, o.visibility == default_render_output(r) ? "the default output" : "-o");
-  if (!o.shaded.empty()) set.add_output(o.shaded, "--shaded");
-  if (!o.gbuffer.empty()) set.add_output(o.gbuffer, "--gbuffer-out");
+  if (!o.visibility.empty()) set.add_output(o.visibility, o.visibility == default_render_output(r) ? "the default output" : field(fields::kRenderVisibility));
+  if (!o.shaded.empty()) set.add_output(o.shaded, field(fields::kRenderShaded));
+  if (!o.gbuffer.empty()) set.add_output(o.gbuffer, field(fields::kRenderGBufferOut));
   if (o.extras && r.ao_map.empty() && !o.visibility.empty())
-    for (std::string_view name : m.extras) set.add_output(extra_path(o.visibility, name), "--extras");
+    for (std::string_view name : m.extras) set.add_output(extra_path(o.visibility, name), field(fields::kRenderExtras));
+  if (o.provenance) {
+    if (r.gbuffer)
+      throw InputError(field(fields::kRenderProvenance) + ": a G-buffer made in memory has no file to record; render from a scene or a G-buffer file");
+    if (set.outputs().empty()) throw InputError(field(fields::kRenderProvenance) + " records how outputs were made: name an output file");
+    declare_provenance(set, set.outputs(), field(fields::kRenderProvenance));
+  }
+}
+
+nlohmann::json vec3_json(const std::optional<Vec3>& v) { return v ? nlohmann::json::array({v->x, v->y, v->z}) : nlohmann::json(); }
+
+// What the record of a render calls its settings: every field that changes an output.
+nlohmann::json render_settings(const RenderRequest& r, const nlohmann::json& params) {
+  const CameraRequest& c = r.camera;
+  const FalloffRequest& f = r.falloff;
+  nlohmann::json s = {
+      {"scene", r.scene.files().empty() && !has_gbuffer_input(r) ? r.scene.name() : std::string()},  // files are inputs
+      {"method", r.ao_map.empty() ? r.method : std::string(kAoMapMethod)},
+      {"parameters", params},
+      {"camera", {{"eye", vec3_json(c.eye)}, {"target", vec3_json(c.target)}, {"up", vec3_json(c.up)}, {"fov", c.fov ? nlohmann::json(*c.fov) : nlohmann::json()},
+                  {"width", c.width.value_or(c.file ? 0 : c.default_width)}, {"height", c.height.value_or(c.file ? 0 : c.default_height)}}},
+      {"membership", to_string(f.membership)},
+      {"radius", f.radius ? nlohmann::json(*f.radius) : nlohmann::json()},
+      {"radius_fraction", f.radius ? nlohmann::json() : nlohmann::json(f.radius_fraction)},
+      {"tau", f.tau},
+      {"normal", r.normal ? to_string(*r.normal) : has_gbuffer_input(r) ? "file" : "shading"},
+      {"seed", r.seed},
+      {"device", to_string(r.device)},
+      {"png_bits", r.outputs.png_bits},
+  };
+  if (r.sun) s["sun"] = {{"direction", vec3_json(r.sun->direction)}, {"irradiance", r.sun->irradiance}};
+  if (r.scene.scene) s["scene_sha256"] = scene_sha256(*r.scene.scene);
+  return s;
 }
 
 void check_memory_of(const RenderRequest& r, const std::optional<MethodParams>& params) {
@@ -127,7 +161,7 @@ void run_on_gpu(GpuDevice& device, const MethodParams& params, const Loaded& in,
   out.gl_renderer = std::move(g.renderer);
 }
 
-void write_outputs(OutputSet& set, const RenderRequest& r, RenderResult& result) {
+void write_outputs(OutputSet& set, const RenderRequest& r, RenderResult& result, const nlohmann::json& record) {
   const RenderOutputs& o = r.outputs;
   const ImageWriteOptions write_opt{.png_bits = o.png_bits};
   const Image<std::uint8_t> coverage = coverage_mask(result.gbuffer);
@@ -144,10 +178,11 @@ void write_outputs(OutputSet& set, const RenderRequest& r, RenderResult& result)
       const std::string& name = extra.first;
       const auto& image = extra.second;  // a named reference: Clang 14 cannot capture structured bindings
       const fs::path path = extra_path(o.visibility, name);
-      set.write(path, [&] { write_v(path, image); }, "--extras");
+      set.write(path, [&] { write_v(path, image); }, field(fields::kRenderExtras));
       result.extras_written[name] = path;
     }
   if (!o.gbuffer.empty()) set.write(o.gbuffer, [&] { write_gbuffer_exr(o.gbuffer, result.gbuffer); });
+  if (o.provenance) stage_provenance(set, record);
   set.commit();
 }
 
@@ -158,6 +193,7 @@ nlohmann::json summary_of(const RenderRequest& r, const RenderResult& out, const
   nlohmann::json extras = nlohmann::json::object();
   for (const auto& [name, path] : out.extras_written) extras[name] = path.string();
   nlohmann::json s = {
+      {"ao", build_info()},
       {"scene", out.scene},
       {"method", out.method},
       {"parameters", out.params},
@@ -198,11 +234,11 @@ MethodParams method_params(const MethodInfo& method, const nlohmann::json& overr
                            std::optional<float> target_error) {
   nlohmann::json params = nlohmann::json::object();
   if (samples) {
-    if (method.samples_param.empty()) throw InputError("--spp: method " + std::string(method.name) + " has no sample count");
+    if (method.samples_param.empty()) throw InputError(field(fields::kRenderSamples) + ": method " + std::string(method.name) + " has no sample count");
     params[std::string(method.samples_param)] = *samples;
   }
   if (target_error) {
-    if (method.target_error_param.empty()) throw InputError("--target-error: only the ray-traced method stops adaptively");
+    if (method.target_error_param.empty()) throw InputError(field(fields::kRenderTargetError) + ": only the ray-traced method stops adaptively");
     params[std::string(method.target_error_param)] = *target_error;
   }
   if (!overrides.is_null()) {
@@ -234,28 +270,40 @@ MethodOutput run_on_scene(const MethodParams& params, const GBuffer& gbuffer, co
 void check_render_request(const RenderRequest& r) {
   const MethodInfo& m = find_method(r.method);
   const bool gbuffer_input = has_gbuffer_input(r);
-  if (gbuffer_input && (r.scene.scene || !r.scene.args.empty())) throw InputError("give either a scene or --gbuffer-in, not both");
-  if (!r.ao_map.empty() && gbuffer_input) throw InputError("--ao-map needs the scene's UVs: give a scene, not --gbuffer-in");
-  if (!r.ao_map.empty() && !m.ground_truth) throw InputError("--ao-map shows a baked map instead of a method: drop --method");
-  if (!r.ao_map.empty() && (r.samples || r.target_error)) throw InputError("--ao-map shows a baked map: --spp and --target-error do not apply");
+  if (gbuffer_input && (r.scene.scene || !r.scene.args.empty())) throw InputError("give either " + field(fields::kRenderScene) + " or " + field(fields::kRenderGBufferFile) + ", not both");
+  if (!r.ao_map.empty() && gbuffer_input) throw InputError(field(fields::kRenderAoMap) + " needs the scene's UVs: give a scene, not " + field(fields::kRenderGBufferFile));
+  if (!r.ao_map.empty() && !m.ground_truth) throw InputError(field(fields::kRenderAoMap) + " shows a baked map instead of a method: drop " + field(fields::kRenderMethod));
+  if (!r.ao_map.empty() && (r.samples || r.target_error)) throw InputError(field(fields::kRenderAoMap) + " shows a baked map: " + field(fields::kRenderSamples) + " and " + field(fields::kRenderTargetError) + " do not apply");
   check_outputs(r.outputs);
   if (gbuffer_input && m.needs_scene)
-    throw InputError("method " + std::string(m.name) + " traces rays in the scene, and --gbuffer-in gives only a G-buffer: pass a scene instead");
+    throw InputError("method " + std::string(m.name) + " traces rays in the scene, and " + field(fields::kRenderGBufferFile) + " gives only a G-buffer: pass a scene instead");
   r.camera.validate();
   r.falloff.validate();
   const std::optional<MethodParams> params = request_params(r, m);
   if (r.device == Device::Gpu && !r.ao_map.empty())
-    throw InputError("--ao-map shows a baked map instead of running a method: --device gpu does not apply");
+    throw InputError(field(fields::kRenderAoMap) + " shows a baked map instead of running a method: " + field(fields::kDevice) + " gpu does not apply");
   if (params) check_device(r.device, *params);
   if (r.normal && gbuffer_input)
-    throw InputError("--normal chooses the normal a scene's G-buffer is rendered with; a --gbuffer-in file brings its own N");
+    throw InputError(field(fields::kNormal) + " chooses the normal a scene's G-buffer is rendered with; a " + field(fields::kRenderGBufferFile) + " file brings its own N");
   if (r.sun) r.sun->validate();
   if (r.sun && gbuffer_input)
-    throw InputError("--sun traces shadow rays in the scene, and --gbuffer-in gives only a G-buffer: give a scene, or a G-buffer EXR with "
+    throw InputError(field(fields::kRenderSun) + " traces shadow rays in the scene, and " + field(fields::kRenderGBufferFile) + " gives only a G-buffer: give a scene, or a G-buffer EXR with "
                      "direct.R direct.G direct.B channels");
   if (params && reads_direct_light(*params) && !r.sun && !gbuffer_input)
-    throw InputError("-p reflectance=radiance reads the occluders' direct light: give a sun with --sun DX,DY,DZ[,E] (or --gbuffer-in "
-                     "with direct.R direct.G direct.B channels)");
+    throw InputError(field(fields::kRenderParams) + " reflectance=radiance reads the occluders' direct light: give a sun with " + field(fields::kRenderSun) + " (or " +
+                     field(fields::kRenderGBufferFile) + " with direct.R direct.G direct.B channels)");
+}
+
+nlohmann::json render_provenance(const RenderRequest& r, bool hash_inputs) {
+  check_render_request(r);
+  std::vector<ProvenanceInput> inputs;
+  for (const std::string& a : r.scene.files())
+    for (const fs::path& f : files_read_by(a)) inputs.push_back({"scene", f});
+  if (r.camera.file) inputs.push_back({"camera", *r.camera.file});
+  if (!r.gbuffer_file.empty()) inputs.push_back({"gbuffer", r.gbuffer_file});
+  if (!r.ao_map.empty()) inputs.push_back({"ao_map", r.ao_map});
+  const std::optional<MethodParams> params = request_params(r, find_method(r.method));
+  return provenance_record("render", inputs, render_settings(r, params ? params_json(*params) : nlohmann::json::object()), hash_inputs);
 }
 
 fs::path default_render_output(const RenderRequest& r) {
@@ -276,6 +324,8 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   OutputSet outputs;
   declare_outputs(outputs, r, m);
   check_memory_of(r, params);
+  // The inputs are hashed as the run starts, before they are read.
+  const nlohmann::json record = r.outputs.provenance ? render_provenance(r) : nlohmann::json();
   std::optional<GpuDevice> gpu;
   if (r.device == Device::Gpu) {  // before anything is loaded: without a usable OpenGL the run stops here
     gpu = GpuDevice::open();
@@ -285,7 +335,7 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   Loaded in = load_inputs(r, m, reporter, timings, clock);
   const bool gbuffer_input = !in.scene;
   if (params && reads_direct_light(*params) && in.gbuffer.direct.empty())
-    throw InputError(r.gbuffer_file.string() + ": -p reflectance=radiance reads the occluders' direct light, and the file has no direct.R direct.G "
+    throw InputError(r.gbuffer_file.string() + ": " + field(fields::kRenderParams) + " reflectance=radiance reads the occluders' direct light, and the file has no direct.R direct.G "
                      "direct.B channels (docs/gbuffer.md)");
   out.falloff = choose_falloff(r.falloff, in.diagonal);
   if (!in.ao_map.empty()) {
@@ -306,7 +356,7 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
 
   out.gbuffer = std::move(in.gbuffer);
   if (r.shade || !r.outputs.shaded.empty()) out.shaded = shade_for_display(out.gbuffer, out.output.visibility, out.output.color);
-  write_outputs(outputs, r, out);
+  write_outputs(outputs, r, out, record);
   timings["write_ms"] = clock.lap_ms();
 
   double sum_v = 0;

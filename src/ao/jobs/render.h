@@ -38,6 +38,9 @@ struct RenderOutputs {
   /// The method's extra outputs (MethodInfo::extras) beside `visibility`, as <stem>-<name><ext>.
   bool extras = false;
   int png_bits = 8;  ///< 8 or 16.
+  /// Also write each output's record beside it, <output>.ao.json (jobs/provenance.h): ao's version,
+  /// the inputs' SHA-256, every setting; in the same transaction, renamed after the outputs.
+  bool provenance = false;
 };
 
 struct RenderRequest {
@@ -86,6 +89,14 @@ struct RenderResult {
 /// The checks that need no file: the method, its parameters, the camera, the falloff, the output
 /// names and the combination of options. InputError with one line naming the problem.
 void check_render_request(const RenderRequest& request);
+
+/// The provenance record (jobs/provenance.h) of what `request` writes, without the per-file
+/// "output": the scene's files, the camera file, the G-buffer and AO map files as inputs (hashed
+/// when `hash_inputs`; otherwise each input has its role and path only), and as settings every
+/// field that changes an output (the method and its complete parameters, the camera and falloff
+/// as requested, normal, seed, device, sun, PNG bits, which outputs). Checks the request first
+/// (check_render_request).
+nlohmann::json render_provenance(const RenderRequest& request, bool hash_inputs = true);
 
 /// `<scene stem>-<method>.png`, the name `ao render` writes without -o.
 std::filesystem::path default_render_output(const RenderRequest& request);

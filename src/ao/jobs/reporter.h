@@ -1,6 +1,7 @@
 // How a job talks to its caller while it runs: stages with progress, warnings, and lines for
 // people. The command line prints them to stderr, the viewer shows them, the Python module turns
-// warnings into Python warnings; a caller that wants none leaves the members empty.
+// warnings into Python warnings; a caller that wants none leaves the members empty. Lines may mark
+// request fields (field(), core/error.h): name_fields() names them in the caller's own words.
 #pragma once
 
 #include <functional>

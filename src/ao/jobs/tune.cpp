@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include "ao/core/error.h"
+#include "ao/jobs/fields.h"
+#include "ao/jobs/provenance.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/output_set.h"
@@ -159,24 +161,24 @@ void declare_output(const TuneRequest& r, OutputSet& outputs) {
 }  // namespace
 
 std::vector<TuneParameter> tune_parameters(const MethodInfo& m, const std::vector<TuneFit>& fit) {
-  if (fit.empty()) throw InputError("--fit: name at least one parameter to fit (key or key=lo:hi)");
+  if (fit.empty()) throw InputError(field(fields::kTuneFit) + ": name at least one parameter to fit (key or key=lo:hi)");
   std::vector<TuneParameter> out;
   for (const TuneFit& f : fit) {
     const ParamSpec* spec = m.params().find(f.key);
-    if (!spec) throw InputError("--fit: method " + std::string(m.name) + " has no parameter '" + f.key + "'");
+    if (!spec) throw InputError(field(fields::kTuneFit) + ": method " + std::string(m.name) + " has no parameter '" + f.key + "'");
     const bool integer = spec->type == ParamType::Int || spec->type == ParamType::OptionalInt;
     if (!integer && spec->type != ParamType::Float && spec->type != ParamType::OptionalFloat)
-      throw InputError("--fit: '" + f.key + "' of " + std::string(m.name) + " is " + spec->valid_text() + ", not a number to fit");
+      throw InputError(field(fields::kTuneFit) + ": '" + f.key + "' of " + std::string(m.name) + " is " + spec->valid_text() + ", not a number to fit");
     const Range& valid = spec->range;
     TuneParameter p{.key = f.key, .lo = f.lo.value_or(valid.min), .hi = f.hi.value_or(valid.max), .integer = integer};
     if (!f.lo && (valid.min_open || !std::isfinite(valid.min)))
-      throw InputError("--fit: '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
+      throw InputError(field(fields::kTuneFit) + ": '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
     if (!f.hi && (valid.max_open || !std::isfinite(valid.max)))
-      throw InputError("--fit: '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
+      throw InputError(field(fields::kTuneFit) + ": '" + f.key + "' is " + spec->valid_text() + ": give its range as " + f.key + "=lo:hi");
     if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
-      throw InputError("--fit: the range of '" + f.key + "' must be finite with lo < hi, got " + number(p.lo) + ":" + number(p.hi));
+      throw InputError(field(fields::kTuneFit) + ": the range of '" + f.key + "' must be finite with lo < hi, got " + number(p.lo) + ":" + number(p.hi));
     if (!valid.contains(p.lo) || !valid.contains(p.hi))
-      throw InputError("--fit: the range " + number(p.lo) + ":" + number(p.hi) + " of '" + f.key + "' leaves its valid values, " + spec->valid_text());
+      throw InputError(field(fields::kTuneFit) + ": the range " + number(p.lo) + ":" + number(p.hi) + " of '" + f.key + "' leaves its valid values, " + spec->valid_text());
     out.push_back(p);
   }
   return out;
@@ -188,8 +190,8 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
   start = m.canonical_params(start);
   TuneSettings settings{.method = r.method, .start = start, .time_budget_s = r.budget_s, .seed = r.seed};
   settings.parameters = tune_parameters(m, r.fit);
-  if (r.spp_reference < 1 || r.spp_reference > (1 << 20)) throw InputError("--reference-samples must be in [1, 1048576]");
-  if (r.scenes.empty()) throw InputError("--scenes: no scene named");
+  if (r.spp_reference < 1 || r.spp_reference > (1 << 20)) throw InputError(field(fields::kTuneSppReference) + " must be in [1, 1048576], got " + std::to_string(r.spp_reference));
+  if (r.scenes.empty()) throw InputError(field(fields::kTuneScenes) + ": no scene named");
   r.camera.validate();
   r.falloff.validate();
   OutputSet outputs;
@@ -221,10 +223,10 @@ TuneJobResult run_tune(const TuneRequest& r, const JobReporter& reporter) {
     const TuneParameter& p = *std::find_if(settings.parameters.begin(), settings.parameters.end(), [&](const TuneParameter& q) { return q.key == key; });
     const bool low = out.tune.params.at(key).get<double>() <= p.lo;
     reporter.warn(key + " = " + format_value(out.tune.params.at(key)) + " is the " + (low ? "lower" : "upper") + " end of its range " + number(p.lo) +
-                  ":" + number(p.hi) + "; the best value may lie beyond it: widen --fit " + key + "=lo:hi if the parameter's valid range allows");
+                  ":" + number(p.hi) + "; the best value may lie beyond it: widen " + field(fields::kTuneFit) + " " + key + "=lo:hi if the parameter's valid range allows");
   }
   const int width = r.camera.width.value_or(r.camera.default_width), height = r.camera.height.value_or(r.camera.default_height);
-  out.file = {{"method", r.method},       {"parameters", out.tune.params}, {"start_rmse", out.tune.start_rmse}, {"best_rmse", out.tune.best_rmse},
+  out.file = {{"ao", build_info()},       {"method", r.method},       {"parameters", out.tune.params}, {"start_rmse", out.tune.start_rmse}, {"best_rmse", out.tune.best_rmse},
               {"evaluations", out.tune.evaluations}, {"seconds", out.tune.seconds}, {"scenes", r.scenes},
               {"width", width},           {"height", height}, {"on_bound", out.tune.on_bound}};
   if (!r.output.empty()) {

@@ -4,6 +4,7 @@
 #include <array>
 #include <vector>
 #include <cmath>
+#include <limits>
 
 #include "ao/core/error.h"
 #include "ao/core/sampling.h"
@@ -227,6 +228,35 @@ VisibilityEstimate estimate_visibility(const RayScene& rs, Vec3 p, Vec3 n, const
     init_packet<N>(rh);
     return estimate<N>(embree_scene(rs), ctx, tbl, s, falloff, params, rh);
   });
+}
+
+std::vector<VisibilityEstimate> estimate_visibility_at_points(const RayScene& rs, std::span<const Vec3> points, std::span<const Vec3> normals,
+                                                              const Falloff& falloff, const RaytracedParams& params, std::uint32_t seed,
+                                                              const ProgressFn& progress) {
+  falloff.validate();
+  params.validate();
+  if (points.size() != normals.size())
+    throw InputError("points: " + std::to_string(points.size()) + " points and " + std::to_string(normals.size()) + " normals; give one normal per point");
+  if (points.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) throw InputError("points: more than 2^31 - 1 points");
+  std::vector<VisibilityEstimate> out(points.size());
+  if (points.empty()) return out;
+  const SampleTable tbl = make_sample_table(params.samples, table_packet(rs.native_packet_width()));
+  ProgressCounter counter(progress, points.size());
+  // The points as one row of "pixels", in tiles of 64.
+  detail::for_each_ray_tile(rs, static_cast<int>(points.size()), 1, detail::RayTiling{.tile_width = 64, .tile_height = 1}, counter,
+                            [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+                              alignas(64) typename detail::Packet<N>::RayHit rh;
+                              init_packet<N>(rh);
+                              for (int i = t.x0; i < t.x1; ++i) {
+                                const Vec3 p = points[static_cast<std::size_t>(i)];
+                                const Vec3 n = normalize(normals[static_cast<std::size_t>(i)]);
+                                const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
+                                const PointSetup s = setup_point(p, n, n, offset, pixel_seed(seed, i, 0));
+                                out[static_cast<std::size_t>(i)] = estimate<N>(embree_scene(rs), ctx, tbl, s, falloff, params, rh);
+                              }
+                              return static_cast<std::size_t>(t.x1 - t.x0);
+                            });
+  return out;
 }
 
 RaytracedImage render_raytraced(const RayScene& rs, const GBuffer& g, const Falloff& falloff, const RaytracedParams& params,

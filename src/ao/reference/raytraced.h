@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -42,6 +44,14 @@ struct VisibilityEstimate {
 /// V at world-space point p with unit normal n. `seed` keys the point's scrambled sample set.
 VisibilityEstimate estimate_visibility(const RayScene& scene, Vec3 p, Vec3 n, const Falloff& falloff, const RaytracedParams& params,
                                        std::uint32_t seed);
+
+/// V at many world-space points with unit normals (`points` and `normals` of the same length):
+/// estimate_visibility at each, in parallel, point i with the sample set keyed by
+/// pixel_seed(seed, i, 0), so the result does not depend on the thread count. Each ray starts off
+/// its point along the point's normal (params.offset, or the scale-free offset of ray_offset.h).
+std::vector<VisibilityEstimate> estimate_visibility_at_points(const RayScene& scene, std::span<const Vec3> points, std::span<const Vec3> normals,
+                                                              const Falloff& falloff, const RaytracedParams& params, std::uint32_t seed,
+                                                              const ProgressFn& progress = {});
 
 struct RaytracedImage {
   Image<float> visibility;       ///< V per pixel; 1 where the G-buffer is not covered.

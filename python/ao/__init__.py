@@ -28,6 +28,7 @@ Progress: the long calls take progress=True (a tqdm bar per stage when tqdm is i
 on stderr every few seconds otherwise) or a callable(stage, done, total).
 """
 
+import functools as _functools
 import os as _os
 
 from . import _ao
@@ -234,11 +235,14 @@ def gbuffer_from_arrays(normal, *, depth=None, position=None, albedo=None, objec
 
 
 def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=True, per_vertex=False, seed=None,
-         vertex_resolution=None, output=None, per_vertex_output=None, bent_normals_output=None, gltf_output=None, png_bits=None,
+         vertex_resolution=None, high=None, cage=None, cage_extrusion=None, max_front=None, max_back=None, cage_points=None,
+         output=None, per_vertex_output=None, bent_normals_output=None, gltf_output=None, png_bits=None,
          provenance=False, full=False, progress=None, **params):
     """bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=16, map=True, per_vertex=False,
-         seed=1, output=None, per_vertex_output=None, bent_normals_output=None, gltf_output=None,
-         png_bits=None, provenance=False, full=False, progress=None, **params) -> numpy.ndarray
+         seed=1, high=None, cage=None, cage_extrusion=None, max_front=None, max_back=None,
+         cage_points=4, output=None, per_vertex_output=None, bent_normals_output=None,
+         gltf_output=None, png_bits=None, provenance=False, full=False, progress=None, **params)
+       -> numpy.ndarray
 
     Bakes AO into a mesh's UV space as `ao bake` does (one mesh; a folder: python3 -m ao.batch).
 
@@ -251,6 +255,12 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
     map         bake the map (H x W float32; row 0 is the top row of the image file)
     per_vertex  bake per-vertex AO (1-D float32, one value per vertex of the mesh as loaded)
     seed        seed of the sample sets (default 1)
+    high        high to low (`ao bake --high`): the AO of these high-poly meshes (an ao.Scene, or a
+                list of mesh files) baked into `mesh`'s UVs, rays from the cage inwards
+    cage        an explicit cage (an ao.Scene or a mesh file with `mesh`'s topology, pushed out);
+                or cage_extrusion: the low mesh pushed out along its smoothed normals, world
+                units (default 0.01 x its diagonal); max_front, max_back, cage_points as
+                `--max-front, --max-back, --cage-points`
     output, per_vertex_output, bent_normals_output, gltf_output, png_bits
                 files to write (mesh files only) as `ao bake -o, --per-vertex, --bent-normals,
                 --gltf, --png-bits`
@@ -267,7 +277,12 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
     request = _bake_request(size=size, method=method, uv_set=uv_set, padding=padding, vertex_resolution=vertex_resolution, seed=seed,
                             params=params, map=map_, per_vertex=per_vertex, output=output, per_vertex_output=per_vertex_output,
                             bent_normals_output=bent_normals_output, gltf_output=gltf_output, png_bits=png_bits, provenance=provenance)
-    out = _run(_ao.bake, progress, _mesh_arg(mesh), request)
+    request.update({k: _check.number(k, v, optional=True) for k, v in
+                    (("cage_extrusion", cage_extrusion), ("max_front", max_front), ("max_back", max_back)) if v is not None})
+    if cage_points is not None:
+        request["cage_points"] = _check.integer("cage_points", cage_points)
+    high_to_low = _functools.partial(_ao.bake, high=_high_arg(high), cage=_cage_arg(cage))
+    out = _run(high_to_low, progress, _mesh_arg(mesh), request)
     if _check.flag("full", full):
         return out
     if map_ and per_vertex:
@@ -279,6 +294,19 @@ def _mesh_arg(mesh):
     if isinstance(mesh, Scene):
         return mesh
     return _check.path("mesh", mesh, optional=False)
+
+
+def _high_arg(high):
+    """bake()'s high: None, an ao.Scene, a mesh file or a list of them."""
+    if high is None or isinstance(high, Scene):
+        return high
+    if isinstance(high, (list, tuple)):
+        return [_check.path(f"high[{k}]", h, optional=False) for k, h in enumerate(high)]
+    return [_check.path("high", high, optional=False)]
+
+
+def _cage_arg(cage):
+    return cage if cage is None or isinstance(cage, Scene) else _check.path("cage", cage, optional=False)
 
 
 def _bake_request(*, size, method, uv_set, padding, vertex_resolution, seed, params, map, per_vertex, output, per_vertex_output,

@@ -56,7 +56,9 @@ def gbuffer_from_arrays(normal: npt.ArrayLike, *, depth: Optional[npt.ArrayLike]
                         camera: Union[Camera, Mapping[str, Any]]) -> GBuffer: ...
 def bake(mesh: Union[_PathLike, Scene], size: Union[None, int, str] = ..., *, method: str = ..., uv_set: int = ..., padding: Optional[int] = ...,
          map: bool = ..., per_vertex: bool = ..., seed: Optional[int] = ..., vertex_resolution: Optional[int] = ...,
-         output: Optional[_PathLike] = ..., per_vertex_output: Optional[_PathLike] = ..., bent_normals_output: Optional[_PathLike] = ...,
+         high: Union[None, Scene, _PathLike, Sequence[_PathLike]] = ..., cage: Union[None, Scene, _PathLike] = ...,
+         cage_extrusion: Optional[float] = ..., max_front: Optional[float] = ..., max_back: Optional[float] = ...,
+         cage_points: Optional[int] = ..., output: Optional[_PathLike] = ..., per_vertex_output: Optional[_PathLike] = ..., bent_normals_output: Optional[_PathLike] = ...,
          gltf_output: Optional[_PathLike] = ..., png_bits: Optional[int] = ..., provenance: bool = ..., full: bool = ...,
          progress: _Progress = ..., **params: Any) -> Any: ...
 @overload

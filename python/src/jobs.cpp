@@ -128,9 +128,34 @@ void bake_params(BakeRequest& r, nlohmann::json params) {
   else raytraced_bake_param_table().from_json(params, r.raytraced);
 }
 
+// High to low: `high` (None, an ao.Scene or a list of mesh files), `cage` (None, an ao.Scene or a
+// mesh file) and the cage's reach ("cage_extrusion", "max_front", "max_back", "cage_points").
+void high_to_low_request(BakeRequest& r, const nlohmann::json& q, py::handle high, py::handle cage) {
+  if (py::isinstance<SceneHandle>(high)) {
+    r.high_scene = high.cast<const SceneHandle&>().scene;
+  } else if (!high.is_none()) {
+    const nlohmann::json files = to_json(high, "high");
+    if (!files.is_array() || !std::all_of(files.begin(), files.end(), [](const nlohmann::json& f) { return f.is_string(); }))
+      throw py::type_error("high: expected an ao.Scene or a list of mesh files");
+    for (const nlohmann::json& f : files) r.high.emplace_back(f.get<std::string>());
+  }
+  if (py::isinstance<SceneHandle>(cage)) {
+    r.cage_scene = cage.cast<const SceneHandle&>().scene;
+  } else if (!cage.is_none()) {
+    const nlohmann::json file = to_json(cage, "cage");
+    if (!file.is_string()) throw py::type_error("cage: expected an ao.Scene or a mesh file");
+    r.cage = file.get<std::string>();
+  }
+  HighToLowParams& h = r.high_to_low;
+  h.cage_extrusion = float_of(q, "cage_extrusion", "cage_extrusion");
+  h.max_front = float_of(q, "max_front", "max_front");
+  h.max_back = float_of(q, "max_back", "max_back");
+  h.cage_points = int_of(q, "cage_points", "cage_points").value_or(h.cage_points);
+}
+
 // `files`: set when the request names files to write (then a mesh file is baked by the job as
 // `ao bake` bakes it, outputs included).
-BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, bool& files) {
+BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, py::handle high, py::handle cage, bool& files) {
   BakeRequest r;
   r.method = baker_from_name(string_of(q, "method", "method").value_or("raytraced"));
   if (q.contains("size") && !q["size"].is_null()) {
@@ -141,6 +166,7 @@ BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, bool& files) 
   r.padding = int_of(q, "padding", "padding").value_or(r.padding);
   r.vertex_resolution = int_of(q, "vertex_resolution", "vertex_resolution").value_or(r.vertex_resolution);
   bake_params(r, object_of(q, "params"));
+  high_to_low_request(r, q, high, cage);
   r.outputs.map = path_of(q, "output");
   r.outputs.per_vertex = path_of(q, "per_vertex_output");
   r.outputs.bent_normals = path_of(q, "bent_normals_output");
@@ -170,17 +196,17 @@ BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, bool& files) 
 
 }  // namespace
 
-py::dict bake_record(py::handle mesh, py::handle request) {
+py::dict bake_record(py::handle mesh, py::handle request, py::handle high, py::handle cage) {
   bool files = false;
-  const BakeRequest r = bake_request(mesh, to_json(request, ""), files);
+  const BakeRequest r = bake_request(mesh, to_json(request, ""), high, cage, files);
   if (r.inputs.size() != 1) throw InputError("provenance: a record describes the outputs of one mesh file");
   return from_json(bake_provenance(r, r.inputs.front(), /*hash_inputs=*/false));
 }
 
-py::dict bake(py::handle mesh, py::handle request, py::object progress) {
+py::dict bake(py::handle mesh, py::handle request, py::object progress, py::handle high, py::handle cage) {
   const nlohmann::json q = to_json(request, "");
   bool files = false;
-  BakeRequest r = bake_request(mesh, q, files);
+  BakeRequest r = bake_request(mesh, q, high, cage, files);
   Call call(std::move(progress));
   BakeBatchResult out = call.run([&] {
     // A mesh file baked without files to write is loaded as `ao bake` loads it and baked in memory.

@@ -16,10 +16,11 @@ py::dict render(py::handle scene, py::handle gbuffer, py::handle request, py::ob
 py::dict render_record(py::handle scene, py::handle gbuffer, py::handle request);
 /// The G-buffer of a scene and camera, rendered as run_render renders it.
 GBufferHandle gbuffer(py::handle scene, py::handle request, py::object progress);
-/// run_bake of one mesh: {"map", "mask", "per_vertex", "summary"}.
-py::dict bake(py::handle mesh, py::handle request, py::object progress);
+/// run_bake of one mesh: {"map", "mask", "per_vertex", "summary"}. High to low: `high` is None, an
+/// ao.Scene or a list of mesh files; `cage` None, an ao.Scene or a mesh file.
+py::dict bake(py::handle mesh, py::handle request, py::object progress, py::handle high, py::handle cage);
 /// bake_provenance of the request for its one mesh file, inputs not hashed.
-py::dict bake_record(py::handle mesh, py::handle request);
+py::dict bake_record(py::handle mesh, py::handle request, py::handle high, py::handle cage);
 /// run_points: {"visibility", "std_error" (1-D float32, one per point), "summary"}.
 py::dict occlusion(py::handle scene, py::handle points, py::handle normals, py::handle request, py::object progress);
 /// run_compare: {"table" (table.json), "markdown", "images"}.

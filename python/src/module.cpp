@@ -233,10 +233,10 @@ PYBIND11_MODULE(_ao, m) {
   m.def("render", &render, py::arg("scene"), py::arg("gbuffer"), py::arg("request"), py::arg("progress") = py::none());
   m.def("render_record", &render_record, py::arg("scene"), py::arg("gbuffer"), py::arg("request"),
         "The provenance record the request's outputs would get (inputs by role and path, not hashed): what ao.batch compares.");
-  m.def("bake_record", &bake_record, py::arg("mesh"), py::arg("request"),
+  m.def("bake_record", &bake_record, py::arg("mesh"), py::arg("request"), py::arg("high") = py::none(), py::arg("cage") = py::none(),
         "The provenance record the request's outputs would get for its one mesh file (inputs not hashed).");
   m.def("gbuffer", &gbuffer, py::arg("scene"), py::arg("request"), py::arg("progress") = py::none());
-  m.def("bake", &bake, py::arg("mesh"), py::arg("request"), py::arg("progress") = py::none());
+  m.def("bake", &bake, py::arg("mesh"), py::arg("request"), py::arg("progress") = py::none(), py::arg("high") = py::none(), py::arg("cage") = py::none());
   m.def("occlusion", &occlusion, py::arg("scene"), py::arg("points"), py::arg("normals"), py::arg("request"), py::arg("progress") = py::none());
   m.def("compare", &compare, py::arg("scene"), py::arg("request"), py::arg("progress") = py::none());
   m.def("build_info", [] { return from_json(ao::build_info()); }, "{'version', 'simd_target'}: what every JSON output of ao names as 'ao'.");

@@ -86,7 +86,7 @@ void check_grouping(const BakeRequest& r) {
   const int grouping = (r.match_by_name ? 1 : 0) + (r.groups.empty() ? 0 : 1) + (r.self_occlusion ? 1 : 0);
   if (grouping > 1) throw InputError(field(fields::kBakeMatchByName) + ", " + field(fields::kBakeGroups) + " and " + field(fields::kBakeSelfOcclusion) +
                                      ": give one way of forming bake groups");
-  if (r.match_by_name && r.high.empty()) throw InputError(field(fields::kBakeMatchByName) + " needs " + field(fields::kBakeHigh) + ": it pairs low meshes NAME_low with high meshes NAME_high");
+  if (r.match_by_name && r.high.empty() && !r.high_scene) throw InputError(field(fields::kBakeMatchByName) + " needs " + field(fields::kBakeHigh) + ": it pairs low meshes NAME_low with high meshes NAME_high");
   if (grouping > 0 && !r.outputs.per_vertex.empty())
     throw InputError(field(fields::kBakePerVertex) + " with bake groups: per-vertex AO is baked with every mesh occluding; drop the grouping");
   if (r.floor && r.method == Baker::Histogram)
@@ -97,8 +97,11 @@ void check_grouping(const BakeRequest& r) {
 // High-to-low options: they need high meshes, the ray-traced baker, a texture map and one low mesh.
 void check_high_to_low(const BakeRequest& r) {
   const HighToLowParams& h = r.high_to_low;
-  if (r.high.empty()) {
-    if (!r.cage.empty() || h.cage_extrusion || h.max_front || h.max_back || !r.outputs.miss_mask.empty())
+  const bool cage = !r.cage.empty() || r.cage_scene != nullptr;
+  if (!r.high.empty() && r.high_scene) throw InputError(field(fields::kBakeHigh) + ": give high mesh files or a high scene made in memory, not both");
+  if (!r.cage.empty() && r.cage_scene) throw InputError(field(fields::kBakeCage) + ": give a cage file or a cage made in memory, not both");
+  if (r.high.empty() && !r.high_scene) {
+    if (cage || h.cage_extrusion || h.max_front || h.max_back || !r.outputs.miss_mask.empty())
       throw InputError(field(fields::kBakeCage) + ", " + field(fields::kBakeCageExtrusion) + ", " + field(fields::kBakeMaxFront) + ", " + field(fields::kBakeMaxBack) +
                        " and " + field(fields::kBakeMissMask) + " need " + field(fields::kBakeHigh) + " (the high-poly mesh to bake from)");
     h.validate();  // every value in its range even where it is not used (--cage-points 0)
@@ -112,7 +115,7 @@ void check_high_to_low(const BakeRequest& r) {
   if (!r.outputs.per_vertex.empty())
     throw InputError(field(fields::kBakePerVertex) + " with " + field(fields::kBakeHigh) + ": per-vertex AO is baked from the mesh itself; bake the high mesh's map, or drop " +
                      field(fields::kBakeHigh));
-  if (!r.cage.empty() && h.cage_extrusion)
+  if (cage && h.cage_extrusion)
     throw InputError(field(fields::kBakeCage) + " and " + field(fields::kBakeCageExtrusion) + ": give one (an explicit cage, or the low mesh pushed out by a distance)");
   if (!r.outputs.miss_mask.empty() && !is_supported_image_path(r.outputs.miss_mask))
     throw InputError(r.outputs.miss_mask.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");

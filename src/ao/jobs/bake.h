@@ -87,6 +87,11 @@ struct BakeRequest {
   // High to low: the AO of the high meshes baked into the low mesh's UVs (ray-traced).
   std::vector<std::filesystem::path> high;
   std::filesystem::path cage;       ///< An explicit cage mesh (the low mesh's topology, pushed out).
+  /// High meshes the caller made (one scene, validated), baked from instead of `high` files: a
+  /// program's meshes in memory (Blender's objects through the Python module). Not with `high`.
+  std::shared_ptr<const Scene> high_scene;
+  /// An explicit cage the caller made (validated; the low mesh's topology), instead of `cage`.
+  std::shared_ptr<const Scene> cage_scene;
   HighToLowParams high_to_low;      ///< Cage extrusion and ray reach; its `ao` comes from `raytraced`.
   // Occluders and bake groups.
   std::vector<std::filesystem::path> occluders;  ///< Meshes that occlude but are not baked.

@@ -29,7 +29,7 @@ struct Plan {
   bool wants_map() const;
   /// The map file itself is written: when named, or under its default name when nothing else is asked for.
   bool writes_map_file() const;
-  bool high_to_low() const { return !r.high.empty(); }
+  bool high_to_low() const { return !r.high.empty() || r.high_scene != nullptr; }
   /// Occluders, a floor, bake groups or high to low: the map is baked group by group.
   bool grouped() const;
 };

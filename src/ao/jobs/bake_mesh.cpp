@@ -53,8 +53,10 @@ struct MeshJob {
   }
 };
 
-// The high meshes (BakeRequest::high), one scene (their UVs are not used).
-Scene load_high_scene(const std::vector<fs::path>& files, const JobReporter& reporter) {
+// The high meshes (BakeRequest::high, or the caller's high_scene), one scene (their UVs are not used).
+Scene load_high_scene(const BakeRequest& r, const JobReporter& reporter) {
+  if (r.high_scene) return *r.high_scene;
+  const std::vector<fs::path>& files = r.high;
   Scene high;
   high.name = files.size() == 1 ? files.front().string() : "the high meshes";
   for (const fs::path& f : files) {
@@ -114,7 +116,9 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
   HighToLowParams p = plan.r.high_to_low;
   p.ao = plan.r.raytraced;
   if (job.high) {
-    if (!plan.r.cage.empty()) {
+    if (plan.r.cage_scene) {
+      cage = cage_from_mesh(scene, *plan.r.cage_scene);
+    } else if (!plan.r.cage.empty()) {
       cage = cage_from_mesh(scene, load_scene_file(plan.r.cage, kBakeLoad));
     } else {
       if (!p.cage_extrusion) p.cage_extrusion = kDefaultCageFraction * scene.bounds().diagonal();
@@ -131,6 +135,7 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
   if (job.high) {
     std::vector<std::string> high_files;
     for (const fs::path& f : plan.r.high) high_files.push_back(f.string());
+    if (plan.r.high_scene) high_files.push_back(plan.r.high_scene->name);
     job.summary["high"] = high_files;
     job.summary["high_triangles"] = job.high->triangle_count();
     job.summary["missed_texels"] = r.missed_texels;
@@ -339,7 +344,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
   job.record = std::move(record);
   job.timings["load_ms"] = job.clock.lap_ms();
   job.summary = {{"ao", build_info()}, {"input", input.string()}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
-  if (plan.high_to_low()) job.high = load_high_scene(plan.r.high, reporter);
+  if (plan.high_to_low()) job.high = load_high_scene(plan.r, reporter);
   job.occluders = load_occluders(plan, scene, job.high_scene(), reporter);
   return bake_and_write(job, outs, &outputs);
 }
@@ -348,7 +353,7 @@ MeshBake bake_scene(const Plan& plan, const Scene& scene, const JobReporter& rep
   check_traceable_size(scene);
   MeshJob job{plan, scene.name, reporter, scene};
   job.summary = {{"ao", build_info()}, {"input", scene.name}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
-  if (plan.high_to_low()) job.high = load_high_scene(plan.r.high, reporter);
+  if (plan.high_to_low()) job.high = load_high_scene(plan.r, reporter);
   job.occluders = load_occluders(plan, scene, job.high_scene(), reporter);
   return bake_and_write(job, MeshOutputs{}, nullptr);
 }

@@ -20,7 +20,7 @@ returns; cancel() stops it from another thread. Errors are reported as Blender r
 import threading
 import warnings
 
-import bpy
+import bpy  # type: ignore[import]  # Blender's module: this file runs inside Blender only
 import numpy as np
 
 import ao
@@ -300,7 +300,6 @@ class AO_PT_bake(bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "render"
-    bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
         layout = self.layout

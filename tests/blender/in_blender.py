@@ -7,7 +7,8 @@ into OUT_DIR what the test compares with `ao bake`:
 - the meshes as OBJ files, written corner by corner from Blender's loop triangles by the plain
   loop below (positions, loop normals and UVs printed with 9 significant digits, which float32
   values survive), not by the add-on's numpy path;
-- results.json: what each call returned or raised.
+- results.json: what each call returned or raised;
+- scene.blend: the scene, for in_window.py.
 """
 
 import json
@@ -129,8 +130,16 @@ import ao._blender_addon as addon  # noqa: E402  (the module the add-on runs)
 select(low)
 threading.Timer(0.5, addon.cancel).start()
 start = time.monotonic()
-bake("cancel", size=2048, samples=4096)
+bake("cancel", size=1024, samples=256)
 results["cancel"]["seconds"] = time.monotonic() - start
+
+# The scene for in_window.py: Suzanne alone, selected and active.
+bpy.data.objects.remove(cube)
+for o in (high, cage):
+    o.hide_set(True)
+    o.hide_render = True
+select(low)
+bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "scene.blend"))
 
 with open(os.path.join(OUT, "results.json"), "w") as f:
     json.dump(results, f, indent=1)

@@ -129,3 +129,34 @@ def test_cancel_stops_within_a_second_and_leaves_no_image(baked):
     r = baked[1]["cancel"]
     assert r["returned"] == ["CANCELLED"] and not r["image"]
     assert r["seconds"] < 0.5 + 5  # the full bake takes minutes; cancel comes at 0.5 s, and stops it within a fraction of a second
+
+
+@pytest.fixture(scope="session")
+def window(baked, blender):
+    """in_window.py's results: the operator run from a window (xvfb-run's virtual display)."""
+    xvfb = shutil.which("xvfb-run")
+    if xvfb is None:
+        pytest.skip("xvfb-run is not installed (Debian: apt-get install xvfb): the modal operator and Esc are not tested")
+    out = baked[0]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env.update(BLENDER_USER_SCRIPTS=str(out.parent / "scripts"), BLENDER_USER_CONFIG=str(out.parent / "config"))
+    q = subprocess.run([xvfb, "-a", "-s", "-screen 0 1280x800x24", blender, "--enable-event-simulate", str(out / "scene.blend"), "--python",
+                        os.path.join(HERE, "in_window.py"), "--", str(out)], env=env, capture_output=True, text=True, timeout=600)
+    assert q.returncode == 0 and os.path.exists(out / "window.json"), q.stdout[-4000:] + q.stderr[-4000:]
+    if os.environ.get("AO_BLENDER_PICTURES"):  # docs/bake.md's picture: AO_BLENDER_PICTURES=docs/images
+        shutil.copyfile(out / "window.png", os.path.join(os.environ["AO_BLENDER_PICTURES"], "blender-addon.png"))
+    with open(out / "window.json") as f:
+        return json.load(f)
+
+
+def test_modal_bake_from_a_window(window):
+    assert "timed_out" not in window and "error" not in window, window
+    assert window["invoke"] == ["RUNNING_MODAL"]
+    assert window["modal"]["size"] == [256, 256] and window["modal"]["float"]  # the panel's settings
+
+
+def test_esc_cancels_a_modal_bake_and_leaves_no_image(window):
+    assert "timed_out" not in window and "error" not in window, window
+    assert window["invoke_long"] == ["RUNNING_MODAL"] and window["long_running"]
+    assert not window["cancel"]["image"]
+    assert window["cancel"]["seconds"] < 5  # the full bake takes minutes

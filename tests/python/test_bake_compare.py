@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ao
-from conftest import bumpy_grid, cli_error, read_ply_quality, run_cli
+from conftest import bumpy_grid, cli_error, read_ply_quality, run_cli, write_obj
 
 
 def test_bake_map_equals_cli(ao_binary, grid_obj, tmp_path):
@@ -25,6 +25,33 @@ def test_bake_from_arrays_equals_the_file(grid_obj):
     vertices, faces, uvs = bumpy_grid()
     scene = ao.Scene.from_arrays(vertices, faces, uvs=uvs, name="grid")
     np.testing.assert_array_equal(ao.bake(scene, 32, samples=8), ao.bake(grid_obj, 32, samples=8))
+
+
+def test_high_to_low_from_arrays_equals_cli(ao_binary, tmp_path):
+    # A flat low square takes the AO of a bumpy high grid over it: from ao.Scene objects made from
+    # arrays (what the Blender add-on passes) and from the same meshes as files, with a cage made
+    # from arrays and as a file (the low mesh lifted by 0.4), and with an extrusion.
+    low_v, low_f, low_t = bumpy_grid(n=4, height=0.0)
+    high_v, high_f, _ = bumpy_grid(n=24)
+    cage_v = low_v + np.float32([0, 0.4, 0])
+    files = [write_obj(tmp_path / name, v, f, t) for name, v, f, t in
+             [("low.obj", low_v, low_f, low_t), ("high.obj", high_v, high_f, None), ("cage.obj", cage_v, low_f, low_t)]]
+    low = ao.Scene.from_arrays(low_v, low_f, uvs=low_t, name="low")
+    high = ao.Scene.from_arrays(high_v, high_f, name="high")
+    cage = ao.Scene.from_arrays(cage_v, low_f, name="cage")
+    for kwargs, args in [(dict(cage=cage), ["--cage", files[2]]), (dict(cage_extrusion=0.4, max_back=0.1), ["--cage-extrusion", 0.4, "--max-back", 0.1])]:
+        out = tmp_path / "map.exr"
+        run_cli(ao_binary, "bake", files[0], "--high", files[1], *args, "-s", 32, "--spp", 16, "-o", out)
+        m = ao.bake(low, 32, samples=16, high=high, **kwargs)
+        np.testing.assert_array_equal(m, ao.read_image(out))
+        np.testing.assert_array_equal(ao.bake(files[0], 32, samples=16, high=[files[1]], **{**kwargs, "cage": kwargs.get("cage") and files[2]}), m)
+        assert m.min() < 0.95 < m.max()  # the bump occludes its foot; the far corners are open
+    with pytest.raises(ao.InputError, match="^high: mesh 0 has 625 vertices .* a cage must have the low mesh.s topology"):
+        ao.bake(low, 32, high=high, cage=high)
+    with pytest.raises(ao.InputError, match="^cage, cage_extrusion, max_front, max_back and .* need high"):
+        ao.bake(low, 32, cage=cage)
+    with pytest.raises(TypeError, match="cage: expected"):
+        ao.bake(low, 32, high=high, cage=3)
 
 
 def test_per_vertex_equals_cli(ao_binary, grid_obj, tmp_path):

@@ -79,8 +79,9 @@ HighHit trace_cage_ray(const RayScene& targets, const TriangleNormals& fn, RTCIn
   return {};
 }
 
-// Smoothed normal per vertex: the sum of the normals of every vertex at the same position, normalised.
-std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
+}  // namespace
+
+std::vector<std::vector<Vec3>> smoothed_vertex_normals(const Scene& low) {
   std::map<std::array<float, 3>, Vec3> sum;
   for (const Mesh& m : low.meshes)
     for (std::size_t v = 0; v < m.positions.size(); ++v) {
@@ -98,12 +99,14 @@ std::vector<std::vector<Vec3>> smoothed_normals(const Scene& low) {
   return out;
 }
 
+namespace {
+
 // Where the AO rays of a point of the low patch leave: its cage ray, through the point, to the
 // first front face of the high mesh.
 struct CageRays {
   const Scene& low;
   const CagePositions& cage;
-  const std::vector<std::vector<Vec3>>& smooth;  // smoothed_normals(low)
+  const std::vector<std::vector<Vec3>>& smooth;  // smoothed_vertex_normals(low)
   const RayScene& targets;
   const TriangleNormals& target_fn;
   const HighToLowParams& params;
@@ -205,7 +208,7 @@ const ParamTable<HighToLowParams>& high_to_low_param_table() {
       "bake high-to-low",
       {nested_params<H>(raytraced_bake_param_table(), &H::ao),
        {P::optional_real("cage_extrusion", &H::cage_extrusion, Range::closed(0, kMaxCoordinate), "world units",
-                         "D: cage = low vertex + D x smoothed normal; null = 0.01 x the low mesh's diagonal; not with an explicit cage"),
+                         "D: cage = low vertex + D x smoothed normal; null = fitted to the pair (rays reach the high mesh from ~99% of the low surface; 0.01 to 0.1 x the low diagonal); not with an explicit cage"),
         P::optional_real("max_front", &H::max_front, Range::closed(0, kMaxCoordinate), "world units",
                          "how far outside the low surface a ray starts; null = at the cage"),
         P::optional_real("max_back", &H::max_back, Range::closed(0, kMaxCoordinate), "world units",
@@ -223,7 +226,7 @@ void to_json(nlohmann::json& j, const HighToLowParams& p) { j = high_to_low_para
 void from_json(const nlohmann::json& j, HighToLowParams& p) { high_to_low_param_table().from_json(j, p); }
 
 CagePositions extrude_cage(const Scene& low, float distance) {
-  const auto normals = smoothed_normals(low);
+  const auto normals = smoothed_vertex_normals(low);
   CagePositions cage;
   for (std::size_t mi = 0; mi < low.meshes.size(); ++mi) {
     const Mesh& m = low.meshes[mi];
@@ -258,7 +261,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   const Falloff falloff = params.ao.falloff();
   const TriangleNormals target_fn = detail::face_normals(targets.scene());
   const TriangleNormals occluder_fn = detail::face_normals(occluders.scene());
-  const auto smooth = smoothed_normals(low);
+  const auto smooth = smoothed_vertex_normals(low);
   const detail::Tracer tracer{occluders, falloff, occluder_fn, params.ao.ignore_back_faces};
   const float offset = params.ao.offset > 0 ? params.ao.offset : ray_offset_distance(bounds_magnitude(occluders.bounds()));
   const int width = cov.width, height = cov.height;

@@ -25,7 +25,7 @@ inline constexpr float kDefaultCageFraction = 0.01f;
 
 struct HighToLowParams {
   RaytracedBakeParams ao;               ///< The AO at the high-poly hit: samples (rays per texel), distance, membership, offset, back faces, seed.
-  std::optional<float> cage_extrusion;  ///< D, world units, >= 0: cage = low vertex + D x smoothed normal; nullopt = kDefaultCageFraction x low diagonal. Ignored with an explicit cage.
+  std::optional<float> cage_extrusion;  ///< D, world units, >= 0: cage = low vertex + D x smoothed normal; nullopt = fitted_cage_extrusion (the bake job). Ignored with an explicit cage.
   std::optional<float> max_front;       ///< How far outside the low surface a ray starts, world units, >= 0; nullopt = at the cage.
   std::optional<float> max_back;        ///< How far inside the low surface a ray still looks for the high mesh, world units, >= 0; nullopt = the cage distance at that point.
   /// Cage rays per texel, [1, 1048576], at most ao.samples of them used: stratified points of the
@@ -58,6 +58,17 @@ inline BvhOptions high_to_low_target_bvh_options(std::size_t triangles) {
 
 /// Per low mesh, the cage position of each vertex.
 using CagePositions = std::vector<std::vector<Vec3>>;
+
+/// Per low mesh, the smoothed normal of each vertex: the normals of all vertices at its position
+/// (hard edges and UV seams split vertices) summed and normalised; the direction extrude_cage pushes.
+std::vector<std::vector<Vec3>> smoothed_vertex_normals(const Scene& low);
+
+/// The cage extrusion D, world units, that lets cage rays reach the high meshes `targets` from
+/// about 99% of the low surface's area: the area-weighted 99th percentile, over four points per
+/// low triangle, of the distance along the smoothed normal (outwards or inwards, whichever is
+/// nearer) to the first high face, times 1.05; at least kDefaultCageFraction and at most 0.1 of
+/// the low diagonal (cage_fit.cpp). The default of a bake without a cage or an extrusion.
+float fitted_cage_extrusion(const Scene& low, const RayScene& targets);
 
 /// The low meshes' vertices pushed out by `distance` along their smoothed normals: the normals of
 /// all vertices at one position (hard edges and UV seams split vertices) averaged, so the cage

@@ -11,6 +11,7 @@
 #include "ao/bake/udim.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
+#include "ao/core/params.h"
 #include "ao/core/stopwatch.h"
 #include "ao/eval/metrics.h"
 #include "ao/io/atomic_file.h"
@@ -108,6 +109,21 @@ BakeResult bake_group_high_to_low(const MeshJob& job, const Scene& group_scene, 
   return bake_high_to_low(group_scene, cov, gc, target_rays, blocker_rays, p, progress);
 }
 
+// Texels every cage ray missed: how many, and what the given options allow to change (an explicit
+// cage excludes an extrusion; a ray's reach is its front and back distances).
+void warn_missed(const MeshJob& job, const BakeResult& r, const HighToLowParams& p) {
+  const BakeRequest& q = job.plan.r;
+  const bool cage = !q.cage.empty() || q.cage_scene;
+  std::string raise;
+  if (cage) raise = "push " + field(fields::kBakeCage) + " further out, or raise " + field(fields::kBakeMaxFront) + " or " + field(fields::kBakeMaxBack);
+  else raise = "raise " + field(fields::kBakeCageExtrusion) + " (" + (q.high_to_low.cage_extrusion ? "given" : "fitted") + ": " + float_text(*p.cage_extrusion) +
+               ") or " + field(fields::kBakeMaxBack);
+  if (p.max_back) raise += " (" + field(fields::kBakeMaxBack) + " given: " + float_text(*p.max_back) + ")";
+  job.reporter.warn(job.input.string() + ": " + std::to_string(r.missed_texels) + " of " + std::to_string(r.covered_texels) +
+                    " texels: every cage ray missed the high mesh; filled from their neighbours (" + raise +
+                    (q.outputs.miss_mask.empty() ? "; " + field(fields::kBakeMissMask) + " shows where)" : std::string(")")));
+}
+
 // The map baked group by group: high to low, or the group's own meshes with the occluders.
 BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& progress) {
   const Plan& plan = job.plan;
@@ -121,7 +137,10 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
     } else if (!plan.r.cage.empty()) {
       cage = cage_from_mesh(scene, load_scene_file(plan.r.cage, kBakeLoad));
     } else {
-      if (!p.cage_extrusion) p.cage_extrusion = kDefaultCageFraction * scene.bounds().diagonal();
+      if (!p.cage_extrusion) {  // fitted to the pair, so cage rays reach the high meshes from ~99% of the low surface
+        const RayScene high_rays(*job.high, high_to_low_target_bvh_options(job.high->triangle_count()));
+        p.cage_extrusion = fitted_cage_extrusion(scene, high_rays);
+      }
       cage = extrude_cage(scene, *p.cage_extrusion);
     }
   }
@@ -140,10 +159,7 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
     job.summary["high_triangles"] = job.high->triangle_count();
     job.summary["missed_texels"] = r.missed_texels;
     job.summary["parameters"] = p;
-    if (r.missed_texels > 0)
-      job.reporter.warn(job.input.string() + ": " + std::to_string(r.missed_texels) + " of " + std::to_string(r.covered_texels) +
-                        " texels: every cage ray missed the high mesh; filled from their neighbours (raise " + field(fields::kBakeCageExtrusion) + " or " +
-                        field(fields::kBakeMaxBack) + (plan.r.outputs.miss_mask.empty() ? "; " + field(fields::kBakeMissMask) + " shows where)" : std::string(")")));
+    if (r.missed_texels > 0) warn_missed(job, r, p);
   }
   return r;
 }

@@ -259,7 +259,7 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
                 list of mesh files) baked into `mesh`'s UVs, rays from the cage inwards
     cage        an explicit cage (an ao.Scene or a mesh file with `mesh`'s topology, pushed out);
                 or cage_extrusion: the low mesh pushed out along its smoothed normals, world
-                units (default 0.01 x its diagonal); max_front, max_back, cage_points as
+                units (default: fitted to the pair, docs/methods/bake.md); max_front, max_back, cage_points as
                 `--max-front, --max-back, --cage-points`
     output, per_vertex_output, bent_normals_output, gltf_output, png_bits
                 files to write (mesh files only) as `ao bake -o, --per-vertex, --bent-normals,

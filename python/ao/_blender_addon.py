@@ -49,7 +49,7 @@ _OPTIONS = [
     ("cage_object", bpy.props.StringProperty, dict(name="Cage Object", default="",
                                                    description="Cage: an object with the active mesh's topology, pushed out; rays start on it and travel inwards (ao bake --cage)")),
     ("cage_extrusion", bpy.props.FloatProperty, dict(name="Extrusion", default=0.0, min=0.0, subtype="DISTANCE", unit="LENGTH",
-                                                     description="Without a cage object: the active mesh pushed out by this distance; 0 = 0.01 x its diagonal (ao bake --cage-extrusion)")),
+                                                     description="Without a cage object: the active mesh pushed out by this distance; 0 = ao's default, fitted to the pair (ao bake --cage-extrusion)")),
     ("max_back", bpy.props.FloatProperty, dict(name="Max Ray Distance", default=0.0, min=0.0, subtype="DISTANCE", unit="LENGTH",
                                                description="How far inside the active mesh a ray still looks for the selected ones; 0 = as far as the cage is outside (ao bake --max-back)")),
 ]

@@ -130,7 +130,7 @@ import ao._blender_addon as addon  # noqa: E402  (the module the add-on runs)
 select(low)
 threading.Timer(0.5, addon.cancel).start()
 start = time.monotonic()
-bake("cancel", size=1024, samples=256)
+bake("cancel", size=1024, samples=4096)
 results["cancel"]["seconds"] = time.monotonic() - start
 
 # The scene for in_window.py: Suzanne alone, selected and active.

@@ -105,7 +105,7 @@ def screenshot():
     bpy.data.objects["Suzanne"].data.materials.clear()
     bpy.data.images.remove(bpy.data.images["Suzanne_ao"])
     with override():
-        results["invoke_long"] = sorted(bpy.ops.object.ao_bake("INVOKE_DEFAULT", size=1024, samples=256))
+        results["invoke_long"] = sorted(bpy.ops.object.ao_bake("INVOKE_DEFAULT", size=1024, samples=4096))
     results["long_running"] = baking()
     bpy.app.timers.register(guarded(press_esc), first_interval=0.5)
 
@@ -118,7 +118,12 @@ def press_esc():
 
 
 def cancelled(seconds):
-    results["cancel"] = {"seconds": seconds, "image": "Suzanne_ao" in bpy.data.images}
+    results["cancel"] = {"seconds": seconds}
+    bpy.app.timers.register(guarded(after_cancel), first_interval=2.0)  # the modal ends at its next timer event (0.1 s)
+
+
+def after_cancel():
+    results["cancel"]["image"] = "Suzanne_ao" in bpy.data.images
     finish()
 
 

@@ -45,7 +45,7 @@ struct Run {
   /// Binds `b` as shader storage buffer `binding`.
   void bind(GLuint binding, const Buffer& b) { c.gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, b.id()); }
   /// After the run, the stats entry `name` of the method's output is the sum of the GPU times of
-  /// the passes `pass_names` (milliseconds): the CPU method's own timing fields from the passes that do
+  /// the passes `passes` (milliseconds): the CPU method's own timing fields from the passes that do
   /// their work.
   void report_ms(std::string name, std::vector<std::string> pass_names) { reported_ms.emplace_back(std::move(name), std::move(pass_names)); }
 

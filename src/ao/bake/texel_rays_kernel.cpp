@@ -94,7 +94,13 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
     hn::Store(tk, d, target + k);
     hn::Store(pk, di, piece + k);
   }
-  if (patch.size() <= T::kMaxPieces) {
+  if (patch.size() <= static_cast<std::size_t>(lanes)) {
+    // Few pieces (the common case): a permute within one register per field.
+    for (int k = 0; k < W; k += lanes) {
+      const auto pk = hn::IndicesFromVec(d, hn::Load(di, piece + k));
+      for (int q = 0; q < T::kFields; ++q) hn::Store(hn::TableLookupLanes(hn::Load(d, table.f[q]), pk), d, lane[q] + k);
+    }
+  } else if (patch.size() <= T::kMaxPieces) {
     for (int k = 0; k < W; k += lanes) {
       const VI pk = hn::Load(di, piece + k);
       for (int q = 0; q < T::kFields; ++q) hn::Store(lookup16(table.f[q], pk), d, lane[q] + k);

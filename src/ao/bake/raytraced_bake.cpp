@@ -101,7 +101,7 @@ class TexelWorker {
       for (int k = 0; k < count; ++k) {
         acc.add(mu[k]);  // a direction below the face (no ray) counts as occluded, mu = 0
         if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
-        if (batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+        if (params_.bent_normals && batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
       }
     }
     out_.visibility[texel] = static_cast<float>(acc.mean());

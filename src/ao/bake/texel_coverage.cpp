@@ -27,26 +27,33 @@ struct Pending {
   TexelFragment frag;
 };
 
-ClipPolygon clip_half_plane(const ClipPolygon& in, int axis, float bound, bool keep_greater) {
-  ClipPolygon out;
-  auto inside = [&](Vec2 p) {
-    const float c = axis == 0 ? p.x : p.y;
-    return keep_greater ? c >= bound : c <= bound;
-  };
-  for (int i = 0; i < in.n; ++i) {
-    const Vec2 a = in.p[i], b = in.p[i + 1 == in.n ? 0 : i + 1];
+// A polygon being clipped: plain corners, so that the buffers of each step are not zeroed first.
+struct Corner {
+  float x, y;
+};
+
+// The corners of in[0 .. n) on the kept side of the line coordinate[kAxis] = bound (>= bound when
+// kKeepGreater, else <=) into out, in order; returns their count. A corner exactly on the line is
+// kept; where an edge crosses the line, the crossing, its coordinate along kAxis set to the bound.
+template <int kAxis, bool kKeepGreater>
+int clip_half_plane(const Corner* in, int n, float bound, Corner* out) {
+  const auto coord = [](Corner p) { return kAxis == 0 ? p.x : p.y; };
+  const auto inside = [&](Corner p) { return kKeepGreater ? coord(p) >= bound : coord(p) <= bound; };
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    const Corner a = in[i], b = in[i + 1 == n ? 0 : i + 1];
     const bool ia = inside(a), ib = inside(b);
-    if (ia) out.p[out.n++] = a;
+    if (ia) out[m++] = a;
     if (ia != ib) {
-      const float ca = axis == 0 ? a.x : a.y, cb = axis == 0 ? b.x : b.y;
+      const float ca = coord(a), cb = coord(b);
       const float t = (bound - ca) / (cb - ca);
-      Vec2 q{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
-      if (axis == 0) q.x = bound;
+      Corner q{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+      if (kAxis == 0) q.x = bound;
       else q.y = bound;
-      out.p[out.n++] = q;
+      out[m++] = q;
     }
   }
-  return out;
+  return m;
 }
 
 }  // namespace
@@ -61,15 +68,28 @@ float ClipPolygon::area() const {
 }
 
 ClipPolygon clip_to_texel(Vec2 a, Vec2 b, Vec2 c, int x, int y) {
+  Corner buf[2][9];
+  buf[0][0] = {a.x, a.y}, buf[0][1] = {b.x, b.y}, buf[0][2] = {c.x, c.y};
+  int n = 3, cur = 0;
+  // A clip whose line keeps every corner would copy the polygon as it is, so it is skipped (a
+  // triangle in a texel's interior needs no clip at all).
+  const auto step = [&]<int kAxis, bool kKeepGreater>(float bound) {
+    bool all_in = true;
+    for (int i = 0; i < n; ++i) {
+      const float v = kAxis == 0 ? buf[cur][i].x : buf[cur][i].y;
+      all_in = all_in && (kKeepGreater ? v >= bound : v <= bound);
+    }
+    if (all_in) return;
+    n = clip_half_plane<kAxis, kKeepGreater>(buf[cur], n, bound, buf[1 - cur]);
+    cur = 1 - cur;
+  };
+  step.template operator()<0, true>(static_cast<float>(x));
+  step.template operator()<0, false>(static_cast<float>(x + 1));
+  step.template operator()<1, true>(static_cast<float>(y));
+  step.template operator()<1, false>(static_cast<float>(y + 1));
   ClipPolygon poly;
-  poly.p[0] = a;
-  poly.p[1] = b;
-  poly.p[2] = c;
-  poly.n = 3;
-  poly = clip_half_plane(poly, 0, static_cast<float>(x), true);
-  poly = clip_half_plane(poly, 0, static_cast<float>(x + 1), false);
-  poly = clip_half_plane(poly, 1, static_cast<float>(y), true);
-  poly = clip_half_plane(poly, 1, static_cast<float>(y + 1), false);
+  poly.n = n;
+  for (int i = 0; i < n; ++i) poly.p[i] = {buf[cur][i].x, buf[cur][i].y};
   return poly;
 }
 

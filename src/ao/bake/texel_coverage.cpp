@@ -6,6 +6,7 @@
 // texel (eq. 4), which fails at chart borders and where triangles of different stretch meet.
 #include "ao/bake/texel_coverage.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -67,13 +68,17 @@ float ClipPolygon::area() const {
   return static_cast<float>(std::abs(s) * 0.5);
 }
 
-ClipPolygon clip_to_texel(Vec2 a, Vec2 b, Vec2 c, int x, int y) {
+namespace {
+
+// A convex polygon being clipped, in two buffers that the clips alternate between.
+struct ClipBuffers {
   Corner buf[2][9];
-  buf[0][0] = {a.x, a.y}, buf[0][1] = {b.x, b.y}, buf[0][2] = {c.x, c.y};
-  int n = 3, cur = 0;
-  // A clip whose line keeps every corner would copy the polygon as it is, so it is skipped (a
-  // triangle in a texel's interior needs no clip at all).
-  const auto step = [&]<int kAxis, bool kKeepGreater>(float bound) {
+  int n = 0, cur = 0;
+  const Corner* corners() const { return buf[cur]; }
+  // The clip against one line. A clip whose line keeps every corner would copy the polygon as it
+  // is, so it is skipped (a triangle in a texel's interior needs no clip at all).
+  template <int kAxis, bool kKeepGreater>
+  void clip(float bound) {
     bool all_in = true;
     for (int i = 0; i < n; ++i) {
       const float v = kAxis == 0 ? buf[cur][i].x : buf[cur][i].y;
@@ -82,16 +87,36 @@ ClipPolygon clip_to_texel(Vec2 a, Vec2 b, Vec2 c, int x, int y) {
     if (all_in) return;
     n = clip_half_plane<kAxis, kKeepGreater>(buf[cur], n, bound, buf[1 - cur]);
     cur = 1 - cur;
-  };
-  step.template operator()<0, true>(static_cast<float>(x));
-  step.template operator()<0, false>(static_cast<float>(x + 1));
-  step.template operator()<1, true>(static_cast<float>(y));
-  step.template operator()<1, false>(static_cast<float>(y + 1));
+  }
+};
+
+// Triangle a b c clipped to the column x <= u <= x + 1: the first two of clip_to_texel's four
+// clips, the same for every texel of the column.
+ClipBuffers clip_to_column(Vec2 a, Vec2 b, Vec2 c, int x) {
+  ClipBuffers col;
+  col.buf[0][0] = {a.x, a.y}, col.buf[0][1] = {b.x, b.y}, col.buf[0][2] = {c.x, c.y};
+  col.n = 3;
+  col.clip<0, true>(static_cast<float>(x));
+  col.clip<0, false>(static_cast<float>(x + 1));
+  return col;
+}
+
+// A column's polygon clipped to the row y <= v <= y + 1: clip_to_texel's last two clips.
+ClipPolygon clip_to_row(const ClipBuffers& column, int y) {
+  ClipBuffers cell;
+  cell.n = column.n;
+  std::copy_n(column.corners(), column.n, cell.buf[0]);
+  cell.clip<1, true>(static_cast<float>(y));
+  cell.clip<1, false>(static_cast<float>(y + 1));
   ClipPolygon poly;
-  poly.n = n;
-  for (int i = 0; i < n; ++i) poly.p[i] = {buf[cur][i].x, buf[cur][i].y};
+  poly.n = cell.n;
+  for (int i = 0; i < cell.n; ++i) poly.p[i] = {cell.corners()[i].x, cell.corners()[i].y};
   return poly;
 }
+
+}  // namespace
+
+ClipPolygon clip_to_texel(Vec2 a, Vec2 b, Vec2 c, int x, int y) { return clip_to_row(clip_to_column(a, b, c, x), y); }
 
 std::vector<std::string> TexelCoverage::warnings() const {
   std::vector<std::string> w;
@@ -173,13 +198,27 @@ void clip_block(const Scene& scene, int width, int height, double mean_ratio, Bl
     if (lo_x < 0 || lo_y < 0 || hi_x > width || hi_y > height) ++blk.outside;
     const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(width - 1, static_cast<int>(std::floor(hi_x)));
     const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(height - 1, static_cast<int>(std::floor(hi_y)));
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const float area = clip_to_texel(a, b, c, x, y).area();
+    // Column by column: the triangle clipped to the column once, then to each row its polygon
+    // reaches. A row wholly above or below the column's polygon would clip it to nothing; the row
+    // whose bottom line touches the polygon's top is kept, as a clip there can leave a sliver.
+    const std::size_t first = blk.pending.size();
+    for (int x = x0; x <= x1; ++x) {
+      const ClipBuffers col = clip_to_column(a, b, c, x);
+      if (col.n == 0) continue;
+      float lo = col.corners()[0].y, hi = lo;
+      for (int i = 1; i < col.n; ++i) lo = std::min(lo, col.corners()[i].y), hi = std::max(hi, col.corners()[i].y);
+      // (Clamped before the conversion: the corners are those of any triangle, however far outside.)
+      const auto row = [&](float v) { return static_cast<int>(std::clamp(std::floor(v), -2.0f, static_cast<float>(height))); };
+      const int ya = std::max(y0, row(lo) - 1), yb = std::min(y1, row(hi));
+      for (int y = ya; y <= yb; ++y) {
+        const float area = clip_to_row(col, y).area();
         if (!(area > 0)) continue;
         blk.pending.push_back({static_cast<std::uint32_t>(static_cast<std::size_t>(y) * width + x),
                                {blk.mesh, static_cast<std::uint32_t>(t), area, static_cast<float>(area * stretch)}});
       }
+    }
+    // The triangle's fragments in texel order (row by row), as the texel-by-texel loop made them.
+    std::sort(blk.pending.begin() + static_cast<std::ptrdiff_t>(first), blk.pending.end(), [](const Pending& p, const Pending& q) { return p.texel < q.texel; });
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include <tbb/parallel_for.h>
 
@@ -19,6 +20,8 @@ namespace {
 
 constexpr int kMaxSize = 16384;
 constexpr std::size_t kBlock = 4096;  // triangles per parallel block (blocks are merged in order)
+constexpr int kBandRows = 16;         // texel rows per band of the parallel merge
+int band_count(int height) { return (height + kBandRows - 1) / kBandRows; }
 // A UV triangle smaller than this many texels^2 per world unit^2 of surface, relative to the
 // map, counts as degenerate: its texels would get a weight 1e6 times the average.
 constexpr double kDegenerateRatio = 1e-6;
@@ -178,9 +181,22 @@ double mean_texel_ratio(const Scene& scene, int width, int height) {
 struct Block {
   std::uint32_t mesh;
   std::size_t first, last;
-  std::vector<Pending> pending;  // the run's fragments, in triangle then texel order
+  std::vector<Pending> pending;  // the run's fragments by band of texel rows, within a band in triangle then texel order
+  std::vector<std::size_t> band_start;  // band b's fragments are pending[band_start[b] .. band_start[b + 1])
   std::size_t degenerate = 0, outside = 0;
 };
+
+// Sorts blk's fragments by band of texel rows, stably (a counting sort), for gather_by_texel.
+void by_band(int width, int height, Block& blk) {
+  const auto band = [&](const Pending& p) { return static_cast<std::size_t>(p.texel / static_cast<std::uint32_t>(width)) / kBandRows; };
+  blk.band_start.assign(static_cast<std::size_t>(band_count(height)) + 1, 0);
+  for (const Pending& p : blk.pending) ++blk.band_start[band(p) + 1];
+  for (std::size_t b = 1; b < blk.band_start.size(); ++b) blk.band_start[b] += blk.band_start[b - 1];
+  std::vector<std::size_t> cursor(blk.band_start.begin(), blk.band_start.end() - 1);
+  std::vector<Pending> sorted(blk.pending.size());
+  for (const Pending& p : blk.pending) sorted[cursor[band(p)]++] = p;
+  blk.pending.swap(sorted);
+}
 
 // Clips the triangles of blk against every texel their UV box touches.
 void clip_block(const Scene& scene, int width, int height, double mean_ratio, Block& blk) {
@@ -220,42 +236,67 @@ void clip_block(const Scene& scene, int width, int height, double mean_ratio, Bl
     // The triangle's fragments in texel order (row by row), as the texel-by-texel loop made them.
     std::sort(blk.pending.begin() + static_cast<std::ptrdiff_t>(first), blk.pending.end(), [](const Pending& p, const Pending& q) { return p.texel < q.texel; });
   }
+  by_band(width, height, blk);
 }
 
 // The blocks' fragments sorted by texel (a counting sort, stable, so the order is deterministic),
-// with each texel's areas, mask and the counts behind the warnings.
+// with each texel's areas, mask and the counts behind the warnings. Band by band in parallel (the
+// blocks hold their fragments by band): a band's texels take their fragments from the blocks in
+// block order, so every texel gets its fragments, and sums its areas, in the order one pass over
+// the blocks would.
 void gather_by_texel(std::vector<Block>& blocks, TexelCoverage& cov) {
   const std::size_t texels = cov.texel_count();
+  const auto width = static_cast<std::size_t>(cov.width);
+  const int bands = band_count(cov.height);
+  const auto band_texels = [&](int b) {
+    return std::pair{static_cast<std::size_t>(b) * kBandRows * width, std::min(texels, static_cast<std::size_t>(b + 1) * kBandRows * width)};
+  };
+  const auto band_fragments = [&](const Block& blk, int b) {
+    return std::span(blk.pending).subspan(blk.band_start[static_cast<std::size_t>(b)], blk.band_start[static_cast<std::size_t>(b) + 1] - blk.band_start[static_cast<std::size_t>(b)]);
+  };
   cov.offsets.assign(texels + 1, 0);
-  std::size_t total = 0;
   for (const Block& blk : blocks) {
     cov.degenerate_uv_triangles += blk.degenerate;
     cov.outside_triangles += blk.outside;
-    total += blk.pending.size();
-    for (const Pending& p : blk.pending) ++cov.offsets[p.texel + 1];
   }
-  for (std::size_t i = 0; i < texels; ++i) cov.offsets[i + 1] += cov.offsets[i];
-  cov.fragments.resize(total);
-  std::vector<std::uint32_t> cursor(cov.offsets.begin(), cov.offsets.end() - 1);
+  // Each band's counts, then its running sums from 0; offsets[lo] is the previous band's.
+  std::vector<std::size_t> band_base(static_cast<std::size_t>(bands) + 1, 0);
+  tbb::parallel_for(0, bands, [&](int b) {
+    for (const Block& blk : blocks)
+      for (const Pending& p : band_fragments(blk, b)) ++cov.offsets[p.texel + 1];
+    const auto [lo, hi] = band_texels(b);
+    std::uint32_t run = 0;
+    for (std::size_t i = lo; i < hi; ++i) cov.offsets[i + 1] = run += cov.offsets[i + 1];
+    band_base[static_cast<std::size_t>(b) + 1] = run;
+  });
+  for (int b = 0; b < bands; ++b) band_base[static_cast<std::size_t>(b) + 1] += band_base[static_cast<std::size_t>(b)];
+  cov.fragments.resize(band_base.back());
   cov.world_area = Image<float>(cov.width, cov.height, 0.0f);
   cov.uv_area = Image<float>(cov.width, cov.height, 0.0f);
   cov.mask = Image<std::uint8_t>(cov.width, cov.height, std::uint8_t{0});
-  for (Block& blk : blocks) {
-    for (const Pending& p : blk.pending) {
-      cov.fragments[cursor[p.texel]++] = p.frag;
-      cov.world_area[p.texel] += p.frag.world_area;
-      cov.uv_area[p.texel] += p.frag.uv_area;
+  std::vector<std::size_t> covered(static_cast<std::size_t>(bands)), overlapping(static_cast<std::size_t>(bands));
+  tbb::parallel_for(0, bands, [&](int b) {
+    const auto [lo, hi] = band_texels(b);
+    const auto base = static_cast<std::uint32_t>(band_base[static_cast<std::size_t>(b)]);
+    for (std::size_t i = lo; i < hi; ++i) cov.offsets[i + 1] += base;
+    std::vector<std::uint32_t> cursor(cov.offsets.begin() + static_cast<std::ptrdiff_t>(lo), cov.offsets.begin() + static_cast<std::ptrdiff_t>(hi));
+    for (const Block& blk : blocks)
+      for (const Pending& p : band_fragments(blk, b)) {
+        cov.fragments[cursor[p.texel - lo]++] = p.frag;
+        cov.world_area[p.texel] += p.frag.world_area;
+        cov.uv_area[p.texel] += p.frag.uv_area;
+      }
+    for (std::size_t i = lo; i < hi; ++i) {
+      if (cov.world_area[i] > 0) {
+        cov.mask[i] = 1;
+        ++covered[static_cast<std::size_t>(b)];
+      }
+      // 1% slack: clipped areas of triangles sharing an edge sum to the texel area up to rounding.
+      if (cov.uv_area[i] > 1.01f) ++overlapping[static_cast<std::size_t>(b)];
     }
-    std::vector<Pending>().swap(blk.pending);
-  }
-  for (std::size_t i = 0; i < texels; ++i) {
-    if (cov.world_area[i] > 0) {
-      cov.mask[i] = 1;
-      ++cov.covered_texels;
-    }
-    // 1% slack: clipped areas of triangles sharing an edge sum to the texel area up to rounding.
-    if (cov.uv_area[i] > 1.01f) ++cov.overlapping_texels;
-  }
+  });
+  for (int b = 0; b < bands; ++b) cov.covered_texels += covered[static_cast<std::size_t>(b)], cov.overlapping_texels += overlapping[static_cast<std::size_t>(b)];
+  for (Block& blk : blocks) std::vector<Pending>().swap(blk.pending);
 }
 
 }  // namespace

@@ -11,7 +11,8 @@
 // in direction order (TexelPoints), the lane-parallel ray maker and the tracer (reference/
 // raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) and
 // the tile loop are in texel_rays_internal.h, shared with high_to_low.cpp; the default bake's 16
-// rays go to Embree as one occlusion packet (BatchTracer).
+// rays go to Embree as one occlusion packet where its native width is 16, else in packets of its
+// width filled straight from the batch (BatchTracer).
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>

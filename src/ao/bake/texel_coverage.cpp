@@ -1,7 +1,9 @@
 // Exact UV coverage of the texel grid. Each triangle is clipped (Sutherland-Hodgman) against every
-// texel square its UV bounding box touches; the clipped area, scaled by the triangle's ratio of
-// world area to UV area (constant over a triangle, since the parameterisation is linear there:
-// the paper's sec. 3, after eq. 3), is that texel's share of surface. Summing these shares gives
+// texel square its UV bounding box touches, column by column: to the column's two lines once, then
+// that polygon to the two lines of each row it reaches (the clips clip_to_texel makes, in its
+// order); the clipped area, scaled by the triangle's ratio of world area to UV area (constant over
+// a triangle, since the parameterisation is linear there: the paper's sec. 3, after eq. 3), is
+// that texel's share of surface. Summing these shares gives
 // the exact denominator of eq. 2/3 without the paper's assumption that stretch is constant over a
 // texel (eq. 4), which fails at chart borders and where triangles of different stretch meet.
 #include "ao/bake/texel_coverage.h"

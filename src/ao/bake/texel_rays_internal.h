@@ -278,7 +278,7 @@ class BatchTracer {
   /// mu of lanes 0 .. count - 1 of `batch` (count in [1, 16]) into mu[k]: 0 where valid[k] is 0
   /// (no ray). `as_packet`: with 16-wide packets and an occlusion-only tracer, the batch goes to
   /// Embree as it is, one packet whose valid lanes may have gaps; otherwise the valid lanes are
-  /// packed, in order, into packets of N.
+  /// packed, in order, into packets of N (an occlusion-only tracer's straight from the batch).
   void trace(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, bool as_packet, float (&mu)[16]) {
     const float reach = tracer_.falloff.reach();
     if constexpr (N == 16) {

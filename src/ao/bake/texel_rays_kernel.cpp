@@ -1,8 +1,10 @@
 // The ray-traced baker's ray makers (bake/texel_rays_internal.h: make_texel_rays,
-// make_hemisphere_rays), compiled once per SIMD target: written as loops over the 16 lanes of a
-// batch, which each target's compiler vectorises with its own registers (4, 8 or 16 floats), so a
-// portable build makes its rays as fast as one compiled for the CPU. Part of ao::ao (the batch and
-// the patch belong to the bakers).
+// make_hemisphere_rays), compiled once per SIMD target. make_texel_rays is written in Highway
+// vectors over the 16 lanes of a batch (4, 8 or 16 floats at a time, as the target holds), with
+// the scalar code's operations in its order, so a lane's bits do not depend on the target;
+// make_hemisphere_rays is a loop over the lanes that the compiler vectorises. A portable build makes
+// its rays as fast as one compiled for the CPU. Part of ao::ao (the batch and the patch belong to
+// the bakers).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "ao/bake/texel_rays_kernel.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep

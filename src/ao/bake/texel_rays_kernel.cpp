@@ -89,7 +89,7 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
   alignas(64) int piece[W];
   const VF total = hn::Set(d, patch.back().cdf);
   for (int k = 0; k < W; k += lanes) {
-    const VF tk = hn::Mul(hn::Load(d, u[2] + k), total);
+    const VF tk = hn::Mul(hn::LoadU(d, u[2] + k), total);
     VI pk = hn::Zero(di);
     for (std::size_t j = 0; j + 1 < patch.size(); ++j)
       pk = hn::Sub(pk, hn::VecFromMask(di, hn::RebindMask(di, hn::Le(hn::Set(d, patch[j].cdf), tk))));  // a true mask lane is -1
@@ -121,7 +121,7 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
     VF su = hn::Mul(hn::Sub(hn::Load(d, target + k), hn::Load(d, lane[T::kLo] + k)), hn::Load(d, lane[T::kInvSpan] + k));
     su = hn::IfThenElse(hn::Lt(su, zero), zero, su);
     su = hn::IfThenElse(hn::Lt(one, su), one, su);
-    const VF r = hn::Sqrt(su), u3 = hn::Load(d, u[3] + k);
+    const VF r = hn::Sqrt(su), u3 = hn::LoadU(d, u[3] + k);
     const VF w0 = hn::Sub(one, r), w1 = hn::Mul(r, hn::Sub(one, u3)), w2 = hn::Mul(r, u3);
     const VF px = corner_sum(lane, T::kP, k, w0, w1, w2), py = corner_sum(lane, T::kP + 1, k, w0, w1, w2), pz = corner_sum(lane, T::kP + 2, k, w0, w1, w2);
     const VF mx = corner_sum(lane, T::kN, k, w0, w1, w2), my = corner_sum(lane, T::kN + 1, k, w0, w1, w2), mz = corner_sum(lane, T::kN + 2, k, w0, w1, w2);
@@ -138,7 +138,7 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
     const VF tx = hn::Add(one, hn::Mul(hn::Mul(hn::Mul(sign, nx), nx), fa)), ty = hn::Mul(sign, fc), tz = hn::Mul(hn::Neg(sign), nx);
     const VF bx = fc, by = hn::Add(sign, hn::Mul(hn::Mul(ny, ny), fa)), bz = hn::Neg(ny);
     VF lx, ly, lz;
-    concentric_hemisphere(hn::Load(d, u[0] + k), hn::Load(d, u[1] + k), lx, ly, lz);
+    concentric_hemisphere(hn::LoadU(d, u[0] + k), hn::LoadU(d, u[1] + k), lx, ly, lz);
     const VF dx = hn::Add(hn::Add(hn::Mul(tx, lx), hn::Mul(bx, ly)), hn::Mul(nx, lz));
     const VF dy = hn::Add(hn::Add(hn::Mul(ty, lx), hn::Mul(by, ly)), hn::Mul(ny, lz));
     const VF dz = hn::Add(hn::Add(hn::Mul(tz, lx), hn::Mul(bz, ly)), hn::Mul(nz, lz));

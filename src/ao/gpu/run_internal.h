@@ -47,7 +47,7 @@ struct Run {
   /// After the run, the stats entry `name` of the method's output is the sum of the GPU times of
   /// the passes `passes` (milliseconds): the CPU method's own timing fields from the passes that do
   /// their work.
-  void report_ms(std::string name, std::vector<std::string> passes) { reported_ms.emplace_back(std::move(name), std::move(passes)); }
+  void report_ms(std::string name, std::vector<std::string> pass_names) { reported_ms.emplace_back(std::move(name), std::move(pass_names)); }
 
   std::vector<std::pair<std::string, std::vector<std::string>>> reported_ms;  ///< What report_ms asked for, in order.
 };

@@ -103,7 +103,8 @@ std::set<std::string> help_values(const std::string& line) {
   else if (std::regex_search(line, m, std::regex(R"(^  \S+ ([a-z-]+(?:\|[a-z-]+)+))"))) list = std::regex_replace(m[1].str(), std::regex("\\|"), ", ");
   else if (std::regex_search(line, m, std::regex(R"(: ([a-z-]+(?:, [a-z-]+)+)(?: \(|$))"))) list = m[1].str();
   std::set<std::string> values;
-  for (auto it = std::sregex_iterator(list.begin(), list.end(), std::regex("[a-z-]+")); it != std::sregex_iterator(); ++it) values.insert(it->str());
+  const std::regex word("[a-z-]+");
+  for (auto it = std::sregex_iterator(list.begin(), list.end(), word); it != std::sregex_iterator(); ++it) values.insert(it->str());
   return values;
 }
 
@@ -151,7 +152,8 @@ TEST(Vocabulary, TheDocumentedDefaultsAndValuesAreWhatHelpSays) {
       if (std::regex_search(text, d, std::regex(R"(default `([^`]+)`|`([^`]+)` \(default\)|\(default ([^) ]+)\))")))
         documented_default = d[1].matched ? d[1].str() : d[2].matched ? d[2].str() : d[3].str();
       std::set<std::string> documented_values;
-      for (auto it = std::sregex_iterator(text.begin(), text.end(), std::regex("`([a-z][a-z-]*)`")); it != std::sregex_iterator(); ++it)
+      const std::regex quoted("`([a-z][a-z-]*)`");
+      for (auto it = std::sregex_iterator(text.begin(), text.end(), quoted); it != std::sregex_iterator(); ++it)
         documented_values.insert((*it)[1].str());
       for (const std::string& c : commands) {
         const std::string help = help_line(c, option);

@@ -17,19 +17,26 @@ namespace fs = std::filesystem;
 std::string shell(const std::string& command, const fs::path& dir) {
   const fs::path script = dir / "cmd.sh", out = dir / "cmd.out";
   test::write_text(script, command + "\n");
-  EXPECT_EQ(std::system(("bash " + script.string() + " > " + out.string() + " 2>&1").c_str()), 0) << test::read_text(out);
+  std::string run = "bash ";
+  run.append(script.string()).append(" > ").append(out.string()).append(" 2>&1");
+  EXPECT_EQ(std::system(run.c_str()), 0) << test::read_text(out);
   return test::read_text(out);
 }
 
 struct CliDocs : ::testing::Test {
   test::TempDir dir;
-  void SetUp() override { shell("bash '" AO_TESTS_DIR "/../scripts/cli-docs' '" AO_CLI_PATH "' '" + (dir / "docs").string() + "' 0.0.0", dir.path()); }
+  void SetUp() override {
+    std::string command = "bash '" AO_TESTS_DIR "/../scripts/cli-docs' '" AO_CLI_PATH "' '";
+    command.append((dir / "docs").string()).append("' 0.0.0");
+    shell(command, dir.path());
+  }
   // What bash completion offers for `words` (the last one being completed), in an empty folder.
   std::string complete(const std::string& words) {
     fs::create_directories(dir / "empty");
-    return shell("source '" + (dir / "docs/bash-completion/ao").string() + "'; cd '" + (dir / "empty").string() + "'; COMP_WORDS=(" + words +
-                     "); COMP_CWORD=$((${#COMP_WORDS[@]} - 1)); _ao; echo \"${COMPREPLY[*]}\"",
-                 dir.path());
+    std::string command = "source '";
+    command.append((dir / "docs/bash-completion/ao").string()).append("'; cd '").append((dir / "empty").string()).append("'; COMP_WORDS=(");
+    command.append(words).append("); COMP_CWORD=$((${#COMP_WORDS[@]} - 1)); _ao; echo \"${COMPREPLY[*]}\"");
+    return shell(command, dir.path());
   }
 };
 

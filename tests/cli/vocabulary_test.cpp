@@ -79,7 +79,7 @@ std::string help_line(const std::string& command, const std::string& option) {
       for (std::string p; std::getline(parts, p, ',');)
         if (p == option) found = line;
     } else if (!found.empty() && line.rfind("   ", 0) == 0) {
-      found += " " + line.substr(line.find_first_not_of(' '));
+      found.append(1, ' ').append(line, line.find_first_not_of(' '));
     } else if (!found.empty()) {
       break;
     }

@@ -168,7 +168,7 @@ TEST(UntrustedCli, TuneOutputIsCheckedAgainstItsInputsAndExtension) {
   dir.write("c.json", R"({"eye": [0, 2, 2], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40})");
   dir.write("p.json", R"({"intensity": 0.7})");
   const std::string tune = "tune -m alchemy --fit intensity=0.5:1 --budget 1 ";
-  expect_one_line_error(run_ao(tune + "--scenes m.off -o m.off", dir.path()), "m.off: -o writes the parameter file as JSON; give it a .json name");
+  expect_one_line_error(run_ao(tune + "--scenes m.off -o m.off", dir.path()), "m.off: -o is the parameter file, written as JSON; give it a .json name");
   expect_one_line_error(run_ao(tune + "--scenes m.off -o m.json.txt", dir.path()), ".json name");
   expect_one_line_error(run_ao(tune + "--scenes plane --camera c.json -o c.json", dir.path()), "c.json: the output of -o is the input of --camera");
   expect_one_line_error(run_ao(tune + "--scenes plane -p @p.json -o p.json", dir.path()), "p.json: the output of -o is the input of -p @p.json");

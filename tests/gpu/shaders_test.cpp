@@ -71,10 +71,10 @@ TEST(GpuShaders, EveryUniformIsDocumentedInItsFile) {
       if (!std::regex_search(line, m, uniform)) continue;
       // A uniform is documented when a comment names it (a family of them may be named together,
       // "u_basis_x/y/z").
-      const std::string name = m[1];
-      const std::string stem = name.substr(0, name.find_last_of('_'));
-      EXPECT_TRUE(comments.find(name) != std::string::npos || comments.find(stem + "_x/y/z") != std::string::npos)
-          << name << ": uniform " << name << " is not documented in its comments";
+      const std::string uniform_name = m[1];
+      const std::string stem = uniform_name.substr(0, uniform_name.find_last_of('_'));
+      EXPECT_TRUE(comments.find(uniform_name) != std::string::npos || comments.find(stem + "_x/y/z") != std::string::npos)
+          << name << ": uniform " << uniform_name << " is not documented in its comments";
     }
   }
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "ao/core/error.h"
+#include "ao/eval/metrics.h"
 #include "ao/registry/registry.h"
 #include "../methods/screen_space_fixtures.h"
 
@@ -68,6 +69,21 @@ TEST(Tune, StartsFromThePresetsValueNotTheMiddleOfTheRange) {
   // A start outside the range begins at its nearest end.
   const TuneResult c = tune_method({view}, {.method = "alchemy", .parameters = {{"intensity", 0.6, 2.0}}, .time_budget_s = 1e-9});
   EXPECT_DOUBLE_EQ(c.params.at("intensity").get<double>(), 0.6);
+}
+
+// Alchemy's radius 0 means the falloff radius R: a fit of it starts at R (the default's own result,
+// the same image), not at the range's end.
+TEST(Tune, AlchemysRadiusStartsAtTheFalloffRadius) {
+  const auto s = test::builtin_gbuffer("sphere-on-plane");
+  const Falloff f{Membership::Step, 0.8f};
+  const MethodInfo& m = find_method("alchemy");
+  const TuneView view{s.rays.get(), &s.g, nullptr, f, Image<float>(s.g.width(), s.g.height(), 1.0f)};
+  const TuneResult r = tune_method({view}, {.method = "alchemy", .parameters = {{"radius", 0.2, 2.0}}, .time_budget_s = 1e-9});
+  EXPECT_EQ(r.evaluations, 1);
+  EXPECT_DOUBLE_EQ(r.params.at("radius").get<double>(), 0.8);
+  const Image<std::uint8_t> covered = coverage_mask(s.g);
+  const double at_default = compare_images(run_method(MethodInput{s.g, s.rays.get(), f, 1}, m.decode(m.default_params())).visibility, view.reference, covered).rmse;
+  EXPECT_EQ(r.start_rmse, at_default);
 }
 
 // The optimum (albedo_scale = 0.4, as in FindsAKnownOptimum) lies below the range asked for: the

@@ -113,7 +113,7 @@ TEST(Alchemy, StaysWithinBoundOfItsReferenceOnDefaultScene) {
   paper.preset = AlchemyPreset::Paper;
   for (const AlchemyParams& p : {paper, AlchemyParams{}}) {
     const AlchemyImage img = render_alchemy(g, p, R, 1);
-    const auto ref = render_raytraced(rs, g, alchemy_reference_falloff(p, R), {.samples = 64}, 2);
+    const auto ref = render_raytraced(rs, g, Falloff{Membership::Step, R}, {.samples = 64}, 2);
     const ErrorMetrics e = compare_images(img.visibility, ref.visibility, coverage_mask(g));
     if (p.preset == AlchemyPreset::Paper) {
       // Not a convergence test: with the paper's sigma the screen-space estimator weights occluders
@@ -168,23 +168,21 @@ TEST(Alchemy, ContrastIsAPowerOfTheUnfilteredResult) {
   for (std::size_t i = 0; i < a.visibility.size(); ++i) EXPECT_NEAR(b.visibility[i], std::pow(a.visibility[i], 2.5f), 1e-6f);
 }
 
-TEST(Alchemy, ReferenceIsStepObscuranceWithinRAtAnyIntensity) {
-  AlchemyParams p;
-  Falloff f = alchemy_reference_falloff(p, 2.0f);
-  EXPECT_EQ(f.membership, Membership::Step);
-  EXPECT_EQ(f.radius, 2.0f);
-  for (float sigma : {0.0f, 0.4f, 1.0f, 5.0f}) {
-    p.intensity = sigma;
-    EXPECT_EQ(alchemy_reference_falloff(p, 2.0f).membership, Membership::Step) << sigma;
-    EXPECT_EQ(alchemy_reference_falloff(p, 2.0f).radius, 2.0f) << sigma;
-  }
-  p.radius = 0.5f;  // the method's own r wins over the caller's R
-  EXPECT_EQ(alchemy_reference_falloff(p, 2.0f).radius, 0.5f);
+// The paper's eq. 3 (step obscurance within the scene's R) judges Alchemy whatever its knobs: sigma
+// (0 included: AO switched off), and its own radius r, which changes the estimate, not the target.
+TEST(Alchemy, ReferenceIsStepObscuranceWithinTheScenesRAtAnyIntensityAndRadius) {
   const MethodInfo& m = find_method("alchemy");
-  nlohmann::json off = m.default_params();
-  off["intensity"] = 0;  // AO switched off is judged against the same step reference
-  EXPECT_EQ(matched_reference({Membership::Step, 2.0f}, m.decode(off)).key(), matched_reference({Membership::Step, 2.0f}, m.decode(m.default_params())).key());
-  EXPECT_EQ(matched_reference({Membership::Step, 2.0f}, m.decode(off)).falloff.membership, Membership::Step);
+  const Falloff scene_r{Membership::Step, 2.0f};
+  const ReferenceSpec defaults = matched_reference(scene_r, m.decode(m.default_params()));
+  EXPECT_EQ(defaults.falloff.membership, Membership::Step);
+  EXPECT_EQ(defaults.falloff.radius, 2.0f);
+  for (const nlohmann::json& knob : {nlohmann::json{{"intensity", 0}}, nlohmann::json{{"intensity", 1}}, nlohmann::json{{"intensity", 5}},
+                                     nlohmann::json{{"radius", 0.5}}, nlohmann::json{{"radius", 0.01}}, nlohmann::json{{"radius", 8}}}) {
+    const ReferenceSpec r = matched_reference(scene_r, m.decode(knob));
+    EXPECT_EQ(r.key(), defaults.key()) << knob;
+    EXPECT_EQ(r.falloff.radius, 2.0f) << knob;
+    EXPECT_EQ(obscurance_falloff(scene_r, m.decode(knob)).radius, 2.0f) << knob;
+  }
 }
 
 TEST(Alchemy, RejectsBadParameters) {

@@ -25,7 +25,7 @@ TEST(Reference, EachMethodIsJudgedAgainstWhatItEstimates) {
   EXPECT_EQ(matched("transfer", f).kind, ReferenceKind::Transfer);
   EXPECT_EQ(matched("transfer", f).label(), "transfer (linear)");
   EXPECT_EQ(matched("cone", f).label(), "step obscurance");
-  // Alchemy: step obscurance within its r at any sigma (eq. 7 with the paper's u = 2r).
+  // Alchemy: step obscurance within the scene's R (the paper's eq. 3) at any sigma and radius.
   EXPECT_EQ(matched("alchemy", f).label(), "step obscurance");
   EXPECT_EQ(matched("gtao", f).label(), "step obscurance");
 }

@@ -135,6 +135,26 @@ TEST(TransferReference, IndependentOfThreadCountAndAtLeastTheObscurance) {
   }
 }
 
+// Where every surface has one albedo, the receiver's is every occluder's: the two references are the
+// same image, bit for bit (the same rays; the G-buffer carries the meshes' albedo exactly).
+TEST(TransferReference, ReceiverAlbedoIsTheOccludersWhereAllShareOne) {
+  Scene scene = make_builtin_scene("box-room");
+  for (Mesh& m : scene.meshes) m.albedo = {0.7f, 0.5f, 0.3f};
+  const auto s = test::scene_gbuffer(std::move(scene));
+  const Falloff f{Membership::Step, 1.0f};
+  const TransferReferenceImage own = render_transfer_reference(*s.rays, s.g, f, 0.8f, {.samples = 32}, 4);
+  const TransferReferenceImage receiver = render_transfer_reference(*s.rays, s.g, f, 0.8f, {.samples = 32}, 4, {}, TransferAlbedo::Receiver);
+  for (std::size_t i = 0; i < own.transfer.size(); ++i) ASSERT_EQ(own.transfer[i], receiver.transfer[i]) << "pixel " << i;
+}
+
+// The receiver's albedo is read from the G-buffer: one rendered without it is refused, not read as black.
+TEST(TransferReference, ReceiverAlbedoNeedsTheGBuffersAlbedo) {
+  const auto s = test::builtin_gbuffer("box-room");
+  GBuffer g = s.g;
+  g.albedo = Image<Vec3>();
+  EXPECT_THROW(render_transfer_reference(*s.rays, g, {Membership::Step, 1.0f}, 1.0f, {.samples = 4}, 4, {}, TransferAlbedo::Receiver), InputError);
+}
+
 TEST(TransferReference, RejectsBadAlbedoScale) {
   const Scene s = make_builtin_scene("plane");
   const RayScene rs(s);

@@ -54,8 +54,9 @@ double covered_mean(const Image<float>& v, const GBuffer& g) {
   return n ? sum / static_cast<double>(n) : 1.0;
 }
 
-// GTAO's multi-bounce fit estimates the light after interreflections with the surfaces' albedo
-// (Jimenez et al. 2016, sec. 5), which the ray-traced ambient transfer W computes; without it GTAO
+// GTAO's multi-bounce fit estimates the light after interreflections with a neighbourhood of the
+// receiver's albedo (Jimenez et al. 2016, sec. 5), which the ray-traced ambient transfer W with the
+// receiver's albedo computes; without it GTAO
 // estimates the cosine-weighted visibility within R, step obscurance, whatever membership is asked.
 TEST(Registry, GtaoWithMultiBounceIsJudgedAgainstAmbientTransfer) {
   const MethodInfo& m = find_method("gtao");
@@ -70,6 +71,8 @@ TEST(Registry, GtaoWithMultiBounceIsJudgedAgainstAmbientTransfer) {
   EXPECT_EQ(bounced.falloff.membership, Membership::Step);
   EXPECT_EQ(bounced.falloff.radius, 1.5f);
   EXPECT_EQ(bounced.albedo_scale, 1.0f);
+  EXPECT_EQ(bounced.albedo, TransferAlbedo::Receiver);
+  EXPECT_EQ(choose_reference("transfer", {Membership::Linear, 1.5f}, m.decode(m.canonical_params(p))).albedo, TransferAlbedo::Occluders);
 }
 
 TEST(Registry, ScreenSpaceMethodsOfferTheFourCharacteristicFunctions) {

@@ -36,7 +36,7 @@ float Falloff::mu(float d) const {
     case Membership::Linear: return t;
     case Membership::Sqrt: return std::sqrt(t);
     case Membership::Cubic: return t * t * t;
-    // 1 - g(d) with g(d) = u/d (eq. 7-10 for d >= u; eq. 10's epsilon only matters for d < epsilon/u, see
+    // 1 - g(d) with g(d) = u/d (eq. 10; eq. 7 for d >= u; eq. 10's epsilon only matters for d < epsilon/u, see
     // docs/methods/alchemy.md), clipped to g <= 1 because a direction cannot be more than fully occluded
     // (eq. 4: 0 <= g <= 1). u/0 = inf gives mu(0) = 0.
     case Membership::Alchemy: return d < radius ? std::max(0.0f, 1.0f - effective_alchemy_u() / d) : 1.0f;

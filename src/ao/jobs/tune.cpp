@@ -26,9 +26,19 @@ namespace ao {
 
 namespace {
 
+// The parameter whose 0 means "the falloff radius R" (Alchemy's r).
+constexpr std::string_view kRadiusParam = "radius";
+
+// The views' falloff radius R (their mean: each scene chooses its own).
+double mean_radius(const std::vector<TuneView>& views) {
+  double sum = 0;
+  for (const TuneView& v : views) sum += v.falloff.radius;
+  return sum / static_cast<double>(views.size());
+}
+
 // The search's start: the method's defaults (or the given start), each fitted parameter a number
 // inside its range (integer where the parameter is).
-nlohmann::json tune_start(const MethodInfo& m, const TuneSettings& s) {
+nlohmann::json tune_start(const MethodInfo& m, const TuneSettings& s, const std::vector<TuneView>& views) {
   nlohmann::json current = s.start.is_null() ? m.default_params() : s.start;
   // A value a preset leaves unset starts where the method has it (Alchemy's intensity 0.4 at the
   // fitted preset), so the start does not depend on the range asked for.
@@ -40,6 +50,8 @@ nlohmann::json tune_start(const MethodInfo& m, const TuneSettings& s) {
     if (current.at(p.key).is_null()) current[p.key] = resolved.value(p.key, nlohmann::json());
     if (current.at(p.key).is_null()) current[p.key] = 0.5 * (p.lo + p.hi);  // no preset gives it a value
     if (!current.at(p.key).is_number()) throw InputError("tune: parameter '" + p.key + "' of " + s.method + " is not a number");
+    // A radius at 0 runs at the views' R: the search starts there, not at the range's end.
+    if (p.key == kRadiusParam && current.at(p.key).get<double>() == 0) current[p.key] = shortest_floats(nlohmann::json(static_cast<float>(mean_radius(views))));
     // A start outside the range begins at its nearest end.
     const double x = current.at(p.key).get<double>();
     if (x < p.lo || x > p.hi) current[p.key] = shortest_floats(nlohmann::json(static_cast<float>(std::clamp(x, p.lo, p.hi))));
@@ -99,7 +111,7 @@ TuneResult tune_method(const std::vector<TuneView>& views, const TuneSettings& s
   if (s.parameters.empty()) throw InputError("tune: no parameter to fit");
   if (!(s.time_budget_s > 0)) throw InputError("tune: the time budget must be > 0 seconds");
   if (!(s.min_step > 0 && s.min_step < 1)) throw InputError("tune: min_step must be in (0, 1)");
-  nlohmann::json current = tune_start(m, s);
+  nlohmann::json current = tune_start(m, s, views);
 
   TuneResult r;
   // Mean RMSE over the views; a parameter value the method refuses counts as infinitely bad.
@@ -152,11 +164,11 @@ void declare_output(const TuneRequest& r, OutputSet& outputs) {
   if (r.output.empty()) return;
   std::string ext = r.output.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".json") throw InputError(r.output.string() + ": -o writes the parameter file as JSON; give it a .json name");
+  if (ext != ".json") throw InputError(r.output.string() + ": " + field(fields::kTuneOutput) + " is the parameter file, written as JSON; give it a .json name");
   for (const std::string& scene : r.scenes) SceneSource{.args = {scene}}.declare_inputs(outputs);
   if (r.camera.file) outputs.add_input(*r.camera.file, "--camera");
   for (const std::filesystem::path& p : r.parameter_files) outputs.add_input(p, "-p @" + p.string());
-  outputs.add_output(r.output, "-o");
+  outputs.add_output(r.output, field(fields::kTuneOutput));
 }
 
 }  // namespace

@@ -46,7 +46,8 @@ struct TuneSettings {
   std::string method;                    ///< Registry name.
   /// Complete parameters to start from (default_params() when null). A fitted value left null
   /// starts where the method's preset puts it (with_presets_resolved, registry.h), else mid-range; a
-  /// start outside [lo, hi] at its nearest end.
+  /// `radius` at 0 (the falloff radius R, Alchemy's r) at the views' mean R; a start outside
+  /// [lo, hi] at its nearest end.
   nlohmann::json start;
   std::vector<TuneParameter> parameters; ///< At least one; keys the method has, numeric values.
   double time_budget_s = 60;             ///< Stops after the first evaluation past this, seconds, > 0.

@@ -38,7 +38,8 @@ std::string reference_kind_names() {
 std::string ReferenceSpec::label() const {
   switch (kind) {
     case ReferenceKind::TangentSphere: return "tangent sphere";
-    case ReferenceKind::Transfer: return std::string("transfer (").append(to_string(falloff.membership)).append(")");
+    case ReferenceKind::Transfer:
+      return std::string("transfer (").append(to_string(falloff.membership)).append(albedo == TransferAlbedo::Receiver ? ", receiver albedo)" : ")");
     default: return std::string(to_string(falloff.membership)).append(" obscurance");
   }
 }
@@ -52,6 +53,7 @@ std::string ReferenceSpec::key() const {
   if (falloff.membership == Membership::Exp) k.append(" tau=").append(shortest(falloff.effective_tau()));
   if (falloff.membership == Membership::Alchemy) k.append(" u=").append(shortest(falloff.effective_alchemy_u()));
   if (kind == ReferenceKind::Transfer) k.append(" albedo_scale=").append(shortest(albedo_scale));
+  if (kind == ReferenceKind::Transfer && albedo == TransferAlbedo::Receiver) k.append(" albedo=receiver");
   return k;
 }
 
@@ -64,6 +66,7 @@ void to_json(nlohmann::json& j, const ReferenceSpec& r) {
     if (r.falloff.membership == Membership::Alchemy) j["u"] = r.falloff.effective_alchemy_u();
   }
   if (r.kind == ReferenceKind::Transfer && r.albedo_scale != 1.0f) j["albedo_scale"] = r.albedo_scale;
+  if (r.kind == ReferenceKind::Transfer && r.albedo == TransferAlbedo::Receiver) j["albedo"] = "receiver";
 }
 
 ReferenceSpec obscurance_reference(Falloff f) {
@@ -79,7 +82,7 @@ ReferenceImage render_reference(const RayScene& scene, const GBuffer& g, const R
       out.scalar = render_tangent_sphere(scene, g, spec.falloff.radius, params, seed, progress);
       break;
     case ReferenceKind::Transfer: {
-      TransferReferenceImage t = render_transfer_reference(scene, g, spec.falloff, spec.albedo_scale, params, seed, progress);
+      TransferReferenceImage t = render_transfer_reference(scene, g, spec.falloff, spec.albedo_scale, params, seed, progress, spec.albedo);
       out.scalar = std::move(t.scalar);
       out.color = std::move(t.transfer);
       out.obscurance = std::move(t.obscurance);

@@ -17,6 +17,7 @@
 #include "ao/core/progress.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/raytraced.h"
+#include "ao/reference/transfer_reference.h"
 
 namespace ao {
 
@@ -39,14 +40,17 @@ struct ReferenceSpec {
   ReferenceKind kind = ReferenceKind::Obscurance;
   Falloff falloff;
   float albedo_scale = 1.0f;  ///< Transfer only: multiplies the occluders' albedo, [0, 1].
+  /// Transfer only: whose albedo the occluders reflect with (transfer_reference.h).
+  TransferAlbedo albedo = TransferAlbedo::Occluders;
 
-  /// Short name for tables and sheets: "step obscurance", "tangent sphere", "transfer (step)".
+  /// Short name for tables and sheets: "step obscurance", "tangent sphere", "transfer (step)",
+  /// "transfer (step, receiver albedo)".
   std::string label() const;
   /// Identifies the image: equal keys render the same reference.
   std::string key() const;
 };
 /// {"kind", "membership" (not for tangent-sphere), "radius", "tau"/"u" where the membership has
-/// one, "albedo_scale" (transfer, when not 1)}.
+/// one, "albedo_scale" (transfer, when not 1), "albedo": "receiver" (transfer with the receiver's)}.
 void to_json(nlohmann::json& j, const ReferenceSpec& r);
 
 /// The obscurance reference of `f`, with Alchemy's falloff written as Step when it is Step (u >= R:

@@ -50,9 +50,10 @@ struct RatioAccumulator {
 
 // One point's estimate about unit normal n, rays from `origin` (the point moved off its surface,
 // ray_offset.h).
-template <int N>
+// `albedo_of(object)` is the albedo of the occluder hit.
+template <int N, class AlbedoOf>
 TransferEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 origin, Vec3 n, const Falloff& falloff,
-                          const std::vector<Vec3>& albedo, const RaytracedParams& params, std::uint32_t seed) {
+                          const AlbedoOf& albedo_of, const RaytracedParams& params, std::uint32_t seed) {
   const Frame frame = Frame::from_normal(n);
   const float reach = falloff.reach();
   constexpr int kBatch = 16;
@@ -67,7 +68,7 @@ TransferEstimate estimate(const RayScene& rs, RTCIntersectContext& ctx, Vec3 ori
           // Eq. 4's two integrands over cosine-weighted directions: mu(d) of the sky, and the
           // occluder's albedo weighted by 1 - mu(d); nothing hit within the reach is open sky.
           const double mu = object == RTC_INVALID_GEOMETRY_ID ? 1.0 : falloff.mu(d);
-          const Vec3 a = object == RTC_INVALID_GEOMETRY_ID ? Vec3{} : albedo[object];
+          const Vec3 a = object == RTC_INVALID_GEOMETRY_ID ? Vec3{} : albedo_of(object);
           const double q[3] = {1.0 - (1.0 - mu) * a.x, 1.0 - (1.0 - mu) * a.y, 1.0 - (1.0 - mu) * a.z};
           acc.add(mu, q);
         });
@@ -100,21 +101,26 @@ TransferEstimate estimate_transfer(const RayScene& rs, Vec3 p, Vec3 n, const Fal
   // No triangle is named: the offset scale is the largest coordinate of the point and the scene.
   const float offset = params.offset > 0 ? params.offset : ray_offset_distance(point_magnitude(p, rs.bounds()));
   const Vec3 nn = normalize(n);
-  return detail::with_ray_context(rs, [&]<int N>(RTCIntersectContext& ctx) { return estimate<N>(rs, ctx, p + nn * offset, nn, falloff, albedo, params, seed); });
+  const auto albedo_of = [&](unsigned object) { return albedo[object]; };
+  return detail::with_ray_context(rs, [&]<int N>(RTCIntersectContext& ctx) { return estimate<N>(rs, ctx, p + nn * offset, nn, falloff, albedo_of, params, seed); });
 }
 
 TransferReferenceImage render_transfer_reference(const RayScene& rs, const GBuffer& g, const Falloff& falloff, float albedo_scale,
-                                                 const RaytracedParams& params, std::uint32_t seed, const ProgressFn& progress) {
+                                                 const RaytracedParams& params, std::uint32_t seed, const ProgressFn& progress, TransferAlbedo source) {
   falloff.validate();
   params.validate();
   const std::vector<Vec3> albedo = scaled_albedos(rs, albedo_scale);
+  if (source == TransferAlbedo::Receiver && g.albedo.empty())
+    throw InputError("transfer reference with the receiver's albedo: the G-buffer has no albedo");
   const int w = g.width(), h = g.height();
   TransferReferenceImage out{Image<Vec3>(w, h, Vec3{1.0f, 1.0f, 1.0f}), {Image<float>(w, h, 1.0f), Image<float>(w, h, 0.0f)},
                              Image<float>(w, h, 1.0f)};
   Image<int> samples(w, h, 0);
   detail::for_each_covered_pixel(rs, g, params.offset, progress, [&]<int N>(RTCIntersectContext& ctx, int x, int y, const detail::PixelSurface& s) {
     const Vec3 origin = s.position + s.geometric * s.offset;
-    const TransferEstimate e = estimate<N>(rs, ctx, origin, s.normal, falloff, albedo, params, pixel_seed(seed, x, y));
+    const Vec3 receiver = source == TransferAlbedo::Receiver ? g.albedo(x, y) * albedo_scale : Vec3{};
+    const auto albedo_of = [&](unsigned object) { return source == TransferAlbedo::Receiver ? receiver : albedo[object]; };
+    const TransferEstimate e = estimate<N>(rs, ctx, origin, s.normal, falloff, albedo_of, params, pixel_seed(seed, x, y));
     out.transfer(x, y) = e.transfer;
     out.scalar.visibility(x, y) = e.luminance;
     out.scalar.std_error(x, y) = e.std_error;

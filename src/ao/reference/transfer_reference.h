@@ -29,6 +29,13 @@
 
 namespace ao {
 
+/// Whose albedo the light reflected between x and its neighbourhood takes in W.
+enum class TransferAlbedo {
+  Occluders,  ///< Each occluder's own (AT eq. 6 with a(y)): what `transfer` estimates.
+  Receiver,   ///< The receiving point's (the G-buffer's albedo at its pixel) for every occluder:
+              ///< the neighbourhood GTAO's multi-bounce fit assumes (Jimenez et al. 2016, sec. 5).
+};
+
 /// The estimate at one point.
 struct TransferEstimate {
   Vec3 transfer{1.0f, 1.0f, 1.0f};  ///< W per RGB channel, in [0, 1].
@@ -52,7 +59,10 @@ struct TransferReferenceImage {
 };
 
 /// The same for every covered pixel of `gbuffer`, pixel (x, y) keyed by pixel_seed(seed, x, y).
+/// With TransferAlbedo::Receiver every occluder takes the pixel's G-buffer albedo (times
+/// `albedo_scale`); InputError when the G-buffer has no albedo.
 TransferReferenceImage render_transfer_reference(const RayScene& scene, const GBuffer& gbuffer, const Falloff& falloff, float albedo_scale,
-                                                 const RaytracedParams& params, std::uint32_t seed, const ProgressFn& progress = {});
+                                                 const RaytracedParams& params, std::uint32_t seed, const ProgressFn& progress = {},
+                                                 TransferAlbedo albedo = TransferAlbedo::Occluders);
 
 }  // namespace ao

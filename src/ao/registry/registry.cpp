@@ -55,27 +55,28 @@ ReferenceSpec matched(const Falloff& requested, const VolumetricParams&) {
 ReferenceSpec matched(const Falloff& requested, const TransferParams& p) { return ReferenceSpec{ReferenceKind::Transfer, requested, p.albedo_scale}; }
 // Cone tracing estimates classical AO with R = R_max (sec. III-C): step membership, the user's R.
 ReferenceSpec matched(const Falloff& requested, const ConeParams&) { return obscurance_reference({Membership::Step, requested.radius}); }
-// Alchemy approximates classical obscurance within its radius r (step, R = r): at the paper's
-// preset eq. 7's falloff is exactly that, and the reference never moves with sigma, the
-// estimator's aesthetic knob (docs/methods/alchemy.md).
-ReferenceSpec matched(const Falloff& requested, const AlchemyParams& p) {
-  return obscurance_reference(alchemy_reference_falloff(p, requested.radius));
-}
+// Alchemy estimates classical obscurance, the paper's eq. 3 (A*_r: cosine-weighted visibility
+// within r), judged at the scene's R like every other method: its own radius r (0 = R), like sigma,
+// is a knob of the estimator, scored against the fixed reference, never moving it
+// (docs/methods/alchemy.md).
+ReferenceSpec matched(const Falloff& requested, const AlchemyParams&) { return obscurance_reference({Membership::Step, requested.radius}); }
 // GTAO without the multi-bounce fit estimates the cosine-weighted visibility within R: step
 // obscurance with the user's R (the membership asked for does not change what it computes). With
-// the fit it estimates the ambient light after interreflections among surfaces of the albedo
-// around the point (Jimenez et al. 2016, sec. 5), which the ray-traced ambient transfer W with the
-// occluders' albedo computes (reference/transfer_reference.h), scored on its luminance.
+// the fit it estimates the ambient light after interreflections with a neighbourhood of the
+// receiver's own albedo (Jimenez et al. 2016, sec. 5: the fit's ground truth gives the occluders
+// the albedo of the point they surround), which the ray-traced ambient transfer W with the
+// receiver's albedo computes (reference/transfer_reference.h, TransferAlbedo::Receiver), scored on
+// its luminance. W with the occluders' own albedo stays available as `--reference transfer`.
 ReferenceSpec matched(const Falloff& requested, const GtaoParams& p) {
   const Falloff step{Membership::Step, requested.radius};
-  return p.multi_bounce ? ReferenceSpec{ReferenceKind::Transfer, step} : obscurance_reference(step);
+  return p.multi_bounce ? ReferenceSpec{.kind = ReferenceKind::Transfer, .falloff = step, .albedo = TransferAlbedo::Receiver} : obscurance_reference(step);
 }
 ReferenceSpec matched(const Falloff& requested, const RaytracedMethodParams& p) { return ReferenceSpec{p.reference, requested}; }
 
 Falloff obscurance_of(const Falloff& requested, const VolumetricParams&) { return {Membership::Cubic, requested.radius}; }
 Falloff obscurance_of(const Falloff& requested, const ConeParams&) { return {Membership::Step, requested.radius}; }
 Falloff obscurance_of(const Falloff& requested, const GtaoParams&) { return {Membership::Step, requested.radius}; }
-Falloff obscurance_of(const Falloff& requested, const AlchemyParams& p) { return alchemy_reference_falloff(p, requested.radius); }
+Falloff obscurance_of(const Falloff& requested, const AlchemyParams&) { return {Membership::Step, requested.radius}; }
 // Containment, transfer and the ray-traced reference: the requested obscurance.
 template <class P>
 Falloff obscurance_of(const Falloff& requested, const P&) {
@@ -104,7 +105,6 @@ P resolved(const P& p) {
 constexpr std::array<std::string_view, 1> kReferenceQuantity{kReferenceParam};
 constexpr std::array<std::string_view, 1> kAlbedoScaleQuantity{"albedo_scale"};
 constexpr std::array<std::string_view, 1> kMultiBounceQuantity{"multi_bounce"};
-constexpr std::array<std::string_view, 1> kRadiusQuantity{"radius"};  // Alchemy's r is the R it integrates within
 constexpr std::array<std::string_view, 1> kObscuranceExtra{"obscurance"};
 constexpr std::array<std::string_view, 1> kUnfilteredExtra{"unfiltered"};
 
@@ -156,7 +156,6 @@ const std::array kMethods{
                .summary = "Alchemy AO: screen-space disk samples, eq. 10 (sigma, k, beta, epsilon, r, s) + 13-tap cross-bilateral filter",
                .gpu = true,
                .extras = kUnfilteredExtra,
-               .quantity_params = kRadiusQuantity,
                .samples_param = "samples",
                .params = schema<alchemy_param_table>,
                .decode = decode<alchemy_param_table>},

@@ -99,10 +99,6 @@ AlchemyConstants alchemy_constants(const AlchemyParams& p, float default_radius)
   return {r, m, p.effective_intensity() * m, p.epsilon * m * m, p.bias};
 }
 
-Falloff alchemy_reference_falloff(const AlchemyParams& p, float default_radius) {
-  return Falloff{Membership::Step, alchemy_constants(p, default_radius).radius};
-}
-
 AlchemyImage render_alchemy(const GBuffer& g, const AlchemyParams& params, float default_radius, std::uint32_t seed, const ProgressFn& progress) {
   if (params.layers.layers < 2) return render_alchemy(g, nullptr, params, default_radius, seed, progress);
   const float separation = effective_separation(params.layers, alchemy_constants(params, default_radius).radius);

@@ -78,13 +78,6 @@ struct AlchemyConstants {
 /// `default_radius` is used when params.radius is 0. Validates.
 AlchemyConstants alchemy_constants(const AlchemyParams& params, float default_radius);
 
-/// The ground truth Alchemy approximates: classical obscurance (step membership) within its radius r
-/// (docs/methods/alchemy.md). Eq. 7's falloff u t / max(u, t)^2 is what eq. 8 integrates, but sec. 2.3
-/// removes u, and what remains of it is sigma, an aesthetic scale of the estimate: a reference that
-/// followed sigma would move with the knob it judges (at sigma = 0, V = 1 everywhere would score
-/// perfectly). With the paper's sigma (u = 2r >= r) eq. 7's falloff is exactly this step. So the
-/// reference depends on r alone, never on intensity, contrast, bias or epsilon.
-Falloff alchemy_reference_falloff(const AlchemyParams& params, float default_radius);
 
 struct AlchemyImage {
   Image<float> visibility;  ///< V in [0,1]; 1 where the G-buffer is not covered. Filtered when params.filter.

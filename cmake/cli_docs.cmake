@@ -1,6 +1,7 @@
-# The ao command's man pages (ao.1, ao-SUBCOMMAND.1; Debian's help2man) and bash completion,
-# generated from the built binary's --help at build time by scripts/cli-docs into
-# build/cli-docs/, and installed (share/man/man1, share/bash-completion/completions/ao).
+# The ao command's man pages (ao.1, ao-SUBCOMMAND.1; Debian's help2man) and bash and zsh
+# completion, generated from the built binary's --help at build time by scripts/cli-docs into
+# build/cli-docs/, and installed (share/man/man1, share/bash-completion/completions/ao,
+# share/zsh/vendor-completions/_ao).
 find_program(AO_HELP2MAN help2man)
 if(NOT AO_HELP2MAN)
   message(WARNING "help2man not found (scripts/setup installs it): ao's man pages are not generated")
@@ -16,4 +17,5 @@ if(AO_INSTALL)
   include(GNUInstallDirs)
   install(DIRECTORY ${AO_CLI_DOCS}/man1 DESTINATION ${CMAKE_INSTALL_MANDIR})
   install(FILES ${AO_CLI_DOCS}/bash-completion/ao DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions)
+  install(FILES ${AO_CLI_DOCS}/zsh-completion/_ao DESTINATION ${CMAKE_INSTALL_DATADIR}/zsh/vendor-completions)
 endif()

@@ -2,7 +2,7 @@
 # The library boundary, checked as a user meets it (run by CTest as `install_and_examples` and
 # `installed_headers_without_embree`, or by hand: examples/check_install.sh BUILD_DIR [examples|headers]):
 #   1. installs the build into a temporary prefix, which carries the licence and its notice, man
-#      pages and bash completion for ao and each subcommand, and whose libao has no tinygltf
+#      pages and bash and zsh completion for ao and each subcommand, and whose libao has no tinygltf
 #      symbol (nm);
 # examples (the default):
 #   2. builds examples/ as a separate CMake project with find_package(ao 0.2 REQUIRED), with
@@ -41,7 +41,7 @@ for lib in $libs; do
     if grep -m 3 gltf_detail "$tmp/exports"; then echo "check_install: $lib exports tinygltf" >&2; exit 1; fi ;;
   esac
 done
-echo "== man pages and bash completion for ao and every subcommand"
+echo "== man pages and bash and zsh completion for ao and every subcommand"
 subcommands=$("$prefix/bin/ao" --help | sed -n '/^Subcommands:/,$p' | awk 'NR > 1 && /^  [a-z]/ { print $1 }')
 [ -n "$subcommands" ] || { echo "check_install: no subcommands in ao --help" >&2; exit 1; }
 completion=$prefix/share/bash-completion/completions/ao
@@ -50,7 +50,8 @@ completion=$prefix/share/bash-completion/completions/ao
 for s in $subcommands; do
   grep -q "ao-$s(1)" "$prefix/share/man/man1/ao.1" || { echo "check_install: ao.1 does not mention ao-$s(1)" >&2; exit 1; }
   grep -q "^\.TH AO-${s^^} " "$prefix/share/man/man1/ao-$s.1" || { echo "check_install: no man page ao-$s.1" >&2; exit 1; }
-  grep -q "^    $s) words=" "$completion" || { echo "check_install: the completion does not know $s" >&2; exit 1; }
+  grep -q "^    $s)$" "$completion" || { echo "check_install: the completion does not know $s" >&2; exit 1; }
+  grep -q "^  $s)$" "$prefix/share/zsh/vendor-completions/_ao" || { echo "check_install: the zsh completion does not know $s" >&2; exit 1; }
 done
 grep -q -- "--spp" "$completion" || { echo "check_install: the completion lacks render's options" >&2; exit 1; }
 PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name ao.pc)")"

@@ -8,7 +8,7 @@ import math
 import numbers
 import os
 
-from ._ao import InputError
+from ._ao import InputError, did_you_mean
 
 _INT32 = (-2 ** 31, 2 ** 31 - 1)
 _UINT32 = (0, 2 ** 32 - 1)
@@ -98,7 +98,7 @@ def one_of(name, value, choices, *, optional=False):
     """`value` as one of the strings `choices`."""
     value = text(name, value, optional=optional)
     if value is not None and value not in choices:
-        raise InputError(f"{name}: expected one of {', '.join(choices)}, got {value!r}")
+        raise InputError(f"{name}: expected one of {', '.join(choices)}, got {value!r}{did_you_mean(value, list(choices))}")
     return value
 
 

@@ -154,7 +154,7 @@ def compare_tasks(args):
     known = [m["name"] for m in ao.methods()]
     for m in methods or []:
         if m not in known:
-            raise Refused(f"--methods: unknown method '{m}' (known: {', '.join(known)})")
+            raise Refused(f"--methods: unknown method '{m}' (known: {', '.join(known)}){_ao.did_you_mean(m, known)}")
     if not 1 <= args.spp_reference <= 1 << 20:
         raise Refused(f"--spp-reference must be in [1, 1048576], got {args.spp_reference}")
     request = {"methods": methods, "spp_reference": args.spp_reference, "seed": args.seed}

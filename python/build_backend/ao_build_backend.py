@@ -51,7 +51,7 @@ def _tag():
 
 def _metadata(version):
     return (f"Metadata-Version: 2.1\nName: ao\nVersion: {version}\n"
-            "Summary: Ambient occlusion on the CPU: five published methods, GTAO and a ray-traced ground truth\n"
+            "Summary: Ambient occlusion on the CPU: six published methods and a ray-traced ground truth\n"
             "Requires-Python: >=3.9\nRequires-Dist: numpy\n")
 
 

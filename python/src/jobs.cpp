@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/io/mesh_io.h"
 #include "ao/jobs/bake.h"
@@ -50,7 +51,7 @@ void check_param_names(const std::string& method, const nlohmann::json& params) 
     if (known.contains(key)) continue;
     std::string names;
     for (const auto& [k, v] : known.items()) names += (names.empty() ? "" : ", ") + k;
-    throw InputError("method " + method + " has no parameter '" + key + "' (it has: " + names + ")");
+    throw InputError("method " + method + " has no parameter '" + key + "' (it has: " + names + ")" + did_you_mean(key, names));
   }
 }
 

@@ -7,6 +7,7 @@
 #include <pybind11/stl/filesystem.h>
 #include <tbb/global_control.h>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/core/params.h"
 #include "ao/io/atomic_file.h"
@@ -249,4 +250,6 @@ PYBIND11_MODULE(_ao, m) {
   m.def("methods", &methods);
   m.def("param_tables", &param_tables);
   m.def("set_threads", &set_threads, py::arg("threads"));
+  m.def("did_you_mean", [](const std::string& typed, const std::vector<std::string>& names) { return ao::did_you_mean(typed, names); },
+        py::arg("typed"), py::arg("names"), "\"; did you mean 'x'?\" naming the name closest to typed, or \"\": the suffix of ao's errors about a name.");
 }

@@ -18,9 +18,10 @@
 #include "ao/version.h"
 
 // core: math, affine maps, images, G-buffers, cameras, sampling, membership functions, parallel
-// tiles, parameter tables, memory estimates, stopwatch, errors.
+// tiles, parameter tables, memory estimates, stopwatch, errors and the closest name they suggest.
 #include "ao/core/affine.h"
 #include "ao/core/camera.h"
+#include "ao/core/closest_name.h"
 #include "ao/core/color_shared.h"
 #include "ao/core/error.h"
 #include "ao/core/hash_shared.h"

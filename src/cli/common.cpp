@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/io/json_text.h"
 #include "ao/jobs/progress_meter.h"
@@ -130,7 +131,8 @@ void apply_param_overrides(nlohmann::json& params, const std::vector<std::string
     if (!known.contains(key)) {
       std::string names;
       for (const auto& [k, v] : known.items()) names += (names.empty() ? "" : ", ") + k;
-      throw InputError("--param: method " + std::string(method) + " has no parameter '" + shown(key) + "' (it has: " + names + ")");
+      throw InputError("--param: method " + std::string(method) + " has no parameter '" + shown(key) + "' (it has: " + names + ")" +
+                       did_you_mean(key.substr(key.find('.') + 1), names));  // "gtao.slices" (compare's form) suggests "slices"
     }
     std::optional<nlohmann::json> parsed = parse_json_limited(value, "--param " + key);
     if (known[key].is_number_integer() && parsed) parsed = whole_number(*parsed, key, value, method);

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/jobs/compare.h"
 #include "ao/io/text.h"
@@ -63,15 +64,21 @@ void parse_params(const std::vector<std::string>& params, CompareSettings& setti
     if (dot != std::string::npos && dot < eq) {
       if (dot == 0) throw InputError("--param: expected key=value or method.key=value, got '" + kv + "'");
       const std::string name = kv.substr(0, dot);
-      if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) throw InputError("--param: method '" + name + "' is not among --methods");
+      if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) throw InputError("--param: method '" + name + "' is not among --methods" + did_you_mean(name, chosen));
       set(name, kv.substr(dot + 1));
       continue;
     }
     const std::string key = kv.substr(0, eq);
     bool any = false;
-    for (const std::string& name : chosen)
-      if (find_method(name).default_params().contains(key)) set(name, kv), any = true;
-    if (!any) throw InputError("--param: no chosen method has a parameter '" + key + "' among the " + std::to_string(chosen.size()) + " methods chosen");
+    std::vector<std::string> keys;  // of every chosen method, for the closest name
+    for (const std::string& name : chosen) {
+      const nlohmann::json defaults = find_method(name).default_params();
+      if (defaults.contains(key)) set(name, kv), any = true;
+      for (std::string& k : key_names(defaults)) keys.push_back(std::move(k));
+    }
+    if (!any)
+      throw InputError("--param: no chosen method has a parameter '" + key + "' among the " + std::to_string(chosen.size()) + " methods chosen" +
+                       did_you_mean(key, keys));
   }
 }
 
@@ -140,7 +147,7 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   cmd->add_option("--sweep", o->sweep, "Also measure error against one parameter: key=v1,v2,... (e.g. samples=4,8,16,32)");
   cmd->add_option("--out-dir", o->out_dir, "Output directory (default: compare-<scene>)");
   cmd->add_option("-p,--param", o->params,
-                  "Method parameter as key=value (every chosen method that has it) or method.key=value (that method); JSON value, repeatable");
+                  "Method parameter as key=value (every chosen method that has it) or method.key=value (that method); JSON value, repeatable")->type_name("KEY=VALUE");
   cmd->add_option("--reference", o->reference,
                   "Reference to judge against: NAME for every method or method=NAME, comma-separated; NAME is matched (each method's own, "
                   "the default), obscurance (the obscurance of the membership it implies), tangent-sphere or transfer");

@@ -8,24 +8,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include "ao/core/closest_name.h"
+
 namespace ao::cli {
 
 namespace {
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 std::vector<std::string> command_names(const CLI::App& app) {
   std::vector<std::string> names;
@@ -114,17 +101,49 @@ std::string bad_value_message(const CLI::App* cmd, const CLI::App& app, const st
   return what;
 }
 
-}  // namespace
-
-std::string closest_name(std::string_view typed, const std::vector<std::string>& candidates) {
-  std::string best;
-  std::size_t best_distance = std::max<std::size_t>(1, typed.size() / 3) + 1;
-  for (const std::string& c : candidates) {
-    const std::size_t d = edit_distance(typed, c);
-    if (d < best_distance) best_distance = d, best = c;
-  }
-  return best;
+// What a value of `o` is, in words: "a whole number", "a number", or its type name ("KEY=VALUE").
+std::string expected_value(const CLI::Option& o) {
+  const std::string type = o.get_type_name();
+  if (type.rfind("UINT", 0) == 0) return "a whole number >= 0";
+  if (type.rfind("INT", 0) == 0) return "a whole number";
+  if (type.rfind("FLOAT", 0) == 0) return "a number";
+  if (type.empty() || type.rfind("TEXT", 0) == 0) return "a value";
+  return type;
 }
+
+// An option given without its value (`ao render -p`): which option, and what it expects.
+std::string missing_value_message(const CLI::App* cmd, const CLI::App& app, const std::string& what) {
+  const CLI::Option* found = nullptr;
+  std::string found_name;
+  for (const CLI::App* scope : {cmd, &app}) {
+    if (scope == nullptr) continue;
+    for (const CLI::Option* o : scope->get_options())
+      for (const std::string& l : o->get_lnames())
+        if (what.find("--" + l) != std::string::npos && l.size() + 2 > found_name.size()) found = o, found_name = "--" + l;
+  }
+  if (found == nullptr) return what;
+  return found_name + " needs a value: " + expected_value(*found);
+}
+
+// An option `cmd` does not take: the closest of its own, or the commands that take it (`ao bake -p`:
+// bake's settings are options of their own). Single letters are all one edit apart, so a
+// single-letter option gets no suggestion.
+std::string unknown_option_message(const CLI::App& app, const CLI::App& cmd, const std::string& name, const std::string& help) {
+  std::vector<std::string> known = option_names(cmd);
+  for (const std::string& n : option_names(app)) known.push_back(n);
+  const bool single_letter = name.size() == 2 && name[0] == '-';
+  const std::string near = single_letter ? "" : closest_name(name, known);
+  if (!near.empty()) return "unknown option '" + name + "'; did you mean '" + near + "'?";
+  std::vector<std::string> takers;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    const std::vector<std::string> names = option_names(*sub);
+    if (sub != &cmd && std::find(names.begin(), names.end(), name) != names.end()) takers.push_back(sub->get_name());
+  }
+  if (takers.empty()) return "unknown option '" + name + "'" + help;
+  return "unknown option '" + name + "': an option of " + joined(takers) + ", not of " + cmd.get_name() + help;
+}
+
+}  // namespace
 
 int report_parse_error(CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {
   const int code = e.get_exit_code();
@@ -150,19 +169,19 @@ int report_parse_error(CLI::App& app, const CLI::ParseError& e, int argc, char**
     return 2;
   }
   if (code == static_cast<int>(CLI::ExitCodes::ExtrasError)) {
-    std::vector<std::string> known = option_names(*cmd);
-    for (const std::string& n : option_names(app)) known.push_back(n);
     for (const std::string& arg : unexpected_arguments(what)) {
       if (arg.empty() || arg[0] != '-') {
         std::fprintf(stderr, "ao: error: %sunexpected argument '%s'%s\n", where.c_str(), arg.c_str(), help.c_str());
         return 2;
       }
-      const std::string name = arg.substr(0, arg.find('='));
-      const std::string near = closest_name(name, known);
-      std::fprintf(stderr, "ao: error: %sunknown option '%s'%s%s\n", where.c_str(), name.c_str(),
-                   near.empty() ? "" : ("; did you mean '" + near + "'?").c_str(), near.empty() ? help.c_str() : "");
+      const std::string message = unknown_option_message(app, *cmd, arg.substr(0, arg.find('=')), help);
+      std::fprintf(stderr, "ao: error: %s%s\n", where.c_str(), message.c_str());
       return 2;
     }
+  }
+  if (code == static_cast<int>(CLI::ExitCodes::ArgumentMismatch)) {
+    std::fprintf(stderr, "ao: error: %s%s%s\n", where.c_str(), missing_value_message(cmd, app, what).c_str(), help.c_str());
+    return 2;
   }
   std::fprintf(stderr, "ao: error: %s%s%s\n", where.c_str(), what.c_str(), help.c_str());
   return 2;

@@ -13,10 +13,6 @@ class ParseError;
 
 namespace ao::cli {
 
-/// The candidate closest to `typed` by edit distance, when close enough to be a typo (at most a
-/// third of its length, and at least 1, edits away); empty otherwise.
-std::string closest_name(std::string_view typed, const std::vector<std::string>& candidates);
-
 /// Prints the one-line message for `e` (thrown by app.parse on argv) and returns the exit code:
 /// 0 for --help and --version (printed as CLI11 does), 1 for a bad value, 2 for bad usage.
 int report_parse_error(CLI::App& app, const CLI::ParseError& e, int argc, char** argv);

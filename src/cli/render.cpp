@@ -146,7 +146,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, std::functio
                   "Show a baked AO map (from ao bake) on the scene instead of computing AO: V = the map at each pixel's UV");
   cmd->add_option("--gbuffer-in", o->gbuffer_in, "Read the G-buffer from an EXR instead of rendering a scene (screen-space methods)");
   cmd->add_option("-p,--param", o->params, "Method parameter as key=value (JSON value), repeatable; --json lists them. containment, volumetric, transfer: "
-                  "characteristic=depth|implicit|height-field|'depth*height-field' (docs/methods/containment.md)");
+                  "characteristic=depth|implicit|height-field|'depth*height-field' (docs/methods/containment.md)")->type_name("KEY=VALUE");
   cmd->add_option("--png-bits", o->request.outputs.png_bits, "PNG bit depth, 8 or 16")->capture_default_str();
   cmd->add_flag("--extras", o->request.outputs.extras,
                 "Also write the method's extra outputs (transfer: obscurance; alchemy: unfiltered) as <output-stem>-<name><ext>");

@@ -77,7 +77,7 @@ void add_tune_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("-m,--method", o->request.method, "Method to tune")->required();
   cmd->add_option("--fit", o->fit, "Parameter to fit: key (within its valid range) or key=lo:hi, repeatable (e.g. intensity=0.1:2)")->required();
   cmd->add_option("--scenes", o->scenes, "Comma-separated scenes, one view each (built-in names or mesh files)")->capture_default_str();
-  cmd->add_option("-p,--param", o->params, "Starting value of a parameter: key=value, repeatable");
+  cmd->add_option("-p,--param", o->params, "Starting value of a parameter: key=value, repeatable")->type_name("KEY=VALUE");
   cmd->add_option("--budget", o->request.budget_s, "Time budget, seconds")->capture_default_str();
   cmd->add_option("--reference-samples,--spp-reference", o->request.spp_reference, "Rays per pixel of the references")->capture_default_str();
   cmd->add_option("-o,--output", o->request.output, "Parameter file to write (JSON; load with -p @FILE); required unless --json");

@@ -82,7 +82,7 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
       ->type_name("cpu|gpu")
       ->capture_default_str();
   add_camera_options(*cmd, o->camera, "Window");
-  cmd->add_option("-p,--param", o->params, "Method parameter as key=value, repeatable (as ao render)");
+  cmd->add_option("-p,--param", o->params, "Method parameter as key=value, repeatable (as ao render)")->type_name("KEY=VALUE");
   cmd->add_option("--ao-map", o->ao_map, "A baked AO map to show on the mesh (view 'map')");
   cmd->add_option("--set", o->sets,
                   "A viewer setting or method parameter as key=value before the first frame: method, view (ao, shaded, transfer, map, error), "

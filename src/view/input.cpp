@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/io/json_text.h"
 #include "ao/registry/registry.h"
@@ -65,7 +66,7 @@ void set_parameter(const std::string& key, const std::string& value, ViewerState
   if (!params.contains(key)) {
     std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud";
     for (const auto& [k, v] : params.items()) known += ", " + k;
-    throw InputError("--set: unknown key '" + key + "' (viewer settings and parameters of " + state.method + ": " + known + ")");
+    throw InputError("--set: unknown key '" + key + "' (viewer settings and parameters of " + state.method + ": " + known + ")" + did_you_mean(key, known));
   }
   std::optional<nlohmann::json> parsed = parse_json_limited(value, "--set " + key);
   params[key] = parsed ? std::move(*parsed) : nlohmann::json(value);
@@ -80,7 +81,7 @@ bool set_display(const std::string& key, const std::string& value, ViewerState& 
         state.set_view(static_cast<ViewMode>(i));
         return true;
       }
-    throw InputError("--set view: one of ao, shaded, transfer, map, error, got '" + value + "'");
+    throw InputError("--set view: one of ao, shaded, transfer, map, error, got '" + value + "'" + did_you_mean(value, "ao, shaded, transfer, map, error"));
   }
   if (key == "wipe") {
     state.wipe = set_number(key, value, 0, 1);
@@ -171,7 +172,7 @@ void apply_set(const std::string& kv, ViewerState& state, ViewerControls& contro
     state.dirty_method = true;
   } else if (key == "membership") {
     const auto m = parse_membership(value);
-    if (!m) throw InputError("--set membership: one of " + membership_names() + ", got '" + value + "'");
+    if (!m) throw InputError("--set membership: one of " + membership_names() + ", got '" + value + "'" + did_you_mean(value, membership_names()));
     state.falloff.membership = *m;
     state.dirty_method = true;
   } else if (key == "up") {

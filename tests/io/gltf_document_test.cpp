@@ -9,6 +9,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/gltf_document.h"
+#include "ao/version.h"
 #include "support/gltf_docs.h"
 #include "support/run.h"
 
@@ -177,6 +178,24 @@ TEST(GltfDocument, AnimationsExtensionsAndExtrasPassThroughASave) {
   EXPECT_EQ(out.json["materials"][0]["emissiveFactor"], b.doc["materials"][0]["emissiveFactor"]);
   // The animation's keyframes are the same bytes.
   EXPECT_EQ(glb_floats(out, moves), glb_floats(parse_glb_file(b.glb()), moves));
+}
+
+TEST(GltfDocument, TheGeneratorNamesAosVersionUnlessTheInputNamesItsOwn) {
+  TempDir dir;
+  GlbFile g = parse_glb_file(instanced_cubes_glb());
+  GltfBuilder b;
+  b.doc = g.json;
+  b.bin = g.bin;
+  b.doc["asset"].erase("generator");
+  write_text(dir / "plain.glb", b.glb());
+  GltfDocument plain(dir / "plain.glb", 0);
+  plain.save_glb(dir / "plain-out.glb");
+  EXPECT_EQ(parse_glb_file(read_text(dir / "plain-out.glb")).json["asset"]["generator"], std::string("ao bake ") + AO_VERSION_STRING);
+  b.doc["asset"]["generator"] = "a modeller 4.2";  // the input's author keeps the credit
+  write_text(dir / "named.glb", b.glb());
+  GltfDocument named(dir / "named.glb", 0);
+  named.save_glb(dir / "named-out.glb");
+  EXPECT_EQ(parse_glb_file(read_text(dir / "named-out.glb")).json["asset"]["generator"], "a modeller 4.2");
 }
 
 TEST(GltfDocument, ImagesBesideTheInputAreEmbeddedAndOthersAreNotRead) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <regex>
 
 #include <nlohmann/json.hpp>
 
@@ -13,6 +14,7 @@
 #include "ao/io/image_io.h"
 #include "ao/io/mesh_io.h"
 #include "ao/scene/procedural.h"
+#include "ao/version.h"
 #include "support/run.h"
 
 namespace ao {
@@ -93,6 +95,9 @@ TEST(GltfExport, ContainerHeaderAndChunksFollowTheSpec) {
   EXPECT_FALSE(g.json["buffers"][0].contains("uri"));
   EXPECT_LE(g.json["buffers"][0]["byteLength"].get<std::size_t>(), g.bin.size());
   EXPECT_EQ(g.json["asset"]["version"], "2.0");
+  // The generator names the tool and the version that wrote the file.
+  EXPECT_EQ(g.json["asset"]["generator"], std::string("ao bake ") + AO_VERSION_STRING);
+  EXPECT_TRUE(std::regex_match(g.json["asset"]["generator"].get<std::string>(), std::regex(R"(ao bake [0-9]+\.[0-9]+\.[0-9]+)")));
   // Every buffer view inside the buffer; those used by accessors start 4-byte aligned.
   for (const auto& v : g.json["bufferViews"]) {
     const std::size_t off = v.value("byteOffset", std::size_t{0}), len = v["byteLength"].get<std::size_t>();

@@ -6,6 +6,7 @@ field (python/src/field_names.cpp)."""
 
 import doctest
 import math
+import re
 
 import numpy as np
 import pytest
@@ -139,3 +140,23 @@ def test_docstrings_say_what_the_calls_do():
     # Per-vertex AO of a mesh made from arrays, without UVs and without files.
     per_vertex = ao.bake(ao.Scene.from_arrays(V, F), map=False, per_vertex=True, samples=8)
     assert per_vertex.shape == (len(V),) and np.all((0 <= per_vertex) & (per_vertex <= 1))
+
+
+@pytest.mark.parametrize("kwargs, suggestion", [
+    ({"scene": "wedge", "method": "gtoa"}, "did you mean 'gtao'?"),
+    ({"scene": "wedge", "method": "raytrace"}, "did you mean 'raytraced'?"),
+    ({"scene": "wedge", "method": "gtao", "slcies": 4}, "did you mean 'slices'?"),
+    ({"scene": "wedge", "method": "cone", "preset": "hihg"}, "did you mean 'high'?"),
+    ({"scene": "wdge"}, "did you mean 'wedge'?"),
+    ({"scene": "wedge", "membership": "stpe"}, "did you mean 'step'?"),
+])
+def test_a_mistyped_name_gets_the_closest_one(kwargs, suggestion):
+    """As on the command line: methods, parameters, their values, scenes and memberships."""
+    with pytest.raises(ao.InputError, match=re.escape(suggestion)):
+        ao.render(camera=ao.Camera(width=8, height=5), **kwargs)
+
+
+def test_a_name_far_from_every_known_one_gets_no_suggestion():
+    with pytest.raises(ao.InputError) as e:
+        ao.render("wedge", ao.Camera(width=8, height=5), method="sphere")
+    assert "did you mean" not in str(e.value) and "unknown method 'sphere'" in str(e.value)

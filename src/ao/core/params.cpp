@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cstdlib>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 
 namespace ao {
@@ -94,7 +95,9 @@ namespace params_detail {
 void throw_bad_value(std::string_view owner, const ParamSpec& spec, const nlohmann::json& got) {
   std::string value = excerpt(got);
   if (got.is_number_float()) value = float_text(got.get<float>());
-  throw InputError(std::string(owner) + ": " + spec.name + " must be " + spec.valid_text() + ", got " + value);
+  // A mistyped enum name gets the closest of the names.
+  const std::string near = spec.type == ParamType::Enum && got.is_string() ? did_you_mean(got.get<std::string>(), spec.enum_names) : "";
+  throw InputError(std::string(owner) + ": " + spec.name + " must be " + spec.valid_text() + ", got " + value + near);
 }
 
 void throw_unknown_key(std::string_view owner, std::string_view key, const std::vector<const ParamSpec*>& specs) {
@@ -103,7 +106,7 @@ void throw_unknown_key(std::string_view owner, std::string_view key, const std::
     if (!known.empty()) known += ", ";
     known += s->name;
   }
-  throw InputError(std::string(owner) + ": unknown parameter '" + std::string(key) + "' (known: " + known + ")");
+  throw InputError(std::string(owner) + ": unknown parameter '" + std::string(key) + "' (known: " + known + ")" + did_you_mean(key, known));
 }
 
 void throw_not_object(std::string_view owner, const nlohmann::json& got) {

@@ -1,5 +1,6 @@
 #include "ao/io/camera_json.h"
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/io_error_internal.h"
@@ -31,7 +32,8 @@ Camera camera_from_json(const nlohmann::json& j, const Camera& defaults, const s
     if (!j.contains(key)) throw InputError(source + ": camera has no '" + key + "' (needs eye, target, up, fov; width, height optional)");
   for (const auto& [key, value] : j.items())
     if (key != "eye" && key != "target" && key != "up" && key != "fov" && key != "width" && key != "height")
-      throw InputError(source + ": unknown camera field '" + io_detail::printable(key, 40) + "' (known: eye, target, up, fov, width, height)");
+      throw InputError(source + ": unknown camera field '" + io_detail::printable(key, 40) + "' (known: eye, target, up, fov, width, height)" +
+                       did_you_mean(key, "eye, target, up, fov, width, height"));
   Camera c = defaults;
   c.eye = read_vec(j, "eye", source);
   c.target = read_vec(j, "target", source);

@@ -25,6 +25,7 @@
 #include "ao/io/gltf_document_internal.h"
 #include "ao/io/io_error_internal.h"
 #include "ao/io/tiny_gltf_internal.h"
+#include "ao/version.h"
 
 namespace ao {
 
@@ -510,7 +511,7 @@ std::vector<std::string> GltfDocument::save_glb(const fs::path& path) {
   d.assign_materials();
   if (d.model.buffers.at(0).data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)
     fail(path, "the binary chunk would be " + std::to_string(d.model.buffers[0].data.size()) + " bytes, more than GLB's 4 GB");
-  if (d.model.asset.generator.empty()) d.model.asset.generator = "ao bake";
+  if (d.model.asset.generator.empty()) d.model.asset.generator = "ao bake " AO_VERSION_STRING;
   std::ostringstream glb;
   tinygltf::TinyGLTF writer;
   Folder nowhere;  // an empty folder: the writer may read nothing either

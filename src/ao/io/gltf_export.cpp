@@ -17,6 +17,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
+#include "ao/version.h"
 
 namespace ao {
 
@@ -134,7 +135,7 @@ struct GlbBuilder {
 
   /// The GLB file: header, JSON chunk padded with spaces, BIN chunk padded with zeros.
   std::string glb() {
-    json root = {{"asset", {{"version", "2.0"}, {"generator", "ao bake"}}},
+    json root = {{"asset", {{"version", "2.0"}, {"generator", "ao bake " AO_VERSION_STRING}}},
                  {"scene", 0},
                  {"buffers", {{{"byteLength", bin.size()}}}},
                  {"bufferViews", views},

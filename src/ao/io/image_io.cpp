@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
 #include "ao/io/exr_common_internal.h"
@@ -43,7 +44,7 @@ Format output_format(const fs::path& path) {
   if (ext == ".tga") return Format::Tga;
   if (ext == ".tif" || ext == ".tiff") return Format::Tiff;
   if (ext == ".jpg" || ext == ".jpeg") return Format::Jpeg;
-  throw InputError(path.string() + ": unsupported image format '" + ext + "'; supported: " + supported_image_extensions());
+  throw InputError(path.string() + ": unsupported image format '" + ext + "'; supported: " + supported_image_extensions() + did_you_mean(ext, supported_image_extensions()));
 }
 
 // IEC 61966-2-1 decoding (encoding: io_detail::quantise).

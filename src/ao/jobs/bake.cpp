@@ -1,6 +1,7 @@
 // The bake job: the request checked and resolved before any mesh is loaded, each mesh's outputs
 // named and declared, the bakers chosen, and the batch loop. One mesh is baked in bake_mesh.cpp,
 // a glTF round trip in bake_gltf.cpp.
+#include "ao/core/closest_name.h"
 #include "ao/jobs/bake.h"
 
 #include <algorithm>
@@ -29,7 +30,7 @@ std::string_view to_string(Baker baker) { return baker == Baker::Histogram ? "hi
 Baker baker_from_name(const std::string& name) {
   if (name == "raytraced") return Baker::Raytraced;
   if (name == "histogram") return Baker::Histogram;
-  throw InputError(field(fields::kBakeMethod) + ": expected histogram or raytraced, got '" + name + "'");
+  throw InputError(field(fields::kBakeMethod) + ": expected histogram or raytraced, got '" + name + "'" + did_you_mean(name, "histogram, raytraced"));
 }
 
 MapSize parse_map_size(const std::string& text) {
@@ -118,7 +119,8 @@ void check_high_to_low(const BakeRequest& r) {
   if (cage && h.cage_extrusion)
     throw InputError(field(fields::kBakeCage) + " and " + field(fields::kBakeCageExtrusion) + ": give one (an explicit cage, or the low mesh pushed out by a distance)");
   if (!r.outputs.miss_mask.empty() && !is_supported_image_path(r.outputs.miss_mask))
-    throw InputError(r.outputs.miss_mask.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+    throw InputError(r.outputs.miss_mask.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")" +
+                     did_you_mean(r.outputs.miss_mask.extension().string(), supported_image_extensions()));
   h.validate();
 }
 
@@ -142,7 +144,8 @@ void check_output_names(const Plan& plan) {
   const BakeOutputs& o = plan.r.outputs;
   for (const fs::path& img : {o.map, o.bent_normals})
     if (!img.empty() && !is_supported_image_path(img))
-      throw InputError(img.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+      throw InputError(img.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")" +
+                       did_you_mean(img.extension().string(), supported_image_extensions()));
   if (!o.per_vertex.empty() && lower_extension(o.per_vertex) != ".ply" && lower_extension(o.per_vertex) != ".glb")
     throw InputError(o.per_vertex.string() + ": " + field(fields::kBakePerVertex) + " writes PLY or binary glTF (COLOR_0), give it a .ply or .glb name");
   if (!o.gltf.empty() && lower_extension(o.gltf) != ".glb") throw InputError(o.gltf.string() + ": " + field(fields::kBakeGltf) + " writes binary glTF, give it a .glb name");

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/jobs/fields.h"
 #include "ao/jobs/provenance.h"
@@ -115,7 +116,7 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
     if (auto it = in.params.find(name); it != in.params.end()) {
       if (!it->second.is_object()) throw InputError(field(fields::kCompareParams) + ": parameters of " + name + " must be a JSON object");
       for (const auto& [k, v] : it->second.items()) {
-        if (!p.contains(k)) throw InputError(field(fields::kCompareParams) + ": " + name + " has no parameter '" + k + "'");
+        if (!p.contains(k)) throw InputError(field(fields::kCompareParams) + ": " + name + " has no parameter '" + k + "'" + did_you_mean(k, key_names(p)));
         p[k] = v;
       }
     }
@@ -128,8 +129,12 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
   if (!s.sweep_key.empty()) {
     if (s.sweep_values.empty()) throw InputError(field(fields::kCompareSweep) + ": no values given for '" + s.sweep_key + "'");
     bool any = false;
-    for (const auto& [name, p] : s.params) any = any || p.contains(s.sweep_key);
-    if (!any) throw InputError(field(fields::kCompareSweep) + ": no chosen method has a parameter '" + s.sweep_key + "'");
+    std::vector<std::string> keys;  // of every chosen method, for the closest name
+    for (const auto& [name, p] : s.params) {
+      any = any || p.contains(s.sweep_key);
+      for (std::string& k : key_names(p)) keys.push_back(std::move(k));
+    }
+    if (!any) throw InputError(field(fields::kCompareSweep) + ": no chosen method has a parameter '" + s.sweep_key + "'" + did_you_mean(s.sweep_key, keys));
   }
   return s;
 }
@@ -137,7 +142,8 @@ CompareSettings resolve_compare_settings(const CompareSettings& in) {
 std::optional<ReferenceSpec> common_reference_spec(const CompareSettings& s) {
   if (s.common_reference == "none") return std::nullopt;
   const std::optional<ReferenceKind> kind = parse_reference_kind(s.common_reference);
-  if (!kind) throw InputError(field(fields::kCompareCommonReference) + ": unknown reference '" + s.common_reference + "' (known: " + reference_kind_names() + ", none)");
+  if (!kind) throw InputError(field(fields::kCompareCommonReference) + ": unknown reference '" + s.common_reference + "' (known: " + reference_kind_names() + ", none)" +
+                          did_you_mean(s.common_reference, reference_kind_names() + ", none"));
   switch (*kind) {
     case ReferenceKind::TangentSphere: return ReferenceSpec{ReferenceKind::TangentSphere, {Membership::Cubic, s.falloff.radius}};
     case ReferenceKind::Transfer: return ReferenceSpec{ReferenceKind::Transfer, s.falloff};

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/jobs/fields.h"
 
@@ -12,7 +13,7 @@ const char* to_string(Device device) { return device == Device::Gpu ? "gpu" : "c
 Device device_from_name(const std::string& name) {
   if (name == "cpu") return Device::Cpu;
   if (name == "gpu") return Device::Gpu;
-  throw InputError(field(fields::kDevice) + ": cpu or gpu, got '" + name + "'");
+  throw InputError(field(fields::kDevice) + ": cpu or gpu, got '" + name + "'" + did_you_mean(name, "cpu, gpu"));
 }
 
 void check_device(Device device, const MethodParams& params) {

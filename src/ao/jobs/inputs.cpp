@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/io/camera_json.h"
@@ -316,14 +317,14 @@ Falloff choose_falloff(const FalloffRequest& request, float diagonal) {
 
 Membership membership_from_name(const std::string& name) {
   const auto m = parse_membership(name);
-  if (!m) throw InputError(field(fields::kFalloffMembership) + ": unknown '" + name + "' (known: " + membership_names() + ")");
+  if (!m) throw InputError(field(fields::kFalloffMembership) + ": unknown '" + name + "' (known: " + membership_names() + ")" + did_you_mean(name, membership_names()));
   return *m;
 }
 
 SurfaceNormal surface_normal_from_name(const std::string& name) {
   if (name == "shading") return SurfaceNormal::Shading;
   if (name == "geometric") return SurfaceNormal::Geometric;
-  throw InputError(field(fields::kNormal) + ": expected shading or geometric, got '" + name + "'");
+  throw InputError(field(fields::kNormal) + ": expected shading or geometric, got '" + name + "'" + did_you_mean(name, "shading, geometric"));
 }
 
 const char* to_string(SurfaceNormal normal) { return normal == SurfaceNormal::Geometric ? "geometric" : "shading"; }

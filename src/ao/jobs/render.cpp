@@ -3,6 +3,7 @@
 #include <cctype>
 #include <chrono>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/eval/shading.h"
@@ -37,7 +38,8 @@ void check_outputs(const RenderOutputs& o) {
   if (o.png_bits != 8 && o.png_bits != 16) throw InputError(field(fields::kRenderPngBits) + " must be 8 or 16, got " + std::to_string(o.png_bits));
   for (const fs::path& out : {o.visibility, o.shaded})
     if (!out.empty() && !is_supported_image_path(out))
-      throw InputError(out.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")");
+      throw InputError(out.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")" +
+                       did_you_mean(out.extension().string(), supported_image_extensions()));
   if (!o.gbuffer.empty() && o.gbuffer.extension() != ".exr")
     throw InputError(o.gbuffer.string() + ": " + field(fields::kRenderGBufferOut) + " writes OpenEXR, give it a .exr name");
 }

@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/jobs/fields.h"
 #include "ao/jobs/provenance.h"
@@ -43,7 +44,7 @@ nlohmann::json tune_start(const MethodInfo& m, const TuneSettings& s, const std:
   // fitted preset), so the start does not depend on the range asked for.
   const nlohmann::json resolved = params_json(with_presets_resolved(m.decode(current)));
   for (const TuneParameter& p : s.parameters) {
-    if (!current.contains(p.key)) throw InputError("tune: method " + s.method + " has no parameter '" + p.key + "'");
+    if (!current.contains(p.key)) throw InputError("tune: method " + s.method + " has no parameter '" + p.key + "'" + did_you_mean(p.key, key_names(current)));
     if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi))
       throw InputError("tune: the range of '" + p.key + "' must be finite with lo < hi");
     if (current.at(p.key).is_null()) current[p.key] = resolved.value(p.key, nlohmann::json());
@@ -177,7 +178,9 @@ std::vector<TuneParameter> tune_parameters(const MethodInfo& m, const std::vecto
   std::vector<TuneParameter> out;
   for (const TuneFit& f : fit) {
     const ParamSpec* spec = m.params().find(f.key);
-    if (!spec) throw InputError(field(fields::kTuneFit) + ": method " + std::string(m.name) + " has no parameter '" + f.key + "'");
+    if (!spec)
+      throw InputError(field(fields::kTuneFit) + ": method " + std::string(m.name) + " has no parameter '" + f.key + "'" +
+                       did_you_mean(f.key, key_names(m.default_params())));
     const bool integer = spec->type == ParamType::Int || spec->type == ParamType::OptionalInt;
     if (!integer && spec->type != ParamType::Float && spec->type != ParamType::OptionalFloat)
       throw InputError(field(fields::kTuneFit) + ": '" + f.key + "' of " + std::string(m.name) + " is " + spec->valid_text() + ", not a number to fit");

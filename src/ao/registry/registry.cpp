@@ -10,6 +10,7 @@
 #include "ao/bake/high_to_low.h"
 #include "ao/bake/histogram.h"
 #include "ao/bake/raytraced_bake.h"
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/reference/ray_scene.h"
@@ -192,7 +193,7 @@ const ParamSchema& find_param_table(std::string_view name) {
     if (t.name == name) return t.schema();
     names += (names.empty() ? "" : ", ") + std::string(t.name);
   }
-  throw InputError("no parameter table '" + std::string(name) + "' (known: " + names + ")");
+  throw InputError("no parameter table '" + std::string(name) + "' (known: " + names + ")" + did_you_mean(name, names));
 }
 
 std::span<const MethodInfo> all_methods() { return kMethods; }
@@ -204,7 +205,7 @@ ReferenceSpec choose_reference(std::string_view name, const Falloff& requested, 
   const std::optional<ReferenceKind> kind = parse_reference_kind(name);
   if (!kind)
     throw InputError("unknown reference '" + std::string(name) + "' for " + std::string(method_of(params).name) + " (known: " + kMatchedReference +
-                     ", " + reference_kind_names() + ")");
+                     ", " + reference_kind_names() + ")" + did_you_mean(name, std::string(kMatchedReference) + ", " + reference_kind_names()));
   switch (*kind) {
     case ReferenceKind::TangentSphere: return {ReferenceKind::TangentSphere, {Membership::Cubic, f.radius}};
     case ReferenceKind::Transfer: {
@@ -271,7 +272,7 @@ const MethodInfo& find_method(std::string_view name) {
     if (m.name == name) return m;
     names += (names.empty() ? "" : ", ") + std::string(m.name);
   }
-  throw InputError("unknown method '" + std::string(name) + "' (known: " + names + ")");
+  throw InputError("unknown method '" + std::string(name) + "' (known: " + names + ")" + did_you_mean(name, names));
 }
 
 const MethodInfo& ground_truth_method() {

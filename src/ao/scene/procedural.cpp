@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 
 namespace ao {
@@ -286,7 +287,7 @@ Scene make_builtin_scene(std::string_view name) {
     }
   std::string names;
   for (const auto& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
-  throw InputError(std::string(name) + ": not a file and not a built-in scene (" + names + ")");
+  throw InputError(std::string(name) + ": not a file and not a built-in scene (" + names + ")" + did_you_mean(name, names));
 }
 
 Mesh make_quad(Vec3 p0, Vec3 p1, Vec3 p2, Vec3 p3, Vec3 albedo) {

@@ -5,6 +5,7 @@
 #include <hwy/highway.h>
 #include <hwy/targets.h>
 
+#include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 
 namespace ao {
@@ -41,7 +42,7 @@ void set_simd_target(std::string_view name) {
     }
     known += (known.empty() ? "" : ", ") + std::string(hwy::TargetName(one));
   }
-  throw InputError("SIMD target '" + std::string(name) + "' is not one this build and CPU run (" + known + ")");
+  throw InputError("SIMD target '" + std::string(name) + "' is not one this build and CPU run (" + known + ")" + did_you_mean(name, known));
 }
 
 }  // namespace ao

@@ -17,8 +17,9 @@ enum class Membership {
   Sqrt,    ///< Localised square root: mu = sqrt(min(d/R, 1)).
   Cubic,   ///< mu = min(d/R, 1)^3, the falloff implied by volumetric AO (its Figure 3e).
   Exp,     ///< mu = 1 - exp(-tau d), not localised: needs the distance of far occluders too.
-  Alchemy, ///< mu = 1 - min(1, u/d) for d < R, else 1: the falloff g(t) = u/t of Alchemy AO's eq. 7-10
-           ///< (eq. 10 folds u into sigma), clipped to g <= 1 as its eq. 4 requires; u >= R makes it Step.
+  Alchemy, ///< mu = 1 - min(1, u/d) for d < R, else 1: the falloff g(t) = u/t that Alchemy AO's eq. 10
+           ///< integrates (eq. 7's u t / max(u, t)^2 for t >= u; eq. 10 replaces eq. 9's max(u^2, v.v) by
+           ///< v.v + epsilon and folds u into sigma), clipped to g <= 1 as its eq. 4 requires; u >= R makes it Step.
            ///< Derivation: docs/methods/alchemy.md.
 };
 

@@ -9,6 +9,7 @@ import logging
 import os
 import threading
 import time
+import uuid
 
 from . import _ao
 from ._batch_tasks import EVENTS, environment_check, run_task
@@ -130,9 +131,12 @@ def _spec(task, args):
 
 
 def _key(task):
-    import hashlib
-    token = hashlib.sha1(json.dumps([task["kind"], task["outputs"]]).encode()).hexdigest()[:12]
-    return f"ao-{task['kind']}-{os.path.basename(task['name'])}-{token}"
+    # Unique to this submission: a scheduler keeps a finished key's result until every client that
+    # held it is gone, and hands it to any client that submits the same key meanwhile. A key made
+    # of the task alone let a rerun with other settings (--size 48 after 32, --force) receive the
+    # result of the run before it, its outputs left as they were, when the scheduler had not yet
+    # forgotten that run's keys.
+    return f"ao-{task['kind']}-{os.path.basename(task['name'])}-{uuid.uuid4().hex}"
 
 
 def run(client, tasks, status, args, out):

@@ -241,6 +241,16 @@ def test_rerun_redoes_exactly_the_changed_outputs(shared_cluster, tmp_path):
     assert all(json.loads((out / f"grid{k}-ao.png.ao.json").read_text())["settings"]["width"] == 48 for k in range(3))
 
 
+def test_every_submission_has_its_own_key():
+    # A scheduler hands a finished key's result to any client that submits that key before it has
+    # forgotten it: a key made of the task alone let a rerun with other settings receive the run
+    # before it's result, its outputs left stale (seen under load in the test above).
+    from ao import _batch_cluster
+    task = {"kind": "bake", "name": "/m/grid0.obj", "outputs": ["/o/grid0-ao.png"]}
+    assert _batch_cluster._key(task) != _batch_cluster._key(task)
+    assert _batch_cluster._key(task).startswith("ao-bake-grid0.obj-")
+
+
 def test_bad_arguments_fail_once_before_submitting(shared_cluster, tmp_path):
     meshes, out = small_meshes(tmp_path / "meshes", count=2), tmp_path / "out"
     before = shared_cluster.task_prefixes()

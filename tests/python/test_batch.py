@@ -56,11 +56,16 @@ class Cluster:
         log = self._log(folder / "scheduler.log")
         self.processes.append(start(["dask", "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
                                      "--scheduler-file", str(scheduler_file)], log))
+        # The scheduler writes its file in place, not by a rename: wait until it is whole.
         deadline = time.monotonic() + 60
-        while not scheduler_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert scheduler_file.exists(), (folder / "scheduler.log").read_text()
-        self.address = json.loads(scheduler_file.read_text())["address"]
+        info = None
+        while info is None and time.monotonic() < deadline:
+            try:
+                info = json.loads(scheduler_file.read_text())
+            except (FileNotFoundError, json.JSONDecodeError):
+                time.sleep(0.05)
+        assert info is not None, (folder / "scheduler.log").read_text()
+        self.address = info["address"]
         assert self.address.startswith("tcp://127.0.0.1:")
         for k in range(workers):
             cmd = f"{worker_prefix} exec dask worker {self.address} --nthreads 1 --no-nanny --host 127.0.0.1 --no-dashboard --name w{k}"

@@ -52,6 +52,13 @@ class Cluster:
 
     def __init__(self, folder, workers=2, worker_env=None, worker_prefix="", wait=True):
         self.processes, self.logs, self.workers = [], [], []
+        try:
+            self._start(folder, workers, worker_env, worker_prefix, wait)
+        except BaseException:
+            self.close()  # a cluster that fails to start leaves no server behind
+            raise
+
+    def _start(self, folder, workers, worker_env, worker_prefix, wait):
         scheduler_file = folder / "scheduler.json"
         log = self._log(folder / "scheduler.log")
         self.processes.append(start(["dask", "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",

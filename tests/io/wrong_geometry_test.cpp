@@ -34,6 +34,24 @@ std::string ascii_stl_facet(float x) {
   return s.str();
 }
 
+// Both scene loaders (instanced and flattened) and the glTF round trip refuse `file` with `needle`.
+void expect_loaders_refuse(const fs::path& file, const std::string& needle) {
+  for (bool flatten : {false, true}) {
+    try {
+      load_scene_file(file, {.flatten_instances = flatten});
+      ADD_FAILURE() << "loaded, flatten_instances " << flatten;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  }
+  try {
+    GltfDocument doc(file, 0);
+    ADD_FAILURE() << "GltfDocument loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
 void expect_cli_refuses(const fs::path& dir, const std::string& file, const std::string& needle) {
   for (const std::string& command : {"render " + file + " -o out.png --width 16 --height 16 --spp 2 -q",
                                      "bake " + file + " --per-vertex pv.ply -q --spp 4"}) {
@@ -98,20 +116,7 @@ TEST(WrongGeometry, SingularNodeTransformsAreRefusedEverywhere) {
     if (name == "parent.gltf") j["scenes"][0]["nodes"] = {0};
     const fs::path file = dir.write(name, j.dump());
     const std::string needle = "has a transform with determinant 0 (it flattens the mesh)";
-    for (bool flatten : {false, true}) {
-      try {
-        load_scene_file(file, {.flatten_instances = flatten});
-        ADD_FAILURE() << "loaded, flatten_instances " << flatten;
-      } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-      }
-    }
-    try {
-      GltfDocument doc(file, 0);
-      ADD_FAILURE() << "GltfDocument loaded";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+    expect_loaders_refuse(file, needle);
     expect_cli_refuses(dir.path(), name, needle);
     const test::RunResult r = test::run_ao("bake " + name + " --gltf out.glb -s 16 --spp 4 -q", dir.path());
     EXPECT_EQ(r.exit_code, 1) << r.err;
@@ -197,20 +202,7 @@ TEST(WrongGeometry, SquashedNodeTransformsAreRefusedEverywhere) {
   for (const auto& [name, nodes] : cases) {
     SCOPED_TRACE(name);
     const fs::path file = dir.write(name, gltf_with_nodes(nodes).dump());
-    for (bool flatten : {false, true}) {
-      try {
-        load_scene_file(file, {.flatten_instances = flatten});
-        ADD_FAILURE() << "loaded, flatten_instances " << flatten;
-      } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-      }
-    }
-    try {
-      GltfDocument doc(file, 0);
-      ADD_FAILURE() << "GltfDocument loaded";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+    expect_loaders_refuse(file, needle);
     expect_cli_refuses(dir.path(), name, needle);
     const test::RunResult r = test::run_ao("compare " + name + " --methods gtao --width 16 --height 16 --reference-samples 4 -q", dir.path());
     EXPECT_EQ(r.exit_code, 1) << r.err;

@@ -23,6 +23,7 @@
 
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
+#include "ao/io/commit_journal.h"
 #include "support/errors.h"
 #include "support/run.h"
 
@@ -307,6 +308,47 @@ TEST(StaleTemporaries, AbandonedOnesAreRemovedWheneverWritten) {
   EXPECT_FALSE(fs::exists(live)) << "the caller owns the output: another writer of it is not live";
   EXPECT_TRUE(fs::exists(other)) << "another output's";
   EXPECT_TRUE(fs::exists(user)) << "not a name ao makes";
+}
+
+// A batch's tasks share their output folder: the cleanup a task does for its own output must not
+// undo another worker's commit that is renaming its outputs at that moment (seen as a forced rerun
+// whose grid1 map and record came back with the previous run's settings, because the task of
+// grid2 rolled grid1's live commit back). Only a commit that lists the owned output is undone.
+TEST(StaleTemporaries, AnOwnedOutputsCleanupLeavesOtherLiveCommitsAlone) {
+  TempDir dir;
+  const fs::path b = dir / "b.png";
+  int ready[2], release[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  ASSERT_EQ(::pipe(release), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // Another worker, half way through its commit of b.png: the journal written, b.png renamed
+    // into place, its previous file kept by a hard link. It waits there until released.
+    write_text(b, "old b");
+    const fs::path temp = dir / (".b.tmp-" + std::to_string(::getpid()) + "-1.png"), backup = dir / (".b.keep-" + std::to_string(::getpid()));
+    write_text(temp, "new b");
+    fs::create_hard_link(b, backup);
+    detail::CommitJournal journal({{b, temp, backup}});
+    fs::rename(temp, b);
+    char c = 'r';
+    if (::write(ready[1], &c, 1) != 1 || ::read(release[0], &c, 1) != 1) ::_exit(2);
+    ::_exit(0);  // leaves the journal, as a worker killed here would
+  }
+  char c = 0;
+  ASSERT_EQ(::read(ready[0], &c, 1), 1);
+  remove_abandoned_temporaries(dir / "a.png");
+  EXPECT_EQ(read_text(b), "new b") << "another output's commit, live, was rolled back";
+  EXPECT_EQ(hidden_files(dir.path()), 2) << "its journal and the link to its previous file stay";
+  // The owner of b.png, rerunning its task, undoes the commit (live or not, it was abandoned).
+  remove_abandoned_temporaries(b);
+  EXPECT_EQ(read_text(b), "old b");
+  EXPECT_EQ(hidden_files(dir.path()), 0);
+  ASSERT_EQ(::write(release[1], &c, 1), 1);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  for (int fd : {ready[0], ready[1], release[0], release[1]}) ::close(fd);
 }
 
 TEST(StaleTemporaries, ALaterCliRunRemovesWhatAKilledRunLeft) {

@@ -281,8 +281,9 @@ void check_output_destination(const fs::path& path, const std::string& what) {
 namespace {
 
 // Removes the temporary files of other processes beside `destination` (write_file_atomically's
-// names) that `abandoned` accepts.
-int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned, bool any_process) {
+// names) that `abandoned` accepts, after rolling back the interrupted commits in its folder: those
+// of processes gone, or, when the caller `owned` the destination, those that list it.
+int remove_temporaries_of(const fs::path& destination, const std::function<bool(long pid, const fs::directory_entry&)>& abandoned, bool owned) {
   std::error_code ec;
   fs::path target = destination;
   if (fs::is_symlink(destination, ec)) {
@@ -292,7 +293,7 @@ int remove_temporaries_of(const fs::path& destination, const std::function<bool(
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   // A killed run's commit first: its journal names the staged files and links it needs to roll
   // back, which the loop below would otherwise remove as stale.
-  detail::recover_interrupted_commits(dir, any_process);
+  detail::recover_interrupted_commits(dir, owned ? target : fs::path());
   int removed = 0;
   fs::directory_iterator it(dir, ec);
   for (; !ec && it != fs::directory_iterator(); it.increment(ec)) {

@@ -75,7 +75,10 @@ int remove_stale_temporaries(const std::filesystem::path& destination);
 /// caller that owns `destination` and knows no other writer of it is live, such as a task of a
 /// batch that the scheduler gives to one worker at a time, rerun after the worker that held it was
 /// killed (SIGKILL leaves its temporary files; remove_stale_temporaries keeps those written after
-/// this process started). Returns how many it removed; never throws.
+/// this process started). A commit of another process journaled in the folder is rolled back
+/// when it lists `destination` (the outputs it had renamed get their previous files back); the
+/// commits of other outputs there are left alone, since their writers may be running (a batch's
+/// tasks share one output folder). Returns how many temporary files it removed; never throws.
 int remove_abandoned_temporaries(const std::filesystem::path& destination);
 
 /// Ignores SIGXFSZ, so that a write beyond the file size limit (ulimit -f, RLIMIT_FSIZE) fails with

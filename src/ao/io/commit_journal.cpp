@@ -33,6 +33,16 @@ const fs::file_time_type g_process_start = fs::file_time_type::clock::now();
 
 fs::path folder_of(const fs::path& p) { return p.has_parent_path() ? p.parent_path() : fs::path("."); }
 
+/// `p` absolute, with ".", ".." and the links of its folders resolved: two names of one output
+/// compare equal (a journal holds absolute paths; a caller may name the output relatively).
+fs::path same_file_key(const fs::path& p) {
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(p, ec);
+  if (ec) return p.lexically_normal();
+  const fs::path folder = fs::weakly_canonical(folder_of(absolute), ec);
+  return ec ? absolute.lexically_normal() : folder / absolute.filename();
+}
+
 /// The pid in a journal's name, or -1.
 long journal_pid(const std::string& name) {
   if (!is_journal_name(name)) return -1;
@@ -143,23 +153,32 @@ void CommitJournal::remove() {
   files_.clear();
 }
 
-int recover_interrupted_commits(const fs::path& folder, bool any_process) {
+int recover_interrupted_commits(const fs::path& folder, const fs::path& owned_output) {
   std::error_code ec;
-  std::vector<fs::path> journals;
+  const fs::path owned = owned_output.empty() ? fs::path() : same_file_key(owned_output);
+  std::vector<std::pair<fs::path, Journal>> abandoned;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     const long pid = journal_pid(name);
     if (pid <= 0 || pid == ::getpid()) continue;
-    std::error_code file_ec;
-    if (!any_process) {
+    Journal j;
+    if (owned.empty()) {
       // A process that still runs (or that we may not signal, EPERM) is not ours to undo.
+      std::error_code file_ec;
       if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
       if (!(it->last_write_time(file_ec) < g_process_start) || file_ec) continue;
+      j = read_journal(it->path());
+    } else {
+      // Another writer's commit in the same folder (a batch's tasks share their output folder)
+      // is live work: only a commit that lists the owned output is undone.
+      j = read_journal(it->path());
+      const bool lists_owned = std::any_of(j.entries.begin(), j.entries.end(), [&](const JournalEntry& e) { return same_file_key(e.destination) == owned; });
+      if (!lists_owned) continue;
     }
-    journals.push_back(it->path());
+    abandoned.emplace_back(it->path(), std::move(j));
   }
-  for (const fs::path& j : journals) roll_back(j, read_journal(j));
-  return static_cast<int>(journals.size());
+  for (const auto& [path, j] : abandoned) roll_back(path, j);
+  return static_cast<int>(abandoned.size());
 }
 
 }  // namespace ao::detail

@@ -15,6 +15,7 @@ struct RunResult {
 /// Runs `AO_CLI_PATH args` through the shell in `cwd` (the current directory when empty).
 RunResult run_ao(const std::string& args, const std::filesystem::path& cwd = {});
 /// The same with `prefix` before the binary (e.g. "xvfb-run -a" for a command that opens a window).
+/// Under strace (a prefix starting "strace "), LeakSanitizer is off: it cannot run under ptrace.
 RunResult run_ao_under(const std::string& prefix, const std::string& args, const std::filesystem::path& cwd = {});
 
 /// The prefix that runs a command in a virtual X display of its own (xvfb-run, 640 x 480), for

@@ -281,7 +281,12 @@ TEST(GltfDocument, BadDocumentsAreOneLineInputErrors) {
   material["meshes"][0]["primitives"][0]["material"] = 5;
   json draco = g.json;
   draco["extensionsUsed"] = draco["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  // Found by scripts/mutate: indices without a bufferView (zeros, valid glTF) reached tinygltf,
+  // whose refusal ("accessor[N] invalid bufferView") was the message.
+  json zero_indices = g.json;
+  zero_indices["accessors"][zero_indices["meshes"][0]["primitives"][0]["indices"].get<int>()].erase("bufferView");
   const std::pair<std::string, std::string> cases[] = {
+      {make_glb(zero_indices, g.bin), "mesh 0 primitive 0, indices accessor"},
       {make_glb(index, g.bin), "99"},
       {make_glb(material, g.bin), "material 5, the file has 1"},
       {make_glb(draco, g.bin), "compressed with KHR_draco_mesh_compression"},

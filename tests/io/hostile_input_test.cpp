@@ -102,6 +102,20 @@ TEST(HostileInput, GltfWithNodeHierarchyAndUvsPassesTheCheckUnchanged) {
   EXPECT_LOAD_ERROR(dir.write("no-attributes.gltf", j.dump()), "mesh 0 primitive 0 has no attributes");
 }
 
+// Found by scripts/mutate: a buffer's data URI of another media type ("applycation/...") passed the
+// check, and the document reader of bake --gltf then took it for a file name (tinygltf's "File not
+// found : data:..."). Both media types glTF gives buffers are read; any other is refused in ao's words.
+TEST(HostileInput, BufferDataUrisOfAnotherMediaTypeAreRefused) {
+  TempDir dir;
+  json j = triangle_gltf();
+  std::string uri = j["buffers"][0]["uri"].get<std::string>();
+  const std::string payload = uri.substr(uri.find(','));
+  j["buffers"][0]["uri"] = "data:application/gltf-buffer;base64" + payload;
+  EXPECT_EQ(load_scene_file(dir.write("buffer.gltf", j.dump())).triangle_count(), 1u);
+  j["buffers"][0]["uri"] = "data:applycation/octet-stream;base64" + payload;
+  EXPECT_LOAD_ERROR(dir.write("typo.gltf", j.dump()), "buffer 0: a data URI of type 'applycation/octet-stream;base64,'");
+}
+
 TEST(HostileInput, DeeplyNestedGltfJsonIsRefused) {
   // assimp's recursive JSON parser overflowed the stack at about 175,000 levels.
   TempDir dir;

@@ -324,6 +324,12 @@ class Checker {
       const std::size_t comma = uri.find(',');
       if (comma == std::string::npos || std::string_view(uri).substr(0, comma).find(";base64") == std::string_view::npos)
         bad(where + ": only base64 data URIs are supported");
+      // The media types glTF gives buffers (and that the document reader knows: another is read
+      // as a file name).
+      const std::string_view header = std::string_view(uri).substr(0, comma + 1);
+      if (header != "data:application/octet-stream;base64," && header != "data:application/gltf-buffer;base64,")
+        bad(where + ": a data URI of type '" + one_line(std::string(header.substr(5, std::min<std::size_t>(header.size() - 5, 48)))) +
+            "'; glTF buffers are application/octet-stream or application/gltf-buffer");
       std::optional<std::string> decoded = decode_base64(std::string_view(uri).substr(comma + 1));
       if (!decoded) bad(where + ": the data URI is not valid base64");
       return owned_.emplace_back(std::move(*decoded));
@@ -543,7 +549,10 @@ class Checker {
     const Accessor& indices = accessors_[ia];
     if (indices.type != "SCALAR" || (indices.component_type != 5121 && indices.component_type != 5123 && indices.component_type != 5125))
       bad(where + ": indices accessor " + std::to_string(ia) + " is " + describe(indices) + ", glTF requires unsigned byte, short or int SCALAR");
-    if (!indices.view) return;  // all zeros
+    if (!indices.view) {  // all zeros
+      if (size_.indices_without_data.empty()) size_.indices_without_data = where + ", indices accessor " + std::to_string(ia);
+      return;
+    }
     for (std::uint64_t k = 0; k < indices.count; ++k) {
       const std::uint32_t i = read_index(*indices.view, indices.offset, indices.component_size, k);
       if (i >= vertices)

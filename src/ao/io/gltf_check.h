@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 namespace ao {
@@ -30,6 +31,10 @@ struct GltfSize {
   Counts stored;           ///< Every mesh once (what is read, and what instancing keeps).
   Counts world;            ///< Every mesh once per node that uses it (what flattening makes).
   std::uint64_t uses = 0;  ///< Nodes that use a mesh.
+  /// The first primitive whose indices accessor has no bufferView ("mesh 1 primitive 0, indices
+  /// accessor 7"): glTF reads its indices as zeros, a primitive without a triangle. The scene
+  /// loaders read the file; the document a bake rewrites (gltf_document.h) refuses it. Empty: none.
+  std::string indices_without_data;
 };
 
 /// Checks `data`, the whole content of `path`, as glTF 2.0 JSON or GLB, without allocating more

@@ -304,7 +304,10 @@ GltfDocument::GltfDocument(const fs::path& path, int uv_set, const fs::path& ass
     if (in.bad()) fail(path, "cannot be read");
     if (data.empty()) fail(path, "the file is empty");
     if (data.size() > std::numeric_limits<std::uint32_t>::max()) fail(path, "larger than 4 GB, more than glTF and GLB can address");
-    check_gltf(path, data, asset_root);  // structure, sizes, nesting and file references first: tinygltf trusts them
+    // Structure, sizes, nesting and file references first: tinygltf trusts them.
+    const GltfSize size = check_gltf(path, data, asset_root);
+    if (!size.indices_without_data.empty())
+      fail(path, size.indices_without_data + " has no bufferView (its indices would all be 0, no triangle); ao rewrites only documents whose indices are stored");
 
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &folder});

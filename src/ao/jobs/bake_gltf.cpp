@@ -4,6 +4,8 @@
 // per-vertex AO becomes each primitive's COLOR_0.
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "ao/bake/padding.h"
 #include "ao/bake/udim.h"
@@ -51,6 +53,9 @@ struct RoundTrip {
   nlohmann::json summary;
   nlohmann::json timings;
   Stopwatch clock;
+  /// Lines for people ("baked ...", "wrote ..."), told once the outputs are committed: a run that
+  /// fails later (another mesh, a write) says only its error.
+  std::vector<std::string> notes;
 
   void add_occluders(GltfWorldScene& ws) {
     check_traceable_size(ws.scene);  // every world scene of the round trip passes here
@@ -85,7 +90,7 @@ void bake_round_trip_vertices(RoundTrip& job) {
   job.summary["per_vertex_vertices"] = vertices;
   job.save(job.outs.per_vertex);
   job.summary["per_vertex_output"] = job.outs.per_vertex.string();
-  job.reporter.tell("wrote " + job.outs.per_vertex.string() + ": " + job.input.string() + ", per-vertex AO (COLOR_0) of " + std::to_string(vertices) +
+  job.notes.push_back("wrote " + job.outs.per_vertex.string() + ": " + job.input.string() + ", per-vertex AO (COLOR_0) of " + std::to_string(vertices) +
                     " vertices");
 }
 
@@ -108,7 +113,7 @@ void bake_round_trip_maps(RoundTrip& job, const std::vector<int>& targets, const
     job.doc.add_occlusion_map(t, encode_png(r.visibility, {.png_bits = plan.png_bits}));
     if (!map.empty()) {
       job.outputs.write(map, [&] { write_image(map, r.visibility, {.png_bits = plan.png_bits}); });
-      job.reporter.tell("wrote " + map.string() + ": the map of mesh " + label);
+      job.notes.push_back("wrote " + map.string() + ": the map of mesh " + label);
     }
     maps.push_back({{"mesh", t}, {"name", label}, {"instances", job.doc.instance_count(t)}, {"texels_covered", r.covered_texels},
                     {"mean_visibility", mean}, {"rays", r.rays}, {"warnings", r.warnings}});
@@ -116,7 +121,7 @@ void bake_round_trip_maps(RoundTrip& job, const std::vector<int>& targets, const
     char line[512];
     std::snprintf(line, sizeof line, "baked %s mesh %s (%d instance%s): %dx%d, %zu texels covered, mean V = %.4f", in.c_str(), label.c_str(),
                   job.doc.instance_count(t), job.doc.instance_count(t) == 1 ? "" : "s", plan.width, plan.height, r.covered_texels, mean);
-    job.reporter.tell(line);
+    job.notes.emplace_back(line);
   }
   job.timings["bake_ms"] = job.clock.lap_ms();
   job.summary["maps"] = maps;
@@ -157,7 +162,7 @@ MeshBake bake_gltf_input(const Plan& plan, const fs::path& input, const MeshOutp
     if (!outs.gltf.empty()) {
       job.save(outs.gltf);
       job.summary["gltf_output"] = outs.gltf.string();
-      reporter.tell("wrote " + outs.gltf.string() + ": " + in + " with " + std::to_string(targets.size()) + " AO map" + (targets.size() == 1 ? "" : "s"));
+      job.notes.push_back("wrote " + outs.gltf.string() + ": " + in + " with " + std::to_string(targets.size()) + " AO map" + (targets.size() == 1 ? "" : "s"));
     }
   }
   job.timings["write_ms"] = job.clock.lap_ms();
@@ -165,6 +170,7 @@ MeshBake bake_gltf_input(const Plan& plan, const fs::path& input, const MeshOutp
   job.summary["method"] = to_string(plan.r.method);
   if (plan.r.outputs.provenance) stage_provenance(outputs, record);
   outputs.commit();
+  for (const std::string& line : job.notes) reporter.tell(line);
   MeshBake out;
   out.input = input;
   out.summary = std::move(job.summary);

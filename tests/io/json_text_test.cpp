@@ -7,6 +7,7 @@
 #include <string>
 
 #include "ao/core/error.h"
+#include "ao/io/mesh_io.h"
 #include "support/run.h"
 
 namespace ao {
@@ -38,6 +39,22 @@ TEST(JsonText, DepthUpToTheLimitParsesAndBeyondIsOneLine) {
     } catch (const InputError& e) {
       EXPECT_STREQ(e.what(), "--param x: JSON nests deeper than 64 levels");
     }
+  }
+}
+
+// Found by scripts/mutate on glTF: a key written twice ("nodes") passed ao's check with one value
+// while assimp's reader used the other. An object with a key twice is refused, wherever JSON comes from.
+TEST(JsonText, AKeyTwiceInOneObjectIsRefused) {
+  expect_input_error([] { (void)parse_json_limited(R"({"fov": 40, "eye": [0, 0, 1], "fov": 60})", "cam.json"); },
+                     "cam.json: JSON has the key 'fov' twice in one object");
+  EXPECT_TRUE(parse_json_limited(R"({"a": {"fov": 1}, "b": {"fov": 2}})", "x").has_value()) << "the same key in two objects is fine";
+  test::TempDir dir;
+  const std::string gltf = R"({"asset": {"version": "2.0"}, "nodes": [], "nodes": [{"mesh": 0}]})";
+  try {
+    (void)load_scene_file(dir.write("twice.gltf", gltf));
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("twice.gltf: glTF JSON has the key 'nodes' twice in one object"), std::string::npos) << e.what();
   }
 }
 

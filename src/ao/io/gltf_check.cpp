@@ -92,6 +92,8 @@ json parse_json(const fs::path& path, std::string_view text) {
     return parse_json_with_depth_limit(text, kMaxGltfJsonDepth);  // linear in the text, the depth checked as it opens
   } catch (const JsonTooDeep&) {
     fail(path, "glTF JSON nests deeper than " + std::to_string(kMaxGltfJsonDepth) + " levels");
+  } catch (const JsonDuplicateKey& e) {
+    fail(path, "glTF JSON has the key '" + one_line(e.key) + "' twice in one object (readers differ on which counts)");
   } catch (const json::parse_error& e) {
     // nlohmann's text names its own grammar; the byte where it stopped, and the text there, is
     // what a person can look at.

@@ -42,6 +42,7 @@ class DepthLimitedBuilder : public nlohmann::json_sax<nlohmann::json> {
   bool binary(binary_t& v) override { return put(nlohmann::json::binary(std::move(v))); }
   bool start_object(std::size_t) override { return open(nlohmann::json::object()); }
   bool key(string_t& k) override {
+    if (stack_.back()->contains(k)) throw JsonDuplicateKey(k.substr(0, 40));
     key_ = &(*stack_.back())[k];
     return true;
   }
@@ -108,6 +109,8 @@ std::optional<nlohmann::json> parse_json_limited(std::string_view text, const st
     return parse_or_throw(text);
   } catch (const JsonTooDeep&) {
     too_deep(source);
+  } catch (const JsonDuplicateKey& e) {
+    throw InputError(source + ": JSON has the key '" + io_detail::one_line(e.key) + "' twice in one object");
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -29,8 +30,18 @@ struct JsonTooDeep : std::runtime_error {
   JsonTooDeep() : std::runtime_error("JSON nests too deep") {}
 };
 
+/// Thrown by parse_json_with_depth_limit for an object that has a key twice: JSON leaves open
+/// which one counts, and readers differ (nlohmann keeps the last, assimp's glTF reader the first),
+/// so a checked value could differ from the one another reader then uses. `key` is the key, cut
+/// to 40 characters.
+struct JsonDuplicateKey : std::runtime_error {
+  explicit JsonDuplicateKey(std::string k) : std::runtime_error("JSON has a key twice"), key(std::move(k)) {}
+  std::string key;
+};
+
 /// `text` parsed as one JSON value, in time linear in its length, refusing nesting deeper than
-/// `max_depth` (JsonTooDeep) before the deeper levels are built; a text that is not JSON throws
+/// `max_depth` (JsonTooDeep) before the deeper levels are built and an object with a key twice
+/// (JsonDuplicateKey); a text that is not JSON throws
 /// what nlohmann::json::parse throws (parse_error, with the byte where it stopped). nlohmann's
 /// own depth hook, the callback parser, rescans a container after each object in it: quadratic,
 /// 2 minutes for a glTF of 200,000 nodes.
@@ -38,7 +49,8 @@ nlohmann::json parse_json_with_depth_limit(std::string_view text, int max_depth)
 
 /// `text` parsed as one JSON value, or nullopt when it is not one (invalid or trailing text).
 /// InputError "<source>: JSON nests deeper than 64 levels" when it nests deeper than
-/// kMaxJsonDepth, found before the deeper levels are built.
+/// kMaxJsonDepth, found before the deeper levels are built; InputError "<source>: JSON has the
+/// key '<key>' twice in one object" for a duplicate key.
 std::optional<nlohmann::json> parse_json_limited(std::string_view text, const std::string& source);
 
 /// The JSON file `path` parsed (parse_json_limited). InputError, one line naming the file:

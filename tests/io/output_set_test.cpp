@@ -337,7 +337,26 @@ TEST(StaleTemporaries, AnOwnedOutputsCleanupLeavesOtherLiveCommitsAlone) {
   }
   char c = 0;
   ASSERT_EQ(::read(ready[0], &c, 1), 1);
+  // And a commit of c.png whose process is gone (killed after its rename): that one is undone.
+  const fs::path cfile = dir / "c.png";
+  const pid_t gone = ::fork();
+  ASSERT_GE(gone, 0);
+  if (gone == 0) {
+    write_text(cfile, "old c");
+    const fs::path temp = dir / (".c.tmp-" + std::to_string(::getpid()) + "-1.png"), backup = dir / (".c.keep-" + std::to_string(::getpid()));
+    write_text(temp, "new c");
+    fs::create_hard_link(cfile, backup);
+    detail::CommitJournal journal({{cfile, temp, backup}});
+    fs::rename(temp, cfile);
+    ::_exit(0);  // the journal stays, as SIGKILL would leave it
+  }
+  int gone_status = 0;
+  ASSERT_EQ(::waitpid(gone, &gone_status, 0), gone);
+  for (const auto& e : fs::directory_iterator(dir.path()))
+    if (e.path().filename().string().find(".journal") != std::string::npos && e.path().filename().string().find(std::to_string(gone)) != std::string::npos)
+      fs::last_write_time(e.path(), fs::file_time_type::clock::now() - std::chrono::hours(1));  // begun before this process
   remove_abandoned_temporaries(dir / "a.png");
+  EXPECT_EQ(read_text(cfile), "old c") << "a commit whose process is gone is rolled back";
   EXPECT_EQ(read_text(b), "new b") << "another output's commit, live, was rolled back";
   EXPECT_EQ(hidden_files(dir.path()), 2) << "its journal and the link to its previous file stay";
   // The owner of b.png, rerunning its task, undoes the commit (live or not, it was abandoned).

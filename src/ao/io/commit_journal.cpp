@@ -161,20 +161,15 @@ int recover_interrupted_commits(const fs::path& folder, const fs::path& owned_ou
     const std::string name = it->path().filename().string();
     const long pid = journal_pid(name);
     if (pid <= 0 || pid == ::getpid()) continue;
-    Journal j;
-    if (owned.empty()) {
-      // A process that still runs (or that we may not signal, EPERM) is not ours to undo.
-      std::error_code file_ec;
-      if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
-      if (!(it->last_write_time(file_ec) < g_process_start) || file_ec) continue;
-      j = read_journal(it->path());
-    } else {
-      // Another writer's commit in the same folder (a batch's tasks share their output folder)
-      // is live work: only a commit that lists the owned output is undone.
-      j = read_journal(it->path());
-      const bool lists_owned = std::any_of(j.entries.begin(), j.entries.end(), [&](const JournalEntry& e) { return same_file_key(e.destination) == owned; });
-      if (!lists_owned) continue;
-    }
+    // Gone: its process no longer runs here (EPERM: one we may not signal, not ours to undo), and
+    // it began before this process, so it is not a live run's on another machine.
+    std::error_code file_ec;
+    const bool gone = ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH && it->last_write_time(file_ec) < g_process_start && !file_ec;
+    if (!gone && owned.empty()) continue;
+    Journal j = read_journal(it->path());
+    // A live writer's commit in the same folder (a batch's tasks share their output folder) is
+    // left alone unless it lists the output the caller owns.
+    if (!gone && std::none_of(j.entries.begin(), j.entries.end(), [&](const JournalEntry& e) { return same_file_key(e.destination) == owned; })) continue;
     abandoned.emplace_back(it->path(), std::move(j));
   }
   for (const auto& [path, j] : abandoned) roll_back(path, j);

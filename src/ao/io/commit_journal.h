@@ -38,11 +38,11 @@ class CommitJournal {
 /// Rolls back the commits journaled in `folder` whose process no longer runs on this machine and
 /// which began before this process started: each destination gets its previous file back (or is
 /// removed when it had none), staged files and links are removed, then the journals. With
-/// `owned_output`, it rolls back instead every commit of another process, live or not, on this
+/// `owned_output`, it also rolls back every commit of another process, live or not, on this
 /// machine or another, whose journal lists that output: the caller owns it (a batch's task rerun
-/// after the worker that held it was lost), so such a commit was abandoned; the commits of other
-/// outputs in the folder are left alone, since their writers may be running. Returns how many
-/// commits it rolled back; never throws.
+/// after the worker that held it was lost), so such a commit was abandoned; the live commits of
+/// other outputs in the folder are left alone, since their writers may be running. Returns how
+/// many commits it rolled back; never throws.
 int recover_interrupted_commits(const std::filesystem::path& folder, const std::filesystem::path& owned_output = {});
 
 /// True when `name` is the name of a journal file (hidden, ".ao-commit-<pid>-<hex>.journal").

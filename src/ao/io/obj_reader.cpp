@@ -35,6 +35,7 @@
 #include "ao/core/error.h"
 #include "ao/io/asset_path.h"
 #include "ao/io/number_text.h"
+#include "ao/io/one_mesh_scene_internal.h"
 
 namespace ao {
 namespace {
@@ -353,11 +354,7 @@ std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data
                      " asked for");
   Mesh mesh = weld_and_triangulate(d);
   mesh.albedo = albedo;
-  Scene scene;
-  scene.name = path.filename().string();
-  scene.meshes.push_back(std::move(mesh));
-  validate_and_prepare(scene);
-  return scene;
+  return io_detail::one_mesh_scene(path, std::move(mesh));
 }
 
 }  // namespace ao

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "ao/io/io_error_internal.h"
+#include "ao/io/one_mesh_scene_internal.h"
 #include "ao/io/number_text.h"
 
 namespace ao {
@@ -210,11 +211,7 @@ Scene read_off(const fs::path& path, std::string_view data) {
   mesh.name = path.stem().string();
   read_off_vertices(path, reader, header, mesh);
   read_off_faces(path, reader, header, mesh);
-  Scene scene;
-  scene.name = path.filename().string();
-  scene.meshes.push_back(std::move(mesh));
-  validate_and_prepare(scene);
-  return scene;
+  return io_detail::one_mesh_scene(path, std::move(mesh));
 }
 
 }  // namespace ao

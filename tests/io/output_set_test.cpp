@@ -18,8 +18,10 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "ao/core/error.h"
 #include "ao/io/atomic_file.h"
@@ -310,6 +312,20 @@ TEST(StaleTemporaries, AbandonedOnesAreRemovedWheneverWritten) {
   EXPECT_TRUE(fs::exists(user)) << "not a name ao makes";
 }
 
+// In a forked child: a commit of `dest` ("old <tag>" -> "new <tag>") stopped after its rename, as a
+// worker killed there leaves it: the journal written, `dest` renamed into place, its previous file
+// kept by a hard link. The child holds the journal returned and ends with _exit, which leaves it.
+std::unique_ptr<detail::CommitJournal> commit_halfway(const fs::path& dest, const std::string& tag) {
+  write_text(dest, "old " + tag);
+  const fs::path dir = dest.parent_path(), pid = std::to_string(::getpid());
+  const fs::path temp = dir / ("." + tag + ".tmp-" + pid.string() + "-1.png"), backup = dir / ("." + tag + ".keep-" + pid.string());
+  write_text(temp, "new " + tag);
+  fs::create_hard_link(dest, backup);
+  auto journal = std::make_unique<detail::CommitJournal>(std::vector<detail::JournalEntry>{{dest, temp, backup}});
+  fs::rename(temp, dest);
+  return journal;
+}
+
 // A batch's tasks share their output folder: the cleanup a task does for its own output must not
 // undo another worker's commit that is renaming its outputs at that moment (seen as a forced rerun
 // whose grid1 map and record came back with the previous run's settings, because the task of
@@ -325,12 +341,7 @@ TEST(StaleTemporaries, AnOwnedOutputsCleanupLeavesOtherLiveCommitsAlone) {
   if (child == 0) {
     // Another worker, half way through its commit of b.png: the journal written, b.png renamed
     // into place, its previous file kept by a hard link. It waits there until released.
-    write_text(b, "old b");
-    const fs::path temp = dir / (".b.tmp-" + std::to_string(::getpid()) + "-1.png"), backup = dir / (".b.keep-" + std::to_string(::getpid()));
-    write_text(temp, "new b");
-    fs::create_hard_link(b, backup);
-    detail::CommitJournal journal({{b, temp, backup}});
-    fs::rename(temp, b);
+    const auto journal = commit_halfway(b, "b");
     char c = 'r';
     if (::write(ready[1], &c, 1) != 1 || ::read(release[0], &c, 1) != 1) ::_exit(2);
     ::_exit(0);  // leaves the journal, as a worker killed here would
@@ -342,12 +353,7 @@ TEST(StaleTemporaries, AnOwnedOutputsCleanupLeavesOtherLiveCommitsAlone) {
   const pid_t gone = ::fork();
   ASSERT_GE(gone, 0);
   if (gone == 0) {
-    write_text(cfile, "old c");
-    const fs::path temp = dir / (".c.tmp-" + std::to_string(::getpid()) + "-1.png"), backup = dir / (".c.keep-" + std::to_string(::getpid()));
-    write_text(temp, "new c");
-    fs::create_hard_link(cfile, backup);
-    detail::CommitJournal journal({{cfile, temp, backup}});
-    fs::rename(temp, cfile);
+    const auto journal = commit_halfway(cfile, "c");
     ::_exit(0);  // the journal stays, as SIGKILL would leave it
   }
   int gone_status = 0;

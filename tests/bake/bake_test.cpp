@@ -234,27 +234,31 @@ TEST(Bake, QuadInsideClosedBoxIsFullyOccluded) {
 TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
   // make_texel_rays (lane-parallel, polynomial sine and cosine) against sample_patch, Frame and
   // cosine_hemisphere one sample at a time, on a quad with bent vertex normals whose texels
-  // straddle its diagonal (patches of one and several pieces, from PatchTable), and on a 4 x 4
-  // grid of bumpy quads baked into one texel (32 pieces: more than PatchTable holds, so read piece
-  // by piece). Tolerance 1e-5: float rounding of unit vectors and unit-sized positions, plus the
-  // polynomials' error (< 1e-7).
-  Mesh grid;
-  for (int j = 0; j <= 4; ++j)
-    for (int i = 0; i <= 4; ++i) {
-      const float x = i / 4.0f, y = j / 4.0f;
-      grid.positions.push_back({x, y, 0.1f * std::sin(6 * x) * std::cos(5 * y)});
-      grid.normals.push_back(normalize(Vec3{-0.6f * std::cos(6 * x) * std::cos(5 * y), 0.5f * std::sin(6 * x) * std::sin(5 * y), 1}));
-      grid.uvs.push_back({x, y});
-    }
-  for (std::uint32_t j = 0; j < 4; ++j)
-    for (std::uint32_t i = 0; i < 4; ++i) {
-      const std::uint32_t a = j * 5 + i;
-      grid.indices.insert(grid.indices.end(), {a, a + 1, a + 6, a, a + 6, a + 5});
-    }
+  // straddle its diagonal (patches of one and several pieces, from PatchTable), on a 2 x 3 grid of
+  // bumpy quads baked into one texel (12 pieces: more than a vector of 4 or 8 lanes holds, fewer
+  // than PatchTable's 16), and on a 4 x 4 grid (32 pieces: more than PatchTable holds, so read
+  // piece by piece). Tolerance 1e-5: float rounding of unit vectors and unit-sized positions, plus
+  // the polynomials' error (< 1e-7).
+  const auto bumpy_grid = [](std::uint32_t nx, std::uint32_t ny) {
+    Mesh grid;
+    for (std::uint32_t j = 0; j <= ny; ++j)
+      for (std::uint32_t i = 0; i <= nx; ++i) {
+        const float x = static_cast<float>(i) / static_cast<float>(nx), y = static_cast<float>(j) / static_cast<float>(ny);
+        grid.positions.push_back({x, y, 0.1f * std::sin(6 * x) * std::cos(5 * y)});
+        grid.normals.push_back(normalize(Vec3{-0.6f * std::cos(6 * x) * std::cos(5 * y), 0.5f * std::sin(6 * x) * std::sin(5 * y), 1}));
+        grid.uvs.push_back({x, y});
+      }
+    for (std::uint32_t j = 0; j < ny; ++j)
+      for (std::uint32_t i = 0; i < nx; ++i) {
+        const std::uint32_t a = j * (nx + 1) + i;
+        grid.indices.insert(grid.indices.end(), {a, a + 1, a + nx + 2, a, a + nx + 2, a + nx + 1});
+      }
+    return grid;
+  };
   Mesh m = uv_quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0.3f}, {0, 1, 0}, {0, 0}, {1, 1});
   m.normals = {normalize(Vec3{0.3f, 0, 1}), normalize(Vec3{-0.2f, 0.4f, 1}), normalize(Vec3{0, -0.6f, 1}), {0, 0, 1}};
-  int multi = 0, many = 0;
-  for (const auto& [mesh, size] : {std::pair{m, 5}, std::pair{grid, 1}}) {
+  int multi = 0, many = 0, between = 0;
+  for (const auto& [mesh, size] : {std::pair{m, 5}, std::pair{bumpy_grid(2, 3), 1}, std::pair{bumpy_grid(4, 4), 1}}) {
     Scene s;
     s.meshes.push_back(mesh);
     s = prepared(std::move(s));
@@ -269,6 +273,7 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
           if (patch.empty()) continue;
           multi += patch.size() > 1;
           many += patch.size() > static_cast<std::size_t>(detail::PatchTable::kMaxPieces);
+          between += patch.size() > 8 && patch.size() <= static_cast<std::size_t>(detail::PatchTable::kMaxPieces);
           const std::uint32_t key = pixel_seed(3, static_cast<int>(texel), 0);
           for (std::uint32_t first = 0; first < 48; first += 16) {
             const int count = first == 32 ? 11 : 16;
@@ -301,8 +306,9 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
           }
         }
   }
-  EXPECT_GT(multi, 0);  // both lookups were exercised
+  EXPECT_GT(multi, 0);  // every lookup was exercised
   EXPECT_GT(many, 0);
+  EXPECT_GT(between, 0);
 }
 
 TEST(Bake, TexelPointsAreTheSobolSetInDirectionCells) {

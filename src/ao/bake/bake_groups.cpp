@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "ao/core/error.h"
@@ -100,6 +101,19 @@ Mesh make_floor_occluder(const Bounds3& b) {
   return floor;
 }
 
+namespace {
+
+// Whether `group` holds every mesh of `scene`, in order: its group scene's UV meshes are then
+// scene's, at the same indices.
+bool is_every_mesh(const BakeGroup& group, const Scene& scene) {
+  if (group.meshes.size() != scene.meshes.size()) return false;
+  for (std::size_t i = 0; i < group.meshes.size(); ++i)
+    if (group.meshes[i] != i) return false;
+  return true;
+}
+
+}  // namespace
+
 Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<Mesh>& occluders) {
   Scene s;
   s.name = scene.name;
@@ -112,7 +126,8 @@ Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<
 }
 
 BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders, int width, int height,
-                       const std::function<BakeResult(const Scene&, const TexelCoverage&, const BakeGroup&)>& bake) {
+                       const std::function<BakeResult(const Scene&, const TexelCoverage&, const BakeGroup&)>& bake,
+                       const TexelCoverage* scene_coverage) {
   BakeResult out;
   Image<double> weighted(width, height, 0.0), area(width, height, 0.0);
   Image<Vec3> bent;
@@ -120,7 +135,10 @@ BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups,
   for (const BakeGroup& g : groups) {
     const Scene gs = group_scene(scene, g, occluders);
     if (!has_uvs(gs)) continue;
-    const TexelCoverage cov = compute_texel_coverage(gs, width, height);
+    const bool whole_scene = scene_coverage && scene_coverage->width == width && scene_coverage->height == height && is_every_mesh(g, scene);
+    std::optional<TexelCoverage> own;
+    if (!whole_scene) own = compute_texel_coverage(gs, width, height);
+    const TexelCoverage& cov = whole_scene ? *scene_coverage : *own;
     BakeResult r = bake(gs, cov, g);
     if (!any) {
       out.visibility = Image<float>(width, height, 0.0f);

@@ -52,7 +52,11 @@ Scene group_scene(const Scene& scene, const BakeGroup& group, const std::vector<
 /// `width` x `height` map) and merges the maps: each texel is the area-weighted mean of the groups covering it
 /// (one group, except where charts of different groups overlap). Groups whose meshes have no UVs
 /// are skipped. Rays, fragments and missed texels are summed; warnings are concatenated.
+/// `scene_coverage`: compute_texel_coverage(scene, width, height) when the caller has it already
+/// (or null): a group of all of scene's meshes, in order, has the same coverage (the occluders
+/// carry no UVs), so it is not computed again.
 BakeResult bake_groups(const Scene& scene, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders, int width, int height,
-                       const std::function<BakeResult(const Scene&, const TexelCoverage&, const BakeGroup&)>& bake);
+                       const std::function<BakeResult(const Scene&, const TexelCoverage&, const BakeGroup&)>& bake,
+                       const TexelCoverage* scene_coverage = nullptr);
 
 }  // namespace ao

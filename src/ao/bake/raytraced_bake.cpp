@@ -11,7 +11,8 @@
 // in direction order (TexelPoints), the lane-parallel ray maker and the tracer (reference/
 // raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) and
 // the tile loop are in texel_rays_internal.h, shared with high_to_low.cpp; the default bake's 16
-// rays go to Embree as one occlusion packet (BatchTracer).
+// rays go to Embree as one occlusion packet where its native width is 16, else in packets of its
+// width filled straight from the batch (BatchTracer).
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>
@@ -101,7 +102,7 @@ class TexelWorker {
       for (int k = 0; k < count; ++k) {
         acc.add(mu[k]);  // a direction below the face (no ray) counts as occluded, mu = 0
         if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
-        if (batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+        if (params_.bent_normals && batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
       }
     }
     out_.visibility[texel] = static_cast<float>(acc.mean());

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "ao/bake/texel_coverage.h"
@@ -270,12 +271,14 @@ class BatchTracer {
  public:
   explicit BatchTracer(const Tracer& tracer) : tracer_(tracer) {
     for (int k = 0; k < 16; ++k) set_ray(packet_, k, {0, 0, 0}, {0, 0, 1}, tracer.falloff.reach());
+    if constexpr (N > 1 && N < 16)
+      for (int k = 0; k < N; ++k) set_ray(narrow_, k, {0, 0, 0}, {0, 0, 1}, tracer.falloff.reach());
   }
 
   /// mu of lanes 0 .. count - 1 of `batch` (count in [1, 16]) into mu[k]: 0 where valid[k] is 0
   /// (no ray). `as_packet`: with 16-wide packets and an occlusion-only tracer, the batch goes to
   /// Embree as it is, one packet whose valid lanes may have gaps; otherwise the valid lanes are
-  /// packed, in order, into packets of N.
+  /// packed, in order, into packets of N (an occlusion-only tracer's straight from the batch).
   void trace(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, bool as_packet, float (&mu)[16]) {
     const float reach = tracer_.falloff.reach();
     if constexpr (N == 16) {
@@ -292,6 +295,12 @@ class BatchTracer {
         return;
       }
     }
+    if constexpr (N > 1 && N < 16) {
+      if (tracer_.falloff.membership == Membership::Step && !tracer_.ignore_back) {
+        trace_narrow(ctx, batch, count, reach, mu);
+        return;
+      }
+    }
     int live = 0;
     for (int k = 0; k < count; ++k)
       if (batch.valid[k]) {
@@ -305,7 +314,34 @@ class BatchTracer {
   }
 
  private:
+  // An occlusion-only batch in packets of N < 16: the valid lanes packed in order into packets
+  // whose fixed fields were set once, a packet's unused lanes repeating its first ray, not valid
+  // (the packets Tracer::trace makes, without its per-ray copies).
+  void trace_narrow(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, float reach, float (&mu)[16]) {
+    int lane_of[16];
+    int live = 0;
+    for (int k = 0; k < 16; ++k) {
+      mu[k] = 0.0f;
+      if (k < count && batch.valid[k]) lane_of[live++] = k;
+    }
+    alignas(64) std::array<int, N> valid;
+    for (int at = 0; at < live; at += N) {
+      const int c = std::min(N, live - at);
+      for (int j = 0; j < N; ++j) {
+        const int s = lane_of[at + (j < c ? j : 0)];
+        narrow_.org_x[j] = batch.ox[s], narrow_.org_y[j] = batch.oy[s], narrow_.org_z[j] = batch.oz[s];
+        narrow_.dir_x[j] = batch.dx[s], narrow_.dir_y[j] = batch.dy[s], narrow_.dir_z[j] = batch.dz[s];
+        narrow_.tfar[j] = reach;
+        valid[static_cast<std::size_t>(j)] = j < c ? -1 : 0;
+      }
+      Packet<N>::occluded(valid.data(), embree_scene(tracer_.rs), &ctx, &narrow_);
+      for (int j = 0; j < c; ++j) mu[lane_of[at + j]] = narrow_.tfar[j] < 0 ? 0.0f : 1.0f;
+    }
+  }
+
+  struct NoPacket {};
   const Tracer& tracer_;
+  alignas(64) std::conditional_t<(N > 1 && N < 16), typename Packet<(N > 1 && N < 16 ? N : 4)>::Ray, NoPacket> narrow_;
   alignas(64) RTCRay16 packet_;
   std::array<Vec3, 16> org_, dir_;
   std::array<float, 16> mu_;

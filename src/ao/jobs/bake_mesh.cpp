@@ -125,7 +125,8 @@ void warn_missed(const MeshJob& job, const BakeResult& r, const HighToLowParams&
 }
 
 // The map baked group by group: high to low, or the group's own meshes with the occluders.
-BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& progress) {
+// `coverage`: the scene's own, when computed already (bake_groups reuses it for a group of every mesh).
+BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& progress, const TexelCoverage* coverage = nullptr) {
   const Plan& plan = job.plan;
   const std::vector<BakeGroup> groups = make_groups(job, scene);
   CagePositions cage;  // of the whole low scene; each group takes its meshes' cages
@@ -148,7 +149,8 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
                              [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
                                if (!job.high) return bake_map_plain(plan, gs, cov, progress);
                                return bake_group_high_to_low(job, gs, cov, g, cage, p, progress);
-                             });
+                             },
+                             coverage);
   if (groups.size() > 1) job.summary["groups"] = groups.size();
   if (!job.occluders.empty()) job.summary["occluder_meshes"] = job.occluders.size();
   if (job.high) {
@@ -198,7 +200,7 @@ BakeResult bake_map(MeshJob& job, const fs::path& map_out) {
   job.timings["uv_coverage_ms"] = job.clock.lap_ms();
   for (const std::string& w : cov.warnings()) job.reporter.warn(job.input.string() + ": " + w);
   const ProgressFn progress = job.reporter.start("bake " + job.label());
-  BakeResult r = plan.grouped() ? bake_in_groups(job, job.scene, progress)
+  BakeResult r = plan.grouped() ? bake_in_groups(job, job.scene, progress, &cov)
                  : plan.r.method == Baker::Histogram ? bake_histogram(job.scene, cov, plan.r.histogram, progress)
                                                       : bake_raytraced(job.ray_scene(), cov, plan.r.raytraced, progress);
   const double bake_ms = job.clock.lap_ms();

@@ -1,0 +1,115 @@
+// UV coverage (bake/texel_coverage.h) held to its definition: every triangle clipped against every
+// texel square its UV box touches, one texel at a time, the fragments of a texel in triangle order.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "ao/bake/texel_coverage.h"
+#include "ao/scene/mesh.h"
+
+namespace ao {
+namespace {
+
+// A deterministic stream of floats in [0, 1) (a 32-bit LCG's top 24 bits).
+struct Lcg {
+  std::uint32_t state;
+  float next() {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) * 0x1.0p-24f;
+  }
+};
+
+// `count` separate triangles of random shapes: most a few texels of a 37 x 23 map across, some
+// spanning many texels, some reaching outside [0, 1]^2; world positions a random affine image of
+// the UVs, so no triangle is degenerate.
+Mesh random_uv_triangles(std::uint32_t seed, int count) {
+  Lcg r{seed};
+  Mesh m;
+  for (int t = 0; t < count; ++t) {
+    const float size = t % 50 == 0 ? 0.6f : (t % 7 == 0 ? 0.15f : 0.06f);
+    const float cu = r.next() * 1.2f - 0.1f, cv = r.next() * 1.2f - 0.1f;
+    for (int c = 0; c < 3; ++c) {
+      const Vec2 uv{cu + (r.next() - 0.5f) * size, cv + (r.next() - 0.5f) * size};
+      m.uvs.push_back(uv);
+      m.positions.push_back({uv.x * 2.0f + uv.y * 0.3f, uv.y * 1.5f, uv.x * 0.7f - uv.y + r.next() * 0.01f});
+      m.indices.push_back(static_cast<std::uint32_t>(m.positions.size() - 1));
+    }
+  }
+  return m;
+}
+
+TEST(TexelCoverage, FragmentsAreTheTexelByTexelClipsInTriangleOrder) {
+  // Two meshes of more triangles than one parallel block holds (4096), on a map whose rows are not
+  // a whole number of merge bands: the fragments, their areas (to the bit: the same clips) and each
+  // texel's sums must be what clipping one texel at a time, triangle after triangle, gives.
+  Scene s;
+  s.name = "random";
+  s.meshes.push_back(random_uv_triangles(7, 5000));
+  s.meshes.push_back(random_uv_triangles(11, 300));
+  validate_and_prepare(s);
+  const int width = 37, height = 23;
+  const TexelCoverage cov = compute_texel_coverage(s, width, height);
+  struct Expected {
+    std::uint32_t mesh, triangle;
+    float uv_area;
+  };
+  std::vector<std::vector<Expected>> per_texel(static_cast<std::size_t>(width) * height);
+  for (std::uint32_t mi = 0; mi < s.meshes.size(); ++mi) {
+    const Mesh& m = s.meshes[mi];
+    for (std::uint32_t t = 0; t < m.triangle_count(); ++t) {
+      const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(t)];
+      const Vec2 a = texel_uv(m, i[0], width, height), b = texel_uv(m, i[1], width, height), c = texel_uv(m, i[2], width, height);
+      const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x, b.x, c.x})))), x1 = std::min(width - 1, static_cast<int>(std::floor(std::max({a.x, b.x, c.x}))));
+      const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y, b.y, c.y})))), y1 = std::min(height - 1, static_cast<int>(std::floor(std::max({a.y, b.y, c.y}))));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const float area = clip_to_texel(a, b, c, x, y).area();
+          if (area > 0) per_texel[static_cast<std::size_t>(y) * width + x].push_back({mi, t, area});
+        }
+    }
+  }
+  ASSERT_EQ(cov.degenerate_uv_triangles, 0u);
+  EXPECT_GT(cov.outside_triangles, 0u);
+  std::size_t fragments = 0, covered = 0;
+  for (std::size_t texel = 0; texel < per_texel.size(); ++texel) {
+    const std::vector<Expected>& want = per_texel[texel];
+    ASSERT_EQ(cov.offsets[texel + 1] - cov.offsets[texel], want.size()) << "texel " << texel;
+    float uv_sum = 0;
+    for (std::size_t k = 0; k < want.size(); ++k) {
+      const TexelFragment& f = cov.fragments[cov.offsets[texel] + k];
+      EXPECT_EQ(f.mesh, want[k].mesh) << "texel " << texel << " fragment " << k;
+      EXPECT_EQ(f.triangle, want[k].triangle) << "texel " << texel << " fragment " << k;
+      EXPECT_EQ(f.uv_area, want[k].uv_area) << "texel " << texel << " fragment " << k;
+      uv_sum += want[k].uv_area;
+    }
+    EXPECT_EQ(cov.uv_area[texel], uv_sum) << "texel " << texel;  // summed in fragment order
+    EXPECT_EQ(cov.mask[texel], want.empty() ? 0 : 1) << "texel " << texel;
+    fragments += want.size();
+    covered += !want.empty();
+  }
+  EXPECT_EQ(cov.fragments.size(), fragments);
+  EXPECT_EQ(cov.covered_texels, covered);
+  EXPECT_GT(fragments, 5000u);  // most triangles reach several texels
+}
+
+TEST(TexelCoverage, ClipOfATriangleInsideATexelIsTheTriangle) {
+  // No line of the texel cuts the triangle: its corners come back as they were, area exact.
+  const ClipPolygon p = clip_to_texel({3.25f, 5.5f}, {3.75f, 5.25f}, {3.5f, 5.75f}, 3, 5);
+  ASSERT_EQ(p.n, 3);
+  EXPECT_EQ(p.p[0].x, 3.25f);
+  EXPECT_EQ(p.p[1].y, 5.25f);
+  EXPECT_EQ(p.p[2].x, 3.5f);
+  EXPECT_FLOAT_EQ(p.area(), 0.09375f);  // half of |(0.5, -0.25) x (0.25, 0.25)|
+  // A triangle covering the texel with room to spare: the unit square.
+  const ClipPolygon q = clip_to_texel({-10, -10}, {30, -10}, {-10, 30}, 2, 4);
+  EXPECT_EQ(q.n, 4);
+  EXPECT_EQ(q.area(), 1.0f);
+  // A triangle wholly in another texel: nothing.
+  EXPECT_EQ(clip_to_texel({3.25f, 5.5f}, {3.75f, 5.25f}, {3.5f, 5.75f}, 4, 5).n, 0);
+}
+
+}  // namespace
+}  // namespace ao

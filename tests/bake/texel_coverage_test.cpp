@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "ao/bake/texel_coverage.h"
@@ -41,16 +42,10 @@ Mesh random_uv_triangles(std::uint32_t seed, int count) {
   return m;
 }
 
-TEST(TexelCoverage, FragmentsAreTheTexelByTexelClipsInTriangleOrder) {
-  // Two meshes of more triangles than one parallel block holds (4096), on a map whose rows are not
-  // a whole number of merge bands: the fragments, their areas (to the bit: the same clips) and each
-  // texel's sums must be what clipping one texel at a time, triangle after triangle, gives.
-  Scene s;
-  s.name = "random";
-  s.meshes.push_back(random_uv_triangles(7, 5000));
-  s.meshes.push_back(random_uv_triangles(11, 300));
-  validate_and_prepare(s);
-  const int width = 37, height = 23;
+// The fragments of compute_texel_coverage(s, width, height), their areas (to the bit: the same
+// clips) and each texel's sums must be what clipping one texel at a time, triangle after triangle,
+// gives.
+void expect_texel_by_texel_clips(const Scene& s, int width, int height) {
   const TexelCoverage cov = compute_texel_coverage(s, width, height);
   struct Expected {
     std::uint32_t mesh, triangle;
@@ -93,6 +88,33 @@ TEST(TexelCoverage, FragmentsAreTheTexelByTexelClipsInTriangleOrder) {
   EXPECT_EQ(cov.fragments.size(), fragments);
   EXPECT_EQ(cov.covered_texels, covered);
   EXPECT_GT(fragments, 5000u);  // most triangles reach several texels
+}
+
+// Two meshes of more triangles than one parallel block holds (4096).
+Scene two_random_meshes() {
+  Scene s;
+  s.name = "random";
+  s.meshes.push_back(random_uv_triangles(7, 5000));
+  s.meshes.push_back(random_uv_triangles(11, 300));
+  validate_and_prepare(s);
+  return s;
+}
+
+TEST(TexelCoverage, FragmentsAreTheTexelByTexelClipsInTriangleOrder) {
+  // A map whose rows are not a whole number of merge bands.
+  expect_texel_by_texel_clips(two_random_meshes(), 37, 23);
+}
+
+TEST(TexelCoverage, FragmentsDoNotDependOnHowTheMergeBandsRunInParallel) {
+  // Many bands (16 rows each), merged on every thread there is, several times: a band's fragment
+  // cursors must not depend on whether the band before it has finished (its last offset is the
+  // next band's first).
+  const Scene s = two_random_meshes();
+  for (int round = 0; round < 8; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    expect_texel_by_texel_clips(s, 29, 301);
+    if (HasFailure()) return;
+  }
 }
 
 TEST(TexelCoverage, ClipOfATriangleInsideATexelIsTheTriangle) {

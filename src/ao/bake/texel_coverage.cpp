@@ -280,8 +280,14 @@ void gather_by_texel(std::vector<Block>& blocks, TexelCoverage& cov) {
   tbb::parallel_for(0, bands, [&](int b) {
     const auto [lo, hi] = band_texels(b);
     const auto base = static_cast<std::uint32_t>(band_base[static_cast<std::size_t>(b)]);
-    for (std::size_t i = lo; i < hi; ++i) cov.offsets[i + 1] += base;
-    std::vector<std::uint32_t> cursor(cov.offsets.begin() + static_cast<std::ptrdiff_t>(lo), cov.offsets.begin() + static_cast<std::ptrdiff_t>(hi));
+    // offsets[lo] is the previous band's last entry, which that band may still be raising by its
+    // own base; its final value is this band's base, so the cursors start from that.
+    std::vector<std::uint32_t> cursor(hi - lo);
+    cursor[0] = base;
+    for (std::size_t i = lo; i < hi; ++i) {
+      cov.offsets[i + 1] += base;
+      if (i + 1 < hi) cursor[i + 1 - lo] = cov.offsets[i + 1];
+    }
     for (const Block& blk : blocks)
       for (const Pending& p : band_fragments(blk, b)) {
         cov.fragments[cursor[p.texel - lo]++] = p.frag;

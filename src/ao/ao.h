@@ -80,7 +80,7 @@
 #include "ao/methods/cone/winding_number.h"
 
 // bake: AO maps (outside-in histogram, inside-out ray-traced), denoising, padding, per-vertex AO,
-// high to low, bake groups, UDIM tiles.
+// high to low, bake groups, UDIM tiles, MikkTSpace tangent frames.
 #include "ao/bake/bake_groups.h"
 #include "ao/bake/bake_result.h"
 #include "ao/bake/denoise.h"
@@ -91,6 +91,7 @@
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/raytraced_bake.h"
 #include "ao/bake/sphere_directions.h"
+#include "ao/bake/tangents.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/bake/udim.h"
 

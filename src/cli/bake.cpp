@@ -31,6 +31,7 @@ struct BakeOptions {
   std::string normalization = default_name(histogram_param_table(), "normalization");
   std::string normal = default_name(raytraced_bake_param_table(), "normal");
   std::string membership = default_name(raytraced_bake_param_table(), "membership");
+  std::string bent_normal_space{to_string(BakeRequest{}.bent_normal_space)};
   std::uint32_t seed = RaytracedBakeParams{}.seed;  ///< Both bakers' (the same default).
   bool json = false;
   // Options given that only one baker reads, by name ("--directions", ...).
@@ -48,6 +49,7 @@ BakeRequest make_request(BakeOptions& o) {
     throw InputError(foreign.front() + " does not apply to --method " + o.method + " (it is a " + other + " option); drop it or choose --method " + other);
   }
   if (o.size_given) r.size = parse_map_size(o.size);
+  r.bent_normal_space = bent_normal_space_from_name(o.bent_normal_space);
   for (const std::string& g : o.groups) r.groups.push_back(split(g, ','));
   // The options given as names go through the bakers' tables, which name the valid values.
   raytraced_bake_param_table().from_json({{"seed", o.seed}, {"normal", o.normal}, {"membership", o.membership}}, r.raytraced);
@@ -101,6 +103,9 @@ void add_raytraced_options(CLI::App& cmd, BakeOptions& o) {
       ->type_name("shading|geometric")
       ->capture_default_str();
   cmd.add_flag("--ignore-back-faces", rt.ignore_back_faces, help("ignore_back_faces"));
+  cmd.add_option("--spread-angle", rt.spread_angle, help("spread_angle") + " (every map: AO, bent normals, thickness, cavity)")->capture_default_str();
+  cmd.add_flag("--relative-distance", rt.relative_distance,
+               "raytraced: --max-distance is a fraction of the diagonal of the baked meshes' bounding box (occluders and --floor excluded)");
 }
 
 void add_high_to_low_options(CLI::App& cmd, BakeOptions& o) {
@@ -137,6 +142,20 @@ void add_output_options(CLI::App& cmd, BakeOptions& o) {
                  "as they were; the map takes its size")
       ->type_name("PNG");
   cmd.add_option("--bent-normals", r.outputs.bent_normals, "Also write the bent normals (average open direction, world space, n*0.5+0.5) to this image");
+  cmd.add_option("--bent-normals-space", o.bent_normal_space,
+                 "world: the direction as is; tangent: in the tangent space of the UV layout (MikkTSpace frames, as Blender, glTF and engines "
+                 "build them), what engines read for specular occlusion")
+      ->type_name("world|tangent")
+      ->capture_default_str();
+  cmd.add_option("--thickness", r.outputs.thickness,
+                 "Also write a thickness map (ray-traced): rays into the mesh, the mean of min(d/R, 1), R = --thickness-distance; white where the "
+                 "mesh is at least R deep behind the surface, darker where it is thinner (subsurface, translucency)");
+  cmd.add_option("--thickness-distance", r.thickness_distance, "R of --thickness as a fraction of the baked meshes' bounding-box diagonal (0, 10]")
+      ->capture_default_str();
+  cmd.add_option("--cavity", r.outputs.cavity,
+                 "Also write a cavity map (ray-traced): AO with R = --cavity-distance, so that only small creases darken");
+  cmd.add_option("--cavity-distance", r.cavity_distance, "R of --cavity as a fraction of the baked meshes' bounding-box diagonal (0, 10]")
+      ->capture_default_str();
   cmd.add_option("--per-vertex", r.outputs.per_vertex, "Also (or, without -o/--gltf, only) write per-vertex AO: .ply (colour + float quality) or .glb (glTF COLOR_0)");
   cmd.add_option("--gltf", r.outputs.gltf, "Also write a .glb of the mesh with the map as its material's occlusion texture; a glTF input keeps its nodes, instances and "
                  "materials, one map per glTF mesh (docs/bake.md)");
@@ -163,7 +182,8 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
   for (const char* name : {"--directions", "--direction-set", "--pixels-per-texel", "--point-size", "--normalization", "--min-samples", "--seam-fix",
                            "--vertex-resolution"})
     histogram_only.push_back(cmd->get_option(name));
-  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal", "--denoise"})
+  for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal", "--denoise", "--spread-angle",
+                           "--relative-distance"})
     raytraced_only.push_back(cmd->get_option(name));
   cmd->callback([o, size_opt, histogram_only, raytraced_only, &global, &action] {
     o->size_given = size_opt->count() > 0;

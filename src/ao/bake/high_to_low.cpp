@@ -145,7 +145,8 @@ class TexelWorker {
  public:
   TexelWorker(const CageRays& cage_rays, const detail::Tracer& tracer, const HighToLowParams& params, float offset, BakeResult& out,
               TexelGuides* guides, std::atomic<std::uint64_t>& rays)
-      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), offset_(offset), out_(out), guides_(guides), rays_(rays) {}
+      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), offset_(offset), out_(out), guides_(guides), rays_(rays),
+        spread_(detail::cone_disk_radius(params.ao.spread_angle)) {}
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
     if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
@@ -159,12 +160,16 @@ class TexelWorker {
     for (int j = 0; j < points; ++j) {
       const HighHit h = cage_rays_(ctx, detail::sample_patch(patch, sobol_owen_2d(static_cast<std::uint32_t>(j), point_key)));
       if (!h.hit) continue;
-      const Vec3 origin = h.p + h.ng * offset_;
+      // Inside (thickness): the high surface turned over, as the texel baker turns its patch.
+      const float side = params_.ao.hemisphere == Hemisphere::Inside ? -1.0f : 1.0f;
+      const Vec3 ng = h.ng * side, n = h.n * side;
+      const Vec3 origin = h.p + ng * offset_;
       const int end = static_cast<int>(static_cast<std::int64_t>(j + 1) * samples / points);
       for (int first = static_cast<int>(static_cast<std::int64_t>(j) * samples / points); first < end; first += 16) {
         const int count = std::min(16, end - first);
         sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, u_);  // dimensions 0-1: the direction
-        detail::make_hemisphere_rays(origin, geometric ? h.ng : h.n, h.ng, u_, count, batch_);
+        if (spread_ < 1.0f) detail::narrow_to_cone(u_, count, spread_, cone_u_);
+        detail::make_hemisphere_rays(origin, geometric ? ng : n, ng, spread_ < 1.0f ? cone_u_ : u_, count, batch_);
         float mu[16];
         batch_tracer_.trace(ctx, batch_, count, true, mu);
         for (int k = 0; k < count; ++k) {
@@ -195,7 +200,9 @@ class TexelWorker {
   TexelGuides* guides_;
   std::atomic<std::uint64_t>& rays_;
   detail::StratifiedVariance noise_;
+  float spread_;                     // the cone's disk radius, sin(spread_angle / 2)
   alignas(64) float u_[4][16] = {};  // lanes past a block's count keep any finite values
+  alignas(64) float cone_u_[4][16] = {};
   alignas(64) detail::TexelRayBatch batch_;
 };
 
@@ -254,8 +261,10 @@ CagePositions cage_from_mesh(const Scene& low, const Scene& cage) {
 }
 
 BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const CagePositions& cage, const RayScene& targets, const RayScene& occluders,
-                            const HighToLowParams& params, const ProgressFn& progress) {
-  params.validate();
+                            const HighToLowParams& given, const ProgressFn& progress) {
+  given.validate();
+  HighToLowParams params = given;  // a relative distance is a fraction of the low mesh's size
+  params.ao = given.ao.with_absolute_distance(baked_bounds(low));
   if (cage.size() != low.meshes.size()) throw InputError("high-to-low: the cage has a different number of meshes than the low scene");
   if (targets.quads()) throw InputError("high-to-low: the high meshes' BVH must hold triangles (built without BvhOptions::quads)");
   const Falloff falloff = params.ao.falloff();

@@ -82,10 +82,14 @@ template <int N>
 class TexelWorker {
  public:
   TexelWorker(const Tracer& tracer, const RaytracedBakeParams& params, BakeResult& out, TexelGuides* guides)
-      : batch_tracer_(tracer), params_(params), out_(out), guides_(guides) {}
+      : batch_tracer_(tracer), params_(params), out_(out), guides_(guides), spread_(detail::cone_disk_radius(params.spread_angle)) {}
 
-  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
+  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& surface) {
     const bool geometric = params_.normal == SurfaceNormal::Geometric;
+    // Inside: the same patch with its normals turned over, so that the offset pushes the points
+    // in and the directions leave below the surface.
+    if (params_.hemisphere == Hemisphere::Inside) detail::turn_over(surface, flipped_);
+    const std::vector<PatchPiece>& patch = params_.hemisphere == Hemisphere::Inside ? flipped_ : surface;
     table_.build(patch, params_.offset);
     if (guides_) detail::patch_guide(patch, geometric, guides_->position[texel], guides_->normal[texel]);
     points_.generate(pixel_seed(params_.seed, x, y), params_.samples);
@@ -95,7 +99,8 @@ class TexelWorker {
     for (int first = 0; first < params_.samples; first += 16) {
       const int count = std::min(16, params_.samples - first);
       points_.lanes(first, count, u_);
-      detail::make_texel_rays(patch, table_, u_, count, geometric, batch_);
+      if (spread_ < 1.0f) detail::narrow_to_cone(u_, count, spread_, cone_u_);
+      detail::make_texel_rays(patch, table_, spread_ < 1.0f ? cone_u_ : u_, count, geometric, batch_);
       // The default bake (no bent normals) hands the batch to Embree as one packet.
       float mu[16];
       batch_tracer_.trace(ctx, batch_, count, !params_.bent_normals, mu);
@@ -117,8 +122,11 @@ class TexelWorker {
   BakeResult& out_;
   TexelGuides* guides_;
   detail::TexelPoints points_;
+  float spread_;  // the cone's disk radius, sin(spread_angle / 2)
+  std::vector<PatchPiece> flipped_;
   alignas(64) detail::PatchTable table_;
   alignas(64) float u_[4][16];
+  alignas(64) float cone_u_[4][16];
   alignas(64) detail::TexelRayBatch batch_;
 };
 
@@ -141,6 +149,11 @@ const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table() {
        P::enumeration<SurfaceNormal>("normal", &R::normal, {{"shading", SurfaceNormal::Shading}, {"geometric", SurfaceNormal::Geometric}},
                                      "the hemisphere: about the interpolated shading normal, or the triangle's own"),
        P::boolean("bent_normals", &R::bent_normals, "also average the unoccluded directions per texel"),
+       P::real("spread_angle", &R::spread_angle, Range::open_closed(0, 180), "degrees",
+               "full angle of the cone of directions about the normal; 180 = the hemisphere"),
+       P::boolean("relative_distance", &R::relative_distance, "max_distance is a fraction of the baked meshes' bounding-box diagonal"),
+       P::enumeration<Hemisphere>("hemisphere", &R::hemisphere, {{"outside", Hemisphere::Outside}, {"inside", Hemisphere::Inside}},
+                                  "outside: AO; inside: rays into the mesh, with a distance a thickness map"),
        P::seed("seed", &R::seed, "keys the per-texel sample sets"),
        P::real("denoise", &R::denoise, Range::closed(0, kMaxDenoiseSigma), "texels",
                "sigma of the texture-space filter of maps (denoise.h); 0 = off, the plain estimate of eq. 2")}};
@@ -149,7 +162,28 @@ const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table() {
 
 void RaytracedBakeParams::validate() const {
   raytraced_bake_param_table().validate(*this);
-  if (max_distance) falloff().validate();
+  if (relative_distance && !max_distance) throw InputError("bake raytraced: relative_distance needs max_distance (the fraction of the bounding-box diagonal)");
+  if (hemisphere == Hemisphere::Inside && ignore_back_faces)
+    throw InputError("bake raytraced: ignore_back_faces is for the outside hemisphere (inside the mesh, every hit is a back face)");
+  if (max_distance && !relative_distance) falloff().validate();
+}
+
+RaytracedBakeParams RaytracedBakeParams::with_absolute_distance(const Bounds3& baked) const {
+  if (!relative_distance || !max_distance) return *this;
+  RaytracedBakeParams p = *this;
+  const float diagonal = baked.empty() ? 0.0f : length(baked.extent());
+  if (!(diagonal > 0)) throw InputError("bake raytraced: relative_distance needs baked meshes of non-zero size");
+  p.max_distance = *max_distance * diagonal;
+  p.relative_distance = false;
+  p.validate();
+  return p;
+}
+
+Bounds3 baked_bounds(const Scene& scene) {
+  Bounds3 b;
+  for (const Mesh& m : scene.meshes)
+    if (!m.uvs.empty()) b.extend(m.bounds());
+  return b;
 }
 
 Falloff RaytracedBakeParams::falloff() const {
@@ -163,9 +197,10 @@ Falloff RaytracedBakeParams::falloff() const {
 void to_json(nlohmann::json& j, const RaytracedBakeParams& p) { j = raytraced_bake_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, RaytracedBakeParams& p) { raytraced_bake_param_table().from_json(j, p); }
 
-BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const RaytracedBakeParams& params, const ProgressFn& progress) {
-  params.validate();
+BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const RaytracedBakeParams& given, const ProgressFn& progress) {
+  given.validate();
   const Scene& scene = rs.scene();
+  const RaytracedBakeParams params = given.with_absolute_distance(baked_bounds(scene));
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
   const Tracer tracer{rs, falloff, fn, params.ignore_back_faces};
@@ -224,10 +259,13 @@ std::vector<std::uint32_t> morton_order(const Scene& scene, const std::vector<st
 
 }  // namespace
 
-std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBakeParams& params, std::uint64_t* rays_traced,
+std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBakeParams& given, std::uint64_t* rays_traced,
                                            const ProgressFn& progress) {
-  params.validate();
+  given.validate();
   const Scene& scene = rs.scene();
+  if (given.hemisphere == Hemisphere::Inside) throw InputError("bake raytraced: per-vertex bakes take the outside hemisphere (AO)");
+  const RaytracedBakeParams params = given.with_absolute_distance(baked_bounds(scene));
+  const float spread = detail::cone_disk_radius(params.spread_angle);
   require_no_instances(scene);
   const Falloff falloff = params.falloff();
   const TriangleNormals fn = face_normals(scene);
@@ -287,7 +325,8 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
           // vertex, so the origin clears all of them (a face normal would leave it on the plane
           // of a neighbouring face in a crease).
           org[static_cast<std::size_t>(k)] = m.positions[v] + nrm * offset;
-          dir[static_cast<std::size_t>(k)] = f.to_world(cosine_hemisphere(sobol_owen_2d(static_cast<std::uint32_t>(first + k), key)));
+          const Vec2 u = sobol_owen_2d(static_cast<std::uint32_t>(first + k), key);
+          dir[static_cast<std::size_t>(k)] = f.to_world(cosine_hemisphere(spread < 1.0f ? detail::narrow_to_cone(u, spread) : u));
         }
         tracer.template trace<N>(ctx, org.data(), dir.data(), c, mu.data());
         for (int k = 0; k < c; ++k) acc.add(mu[static_cast<std::size_t>(k)]);

@@ -20,6 +20,9 @@
 
 namespace ao {
 
+/// Which side of the surface a bake's rays leave to (RaytracedBakeParams::hemisphere).
+enum class Hemisphere { Outside, Inside };
+
 struct RaytracedBakeParams {
   int samples = 64;                      ///< Rays per texel (or vertex), each from its own point of the patch. [1, 1048576]. 64: the fewest that bake refined_elephant_uv at 1024^2 within RMSE 0.02 of a 1024-ray bake (docs/methods/bake.md).
   std::optional<float> max_distance;     ///< R, world units, > 0; nullopt = unlimited distance (the paper's eq. 1).
@@ -32,6 +35,19 @@ struct RaytracedBakeParams {
   /// mean over the vertex's triangles of the integral about each face normal.
   SurfaceNormal normal = SurfaceNormal::Shading;
   bool bent_normals = false;             ///< Also average the unoccluded directions per texel.
+  /// The full angle, degrees, of the cone of directions about the normal that each point
+  /// integrates over: (0, 180], 180 = the hemisphere. V is the cosine-weighted mean of mu over the
+  /// cone, (1 / (pi sin^2(a/2))) * integral over the cone of mu cos dw: narrower cones darken only
+  /// what lies straight ahead (Substance's and Marmoset's "spread angle").
+  float spread_angle = 180.0f;
+  /// max_distance is a fraction of the diagonal of the baked meshes' bounding box (the meshes with
+  /// UVs; occluders and the floor excluded), so one setting suits models of any scale. [Needs max_distance.]
+  bool relative_distance = false;
+  /// Outside (default): the hemisphere above the surface, AO. Inside: the one below it, rays into
+  /// the mesh from points pushed in along the face normal, back faces hit like any other (the
+  /// inside of a closed mesh is its back faces): with a distance R, a thickness map, 1 where nothing
+  /// of the mesh lies within R behind the point, darker the thinner the mesh there.
+  Hemisphere hemisphere = Hemisphere::Outside;
   std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
   /// Maps only: sigma, in texels, of the texture-space filter that averages the noise of texels
   /// that are neighbours on the surface (denoise.h); 0 = off, the plain estimate of eq. 2.
@@ -43,7 +59,11 @@ struct RaytracedBakeParams {
   /// Throws InputError naming the bad field.
   void validate() const;
   /// The falloff actually used; for unlimited distance, a Step whose reach is +infinity.
+  /// max_distance as given: resolve a relative one first (with_absolute_distance).
   Falloff falloff() const;
+  /// These settings with a relative max_distance made absolute for baked meshes whose bounding
+  /// box is `baked` (unchanged when relative_distance is off).
+  RaytracedBakeParams with_absolute_distance(const Bounds3& baked) const;
 };
 void to_json(nlohmann::json& j, const RaytracedBakeParams& p);
 void from_json(const nlohmann::json& j, RaytracedBakeParams& p);
@@ -70,6 +90,9 @@ inline BvhOptions bake_bvh_options(std::size_t triangles) {
   o.quads = triangles <= kCompactBvhTriangles;
   return o;
 }
+
+/// The bounding box of `scene`'s meshes with UVs: the meshes a bake bakes (occluders have none).
+Bounds3 baked_bounds(const Scene& scene);
 
 /// V per covered texel, the area-weighted mean of the obscurance integral over the texel's patch
 /// (eq. 2 of the per-texel AO paper, with mu(D) in place of V when R is set). Sample i of texel

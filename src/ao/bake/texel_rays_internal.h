@@ -90,6 +90,35 @@ inline PatchSample sample_patch(const std::vector<PatchPiece>& patch, Vec2 u) {
   return {&patch[pi], {1.0f - r, r * (1.0f - u.y), r * u.y}};
 }
 
+/// The patch with its normals turned over (interpolated and face normals negated): what the
+/// inside hemisphere's rays leave from.
+inline void turn_over(const std::vector<PatchPiece>& patch, std::vector<PatchPiece>& out) {
+  out = patch;
+  for (PatchPiece& p : out) {
+    for (Vec3& n : p.n) n = -n;
+    p.ng = -p.ng;
+  }
+}
+
+/// The radius, sin(angle / 2), of the disk whose lift (Malley's method) is the cone of full angle
+/// `spread_angle` degrees about the normal.
+inline float cone_disk_radius(float spread_angle) { return spread_angle >= 180.0f ? 1.0f : std::sin(spread_angle * (kPi / 360.0f)); }
+
+/// Direction uniforms for the cone whose disk radius is `radius`: the concentric map takes the
+/// square [0,1)^2 scaled about its centre by `radius` onto the disk of that radius (it keeps the
+/// angle and scales the radius of each point), whose lift is the cosine-weighted distribution
+/// restricted to the cone. Stratification carries over unchanged.
+inline Vec2 narrow_to_cone(Vec2 u, float radius) { return {0.5f + (u.x - 0.5f) * radius, 0.5f + (u.y - 0.5f) * radius}; }
+/// The same for lanes 0 .. count - 1 of dimensions 0-1 of u (dimensions 2-3 copied).
+inline void narrow_to_cone(const float (&u)[4][16], int count, float radius, float (&out)[4][16]) {
+  for (int k = 0; k < count; ++k) {
+    out[0][k] = 0.5f + (u[0][k] - 0.5f) * radius;
+    out[1][k] = 0.5f + (u[1][k] - 0.5f) * radius;
+    out[2][k] = u[2][k];
+    out[3][k] = u[3][k];
+  }
+}
+
 /// Up to 16 rays of one texel, laid out as an RTCRay16's origins and directions (structure of
 /// arrays, one lane per ray).
 struct TexelRayBatch {

@@ -33,6 +33,14 @@ Baker baker_from_name(const std::string& name) {
   throw InputError(field(fields::kBakeMethod) + ": expected histogram or raytraced, got '" + name + "'" + did_you_mean(name, "histogram, raytraced"));
 }
 
+std::string_view to_string(BentNormalSpace space) { return space == BentNormalSpace::Tangent ? "tangent" : "world"; }
+
+BentNormalSpace bent_normal_space_from_name(const std::string& name) {
+  if (name == "world") return BentNormalSpace::World;
+  if (name == "tangent") return BentNormalSpace::Tangent;
+  throw InputError(field(fields::kBakeBentNormalSpace) + ": expected world or tangent, got '" + name + "'" + did_you_mean(name, "world, tangent"));
+}
+
 MapSize parse_map_size(const std::string& text) {
   auto side = [](const std::string& s) -> std::optional<int> {
     if (s.empty() || s.size() > 5 || !std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); })) return std::nullopt;
@@ -142,7 +150,7 @@ void check_settings(const BakeRequest& r) {
 // known extensions, and (for a single mesh, whose outputs are the given paths) existing folders.
 void check_output_names(const Plan& plan) {
   const BakeOutputs& o = plan.r.outputs;
-  for (const fs::path& img : {o.map, o.bent_normals})
+  for (const fs::path& img : {o.map, o.bent_normals, o.thickness, o.cavity})
     if (!img.empty() && !is_supported_image_path(img))
       throw InputError(img.string() + ": unknown image extension (supported: " + supported_image_extensions() + ")" +
                        did_you_mean(img.extension().string(), supported_image_extensions()));
@@ -157,7 +165,7 @@ void check_output_names(const Plan& plan) {
                        (ec ? ": " + ec.message() : std::string(" (a file has that name)")));
   }
   if (plan.batch) return;  // outputs go to out_dir or beside each mesh
-  for (const fs::path& out : {o.map, o.bent_normals, o.per_vertex, o.gltf}) {
+  for (const fs::path& out : {o.map, o.bent_normals, o.thickness, o.cavity, o.per_vertex, o.gltf}) {
     if (out.empty()) continue;
     const fs::path parent = out.parent_path();
     if (!parent.empty() && !fs::is_directory(parent)) throw InputError(out.string() + ": folder " + parent.string() + " does not exist");
@@ -193,12 +201,31 @@ void check_udim(const Plan& plan) {
   if (!is_udim_pattern(r.outputs.map)) return;
   const std::pair<bool, std::string> single_map_options[] = {{!r.outputs.gltf.empty(), field(fields::kBakeGltf) + " (a material takes one occlusion texture)"},
                                                             {!r.outputs.bent_normals.empty(), field(fields::kBakeBentNormals)},
+                                                            {!r.outputs.thickness.empty(), field(fields::kBakeThickness)},
+                                                            {!r.outputs.cavity.empty(), field(fields::kBakeCavity)},
                                                             {!r.outputs.miss_mask.empty(), field(fields::kBakeMissMask)},
                                                             {!r.orm.empty(), field(fields::kBakeOrm)},
                                                             {!r.reference.empty(), field(fields::kBakeReference)}};
   for (const auto& [given, what] : single_map_options)
     if (given)
       throw InputError(r.outputs.map.string() + ": UDIM tiles are written for the map only; " + what + " needs a single map, drop it or the tile pattern");
+}
+
+// The AO family's maps: ray-traced, with the AO map's settings but their own distance.
+void check_family(const Plan& plan) {
+  const BakeRequest& r = plan.r;
+  const BakeOutputs& o = r.outputs;
+  const std::pair<const fs::path*, std::string_view> family[] = {{&o.thickness, fields::kBakeThickness}, {&o.cavity, fields::kBakeCavity}};
+  for (const auto& [path, name] : family)
+    if (!path->empty() && r.method == Baker::Histogram)
+      throw InputError(field(name) + " is baked by the ray-traced baker; drop " + field(fields::kBakeMethod) + " histogram");
+  for (const auto& [value, name] : {std::pair{r.thickness_distance, fields::kBakeThicknessDistance}, std::pair{r.cavity_distance, fields::kBakeCavityDistance}})
+    if (!(value > 0 && value <= 10))
+      throw InputError(field(name) + " must be in (0, 10] (a fraction of the bounding-box diagonal), got " + float_text(value));
+  if (!o.thickness.empty() && r.raytraced.ignore_back_faces)
+    throw InputError(field(fields::kBakeThickness) + " looks into the mesh, where every hit is a back face; it cannot be baked with ignore_back_faces (the ray-traced setting)");
+  if (r.bent_normal_space == BentNormalSpace::Tangent && o.bent_normals.empty())
+    throw InputError(field(fields::kBakeBentNormalSpace) + " tangent is the space of " + field(fields::kBakeBentNormals) + "; name that output too");
 }
 
 // Both bakers' settings as the request sets them: the filter of ray-traced maps (high to low
@@ -210,6 +237,7 @@ void resolve_baker_settings(Plan& plan) {
   r.raytraced.bent_normals = r.histogram.bent_normals = !r.outputs.bent_normals.empty();
   r.raytraced.validate();  // before any mesh is loaded: samples, offset, denoise
   r.histogram.validate();
+  check_family(plan);
 }
 
 void check_memory_of(const Plan& plan) {
@@ -228,7 +256,8 @@ bool Plan::wants_map() const { return r.outputs.per_vertex.empty() || !r.outputs
 
 bool Plan::writes_map_file() const {
   const BakeOutputs& o = r.outputs;
-  return !o.map.empty() || (o.gltf.empty() && o.bent_normals.empty() && o.per_vertex.empty() && o.miss_mask.empty());
+  return !o.map.empty() || (o.gltf.empty() && o.bent_normals.empty() && o.thickness.empty() && o.cavity.empty() && o.per_vertex.empty() &&
+                            o.miss_mask.empty());
 }
 
 bool Plan::grouped() const { return high_to_low() || !r.occluders.empty() || r.floor || !r.groups.empty() || r.self_occlusion; }
@@ -270,6 +299,8 @@ MeshOutputs outputs_of(const fs::path& input, const Plan& plan) {
     if (plan.writes_map_file()) out.files.emplace_back(out.map, o.map.empty() ? "the default map output" : field(fields::kBakeMap));
     if (!o.miss_mask.empty()) out.files.emplace_back(out.miss = batch_path(input, o.miss_mask, plan, "-miss.png"), field(fields::kBakeMissMask));
     if (!o.bent_normals.empty()) out.files.emplace_back(out.bent = batch_path(input, o.bent_normals, plan, "-bent.png"), field(fields::kBakeBentNormals));
+    if (!o.thickness.empty()) out.files.emplace_back(out.thickness = batch_path(input, o.thickness, plan, "-thickness.png"), field(fields::kBakeThickness));
+    if (!o.cavity.empty()) out.files.emplace_back(out.cavity = batch_path(input, o.cavity, plan, "-cavity.png"), field(fields::kBakeCavity));
     if (!o.gltf.empty()) out.files.emplace_back(out.gltf = batch_path(input, o.gltf, plan, "-ao.glb"), field(fields::kBakeGltf));
   }
   if (!o.per_vertex.empty()) out.files.emplace_back(out.per_vertex = batch_path(input, o.per_vertex, plan, "-ao.ply"), field(fields::kBakePerVertex));
@@ -301,6 +332,10 @@ nlohmann::json bake_record(const Plan& plan, const fs::path& input, bool hash_in
   const auto kind = [](const fs::path& p) { return p.empty() ? nlohmann::json() : nlohmann::json(lower_extension(p)); };
   s["outputs"] = {{"map", plan.wants_map() && plan.writes_map_file() ? kind(o.map.empty() ? fs::path("default.png") : o.map) : nlohmann::json()},
                   {"bent_normals", kind(o.bent_normals)}, {"per_vertex", kind(o.per_vertex)}, {"gltf", kind(o.gltf)}, {"miss_mask", kind(o.miss_mask)}};
+  // The AO family's settings, only where asked for (the records of other bakes stay as they were).
+  if (r.bent_normal_space == BentNormalSpace::Tangent) s["bent_normal_space"] = to_string(r.bent_normal_space);
+  if (!o.thickness.empty()) s["outputs"]["thickness"] = kind(o.thickness), s["thickness_distance"] = r.thickness_distance;
+  if (!o.cavity.empty()) s["outputs"]["cavity"] = kind(o.cavity), s["cavity_distance"] = r.cavity_distance;
   return provenance_record("bake", inputs, s, hash_inputs);
 }
 
@@ -336,10 +371,10 @@ std::vector<Mesh> load_occluders(const Plan& plan, const Scene& scene, const Sce
   return out;
 }
 
-BakeResult bake_map_plain(const Plan& plan, const Scene& scene, const TexelCoverage& coverage, const ProgressFn& progress) {
+BakeResult bake_map_plain(const Plan& plan, const Scene& scene, const TexelCoverage& coverage, const ProgressFn& progress, const RaytracedBakeParams* rt) {
   if (plan.r.method == Baker::Histogram) return bake_histogram(scene, coverage, plan.r.histogram, progress);
   const RayScene rays(scene, bake_bvh_options(scene.triangle_count()));
-  return bake_raytraced(rays, coverage, plan.r.raytraced, progress);
+  return bake_raytraced(rays, coverage, rt ? *rt : plan.r.raytraced, progress);
 }
 
 std::vector<float> bake_vertices_of(const Plan& plan, const Scene& scene, std::uint64_t* rays, const ProgressFn& progress) {

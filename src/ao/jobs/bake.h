@@ -41,6 +41,16 @@ std::string_view to_string(Baker baker);
 /// The baker called `name`; InputError naming --method and the choices otherwise.
 Baker baker_from_name(const std::string& name);
 
+/// The space bent normals are written in.
+enum class BentNormalSpace {
+  World,    ///< World-space direction.
+  Tangent,  ///< The UV layout's tangent space, MikkTSpace frames (bake/tangents.h): what engines read.
+};
+/// "world", "tangent".
+std::string_view to_string(BentNormalSpace space);
+/// The space called `name`; InputError naming --bent-normals-space and the choices otherwise.
+BentNormalSpace bent_normal_space_from_name(const std::string& name);
+
 /// The size of a map, texels per side, each in [1, kMaxMapSide].
 struct MapSize {
   int width = 1024, height = 1024;
@@ -56,7 +66,14 @@ struct BakeOutputs {
   /// A name with <UDIM> or .1001. writes one map per UDIM tile. Without any output named, the map
   /// is written as <mesh stem>-ao.png.
   std::filesystem::path map;
-  std::filesystem::path bent_normals;  ///< The average open direction, world space, n * 0.5 + 0.5.
+  std::filesystem::path bent_normals;  ///< The average open direction, n * 0.5 + 0.5, in BakeRequest::bent_normal_space.
+  /// The thickness map (ray-traced): the inside hemisphere's mean of min(d / R, 1) (linear
+  /// membership), R = BakeRequest::thickness_distance: 1 where the mesh reaches R or more behind
+  /// the surface, darker the thinner it is. Same formats as the map.
+  std::filesystem::path thickness;
+  /// The cavity map (ray-traced): AO as the map bakes it, with R = BakeRequest::cavity_distance:
+  /// only the small creases darken. Same formats as the map.
+  std::filesystem::path cavity;
   std::filesystem::path per_vertex;    ///< Per-vertex AO: .ply (colour + float quality) or .glb (COLOR_0).
   std::filesystem::path gltf;          ///< A .glb of the mesh with the map as its occlusion texture.
   std::filesystem::path miss_mask;     ///< High to low: 1 where every cage ray of a texel missed.
@@ -82,6 +99,13 @@ struct BakeRequest {
   /// Sigma, texels, of the texture-space filter of ray-traced maps, [0, kMaxDenoiseSigma]; 0 = off.
   /// Unset: kDefaultBakeDenoise (docs/methods/bake.md, "Denoising"). Per-vertex AO is never filtered.
   std::optional<float> denoise;
+  BentNormalSpace bent_normal_space = BentNormalSpace::World;
+  /// R of the thickness map as a fraction of the baked meshes' bounding-box diagonal, (0, 10].
+  /// 0.25: the thin parts of a figure (ears, fingers, cloth) grade from dark to white.
+  float thickness_distance = 0.25f;
+  /// R of the cavity map as a fraction of the baked meshes' bounding-box diagonal, (0, 10].
+  /// 0.02: creases a few hundredths of the model's size across.
+  float cavity_distance = 0.02f;
   HistogramParams histogram;        ///< The histogram baker's settings; bent_normals set by the job.
   int vertex_resolution = 1024;     ///< Histogram per-vertex bakes: view size in pixels, [64, 8192].
   // High to low: the AO of the high meshes baked into the low mesh's UVs (ray-traced).
@@ -109,6 +133,7 @@ struct BakeRequest {
 struct MeshBake {
   std::filesystem::path input;
   BakeResult map;                  ///< Padded; empty when no map was asked for (or a UDIM or glTF round trip wrote several).
+  Image<float> thickness, cavity;  ///< Padded; empty unless asked for (BakeOutputs).
   std::vector<float> vertex_ao;    ///< Per vertex of each mesh, concatenated; empty unless asked for.
   std::string error;               ///< In a batch: the one-line error of a mesh that failed; empty on success.
   nlohmann::json summary;          ///< What `ao bake --json` prints for it.

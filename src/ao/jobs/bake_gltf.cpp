@@ -31,6 +31,8 @@ void check_round_trip_options(const Plan& plan, const fs::path& input) {
       {plan.high_to_low(), field(fields::kBakeHigh)},
       {!r.groups.empty() || r.self_occlusion || r.match_by_name, "bake groups"},
       {!r.outputs.bent_normals.empty(), field(fields::kBakeBentNormals)},
+      {!r.outputs.thickness.empty(), field(fields::kBakeThickness)},
+      {!r.outputs.cavity.empty(), field(fields::kBakeCavity)},
       {!r.orm.empty(), field(fields::kBakeOrm)},
       {!r.reference.empty(), field(fields::kBakeReference)},
       {!r.outputs.per_vertex.empty() && lower_extension(r.outputs.per_vertex) != ".glb", field(fields::kBakePerVertex) + " .ply"},

@@ -40,7 +40,7 @@ Plan plan_bake(const BakeRequest& request);
 /// The outputs of one mesh, each with what names it (for messages).
 struct MeshOutputs {
   std::vector<std::pair<fs::path, std::string>> files;
-  fs::path map, miss, bent, gltf, per_vertex;  ///< Empty when not written.
+  fs::path map, miss, bent, thickness, cavity, gltf, per_vertex;  ///< Empty when not written.
 };
 MeshOutputs outputs_of(const fs::path& input, const Plan& plan);
 
@@ -56,8 +56,10 @@ inline const LoadOptions kBakeLoad{.flatten_instances = true};
 /// `scene` (and `high`).
 std::vector<Mesh> load_occluders(const Plan& plan, const Scene& scene, const Scene* high, const JobReporter& reporter);
 
-/// The map of `scene`'s meshes with UVs by the plan's baker (the others occlude).
-BakeResult bake_map_plain(const Plan& plan, const Scene& scene, const TexelCoverage& coverage, const ProgressFn& progress);
+/// The map of `scene`'s meshes with UVs by the plan's baker (the others occlude); ray-traced with
+/// `rt` in place of the plan's settings when given (the AO family's maps).
+BakeResult bake_map_plain(const Plan& plan, const Scene& scene, const TexelCoverage& coverage, const ProgressFn& progress,
+                          const RaytracedBakeParams* rt = nullptr);
 /// Per-vertex AO of every mesh of `scene`, concatenated; `rays` (may be null) gets the ray count.
 std::vector<float> bake_vertices_of(const Plan& plan, const Scene& scene, std::uint64_t* rays, const ProgressFn& progress);
 

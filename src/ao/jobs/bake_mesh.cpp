@@ -7,6 +7,7 @@
 
 #include "ao/bake/bake_groups.h"
 #include "ao/bake/padding.h"
+#include "ao/bake/tangents.h"
 #include "ao/bake/per_vertex.h"
 #include "ao/bake/udim.h"
 #include "ao/core/error.h"
@@ -39,6 +40,10 @@ struct MeshJob {
   nlohmann::json timings;
   Stopwatch clock;
   std::unique_ptr<RayScene> rays;  ///< Of the scene alone, built once for the map and per-vertex AO.
+  /// The ray-traced settings with a relative distance resolved for the whole scene (so that
+  /// every group, tile and map of the family takes the same R).
+  RaytracedBakeParams ao;
+  Image<float> thickness, cavity;  ///< The AO family's maps, padded; empty unless asked for.
   nlohmann::json record;           ///< The provenance record of the outputs, when asked for (inputs hashed before loading).
 
   const Scene* high_scene() const { return high ? &*high : nullptr; }
@@ -126,12 +131,14 @@ void warn_missed(const MeshJob& job, const BakeResult& r, const HighToLowParams&
 
 // The map baked group by group: high to low, or the group's own meshes with the occluders.
 // `coverage`: the scene's own, when computed already (bake_groups reuses it for a group of every mesh).
-BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& progress, const TexelCoverage* coverage = nullptr) {
+// `rt`: the ray-traced settings, when not the job's (a map of the AO family).
+BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& progress, const TexelCoverage* coverage = nullptr,
+                          const RaytracedBakeParams* rt = nullptr) {
   const Plan& plan = job.plan;
   const std::vector<BakeGroup> groups = make_groups(job, scene);
   CagePositions cage;  // of the whole low scene; each group takes its meshes' cages
   HighToLowParams p = plan.r.high_to_low;
-  p.ao = plan.r.raytraced;
+  p.ao = rt ? *rt : job.ao;
   if (job.high) {
     if (plan.r.cage_scene) {
       cage = cage_from_mesh(scene, *plan.r.cage_scene);
@@ -147,7 +154,7 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
   }
   BakeResult r = bake_groups(scene, groups, job.high ? std::vector<Mesh>{} : job.occluders, plan.width, plan.height,
                              [&](const Scene& gs, const TexelCoverage& cov, const BakeGroup& g) -> BakeResult {
-                               if (!job.high) return bake_map_plain(plan, gs, cov, progress);
+                               if (!job.high) return bake_map_plain(plan, gs, cov, progress, &p.ao);
                                return bake_group_high_to_low(job, gs, cov, g, cage, p, progress);
                              },
                              coverage);
@@ -177,7 +184,8 @@ void bake_udim_tiles(MeshJob& job, const fs::path& pattern, OutputSet& outputs) 
   for (const UdimTile& t : tiles) {
     const Scene ts = udim_tile_scene(job.scene, t);
     const ProgressFn progress = job.reporter.start("bake " + job.label() + " tile " + std::to_string(t.number()));
-    BakeResult tr = plan.grouped() ? bake_in_groups(job, ts, progress) : bake_map_plain(plan, ts, compute_texel_coverage(ts, plan.width, plan.height), progress);
+    BakeResult tr = plan.grouped() ? bake_in_groups(job, ts, progress)
+                                   : bake_map_plain(plan, ts, compute_texel_coverage(ts, plan.width, plan.height), progress, &job.ao);
     if (tr.covered_texels == 0) continue;  // a tile without texels is not written
     if (plan.r.padding > 0) pad(tr.visibility, nearest_valid_texel(tr.mask, plan.r.padding));
     const double mean = covered_mean(tr);
@@ -193,6 +201,43 @@ void bake_udim_tiles(MeshJob& job, const fs::path& pattern, OutputSet& outputs) 
   job.summary["texels_covered"] = covered;
 }
 
+// World-space bent normals of the covered texels of `cov` into the tangent space of the scene's
+// UV layout (bake/tangents.h).
+void into_tangent_space(const Scene& scene, const TexelCoverage& cov, Image<Vec3>& bent) {
+  std::vector<std::vector<CornerTangent>> tangents;
+  for (const Mesh& m : scene.meshes) tangents.push_back(m.uvs.empty() ? std::vector<CornerTangent>{} : mikktspace_tangents(m));
+  const TexelFrames frames = texel_frames(scene, cov, tangents);
+  for (std::size_t i = 0; i < bent.size(); ++i)
+    if (cov.mask[i] && length(bent[i]) > 0) bent[i] = to_tangent_space(bent[i], frames.t[i], frames.n[i], frames.sign[i]);
+}
+
+// Thickness: the AO map's rays turned into the mesh, mu = min(d / R, 1), R a fraction of the scene's size.
+RaytracedBakeParams thickness_settings(const MeshJob& job) {
+  RaytracedBakeParams rt = job.plan.r.raytraced;
+  rt.hemisphere = Hemisphere::Inside;
+  rt.membership = Membership::Linear;
+  rt.max_distance = job.plan.r.thickness_distance;
+  rt.relative_distance = true;
+  return rt.with_absolute_distance(baked_bounds(job.scene));
+}
+
+// Cavity: the AO map's bake within a short R, a fraction of the scene's size.
+RaytracedBakeParams cavity_settings(const MeshJob& job) {
+  RaytracedBakeParams rt = job.plan.r.raytraced;
+  rt.max_distance = job.plan.r.cavity_distance;
+  rt.relative_distance = true;
+  return rt.with_absolute_distance(baked_bounds(job.scene));
+}
+
+// One map of the AO family: the AO map's bake (plain or by groups) with settings `rt`.
+Image<float> bake_family_map(MeshJob& job, const TexelCoverage& cov, RaytracedBakeParams rt, const std::string& what) {
+  rt.bent_normals = false;
+  const ProgressFn progress = job.reporter.start(what + " " + job.label());
+  BakeResult r = job.plan.grouped() ? bake_in_groups(job, job.scene, progress, &cov, &rt) : bake_raytraced(job.ray_scene(), cov, rt, progress);
+  job.summary[what] = {{"mean", covered_mean(r)}, {"max_distance", *rt.max_distance}, {"rays", r.rays}};
+  return std::move(r.visibility);
+}
+
 // The map of the whole scene, with its summary, padded.
 BakeResult bake_map(MeshJob& job, const fs::path& map_out) {
   const Plan& plan = job.plan;
@@ -202,9 +247,14 @@ BakeResult bake_map(MeshJob& job, const fs::path& map_out) {
   const ProgressFn progress = job.reporter.start("bake " + job.label());
   BakeResult r = plan.grouped() ? bake_in_groups(job, job.scene, progress, &cov)
                  : plan.r.method == Baker::Histogram ? bake_histogram(job.scene, cov, plan.r.histogram, progress)
-                                                      : bake_raytraced(job.ray_scene(), cov, plan.r.raytraced, progress);
+                                                      : bake_raytraced(job.ray_scene(), cov, job.ao, progress);
   const double bake_ms = job.clock.lap_ms();
   job.timings["bake_ms"] = bake_ms;
+  if (plan.r.bent_normal_space == BentNormalSpace::Tangent && !r.bent_normal.empty()) into_tangent_space(job.scene, cov, r.bent_normal);
+  const BakeOutputs& o = plan.r.outputs;
+  if (!o.thickness.empty()) job.thickness = bake_family_map(job, cov, thickness_settings(job), "thickness");
+  if (!o.cavity.empty()) job.cavity = bake_family_map(job, cov, cavity_settings(job), "cavity");
+  if (!o.thickness.empty() || !o.cavity.empty()) job.timings["family_ms"] = job.clock.lap_ms();
   nlohmann::json& s = job.summary;
   s["output"] = map_out.string();
   if (plan.width == plan.height) s["size"] = plan.width;
@@ -231,6 +281,8 @@ BakeResult bake_map(MeshJob& job, const fs::path& map_out) {
     const Image<std::int32_t> nearest = nearest_valid_texel(r.mask, plan.r.padding);
     pad(r.visibility, nearest);
     if (!r.bent_normal.empty()) pad(r.bent_normal, nearest);
+    for (Image<float>* family : {&job.thickness, &job.cavity})
+      if (!family->empty()) pad(*family, nearest);
   }
   job.timings["padding_ms"] = job.clock.lap_ms();
   return r;
@@ -244,7 +296,7 @@ std::vector<float> bake_vertex_ao(MeshJob& job) {
   std::vector<float> v;
   if (job.occluders.empty()) {
     v = job.plan.r.method == Baker::Histogram ? bake_vertices_of(job.plan, job.scene, &nrays, progress)
-                                                : bake_vertices_raytraced(job.ray_scene(), job.plan.r.raytraced, &nrays, progress);
+                                                : bake_vertices_raytraced(job.ray_scene(), job.ao, &nrays, progress);
   } else {
     Scene with_occluders = job.scene;
     for (const Mesh& m : job.occluders) with_occluders.meshes.push_back(m);
@@ -283,6 +335,8 @@ void write_map_outputs(MeshJob& job, const BakeResult& r, const MeshOutputs& out
       if (length(r.bent_normal[i]) > 0) enc[i] = r.bent_normal[i] * 0.5f + Vec3{0.5f, 0.5f, 0.5f};
     outputs.write(outs.bent, [&] { write_rgb_image(outs.bent, enc, {.png_bits = plan.png_bits}); });
   }
+  if (!outs.thickness.empty()) outputs.write(outs.thickness, [&] { write_image(outs.thickness, job.thickness, {.png_bits = plan.png_bits}); });
+  if (!outs.cavity.empty()) outputs.write(outs.cavity, [&] { write_image(outs.cavity, job.cavity, {.png_bits = plan.png_bits}); });
   if (!outs.gltf.empty()) {
     if (png.empty()) png = encode_png(r.visibility, {.png_bits = plan.png_bits});
     outputs.write(outs.gltf, [&] { write_ao_glb(outs.gltf, job.scene, png, vertex_ao.empty() ? nullptr : &vertex_ao); });
@@ -325,6 +379,7 @@ MeshBake bake_and_write(MeshJob& job, const MeshOutputs& outs, OutputSet* output
   if (udim) bake_udim_tiles(job, outs.map, *outputs);
   else if (plan.wants_map()) out.map = bake_map(job, outs.map);
   if (!plan.r.outputs.per_vertex.empty()) out.vertex_ao = bake_vertex_ao(job);
+  out.thickness = job.thickness, out.cavity = job.cavity;
   if (!plan.writes_map_file() || udim) job.summary.erase("output");  // UDIM tiles were written above
   if (outputs) {
     if (plan.wants_map() && !udim) write_map_outputs(job, out.map, outs, out.vertex_ao, *outputs);
@@ -358,6 +413,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
   for (const std::string& w : scene.warnings) reporter.warn(w);  // the loader names the file
   check_traceable_size(scene);  // the histogram baker traces no ray: checked here for both
   MeshJob job{plan, input, reporter, scene};
+  job.ao = plan.r.raytraced.with_absolute_distance(baked_bounds(scene));
   job.clock = clock;
   job.record = std::move(record);
   job.timings["load_ms"] = job.clock.lap_ms();
@@ -370,6 +426,7 @@ MeshBake bake_mesh(const Plan& plan, const fs::path& input, const JobReporter& r
 MeshBake bake_scene(const Plan& plan, const Scene& scene, const JobReporter& reporter) {
   check_traceable_size(scene);
   MeshJob job{plan, scene.name, reporter, scene};
+  job.ao = plan.r.raytraced.with_absolute_distance(baked_bounds(scene));
   job.summary = {{"ao", build_info()}, {"input", scene.name}, {"method", to_string(plan.r.method)}, {"triangles", scene.triangle_count()}, {"vertices", scene.vertex_count()}};
   if (plan.high_to_low()) job.high = load_high_scene(plan.r, reporter);
   job.occluders = load_occluders(plan, scene, job.high_scene(), reporter);

@@ -62,6 +62,11 @@ inline constexpr std::string_view kBakeReference = "BakeRequest::reference";
 inline constexpr std::string_view kBakeOutDir = "BakeRequest::out_dir";
 inline constexpr std::string_view kBakeMap = "BakeRequest::outputs.map";
 inline constexpr std::string_view kBakeBentNormals = "BakeRequest::outputs.bent_normals";
+inline constexpr std::string_view kBakeThickness = "BakeRequest::outputs.thickness";
+inline constexpr std::string_view kBakeCavity = "BakeRequest::outputs.cavity";
+inline constexpr std::string_view kBakeBentNormalSpace = "BakeRequest::bent_normal_space";
+inline constexpr std::string_view kBakeThicknessDistance = "BakeRequest::thickness_distance";
+inline constexpr std::string_view kBakeCavityDistance = "BakeRequest::cavity_distance";
 inline constexpr std::string_view kBakePerVertex = "BakeRequest::outputs.per_vertex";
 inline constexpr std::string_view kBakeGltf = "BakeRequest::outputs.gltf";
 inline constexpr std::string_view kBakeMissMask = "BakeRequest::outputs.miss_mask";
@@ -92,7 +97,8 @@ inline constexpr std::string_view kAll[] = {
     kRenderSamples, kRenderTargetError, kRenderSun, kRenderAoMap, kRenderVisibility, kRenderShaded, kRenderGBufferOut, kRenderExtras,
     kRenderPngBits, kRenderProvenance, kBakeMethod, kBakeSize, kBakeUvSet, kBakePadding, kBakeDenoise, kBakeMembership,
     kBakeMaxDistance, kBakeHigh, kBakeCage, kBakeCageExtrusion, kBakeMaxFront, kBakeMaxBack, kBakeOccluders, kBakeFloor, kBakeGroups,
-    kBakeSelfOcclusion, kBakeMatchByName, kBakeOrm, kBakeReference, kBakeOutDir, kBakeMap, kBakeBentNormals, kBakePerVertex,
+    kBakeSelfOcclusion, kBakeMatchByName, kBakeOrm, kBakeReference, kBakeOutDir, kBakeMap, kBakeBentNormals, kBakeThickness, kBakeCavity,
+    kBakeBentNormalSpace, kBakeThicknessDistance, kBakeCavityDistance, kBakePerVertex,
     kBakeGltf, kBakeMissMask, kBakePngBits, kBakeProvenance, kPointsPoints, kPointsNormals, kCompareMethods, kCompareParams, kCompareReferences,
     kCompareCommonReference, kCompareSppReference, kCompareSweep, kCompareOutDir, kTuneScenes, kTuneFit, kTuneSppReference,
     kTuneOutput};

@@ -236,12 +236,15 @@ def gbuffer_from_arrays(normal, *, depth=None, position=None, albedo=None, objec
 
 def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=True, per_vertex=False, seed=None,
          vertex_resolution=None, high=None, cage=None, cage_extrusion=None, max_front=None, max_back=None, cage_points=None,
-         output=None, per_vertex_output=None, bent_normals_output=None, gltf_output=None, png_bits=None,
-         provenance=False, full=False, progress=None, **params):
+         bent_normals=False, thickness=False, cavity=False, bent_normals_space=None, thickness_distance=None, cavity_distance=None,
+         output=None, per_vertex_output=None, bent_normals_output=None, thickness_output=None, cavity_output=None, gltf_output=None,
+         png_bits=None, provenance=False, full=False, progress=None, **params):
     """bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=16, map=True, per_vertex=False,
          seed=1, high=None, cage=None, cage_extrusion=None, max_front=None, max_back=None,
-         cage_points=4, output=None, per_vertex_output=None, bent_normals_output=None,
-         gltf_output=None, png_bits=None, provenance=False, full=False, progress=None, **params)
+         cage_points=4, bent_normals=False, thickness=False, cavity=False, bent_normals_space="world",
+         thickness_distance=0.25, cavity_distance=0.02, output=None, per_vertex_output=None,
+         bent_normals_output=None, thickness_output=None, cavity_output=None, gltf_output=None,
+         png_bits=None, provenance=False, full=False, progress=None, **params)
        -> numpy.ndarray
 
     Bakes AO into a mesh's UV space as `ao bake` does (one mesh; a folder: python3 -m ao.batch).
@@ -261,14 +264,25 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
                 or cage_extrusion: the low mesh pushed out along its smoothed normals, world
                 units (default: fitted to the pair, docs/methods/bake.md); max_front, max_back, cage_points as
                 `--max-front, --max-back, --cage-points`
-    output, per_vertex_output, bent_normals_output, gltf_output, png_bits
+    bent_normals, thickness, cavity
+                also bake these maps of the AO family (ray-traced; docs/methods/bake.md): the
+                average open direction (H x W x 3), the thickness (rays into the mesh) and the
+                cavity (AO within a short distance), H x W float32 each; they come back in the
+                dict that full=True returns, which bake then returns whatever `full` says
+    bent_normals_space  "world" (default) or "tangent": MikkTSpace frames, as Blender and engines read them
+    thickness_distance, cavity_distance
+                R of the thickness and cavity maps, fractions of the baked mesh's bounding-box
+                diagonal (default 0.25 and 0.02)
+    output, per_vertex_output, bent_normals_output, thickness_output, cavity_output, gltf_output, png_bits
                 files to write (mesh files only) as `ao bake -o, --per-vertex, --bent-normals,
-                --gltf, --png-bits`
+                --thickness, --cavity, --gltf, --png-bits`
     provenance  also write each file's record beside it, FILE.ao.json (`--provenance`)
-    full        return {"map", "mask" (1 where a texel is covered), "per_vertex", "summary"}
+    full        return {"map", "mask" (1 where a texel is covered), "per_vertex", "bent_normals", "thickness",
+                "cavity", "summary"} (those baked)
     progress    True (a bar) or a callable(stage, done, total) (module docstring)
     **params    the baker's parameters (`ao bake --help`): samples, denoise, max_distance,
-                membership, offset, normal, ignore_back_faces; histogram: directions, ...
+                membership, offset, normal, ignore_back_faces, spread_angle, relative_distance;
+                histogram: directions, ...
 
     Returns the map; only per-vertex values when map=False; (map, per_vertex) when both.
     """
@@ -276,14 +290,19 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
     per_vertex = _check.flag("per_vertex", per_vertex)
     request = _bake_request(size=size, method=method, uv_set=uv_set, padding=padding, vertex_resolution=vertex_resolution, seed=seed,
                             params=params, map=map_, per_vertex=per_vertex, output=output, per_vertex_output=per_vertex_output,
-                            bent_normals_output=bent_normals_output, gltf_output=gltf_output, png_bits=png_bits, provenance=provenance)
+                            bent_normals_output=bent_normals_output, gltf_output=gltf_output, png_bits=png_bits, provenance=provenance,
+                            thickness_output=thickness_output, cavity_output=cavity_output, bent_normals_space=bent_normals_space,
+                            thickness_distance=thickness_distance, cavity_distance=cavity_distance)
+    family = {"bent_normals": _check.flag("bent_normals", bent_normals), "thickness": _check.flag("thickness", thickness),
+              "cavity": _check.flag("cavity", cavity)}
+    request.update({k: v for k, v in family.items() if v})
     request.update({k: _check.number(k, v, optional=True) for k, v in
                     (("cage_extrusion", cage_extrusion), ("max_front", max_front), ("max_back", max_back)) if v is not None})
     if cage_points is not None:
         request["cage_points"] = _check.integer("cage_points", cage_points)
     high_to_low = _functools.partial(_ao.bake, high=_high_arg(high), cage=_cage_arg(cage))
     out = _run(high_to_low, progress, _mesh_arg(mesh), request)
-    if _check.flag("full", full):
+    if _check.flag("full", full) or any(family.values()):
         return out
     if map_ and per_vertex:
         return out.get("map"), out.get("per_vertex")
@@ -310,7 +329,8 @@ def _cage_arg(cage):
 
 
 def _bake_request(*, size, method, uv_set, padding, vertex_resolution, seed, params, map, per_vertex, output, per_vertex_output,
-                  bent_normals_output, gltf_output, png_bits, provenance):
+                  bent_normals_output, gltf_output, png_bits, provenance, thickness_output=None, cavity_output=None, bent_normals_space=None,
+                  thickness_distance=None, cavity_distance=None):
     """The job layer's request for bake() (and ao.batch's records), every argument checked."""
     params = dict(params)
     if seed is not None:
@@ -322,6 +342,10 @@ def _bake_request(*, size, method, uv_set, padding, vertex_resolution, seed, par
                "vertex_resolution": _check.integer("vertex_resolution", vertex_resolution, optional=True), "params": params, "map": map,
                "per_vertex": per_vertex, "output": _check.path("output", output), "per_vertex_output": _check.path("per_vertex_output", per_vertex_output),
                "bent_normals_output": _check.path("bent_normals_output", bent_normals_output),
+               "thickness_output": _check.path("thickness_output", thickness_output), "cavity_output": _check.path("cavity_output", cavity_output),
+               "bent_normals_space": _check.text("bent_normals_space", bent_normals_space, optional=True),
+               "thickness_distance": _check.number("thickness_distance", thickness_distance, optional=True),
+               "cavity_distance": _check.number("cavity_distance", cavity_distance, optional=True),
                "gltf_output": _check.path("gltf_output", gltf_output), "png_bits": _check.integer("png_bits", png_bits, optional=True),
                "provenance": _check.flag("provenance", provenance)}
     return {k: v for k, v in request.items() if v is not None}

@@ -58,7 +58,10 @@ def bake(mesh: Union[_PathLike, Scene], size: Union[None, int, str] = ..., *, me
          map: bool = ..., per_vertex: bool = ..., seed: Optional[int] = ..., vertex_resolution: Optional[int] = ...,
          high: Union[None, Scene, _PathLike, Sequence[_PathLike]] = ..., cage: Union[None, Scene, _PathLike] = ...,
          cage_extrusion: Optional[float] = ..., max_front: Optional[float] = ..., max_back: Optional[float] = ...,
-         cage_points: Optional[int] = ..., output: Optional[_PathLike] = ..., per_vertex_output: Optional[_PathLike] = ..., bent_normals_output: Optional[_PathLike] = ...,
+         cage_points: Optional[int] = ..., bent_normals: bool = ..., thickness: bool = ..., cavity: bool = ...,
+         bent_normals_space: Optional[str] = ..., thickness_distance: Optional[float] = ..., cavity_distance: Optional[float] = ...,
+         output: Optional[_PathLike] = ..., per_vertex_output: Optional[_PathLike] = ..., bent_normals_output: Optional[_PathLike] = ...,
+         thickness_output: Optional[_PathLike] = ..., cavity_output: Optional[_PathLike] = ...,
          gltf_output: Optional[_PathLike] = ..., png_bits: Optional[int] = ..., provenance: bool = ..., full: bool = ...,
          progress: _Progress = ..., **params: Any) -> Any: ...
 @overload

@@ -11,7 +11,8 @@ import os
 from . import _ao
 from ._batch_plan import Refused, confined, meshes
 
-BAKE_KINDS = {"map": "-ao.{format}", "per_vertex": "-ao.{per_vertex}", "bent_normals": "-bent.png", "gltf": "-ao.glb"}
+BAKE_KINDS = {"map": "-ao.{format}", "per_vertex": "-ao.{per_vertex}", "bent_normals": "-bent.png", "thickness": "-thickness.png",
+              "cavity": "-cavity.png", "gltf": "-ao.glb"}
 
 
 def _params(pairs):
@@ -42,10 +43,12 @@ def _task(kind, name, outputs, call, record):
 
 
 def bake_tasks(args):
-    """One task per mesh: its map (--format), and with --per-vertex, --bent-normals, --gltf those
-    files too, as OUT/<stem>-ao.png, -ao.ply, -bent.png, -ao.glb."""
+    """One task per mesh: its map (--format), and with --per-vertex, --bent-normals, --thickness,
+    --cavity, --gltf those files too, as OUT/<stem>-ao.png, -ao.ply, -bent.png, -thickness.png,
+    -cavity.png, -ao.glb."""
     import ao
-    wanted = {"map": not args.no_map, "per_vertex": bool(args.per_vertex), "bent_normals": args.bent_normals, "gltf": args.gltf}
+    wanted = {"map": not args.no_map, "per_vertex": bool(args.per_vertex), "bent_normals": args.bent_normals, "thickness": args.thickness,
+              "cavity": args.cavity, "gltf": args.gltf}
     if not any(wanted.values()):
         raise Refused("--no-map: name another output (--per-vertex, --gltf)")
     options = _params(args.param)
@@ -58,7 +61,8 @@ def bake_tasks(args):
             size=args.size, method=args.method, uv_set=args.uv_set, padding=None, vertex_resolution=None, seed=args.seed,
             params=dict(options), map=wanted["map"], per_vertex=wanted["per_vertex"], output=files.get("map"),
             per_vertex_output=files.get("per_vertex"), bent_normals_output=files.get("bent_normals"), gltf_output=files.get("gltf"),
-            png_bits=None, provenance=True))
+            png_bits=None, provenance=True, thickness_output=files.get("thickness"), cavity_output=files.get("cavity"),
+            bent_normals_space=args.bent_normals_space, thickness_distance=args.thickness_distance, cavity_distance=args.cavity_distance))
         record = _checked("", lambda: _ao.bake_record(mesh, request))
         tasks.append(_task("bake", stem + os.path.splitext(mesh)[1], list(files.values()), {"mesh": mesh, "request": request}, record))
     return tasks

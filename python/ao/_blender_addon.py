@@ -2,7 +2,9 @@
 
 bpy.ops.object.ao_bake bakes the ambient occlusion of the active mesh object into its UV map with
 ao's ray-traced baker, as `ao bake` does, into a float image named "<object name>_ao" (non-colour
-data, V in red, green and blue, 1 in alpha). The mesh goes from Blender's own data (modifiers
+data, V in red, green and blue, 1 in alpha); on request also the rest of the AO family, each a
+float image of its own: "<object name>_bent" (bent normals in tangent space, n * 0.5 + 0.5 in RGB,
+for the Normal Map node), "_thickness" and "_cavity". The mesh goes from Blender's own data (modifiers
 applied, world space, Blender's shading normals, the active UV map) through numpy into
 ao.Scene.from_arrays (ao/_blender_mesh.py): no file is written. With selected_to_active the AO of
 the other selected mesh objects is baked into the active one's UVs (`ao bake --high`), rays from a
@@ -43,6 +45,18 @@ _OPTIONS = [
     ("padding", bpy.props.IntProperty, dict(name="Padding", default=16, min=0, max=1024, subtype="PIXEL", description="Texels filled outside the UV islands (ao bake --padding)")),
     ("seed", bpy.props.IntProperty, dict(name="Seed", default=1, min=0, description="Seed of the per-texel sample sets (ao bake --seed)")),
     ("ignore_back_faces", bpy.props.BoolProperty, dict(name="Ignore Back Faces", default=False, description="Rays pass through back faces (ao bake -p ignore_back_faces=true)")),
+    ("spread_angle", bpy.props.FloatProperty, dict(name="Spread", default=180.0, min=0.001, max=180.0,
+                                                   description="Full angle, degrees, of the cone of directions about the normal; 180 = the hemisphere (ao bake --spread-angle)")),
+    ("bent_normals", bpy.props.BoolProperty, dict(name="Bent Normals", default=False,
+                                                  description="Also bake <object>_bent: the average open direction in tangent space, as the Normal Map node reads it (ao bake --bent-normals --bent-normals-space tangent)")),
+    ("thickness", bpy.props.BoolProperty, dict(name="Thickness", default=False,
+                                               description="Also bake <object>_thickness: rays into the mesh, white where it is at least the thickness distance deep (ao bake --thickness)")),
+    ("thickness_distance", bpy.props.FloatProperty, dict(name="Thickness Distance", default=0.25, min=0.0001, max=10.0,
+                                                         description="R of the thickness, a fraction of the mesh's bounding-box diagonal (ao bake --thickness-distance)")),
+    ("cavity", bpy.props.BoolProperty, dict(name="Cavity", default=False,
+                                            description="Also bake <object>_cavity: AO within the cavity distance, the small creases only (ao bake --cavity)")),
+    ("cavity_distance", bpy.props.FloatProperty, dict(name="Cavity Distance", default=0.02, min=0.0001, max=10.0,
+                                                      description="R of the cavity, a fraction of the mesh's bounding-box diagonal (ao bake --cavity-distance)")),
     ("uv_map", bpy.props.StringProperty, dict(name="UV Map", default="", description="The UV map to bake into; empty = the active one")),
     ("selected_to_active", bpy.props.BoolProperty, dict(name="Selected to Active", default=False,
                                                         description="Bake the AO of the selected mesh objects into the active one's UVs (ao bake --high)")),
@@ -131,6 +145,14 @@ def prepare(context, options):
     scene = ao.Scene.from_arrays(name=low.name, **arrays)
     args = dict(size=options.size, padding=options.padding, seed=options.seed, samples=options.samples, denoise=options.denoise,
                 membership=options.membership, ignore_back_faces=options.ignore_back_faces)
+    if options.spread_angle < 180.0:
+        args["spread_angle"] = options.spread_angle
+    if options.bent_normals:
+        args.update(bent_normals=True, bent_normals_space="tangent")
+    if options.thickness:
+        args.update(thickness=True, thickness_distance=options.thickness_distance)
+    if options.cavity:
+        args.update(cavity=True, cavity_distance=options.cavity_distance)
     if options.max_distance > 0:
         args["max_distance"] = options.max_distance
     if options.selected_to_active:
@@ -167,9 +189,10 @@ def run(scene, args, progress=None):
     return out, [str(w.message) for w in caught]
 
 
-def store(name, visibility):
-    """The map into the float image `name` (made, or resized and overwritten), as non-colour data."""
-    height, width = visibility.shape
+def store(name, visibility, pixels=None):
+    """The map into the float image `name` (made, or resized and overwritten), as non-colour data;
+    `pixels`: Blender's pixels when not the map's grey (map_to_pixels)."""
+    height, width = visibility.shape[:2]
     image = bpy.data.images.get(name)
     if image is None:
         image = bpy.data.images.new(name, width, height, alpha=False, float_buffer=True)
@@ -181,7 +204,7 @@ def store(name, visibility):
     elif tuple(image.size) != (width, height):
         image.scale(width, height)
     image.colorspace_settings.name = "Non-Color"
-    image.pixels.foreach_set(mesh_data.map_to_pixels(visibility))
+    image.pixels.foreach_set(mesh_data.map_to_pixels(visibility) if pixels is None else pixels)
     image.update()
     return image
 
@@ -224,6 +247,12 @@ class AO_OT_bake(bpy.types.Operator):
             self.report({"WARNING"}, w)
         try:
             store(name, out["map"])
+            base = name[: -len("_ao")]
+            for key in ("thickness", "cavity"):
+                if key in out:
+                    store(base + "_" + key, out[key])
+            if "bent_normals" in out:
+                store(base + "_bent", out["bent_normals"], mesh_data.vectors_to_pixels(out["bent_normals"]))
         except ao.InputError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
@@ -309,8 +338,18 @@ class AO_PT_bake(bpy.types.Panel):
         layout.operator(AO_OT_bake.bl_idname, icon="RENDER_STILL",
                         text=f"Bake {obj.name}_ao" if obj is not None and obj.type == "MESH" else "ao Bake")
         col = layout.column()
-        for key in ("size", "samples", "max_distance", "membership", "denoise", "padding", "seed", "ignore_back_faces"):
+        for key in ("size", "samples", "max_distance", "membership", "denoise", "padding", "seed", "ignore_back_faces", "spread_angle"):
             col.prop(s, key)
+        col = layout.column(heading="Also Bake")
+        col.prop(s, "bent_normals")
+        col.prop(s, "thickness")
+        sub = col.column()
+        sub.active = s.thickness
+        sub.prop(s, "thickness_distance")
+        col.prop(s, "cavity")
+        sub = col.column()
+        sub.active = s.cavity
+        sub.prop(s, "cavity_distance")
         if obj is not None and obj.type == "MESH":
             col.prop_search(s, "uv_map", obj.data, "uv_layers")
         col = layout.column(heading="Selected to Active")

@@ -77,6 +77,17 @@ def map_to_pixels(visibility):
     return rgba.ravel()
 
 
+def vectors_to_pixels(vectors):
+    """Bent normals (H x W x 3, row 0 on top) as Blender's RGBA float pixels: n * 0.5 + 0.5 in RGB
+    (0.5 where there is no direction), as `ao bake --bent-normals` writes them; 1 in alpha."""
+    n = np.flipud(np.asarray(vectors, dtype=np.float32))
+    rgba = np.ones(n.shape[:2] + (4,), np.float32)
+    empty = ~np.any(n != 0, axis=-1)
+    rgba[..., :3] = n * np.float32(0.5) + np.float32(0.5)
+    rgba[empty, :3] = 0.5
+    return rgba.ravel()
+
+
 def pixels_to_map(pixels, width, height):
     """The inverse of map_to_pixels: the red channel of Blender's pixels as an H x W map, row 0 on top."""
     return np.flipud(np.asarray(pixels, dtype=np.float32).reshape(height, width, 4)[..., 0]).copy()

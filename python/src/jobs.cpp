@@ -171,10 +171,16 @@ BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, py::handle hi
   r.outputs.map = path_of(q, "output");
   r.outputs.per_vertex = path_of(q, "per_vertex_output");
   r.outputs.bent_normals = path_of(q, "bent_normals_output");
+  r.outputs.thickness = path_of(q, "thickness_output");
+  r.outputs.cavity = path_of(q, "cavity_output");
   r.outputs.gltf = path_of(q, "gltf_output");
+  if (const auto space = string_of(q, "bent_normals_space", "bent_normals_space")) r.bent_normal_space = bent_normal_space_from_name(*space);
+  r.thickness_distance = float_of(q, "thickness_distance", "thickness_distance").value_or(r.thickness_distance);
+  r.cavity_distance = float_of(q, "cavity_distance", "cavity_distance").value_or(r.cavity_distance);
   r.outputs.png_bits = int_of(q, "png_bits", "png_bits");
   r.outputs.provenance = bool_of(q, "provenance", "provenance").value_or(false);
-  files = !r.outputs.map.empty() || !r.outputs.per_vertex.empty() || !r.outputs.bent_normals.empty() || !r.outputs.gltf.empty();
+  files = !r.outputs.map.empty() || !r.outputs.per_vertex.empty() || !r.outputs.bent_normals.empty() || !r.outputs.thickness.empty() ||
+          !r.outputs.cavity.empty() || !r.outputs.gltf.empty();
   if (py::isinstance<SceneHandle>(mesh)) {
     if (files) throw InputError("ao.bake: outputs are written for mesh files; bake a mesh made from arrays and save the arrays");
     r.scene = mesh.cast<const SceneHandle&>().scene;
@@ -190,6 +196,9 @@ BakeRequest bake_request(py::handle mesh, const nlohmann::json& q, py::handle hi
   if (!files) {
     if (bool_of(q, "map", "map").value_or(true)) r.outputs.map = "map.png";
     if (bool_of(q, "per_vertex", "per_vertex").value_or(false)) r.outputs.per_vertex = "per-vertex.ply";
+    if (bool_of(q, "bent_normals", "bent_normals").value_or(false)) r.outputs.bent_normals = "bent.png";
+    if (bool_of(q, "thickness", "thickness").value_or(false)) r.outputs.thickness = "thickness.png";
+    if (bool_of(q, "cavity", "cavity").value_or(false)) r.outputs.cavity = "cavity.png";
     if (r.outputs.map.empty() && r.outputs.per_vertex.empty()) throw InputError("ao.bake: nothing to bake: ask for the map or per_vertex");
   }
   return r;
@@ -226,6 +235,9 @@ py::dict bake(py::handle mesh, py::handle request, py::object progress, py::hand
     d["map"] = to_array(std::move(m.map.visibility));
     d["mask"] = to_array(std::move(m.map.mask));
   }
+  if (!m.map.bent_normal.empty()) d["bent_normals"] = to_array(std::move(m.map.bent_normal));
+  if (!m.thickness.empty()) d["thickness"] = to_array(std::move(m.thickness));
+  if (!m.cavity.empty()) d["cavity"] = to_array(std::move(m.cavity));
   if (!m.vertex_ao.empty()) d["per_vertex"] = to_array(std::move(m.vertex_ao));
   d["summary"] = from_json(m.summary);
   return d;

@@ -7,6 +7,7 @@
 #include <pybind11/stl/filesystem.h>
 #include <tbb/global_control.h>
 
+#include "ao/bake/tangents.h"
 #include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/core/params.h"
@@ -148,6 +149,21 @@ void bind_scene(py::module_& m) {
                                const Bounds3 b = s.scene->bounds();
                                return py::make_tuple(py::make_tuple(b.lo.x, b.lo.y, b.lo.z), py::make_tuple(b.hi.x, b.hi.y, b.hi.z));
                              })
+      .def(
+          "tangents",
+          [](const SceneHandle& s) {
+            // Every triangle corner of every mesh, in order: tangent x, y, z and the bitangent's sign.
+            std::vector<float> values;
+            for (const Mesh& mesh : s.scene->meshes) {
+              if (mesh.uvs.empty()) throw InputError(s.scene->name + ": mesh '" + mesh.name + "' has no UVs, so it has no tangent frames");
+              for (const CornerTangent& c : mikktspace_tangents(mesh)) values.insert(values.end(), {c.t.x, c.t.y, c.t.z, c.sign});
+            }
+            py::array_t<float> out({static_cast<py::ssize_t>(values.size() / 4), py::ssize_t{4}});
+            std::copy(values.begin(), values.end(), out.mutable_data());
+            return out;
+          },
+          "MikkTSpace tangent frames (as Blender's mesh.calc_tangents, glTF and engines build them) of every triangle corner, meshes in "
+          "order: corners x 4 float32, the unit tangent and the bitangent's sign (bitangent = sign * cross(normal, tangent)).")
       .def("__repr__", [](const SceneHandle& s) {
         return "<ao.Scene '" + s.scene->name + "': " + std::to_string(s.scene->triangle_count()) + " triangles>";
       });
@@ -197,8 +213,10 @@ void bind_files(py::module_& m) {
       [](const std::filesystem::path& path, const std::string& text) { write_bytes_atomically(path, text); },
       py::arg("path"), py::arg("text"), "Writes `text` to `path` atomically (a temporary file beside it, renamed into place).");
   m.def(
-      "read_image", [](const std::filesystem::path& path) { return to_array(read_image(path)); }, py::arg("path"),
-      "read_image(path) -> numpy.ndarray\n\nOne channel of an image file as float32 H x W, as ao reads its own outputs: EXR floats as "
+      "read_image", [](const std::filesystem::path& path, bool rgb) { return rgb ? to_array(read_rgb_image(path)) : to_array(read_image(path)); },
+      py::arg("path"), py::arg("rgb") = false,
+      "read_image(path, rgb=False) -> numpy.ndarray\n\nOne channel of an image file as float32 H x W (rgb=True: red, green and blue, "
+      "H x W x 3, as bent normals are written), as ao reads its own outputs: EXR floats as "
       "stored, PNG values normalised to [0, 1] (no sRGB decoding). A bad file raises ao.InputError naming it.");
   m.def("remove_abandoned_temporaries", [](const std::filesystem::path& path) { return remove_abandoned_temporaries(path); }, py::arg("path"),
         "Removes the temporary files other processes left for the output `path` (io/atomic_file.h); returns how many.");

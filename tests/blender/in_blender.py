@@ -70,12 +70,22 @@ def select(active, *others):
 
 
 def bake(case, **options):
-    """The operator's result and the image it left (or its error), recorded under `case`."""
-    name = bpy.context.active_object.name + "_ao"
+    """The operator's result and the image it left (or its error), recorded under `case`; the AO
+    family's images as <case>_bent, <case>_thickness, <case>_cavity."""
+    base = bpy.context.active_object.name
     try:
         results[case] = {"returned": sorted(bpy.ops.object.ao_bake(**options))}
     except RuntimeError as e:  # an operator's {'ERROR'} report
         results[case] = {"error": str(e)}
+    for kind in ("bent", "thickness", "cavity"):
+        image = bpy.data.images.get(base + "_" + kind)
+        if image is not None:
+            w, h = image.size
+            pixels = np.empty(w * h * 4, np.float32)
+            image.pixels.foreach_get(pixels)
+            np.save(os.path.join(OUT, f"{case}_{kind}.npy"), pixels.reshape(h, w, 4))
+            bpy.data.images.remove(image)
+    name = base + "_ao"
     image = bpy.data.images.get(name)
     results[case]["image"] = image is not None
     if image is not None:
@@ -99,6 +109,29 @@ write_obj(os.path.join(OUT, "low.obj"), low)
 select(low)
 bake("single", size=SIZE, samples=SAMPLES)
 bake("options", size=SIZE, samples=SAMPLES, max_distance=0.5, membership="linear", denoise=0.0, padding=3, seed=7, ignore_back_faces=True)
+# The AO family: bent normals in tangent space, thickness, cavity, with a narrower cone.
+bake("family", size=SIZE, samples=SAMPLES, spread_angle=150.0, bent_normals=True, thickness=True, thickness_distance=0.3, cavity=True,
+     cavity_distance=0.05)
+
+# Tangent frames: Suzanne triangulated (so that Blender's MikkTSpace and ao see the same
+# triangles), the UVs of her left half mirrored (u -> 1 - u) so that both orientations occur,
+# Blender's calc_tangents() per corner of each loop triangle, in the order write_obj writes them.
+tri = monkey("Tri")
+tri.modifiers.new("triangulate", "TRIANGULATE")
+select(tri)
+bpy.ops.object.modifier_apply(modifier="triangulate")
+uv = tri.data.uv_layers.active.data
+for poly in tri.data.polygons:
+    if poly.center.x < 0:
+        for li in poly.loop_indices:
+            uv[li].uv.x = 1.0 - uv[li].uv.x
+write_obj(os.path.join(OUT, "tri.obj"), tri)
+tri_mesh = tri.data
+tri_mesh.calc_loop_triangles()
+tri_mesh.calc_tangents()
+frames = [list(tri_mesh.loops[li].tangent) + [tri_mesh.loops[li].bitangent_sign] for t in tri_mesh.loop_triangles for li in t.loops]
+np.save(os.path.join(OUT, "tri_tangents.npy"), np.array(frames, np.float32))
+bpy.data.objects.remove(tri)
 
 # High to low: a subdivided copy into the plain one's UVs, rays from the pushed-out low mesh, then
 # from a cage object (the low mesh with its vertices moved out along their normals).

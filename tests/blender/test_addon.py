@@ -105,6 +105,43 @@ def test_every_option_reaches_ao_bake(baked):
     assert not np.array_equal(addon_map(out, "options"), addon_map(out, "single"))
 
 
+def cli_family(tmp, *args):
+    """`ao bake ARGS` with the AO family into EXRs: {map, bent (H x W x 3), thickness, cavity}."""
+    paths = {k: os.path.join(tmp, f"cli-family-{k}.exr") for k in ("map", "bent", "thickness", "cavity")}
+    p = subprocess.run([os.environ["AO_BINARY"], "bake", *map(str, args), "-o", paths["map"], "--bent-normals", paths["bent"], "--bent-normals-space",
+                        "tangent", "--thickness", paths["thickness"], "--cavity", paths["cavity"], "-q"], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    return {k: ao.read_image(v, rgb=(k == "bent")) for k, v in paths.items()}
+
+
+def test_the_ao_family_equals_ao_bake(baked):
+    out, r = baked
+    assert r["family"]["returned"] == ["FINISHED"]
+    cli = cli_family(out, out / "low.obj", "--size", SIZE, "--samples", SAMPLES, "--spread-angle", 150, "--thickness-distance", 0.3,
+                     "--cavity-distance", 0.05)
+    assert_same(addon_map(out, "family"), cli["map"], "AO with a 150-degree cone")
+    for kind in ("thickness", "cavity"):
+        pixels = np.load(os.path.join(out, f"family_{kind}.npy"))
+        assert_same(np.flipud(pixels[..., 0]), cli[kind], kind)
+    bent = np.flipud(np.load(os.path.join(out, "family_bent.npy"))[..., :3])
+    assert_same(bent, cli["bent"], "bent normals, tangent space")
+    # Tangent space: mostly along the normal (blue), leaning where Suzanne's creases close one side.
+    assert 0.85 < bent[..., 2].mean() <= 1.0 and np.abs(bent[..., :2] - 0.5).max() > 0.2
+    thickness = np.flipud(np.load(os.path.join(out, "family_thickness.npy"))[..., 0])
+    assert thickness.min() < 0.5 < thickness.max()  # her ears are thin, her head is not
+
+
+def test_tangent_frames_are_blenders(baked):
+    out, _ = baked
+    blender = np.load(os.path.join(out, "tri_tangents.npy"))
+    ours = ao.Scene.load(str(out / "tri.obj")).tangents()
+    assert ours.shape == blender.shape
+    assert set(np.unique(blender[:, 3])) == {-1.0, 1.0}, "the test mesh should have mirrored and kept UV islands"
+    np.testing.assert_array_equal(ours[:, 3], blender[:, 3])
+    err = np.abs(ours[:, :3] - blender[:, :3]).max(axis=1)
+    assert err.max() <= 1e-4, f"{np.count_nonzero(err > 1e-4)} of {len(err)} corners differ, up to {err.max()}"
+
+
 def test_selected_to_active_equals_ao_bake_high(baked):
     out, r = baked
     assert r["high"]["returned"] == ["FINISHED"]

@@ -27,6 +27,39 @@ def test_bake_from_arrays_equals_the_file(grid_obj):
     np.testing.assert_array_equal(ao.bake(scene, 32, samples=8), ao.bake(grid_obj, 32, samples=8))
 
 
+def test_the_ao_family_equals_cli(ao_binary, grid_obj, tmp_path):
+    paths = {k: tmp_path / f"{k}.exr" for k in ("map", "bent", "thickness", "cavity")}
+    run_cli(ao_binary, "bake", grid_obj, "-s", 32, "--spp", 16, "--spread-angle", 140, "-o", paths["map"], "--bent-normals", paths["bent"],
+            "--bent-normals-space", "tangent", "--thickness", paths["thickness"], "--thickness-distance", 0.2, "--cavity", paths["cavity"])
+    m = ao.bake(grid_obj, 32, samples=16, spread_angle=140, bent_normals=True, bent_normals_space="tangent", thickness=True,
+                thickness_distance=0.2, cavity=True)
+    assert set(m) >= {"map", "mask", "bent_normals", "thickness", "cavity", "summary"}  # the family's flags return the full dict
+    np.testing.assert_array_equal(m["map"], ao.read_image(paths["map"]))
+    np.testing.assert_array_equal(m["thickness"], ao.read_image(paths["thickness"]))
+    np.testing.assert_array_equal(m["cavity"], ao.read_image(paths["cavity"]))
+    n = m["bent_normals"]
+    assert n.shape == (32, 32, 3)
+    encoded = np.where(np.any(n != 0, axis=-1, keepdims=True), n * np.float32(0.5) + np.float32(0.5), np.float32(0.5))
+    np.testing.assert_array_equal(encoded, ao.read_image(paths["bent"], rgb=True))
+    covered = m["mask"] != 0
+    # A single-sided bumpy grid: nothing behind its flat parts (thickness 1), the grid's other side
+    # within reach of rays into its slopes (below 1).
+    assert m["thickness"][covered].max() == pytest.approx(1.0, abs=1e-6) and m["thickness"][covered].min() < 0.9
+    assert m["cavity"][covered].min() >= m["map"][covered].min() - 1e-6  # cavity's R is shorter than the map's (unlimited)
+    with pytest.raises(ao.InputError, match="tangent"):
+        ao.bake(grid_obj, 32, bent_normals_space="tangnet", bent_normals=True)
+
+
+def test_scene_tangents_are_unit_and_perpendicular(grid_obj):
+    scene = ao.Scene.load(grid_obj)
+    t = scene.tangents()
+    assert t.shape == (3 * scene.triangles, 4) and t.dtype == np.float32
+    np.testing.assert_allclose(np.linalg.norm(t[:, :3], axis=1), 1.0, atol=1e-5)
+    assert set(np.unique(t[:, 3])) <= {-1.0, 1.0}
+    with pytest.raises(ao.InputError, match="no UVs"):
+        ao.Scene.from_arrays(*bumpy_grid()[:2]).tangents()
+
+
 def test_high_to_low_from_arrays_equals_cli(ao_binary, tmp_path):
     # A flat low square takes the AO of a bumpy high grid over it: from ao.Scene objects made from
     # arrays (what the Blender add-on passes) and from the same meshes as files, with a cage made

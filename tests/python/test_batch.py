@@ -253,6 +253,25 @@ def test_rerun_redoes_exactly_the_changed_outputs(shared_cluster, tmp_path):
     assert all(json.loads((out / f"grid{k}-ao.png.ao.json").read_text())["settings"]["width"] == 48 for k in range(3))
 
 
+def test_bake_folder_writes_the_ao_family(ao_binary, shared_cluster, tmp_path):
+    meshes, out = small_meshes(tmp_path / "meshes", count=2), tmp_path / "out"
+    settings = ["--size", 32, "-p", "samples=8", "-p", "spread_angle=150"]
+    p = run_batch("bake", meshes, "--out-dir", out, "--scheduler", shared_cluster.address, "--threads", 1, *settings, "--bent-normals",
+                  "--bent-normals-space", "tangent", "--thickness", "--thickness-distance", 0.3, "--cavity")
+    assert p.returncode == 0 and "done 2, failed 0, skipped 0" in p.stdout, p.stdout + p.stderr
+    kinds = ["ao", "bent", "thickness", "cavity"]
+    assert sorted(os.listdir(out)) == outputs_and_records([f"grid{k}-{kind}.png" for k in range(2) for kind in kinds])
+    for k in range(2):
+        cli = tmp_path / f"cli{k}"
+        run_cli(ao_binary, "bake", meshes / f"grid{k}.obj", "--size", 32, "--samples", 8, "--spread-angle", 150, "-o", cli.with_suffix(".ao.png"),
+                "--bent-normals", cli.with_suffix(".bent.png"), "--bent-normals-space", "tangent", "--thickness", cli.with_suffix(".thickness.png"),
+                "--thickness-distance", 0.3, "--cavity", cli.with_suffix(".cavity.png"))
+        for kind in kinds:
+            assert (out / f"grid{k}-{kind}.png").read_bytes() == cli.with_suffix(f".{kind}.png").read_bytes(), (k, kind)
+    record = json.loads((out / "grid0-thickness.png.ao.json").read_text())["settings"]
+    assert record["thickness_distance"] == pytest.approx(0.3) and record["bent_normal_space"] == "tangent"
+
+
 def test_every_submission_has_its_own_key():
     # A scheduler hands a finished key's result to any client that submits that key before it has
     # forgotten it: a key made of the task alone let a rerun with other settings receive the run

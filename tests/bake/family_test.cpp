@@ -277,6 +277,37 @@ TEST(BakeFamily, CavityIsTheMapWithinItsRelativeDistance) {
   }
 }
 
+TEST(BakeFamily, HighToLowThicknessIsTheHighMeshsDepth) {
+  // The low mesh is a quad on the top of a slab of depth 1 that is the high mesh: rays into the
+  // high surface meet its bottom, as in ThicknessOfASlabIsTheClosedForm. R = 2 (a fraction
+  // 2 / sqrt 2 of the low quad's diagonal): 2a - a^2 at a = 1/2.
+  Scene low;
+  low.meshes.push_back(uv_floor(1.0f));
+  low = prepared(std::move(low));
+  Scene high;
+  high.meshes.push_back(make_box({-20, 0, -20}, {20, 1, 20}));
+  high = prepared(std::move(high));
+  BakeRequest r;
+  r.scene = std::make_shared<const Scene>(low);
+  r.high_scene = std::make_shared<const Scene>(high);
+  r.size = MapSize{16, 16};
+  r.raytraced.samples = 256;
+  r.outputs.map = "map.png";
+  r.outputs.thickness = "thickness.png";
+  r.thickness_distance = 2.0f / std::sqrt(2.0f);
+  const BakeBatchResult out = run_bake(r);
+  const MeshBake& m = out.meshes.at(0);
+  ASSERT_FALSE(m.thickness.empty());
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < m.thickness.size(); ++i)
+    if (m.map.mask[i]) sum += m.thickness[i], ++n;
+  ASSERT_GT(n, 100u);
+  EXPECT_NEAR(sum / static_cast<double>(n), 0.75, 0.01);
+  EXPECT_NEAR(m.summary.at("thickness").at("max_distance").get<double>(), 2.0, 1e-5);
+  EXPECT_EQ(m.summary.at("parameters").at("hemisphere"), "outside");  // the summary's settings are the AO map's
+}
+
 TEST(BakeFamily, BadFamilyRequestsAreRefused) {
   BakeRequest r;
   r.inputs = {"mesh.obj"};

@@ -44,6 +44,7 @@ struct MeshJob {
   /// every group, tile and map of the family takes the same R).
   RaytracedBakeParams ao;
   Image<float> thickness, cavity;  ///< The AO family's maps, padded; empty unless asked for.
+  std::optional<float> fitted_extrusion;  ///< High to low: the cage distance fitted for job.scene, reused by the family's maps.
   nlohmann::json record;           ///< The provenance record of the outputs, when asked for (inputs hashed before loading).
 
   const Scene* high_scene() const { return high ? &*high : nullptr; }
@@ -145,9 +146,11 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
     } else if (!plan.r.cage.empty()) {
       cage = cage_from_mesh(scene, load_scene_file(plan.r.cage, kBakeLoad));
     } else {
+      if (!p.cage_extrusion && &scene == &job.scene && job.fitted_extrusion) p.cage_extrusion = job.fitted_extrusion;  // the family's maps
       if (!p.cage_extrusion) {  // fitted to the pair, so cage rays reach the high meshes from ~99% of the low surface
         const RayScene high_rays(*job.high, high_to_low_target_bvh_options(job.high->triangle_count()));
         p.cage_extrusion = fitted_cage_extrusion(scene, high_rays);
+        if (&scene == &job.scene) job.fitted_extrusion = p.cage_extrusion;
       }
       cage = extrude_cage(scene, *p.cage_extrusion);
     }
@@ -158,6 +161,7 @@ BakeResult bake_in_groups(MeshJob& job, const Scene& scene, const ProgressFn& pr
                                return bake_group_high_to_low(job, gs, cov, g, cage, p, progress);
                              },
                              coverage);
+  if (rt) return r;  // a map of the family: the summary and the warnings are the AO map's
   if (groups.size() > 1) job.summary["groups"] = groups.size();
   if (!job.occluders.empty()) job.summary["occluder_meshes"] = job.occluders.size();
   if (job.high) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Alchemy AO and its cross-bilateral filter: the AO pass only (G-buffer given), 1280x720, 12
 // samples per pixel, 2 threads, the budget (8 ms and 3 ms). Inputs are built once outside
 // the timed loops. Counters: Mpix/s (all pixels of the image) and Msamples/s (covered pixels x s).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // AO map baking: the histogram baker (McGraw & Sowers) against the ray-traced baker, as rates.
 // The paper's Table 1 setting: 1024 x 1024 map, 512 and 1024 directions. Run with 2 threads:
 //   ao_bench --benchmark_filter=Bake --benchmark_min_time=1 (taskset/--threads via TBB default).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An independent bare Embree 3 loop: the yardstick the G-buffer and the ray-traced reference are
 // measured against (BENCHMARKS.md, "Reference against a bare Embree loop"). It shares nothing of
 // ao's ray setup: its own Embree device and scene (default build settings, as a minimal program

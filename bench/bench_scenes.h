@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scenes the benchmarks share, built once outside the timed loops.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone traced AO (docs/methods/cone.md): voxelization and the cone pass separately, the
 // shape of the paper's Table III (time against resolution) and Table IV (time against triangle
 // count), and quality against the ray-traced reference as counters (RMSE), so one run gives the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GPU backend (src/ao/gpu/) against the CPU backend, method by method, on the same G-buffer:
 // the built-in default scene at 640x360 (cone: closed meshes, below), each method at its defaults,
 // R = 0.1 x the scene's diagonal. gpu/<method> runs the method on a G-buffer already on the device

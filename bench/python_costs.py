@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What the Python module and ao.batch cost (BENCHMARKS.md "Python and Dask", docs/cluster.md):
 
   render   a 1280 x 720 render through ao.render against the same job's own time inside the library

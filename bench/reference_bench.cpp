@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // G-buffer and ray-traced ground truth against an independent bare Embree loop (bare_embree.h)
 // on the same scene, camera, R and ray count: the ratios BENCHMARKS.md reports. Run them
 // interleaved (--benchmark_enable_random_interleaving=true) so that both contenders see the same

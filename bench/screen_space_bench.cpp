@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Screen-space AO passes (containment, volumetric, transfer, gtao) and the 4x4 depth-aware box filter,
 // AO pass only: the G-buffer of the built-in default scene at 1280x720 is rendered once outside
 // the timed loops. 12 samples per pixel (VAO fig. 12's count), R = 0.1 x scene diagonal (the

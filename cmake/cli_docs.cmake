@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The ao command's man pages (ao.1, ao-SUBCOMMAND.1; Debian's help2man) and bash and zsh
 # completion, generated from the built binary's --help at build time by scripts/cli-docs into
 # build/cli-docs/, and installed (share/man/man1, share/bash-completion/completions/ao,

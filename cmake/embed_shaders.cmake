@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Writes OUTPUT: a C++ file defining ao::gpu_detail::embedded_shaders() over the files of SHADERS
 # (src/ao/gpu/shaders/ and each method's folder; found by their file names, which are unique), so
 # that the library carries its shaders wherever it is installed. Run by the build

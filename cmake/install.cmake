@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Install rules: the libraries, the public headers (not *_internal.h), the ao command, the CMake
 # package (aoConfig.cmake, aoConfigVersion.cmake, aoTargets.cmake: find_package(ao 0.2)), a
 # pkg-config file (ao.pc) and the licence with its notice (share/doc/ao/). export() makes the same

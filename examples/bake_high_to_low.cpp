@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The two other bakes of `ao bake`, as library calls with its defaults:
 //   1. high to low: the AO of a detailed mesh baked into a simple mesh's UVs
 //      (`ao bake LOW --high HIGH -o LOW_ao.png`): rays start on a cage pushed out from the low

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bake an AO map in a mesh's UVs and save it: one library call that bakes as `ao bake MESH -o OUT
 // --size SIZE` does, with its defaults (ray-traced, 64 rays per texel, texture-space denoising,
 // 16 texels of padding).

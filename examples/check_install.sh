@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The library boundary, checked as a user meets it (run by CTest as `install_and_examples` and
 # `installed_headers_without_embree`, or by hand: examples/check_install.sh BUILD_DIR [examples|headers]):
 #   1. installs the build into a temporary prefix, which carries the licence and its notice, man
@@ -13,7 +14,9 @@
 # headers:
 #   4. checks that ao/ao.h includes every other installed header, and compiles every installed
 #      header in one translation unit with Embree's, assimp's, OpenEXR's, libpng's and FreeType's
-#      headers replaced by ones that fail: no installed header includes them.
+#      headers replaced by ones that fail: no installed header includes them; and compiles ao/ao.h
+#      included plainly with -Wall -Wextra -Wconversion -Wshadow -Werror by the build's compiler
+#      and by g++ and clang++ where installed.
 # Everything is written below a temporary folder, removed at the end.
 set -euo pipefail
 build=$(cd "${1:?usage: check_install.sh BUILD_DIR [examples|headers]}" && pwd)
@@ -142,4 +145,13 @@ echo "== ao/ao.h names every installed header"
 missing=$(cd "$prefix/include" && for h in $(find ao -name '*.h' ! -path ao/ao.h | sort); do grep -q "^#include \"$h\"" ao/ao.h || echo "$h"; done)
 [ -z "$missing" ] || { echo "check_install: ao/ao.h does not include:" $missing >&2; exit 1; }
 "$cxx" -std=c++20 -fsyntax-only -I"$poison" -I"$prefix/include" $(pkg-config --cflags-only-other tbb nlohmann_json) "$tmp/all_headers.cpp"
+echo "== ao/ao.h included plainly (-I, not -isystem) is warning-free: -Wall -Wextra -Wconversion -Wshadow, GCC and Clang"
+printf '#include <ao/ao.h>\nint main() { return 0; }\n' > "$tmp/umbrella.cpp"
+compilers=("$cxx")
+for c in g++ clang++; do command -v "$c" >/dev/null && [ "$(command -v "$c")" != "$(command -v "$cxx")" ] && compilers+=("$c"); done
+for c in "${compilers[@]}"; do
+  "$c" -std=c++20 -fsyntax-only -Wall -Wextra -Wconversion -Wshadow -Werror -I"$prefix/include" $(pkg-config --cflags-only-other tbb nlohmann_json) "$tmp/umbrella.cpp" ||
+    { echo "check_install: ao/ao.h warns under $c (above)" >&2; exit 1; }
+  echo "   $c: no warning"
+done
 echo "check_install: headers passed"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient occlusion of a mesh file, written as a float EXR image: one library call that renders as
 // `ao render MESH -o OUT.exr -m METHOD` does, with its defaults (auto-framing, 1280x720, R = 0.1 x
 // the objects' diagonal, the method's own samples).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // AO from your own depth and normal buffers (a compositor's passes, another renderer's G-buffer),
 // with volumetric AO. Links ao::core only: no Embree, no file formats. Here the "renderer" is a
 // floor with a box standing on it, written straight into the buffers; writes the result as PGM.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer harness of ao bake's glTF round trip: each input is the content of a .gltf or .glb
 // (AO_FUZZ_EXTENSION) loaded as a GltfDocument, whose first bakeable mesh's world scene is built,
 // given a map and COLOR_0, and saved as GLB. InputError is the expected answer to bad input; a

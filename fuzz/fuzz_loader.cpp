@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer harness: each input is the content of a mesh file named *AO_FUZZ_EXTENSION, loaded with
 // load_scene_file. InputError is the expected answer to bad input; a crash, a sanitizer report, an
 // allocation over libFuzzer's -malloc_limit_mb, a timeout or any other exception is a finding.

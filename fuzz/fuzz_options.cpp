@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer harness over ao's command line: each input is a command line, one argument per line
 // ("render\n--width\n64"), parsed by the same CLI11 app as ao (cli/app.h). A parse error is reported
 // as ao reports it (one line, closest names: parse_errors.h), and a command line that parses is turned

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao_bare: the bare Embree loop of bench/bare_embree.h as a process of its own, for comparing
 // cold runs with `ao render --method raytraced --json` (BENCHMARKS.md). It takes the camera, R and
 // ray count from the command line, as `ao render` reports them, and prints the times of its BVH

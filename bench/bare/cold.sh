@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Cold-process comparison of `ao render --method raytraced` with the bare Embree loop (ao_bare):
 #   bench/bare/cold.sh MESH.off [ROUNDS]
 # puts MESH on a ground quad three times its footprint (as bench_scenes.h), runs both processes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # ao's Blender add-on against Cycles' AO bake in one Blender process, at equal error, each baker
 # judged against its own converged map (BENCHMARKS.md, "bake", "In Blender"). Needs Debian's blender
 # and ao's Python package on PYTHONPATH (build/python):
@@ -20,7 +21,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mesh_io import load_mesh  # noqa: E402
+from mesh_io import bake_image, load_mesh  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
 mesh_path, size, out_dir = args[0], int(args[1]), args[2]
@@ -58,15 +59,7 @@ world.light_settings.distance = 1e6  # unlimited, as ao bake without --max-dista
 obj, _ = load_mesh(mesh_path, "mesh")
 bpy.context.view_layer.objects.active = obj
 obj.select_set(True)
-image = bpy.data.images.new("cycles", width=size, height=size, float_buffer=True, alpha=False)
-image.colorspace_settings.name = "Non-Color"
-material = bpy.data.materials.new("bake")
-material.use_nodes = True
-node = material.node_tree.nodes.new("ShaderNodeTexImage")
-node.image = image
-material.node_tree.nodes.active = node
-obj.data.materials.clear()
-obj.data.materials.append(material)
+image = bake_image(obj, "cycles", size)
 
 
 def pixels(img):

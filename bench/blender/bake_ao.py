@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Blender (Cycles) AO bake of one OBJ into its UVs: the peer baker `ao bake` is compared with.
 # Run by bench/blender/compare.sh; by hand:
 #   blender -b --factory-startup --python bench/blender/bake_ao.py -- MESH.obj SIZE SAMPLES OUT.exr THREADS [HIGH.obj|HIGH.off CAGE_EXTRUSION]
@@ -13,7 +14,7 @@ import time
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mesh_io import load_mesh  # noqa: E402
+from mesh_io import bake_image, load_mesh  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
 mesh_path, size, samples, out_path, threads = args[0], int(args[1]), int(args[2]), args[3], int(args[4])
@@ -45,16 +46,7 @@ world = bpy.data.worlds.new("World")
 scene.world = world
 world.light_settings.distance = 1e6
 
-image = bpy.data.images.new("ao", width=size, height=size, float_buffer=True, alpha=False)
-# Data, not colour: without this the saved EXR holds sRGB-encoded values.
-image.colorspace_settings.name = "Non-Color"
-material = bpy.data.materials.new("bake")
-material.use_nodes = True
-node = material.node_tree.nodes.new("ShaderNodeTexImage")
-node.image = image
-material.node_tree.nodes.active = node
-obj.data.materials.clear()
-obj.data.materials.append(material)
+image = bake_image(obj, "ao", size)
 
 bake = scene.render.bake
 bake.margin = 0

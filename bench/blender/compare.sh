@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # `ao bake` against Blender Cycles' AO bake of the same mesh and UVs at equal error (BENCHMARKS.md,
 # "bake"), single mesh or high to low. Needs Debian's blender and python3-numpy (not installed by
 # scripts/setup: a benchmark check, not a dependency of ao).

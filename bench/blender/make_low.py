@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Makes the low mesh of a high-to-low bake case: the high mesh decimated (Blender's Decimate
 # modifier, collapse) to a fraction of its triangles, smooth-shaded, with UVs: the high mesh's own
 # where it has them (decimation keeps them), else Smart UV Project's charts. Run by

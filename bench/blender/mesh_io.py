@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Loading a mesh into Blender's scene for the bench scripts: OBJ through Blender's importer (the
 # file's axes kept), OFF by hand (Blender reads no OFF). Returns the object and the axis arguments
 # that write it back in the file's coordinates (wm.obj_export).
@@ -27,3 +28,18 @@ def load_mesh(path, name):
     obj = [o for o in bpy.context.scene.objects if o.type == "MESH" and o not in before][0]
     obj.name = name
     return obj, dict(forward_axis="NEGATIVE_Z", up_axis="Y")
+
+
+def bake_image(obj, name, size):
+    """A float size x size image `name` (non-colour data: saved as stored, not sRGB-encoded) made the
+    active image node of `obj`'s one material: where Cycles' bake writes."""
+    image = bpy.data.images.new(name, width=size, height=size, float_buffer=True, alpha=False)
+    image.colorspace_settings.name = "Non-Color"
+    material = bpy.data.materials.new("bake")
+    material.use_nodes = True
+    node = material.node_tree.nodes.new("ShaderNodeTexImage")
+    node.image = image
+    material.node_tree.nodes.active = node
+    obj.data.materials.clear()
+    obj.data.materials.append(material)
+    return image

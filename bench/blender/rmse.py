@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # RMSE of a baked AO map against a reference map over the texels both cover, read with Blender's
 # image loader (both files go through the same one, so row order cannot differ between them).
 #   blender -b --factory-startup --python bench/blender/rmse.py -- MAP.exr REFERENCE.exr [--flip]

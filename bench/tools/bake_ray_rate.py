@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Rays per second of `ao bake` against `ao render` on the same mesh and threads, in one alternated run.
 
     bench/tools/bake_ray_rate.py MESH [--ao build/src/ao] [--baseline OLD_AO] [--pairs 5] [--threads 2]

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 # Writes an OBJ of a unit cube standing on a 4 x 4 floor, each of the six faces (floor, cube top and
 # four sides) its own UV chart in a 3 x 3 grid: a hard-surface bake case with contact-shadow edges on
 # flat charts (docs/methods/bake.md, "Denoising").

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Side-by-side speed of two builds' ao_bench, alternating runs so both see the same machine load.
 
     bench/tools/compare_builds.py A/bench/ao_bench B/bench/ao_bench --pairs 5 --filter REGEX [-- more ao_bench arguments]

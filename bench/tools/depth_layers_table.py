@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Error and time of the screen-space methods with one and two depth layers (docs/methods/depth-layers.md).
 
     bench/tools/depth_layers_table.py BUILD/src/ao [--meshes ../shared/data/meshes] [--out-dir DIR]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // How large may coordinates be before Embree 3 gives wrong hits? (BENCHMARKS.md, "Input limits").
 // A cube of half-side s (12 triangles), seen from (3s, 2s, 4s): 4096 primary rays (16-wide
 // packets, unit directions) at its middle, each checked against an exact slab test in double

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Writes a GLB whose mesh 0 is used by three nodes side by side, from a GLB with one mesh (e.g. one
 written by `ao bake mesh.obj --gltf in.glb`): the input of the glTF round-trip timing in docs/bake.md.
 Usage: bench/tools/gltf_instances.py in.glb out.glb"""

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The measurement behind docs/bake.md, "Image formats": ao's own writers (libpng, libtiff,
 // libjpeg, a hand-written TGA) against OpenImageIO 2.4 for the map formats of `ao bake`, and both
 // readers on damaged files. Built only with -DAO_OIIO_COMPARE=ON (OpenImageIO is not a dependency

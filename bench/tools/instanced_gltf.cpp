@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Generator of the instanced glTF of BENCHMARKS.md ("Instanced glTF"): one mesh used by COUNT
 // nodes, so that loading it with and without LoadOptions::flatten_instances compares copies with
 // Embree instances.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Load, BVH and trace costs of one mesh file, as BENCHMARKS.md's "Loading big meshes" reports them:
 //   ao_load_timer /tmp/elephant-30M.ply [--quality low|medium|high] [--compact 0|1] [--flatten] [--trace] [--bake N [--distance R]]
 // prints the triangle count, the load's wall and CPU seconds, the BVH build's wall and CPU seconds

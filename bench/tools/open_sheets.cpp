@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writes the open test meshes of the cone method's open-surface voxelization
 // (tests/support/open_sheets.h) and closed meshes of the same sizes, each on a ground quad, as OBJ
 // files for `ao compare`, with a camera that frames the object (docs/methods/cone.md, "Open meshes"):

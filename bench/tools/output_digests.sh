@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Prints a SHA-256 digest of every output of a fixed set of `ao render` and `ao bake` runs: the
 # ray-traced passes (reference of each membership, tangent sphere, transfer, adaptive sampling, the
 # sun pass, the G-buffer) on every built-in scene, and the bakes (map filtered and not, intersect

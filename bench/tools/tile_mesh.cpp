@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writes a big binary PLY for the loading benchmarks (BENCHMARKS.md, "Loading big meshes") by
 // tiling copies of a mesh on a square grid in the xz plane until the triangle count is reached:
 //   ao_tile_mesh ../shared/data/meshes/refined_elephant.off 30000000 /tmp/elephant-30M.ply

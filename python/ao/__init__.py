@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ao: ambient occlusion on the CPU, from Python (README "Python").
 
 The calls stand on the C++ library's job layer (src/ao/jobs/), the same code `ao render`, `ao bake`

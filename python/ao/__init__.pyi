@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Type stubs of the package ao (python/ao/__init__.py), installed with it (PEP 561: py.typed).
 # Checked against the module by tests/python/test_stubs.py (mypy's stubtest).
 import os

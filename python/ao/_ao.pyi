@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Type stubs of ao._ao, the compiled half of ao (python/src/). Checked against the module by
 # tests/python/test_stubs.py (mypy's stubtest).
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The checks of ao's keyword arguments before anything reaches the library: a value of the wrong
 type raises TypeError, a NaN, an infinity or an integer too large for the library's field raises
 ao.InputError (a ValueError), each naming the argument as the caller wrote it. Ranges that the

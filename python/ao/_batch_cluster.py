@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The cluster side of ao.batch, on the client: connecting to the scheduler (or starting local
 workers), checking every worker's environment before a task is submitted, submitting the tasks,
 and following them: a line per finished task, a status line with the running tasks' progress and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tasks of each ao.batch command, built on the client: for every mesh, view or frame, the
 library call a worker will make, its outputs under --out-dir, and the provenance record those
 outputs will carry. Every request is checked by the library here, as the worker will run it, so

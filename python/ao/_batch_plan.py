@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What an ao.batch run will do, decided on the client before any task is submitted: the inputs
 (folders, optionally recursive, and list files), every task with its outputs under --out-dir,
 every argument checked by the library as the tasks will use it (a bad one is one line, exit 2,

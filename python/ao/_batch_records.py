@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Provenance records for ao.batch: what made an output, beside it as OUTPUT.ao.json (the library's
 format, src/ao/jobs/provenance.h). The client computes the record a task would write (the
 library's record of the request, with the inputs' SHA-256 added here) and compares it with the one

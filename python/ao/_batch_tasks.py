@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The tasks of ao.batch, run on the Dask workers: one bake, render or compare each, described by a
 dict the client made and checked (ao/_batch_plan.py).
 

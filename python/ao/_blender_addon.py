@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ao's Blender add-on (installed by `python3 -m ao.blender install`; docs/bake.md, "From Blender").
 
 bpy.ops.object.ao_bake bakes the ambient occlusion of the active mesh object into its UV map with

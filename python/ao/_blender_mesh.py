@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Blender's mesh data as the arrays of ao.Scene.from_arrays, and ao's maps as Blender's pixels.
 
 Used by the Blender add-on (ao/_blender_addon.py); needs numpy only, so it takes Blender's mesh

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Progress of a long call: `progress=True` shows a bar per stage ("G-buffer", "raytraced",
 "bake grid.obj") with tqdm when it is installed, and otherwise a line on stderr every few seconds;
 a callable gets (stage, done, total) itself. The library calls it on the calling thread, at most

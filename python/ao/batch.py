@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Batch work on a Dask cluster: one task per mesh, view or frame (README "Cluster", docs/cluster.md).
 
     python3 -m ao.batch bake INPUT... --out-dir OUT [--size N] [--per-vertex ply] [-p key=value ...] (--scheduler ADDR | --local N)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Type stubs of ao.batch (python/ao/batch.py): the command line `python3 -m ao.batch`.
 import argparse
 from typing import Optional, Sequence, TextIO

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Installs ao's Blender add-on: `/usr/bin/python3 -m ao.blender install` (docs/bake.md, "From Blender").
 
 The add-on itself is part of this package (ao/_blender_addon.py, with ao/_blender_mesh.py), so it

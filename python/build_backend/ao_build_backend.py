@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A PEP 517 build backend for the Python module ao that needs nothing outside Debian's packages.
 
 `pip install --no-build-isolation .` calls build_wheel here: it configures and builds the project

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One call of a job from Python: the job runs with the GIL released; its progress callbacks check
 // for Ctrl-C (the thread that called from Python runs Python's signal handlers about every 20 ms)
 // and stop the job by throwing, so a KeyboardInterrupt ends a long render or bake within a

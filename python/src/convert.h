@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the Python module's bindings share: JSON <-> Python objects, images <-> numpy arrays
 // without a copy where the layout allows, the request fields every job takes (scene, camera,
 // falloff), and the Scene and GBuffer handles Python holds.

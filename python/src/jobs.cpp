@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The jobs as Python calls: each fills the job layer's request (ao/jobs/) from a dict that
 // ao/__init__.py builds from the keyword arguments, runs it through Call (GIL released, Ctrl-C,
 // warnings), and hands the images back as numpy arrays that own them.

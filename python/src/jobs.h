@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The job calls of the Python module (jobs.cpp). Each takes the request as a dict of the job
 // layer's fields, built by ao/__init__.py from the keyword arguments.
 #pragma once

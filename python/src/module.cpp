@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao._ao: the compiled half of the Python module `ao` (python/ao/__init__.py is the other): the
 // library's errors as Python exceptions, scenes and G-buffers as objects, the jobs, the parameter
 // tables, and the few file helpers ao.batch needs. Docs: README "Python", docs/cluster.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao: ambient occlusion on the CPU. The one header a program includes; it names every public
 // header of the library (every installed header but this one: examples/check_install.sh checks),
 // grouped as the README's layout. Link ao::ao (CMake: find_package(ao 0.2),

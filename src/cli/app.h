@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ao command line as one CLI11 app: the global options and every subcommand. main.cpp parses
 // argv with it and runs the chosen command; the option parser's fuzzing harness
 // (fuzz/fuzz_options.cpp) parses its inputs with the same app.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao bake: parses the options into a BakeRequest (ao/jobs/bake.h), runs it, and prints the JSON
 // summary; exit status 1 when a mesh of a batch failed.
 #include <cstdio>

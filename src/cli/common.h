@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every subcommand shares: the options that fill the job layer's scene, camera and falloff
 // requests, the key=value method parameters, and the reporter that prints a job's progress,
 // warnings and notes on stderr.

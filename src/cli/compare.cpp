@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao compare: parses the options into a CompareRequest (ao/jobs/compare.h), runs it, and prints
 // the table. docs/compare.md.
 #include <algorithm>

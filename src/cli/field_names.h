@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The command line's names of the request fields the job layer's errors name (jobs/fields.h): an
 // error "BakeRequest::padding must be in [0, 1024] texels" reads "--padding must be ..." here.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao: ambient occlusion on the CPU. The only place errors become exit codes:
 //   0 success, 1 bad input (file, option value, including a value of the wrong type), 2 bad usage
 //   (unknown option, missing argument), 3 system failure (disk, library, not enough memory),

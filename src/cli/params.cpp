@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao params: a method's or a baker's parameter table as Markdown (the tables in docs/ come from it).
 #include <cstdio>
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `ao` says when its command line cannot be parsed: one line in ao's words, prefixed
 // "ao: error:", naming the command, with the closest known name for a mistyped command or option.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao render: parses the options into a RenderRequest (ao/jobs/render.h), runs it, and prints the
 // summary line or the JSON summary.
 #include <cmath>

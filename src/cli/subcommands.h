@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Each subcommand registers its options and, when chosen, sets `action` to the work to run.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao tune: parses the options into a TuneRequest (ao/jobs/tune.h), runs it, and says what it
 // found. docs/compare.md#ao-tune.
 #include <cstdio>

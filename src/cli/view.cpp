@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao view: the methods live in a window beside a progressive ray-traced reference (src/view/).
 // Parses the same scene, camera, method and parameter options as ao render, then hands over.
 #include <CLI/CLI.hpp>

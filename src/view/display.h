@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The image `ao view` shows, as 8-bit codes: the method's V (or the shaded picture, transfer's W,
 // the baked map, the error heat map) left of the wipe and the reference right of it. Plain CPU
 // work; the window uploads the bytes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `ao view` measures about its frames and shows in the HUD: the wall time of each stage
 // (G-buffer, method, filter, display), averaged over the last second for the HUD and over the whole
 // run for --json, and the reference's state.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Input of `ao view`: the mouse and keys, scripted events (--event) and settings (--set), all
 // turned into the same changes of the viewer's state and camera, so a script drives exactly what a
 // user would. Mouse: left drag orbits, right or middle drag pans, the wheel zooms. Keys: F frame

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The viewer's camera: an orbit about a target point, in the terms people drag with (yaw and pitch
 // about the up axis, a distance, a pan of the target), turned into the library's look-at Camera.
 // Pure math, no window: `ao view` drives it from mouse and key events, the tests drive it directly.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The panel of `ao view` (Dear ImGui): the method and one widget per parameter, generated from its
 // parameter table; the neighbourhood (membership, R, seed); the view (mode, wipe, resolution,
 // threads, frame all, up axis, screenshot); the reference's state; the last error.

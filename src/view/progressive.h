@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The viewer's ground truth: the ray-traced reference of the method being looked at (its own
 // membership and R, from the registry), accumulated batch after batch on a background thread
 // while the camera is still, so the error of the method against it can be shown live.

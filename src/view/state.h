@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the user of `ao view` has chosen (method and parameters, neighbourhood, view, wipe,
 // resolution) and what has to be redone because of it. Input, the panel and --set change it; the
 // viewer's frame loop reads it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The frame loop of `ao view`: input, then the work through the job layer (FrameRenderer: the
 // G-buffer of the camera and the method on it), the progressive reference, and the display. The
 // window and GL are window.cpp, input and scripted events input.cpp, the panel panel.cpp, the HUD

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao view`: the methods live in a window (GLFW 3.3, OpenGL 3.3 core, Dear ImGui), beside a
 // ray-traced reference that accumulates while the camera is still. The library's job layer does the
 // work (FrameRenderer: G-buffer and method; the references; metrics); this folder only shows it and

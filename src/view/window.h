@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The window of `ao view` and everything OpenGL: GLFW, Dear ImGui's context, the two textures the
 // image is shown from, the frame's drawing, and reading it back for screenshots. The rest of the
 // viewer never calls GL (the GPU backend, src/ao/gpu/, computes in this window's context when the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bake groups and occluders: meshes of different groups do not darken each other, shared
 // occluders darken every group, the floor is a ground plane, and group names are checked.
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include "ao/core/error.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/scene/procedural.h"
+#include "support/bake_maps.h"
 
 namespace ao {
 namespace {
@@ -30,16 +32,7 @@ Scene floor_and_box() {
   return s;
 }
 
-double mean_covered(const BakeResult& r) {
-  double sum = 0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < r.mask.size(); ++i)
-    if (r.mask[i]) {
-      sum += r.visibility[i];
-      ++n;
-    }
-  return n ? sum / static_cast<double>(n) : 0.0;
-}
+using test::mean_covered;
 
 BakeResult bake(const Scene& s, const std::vector<BakeGroup>& groups, const std::vector<Mesh>& occluders) {
   RaytracedBakeParams p;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ray-traced baker's choice of hemisphere (RaytracedBakeParams::normal, `ao bake --normal`):
 // where the shading normals are the face normals (a flat-shaded cube) both choices bake the same
 // map and the same vertex values; where they are not (a coarse smooth-shaded sphere, a convex

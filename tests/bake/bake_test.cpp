@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The texel bakers against configurations with known answers (unlimited distance, the paper's
 // eq. 1), against each other, and their properties. Scenes are tiny procedural meshes with UVs
 // built here, at small map sizes, so the whole file runs in a few seconds.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every bake gives the same bits at any thread count, run after run: the ray-traced map with and
 // without the filter (and its bent normals), high to low with and without the filter, per-vertex
 // AO and the histogram map, each at 1, 2 and 5 threads, three times, compared byte for byte. Between

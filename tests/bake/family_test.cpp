@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The AO family of maps (thickness, cavity, spread angle, relative distance, tangent-space bent
 // normals) against configurations with known answers: a slab of known depth, a floor under a
 // ceiling, planes and a cylinder whose UV parameterisation gives the tangent frame in closed form.
@@ -12,6 +13,8 @@
 #include "ao/jobs/bake.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/scene/procedural.h"
+#include "support/bake_maps.h"
+#include "support/scenes.h"
 
 namespace ao {
 namespace {
@@ -23,19 +26,8 @@ Mesh uv_floor(float y) {
   return m;
 }
 
-Scene prepared(Scene s) {
-  s.name = "test";
-  validate_and_prepare(s);
-  return s;
-}
-
-double covered_mean(const BakeResult& r) {
-  double sum = 0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < r.visibility.size(); ++i)
-    if (r.mask[i]) sum += r.visibility[i], ++n;
-  return n ? sum / static_cast<double>(n) : -1.0;
-}
+using test::mean_covered;
+using test::scene_of;
 
 BakeResult bake(const Scene& s, const RaytracedBakeParams& p, int size = 16) {
   const RayScene rays(s);
@@ -66,32 +58,26 @@ RaytracedBakeParams linear(float r, float spread = 180.0f, Hemisphere side = Hem
 TEST(BakeFamily, ThicknessOfASlabIsTheClosedForm) {
   // The baked face is the top of a slab of depth h = 1, 40 wide: rays into it meet the bottom at
   // d = h / cos(theta); the side walls lie 20 away, beyond every R here.
-  Scene s;
-  s.meshes.push_back(uv_floor(1.0f));
-  s.meshes.push_back(make_box({-20, 0, -20}, {20, 1, 20}));
-  s = prepared(std::move(s));
+  const Scene s = scene_of({uv_floor(1.0f), make_box({-20, 0, -20}, {20, 1, 20})});
   for (const float r : {0.5f, 2.0f, 4.0f}) {
     SCOPED_TRACE("R = " + std::to_string(r));
     const double want = linear_between_planes(1.0 / r, kPi / 2);
-    EXPECT_NEAR(covered_mean(bake(s, linear(r, 180.0f, Hemisphere::Inside))), want, 0.01);
+    EXPECT_NEAR(mean_covered(bake(s, linear(r, 180.0f, Hemisphere::Inside))), want, 0.01);
   }
   EXPECT_NEAR(linear_between_planes(0.5, kPi / 2), 0.75, 1e-12);  // 2a - a^2: the closed form itself
   // A 120-degree cone (alpha = 60 degrees), R = 2: the grazing half of the hemisphere is left out.
-  EXPECT_NEAR(covered_mean(bake(s, linear(2.0f, 120.0f, Hemisphere::Inside))), linear_between_planes(0.5, kPi / 3), 0.01);
+  EXPECT_NEAR(mean_covered(bake(s, linear(2.0f, 120.0f, Hemisphere::Inside))), linear_between_planes(0.5, kPi / 3), 0.01);
   // The outside of the slab's top is open sky: thickness looks the other way, AO sees nothing.
-  EXPECT_EQ(covered_mean(bake(s, linear(2.0f))), 1.0);
+  EXPECT_EQ(mean_covered(bake(s, linear(2.0f))), 1.0);
 }
 
 TEST(BakeFamily, SpreadAngleNarrowsTheConeOfAO) {
   // A floor under a ceiling at height 1: the same closed form as the slab, for the outside.
-  Scene s;
-  s.meshes.push_back(uv_floor(0.0f));
-  s.meshes.push_back(make_box({-20, 1, -20}, {20, 1.2f, 20}));
-  s = prepared(std::move(s));
+  const Scene s = scene_of({uv_floor(0.0f), make_box({-20, 1, -20}, {20, 1.2f, 20})});
   for (const float spread : {180.0f, 120.0f, 60.0f}) {
     SCOPED_TRACE("spread " + std::to_string(spread));
     const double alpha = spread * kPi / 360.0;
-    EXPECT_NEAR(covered_mean(bake(s, linear(2.0f, spread))), linear_between_planes(0.5, alpha), 0.01);
+    EXPECT_NEAR(mean_covered(bake(s, linear(2.0f, spread))), linear_between_planes(0.5, alpha), 0.01);
   }
   // Step membership, R = 1.5: a ray is unoccluded when d = 1 / c >= R, i.e. c <= 2/3; in a cone
   // of half-angle 60 degrees that is (4/9 - 1/4) / (3/4) of the cosine-weighted directions.
@@ -99,20 +85,17 @@ TEST(BakeFamily, SpreadAngleNarrowsTheConeOfAO) {
   step.samples = 256;
   step.max_distance = 1.5f;
   step.spread_angle = 120.0f;
-  EXPECT_NEAR(covered_mean(bake(s, step)), (4.0 / 9 - 0.25) / 0.75, 0.01);
+  EXPECT_NEAR(mean_covered(bake(s, step)), (4.0 / 9 - 0.25) / 0.75, 0.01);
 }
 
 TEST(BakeFamily, RelativeDistanceIsAFractionOfTheBakedMeshesDiagonal) {
   // The baked floor is 1 x 1 (diagonal sqrt 2); the ceiling occludes but does not count.
-  Scene s;
-  s.meshes.push_back(uv_floor(0.0f));
-  s.meshes.push_back(make_box({-20, 1, -20}, {20, 1.2f, 20}));
-  s = prepared(std::move(s));
+  const Scene s = scene_of({uv_floor(0.0f), make_box({-20, 1, -20}, {20, 1.2f, 20})});
   RaytracedBakeParams relative = linear(1.0f);
   relative.relative_distance = true;
   const BakeResult a = bake(s, relative), b = bake(s, linear(std::sqrt(2.0f)));
   for (std::size_t i = 0; i < a.visibility.size(); ++i) ASSERT_EQ(a.visibility[i], b.visibility[i]) << "texel " << i;
-  EXPECT_LT(covered_mean(a), 0.99);  // the ceiling is within reach
+  EXPECT_LT(mean_covered(a), 0.99);  // the ceiling is within reach
   RaytracedBakeParams no_distance;
   no_distance.relative_distance = true;
   EXPECT_THROW(no_distance.validate(), InputError);
@@ -150,9 +133,7 @@ TEST(Tangents, APlaneTakesItsParameterisationsDirections) {
     for (const float phi : {0.0f, 0.7f, 2.5f}) {
       SCOPED_TRACE(std::string(mirror ? "mirrored" : "kept") + ", phi " + std::to_string(phi));
       const float c = std::cos(phi), s = std::sin(phi), m = mirror ? -1.0f : 1.0f;
-      Scene scene;
-      scene.meshes.push_back(uv_grid(4, [&](float x, float z) { return Vec2{m * (c * x - s * z) * 0.5f, (s * x + c * z) * 0.5f}; }));
-      scene = prepared(std::move(scene));
+      const Scene scene = scene_of({uv_grid(4, [&](float x, float z) { return Vec2{m * (c * x - s * z) * 0.5f, (s * x + c * z) * 0.5f}; })});
       // (u, v) = 0.5 * [[m c, -m s], [s, c]] (x, z): its inverse's columns, normalised.
       const Vec3 du = normalize(Vec3{m * c, 0, -m * s}), dv = normalize(Vec3{s, 0, c});
       const Mesh& mesh = scene.meshes[0];
@@ -182,9 +163,7 @@ TEST(Tangents, ACylinderTakesTheDirectionAroundIt) {
       const auto v = [&](int a, int b) { return static_cast<std::uint32_t>(b * (segments + 1) + a); };
       for (const std::uint32_t k : {v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j), v(i + 1, j + 1), v(i, j + 1)}) m.indices.push_back(k);
     }
-  Scene s;
-  s.meshes.push_back(m);
-  s = prepared(std::move(s));
+  const Scene s = scene_of({m});
   const Mesh& mesh = s.meshes[0];
   const std::vector<CornerTangent> t = mikktspace_tangents(mesh);
   for (std::size_t k = 0; k < t.size(); ++k) {
@@ -217,10 +196,8 @@ TEST(BakeFamily, TangentSpaceBentNormalsAreTheWorldOnesInThePlanesFrame) {
   // A floor beside a wall, UVs rotated on it: the tangent-space map is the world-space map seen in
   // the frame (dP/du, dP/dv, n) of the parameterisation.
   const float phi = 0.7f, c = std::cos(phi), s = std::sin(phi);
-  Scene scene;
-  scene.meshes.push_back(uv_grid(4, [&](float x, float z) { return Vec2{0.5f + 0.5f * (c * x - s * z), 0.05f + 0.5f * (s * x + c * z)}; }));
-  scene.meshes.push_back(make_box({-1, 0, -0.2f}, {2, 0.5f, 0}));
-  scene = prepared(std::move(scene));
+  const Scene scene = scene_of({uv_grid(4, [&](float x, float z) { return Vec2{0.5f + 0.5f * (c * x - s * z), 0.05f + 0.5f * (s * x + c * z)}; }),
+                                 make_box({-1, 0, -0.2f}, {2, 0.5f, 0})});
   BakeRequest r;
   r.scene = std::make_shared<const Scene>(scene);
   r.size = MapSize{32, 32};
@@ -246,10 +223,7 @@ TEST(BakeFamily, TangentSpaceBentNormalsAreTheWorldOnesInThePlanesFrame) {
 }
 
 TEST(BakeFamily, CavityIsTheMapWithinItsRelativeDistance) {
-  Scene scene;
-  scene.meshes.push_back(uv_floor(0.0f));
-  scene.meshes.push_back(make_box({-0.2f, 0, 0.3f}, {0.2f, 0.05f, 0.6f}));
-  scene = prepared(std::move(scene));
+  const Scene scene = scene_of({uv_floor(0.0f), make_box({-0.2f, 0, 0.3f}, {0.2f, 0.05f, 0.6f})});
   BakeRequest r;
   r.scene = std::make_shared<const Scene>(scene);
   r.size = MapSize{32, 32};
@@ -281,12 +255,8 @@ TEST(BakeFamily, HighToLowThicknessIsTheHighMeshsDepth) {
   // The low mesh is a quad on the top of a slab of depth 1 that is the high mesh: rays into the
   // high surface meet its bottom, as in ThicknessOfASlabIsTheClosedForm. R = 2 (a fraction
   // 2 / sqrt 2 of the low quad's diagonal): 2a - a^2 at a = 1/2.
-  Scene low;
-  low.meshes.push_back(uv_floor(1.0f));
-  low = prepared(std::move(low));
-  Scene high;
-  high.meshes.push_back(make_box({-20, 0, -20}, {20, 1, 20}));
-  high = prepared(std::move(high));
+  const Scene low = scene_of({uv_floor(1.0f)});
+  const Scene high = scene_of({make_box({-20, 0, -20}, {20, 1, 20})});
   BakeRequest r;
   r.scene = std::make_shared<const Scene>(low);
   r.high_scene = std::make_shared<const Scene>(high);
@@ -298,12 +268,8 @@ TEST(BakeFamily, HighToLowThicknessIsTheHighMeshsDepth) {
   const BakeBatchResult out = run_bake(r);
   const MeshBake& m = out.meshes.at(0);
   ASSERT_FALSE(m.thickness.empty());
-  double sum = 0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < m.thickness.size(); ++i)
-    if (m.map.mask[i]) sum += m.thickness[i], ++n;
-  ASSERT_GT(n, 100u);
-  EXPECT_NEAR(sum / static_cast<double>(n), 0.75, 0.01);
+  ASSERT_GT(m.map.covered_texels, 100u);
+  EXPECT_NEAR(mean_covered(m.map, m.thickness), 0.75, 0.01);
   EXPECT_NEAR(m.summary.at("thickness").at("max_distance").get<double>(), 2.0, 1e-5);
   EXPECT_EQ(m.summary.at("parameters").at("hemisphere"), "outside");  // the summary's settings are the AO map's
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // High-to-low baking against a direct ray-traced reference on the high mesh, miss handling and
 // cage checks. The meshes are spheres built here: a coarse low-poly sphere with lat-long UVs and a
 // finely tessellated sphere with bumps (radius 1 + A sin(K phi) sin(K theta)).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // UV coverage (bake/texel_coverage.h) held to its definition: every triangle clipped against every
 // texel square its UV box touches, one texel at a time, the fragments of a texel in triangle order.
 #include <gtest/gtest.h>

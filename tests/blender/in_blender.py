@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Runs inside Blender (`blender -b --python in_blender.py -- OUT_DIR`) for test_addon.py: with the
 add-on enabled from the user preferences (as `python3 -m ao.blender install` leaves it), it makes
 the test scenes from Blender's own primitives, bakes them with bpy.ops.object.ao_bake, and writes

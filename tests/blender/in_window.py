@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Runs in Blender with a window (`xvfb-run blender --enable-event-simulate scene.blend --python
 in_window.py -- OUT_DIR`) for test_addon.py: the operator as the panel's button runs it (modal, a
 thread, progress in the status bar), a bake to the end and one cancelled by a simulated Esc. Writes

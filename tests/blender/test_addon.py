@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ao's Blender add-on, in Debian's Blender run headless (`blender -b`): the package installed with
 `cmake --install --component python` into a temporary prefix, the add-on installed and enabled by
 `python3 -m ao.blender install` into temporary user scripts and preferences folders

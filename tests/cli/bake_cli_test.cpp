@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao bake` as users and scripts meet it: outputs, --json, batches, and bad input that gets a
 // one-line error naming the file, exit status 1 and no (partial) output (SPEC, "Behaviour on bad
 // input"). Meshes are tiny OBJ files written here; maps are 16-32 texels, so each run is quick.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao bake` output formats as a pipeline meets them: non-square maps, ORM packing, TGA/TIFF/JPEG,
 // UDIM tiles, glTF outputs. Meshes are tiny OBJ files written here; maps are a few dozen texels.
 #include <gtest/gtest.h>

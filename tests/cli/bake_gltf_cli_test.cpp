@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao bake` on glTF inputs with --gltf / --per-vertex .glb: the document's round trip
 // (gltf_document.h, bake_gltf.h). The inputs are built in the test (support/gltf_docs.h): an
 // instanced pair of cubes in a node hierarchy, and a material shared by three meshes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The man pages and shell completions scripts/cli-docs makes from ao's --help (as the build does
 // into build/cli-docs/): the sections help2man cannot take from --help, and completion of values.
 #include <gtest/gtest.h>

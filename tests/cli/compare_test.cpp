@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao compare` end to end: runs the built binary (AO_CLI_PATH) on tiny images and checks exit codes,
 // outputs and their contents; bad input exits non-zero with one line and leaves no output directory.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every numeric option at the extremes a script or a typo produces (0, -1, 1e9, 2e18, inf, nan):
 // either a result or one line naming the option, exit 1, and nothing written; never a crash, a
 // hang or a half-written file. Values in range are accepted (a 1e9 distance is a long reach).

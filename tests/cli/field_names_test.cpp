@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Library errors in library words: the job layer names the request's fields (jobs/fields.h), the
 // command line its options (src/cli/field_names.cpp), each from one table that covers every field.
 #include <gtest/gtest.h>

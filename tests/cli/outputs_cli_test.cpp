@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The outputs of `ao render`, `ao bake` and `ao compare` as one transaction (SPEC, "Behaviour on
 // bad input"; output_set.h): a write that fails late leaves the earlier outputs as they were, an
 // output that names an input or another output is refused before any work, and a run killed by

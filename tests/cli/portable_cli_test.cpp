@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The default (portable) build of `ao` on a baseline x86-64 CPU: under qemu-x86_64 -cpu Nehalem
 // (SSE4.2, no AVX; Debian's qemu-user) it runs, its kernels pick a target without AVX, and its
 // images match this machine's run of the same binary within the targets' agreement

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao render` as users and scripts meet it: outputs, JSON, exit codes, and bad input that gets a
 // one-line error, a non-zero exit and no output (SPEC, "Behaviour on bad input").
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every command gives the same bits at any thread count, and the job layer called as a library
 // writes the same file as the command: `ao` is a thin shell over run_render and run_bake.
 #include <gtest/gtest.h>

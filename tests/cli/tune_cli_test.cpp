@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao tune` end to end: it writes a parameter file that `ao render -p @FILE` loads; bad input exits 1.
 #include <gtest/gtest.h>
 

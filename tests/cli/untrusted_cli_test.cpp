@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Issue 41's reproducers, end to end: hostile files, parameters and environments that crashed `ao`,
 // made it write where it should not, or gave a wrong result with exit 0. Each test runs the
 // built binary (AO_CLI_PATH), so a crash shows as a failed expectation, not as a crash of the

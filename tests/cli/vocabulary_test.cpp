@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One option vocabulary (docs/cli.md): the table of shared options agrees with every command's
 // --help both ways, and a wrong command line gets one line in ao's words with a suggestion.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GBuffer's derived channels: linear depth is -position.z and coverage is object_id != 0, per
 // pixel and as the planes kernels and metrics read.
 #include "ao/core/gbuffer.h"

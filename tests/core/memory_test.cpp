@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Memory estimates: they grow with what they count, the check refuses what cannot fit with one
 // line naming the size and the limit, and the available memory is known on Linux.
 #include "ao/core/memory.h"

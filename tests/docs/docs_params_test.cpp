@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The parameter tables in docs/ are generated from the code's tables (scripts/update-docs): these
 // tests fail while a doc is stale, and while a table has no doc.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Cone tracing on the GPU: the voxel grid built by rasterization with XOR is the CPU's, bit for bit.
 #include <gtest/gtest.h>
 

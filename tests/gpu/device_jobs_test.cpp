@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `--device gpu` through the job layer and the command line: `ao render --device gpu` writes what
 // the library call computes, `ao compare --device gpu` puts the GPU backend's column beside the
 // CPU's with each method's RMSE within 0.002 of the CPU's, `ao view --device gpu` computes in its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GPU device: a headless context through EGL, the caller's current context, and the one-line
 // SystemError when there is no usable GL.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The G-buffer on the GPU: an uploaded CPU G-buffer comes back bit for bit, and the rasterized
 // one agrees with the ray-traced one (render_gbuffer) except on silhouette pixels.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared by the GPU backend's tests: one device for the whole test binary (Mesa's software
 // renderer, so results do not depend on the machine's GPU; CI has no GPU), and small scenes with
 // their CPU G-buffers (the images are small: llvmpipe runs the shaders on the CPU).

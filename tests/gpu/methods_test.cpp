@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The methods on the GPU against the CPU kernels on the same G-buffer (uploaded), with the same
 // parameters, seed, sample sets and rotations; against the ray-traced reference; and their
 // refusals of what the GPU backend does not implement.

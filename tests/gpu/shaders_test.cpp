@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The shaders as an engine takes them (src/ao/gpu/shaders/ and each method's folder, installed to
 // share/ao/shaders/): each
 // file is the one the library embeds, says in its comments what it computes, and documents every

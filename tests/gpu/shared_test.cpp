@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The headers C++ and GLSL both read (*_shared.h: core/shared.h says how): a compute shader built
 // from them on the device writes each constant's bits and each shared function's results into a
 // buffer, and every one equals what the C++ compiler made of the same text. The check would fail

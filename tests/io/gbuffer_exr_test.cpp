@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // G-buffer EXR files: exact round trips with the camera, reconstruction of what compositors leave
 // out, and bad input.
 #include "ao/io/gbuffer_exr.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GltfDocument (gltf_document.h): node transforms, primitive modes and accessor encodings read into
 // world scenes with known answers; what passes through a save untouched; files outside the input's
 // folder never read; bad documents refused with one line.

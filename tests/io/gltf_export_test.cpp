@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The .glb written by `ao bake --gltf` (gltf_export.h): the binary container parsed here by hand
 // (glTF 2.0 spec, "Binary glTF Layout"), the JSON checked for the occlusion texture, the embedded
 // PNG decoded, and the file loaded back with assimp.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glTF instances (docs/instancing.md): a mesh that the node tree uses several times is loaded once
 // with one Scene::instances entry per node and traced through Embree instances. Known answer: the
 // same scene with every instance copied into world space (flatten_instances, and the loader's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every kind of GLB the tests write, checked by the Khronos glTF-Validator (npm gltf-validator,
 // installed by scripts/setup when the npm registry is reachable). Without node or the validator the
 // test is SKIPPED with the reason, never passed silently.

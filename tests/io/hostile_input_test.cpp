@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reproducers of issue 12's crashes and silent misreads, rebuilt here from scratch (generated,
 // not copied): each is refused with one InputError line naming the file and the problem, and the
 // CLI turns each into one line on stderr, exit 1 and no file written.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TGA, TIFF and JPEG outputs, read back with their reference libraries (libtiff, libjpeg) or, for
 // TGA, byte by byte against the format's header layout: exact 8/16-bit quantisation where the
 // format is lossless, a stated error bound for JPEG.

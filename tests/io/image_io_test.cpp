@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image files and atomic writes: exact EXR round trips, PNG quantisation bounds, RGB handling, and
 // families of bad input that must each give one line naming the file.
 #include "ao/io/image_io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // JSON from users' files and options (json_text.h): the depth limit found while parsing, the size
 // limit of files, and messages that never quote the value.
 #include "ao/io/json_text.h"

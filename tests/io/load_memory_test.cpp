@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Issue 27, "memory estimated before expansion": a small glTF whose meshes share accessors, or
 // whose node tree uses one mesh many times, describes far more geometry than its size; the loader
 // counts it from the JSON and refuses a load that does not fit before assimp copies anything

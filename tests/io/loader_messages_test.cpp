@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Issue 27, "messages in ao's words": the malformed files the mutation campaign (scripts/mutate)
 // meets most, each with the message ao gives. None quotes assimp's or the JSON parser's own text
 // ("malformed or truncated file (...)", "[json.exception..."), which names their internals instead of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh loading: counts and positions survive each format, generated meshes (and the shared ones,
 // when ../shared is present) load with the counts their headers state, and every family of bad
 // input ends in one InputError line naming the file.

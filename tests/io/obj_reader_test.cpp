@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The fast OBJ reader (obj_reader.h) against the reader it replaces for one-mesh files: assimp 5.2
 // with the post-processing load_scene_file gave it (triangulate, join identical vertices, sort by
 // primitive type, pre-transform). Same vertices in the same order, same triangles, UVs, normals,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Outputs as one transaction (SPEC, "Behaviour on bad input"): a run's outputs are renamed into
 // place only when all were written, an output that names an input or another output is refused
 // before anything is written, and temporary files never outlive a failure or a signal. Issue 27:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-vertex AO PLY (ply_export.h): parsed back here with a reader of our own (independent of the
 // writer and of assimp), then loaded with load_scene_file to check that a real PLY reader takes it.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The PLY reader: every encoding and property type gives the same mesh, what it does not use is
 // skipped, what ply_export writes reads back exactly, and damaged files are refused naming the
 // element and the problem.

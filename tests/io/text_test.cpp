@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Text on images: ink lands inside the box text_width x line_height reports and nowhere else, the
 // box is tight, blending follows coverage, and a missing or broken font is reported, not thrown.
 // The font is the DejaVu Sans that scripts/setup installs; the tests that draw skip without it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Issue 27, "inputs stay inside their asset": a model's references (glTF buffers and images)
 // resolve only inside the model's folder or the folder LoadOptions::asset_root names; anything
 // else is one InputError line, and nothing of the file outside appears in any output.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Issue 27, "wrong geometry is an error": files that used to load part of their geometry with
 // exit 0 are refused (a truncated ASCII STL, an OFF face count one short, a glTF node transform
 // that flattens its mesh, in render and bake alike), while valid geometry at any scale keeps every

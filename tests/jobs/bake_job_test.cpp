@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // run_bake as a library user meets it: a BakeRequest with nothing but its input and output bakes
 // exactly what `ao bake` bakes with no options.
 #include "ao/jobs/bake.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The comparison behind `ao compare` (jobs/compare.h): every row judged against its matched
 // reference and against one common reference, so that rows can be ranked; a common reference that
 // equals a matched one is that image; AO switched off is never rewarded.

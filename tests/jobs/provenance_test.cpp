@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Outputs that know how they were made (jobs/provenance.h): `--provenance` writes beside each
 // output its record, with the hashes of what was read and written and every setting; every JSON
 // names the build; run_points estimates V at given points.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Parameter fitting (eval/tune.h): a known optimum found, improvement over the start, and bad input.
 #include "ao/jobs/tune.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Alchemy AO (eq. 10) against known answers: the open plane, the 90-degree wedge against an
 // independent quadrature of the integral the screen-space estimator converges to
 // (docs/methods/alchemy.md), its ray-traced reference, and properties.

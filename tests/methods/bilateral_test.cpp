@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cross-bilateral filter on synthetic G-buffers with known answers: constants stay constant,
 // depth discontinuities are not crossed, noise on a plane falls, and bad parameters are refused.
 #include "ao/methods/filters/bilateral.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Characteristic functions (VAO fig. 2) on configurations whose inner/outer split and view-axis
 // distance are known exactly.
 #include "ao/methods/characteristic.h"

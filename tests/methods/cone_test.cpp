@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone traced AO: configurations with known answers, the depth-resolution limitation the
 // paper names (sec. IV-A) and its fix, the ray-traced reference, properties, bad parameters.
 #include "ao/methods/cone/cone.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Containment-test AO (VAO eq. 5) on known answers, against its reference, and its properties.
 #include "ao/methods/containment/containment.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The screen-space methods' row loader (simd::load_covered_pixels): the covered pixels of a row
 // segment, compacted in order, with their position, normal and rotation, and the padding entries
 // up to a whole vector a harmless point. Checked against a plain loop over the pixels on coverage

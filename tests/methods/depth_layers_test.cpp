@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The deep G-buffer's second layer (Mara et al. 2016; methods/depth_layers.h): what it holds on
 // shapes whose depths are known, and what the screen-space methods make of it: a plate floating
 // more than R above the ground occludes none of it, which one depth layer gets wrong around the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GTAO (Jimenez et al. 2016) on known answers, against its reference (step obscurance with R), and
 // its properties.
 #include "ao/methods/gtao/gtao.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The 4x4 depth-aware box filter of interleaved sampling (VAO and AT sec. 4.2).
 #include "ao/methods/filters/interleave.h"
 

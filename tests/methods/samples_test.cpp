@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sample sets: Poisson-disk sets by Lloyd relaxation, containment offsets with r = mu^-1(xi), disk
 // samples of volumetric AO, and the interleaving rotations.
 #include "ao/methods/samples.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared by the screen-space method tests: small G-buffers of built-in and hand-made scenes, and
 // one-pixel G-buffers for the analytic (implicit-surface) cases.
 #pragma once

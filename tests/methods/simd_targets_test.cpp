@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The SIMD kernels on every target this machine runs (ao/simd/target.h): each target can be
 // chosen, and the methods' images agree between targets. Targets with FMA (AVX3_DL, AVX3, AVX2)
 // compute the same operations with the same roundings, so they agree bit for bit; SSE4, SSSE3 and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer (AT eq. 6, 9): its relation to obscurance and known answers.
 #include "ao/methods/transfer/transfer.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric AO (VAO eq. 6-7) on known answers, against its reference (cubic membership, same R),
 // and the paper's claims measured on the default scene. The claims test prints the table that
 // docs/methods/volumetric.md reproduces:

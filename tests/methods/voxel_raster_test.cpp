@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The voxelizer's raster stage (methods/cone/raster_kernel.cpp) tests only the column centres of each row's span
 // between the triangle's edges (widened by a column), not the whole bounding box. Its grid must be
 // the one a test of every centre of the box gives: the same edge functions and tie rule, evaluated

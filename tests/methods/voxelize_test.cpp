@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Parity voxelization against sets with exact answers: a voxel is solid exactly when its centre
 // is inside a closed mesh, so an axis-aligned box gives an exact count.
 #include "ao/methods/cone/voxelize.h"

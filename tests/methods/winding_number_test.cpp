@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Generalized winding numbers: known answers (a closed mesh, a flat sheet, a sphere with a cap cut
 // off, seen from its centre), the jump across a surface, and the fast hierarchy against the exact
 // sum.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Shared pieces of the Python module's tests: the ao binary they compare against (AO_BINARY, set
 by ctest), tiny generated meshes (the project's tests use only what they generate or carry), and
 readers of the CLI's outputs."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ao.bake and ao.compare: arrays and tables equal `ao bake`'s and `ao compare`'s outputs for the
 same inputs and seed (the same job functions run underneath, so equality is exact)."""
 

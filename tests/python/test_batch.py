@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """python3 -m ao.batch on a real Dask cluster: `dask scheduler` and `dask worker` processes on
 127.0.0.1, each stopped by the test that started it (also when it fails).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Python errors in Python words: every wrong shape, dtype, type, None, NaN, string or huge value is
 a TypeError or ValueError naming the argument, never the binding's or the JSON library's text, and
 never a crash (a list that contains itself, nesting 100,000 deep). The job layer's errors name its

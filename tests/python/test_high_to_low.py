@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """High to low without a cage or an extrusion: the default cage distance is fitted to the pair
 (src/ao/bake/cage_fit.cpp), so a plain bake reaches the high mesh from almost every texel. The
 pair is tests/bake/high_to_low_test.cpp's: a 24 x 12 lat-long unit sphere (low, UVs) and a 250 x

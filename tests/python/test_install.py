@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The module installs: `pip install --no-build-isolation .` into a virtual environment made from
 Debian's python3 (with its system packages: numpy), without network (--no-index), through the
 in-tree build backend (python/build_backend/); the backend reuses the test's build folder, so this

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Ctrl-C stops a long call: SIGINT to a child process in the middle of a render that would take
 minutes raises KeyboardInterrupt in it within seconds, and the module keeps working afterwards."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """NOTICE against what is built: every shared library the ao command and the Python module link
 (their ELF NEEDED entries), every library compiled in from headers, every package the module
 imports is named, in a run-time section that fits who uses it; nothing they use is listed as tests

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ao.occlusion (AO at given points) against `ao render`'s ray-traced reference at the same points,
 and the progress of long calls reaching Python: a callable, a tqdm bar, lines on stderr."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ao.render, ao.gbuffer and the caller's own G-buffer: the arrays equal `ao render`'s output for
 the same inputs and seed (both run the job layer's run_render, so equality is exact: the same
 floats, written to EXR as 32-bit floats and read back unchanged)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The type stubs (python/ao/*.pyi, installed with the package) agree with the module: mypy's
 stubtest (Debian's python3-mypy) compares every stubbed name, signature and default with the
 module as imported, and type-checks the stubs themselves."""

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The sun's direct-light pass against answers known in closed form: Ld = a/pi E max(0, n.l) in the
 // open, 0 in a shadow and on faces turned away.
 #include "ao/reference/direct_light.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scale-free ray offset (reference/ray_offset.h) and the choice of normal: no
 // self-intersection at large coordinates or tiny sizes, no bias against a much smaller offset,
 // and the same V about geometric and shading normals where they agree.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RayScene's build settings change how the BVH is built, never what a ray hits: every quality,
 // compact or not, with the mesh arrays shared or copied, gives the same G-buffer depths.
 #include "ao/reference/ray_scene.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ray-traced ground truth against configurations with known answers. Tolerances come from
 // the estimator's own reported standard error: a correct estimator lands within 4 standard
 // errors of the truth except with probability ~6e-5 (and scrambled Sobol errors are smaller

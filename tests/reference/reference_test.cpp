@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reference kinds by name: the registry's matched reference of each method, the names `ao compare
 // --reference` and `raytraced -p reference=` accept, and their bad values.
 #include "ao/reference/reference.h"

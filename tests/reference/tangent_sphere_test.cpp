@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tangent-sphere reference (volumetric AO's V, ray-traced) against configurations with known
 // answers, and volumetric AO against it. Tolerances as in raytraced_test.cpp: 4 reported standard
 // errors (a correct estimator lands outside with probability ~6e-5) plus 1e-3 for the ray offset.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ambient transfer reference (AT eq. 6, ray-traced) against known answers: the open plane, the
 // white room (albedo 1: W = 1 however closed, AT sec. 3's "corners of white rooms will not be darker
 // than the wall itself"), and an empty room of coloured walls where both integrals of eq. 6 come

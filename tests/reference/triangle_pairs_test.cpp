@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pairing triangles into Embree quads (BvhOptions::quads): every triangle lands in exactly one
 // quad half with its own vertices in its own winding, on meshes with seams, lone triangles,
 // non-manifold edges and flipped neighbours; and a quad BVH answers rays as the triangle BVH does.

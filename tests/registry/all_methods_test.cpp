@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every method of the registry through the same checks, so that a new row is tested without a
 // line here: the open plane is fully visible, V stays in [0, 1], results are identical at 1 and 2
 // threads, the mean V falls as R grows, parameters round trip through JSON (floats at the

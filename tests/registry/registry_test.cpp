@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The registry's characteristic-function choice for the screen-space methods (registry.h,
 // kCharacteristicParam): the paper's other characteristic functions (VAO fig. 2a implicit, 2b height
 // field, fig. 12 depth x height field) on the built-in scenes that describe them, against known

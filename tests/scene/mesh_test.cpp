@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // validate_and_prepare and generate_normals on meshes big enough to span several of their parallel
 // blocks: the results equal a plain serial loop written here (the definition in mesh.h), do not
 // depend on the thread count, and the first offender in file order is the one named.

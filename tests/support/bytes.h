@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Building binary payloads for hand-made test files: raw arrays appended to a byte string, and
 // base64 for glTF's embedded `data:` URIs (RFC 4648, with padding).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks for the bad-input rule of SPEC: a library call throws the expected error type with one
 // line that names the file and the problem.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glTF documents for the round-trip tests of `ao bake` (built here as GLB, nothing read from disk),
 // and a reader of the GLB container (glTF 2.0 spec, "Binary glTF Layout").
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The bad-input rule of SPEC for the mesh loaders: load_scene_file refuses a file with one
 // InputError line that names the file.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Open meshes (sheets and containers) for the cone method's open-surface voxelization, generated
 // so that the tests and bench/tools/open_sheets.cpp (which writes them as OBJ for `ao compare`)
 // need no files. Each is one mesh whose fronts (counter-clockwise) face out, standing on y = 0.

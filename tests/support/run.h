@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runs the `ao` binary the way a user or a script does and captures what it says.
 #pragma once
 

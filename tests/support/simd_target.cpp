@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runs the test binary with the SIMD kernels restricted to one target: AO_SIMD_TARGET=AVX2 (one of
 // ao::simd_targets()) makes every kernel of the run use that target, so one machine tests all the
 // targets it has (tests/CMakeLists.txt registers the method, filter and cone tests once per

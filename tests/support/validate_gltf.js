@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Validates glTF/GLB files with the Khronos glTF-Validator (npm package gltf-validator) and prints
 // one JSON line per file: {"file", "errors", "warnings", "messages": ["CODE at POINTER: message", ...]}.
 // Exit status 3 when the validator is not installed (the caller reports the check as not run),

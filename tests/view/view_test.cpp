@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ao view: the orbit camera's geometry, the camera file, and scripted runs in a real window under
 // Xvfb (installed by scripts/setup) that must show exactly what ao render computes.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bake groups (see bake_groups.h). Merging is exact for the area-weighted texel mean of eq. 2 of
 // the per-texel AO paper: a texel shared by two groups' charts averages their V by the world area
 // each covers in it.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bake groups: which meshes occlude which. A group's meshes are baked with only that group's
 // meshes (plus the shared occluders: --occluder files, the floor) in the scene, so meshes of
 // different groups do not darken each other, as Substance's and Marmoset's bake groups do. Groups

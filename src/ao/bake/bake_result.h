@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What a texel baker returns, whichever method made it.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The default cage distance of a high-to-low bake, chosen from the pair's geometry (high_to_low.h,
 // fitted_cage_extrusion). A cage ray through a point p of the low surface finds the high mesh
 // when the high surface lies within the cage distance D of p along the ray: outside p (the ray

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Texture-space denoising of an AO map: see denoise.h.
 #include "ao/bake/denoise.h"
 

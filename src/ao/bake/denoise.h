@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Texture-space denoising of a ray-traced AO map: a cross-bilateral filter (a Gaussian over each
 // texel's neighbours in the map) guided by where the texels lie on the surface, so that it
 // averages the Monte Carlo noise of texels that are neighbours on the surface and leaves alone

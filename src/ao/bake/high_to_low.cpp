@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // High-to-low AO baking (see high_to_low.h). Per texel T of the low mesh's map:
 //   V(T) = (1/A(T)) * integral over the low patch S of V_high(h(p)) dp,
 // where h(p) is where the cage ray through p first meets a front face of the high mesh and V_high

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // High-to-low baking, as xNormal, Substance and Marmoset do it: the AO of a detailed (high-poly)
 // mesh transferred into the UV layout of a simple (low-poly) mesh. For each sample point p of a
 // texel's patch on the low mesh, a ray leaves the cage (the low mesh pushed outwards along its

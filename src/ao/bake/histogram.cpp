@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Based on McGraw & Sowers, "Hardware Accelerated Per-Texel Ambient Occlusion Mapping" (2008).
 //
 // The paper's pipeline, stage by stage, and where it lives here:

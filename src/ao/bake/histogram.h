@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Outside-in AO map baking: McGraw & Sowers, "Hardware Accelerated Per-Texel Ambient Occlusion
 // Mapping" (ISVC 2008), on the CPU. See histogram.cpp and docs/methods/bake.md.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the outside-in baker's stages 1 and 2 (histogram_internal.h; bake/histogram.cpp for
 // the method), compiled once per SIMD target. Stage 1 is a half-space rasteriser tuned for what
 // baking feeds it: many small triangles (an 89k-triangle mesh at map resolution covers a few pixels

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the outside-in baker (McGraw & Sowers, "Hardware Accelerated Per-Texel Ambient
 // Occlusion Mapping", 2008; bake/histogram.cpp), compiled once for every SIMD target
 // (histogram.cpp): per direction, stage 1's orthographic z-buffered rasterisation with back-face

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The flattened mesh and the orthographic views of the outside-in baker; the rasteriser itself
 // (a half-space rasteriser for many small triangles) is simd::rasterize_front_faces.
 #include "ao/bake/ortho_raster.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Orthographic z-buffered rasterisation with back-face culling: stage 1 of the per-texel AO paper
 // (McGraw & Sowers, sec. 3, "Render from light direction w"), on the CPU. The output is a
 // visibility buffer (depth + triangle id per pixel); the histogram baker turns it into (u, v) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Based on the seam fix of McGraw & Sowers (sec. 3.3): "the first dilation step replaces the
 // boundary pixels with the nearest valid AO value, and the second step expands the AO map by 1
 // pixel further so that bilinear texture filtering will be correct". Padding is the same dilation

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // UV padding (a margin around every chart) and the paper's seam fix (McGraw & Sowers, sec. 3.3:
 // erosion, then two dilations). Both are "copy the nearest valid texel outwards".
 #pragma once

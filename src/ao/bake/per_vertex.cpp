@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Outside-in per-vertex AO: for each direction, the z-buffer of ortho_raster.cpp (back faces
 // culled) is a shadow map, and a vertex whose normal faces the direction is lit when its depth is
 // within a bias of the stored depth at its pixel. Summing (w . n) over lit directions with weight

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-vertex AO by the outside-in method: the per-texel AO paper's z-buffered renders from D
 // directions (sec. 3), with each vertex tested against the z-buffer instead of scattered into a
 // texture. (The ray-traced per-vertex baker is bake_vertices_raytraced in raytraced_bake.h.)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inside-out baking of the per-texel AO of McGraw & Sowers' eq. 2 (and, with a distance R, of the
 // obscurance integral the ground truth in reference/raytraced.h estimates):
 //   V(T) = (1/A(T)) * integral over the texel's patch S of (1/pi) * integral over the hemisphere

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inside-out AO map baking with Embree: per texel, rays from points spread over the texel's patch
 // of surface. The reference for the histogram baker, and the baker to use when occluders should
 // only count within a distance R (the histogram baker's distance is unlimited).

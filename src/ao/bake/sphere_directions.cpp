@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/bake/sphere_directions.h"
 
 #include <cmath>

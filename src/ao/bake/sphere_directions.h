@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Direction sets on the unit sphere for outside-in baking (the per-texel AO paper, sec. 3:
 // "Uniformly distributed unit vectors can be produced by drawing each component from a zero mean
 // normal distribution and normalizing the vector"), and a stratified alternative.

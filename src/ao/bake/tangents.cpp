@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MikkTSpace tangent frames (Mikkelsen 2008) and the tangent space of a texel; see tangents.h.
 #include "ao/bake/tangents.h"
 

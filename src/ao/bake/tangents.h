@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tangent frames of a mesh's UV layout as MikkTSpace defines them (Mikkelsen 2008, "Simulation of
 // wrinkled surfaces revisited"; the definition Blender, glTF and the game engines share), so that
 // a tangent-space map baked here decodes to the same direction in any of them; and the change of

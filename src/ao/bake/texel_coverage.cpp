@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Exact UV coverage of the texel grid. Each triangle is clipped (Sutherland-Hodgman) against every
 // texel square its UV bounding box touches, column by column: to the column's two lines once, then
 // that polygon to the two lines of each row it reaches (the clips clip_to_texel makes, in its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which surface each texel of an AO map covers: the UV layout of a scene clipped exactly against
 // the texel grid. Both bakers use it: the histogram baker for the exact normalisation (each
 // texel's world-space area, the denominator of the paper's eq. 2), the ray-traced baker to spread
@@ -47,7 +48,7 @@ struct TexelCoverage {
   std::size_t degenerate_uv_triangles = 0;  ///< Triangles with surface area but (near) zero UV area: they get no texel.
   std::size_t outside_triangles = 0;        ///< Triangles partly outside [0,1]^2: the part outside is not baked.
 
-  std::size_t texel_count() const { return static_cast<std::size_t>(width) * height; }
+  std::size_t texel_count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   /// One-line warnings for the user (overlaps, degenerate and out-of-range UVs); empty when clean.
   std::vector<std::string> warnings() const;
 };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Patch sampling for the inside-out bakers: see texel_rays_internal.h.
 #include "ao/bake/texel_rays_internal.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pieces shared by the inside-out bakers (raytraced_bake.cpp, high_to_low.cpp): a texel's patch of
 // surface as sub-triangles for sampling points by area, the ray tracer that turns a batch of rays
 // into mu(D), the lane-parallel ray maker (make_texel_rays, TexelPoints) of the ray-traced baker,

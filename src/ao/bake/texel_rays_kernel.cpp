@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ray-traced baker's ray makers (bake/texel_rays_internal.h: make_texel_rays,
 // make_hemisphere_rays), compiled once per SIMD target. make_texel_rays is written in Highway
 // vectors over the 16 lanes of a batch (4, 8 or 16 floats at a time, as the target holds), with

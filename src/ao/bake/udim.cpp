@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // UDIM tiles (udim.h).
 #include "ao/bake/udim.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // UDIM tiles: a UV layout spread over unit squares, tile (k, r) holding u in [k, k+1) and
 // v in [r, r+1) and numbered 1001 + k + 10 r (k in [0, 9], r in [0, 99]), the convention of Mari,
 // Substance, Blender and USD. Each tile is baked as a map of its own.

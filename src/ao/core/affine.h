@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Affine maps of 3D space (3x4 matrices), as glTF nodes place instanced meshes in the world.
 #pragma once
 

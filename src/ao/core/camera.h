@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pinhole camera. Camera space is right-handed and looks down -z, with +x right and +y up in
 // the image; pixel (0,0) is the top-left corner of the image and pixel centres sit at +0.5.
 #pragma once

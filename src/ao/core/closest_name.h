@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The known name closest to a mistyped one, for the "did you mean" of every error that refuses a
 // name: commands and options, methods, parameters and their enum values, scenes, formats.
 #pragma once

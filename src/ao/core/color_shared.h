@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Rec. 709 luminance, the scalar value of an RGB result (ambient transfer's W, GTAO's multi-bounce
 // albedo, the reference's transfer), read by C++ and by the GPU shaders alike (core/shared.h).
 #ifndef AO_CORE_COLOR_SHARED_H_

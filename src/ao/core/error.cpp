@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The field marks of InputError's text (error.h): each field is written between two unit
 // separators (0x1F), a character no message, option or file name of ao's uses.
 #include "ao/core/error.h"

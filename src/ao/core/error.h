@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Errors. Library code never exits: bad input throws InputError with one line that names the
 // file (or request field) and the problem; only src/cli/main.cpp turns errors into exit codes.
 #pragma once

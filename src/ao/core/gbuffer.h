@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GBuffer: what every screen-space method reads. One entry per pixel, all in camera space
 // (right-handed, looking down -z; see camera.h). Linear depth and coverage are not stored: they
 // follow from the position and the object id (GBuffer::depth, GBuffer::covered), so rendering a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The per-pixel hash every method's sampling is keyed by (core/sampling.h), read by C++ and by the
 // GPU shaders (gpu/shaders/common.glsl) alike, so both backends draw the same samples bit for bit:
 // the "lowbias32" finaliser, hash_combine, pixel_seed and to_unit_float. Written in the language

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image<T>: an owning 2-D array of pixels, row-major, (0,0) at the top left.
 // ImageView<T>: a non-owning view of one, what kernels take.
 #pragma once
@@ -22,7 +23,7 @@ struct ImageView {
 
   T& operator()(int x, int y) const {
     AO_ASSERT(x >= 0 && x < width && y >= 0 && y < height);
-    return data[static_cast<std::size_t>(y) * width + x];
+    return data[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
   }
   std::span<T> row(int y) const { return {data + static_cast<std::size_t>(y) * width, static_cast<std::size_t>(width)}; }
   std::size_t size() const { return static_cast<std::size_t>(width) * height; }
@@ -71,7 +72,7 @@ class Image {
  public:
   Image() = default;
   Image(int width, int height, T fill = T{})
-      : width_(width), height_(height), pixels_(static_cast<std::size_t>(width) * height, fill) {
+      : width_(width), height_(height), pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), fill) {
     AO_ASSERT(width >= 0 && height >= 0);
   }
 

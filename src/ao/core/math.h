@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Small vector types for geometry. Float32 throughout, as SPEC asks.
 #pragma once
 

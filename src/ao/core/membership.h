@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fuzzy membership (falloff) functions mu(d) of the obscurance integral
 //   V(x) = (1/pi) * integral over the hemisphere of mu(D(w)) cos(theta) dw        (volumetric AO, eq. 2)
 // where D(w) is the distance to the first surface in direction w (infinite when nothing is hit).

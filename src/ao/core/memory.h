@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Memory a run needs, estimated before the big allocations, against the memory the machine can
 // give (SPEC, "Behaviour on bad input": never an endless allocation). The estimates are upper
 // bounds in bytes built from what the code allocates (per-pixel, per-texel, per-triangle terms

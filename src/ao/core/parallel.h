@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tile-parallel loops over images. The same code runs serial (one thread) or parallel; results
 // never depend on the thread count because per-pixel work is independent and seeded per pixel.
 #pragma once

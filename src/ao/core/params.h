@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One parameter table per method: each parameter of a Params struct is declared once, with its
 // name, where it lives in the struct, type, unit, valid range, one-line help and enum names. JSON in
 // and out (from_json / to_json), the range checks of validate(), `ao render -p key=value`, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Progress reporting from parallel kernels to whoever shows it (the CLI's bar on stderr).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Hashing and sample generation. Per-pixel randomness comes from hash(seed, pixel, sample), never
 // from thread-local state, so results do not depend on the thread count.
 #pragma once

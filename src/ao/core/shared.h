@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The prelude of a header that C++ and GLSL both read (a *_shared.h file: constants and small
 // functions the CPU kernels and the GPU shaders must agree on, typed once; the shader loader
 // expands `#include`, each file once).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Wall-clock stopwatch in milliseconds, for the timings jobs report.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Texture lookup in UV space, with the convention of the AO maps `ao bake` writes and of OpenGL:
 // u runs left to right, v bottom to top, so texel (x, y) of a w x h image covers
 // u in [x/w, (x+1)/w] and v in [1 - (y+1)/h, 1 - y/h].

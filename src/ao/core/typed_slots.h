@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Objects kept by their type, at most one of each: what a caller keeps between calls on behalf of
 // code it does not know (a method's state between frames in MethodCache, a method's buffers with a
 // GpuScene), so that neither has to name the types it keeps.

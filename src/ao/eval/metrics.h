@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image quality metrics between a method's visibility and its reference, over the pixels a mask
 // selects (the G-buffer's coverage: background pixels say nothing about a method).
 #pragma once

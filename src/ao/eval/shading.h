@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Turning visibility into pictures and pictures into visibility, for people looking at results:
 // the display shading of `ao render --shaded` and the lookup of a baked AO map on its mesh
 // (`ao render --ao-map`). Neither is an AO method; both are what a viewer does with one.

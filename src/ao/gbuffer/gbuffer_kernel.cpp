@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of the G-buffer pass (gbuffer/render_gbuffer.h; gbuffer_internal.h), compiled once per
 // SIMD target: a tile's primary rays in Embree packets (their directions and hits copied in and out
 // lane by lane), then each row's points, normals, ids, albedo and UVs assembled in cache from the

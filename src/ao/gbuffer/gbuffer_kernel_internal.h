@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of the G-buffer pass (gbuffer/render_gbuffer.h), written once for every SIMD target
 // (gbuffer.cpp): one tile's primary rays traced in Embree packets and its rows of every channel
 // streamed to the images. render_gbuffer sizes the images and hands out the tiles.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scene -> G-buffer by Embree primary rays, one coherent packet per block of pixels.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GpuDevice: a headless OpenGL context through EGL, or the caller's current one (device.h).
 // libEGL is opened with dlopen and every EGL and GL function is resolved through
 // eglGetProcAddress (EGL_KHR_get_all_proc_addresses, EGL 1.5), so libao links no GL library.

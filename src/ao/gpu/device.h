@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GPU backend's device: an OpenGL 4.3+ core context that runs the methods as compute shaders
 // (docs/gpu.md). Either headless through EGL (no window, no X: Mesa's software renderer llvmpipe
 // where there is no GPU) or the caller's current context (a viewer's window).

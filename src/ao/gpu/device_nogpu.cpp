@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GPU backend's device and G-buffers in a library built without it (CMake AO_GPU=OFF: no EGL or
 // GL headers; each *_nogpu.cpp stands in for its *_gpu.cpp): every way to get a device says so, so
 // callers need no build switches of their own. Nothing else can be called without a device.

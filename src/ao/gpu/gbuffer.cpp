@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GpuScene and GpuGBuffer (gbuffer.h): scene upload, G-buffer upload and rasterization
 // (shaders/gbuffer.vert, .geom, .frag; shaders/gbuffer_depth.comp), read-back.
 #include "ao/gpu/gbuffer.h"

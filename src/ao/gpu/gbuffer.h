@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scenes and G-buffers in a GpuDevice's memory: what the GPU methods read (docs/gpu.md).
 //
 // A GpuGBuffer is made either by uploading a CPU G-buffer (render_gbuffer, a G-buffer file, your

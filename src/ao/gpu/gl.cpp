@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GL layer of the GPU backend: function loading, programs from the embedded shader files,
 // timer queries, textures and buffers (gl_internal.h).
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of the GPU backend, not installed: the OpenGL functions it calls (resolved at run time,
 // so libao links no GL library), the context a GpuDevice owns or borrows, and small RAII wrappers
 // of GL objects. Only src/ao/gpu/ and its tests include this header.

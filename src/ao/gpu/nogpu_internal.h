@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the *_nogpu.cpp files of a library built without the GPU backend (CMake AO_GPU=OFF) throw.
 #pragma once
 

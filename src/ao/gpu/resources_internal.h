@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of the GPU backend, not installed: what GpuScene and GpuGBuffer hold (gbuffer.h).
 #pragma once
 

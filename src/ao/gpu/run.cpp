@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every GPU method's run does (run_internal.h: Run): its programs made current with the
 // G-buffer bound and the camera's projection set, its passes timed, its results read back.
 #include <vector>

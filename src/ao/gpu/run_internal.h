@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of the GPU backend, not installed: a method's run on the device (Run), which each
 // method's GPU file (methods/<name>/<name>_gpu.cpp) drives, and reading its results back.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where an asset's own references may point: a glTF's external buffers and images, an OBJ's
 // material libraries. A model is untrusted input (a farm bakes assets nobody has looked at), and a
 // reference that climbs out of its folder ("../../home/x/.ssh/id_rsa", "/etc/passwd") would carry a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Meshes through assimp (OBJ files beyond obj_reader's shape, STL, glTF/GLB), after the checks
 // of our own that load_scene_file runs first, and assimp's messages in ao's words. Part of
 // load_scene_file (mesh_io.cpp); not installed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // assimp's messages in ao's words (found by scripts/mutate, tested case by case in
 // tests/io/loader_messages_test.cpp).
 #include <string>

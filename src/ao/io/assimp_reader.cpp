@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Meshes through assimp (see assimp_internal.h): OBJ files beyond obj_reader's shape, STL and
 // glTF/GLB, each after a check of our own (obj_check.h, stl_check.h, gltf_check.h), because
 // assimp 5.2's readers fail the SPEC's bad-input rules (measured with libassimp 5.2.5):

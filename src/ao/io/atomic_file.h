@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Atomic output: a file is written under a temporary name in its own directory and renamed over
 // the destination only once it is complete, so a failure (bad data, full disk, a crash) never
 // leaves a half-written file and never damages a file that was already there (SPEC, "Behaviour on

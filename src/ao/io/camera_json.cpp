@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/io/camera_json.h"
 
 #include "ao/core/closest_name.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A camera as a small JSON file, so a view found interactively (`ao view`) can be rendered again
 // offline (`ao render --camera cam.json`) and the other way round:
 //

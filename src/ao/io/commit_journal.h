@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The journal of a multi-output commit (OutputSet::commit), so that a run killed between two
 // renames (SIGKILL, a power cut) leaves nothing mixed: before the first rename, the commit writes
 // in the folder of each output a hidden journal listing every output, its staged file and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/io/exr_common_internal.h"
 
 #include <OpenEXR/ImfOutputFile.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal helpers shared by image_io.cpp and gbuffer_exr.cpp: checks on input files and sizes,
 // and reading OpenEXR channels into display-window images. Not part of the public API.
 #pragma once

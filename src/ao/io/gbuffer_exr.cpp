@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/io/gbuffer_exr.h"
 
 #include <OpenEXR/ImfChannelList.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // G-buffers as multi-channel OpenEXR files: what `ao render` can save and what a compositor
 // supplies to run the screen-space methods on another renderer's passes. Channel names,
 // conventions and how Blender and Nuke passes map onto them: docs/gbuffer.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glTF 2.0 / GLB structure check, run before assimp. Measured with libassimp 5.2.5 (mutation
 // fuzzing of small files):
 //  - JSON nested ~175,000 levels deep, or a node chain ~17,500 deep, overflows the stack (its JSON

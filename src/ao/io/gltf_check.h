@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A structure check of glTF 2.0 and GLB files, run before assimp reads them, because assimp 5.2
 // crashes on or silently misreads hostile ones (see gltf_check.cpp). Part of load_scene_file;
 // declared here for the fuzz harness and the tests.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glTF load-modify-save with tinygltf (see gltf_document.h). The structure is checked by
 // check_gltf before tinygltf parses anything (tinygltf trusts counts, offsets and nesting), and
 // every accessor read here is bounds-checked again, so a hostile file ends in one InputError.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A glTF 2.0 document kept whole for `ao bake`'s round trip: load it (tinygltf, after check_gltf),
 // hand out world-space scenes to bake, add the baked maps (one image and texture per baked mesh,
 // an occlusionTexture on the materials of its primitives) or per-vertex AO (COLOR_0), and save the

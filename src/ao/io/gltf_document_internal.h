@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The parts of GltfDocument (gltf_document.h) that work on tinygltf's model by themselves: reading
 // a primitive's accessors into a Mesh (gltf_primitive.cpp) and putting the baked maps on the
 // materials (gltf_materials.cpp). Not installed; hidden, as the tinygltf types they take.

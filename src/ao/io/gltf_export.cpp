@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GLB layout (glTF 2.0 spec, "Binary glTF Layout"): a 12-byte header (magic "glTF", version 2,
 // total length), a JSON chunk padded with spaces to 4 bytes, and a BIN chunk padded with zeros.
 // Every accessor's bufferView starts on a 4-byte boundary, as the spec requires for float/uint32.

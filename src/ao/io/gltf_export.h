@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A scene with its baked AO map as a binary glTF 2.0 (.glb) that any glTF viewer opens: one mesh
 // per scene mesh (positions, normals, TEXCOORD_0, uint32 indices), each with a fresh material
 // (baseColorFactor = the mesh's albedo) whose occlusionTexture is the map (embedded PNG, red

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The baked AO maps onto the materials of a glTF document (gltf_document_internal.h): glTF's
 // occlusionTexture belongs to a material, which primitives of other meshes (or unbaked primitives)
 // may share, so a shared material is cloned where its users need different maps.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A glTF primitive's accessors read into a Mesh (gltf_document_internal.h). tinygltf checks
 // little of what it parses (check_gltf covers the structure first), so every accessor, bufferView
 // and sparse block read here is bounds-checked again: a hostile file ends in one InputError.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TGA, TIFF and JPEG writers (see image_formats_internal.h). Formats:
 // - TGA: Truevision TGA 2.0 specification, an 18-byte header (no ID, no colour map), image type 3
 //   (uncompressed grey) or 2 (uncompressed true colour, stored B, G, R), descriptor bit 5 set so

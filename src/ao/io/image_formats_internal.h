@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writers of the 8/16-bit interchange formats besides PNG and EXR (image_io.cpp dispatches by
 // extension): TGA (hand-written, 8 bit), TIFF (libtiff, 8/16 bit, Deflate) and JPEG (libjpeg,
 // 8 bit, lossy). Samples are linear floats, `channels` per pixel (1 grey or 3 RGB), row 0 the top

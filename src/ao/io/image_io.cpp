@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/io/image_io.h"
 
 #include <OpenEXR/ImfChannelList.h>

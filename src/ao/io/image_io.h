@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image files: OpenEXR (float32, lossless), PNG and TIFF (8 or 16 bit, lossless), TGA (8 bit) and
 // JPEG (8 bit, lossy: for previews, not for data). Reads: EXR and PNG. Writes are atomic
 // (atomic_file.h). Reads check the size before allocating and turn every library failure into an

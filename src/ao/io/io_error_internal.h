@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The io layer's one way to word an error: "<file>: <problem>" on one line, with any text quoted
 // from a file or a library (assimp, tinygltf, OpenEXR, libpng, nlohmann-json) made printable,
 // short and single-line first. Every reader and writer in io/ uses these; not installed.

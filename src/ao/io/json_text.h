@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // JSON from users' files and options (camera files, parameter files, `-p key=value` values,
 // sweep values), parsed with limits: a depth limit checked while parsing (nlohmann-json's
 // parser is iterative, but copying, printing or comparing a value recurses, so a value nested

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh loading: the file's format chosen by content and extension, and each handed to its reader.
 // OFF, PLY and one-mesh OBJ files have readers of our own (off_reader.h, ply_reader.h,
 // obj_reader.h); other OBJ files, STL and glTF/GLB go through assimp (assimp_reader.cpp) after a

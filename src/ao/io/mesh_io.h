@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mesh files -> Scene. OFF, PLY and one-mesh OBJ files are read by our own strict readers; other
 // OBJ files, STL and glTF/GLB go through assimp, after checks of our own (see assimp_reader.cpp for why).
 #pragma once

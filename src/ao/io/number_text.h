@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Numbers in text mesh files (OBJ, OFF, ASCII PLY and STL), read the same way in every format:
 // a value too small for a float reads as 0 (or a float denormal), as C's strtof and every other
 // mesh tool read it; a value too large is infinite, which the loaders refuse as non-finite.

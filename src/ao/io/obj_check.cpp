@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OBJ line scan: numbers and indices, checked before assimp can take NaN UVs or drop UVs.
 // assimp resolves positive indices after reading the whole file (so they may point forwards) and
 // negative ones against the elements read so far; the scan counts the same way.

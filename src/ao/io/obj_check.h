@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A line scan of Wavefront OBJ files, run before assimp reads them, because assimp 5.2 takes
 // `vt nan` as a UV and drops every UV of a file that has one out-of-range UV index, without a word.
 // Part of load_scene_file; declared here for the fuzz harness and the tests.

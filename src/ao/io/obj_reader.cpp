@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fast OBJ reader for one-mesh files (obj_reader.h). One pass over the mapped file collects the
 // numbers and the face corners; anything outside the supported shape ends the attempt (nullopt),
 // and load_scene_file reads the file as it always did. What assimp 5.2 and ao's post-processing

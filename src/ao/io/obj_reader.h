@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A fast reader for the Wavefront OBJ files that hold one mesh (scans, exports of one object: the
 // meshes that are big), loading them as assimp 5.2 plus ao's post-processing did, at a fraction of
 // its time (BENCHMARKS.md, "Loading"). Anything beyond that shape returns no scene, and the caller

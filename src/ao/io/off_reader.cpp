@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OFF (Geomview): [C][N]OFF, counts "vertices faces [edges]", one vertex per line (x y z, then
 // nx ny nz for N, then a colour we ignore), one face per line ("n i0 ... in-1", then an ignored
 // colour). '#' starts a comment. Our own reader rather than assimp's, which (libassimp 5.2.5)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OFF (Geomview object file format) reader of our own: text OFF, COFF, NOFF and CNOFF, read
 // straight into the Mesh arrays. Part of load_scene_file; declared here for the fuzz harness and
 // the tests.

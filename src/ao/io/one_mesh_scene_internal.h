@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scene of a file that holds one mesh (OFF, and OBJ on its fast path): named after the file,
 // validated and prepared for tracing as every loader's scene is.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The outputs of one run as one transaction (SPEC, "Behaviour on bad input"): every output is
 // declared before the work starts, so one that names an input or another output is refused while
 // nothing has been computed or written; each is then written to a temporary file beside its

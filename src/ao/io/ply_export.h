@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-vertex AO as a PLY file that MeshLab and Blender read: binary little-endian, vertices with
 // position, normal, 8-bit colour (V as grey, linear) and a float `quality` (V exactly, MeshLab's
 // name for a per-vertex scalar), triangles as `vertex_indices`. Written atomically.

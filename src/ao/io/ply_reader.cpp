@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PLY reader. assimp 5.2's PLY path failed the SPEC's bad-input rules (a file cut inside its header
 // loops forever, a header claiming 3e9 vertices ends in bad_alloc, a list count of 4294967295
 // allocates 16 GB, an ASCII file missing its last faces loads with invented ones, a damaged

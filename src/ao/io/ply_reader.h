@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PLY (Stanford polygon file) reader of our own: ASCII, binary little- and big-endian, read straight
 // into the Mesh arrays. Part of load_scene_file; declared here for the fuzz harness and the tests.
 #pragma once

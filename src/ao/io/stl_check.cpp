@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ASCII STL structure check (stl_check.h). The grammar is fixed and small, so a token scan with the
 // line number for messages is all it takes; the numbers are read the way ao reads them in every
 // text format (number_text.h), so a value that does not parse is named here, not misread later.

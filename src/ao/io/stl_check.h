@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A structure check of ASCII STL files, run before assimp reads them: assimp 5.2 reads an ASCII
 // STL cut off inside a facet as the facets before the cut, without a word (half a mesh, exit 0).
 // Part of load_scene_file; declared here for the fuzz harness and the tests.

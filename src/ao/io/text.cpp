@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Text on images with FreeType: each glyph is rendered to an 8-bit coverage bitmap (FreeType's
 // anti-aliased rasteriser) and blended over the image. See text.h for the box every string occupies.
 #include "ao/io/text.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Text on images: anti-aliased glyphs from a TrueType/OpenType font (FreeType), blended over an RGB
 // image. Used to label `ao compare`'s contact sheet. A font is a file read at run time, so a missing
 // one is reported, not thrown: a picture without labels is better than no picture.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tinygltf 2.7 (Debian libtinygltf-dev, header only) compiled into ao's library, without its stb
 // image decoder and encoder: images are kept encoded (gltf_document.cpp hands tinygltf a loader
 // that copies the bytes), and nothing is ever written through it but the GLB stream.

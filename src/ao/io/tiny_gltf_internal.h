@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tinygltf 2.7 (Debian libtinygltf-dev, header only) as ao's library compiles it: every file that
 // uses tinygltf includes it through here, never <tiny_gltf.h> itself. Its namespace is renamed to
 // ao::gltf_detail and its declarations get hidden visibility, so that libao exports no tinygltf

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The bake job: the request checked and resolved before any mesh is loaded, each mesh's outputs
 // named and declared, the bakers chosen, and the batch loop. One mesh is baked in bake_mesh.cpp,
 // a glTF round trip in bake_gltf.cpp.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao bake` as a library call: one mesh (or a batch of mesh files) with UVs in, its AO map,
 // per-vertex AO, bent normals and a glTF with the map out, baked the way `ao bake` bakes by
 // default (ray-traced, 64 rays per texel, texture-space denoising, padding). High to low, bake

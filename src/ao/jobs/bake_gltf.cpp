@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The bake job's glTF round trip: a glTF/GLB input baked to a .glb (the gltf output, or a
 // per-vertex .glb) keeps its document (gltf_document.h). Each glTF mesh with the UV set is baked
 // once, into a map of its own, at its first instance with every other instance and mesh occluding;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pieces of the bake job (bake.h) shared by its files: the plan (the request with its defaults
 // resolved and its inputs expanded), each mesh's output names, the occluders, and the bakers run
 // as the plan says. Internal: not installed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One mesh of the bake job: loaded, its map baked (plainly, group by group, high to low, or per
 // UDIM tile), its per-vertex AO baked, and every output written at the end as one transaction, so
 // a mesh that fails half-way leaves no partial set of outputs behind.
@@ -364,6 +365,12 @@ void tell_written(const MeshJob& job, const MeshBake& out, const MeshOutputs& ou
                   job.summary["mean_visibility"].get<double>(), job.timings["bake_ms"].get<double>(), job.summary["texels_per_second"].get<double>() / 1e6);
     job.reporter.tell(line);
   }
+  for (const auto& [path, what] : {std::pair{outs.thickness, "thickness"}, std::pair{outs.cavity, "cavity"}})
+    if (!path.empty() && job.summary.contains(what)) {
+      std::snprintf(line, sizeof line, "wrote %s: %s of %s, R = %g, mean %.4f", path.string().c_str(), what, job.label().c_str(),
+                    job.summary[what]["max_distance"].get<double>(), job.summary[what]["mean"].get<double>());
+      job.reporter.tell(line);
+    }
   if (!outs.per_vertex.empty()) {
     std::snprintf(line, sizeof line, "wrote %s: %zu vertices, %.0f ms", outs.per_vertex.string().c_str(), out.vertex_ao.size(),
                   job.timings.value("per_vertex_ms", 0.0));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Comparing AO methods with their references: the pipeline behind `ao compare`, usable without
 // the command line. Each method runs through the registry on one G-buffer, is judged against the
 // ray-traced reference its registry row names (or one chosen by name), and the results come back
@@ -159,7 +160,7 @@ std::string compare_key_params(const CompareRow& row, std::size_t max_chars = 40
 
 struct CompareRequest {
   SceneSource scene;
-  CameraRequest camera{.default_width = 640, .default_height = 360};
+  CameraRequest camera = CameraRequest::sized(640, 360);
   FalloffRequest falloff;
   SurfaceNormal normal = SurfaceNormal::Shading;  ///< The G-buffer's N, for every method and its reference.
   CompareSettings settings;   ///< Methods, parameters, references, spp, seed, sweep (falloff and progress are set by the job).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/jobs/compare_gpu_internal.h"
 
 #include <algorithm>

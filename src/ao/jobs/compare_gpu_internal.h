@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GPU backend's column of a comparison (CompareSettings::device gpu, compare.h): the G-buffer
 // uploaded once, the scene for cone, each method run on the device and judged as its CPU row is.
 // Not installed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao compare` as a library call (compare.h, run_compare): the scene and its G-buffer, the
 // comparison, and its table, sheet and sweep written as one transaction. docs/compare.md.
 #include <cstdio>

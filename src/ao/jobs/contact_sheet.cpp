@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The contact sheet is built as horizontal bands (the header, then one per row: label above
 // images) that are stacked with gutters between them.
 #include "ao/jobs/contact_sheet.h"

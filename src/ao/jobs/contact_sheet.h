@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The contact sheet of `ao compare` (sheet.png): one row per method, a column per image: [method's
 // V | reference's V | signed error heat map], and with the GPU backend the method's V and its heat
 // map once per backend. With a font, a header names the columns and shows the heat map's colour

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which backend computes a job's AO: the CPU kernels (src/ao/methods/, the default) or the GPU
 // backend's compute shaders (src/ao/gpu/, docs/gpu.md). The requests carry the choice (RenderRequest,
 // CompareSettings, FrameRenderer); the ray-traced reference, the G-buffer of `ao render` and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The request fields the job layer's errors name. An error marks them with field() (core/error.h),
 // so that its text says "BakeRequest::padding must be in [0, 1024] texels, got 2000" to a library
 // caller while the command line and the Python module each show their own name for the field

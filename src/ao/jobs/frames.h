@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One scene rendered frame after frame, as a viewer (or a script rendering many views) does: the
 // G-buffer of each camera, then a method on it, keeping what methods cache between frames (cone's
 // voxel grid, transfer's scratch images) and reusing the G-buffer's storage while nobody else holds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every job starts from: the scene (mesh files, a built-in scene, or one made in memory),
 // the camera (look-at and field of view, or the scene's own view, or auto-framing) and the falloff
 // (R in world units or as a fraction of the objects' size). The requests hold what the caller
@@ -75,6 +76,13 @@ struct CameraRequest {
   std::optional<int> width, height;     ///< Pixels, [1, kMaxImageSide]; unset: the camera file's, else the default.
   std::optional<std::filesystem::path> file;  ///< A camera JSON (io/camera_json.h), as ao view's S key writes.
   int default_width = 1280, default_height = 720;  ///< The job's own size when neither the caller nor a file gives one.
+
+  /// A request with nothing set and the job's own default size.
+  static CameraRequest sized(int width, int height) {
+    CameraRequest r;
+    r.default_width = width, r.default_height = height;
+    return r;
+  }
 
   /// InputError naming the option (--width, --fov, ...), its value and its valid range: the checks
   /// that need no scene, made before anything is loaded.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // AO at points the caller chooses: the ray-traced reference's estimator (reference/raytraced.h,
 // the obscurance integral of volumetric AO's eq. 2 with cosine-weighted Sobol directions) at
 // world-space points and normals, with the scene, falloff and seed of a render, and the standard

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A job stage's progress as text for people: on a terminal a bar redrawn in place, in a log (a
 // file, CI, a render farm: stderr not a terminal) a line every few seconds. Both give the fraction
 // of the work done, the time elapsed and the time left, estimated from work units (pixels, texels,

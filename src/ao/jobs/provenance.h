@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What made an output: ao's version and SIMD target, the job, its input files with their SHA-256,
 // and every setting of the request that can change the output. A job asked for it
 // (RenderOutputs::provenance, BakeOutputs::provenance; `--provenance` on the command line) writes

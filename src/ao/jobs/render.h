@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `ao render` as a library call: a scene (or a G-buffer) and a method in, the AO image, the
 // G-buffer, the method's other outputs and a summary out, and the files asked for written as one
 // transaction. The command line, the viewer and the Python module all render through here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // How a job talks to its caller while it runs: stages with progress, warnings, and lines for
 // people. The command line prints them to stderr, the viewer shows them, the Python module turns
 // warnings into Python warnings; a caller that wants none leaves the members empty. Lines may mark

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fitting a method's numeric parameters to its reference: coordinate descent on the mean RMSE over
 // a set of views (scenes and cameras), each judged against the method's matched reference, within
 // a time budget. The references are rendered once per view; each evaluation runs the method on
@@ -88,7 +89,7 @@ struct TuneRequest {
   nlohmann::json params = nlohmann::json::object();  ///< Overrides of the defaults: the starting point.
   double budget_s = 60;                            ///< Seconds, > 0.
   int spp_reference = 256;                         ///< Rays per pixel of the references, [1, 1048576].
-  CameraRequest camera{.default_width = 320, .default_height = 180};
+  CameraRequest camera = CameraRequest::sized(320, 180);
   FalloffRequest falloff;
   SurfaceNormal normal = SurfaceNormal::Shading;  ///< The G-buffer's N, for the method and its reference.
   std::uint32_t seed = 1;

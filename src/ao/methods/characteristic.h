@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Characteristic functions I(p) of volumetric-ambient-occlusion (VAO), fig. 2, and ambient
 // transfer (AT) sec. 4: I(p) = 1 when camera-space point p is in the OUTER region (where the
 // camera is) and 0 in the inner region. Every function here also gives the distance from p to

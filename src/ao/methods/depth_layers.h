@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The deep G-buffer option of the screen-space methods (Mara, McGuire, Nowrouzezahrai and Luebke,
 // "Deep G-Buffers for Stable Global Illumination Approximation", HPG 2016): a second depth layer,
 // the nearest surface at least a minimum separation behind the visible one, so that the space

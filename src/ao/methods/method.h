@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every method reads and returns, on the CPU and on the GPU: the interface between a method's
 // folder (methods/<name>/: its parameters, host code, kernel, shaders) and its callers (the
 // registry, which holds the one table of methods, and through it the jobs, the viewer and Python).

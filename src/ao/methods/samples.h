@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sample sets shared by the screen-space methods of volumetric-ambient-occlusion (VAO) and
 // ambient-transfer (AT):
 //  - Poisson-disk point sets obtained by Lloyd relaxation (AT sec. 4.1, citing Lloyd 1982), in the

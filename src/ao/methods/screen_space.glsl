@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the screen-space methods' shaders share (containment.comp, volumetric.comp, transfer.comp),
 // after common.glsl: their automatic depth-test bias, with the constants the CPU kernels read.
 #include "ao/methods/screen_space_shared.h"

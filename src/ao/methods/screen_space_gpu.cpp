@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the screen-space methods' GPU runs share: screen_space_gpu_internal.h.
 #include "ao/methods/screen_space_gpu_internal.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the screen-space methods' GPU runs share (containment_gpu.cpp, volumetric_gpu.cpp,
 // transfer_gpu.cpp), not installed: the uniforms of their sampling, containment's test offsets as
 // a buffer, and the filter after an interleaved pass.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of the screen-space methods (containment, volumetric, transfer), not installed: their
 // inputs in the form of their SIMD kernels (screen_space_kernel_internal.h), which take a
 // row's covered pixels as structure-of-arrays and runs the loops over samples across pixels.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The screen-space methods' row loader (screen_space_kernel_internal.h: load_covered_pixels),
 // compiled once per SIMD target: a row's covered pixels compacted into the lanes the containment,
 // volumetric and transfer kernels (each in its method's folder) run their samples across.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the kernels of the depth-buffer screen-space methods share (containment and volumetric AO:
 // Szirmay-Kalos et al., "Volumetric Ambient Occlusion for Real-Time Rendering and Games", eq. 5-7;
 // ambient transfer: Szirmay-Kalos et al., "Ambient Transfer", eq. 8-9 and sec. 4; each kernel in its

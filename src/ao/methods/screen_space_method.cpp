@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the runs of the screen-space methods share: screen_space_method_internal.h.
 #include "ao/methods/screen_space_method_internal.h"
 

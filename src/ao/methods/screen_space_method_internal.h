@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the runs of containment, volumetric and transfer share (their `run` overloads, method.h),
 // not installed: the characteristic function their parameters ask for, built in the G-buffer's
 // camera space from the depth buffer (with a second layer when asked) or from the scene's analytic

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the screen-space methods' CPU kernels (screen_space_kernel.cpp) and GPU shaders
 // (gpu/shaders/common.glsl: depth_bias) agree on, typed once for both compilers (core/shared.h).
 #ifndef AO_METHODS_SCREEN_SPACE_SHARED_H_

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the screen-space methods' kernels share (containment, volumetric and transfer: each
 // method's folder holds its kernel), included by each of their sources once per target (Highway's
 // "-inl.h" convention, as simd/vec_internal.h): the depth plane in vectors, a vector of a row's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The direct-light pass for scenes `ao` renders itself: a sun (directional light) with shadow
 // rays, giving the radiance Ld that ambient transfer's radiance mode reads at occluders (AT sec.
 // 4.1, the sentence after eq. 9; docs/methods/transfer.md) and that shading adds to a W La.

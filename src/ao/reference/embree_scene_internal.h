@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal: the Embree objects behind a RayScene, for the ray kernels of reference/, gbuffer/ and
 // bake/, and the one place a hit is mapped back to the scene (resolve). Not installed; programs
 // using the library never see an Embree type.

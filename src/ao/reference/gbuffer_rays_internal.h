@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal: where the ray-traced passes over a G-buffer (the ground truth, the sun) start their
 // rays from a pixel: its world position, its normal, the geometric normal of the triangle it lies
 // on, and the robust offset of ray_offset.h.

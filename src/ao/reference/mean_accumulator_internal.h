@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Running sums of one point's (pixel's, texel's) Monte Carlo samples: the mean and its standard
 // error, for the references' adaptive stopping and reports and for the bakers' texels. Internal
 // to the ray-tracing passes (namespace detail).

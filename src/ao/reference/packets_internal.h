@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Compile-time mapping from a packet width to Embree 3's packet types and calls, so kernels are
 // written once for 4-, 8- and 16-wide packets and pick the width the CPU supports at run time.
 #pragma once

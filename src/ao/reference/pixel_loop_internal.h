@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The per-pixel loop the ray-traced references share (tangent_sphere.cpp, transfer_reference.cpp):
 // every covered pixel of a G-buffer, in the tiles of ray_tiles_internal.h, with the ray setup of
 // gbuffer_rays_internal.h (the one raytraced.cpp uses).

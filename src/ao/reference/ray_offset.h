@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where a secondary ray starts: a surface point moved off its own triangle by a distance that
 // follows the float precision of the coordinates involved, so it works at any scene scale and at
 // any distance from the world origin (after Waechter & Binder, "A Fast and Robust Method for

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RayScene: a Scene built into a BVH for ray queries. Embree does the work, but no Embree type
 // appears here: kernels in reference/, gbuffer/ and bake/ reach the Embree scene through the
 // internal header ao/reference/embree_scene_internal.h, which is not part of the installed API.

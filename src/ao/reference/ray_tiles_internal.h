@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one tile loop of every Embree pass (the references, the sun pass, the G-buffer, the bakers):
 // the packet width chosen once for the scene, the image cut into tiles spread over TBB's threads,
 // flush-to-zero and denormals-are-zero on the thread that traces, and a fresh intersect context per

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ray-traced ground truth: the obscurance integral of volumetric AO's eq. 2,
 //   V(x) = (1/pi) * integral over the hemisphere about N of mu(D(w)) cos(theta) dw,
 // estimated per pixel by Monte Carlo with cosine-weighted directions (pdf cos(theta)/pi, which

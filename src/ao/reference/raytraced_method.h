@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ray-traced ground truth as a method of the registry (`ao render -m raytraced`): the
 // reference of a kind (reference.h) rendered with its ray settings.
 #pragma once

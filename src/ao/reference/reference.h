@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ray-traced references by kind: what `ao render -m raytraced -p reference=KIND` renders and
 // what `ao compare` judges each method against (the registry's MethodInfo::reference says which).
 //  - obscurance:     the obscurance integral of a membership (VAO eq. 2; raytraced.h);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ray-traced reference of volumetric AO (Szirmay-Kalos et al., "Volumetric Ambient Occlusion for
 // Real-Time Rendering and Games", VAO): the fraction of the tangent sphere S (radius R/2, centre
 // x + N R/2, eq. 6-7) that is visible from x, which is the quantity the method's V estimates.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ray-traced reference of ambient transfer (Umenhoffer, Toth, Szirmay-Kalos, "Efficient Methods for
 // Ambient Lighting", AT): the transfer function W of eq. 6,
 //

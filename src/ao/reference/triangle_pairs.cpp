@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Greedy pairing of a mesh's triangles into quads across shared edges (triangle_pairs_internal.h).
 #include "ao/reference/triangle_pairs_internal.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal: a triangle mesh as Embree quads, two triangles that share an edge per quad, for the
 // quad BVH a RayScene builds with BvhOptions::quads. Embree intersects a quad (v0, v1, v2, v3) as
 // the two triangles (v0, v1, v3) and (v2, v3, v1), and a quad whose last two indices are equal as

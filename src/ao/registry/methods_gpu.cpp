@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // run_gpu_method (methods_gpu.h): the method's GPU path, chosen by its parameter struct.
 #include "ao/registry/methods_gpu.h"
 

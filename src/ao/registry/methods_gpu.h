@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The methods on the GPU: each method's OpenGL compute shaders (in its folder, methods/<name>/;
 // installed to share/ao/shaders/; docs/gpu.md), run on a GpuGBuffer with the CPU methods' parameter
 // structs, sample sets and rotations, returning what run_method returns (registry.h) plus the GPU

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // run_gpu_method in a library built without the GPU backend (AO_GPU=OFF): there is no device to
 // run on (gpu/device_nogpu.cpp refuses to open one).
 #include "ao/gpu/nogpu_internal.h"

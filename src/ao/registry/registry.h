@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one table of AO methods. `ao render --method`, `ao compare`, `ao tune`, `ao view`, the
 // Python module and the parametrised tests are driven by it, so a new method is one folder
 // (methods/<name>/, with its parameter struct and its `run` overloads: methods/method.h) plus one

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Analytic descriptions of a scene's surfaces in world space, for the characteristic functions of
 // Szirmay-Kalos et al., "Volumetric Ambient Occlusion" (VAO), fig. 2: (a) an implicit surface made
 // of half-spaces and sphere exteriors, (b) a height field over a macrostructure plane. Built-in

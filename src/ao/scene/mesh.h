@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Indexed triangle meshes and scenes made of several of them.
 #pragma once
 

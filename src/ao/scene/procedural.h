@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Built-in scenes: the default demo and analytic test scenes with known AO, plus the shape
 // builders they are made of (also used by tests to build their own configurations).
 // World space is y-up. All shapes are triangle meshes with outward (or, for rooms, inward)

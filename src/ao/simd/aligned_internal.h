@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Storage the SIMD kernels (*_kernel.cpp) read and write: arrays on 64-byte boundaries, so that a
 // vector of any target is one aligned load, sized in whole vectors of the widest target.
 #pragma once

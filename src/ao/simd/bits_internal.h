@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the cone method's voxelizer on its bit columns (methods/voxelize.cpp), written once for
 // every SIMD target (bits.cpp): the prefix XOR that turns parity toggles into solid voxels
 // (Dalla Favera and Celes, sec. III-B: a voxel is inside when an odd number of surfaces lie in front

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the voxelizer's bit columns (bits_internal.h), compiled once per SIMD target: 64-bit
 // words in the lanes, the prefix XOR by six shifts (a word's bits are independent columns' voxels
 // only along its column, so the shifts stay inside a lane), popcount where the target has it as an

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The floating-point mode of the x86 SSE control register (MXCSR), the one place outside the SIMD
 // kernels' sources that speaks to the instruction set: every x86-64 CPU has it, so it needs no
 // dispatch.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of the G-buffer's depth plane (core/gbuffer.h: depth_plane), which every depth-reading
 // pass builds once from the positions and ids, written once for every SIMD target (depth.cpp).
 #pragma once

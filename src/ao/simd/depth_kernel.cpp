@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of the depth plane (depth_plane.h, depth_internal.h), compiled once per SIMD target: the
 // positions' z deinterleaved from their 12-byte records a vector at a time, the background replaced
 // by +infinity.

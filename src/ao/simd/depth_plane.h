@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The G-buffer's depth as one contiguous plane, built by a SIMD kernel (depth_kernel.cpp):
 // the form every kernel that gathers depths reads (the screen-space methods, their filters).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the sample points, written once for every SIMD target (sampling.cpp):
 //  - the scrambled Sobol points the bakers' rays are made from (sobol_owen_4d_batch below, over
 //    core/sampling.h's sobol_reversed_4d_batch): Owen scrambling in bit-reversed order (Laine and

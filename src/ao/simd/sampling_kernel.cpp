@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the sample points (sampling_internal.h), compiled once per SIMD target: the hash and
 // the bit reversal of core/sampling.cpp, lane-wise over the 16 points of a batch; and the
 // reference's cosine-weighted directions, lane-wise over a packet's samples.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Streaming (non-temporal) copies, for data written once and read later by another pass (the
 // G-buffer's channels): the stores skip reading every destination cache line into the cache before
 // overwriting it, half the memory traffic of plain stores. 16-byte SSE2 stores, which every x86-64

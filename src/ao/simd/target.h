@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The SIMD kernels' instruction sets (the *_kernel.cpp files: simd/ and each owner's folder): every kernel is compiled
 // once per x86-64 target (Highway's: AVX3_DL (Ice Lake, Zen 4) and AVX3 (Skylake-X), the AVX-512
 // variants; AVX2 (Haswell, Zen); SSE4 (with AES and CLMUL: Westmere); SSSE3 (Core 2, Nehalem); the

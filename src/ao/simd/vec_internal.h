@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The kernel layer's vector vocabulary, included by each kernel source once per target (Highway's
 // "-inl.h" convention: the guard flips with HWY_TARGET_TOGGLE so every target gets its own copy).
 // Kernels speak in these terms: a vector of floats across pixels (or prisms, or taps), its lane

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A library built without the GPU backend (AO_GPU=OFF) keeps its API and says so when asked for a
 // device (the rest of tests/gpu/ needs the backend).
 #include <gtest/gtest.h>

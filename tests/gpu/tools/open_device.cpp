@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Opens a GPU device and says what happened: run by GpuDevice.NoUsableGlIsAOneLineSystemError
 // (tests/gpu/device_test.cpp) in an environment without a usable GL, as a process of its own
 // (the test binary's own EGL state is set up by then). Prints "opened RENDERER" or

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared by the GPU backend's compute shaders (each method's, in its folder): the G-buffer's bindings
 // and conventions, the integer hashes of src/ao/core/sampling.h, and small helpers every method uses.
 // A shader that includes this file (`#include "common.glsl"`, expanded by the loader in

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // G-buffer rasterization, fragment stage: one G-buffer texel per pixel centre, the nearest
 // surface winning by depth (the depth buffer holds u_clip.z / depth, written here exactly from the
 // fragment's own depth, so that the test compares the same depths the G-buffer stores).

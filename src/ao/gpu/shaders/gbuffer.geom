@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // G-buffer rasterization, geometry stage: the per-triangle values the fragment stage needs, as
 // render_gbuffer's CameraTriangle holds them. The unit geometric normal is taken in world space,
 // as wound (counter-clockwise seen from the front), then turned into camera space; the plane of the

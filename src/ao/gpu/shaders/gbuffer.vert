@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // G-buffer rasterization, vertex stage (src/ao/gpu/gbuffer.cpp draws one object of the scene per
 // call). Conventions of docs/gbuffer.md and gbuffer/render_gbuffer.cpp: world -> camera space is
 // q = basis^T (p - eye) (Camera::world_to_camera_point), camera space right-handed looking down -z.

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // The linear depth plane of an uploaded G-buffer (core/gbuffer.h GBuffer::depth): -P.z where
 // covered, +infinity where not. Every method's depth lookups read this plane.
 #include "common.glsl"

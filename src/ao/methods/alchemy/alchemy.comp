@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Alchemy screen-space ambient obscurance, one invocation per pixel. Based on McGuire, Osman,
 // Bukowski, Hennessy, "The Alchemy Screen-Space Ambient Obscurance Algorithm" (HPG 2011), eq. 10
 // (the CPU kernel: src/ao/methods/alchemy/alchemy.cpp):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Alchemy screen-space ambient obscurance, based on McGuire, Osman, Bukowski, Hennessy, "The Alchemy
 // Screen-Space Ambient Obscurance Algorithm" (HPG 2011). Implements eq. 10,
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Alchemy AO on the GPU (alchemy.comp), then the separable cross-bilateral filter
 // (filters_gpu.cpp). The sample pattern is the CPU's:
 // alchemy_internal.h's rotation table and golden-angle directions are uploaded, the per-pixel

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Alchemy's GPU path (alchemy_gpu.cpp: alchemy.comp, then the bilateral filter), not installed: what the registry's
 // run_gpu_method calls for its parameters (methods/method.h).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of Alchemy AO, not installed: its sample pattern (alchemy.cpp), shared with the GPU
 // backend (src/ao/methods/alchemy/alchemy_gpu.cpp), which uploads these tables so that both sample the same points.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of Alchemy AO's estimator, eq. 10 (alchemy_internal.h; methods/alchemy.cpp for the method
 // and its constants), compiled once per SIMD target: a vector of a row's pixels runs all s samples
 // with its sums in registers, one depth gather per sample. Multiply-adds are written out (MulAdd);

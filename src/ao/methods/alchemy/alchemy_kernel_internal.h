@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of Alchemy AO's estimator (McGuire, Osman, Bukowski, Hennessy, "The Alchemy Screen-Space
 // Ambient Obscurance Algorithm", HPG 2011, eq. 10), written once for every SIMD target
 // (alchemy.cpp). methods/alchemy.cpp turns the paper's constants into world units and builds the

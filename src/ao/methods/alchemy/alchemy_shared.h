@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What Alchemy AO's CPU kernel (alchemy_kernel.cpp) and GPU shader (alchemy.comp) agree on, typed
 // once for both compilers (core/shared.h), so both place the same samples.
 #ifndef AO_METHODS_ALCHEMY_ALCHEMY_SHARED_H_

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone traced AO (Dalla Favera & Celes 2012, sec. III-C). See cone.h for the convention
 // (we return V = 1 - the paper's blocked fraction) and voxelize.h for the grid.
 #include "ao/methods/cone/cone.h"

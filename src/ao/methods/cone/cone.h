@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone traced ambient occlusion, based on E. C. Dalla Favera and W. Celes, "Ambient
 // occlusion using cone tracing with scene voxelization", SIBGRAPI 2012.
 //

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // The voxel grid's statistics after cone_voxelize.frag (VoxelStats): solid voxels, and columns
 // whose parity ends odd (their last voxel is set: the geometry is not closed there).
 //

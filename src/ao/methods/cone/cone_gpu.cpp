@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone tracing on the GPU (Dalla Favera & Celes 2012): the world voxel grid built by
 // rasterization, each fragment XOR-ing its depth-slab mask into its column
 // (cone_voxelize.vert, .geom, .frag; statistics: cone_count.comp), the cones of spheres and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Cone's GPU path (cone_gpu.cpp: cone_voxelize.*, cone_count.comp, cone_trace.comp, then the bilateral filter), not installed: what the registry's
 // run_gpu_method calls for its parameters (methods/method.h).
 #pragma once

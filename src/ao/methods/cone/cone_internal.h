@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of the cone method's kernel shared by its two grids (cone.cpp: the eye grid and the
 // parameters; cone_world.cpp: the world grid), not installed.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of voxel cone traced AO on the world grid (cone_internal.h; methods/cone_world.cpp for the
 // tables, docs/methods/cone.md for the method and its speed), compiled once per SIMD target. Per
 // pixel: the prism pattern turned and the cones' axes taken into the grid (vectors over prisms and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of voxel cone traced AO on the world grid (Dalla Favera and Celes, "Ambient occlusion
 // using cone tracing with scene voxelization", SIBGRAPI 2012, sec. III-C), written once for every
 // SIMD target (cone.cpp). methods/cone_world.cpp derives what it reads from the paper: the prisms of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cone method's sampling pattern: see cone_pattern_internal.h.
 #include "ao/methods/cone/cone_pattern_internal.h"
 

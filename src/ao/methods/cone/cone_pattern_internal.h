@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of the cone method, not installed: its sampling pattern (the tabulated per-pixel
 // jitter and the prisms' points on the great disk), built once per call or per prism count.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What cone tracing's CPU kernel (cone_kernel.cpp, cone.cpp) and GPU shader (cone_trace.comp) agree
 // on, typed once for both compilers (core/shared.h).
 #ifndef AO_METHODS_CONE_CONE_SHARED_H_

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which side of each open mesh a pixel's point lies on (cone_sides_internal.h).
 #include "ao/methods/cone/cone_sides_internal.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which side of each open mesh a pixel's point lies on, for the cone method's open-surface
 // voxelization (voxelize.h: a sheet stands for a slab on its far side from the point; a solid with
 // holes seen from inside, for a slab outside its shell). Not installed.

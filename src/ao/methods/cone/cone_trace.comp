@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone traced ambient occlusion on the world grid, one invocation per pixel. Based on E. C.
 // Dalla Favera and W. Celes, "Ambient occlusion using cone tracing with scene voxelization",
 // SIBGRAPI 2012, sec. III-C (the CPU kernel, with the same tables: src/ao/methods/cone/cone_world.cpp).

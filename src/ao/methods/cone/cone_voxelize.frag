@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Solid voxelization by parity, fragment stage (see cone_voxelize.vert and .geom): one fragment per
 // column centre (i + 0.5, j + 0.5) of the triangle's grown box. A centre inside the triangle (the
 // CPU's edge functions and tie rule: E > 0, or E = 0 on an edge whose normal points right, or

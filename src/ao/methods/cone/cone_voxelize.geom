@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Solid voxelization by parity, geometry stage (see cone_voxelize.vert). Every triangle, front and
 // back faces alike (sec. III-B), is drawn as the box of columns its bounding box covers, grown by
 // one column: the fragment stage then decides coverage itself, at each column centre, with the

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Solid voxelization by parity, vertex stage (then cone_voxelize.geom, .frag). Based on Eisemann & Decoret, "Single-pass GPU solid
 // voxelization for real-time applications" (GI 2008), as used by Dalla Favera & Celes, "Ambient
 // occlusion using cone tracing with scene voxelization" (SIBGRAPI 2012), sec. III-B; the CPU

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Voxel cone traced AO on the world grid (Dalla Favera & Celes 2012, sec. III-C): the quantities
 // of the paper the kernel (simd::trace_cones, src/ao/methods/cone/cone_kernel.cpp) runs with for every pixel. See
 // cone.h for the convention (V = 1 - the paper's blocked fraction), docs/methods/cone.md (Speed)

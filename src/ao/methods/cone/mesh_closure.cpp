@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What each mesh stands for (mesh_closure.h): its boundary edges and holes, and for an open mesh
 // its enclosure by its generalized winding number (Jacobson, Kavan, Sorkine-Hornung, SIGGRAPH
 // 2013; winding_number.h); and the closed meshes around the camera (rooms).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What each mesh of a scene stands for in the cone method's voxelization (voxelize.h): closed
 // (parity), a solid with holes or a sheet, decided from its boundary edges and its generalized
 // winding number (Jacobson, Kavan, Sorkine-Hornung, "Robust inside-outside segmentation using

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The voxelizer's raster stage (raster_internal.h), compiled once per SIMD target. The loops are
 // scalar (one column centre at a time: the tests decide which of two triangles sharing an edge owns
 // a centre on it); each target compiles them with its own instructions, none of them fused

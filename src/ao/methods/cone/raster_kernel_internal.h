@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The voxelizer's raster stage (methods/voxelize.cpp, step 2), compiled once per SIMD target
 // (raster.cpp): its scalar edge tests and depth arithmetic are the voxelizer's hottest loop, and a
 // build for baseline x86-64 would otherwise run them without the FMA and three-operand AVX

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The voxel grid's column scan and coarse occupancy (voxel_grid_internal.h): the last stages of
 // the parity voxelization (Eisemann & Decoret 2008; Dalla Favera & Celes 2012, sec. III-B) and the
 // empty-space skipping masks the cone tracer reads (voxelize.h).

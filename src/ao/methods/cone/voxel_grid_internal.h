@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The last stages of the voxelizer on a grid whose column bits hold the fragments' toggles
 // (voxelize.cpp), and its coarse occupancy for empty-space skipping (voxelize.h). Not installed.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The voxelizer's triangles in grid space and what their rasterisation writes besides the grid's
 // bits, shared by the voxelizer (voxelize.cpp: projection, bands; winding_solid_internal.h: the
 // winding number's walk) and its raster kernel (raster_kernel.cpp), not installed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Solid parity voxelization (Eisemann & Decoret 2008; Dalla Favera & Celes 2012, sec. III-B).
 // See voxelize.h for the grid layout. The CPU pipeline:
 //  1. every triangle is mapped to the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Solid binary voxelization by parity, after Eisemann & Decoret ("Single-pass GPU solid
 // voxelization for real-time applications", GI 2008), as used by Dalla Favera & Celes, "Ambient
 // occlusion using cone tracing with scene voxelization" (SIBGRAPI 2012), sec. III-B.
@@ -132,7 +133,7 @@ struct VoxelGrid {
   static constexpr int kBlock = 8;
   int bnx = 0, bny = 0;
   std::vector<std::uint64_t> block_bits;
-  const std::uint64_t* block(int bi, int bj) const { return block_bits.data() + (static_cast<std::size_t>(bj) * bnx + bi) * words; }
+  const std::uint64_t* block(int bi, int bj) const { return block_bits.data() + (static_cast<std::size_t>(bj) * static_cast<std::size_t>(bnx) + static_cast<std::size_t>(bi)) * static_cast<std::size_t>(words); }
 
   // Windowed coarse occupancy for O(1) empty-space skipping. Cells are kCellXY x kCellXY columns x
   // cell_bits voxels (cell_bits: the smallest power of two that gives at most 64 cells per column).
@@ -147,10 +148,10 @@ struct VoxelGrid {
   int dnx = 0, dny = 0;
   int cell_bits = 0, cell_shift = 0;  ///< cell_bits = 1 << cell_shift.
   std::vector<std::uint64_t> window;
-  std::uint64_t window_mask(int w, int ci, int cj) const { return window[(static_cast<std::size_t>(cj) * dnx + ci) * (kWindowCap + 1) + w]; }
+  std::uint64_t window_mask(int w, int ci, int cj) const { return window[(static_cast<std::size_t>(cj) * static_cast<std::size_t>(dnx) + static_cast<std::size_t>(ci)) * (kWindowCap + 1) + static_cast<std::size_t>(w)]; }
 
   /// Words of column (i, j), which must be inside the grid.
-  const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * nx + i) * words; }
+  const std::uint64_t* column(int i, int j) const { return bits.data() + (static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)) * static_cast<std::size_t>(words); }
   /// Bit k of column (i, j).
   bool voxel(int i, int j, int k) const { return (column(i, j)[k >> 6] >> (k & 63)) & 1u; }
   /// Set voxels in the whole grid.

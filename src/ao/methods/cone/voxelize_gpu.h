@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The cone method's voxel grid built on the GPU as Dalla Favera & Celes (SIBGRAPI 2012, sec.
 // III-B) build it after Eisemann & Decoret (GI 2008): every triangle rasterized into the grid's
 // columns, each fragment XOR-ing the depth-slab mask of the voxels beyond it into the column's bits

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Generalized winding numbers (Jacobson et al. 2013), fast by Barill et al. 2018; see
 // winding_number.h.
 #include "ao/methods/cone/winding_number.h"

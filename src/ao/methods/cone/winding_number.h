@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Generalized winding numbers of triangle meshes, based on A. Jacobson, L. Kavan and
 // O. Sorkine-Hornung, "Robust inside-outside segmentation using generalized winding numbers"
 // (SIGGRAPH 2013), evaluated with the hierarchy of G. Barill, N. Dickson, R. Schmidt, D. Levin and

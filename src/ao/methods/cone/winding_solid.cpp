@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The winding-number solid of a mesh with holes (winding_solid_internal.h): each hole's centroid,
 // flatness and the triangles near its rim, and the winding number of the fans that close the
 // holes (Jacobson, Kavan, Sorkine-Hornung 2013; voxelize.h, voxelize_world).

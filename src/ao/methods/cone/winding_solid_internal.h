@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The winding-number solid of a mesh with holes, for the voxelizer (voxelize.cpp; voxelize.h,
 // voxelize_world): parity closes each hole by a fan, and next to a fan that is not flat the solid
 // w > 1/2 (Jacobson, Kavan, Sorkine-Hornung, SIGGRAPH 2013) is found by walking the columns from

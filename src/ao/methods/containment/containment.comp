@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Containment-test ambient occlusion, one invocation per pixel. Based on Szirmay-Kalos, Umenhoffer,
 // Toth, Szecsi, Sbert, "Volumetric Ambient Occlusion for Real-Time Rendering and Games" (VAO),
 // eq. 4-5, with the samples of Umenhoffer, Toth, Szirmay-Kalos, "Efficient Methods for Ambient

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Containment-test ambient occlusion. Based on Szirmay-Kalos, Umenhoffer, Toth, Szecsi, Sbert,
 // "Volumetric Ambient Occlusion for Real-Time Rendering and Games" (VAO), eq. 4-5, with the
 // samples of Umenhoffer, Toth, Szirmay-Kalos, "Efficient Methods for Ambient Lighting" (AT),

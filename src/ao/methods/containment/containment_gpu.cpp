@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Containment AO on the GPU (containment.comp): the CPU kernel's test offsets
 // (make_containment_samples) and 4x4 rotations (interleave_rotations) as uploaded tables, so both
 // backends sample the same points; then the 4x4 depth-aware box filter (filters_gpu.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Containment's GPU path (containment_gpu.cpp: containment.comp), not installed: what the registry's
 // run_gpu_method calls for its parameters (methods/method.h).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Containment AO's kernel (VAO eq. 5, AT sec. 4 with m tests per ray; screen_space_kernel_internal.h
 // states what it computes), compiled once per SIMD target. Lanes are a row's covered pixels; a
 // vector of pixels keeps its counts in registers through all of its samples, so the gathers of

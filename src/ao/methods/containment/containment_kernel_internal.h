@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Containment AO's kernel (containment_kernel.cpp), compiled once per SIMD target; containment.cpp
 // derives its samples from the papers and hands them over.
 #pragma once

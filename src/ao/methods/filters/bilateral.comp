@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // One 1-D pass of the separable cross-bilateral filter, one invocation per pixel. Based on McGuire,
 // Osman, Bukowski, Hennessy, "The Alchemy Screen-Space Ambient Obscurance Algorithm" (HPG 2011),
 // sec. 2 (Listing 1, pass 5) and Figure 6: "two 13-tap 1D cross-bilateral filter passes" over the

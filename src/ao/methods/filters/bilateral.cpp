@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "ao/methods/filters/bilateral.h"
 
 #include <algorithm>

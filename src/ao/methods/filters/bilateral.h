@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Separable cross-bilateral filter, based on McGuire, Osman, Bukowski, Hennessy, "The Alchemy
 // Screen-Space Ambient Obscurance Algorithm" (HPG 2011), sec. 2 (Listing 1, pass 5) and Figure 6:
 // "two 13-tap 1D cross-bilateral filter passes" over the obscurance buffer, weighted by camera-space

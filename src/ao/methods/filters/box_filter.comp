@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // The depth-aware 4x4 box filter after an interleaved pass, one invocation per pixel (VAO and AT
 // sec. 4.2, interleaved sampling after Keller and Heidrich 2001; the CPU filter:
 // src/ao/methods/filters/interleave.cpp). Neighbours at offsets -2..+1 in x and y hold each of the 16

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The filters of the methods on the GPU: the 4x4 depth-aware box filter of interleaved sampling
 // (box_filter.comp; VAO and AT sec. 4.2) after containment, volumetric and transfer, and the
 // separable cross-bilateral filter (bilateral.comp; Alchemy AO sec. 3.3) after Alchemy and cone

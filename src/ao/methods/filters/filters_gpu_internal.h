@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The methods' filters on the GPU (filters_gpu.cpp), not installed: the 4x4 depth-aware box filter
 // of interleaved sampling and the separable cross-bilateral filter, as their CPU versions compute them.
 #pragma once

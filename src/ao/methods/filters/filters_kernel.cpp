@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the 4x4 depth-aware box filter and the cross-bilateral filter (filters_internal.h
 // states what they compute), compiled once per SIMD target. The box filter only adds and divides,
 // so every target gives the same bits; the bilateral filter's multiply-adds are written out

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernels of the two denoising filters, written once for every SIMD target (filters.cpp):
 //  - the 4x4 depth-aware box filter of interleaved sampling (Keller and Heidrich 2001, as
 //    volumetric AO and ambient transfer use it in their sec. 4.2; methods/interleave.h), and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Interleaved sampling (Keller and Heidrich 2001) as volumetric-ambient-occlusion (VAO) and
 // ambient transfer (AT) use it, both in their sec. 4.2: the pixels of a 4x4 pattern use 16
 // rotations of one sample set about the surface normal (VAO: about the view axis for the pipes'

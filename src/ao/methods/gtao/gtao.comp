@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Ground-truth-based ambient occlusion (GTAO), one invocation per pixel. Based on Jimenez, Wu,
 // Pesce, Jarabo, "Practical Realtime Strategies for Accurate Indirect Occlusion" (Activision tech.
 // memo ATVI-TR-16-01, SIGGRAPH 2016 course); the CPU kernel, with the same steps and tables:

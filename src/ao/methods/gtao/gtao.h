@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ground-truth-based ambient occlusion (GTAO). Based on Jimenez, Wu, Pesce, Jarabo, "Practical
 // Realtime Strategies for Accurate Indirect Occlusion" (Activision tech. memo ATVI-TR-16-01,
 // SIGGRAPH 2016 course). The paper is not in the project's papers folder; its equations are cited

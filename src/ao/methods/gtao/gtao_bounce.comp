@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // GTAO's multi-bounce approximation (Jimenez et al. 2016, "Multi-bounce approximation": a cubic
 // fitted to path-traced references), per pixel on the filtered visibility V with the G-buffer's
 // albedo rho (gtao_shared.h: multi_bounce_fit, which the CPU's gtao_multi_bounce calls too):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GTAO on the GPU (gtao.comp), its 4x4 denoiser (filters_gpu.cpp: box_filter.comp) and its
 // multi-bounce fit (shaders/gtao_bounce.comp). The slice directions and step fractions are the CPU
 // kernel's tables (gtao_internal.h), uploaded.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // GTAO's GPU path (gtao_gpu.cpp: gtao.comp, gtao_bounce.comp), not installed: what the registry's
 // run_gpu_method calls for its parameters (methods/method.h).
 #pragma once

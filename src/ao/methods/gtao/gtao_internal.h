@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of GTAO, not installed: its per-pixel sampling tables (gtao.cpp), shared with the GPU
 // backend (src/ao/methods/gtao/gtao_gpu.cpp), which uploads them so that both sample the same slices and steps.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of GTAO (gtao_internal.h; methods/gtao.cpp for the method, its parameters and deviations),
 // compiled once per SIMD target: a vector of a row's covered pixels runs every slice, both sides'
 // horizon searches and the inner integral with its values in registers. Multiply-adds are written

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel of GTAO (Jimenez, Wu, Pesce, Jarabo, "Practical Realtime Strategies for Accurate Indirect
 // Occlusion", 2016: the horizon search in screen-space slices and the cosine-weighted inner
 // integral of its eq. 10), written once for every SIMD target (gtao.cpp). methods/gtao.cpp derives

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What GTAO's CPU kernel (gtao_kernel.cpp, gtao.cpp) and GPU shaders (gtao.comp, gtao_bounce.comp)
 // agree on, typed once for both compilers (core/shared.h).
 #ifndef AO_METHODS_GTAO_GTAO_SHARED_H_

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer, one invocation per pixel. Based on Umenhoffer, Toth, Szirmay-Kalos, "Efficient
 // Methods for Ambient Lighting" (AT), eq. 6, 7 and 9 (the CPU kernel: src/ao/methods/transfer/transfer.cpp):
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer (Szirmay-Kalos, Antal, Csonka, "Ambient Transfer: Efficient Methods for Ambient
 // Lighting"): W of eq. 6 estimated by eq. 9 from containment tests (sec. 4) of cosine-distributed
 // rays r = mu^-1(xi) (eq. 8), a~ read at the nearest occluded test point's pixel, with interleaved

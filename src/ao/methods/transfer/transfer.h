@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer. Based on Umenhoffer, Toth, Szirmay-Kalos, "Efficient Methods for Ambient
 // Lighting" (AT), eq. 6, 7 and 9:
 //

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer's scalar visibility (src/ao/methods/transfer/transfer.h): the Rec. 709 luminance of W,
 // 0.2126 W_r + 0.7152 W_g + 0.0722 W_b (color_shared.h), from transfer.comp's (W, O) after the filter.
 //

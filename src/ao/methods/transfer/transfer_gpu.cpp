@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer on the GPU (transfer.comp, then transfer_finish.comp for W's luminance): the
 // CPU kernel's test offsets and 4x4 rotations as uploaded tables; sec. 4.2's box filter on W and O
 // alike (filters_gpu.cpp).

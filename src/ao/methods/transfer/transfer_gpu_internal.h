@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Transfer's GPU path (transfer_gpu.cpp: transfer.comp, transfer_finish.comp), not installed: what the registry's
 // run_gpu_method calls for its parameters (methods/method.h).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internals of ambient transfer, not installed: the scratch buffers a caller that renders every
 // frame (the benchmark, a viewer) keeps between calls, and the overloads that use them.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer's kernels (AT eq. 6, 8-9 and sec. 4 on the depth buffer; transfer_kernel_internal.h
 // states what they compute), compiled once per SIMD target: the rays' nearest occluders and eq. 9's
 // sums across a row's covered pixels, and the last pass that interleaves the filtered planes.

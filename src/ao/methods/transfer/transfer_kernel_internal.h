@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ambient transfer's kernels (transfer_kernel.cpp), compiled once per SIMD target; transfer.cpp
 // derives its samples and inputs from the paper and hands them over.
 #pragma once

@@ -1,4 +1,5 @@
 #version 430
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric ambient occlusion, one invocation per pixel. Based on Szirmay-Kalos, Umenhoffer,
 // Toth, Szecsi, Sbert, "Volumetric Ambient Occlusion for Real-Time Rendering and Games" (VAO),
 // eq. 6-7 (the CPU kernel: src/ao/methods/volumetric/volumetric.cpp):

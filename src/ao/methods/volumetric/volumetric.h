@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric ambient occlusion. Based on Szirmay-Kalos, Umenhoffer, Toth, Szecsi, Sbert,
 // "Volumetric Ambient Occlusion for Real-Time Rendering and Games" (VAO), eq. 6-7:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric AO on the GPU (volumetric.comp): the CPU kernel's disk samples (make_disk_samples)
 // and 4x4 rotations as uploaded tables, eq. 7's normaliser from the same points; then the 4x4
 // depth-aware box filter (filters_gpu.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric's GPU path (volumetric_gpu.cpp: volumetric.comp), not installed: what the registry's
 // run_gpu_method calls for its parameters (methods/method.h).
 #pragma once

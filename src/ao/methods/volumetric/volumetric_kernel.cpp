@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric AO's kernel: the free lengths of the tangent sphere's pipes (VAO eq. 6-7, fig. 4 and
 // 7; screen_space_kernel_internal.h states what it computes), compiled once per SIMD target. Lanes
 // are a row's covered pixels; multiply-adds are written out (MulAdd) in the order the scalar reading

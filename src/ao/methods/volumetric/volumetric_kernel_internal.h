@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Volumetric AO's kernel (volumetric_kernel.cpp), compiled once per SIMD target; volumetric.cpp
 // derives its disk samples from the paper and hands them over.
 #pragma once

@@ -96,6 +96,16 @@ TEST(BakeFamily, RelativeDistanceIsAFractionOfTheBakedMeshesDiagonal) {
   const BakeResult a = bake(s, relative), b = bake(s, linear(std::sqrt(2.0f)));
   for (std::size_t i = 0; i < a.visibility.size(); ++i) ASSERT_EQ(a.visibility[i], b.visibility[i]) << "texel " << i;
   EXPECT_LT(mean_covered(a), 0.99);  // the ceiling is within reach
+  // Per-vertex AO of meshes without UVs: a fraction of every mesh's diagonal (here the ceiling's box and a
+  // floor quad: from (-20, 0, -20) to (20, 1.2, 20)).
+  const Scene bare = scene_of({make_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}), make_box({-20, 1, -20}, {20, 1.2f, 20})});
+  const RayScene bare_rays(bare);
+  RaytracedBakeParams per_vertex = relative;
+  per_vertex.max_distance = 0.05f;
+  const std::vector<float> rel = bake_vertices_raytraced(bare_rays, per_vertex);
+  const std::vector<float> abs = bake_vertices_raytraced(bare_rays, linear(0.05f * length(Vec3{40, 1.2f, 40})));
+  ASSERT_EQ(rel, abs);
+  EXPECT_LT(rel[0], 0.99f);  // the ceiling at 1 is within 0.05 x 56.6
   RaytracedBakeParams no_distance;
   no_distance.relative_distance = true;
   EXPECT_THROW(no_distance.validate(), InputError);

@@ -184,7 +184,7 @@ Bounds3 baked_bounds(const Scene& scene) {
   Bounds3 b;
   for (const Mesh& m : scene.meshes)
     if (!m.uvs.empty()) b.extend(m.bounds());
-  return b;
+  return b.empty() ? scene.bounds() : b;  // no UVs: a per-vertex bake bakes every mesh
 }
 
 Falloff RaytracedBakeParams::falloff() const {

@@ -42,7 +42,8 @@ struct RaytracedBakeParams {
   /// what lies straight ahead (Substance's and Marmoset's "spread angle").
   float spread_angle = 180.0f;
   /// max_distance is a fraction of the diagonal of the baked meshes' bounding box (the meshes with
-  /// UVs; occluders and the floor excluded), so one setting suits models of any scale. [Needs max_distance.]
+  /// UVs, or every mesh of a per-vertex bake of meshes without; occluders and the floor excluded), so
+  /// one setting suits models of any scale. [Needs max_distance.]
   bool relative_distance = false;
   /// Outside (default): the hemisphere above the surface, AO. Inside: the one below it, rays into
   /// the mesh from points pushed in along the face normal, back faces hit like any other (the
@@ -92,7 +93,8 @@ inline BvhOptions bake_bvh_options(std::size_t triangles) {
   return o;
 }
 
-/// The bounding box of `scene`'s meshes with UVs: the meshes a bake bakes (occluders have none).
+/// The bounding box of `scene`'s meshes with UVs: the meshes a bake bakes (occluders have none);
+/// of every mesh when none has UVs (a per-vertex bake).
 Bounds3 baked_bounds(const Scene& scene);
 
 /// V per covered texel, the area-weighted mean of the obscurance integral over the texel's patch

@@ -113,8 +113,9 @@ inline Vec2 narrow_to_cone(Vec2 u, float radius) { return {0.5f + (u.x - 0.5f) *
 /// The same for lanes 0 .. count - 1 of dimensions 0-1 of u (dimensions 2-3 copied).
 inline void narrow_to_cone(const float (&u)[4][16], int count, float radius, float (&out)[4][16]) {
   for (int k = 0; k < count; ++k) {
-    out[0][k] = 0.5f + (u[0][k] - 0.5f) * radius;
-    out[1][k] = 0.5f + (u[1][k] - 0.5f) * radius;
+    const Vec2 c = narrow_to_cone(Vec2{u[0][k], u[1][k]}, radius);
+    out[0][k] = c.x;
+    out[1][k] = c.y;
     out[2][k] = u[2][k];
     out[3][k] = u[3][k];
   }

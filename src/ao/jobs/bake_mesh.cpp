@@ -390,7 +390,6 @@ MeshBake bake_and_write(MeshJob& job, const MeshOutputs& outs, OutputSet* output
   if (udim) bake_udim_tiles(job, outs.map, *outputs);
   else if (plan.wants_map()) out.map = bake_map(job, outs.map);
   if (!plan.r.outputs.per_vertex.empty()) out.vertex_ao = bake_vertex_ao(job);
-  out.thickness = job.thickness, out.cavity = job.cavity;
   if (!plan.writes_map_file() || udim) job.summary.erase("output");  // UDIM tiles were written above
   if (outputs) {
     if (plan.wants_map() && !udim) write_map_outputs(job, out.map, outs, out.vertex_ao, *outputs);
@@ -407,6 +406,7 @@ MeshBake bake_and_write(MeshJob& job, const MeshOutputs& outs, OutputSet* output
   }
   job.timings["write_ms"] = job.clock.lap_ms();
   job.summary["timings"] = job.timings;
+  out.thickness = std::move(job.thickness), out.cavity = std::move(job.cavity);  // written above from the job's
   out.summary = std::move(job.summary);
   return out;
 }

@@ -87,11 +87,11 @@ void add_view_command(CLI::App& app, const GlobalOptions& global, std::function<
   cmd->add_option("--ao-map", o->ao_map, "A baked AO map to show on the mesh (view 'map')");
   cmd->add_option("--set", o->sets,
                   "A viewer setting or method parameter as key=value before the first frame: method, view (ao, shaded, transfer, map, error), "
-                  "wipe (0-1), scale (1, 2, 4), device (cpu, gpu), seed, threads, radius, radius_fraction, membership, up (y, z), panel, hud (on, off), "
-                  "or any -p key");
+                  "wipe (0-1), scale (1, 2, 4), device (cpu, gpu), seed, threads, radius, radius_fraction, membership, up (y, z), "
+                  "panel (open, collapsed, off), hud (on, off), reference (on, off: with --benchmark), or any -p key");
   cmd->add_option("--event", o->events, "Scripted input FRAME:KIND:ARGS, repeatable: orbit:dx,dy  pan:dx,dy  zoom:steps  key:K  set:key=value");
   cmd->add_option("--frames", o->frames, "Render this many frames and exit (scripts, tests, benchmarks)")->check(CLI::Range(0, 1000000));
-  cmd->add_option("--wait-reference", o->wait_reference, "With --frames: go on until the reference has this many rays per pixel")
+  cmd->add_option("--wait-reference", o->wait_reference, "With --frames: go on until the reference has this many rays per pixel (with --benchmark, only if --set reference=on)")
       ->check(CLI::Range(0, 4096));
   cmd->add_flag("--benchmark", o->benchmark, "With --frames: recompute the G-buffer and the method every frame, as a moving camera does");
   cmd->add_option("--screenshot", o->screenshot, "With --frames: write the last frame as PNG");

@@ -3,6 +3,8 @@
 
 #include <imgui.h>
 
+#include <algorithm>
+
 namespace ao::view {
 
 namespace {
@@ -72,6 +74,16 @@ void draw_hud(const StageStats& stats, const ViewerReadout& readout) {
     ImGui::Text("GPU %s", readout.gl_renderer.c_str());
     for (const GpuPassTime& p : readout.gpu_passes) ImGui::Text("  %-11s %6.2f ms", p.name.c_str(), p.ms);
   }
+  ImGui::End();
+}
+
+void draw_notice(const std::string& text, float left) {
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(0.5f * (left + size.x), 0.5f * size.y), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(ImVec2(std::min(420.0f, 0.9f * (size.x - left)), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.75f);
+  ImGui::Begin("notice", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoSavedSettings);
+  ImGui::TextWrapped("%s", text.c_str());
   ImGui::End();
 }
 

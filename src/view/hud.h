@@ -54,10 +54,15 @@ struct ViewerReadout {
   int width = 0, height = 0;  ///< Of the computed image.
   std::string gl_renderer;    ///< The GPU backend's renderer when the method ran on it; empty on the CPU.
   std::vector<GpuPassTime> gpu_passes;  ///< Its passes in the last run, in the order they ran.
+  bool benchmark = false;     ///< --benchmark: the method is recomputed every frame.
 };
 
 /// The HUD (top right): frames per second, each stage's ms, the reference's rays per pixel and
 /// standard error, and the method's RMSE against it; on the GPU the renderer and each pass's GPU ms.
 void draw_hud(const StageStats& stats, const ViewerReadout& readout);
+
+/// A message in the middle of the image, which starts `left` pixels from the window's left edge:
+/// why a view that needs the reference is empty.
+void draw_notice(const std::string& text, float left);
 
 }  // namespace ao::view

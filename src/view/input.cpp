@@ -40,11 +40,12 @@ Key key_from_name(const std::string& name) {
       case 'S': return Key::S;
       case 'P': return Key::P;
       case 'H': return Key::H;
+      case 'R': return Key::R;
       case '1': case '2': case '3': case '4': case '5': return static_cast<Key>(static_cast<int>(Key::View1) + (name[0] - '1'));
       default: break;
     }
   }
-  throw InputError("--event: unknown key '" + name + "' (keys: F, Z, S, P, H, 1-5)");
+  throw InputError("--event: unknown key '" + name + "' (keys: F, Z, S, P, H, R, 1-5)");
 }
 
 // `value` as a number in [lo, hi]; InputError naming --set `key` otherwise.
@@ -65,7 +66,7 @@ float set_number(const std::string& key, const std::string& value, float lo, flo
 void set_parameter(const std::string& key, const std::string& value, ViewerState& state) {
   nlohmann::json& params = state.params();
   if (!params.contains(key)) {
-    std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud";
+    std::string known = "method, view, wipe, scale, seed, threads, radius, radius_fraction, membership, up, panel, hud, reference";
     for (const auto& [k, v] : params.items()) known += ", " + k;
     throw InputError("--set: unknown key '" + key + "' (viewer settings and parameters of " + state.method + ": " + known + ")" + did_you_mean(key, known));
   }
@@ -74,7 +75,7 @@ void set_parameter(const std::string& key, const std::string& value, ViewerState
   state.dirty_method = true;
 }
 
-// --set of the view: view, wipe, scale, panel, hud. Returns whether `key` was one of them.
+// --set of the view: view, wipe, scale, panel, hud, reference. Returns whether `key` was one of them.
 bool set_display(const std::string& key, const std::string& value, ViewerState& state) {
   if (key == "view") {
     for (int i = 0; i < kViewCount; ++i)
@@ -92,9 +93,20 @@ bool set_display(const std::string& key, const std::string& value, ViewerState& 
     if (v != 1 && v != 2 && v != 4) throw InputError("--set scale: 1, 2 or 4 (the image is computed at 1/scale of the window), got " + value);
     state.scale = static_cast<int>(v);
     state.dirty_gbuffer = true;
-  } else if (key == "panel" || key == "hud") {
+  } else if (key == "panel") {
+    // "on" is "open", as before the panel could collapse.
+    if (value == "open" || value == "on") state.panel = PanelMode::Open;
+    else if (value == "collapsed") state.panel = PanelMode::Collapsed;
+    else if (value == "off") state.panel = PanelMode::Off;
+    else throw InputError("--set panel: open, collapsed or off, got '" + value + "'" + did_you_mean(value, "open, collapsed, off"));
+  } else if (key == "hud" || key == "reference") {
     if (value != "on" && value != "off") throw InputError("--set " + key + ": on or off, got '" + value + "'");
-    (key == "panel" ? state.show_panel : state.show_hud) = value == "on";
+    if (key == "hud") {
+      state.show_hud = value == "on";
+    } else {
+      state.reference_in_benchmark = value == "on";
+      state.dirty_method = true;  // the reference restarts (or stops) with the next run of the method
+    }
   } else {
     return false;
   }
@@ -108,8 +120,12 @@ bool press_key(Key key, ViewerState& state, ViewerControls& controls) {
     case Key::F: controls.frame_all(); break;
     case Key::Z: controls.set_up_axis(controls.up_axis() == UpAxis::Y ? UpAxis::Z : UpAxis::Y); break;
     case Key::S: controls.screenshot(); break;
-    case Key::P: state.show_panel = !state.show_panel; break;
+    case Key::P: state.panel = state.panel == PanelMode::Open ? PanelMode::Collapsed : PanelMode::Open; break;
     case Key::H: state.show_hud = !state.show_hud; break;
+    case Key::R:
+      state.reference_in_benchmark = !state.reference_in_benchmark;
+      state.dirty_method = true;
+      break;
     default: state.set_view(static_cast<ViewMode>(static_cast<int>(key) - static_cast<int>(Key::View1))); break;
   }
   return true;
@@ -128,7 +144,7 @@ bool handle_input(ViewerState& state, ViewerControls& controls) {
   if (io.WantCaptureKeyboard) return any;
   const std::pair<int, Key> keys[] = {{GLFW_KEY_F, Key::F},     {GLFW_KEY_Z, Key::Z},     {GLFW_KEY_S, Key::S},     {GLFW_KEY_1, Key::View1},
                                       {GLFW_KEY_2, Key::View2}, {GLFW_KEY_3, Key::View3}, {GLFW_KEY_4, Key::View4}, {GLFW_KEY_5, Key::View5},
-                                      {GLFW_KEY_P, Key::P},     {GLFW_KEY_H, Key::H}};
+                                      {GLFW_KEY_P, Key::P},     {GLFW_KEY_H, Key::H},     {GLFW_KEY_R, Key::R}};
   for (const auto& [code, key] : keys)
     if (ImGui::IsKeyPressed(code, false)) any |= press_key(key, state, controls);
   return any;

@@ -30,7 +30,7 @@ class ViewerControls {
 };
 
 /// The keys the viewer knows, by name.
-enum class Key { F, Z, S, P, H, View1, View2, View3, View4, View5 };
+enum class Key { F, Z, S, P, H, R, View1, View2, View3, View4, View5 };
 
 /// Applies one key press. Returns whether it was a key the viewer knows.
 bool press_key(Key key, ViewerState& state, ViewerControls& controls);
@@ -43,7 +43,7 @@ bool handle_input(ViewerState& state, ViewerControls& controls);
 void apply_event(const ScriptedEvent& event, ViewerState& state, ViewerControls& controls);
 
 /// --set key=value: a viewer setting (method, view, wipe, scale, seed, threads, radius,
-/// radius_fraction, membership, up, panel, hud), else a parameter of the current method.
+/// radius_fraction, membership, up, panel, hud, reference), else a parameter of the current method.
 /// InputError with one line naming the key and what is valid.
 void apply_set(const std::string& kv, ViewerState& state, ViewerControls& controls);
 

@@ -53,8 +53,8 @@ void OrbitCamera::pan(float dx, float dy, int window_height) {
 
 void OrbitCamera::zoom(float steps) { distance_ = std::max(distance_ * std::pow(0.85f, steps), 1e-6f); }
 
-void OrbitCamera::frame(const Bounds3& bounds) {
-  const Camera framed = frame_bounds(bounds, -forward_direction(), fov_deg_, 16, 9);
+void OrbitCamera::frame(const Bounds3& bounds, int width, int height) {
+  const Camera framed = frame_bounds(bounds, -forward_direction(), fov_deg_, width, height);
   target_ = framed.target;
   distance_ = std::max(length(framed.eye - framed.target), 1e-6f);
 }

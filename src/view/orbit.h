@@ -28,8 +28,9 @@ class OrbitCamera {
   void pan(float dx, float dy, int window_height);
   /// Scroll: each step brings the eye 15% closer to (steps > 0) or farther from the target.
   void zoom(float steps);
-  /// Looks at `bounds` from the current direction at the distance where they fill the view.
-  void frame(const Bounds3& bounds);
+  /// Looks at `bounds` from the current direction at the distance where they fill a view of
+  /// width x height pixels.
+  void frame(const Bounds3& bounds, int width, int height);
   /// Switches the up axis, keeping the eye's position relative to the target as far as possible.
   void set_up_axis(UpAxis axis);
 

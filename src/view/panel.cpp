@@ -15,8 +15,6 @@ namespace ao::view {
 
 namespace {
 
-constexpr int kPanelWidth = 340;
-
 void tooltip(const std::string& text) {
   if (!text.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text.c_str());
 }
@@ -138,13 +136,28 @@ void draw_view_settings(ViewerState& state, ViewerControls& controls) {
 
 }  // namespace
 
+int panel_width(PanelMode mode, int window_width) { return mode == PanelMode::Open ? std::min(kPanelWidth, window_width / 2) : 0; }
+
 void draw_panel(ViewerState& state, ViewerControls& controls, const ViewerReadout& readout) {
-  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_Once);
-  // As tall as its contents, but never taller than the window (it scrolls then).
-  const float max_height = std::max(100.0f, ImGui::GetIO().DisplaySize.y - 16.0f);
-  ImGui::SetNextWindowSizeConstraints(ImVec2(kPanelWidth, 0), ImVec2(kPanelWidth, max_height));
-  ImGui::SetNextWindowBgAlpha(0.85f);
-  ImGui::Begin("ao view", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  constexpr ImGuiWindowFlags fixed = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
+  if (state.panel == PanelMode::Off) return;
+  if (state.panel == PanelMode::Collapsed) {
+    ImGui::SetNextWindowPos(ImVec2(4, 4), ImGuiCond_Always);
+    ImGui::SetNextWindowBgAlpha(0.6f);
+    ImGui::Begin("ao view (collapsed)", nullptr, fixed | ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize);
+    if (ImGui::SmallButton("> panel (P)")) state.panel = PanelMode::Open;
+    ImGui::End();
+    return;
+  }
+  // Docked: the window's full height at its left edge, opaque; it scrolls when taller.
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(static_cast<float>(panel_width(state.panel, static_cast<int>(display.x))), display.y), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(1.0f);
+  ImGui::Begin("ao view", nullptr, fixed | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoBringToFrontOnFocus);
+  ImGui::TextDisabled("ao view");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("< collapse (P)")) state.panel = PanelMode::Collapsed;
   ImGui::PushItemWidth(-150.0f);  // room for the longest parameter name
   if (ImGui::BeginCombo("method", state.method.c_str())) {
     for (const MethodInfo& m : all_methods()) {
@@ -165,6 +178,10 @@ void draw_panel(ViewerState& state, ViewerControls& controls, const ViewerReadou
   if (ImGui::CollapsingHeader("neighbourhood", ImGuiTreeNodeFlags_DefaultOpen)) draw_neighbourhood(state);
   if (ImGui::CollapsingHeader("view", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_settings(state, controls);
   if (ImGui::CollapsingHeader("reference", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (readout.benchmark) {
+      if (ImGui::Checkbox("accumulate (R)", &state.reference_in_benchmark)) state.dirty_method = true;
+      tooltip("--benchmark recomputes the method every frame, so no reference accumulates; this pauses it and accumulates one");
+    }
     ImGui::Text("%d rays/pixel, std error %s", readout.reference_spp, readout.std_error.c_str());
     if (readout.rmse >= 0) ImGui::Text("RMSE of %s: %.4f", state.method.c_str(), readout.rmse);
   }

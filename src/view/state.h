@@ -21,6 +21,10 @@ enum class ViewMode { AO, Shaded, Transfer, Map, Error };
 inline constexpr const char* kViewNames[] = {"ao", "shaded", "transfer", "map", "error"};
 inline constexpr int kViewCount = 5;
 
+/// The panel: docked beside the image (open; the image takes the rest of the window), a button in
+/// the image's corner (collapsed), or not drawn at all (off: screenshots of the image alone).
+enum class PanelMode { Open, Collapsed, Off };
+
 struct ViewerState {
   std::string method;
   std::map<std::string, nlohmann::json> params_by_method;  ///< Each method's parameters as last set.
@@ -32,7 +36,11 @@ struct ViewerState {
   float wipe = 1.0f;          ///< Left of wipe x width: the method; right: the reference.
   int scale = 1;              ///< The image is computed at 1/scale of the window: 1, 2 or 4.
   int threads = 0;            ///< 0: all cores.
-  bool show_panel = true, show_hud = true;
+  PanelMode panel = PanelMode::Open;
+  bool show_hud = true;
+  /// With --benchmark: accumulate the reference anyway (key R, --set reference=on), which pauses
+  /// the benchmark's recomputation so that the camera is still.
+  bool reference_in_benchmark = false;
   bool moved = false;         ///< The camera has left the start view.
   bool dirty_gbuffer = true, dirty_method = true, dirty_display = true;
   bool dirty_reference_side = false;  ///< Only the reference (right of the wipe) changed.

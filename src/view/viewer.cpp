@@ -15,6 +15,7 @@
 #include <limits>
 #include <malloc.h>
 #include <memory>
+#include <numbers>
 #include <optional>
 
 #include "ao/core/error.h"
@@ -65,6 +66,9 @@ class Viewer final : public ViewerControls {
     state_.radius_basis = s_.radius_basis;
     state_.seed = s_.seed;
     state_.device = s_.device;
+    state_.panel = width_ >= kOpenPanelMinWindowWidth ? PanelMode::Open : PanelMode::Collapsed;
+    image_width_ = image_width();
+    orbit_.set_fov_deg(fov_for(image_width_));
     if (s_.threads > 0) set_threads(s_.threads);
     for (const std::string& kv : s_.sets) apply_set(kv, state_, *this);
   }
@@ -99,7 +103,7 @@ class Viewer final : public ViewerControls {
   void orbit(float dx, float dy) override { orbit_.orbit(dx, dy, height_), camera_moved(); }
   void pan(float dx, float dy) override { orbit_.pan(dx, dy, height_), camera_moved(); }
   void zoom(float steps) override { orbit_.zoom(steps), camera_moved(); }
-  void frame_all() override { orbit_.frame(s_.scene->bounds()), camera_moved(); }
+  void frame_all() override { orbit_.frame(s_.scene->bounds(), image_width(), height_), camera_moved(); }
   UpAxis up_axis() const override { return orbit_.up_axis(); }
   void set_up_axis(UpAxis axis) override { orbit_.set_up_axis(axis), camera_moved(); }
   void screenshot() override {
@@ -127,8 +131,9 @@ class Viewer final : public ViewerControls {
       if (e.frame == frame_) apply_event(e, state_, *this);
     window_->begin_frame();
     if (handle_input(state_, *this)) last_input = Clock::now();
-    if (state_.show_panel) draw_panel(state_, *this, readout());
-    if (s_.benchmark) state_.dirty_gbuffer = true;
+    draw_panel(state_, *this, readout());
+    fit_image_to_panel();
+    if (benchmarking()) state_.dirty_gbuffer = true;
     update(times);
     const Clock::time_point display_start = Clock::now();
     const auto [fbw, fbh] = draw_frame();
@@ -143,6 +148,34 @@ class Viewer final : public ViewerControls {
   void camera_moved() {
     state_.camera_moved();
     progressive_.stop();  // lets go of the G-buffer, so the next one can reuse its storage
+  }
+
+  // --benchmark, unless the user asked for the reference, which pauses it.
+  bool benchmarking() const { return s_.benchmark && !state_.reference_in_benchmark; }
+
+  // The image's width in the window: what the docked panel leaves.
+  int image_width() const { return width_ - panel_width(state_.panel, width_); }
+
+  // The vertical field of view that shows, in an image `w` pixels wide and as tall as the window,
+  // what the start camera shows across the whole window: the same horizontal field, more above and
+  // below. The start camera's own at the window's width.
+  float fov_for(int w) const {
+    const float fov = s_.camera.vertical_fov_deg;
+    if (w == width_) return fov;
+    const double degree = std::numbers::pi / 180.0;
+    const double t = std::tan(0.5 * fov * degree) * width_ / std::max(w, 1);
+    return static_cast<float>(std::min(2.0 * std::atan(t) / degree, 179.0));
+  }
+
+  // The panel was opened or collapsed: the image changed width, so the camera keeps its horizontal
+  // field in the new width, and the G-buffer is redone.
+  void fit_image_to_panel() {
+    const int w = image_width();
+    if (w == image_width_) return;
+    image_width_ = w;
+    orbit_.set_fov_deg(fov_for(w));
+    state_.dirty_gbuffer = true;
+    progressive_.stop();
   }
 
   const MethodInfo& method() const { return find_method(state_.method); }
@@ -175,10 +208,20 @@ class Viewer final : public ViewerControls {
     }
   }
 
+  // The camera of the image at full resolution (the window's height, the width the panel leaves).
+  Camera image_camera() const {
+    Camera c = current_camera();
+    c.width = image_width(), c.height = height_;
+    return c;
+  }
+
   Camera current_camera() const {
-    const int w = std::max(1, width_ / state_.scale), h = std::max(1, height_ / state_.scale);
-    // Until the user moves, the start view exactly as ao render chose it (no trip through yaw and pitch).
-    Camera c = state_.moved ? orbit_.camera(w, h) : s_.camera;
+    const int w = std::max(1, image_width() / state_.scale), h = std::max(1, height_ / state_.scale);
+    // Until the user moves, the start view exactly as ao render chose it (no trip through yaw and
+    // pitch), with the field of view fitted to the image's width beside the panel.
+    Camera c = s_.camera;
+    if (state_.moved) c = orbit_.camera(w, h);
+    else c.vertical_fov_deg = fov_for(image_width());
     c.width = w;
     c.height = h;
     return c;
@@ -231,7 +274,7 @@ class Viewer final : public ViewerControls {
     }
     state_.dirty_method = false;
     state_.dirty_display = true;
-    if (s_.benchmark) {  // a moving camera: nothing to accumulate
+    if (benchmarking()) {  // a moving camera: nothing to accumulate
       progressive_.stop();
     } else {
       progressive_.restart({frames_.shared_gbuffer(), frames_.scene().rays.get(), matched_reference(state_.falloff, params), state_.seed});
@@ -254,8 +297,9 @@ class Viewer final : public ViewerControls {
     rmse_ = n > 0 ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
   }
 
+  // --wait-reference is met, or cannot be: a benchmark accumulates nothing.
   bool reference_ready() const {
-    return s_.wait_reference_spp <= 0 || ref_.samples_per_pixel >= s_.wait_reference_spp || !progressive_.error().empty();
+    return s_.wait_reference_spp <= 0 || benchmarking() || ref_.samples_per_pixel >= s_.wait_reference_spp || !progressive_.error().empty();
   }
 
   // The method's V, or the reference's for the ground truth.
@@ -301,13 +345,27 @@ class Viewer final : public ViewerControls {
   std::pair<int, int> draw_frame() {
     const Clock::time_point image_start = Clock::now();
     image_ms_ = upload_if_needed() ? ms_since(image_start) : 0.0;
-    window_->draw_image(shown_grey_, state_.wipe, state_.view != ViewMode::Error);
+    const int left = panel_width(state_.panel, width_);
+    window_->draw_image(shown_grey_, state_.wipe, state_.view != ViewMode::Error, left);
+    if (const std::string why = why_no_reference(); !why.empty()) draw_notice(why, static_cast<float>(left));
     if (state_.show_hud) draw_hud(stats_, readout());
     return window_->render();
   }
 
+  // Why the view, which needs the reference, shows none; empty when it has one or needs none.
+  std::string why_no_reference() const {
+    const GBuffer* g = frames_.gbuffer();
+    const bool needs = state_.view == ViewMode::Error || state_.wipe < 1 || method().ground_truth;
+    if (!needs || !g || ref_.visibility.size() == g->object_id.size()) return "";
+    if (!progressive_.error().empty()) return "No reference: " + progressive_.error();
+    if (benchmarking())
+      return "No reference: --benchmark recomputes the method every frame, as a moving camera would, so none accumulates. "
+             "Press R (or --set reference=on) to pause the benchmark and accumulate one.";
+    return "The reference is accumulating: its first rays per pixel are on their way.";
+  }
+
   ViewerReadout readout() const {
-    ViewerReadout r{.reference_spp = ref_.samples_per_pixel, .std_error = "-", .rmse = rmse_, .error = error_};
+    ViewerReadout r{.reference_spp = ref_.samples_per_pixel, .std_error = "-", .rmse = rmse_, .error = error_, .benchmark = s_.benchmark};
     if (ref_.mean_std_error) {
       char text[32];
       std::snprintf(text, sizeof text, "%.4f", *ref_.mean_std_error);
@@ -321,17 +379,13 @@ class Viewer final : public ViewerControls {
   void take_screenshot(int fbw, int fbh) {
     screenshot_pending_ = false;
     write_rgb_image(screenshot_path_, window_->read_back(fbw, fbh));
-    if (!camera_path_.empty()) {
-      Camera cam = current_camera();
-      cam.width = width_, cam.height = height_;
-      write_camera_file(camera_path_, cam);
-    }
+    if (!camera_path_.empty()) write_camera_file(camera_path_, image_camera());
     if (s_.frames == 0) std::fprintf(stderr, "wrote %s%s%s\n", screenshot_path_.c_str(), camera_path_.empty() ? "" : " and ", camera_path_.c_str());
   }
 
   void redraw_for_screenshot() {
     window_->begin_frame();
-    if (state_.show_panel) draw_panel(state_, *this, readout());
+    draw_panel(state_, *this, readout());
     state_.dirty_display = true;
     const auto [fbw, fbh] = draw_frame();
     take_screenshot(fbw, fbh);
@@ -346,6 +400,7 @@ class Viewer final : public ViewerControls {
     j["radius"] = state_.falloff.radius;
     j["width"] = width_;
     j["height"] = height_;
+    j["image_width"] = image_width();  // the window's width less the docked panel's
     j["scale"] = state_.scale;
     j["threads"] = state_.threads;
     j["device"] = to_string(state_.device);
@@ -382,6 +437,7 @@ class Viewer final : public ViewerControls {
   bool shown_grey_ = true;  // which of the window's textures the frame shows
   std::vector<std::uint8_t> pixels_;
   int width_ = 0, height_ = 0;
+  int image_width_ = 0;  // the image's width the camera was last fitted to
   long frame_ = 0;
   MethodOutput result_;
   Image<Vec3> shaded_;

@@ -38,7 +38,7 @@ Window::Window(int width, int height, const std::string& title, bool vsync) : im
   if (!glfwInit()) throw SystemError("ao view: no display (" + last_glfw_error() + "): set DISPLAY, or run it under xvfb-run");
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // the window is the image: its size is the camera's
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // the image and the panel share a window of fixed size
   // 4.3 (compute shaders, for the GPU backend) when the driver has it, else 3.3 (the CPU's images).
   for (const int minor_of_4 : {3, -1}) {
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, minor_of_4 < 0 ? 3 : 4);
@@ -123,18 +123,19 @@ bool Window::holds(bool grey, int w, int h) const {
   return tex.w == w && tex.h == h;
 }
 
-void Window::draw_image(bool grey, float wipe, bool wipe_line) {
+void Window::draw_image(bool grey, float wipe, bool wipe_line, int left) {
   const Texture& tex = impl_->texture(grey);
   if (tex.w == 0) return;
   const ImVec2 size = ImGui::GetIO().DisplaySize;
-  // The image is opaque and covers the window: drawn without blending, llvmpipe does not read the
-  // framebuffer under it. The backend restores its own state (blending on) after it.
+  const float x0 = static_cast<float>(left);
+  // The image is opaque and covers its part of the window: drawn without blending, llvmpipe does
+  // not read the framebuffer under it. The backend restores its own state (blending on) after it.
   ImDrawList* list = ImGui::GetBackgroundDrawList();
   list->AddCallback([](const ImDrawList*, const ImDrawCmd*) { glDisable(GL_BLEND); }, nullptr);
-  list->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(tex.id)), ImVec2(0, 0), size);
+  list->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(tex.id)), ImVec2(x0, 0), size);
   list->AddCallback(ImDrawCallback_ResetRenderState, nullptr);
   if (wipe > 0 && wipe < 1 && wipe_line) {
-    const float x = std::round(wipe * size.x);
+    const float x = x0 + std::round(wipe * (size.x - x0));
     ImGui::GetForegroundDrawList()->AddLine(ImVec2(x, 0), ImVec2(x, size.y), IM_COL32(255, 200, 0, 255), 1.0f);
   }
 }

@@ -44,9 +44,10 @@ class Window {
   void upload(const std::vector<std::uint8_t>& pixels, int w, int h, bool grey, int x0);
   /// Whether the texture of that kind holds an image of w x h.
   bool holds(bool grey, int w, int h) const;
-  /// Draws the last uploaded image of that kind over the whole window, and the wipe line at
-  /// `wipe` (a fraction of the width) when it is inside (0, 1) and `wipe_line`.
-  void draw_image(bool grey, float wipe, bool wipe_line);
+  /// Draws the last uploaded image of that kind over the window right of column `left` (the
+  /// docked panel's width; 0: the whole window), and the wipe line at `wipe` (a fraction of the
+  /// image's width) when it is inside (0, 1) and `wipe_line`.
+  void draw_image(bool grey, float wipe, bool wipe_line, int left);
   /// Renders the frame's widgets over the image into the back buffer and waits for the drawing.
   /// Returns the framebuffer's size.
   std::pair<int, int> render();

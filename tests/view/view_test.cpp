@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ao/core/error.h"
+#include "ao/eval/shading.h"
 #include "ao/io/camera_json.h"
 #include "ao/io/image_io.h"
 #include "support/run.h"
@@ -78,7 +79,7 @@ TEST(ViewOrbit, FrameAllPutsEveryCornerInTheImage) {
   Bounds3 b;
   b.extend(Vec3{10, 10, 10});
   b.extend(Vec3{14, 12, 11});
-  orbit.frame(b);
+  orbit.frame(b, 320, 180);
   const Camera o = orbit.camera(320, 180);
   for (int i = 0; i < 8; ++i) {
     const Vec3 corner{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
@@ -87,6 +88,22 @@ TEST(ViewOrbit, FrameAllPutsEveryCornerInTheImage) {
     EXPECT_LE(p.x, 320.0f);
     EXPECT_GE(p.y, 0.0f);
     EXPECT_LE(p.y, 180.0f);
+  }
+}
+
+TEST(ViewOrbit, FrameAllFitsANarrowImage) {
+  // A tall image beside a docked panel: the box fits across its narrow width too.
+  view::OrbitCamera orbit(start_camera());
+  Bounds3 b;
+  b.extend(Vec3{-4, 0, -1});
+  b.extend(Vec3{4, 1, 1});
+  orbit.frame(b, 90, 320);
+  const Camera o = orbit.camera(90, 320);
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
+    const Vec2 p = o.project(o.world_to_camera_point(corner));
+    EXPECT_GE(p.x, 0.0f);
+    EXPECT_LE(p.x, 90.0f);
   }
 }
 
@@ -131,17 +148,27 @@ TEST(CameraJson, BadFilesAreOneLineErrors) {
 
 const std::string kSize = " --width 160 --height 90 ";
 
-// The R channel of an RGB screenshot against the grey PNG ao render wrote, as 8-bit codes (both
-// show display_background where no surface is visible).
-int max_code_difference(const std::filesystem::path& screenshot, const std::filesystem::path& render) {
+// The R channel of an RGB screenshot's columns from `left` on against the grey PNG ao render
+// wrote, as 8-bit codes (both show display_background where no surface is visible).
+int max_code_difference(const std::filesystem::path& screenshot, const std::filesystem::path& render, int left = 0) {
   const Image<Vec3> shot = read_rgb_image(screenshot);
   const Image<float> ref = read_image(render);
-  EXPECT_EQ(shot.width(), ref.width());
+  EXPECT_EQ(shot.width() - left, ref.width());
   EXPECT_EQ(shot.height(), ref.height());
-  if (shot.width() != ref.width() || shot.height() != ref.height()) return 255;
+  if (shot.width() - left != ref.width() || shot.height() != ref.height()) return 255;
   long worst = 0;
-  for (std::size_t i = 0; i < ref.size(); ++i) worst = std::max(worst, std::labs(std::lround(shot[i].x * 255) - std::lround(ref[i] * 255)));
+  for (int y = 0; y < ref.height(); ++y)
+    for (int x = 0; x < ref.width(); ++x)
+      worst = std::max(worst, std::labs(std::lround(shot(x + left, y).x * 255) - std::lround(ref(x, y) * 255)));
   return static_cast<int>(worst);
+}
+
+int code(float v) { return static_cast<int>(std::lround(v * 255)); }
+
+// tan of half the horizontal field of a camera file.
+double horizontal_tangent(const std::filesystem::path& camera) {
+  const Camera c = read_camera_file(camera, Camera{});
+  return c.tan_half_fov() * c.aspect();
 }
 
 TEST(ViewCli, WithoutADisplayIsOneLineAndExitThree) {
@@ -161,6 +188,52 @@ TEST(ViewCli, ScreenshotShowsExactlyWhatRenderComputes) {
   const RunResult r = run_ao("render -m containment --camera c.json -o r.png", dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(max_code_difference(dir / "s.png", dir / "r.png"), 0);
+}
+
+// At 960x540, ao view's default window, the panel starts collapsed (a button in the corner) and
+// must leave the picture visible; opened (--set or the P key), it docks at the left and the image
+// beside it is exactly what ao render computes for the written camera, which keeps the start
+// view's horizontal field.
+TEST(ViewCli, ThePanelNeverCoversTheImage) {
+  TempDir dir;
+  const std::string view = "view -m containment --width 960 --height 540 --frames 2 --set hud=off --screenshot ";
+  for (const std::string how : {"off.png --set panel=off --camera-out off.json", "default.png", "open.png --set panel=open --camera-out open.json",
+                                 "key.png --event 1:key:P --camera-out key.json"}) {
+    const RunResult v = run_ao_under(xvfb(), view + how, dir.path());
+    ASSERT_EQ(v.exit_code, 0) << how << ": " << v.err;
+  }
+  // The model's pixels: those of the whole-window image that are not the background.
+  const Image<Vec3> off = read_rgb_image(dir / "off.png"), shown = read_rgb_image(dir / "default.png");
+  ASSERT_EQ(shown.width(), off.width());
+  long model = 0, visible = 0;
+  for (int y = 0; y < off.height(); ++y)
+    for (int x = 0; x < off.width(); ++x) {
+      if (code(off(x, y).x) == code(display_background(x, y))) continue;
+      ++model;
+      visible += code(shown(x, y).x) == code(off(x, y).x);
+    }
+  ASSERT_GT(model, 100000);  // the default scene fills most of the window
+  EXPECT_GE(static_cast<double>(visible), 0.95 * static_cast<double>(model)) << visible << " of " << model;
+  // Docked: the image is the window less the panel, and exactly the render of its camera.
+  for (const char* name : {"open", "key"}) {
+    const std::string stem(name);
+    const RunResult r = run_ao("render -m containment --camera " + stem + ".json -o " + stem + "-render.png", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(read_image(dir / (stem + "-render.png")).width(), 960 - 340) << name;
+    EXPECT_EQ(max_code_difference(dir / (stem + ".png"), dir / (stem + "-render.png"), 340), 0) << name;
+    EXPECT_NEAR(horizontal_tangent(dir / (stem + ".json")), horizontal_tangent(dir / "off.json"), 1e-5) << name;
+  }
+}
+
+TEST(ViewCli, BenchmarkAccumulatesTheReferenceOnRequest) {
+  // --benchmark recomputes every frame, so nothing accumulates: --wait-reference cannot wait for it.
+  const RunResult bench = run_ao_under(xvfb(), "view" + kSize + "--frames 2 --benchmark --wait-reference 8 --json");
+  ASSERT_EQ(bench.exit_code, 0) << bench.err;
+  EXPECT_EQ(nlohmann::json::parse(bench.out)["reference"]["samples_per_pixel"].get<int>(), 0);
+  // reference=on pauses the benchmark and accumulates it.
+  const RunResult asked = run_ao_under(xvfb(), "view" + kSize + "--frames 2 --benchmark --set reference=on --wait-reference 8 --json");
+  ASSERT_EQ(asked.exit_code, 0) << asked.err;
+  EXPECT_EQ(nlohmann::json::parse(asked.out)["reference"]["samples_per_pixel"].get<int>(), 8);
 }
 
 TEST(ViewCli, SetAndScriptedInputChangeTheImageAsOfflineOptionsDo) {
@@ -207,7 +280,8 @@ TEST(ViewCli, ReferenceStandardErrorFallsAsItAccumulates) {
 }
 
 TEST(ViewCli, BadSettingsAreOneLineErrors) {
-  for (const char* args : {"--set view=sideways", "--set scale=3", "--set nonsense=1", "--event 1:twist:3", "--screenshot x.png"}) {
+  for (const char* args : {"--set view=sideways", "--set scale=3", "--set nonsense=1", "--set panel=docked", "--set reference=yes", "--event 1:twist:3",
+                           "--screenshot x.png"}) {
     const RunResult r = run_ao_under(xvfb(), "view" + kSize + args);
     EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;

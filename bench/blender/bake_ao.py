@@ -5,7 +5,8 @@
 # With HIGH: high to low, Cycles' "selected to active" (the AO of HIGH, found by rays from MESH
 # pushed out by CAGE_EXTRUSION along its normals, in MESH's UVs); MESH itself is invisible to the
 # AO rays, as the low mesh is to `ao bake --high`.
-# Writes OUT.exr (linear float RGB, AO in every channel) and
+# CYCLES_SEED=N in the environment sets Cycles' seed (default 0). Writes OUT.exr (linear float
+# RGB, AO in every channel) and
 # prints one line "bake_seconds S" (the bpy.ops.object.bake call alone: BVH build and baking).
 import os
 import sys
@@ -27,6 +28,7 @@ scene.cycles.device = "CPU"
 scene.cycles.samples = samples
 scene.cycles.use_denoising = False
 scene.cycles.use_adaptive_sampling = False
+scene.cycles.seed = int(os.environ.get("CYCLES_SEED", "0"))  # another seed: an independent map, for Cycles' own noise
 scene.render.threads_mode = "FIXED"
 scene.render.threads = threads
 

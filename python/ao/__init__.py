@@ -282,7 +282,7 @@ def bake(mesh, size=None, *, method="raytraced", uv_set=0, padding=None, map=Tru
                 "cavity", "summary"} (those baked)
     progress    True (a bar) or a callable(stage, done, total) (module docstring)
     **params    the baker's parameters (`ao bake --help`): samples, denoise, max_distance,
-                membership, offset, normal, ignore_back_faces, spread_angle, relative_distance;
+                membership, texel_sampling, offset, normal, ignore_back_faces, spread_angle, relative_distance;
                 histogram: directions, ...
 
     Returns the map; only per-vertex values when map=False; (map, per_vertex) when both.

@@ -45,6 +45,7 @@ constexpr std::pair<std::string_view, std::string_view> kKeywords[] = {
     {f::kBakePadding, "padding"},
     {f::kBakeDenoise, "denoise"},
     {f::kBakeMembership, "membership"},
+    {f::kBakeTexelSampling, "texel_sampling"},
     {f::kBakeMaxDistance, "max_distance"},
     {f::kBakeHigh, "high"},
     {f::kBakeCage, "cage"},

@@ -32,6 +32,7 @@ struct BakeOptions {
   std::string normalization = default_name(histogram_param_table(), "normalization");
   std::string normal = default_name(raytraced_bake_param_table(), "normal");
   std::string membership = default_name(raytraced_bake_param_table(), "membership");
+  std::string texel_sampling = default_name(raytraced_bake_param_table(), "texel_sampling");
   std::string bent_normal_space{to_string(BakeRequest{}.bent_normal_space)};
   std::uint32_t seed = RaytracedBakeParams{}.seed;  ///< Both bakers' (the same default).
   bool json = false;
@@ -53,7 +54,8 @@ BakeRequest make_request(BakeOptions& o) {
   r.bent_normal_space = bent_normal_space_from_name(o.bent_normal_space);
   for (const std::string& g : o.groups) r.groups.push_back(split(g, ','));
   // The options given as names go through the bakers' tables, which name the valid values.
-  raytraced_bake_param_table().from_json({{"seed", o.seed}, {"normal", o.normal}, {"membership", o.membership}}, r.raytraced);
+  raytraced_bake_param_table().from_json({{"seed", o.seed}, {"normal", o.normal}, {"membership", o.membership}, {"texel_sampling", o.texel_sampling}},
+                                         r.raytraced);
   histogram_param_table().from_json({{"seed", o.seed}, {"direction_set", o.direction_set}, {"normalization", o.normalization}}, r.histogram);
   return r;
 }
@@ -97,6 +99,7 @@ void add_raytraced_options(CLI::App& cmd, BakeOptions& o) {
       ->default_str(float_text(kDefaultBakeDenoise));
   cmd.add_option("--max-distance", rt.max_distance, help("max_distance"));
   cmd.add_option("--membership", o.membership, help("membership"))->capture_default_str();
+  cmd.add_option("--texel-sampling", o.texel_sampling, help("texel_sampling"))->type_name("area|centre")->capture_default_str();
   cmd.add_option("--offset", rt.offset, help("offset"))->capture_default_str();
   cmd.add_option("--normal", o.normal,
                  help("normal") + " (per vertex: the area-weighted mean over its triangles); the histogram baker integrates the whole "
@@ -184,7 +187,7 @@ void add_bake_command(CLI::App& app, const GlobalOptions& global, std::function<
                            "--vertex-resolution"})
     histogram_only.push_back(cmd->get_option(name));
   for (const char* name : {"--samples", "--max-distance", "--membership", "--offset", "--ignore-back-faces", "--normal", "--denoise", "--spread-angle",
-                           "--relative-distance"})
+                           "--relative-distance", "--texel-sampling"})
     raytraced_only.push_back(cmd->get_option(name));
   cmd->callback([o, size_opt, histogram_only, raytraced_only, &global, &action] {
     o->size_given = size_opt->count() > 0;

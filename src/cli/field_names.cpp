@@ -46,6 +46,7 @@ constexpr std::pair<std::string_view, std::string_view> kOptions[] = {
     {f::kBakePadding, "--padding"},
     {f::kBakeDenoise, "--denoise"},
     {f::kBakeMembership, "--membership"},
+    {f::kBakeTexelSampling, "--texel-sampling"},
     {f::kBakeMaxDistance, "--max-distance"},
     {f::kBakeHigh, "--high"},
     {f::kBakeCage, "--cage"},

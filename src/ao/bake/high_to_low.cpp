@@ -229,6 +229,7 @@ const ParamTable<HighToLowParams>& high_to_low_param_table() {
 void HighToLowParams::validate() const {
   high_to_low_param_table().validate(*this);
   ao.validate();
+  if (ao.texel_sampling == TexelSampling::Centre) throw InputError("high-to-low: texel_sampling centre is for single-mesh maps; rays leave each texel's patch of the cage");
 }
 void to_json(nlohmann::json& j, const HighToLowParams& p) { j = high_to_low_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, HighToLowParams& p) { high_to_low_param_table().from_json(j, p); }

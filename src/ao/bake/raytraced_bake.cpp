@@ -82,17 +82,23 @@ using detail::TriangleNormals;
 template <int N>
 class TexelWorker {
  public:
-  TexelWorker(const Tracer& tracer, const RaytracedBakeParams& params, BakeResult& out, TexelGuides* guides)
-      : batch_tracer_(tracer), params_(params), out_(out), guides_(guides), spread_(detail::cone_disk_radius(params.spread_angle)) {}
+  /// `texels`: the map's coverage and the scene it was computed on, for texel_sampling centre.
+  TexelWorker(const Tracer& tracer, const RaytracedBakeParams& params, BakeResult& out, TexelGuides* guides, const detail::TexelSource& texels)
+      : batch_tracer_(tracer), params_(params), out_(out), guides_(guides), texels_(texels), spread_(detail::cone_disk_radius(params.spread_angle)) {}
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& surface) {
     const bool geometric = params_.normal == SurfaceNormal::Geometric;
+    // Centre: the rays' patch is the single point under the texel's centre (the filter's guides
+    // still describe the whole texel).
+    const bool centre = params_.texel_sampling == TexelSampling::Centre;
+    if (centre) detail::centre_patch(texels_, texel, surface, point_);
+    const std::vector<PatchPiece>& sampled = centre ? point_ : surface;
     // Inside: the same patch with its normals turned over, so that the offset pushes the points
     // in and the directions leave below the surface.
-    if (params_.hemisphere == Hemisphere::Inside) detail::turn_over(surface, flipped_);
-    const std::vector<PatchPiece>& patch = params_.hemisphere == Hemisphere::Inside ? flipped_ : surface;
+    if (params_.hemisphere == Hemisphere::Inside) detail::turn_over(sampled, flipped_);
+    const std::vector<PatchPiece>& patch = params_.hemisphere == Hemisphere::Inside ? flipped_ : sampled;
     table_.build(patch, params_.offset);
-    if (guides_) detail::patch_guide(patch, geometric, guides_->position[texel], guides_->normal[texel]);
+    if (guides_) detail::patch_guide(surface, geometric, guides_->position[texel], guides_->normal[texel]);
     points_.generate(pixel_seed(params_.seed, x, y), params_.samples);
     if (guides_) noise_.reset(params_.samples);
     detail::MeanAccumulator acc;
@@ -122,9 +128,10 @@ class TexelWorker {
   const RaytracedBakeParams& params_;
   BakeResult& out_;
   TexelGuides* guides_;
+  const detail::TexelSource& texels_;
   detail::TexelPoints points_;
   float spread_;  // the cone's disk radius, sin(spread_angle / 2)
-  std::vector<PatchPiece> flipped_;
+  std::vector<PatchPiece> point_, flipped_;
   alignas(64) detail::PatchTable table_;
   alignas(64) float u_[4][16];
   alignas(64) float cone_u_[4][16];
@@ -155,6 +162,8 @@ const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table() {
        P::boolean("relative_distance", &R::relative_distance, "max_distance is a fraction of the baked meshes' bounding-box diagonal"),
        P::enumeration<Hemisphere>("hemisphere", &R::hemisphere, {{"outside", Hemisphere::Outside}, {"inside", Hemisphere::Inside}},
                                   "outside: AO; inside: rays into the mesh, with a distance a thickness map"),
+       P::enumeration<TexelSampling>("texel_sampling", &R::texel_sampling, {{"area", TexelSampling::Area}, {"centre", TexelSampling::Centre}},
+                                     "maps: rays from points spread over each texel's surface (its mean V) or all from the point under its centre (point sampling, as Cycles)"),
        P::seed("seed", &R::seed, "keys the per-texel sample sets"),
        P::real("denoise", &R::denoise, Range::closed(0, kMaxDenoiseSigma), "texels",
                "sigma of the texture-space filter of maps (denoise.h); 0 = off, the plain estimate of eq. 2")}};
@@ -216,8 +225,9 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   const bool denoise = params.denoise > 0;
   TexelGuides guides;
   if (denoise) guides = TexelGuides(cov.width, cov.height);
+  const detail::TexelSource texels{scene, cov, fn};
   detail::for_each_texel_patch(rs, scene, cov, fn, progress, [&]<int N>() {
-    return TexelWorker<N>(tracer, params, out, denoise ? &guides : nullptr);
+    return TexelWorker<N>(tracer, params, out, denoise ? &guides : nullptr, texels);
   });
   if (denoise) denoise_map(out.visibility, cov.mask, cov, guides, params.denoise);
   out.rays = static_cast<std::uint64_t>(cov.covered_texels) * static_cast<std::uint64_t>(params.samples);
@@ -265,6 +275,7 @@ std::vector<float> bake_vertices_raytraced(const RayScene& rs, const RaytracedBa
   given.validate();
   const Scene& scene = rs.scene();
   if (given.hemisphere == Hemisphere::Inside) throw InputError("bake raytraced: per-vertex bakes take the outside hemisphere (AO)");
+  if (given.texel_sampling == TexelSampling::Centre) throw InputError("bake raytraced: texel_sampling centre is for maps (a vertex has no texel)");
   const RaytracedBakeParams params = given.with_absolute_distance(baked_bounds(scene));
   const float spread = detail::cone_disk_radius(params.spread_angle);
   require_no_instances(scene);

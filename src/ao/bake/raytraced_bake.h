@@ -24,6 +24,9 @@ namespace ao {
 /// Which side of the surface a bake's rays leave to (RaytracedBakeParams::hemisphere).
 enum class Hemisphere { Outside, Inside };
 
+/// Where a map's rays start within each texel (RaytracedBakeParams::texel_sampling).
+enum class TexelSampling { Area, Centre };
+
 struct RaytracedBakeParams {
   int samples = 64;                      ///< Rays per texel (or vertex), each from its own point of the patch. [1, 1048576]. 64: the fewest that bake refined_elephant_uv at 1024^2 within RMSE 0.02 of a 1024-ray bake (docs/methods/bake.md).
   std::optional<float> max_distance;     ///< R, world units, > 0; nullopt = unlimited distance (the paper's eq. 1).
@@ -50,6 +53,12 @@ struct RaytracedBakeParams {
   /// inside of a closed mesh is its back faces): with a distance R, a thickness map, 1 where nothing
   /// of the mesh lies within R behind the point, darker the thinner the mesh there.
   Hemisphere hemisphere = Hemisphere::Outside;
+  /// Maps only. Area (default): each ray from its own point of the texel's patch of surface, so a
+  /// texel holds the mean of V over the surface it covers (what a filtered texture lookup of it
+  /// returns). Centre: every ray from the one surface point under the texel's centre (the nearest
+  /// point of its patch when the centre is off the chart), point sampling as Cycles and most bakers
+  /// rasterize the UVs; where V changes within a texel (contacts, creases) the two differ.
+  TexelSampling texel_sampling = TexelSampling::Area;
   std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
   /// Maps only: sigma, in texels, of the texture-space filter that averages the noise of texels
   /// that are neighbours on the surface (denoise.h); 0 = off, the plain estimate of eq. 2.

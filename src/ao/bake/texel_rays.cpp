@@ -70,6 +70,71 @@ void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals
   }
 }
 
+namespace {
+
+Vec2 sub(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
+float dot2(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
+Vec2 weighted(Vec2 a, Vec2 b, Vec2 c, Vec3 l) { return {a.x * l.x + b.x * l.y + c.x * l.z, a.y * l.x + b.y * l.y + c.y * l.z}; }
+
+// The point of triangle (a, b, c) nearest to q, as barycentrics: q's own when inside, else the
+// nearest point of the nearest edge.
+Vec3 nearest_barycentrics(Vec2 a, Vec2 b, Vec2 c, Vec2 q) {
+  const float det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+  if (det != 0) {
+    const float l1 = ((q.x - a.x) * (c.y - a.y) - (c.x - a.x) * (q.y - a.y)) / det;
+    const float l2 = ((b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y)) / det;
+    if (l1 >= 0 && l2 >= 0 && l1 + l2 <= 1) return {1 - l1 - l2, l1, l2};
+  }
+  Vec3 best{1, 0, 0};
+  float best_d2 = kInfinity;
+  const Vec2 v[3] = {a, b, c};
+  for (int e = 0; e < 3; ++e) {
+    const Vec2 p = v[e], d = sub(v[(e + 1) % 3], p);
+    const float len2 = dot2(d, d);
+    const float t = len2 > 0 ? std::clamp(dot2(sub(q, p), d) / len2, 0.0f, 1.0f) : 0.0f;
+    const Vec2 off = sub(q, Vec2{p.x + d.x * t, p.y + d.y * t});
+    if (const float d2 = dot2(off, off); d2 < best_d2) {
+      best_d2 = d2;
+      float l[3] = {0, 0, 0};
+      l[e] = 1 - t, l[(e + 1) % 3] = t;
+      best = {l[0], l[1], l[2]};
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+void centre_patch(const TexelSource& texels, std::size_t texel, const std::vector<PatchPiece>& patch, std::vector<PatchPiece>& out) {
+  const TexelCoverage& cov = texels.cov;
+  const Vec2 q{static_cast<float>(texel % static_cast<std::size_t>(cov.width)) + 0.5f,
+               static_cast<float>(texel / static_cast<std::size_t>(cov.width)) + 0.5f};
+  float best_d2 = kInfinity;
+  PatchPiece pc{};
+  for (std::uint32_t f = cov.offsets[texel]; f < cov.offsets[texel + 1] && best_d2 > 0; ++f) {
+    const TexelFragment& fr = cov.fragments[f];
+    const Mesh& m = texels.scene.meshes[fr.mesh];
+    const std::uint32_t* i = &m.indices[3 * fr.triangle];
+    const Vec2 a = texel_uv(m, i[0], cov.width, cov.height), b = texel_uv(m, i[1], cov.width, cov.height), c = texel_uv(m, i[2], cov.width, cov.height);
+    const Vec3 l = nearest_barycentrics(a, b, c, q);
+    const Vec2 off = sub(q, weighted(a, b, c, l));
+    const float d2 = dot2(off, off);
+    if (!(d2 < best_d2)) continue;
+    best_d2 = d2;
+    pc.mesh = fr.mesh;
+    pc.triangle = fr.triangle;
+    const Vec3 p = m.positions[i[0]] * l.x + m.positions[i[1]] * l.y + m.positions[i[2]] * l.z;
+    const Vec3 n = m.normals[i[0]] * l.x + m.normals[i[1]] * l.y + m.normals[i[2]] * l.z;
+    pc.p = {p, p, p};
+    pc.n = {n, n, n};
+    pc.bary = {l, l, l};
+    pc.ng = texels.fn.per_mesh[fr.mesh][fr.triangle];
+    pc.offset = ray_offset_distance(triangle_magnitude(m, fr.triangle));
+  }
+  pc.cdf = patch.back().cdf;
+  out.assign(1, pc);
+}
+
 void patch_guide(const std::vector<PatchPiece>& patch, bool geometric, Vec3& position, Vec3& normal) {
   Vec3 c{0, 0, 0}, n{0, 0, 0};
   float lo = 0;

@@ -56,6 +56,21 @@ struct PatchPiece {
 /// The pieces of texel `texel` of `cov` (computed on `s`), in fragment order. `fn` = face_normals(s).
 void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::size_t texel, std::vector<PatchPiece>& out);
 
+/// What a texel's patch was built from: the scene, the map's coverage computed on it, and its face
+/// normals (face_normals).
+struct TexelSource {
+  const Scene& scene;
+  const TexelCoverage& cov;
+  const TriangleNormals& fn;
+};
+
+/// The point of texel `texel`'s surface under its centre, as a patch of one piece whose three
+/// corners are that point and whose area is the whole patch's (`patch`, non-empty), so that every
+/// sample of it starts there: the fragment whose UV triangle holds the centre, else the point of a
+/// fragment's triangle nearest to the centre in UV (a texel on a chart's border whose centre lies
+/// outside the chart).
+void centre_patch(const TexelSource& texels, std::size_t texel, const std::vector<PatchPiece>& patch, std::vector<PatchPiece>& out);
+
 /// The area-weighted centroid and unit mean normal of a non-empty patch (of the face normals when
 /// `geometric`, else of the interpolated normals; the first piece's face normal where they cancel):
 /// where denoise_map finds the texel on the surface.

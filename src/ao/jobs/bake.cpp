@@ -238,6 +238,11 @@ void resolve_baker_settings(Plan& plan) {
   r.raytraced.bent_normals = r.histogram.bent_normals = !r.outputs.bent_normals.empty();
   r.raytraced.validate();  // before any mesh is loaded: samples, offset, denoise
   r.histogram.validate();
+  if (r.raytraced.texel_sampling == TexelSampling::Centre) {
+    if (r.method == Baker::Histogram) throw InputError(field(fields::kBakeTexelSampling) + " is the ray-traced baker's; the histogram baker samples each texel's patch");
+    if (!r.outputs.per_vertex.empty()) throw InputError(field(fields::kBakeTexelSampling) + " centre is for maps: a vertex has no texel, so drop it or " + field(fields::kBakePerVertex));
+    if (plan.high_to_low()) throw InputError(field(fields::kBakeTexelSampling) + " centre is for single-mesh maps: high to low casts from each texel's patch of the cage");
+  }
   check_family(plan);
 }
 

@@ -47,6 +47,7 @@ inline constexpr std::string_view kBakeUvSet = "BakeRequest::uv_set";
 inline constexpr std::string_view kBakePadding = "BakeRequest::padding";
 inline constexpr std::string_view kBakeDenoise = "BakeRequest::denoise";
 inline constexpr std::string_view kBakeMembership = "BakeRequest::raytraced.membership";
+inline constexpr std::string_view kBakeTexelSampling = "BakeRequest::raytraced.texel_sampling";
 inline constexpr std::string_view kBakeMaxDistance = "BakeRequest::raytraced.max_distance";
 inline constexpr std::string_view kBakeHigh = "BakeRequest::high";
 inline constexpr std::string_view kBakeCage = "BakeRequest::cage";
@@ -96,7 +97,7 @@ inline constexpr std::string_view kAll[] = {
     kCameraWidth, kCameraHeight, kCameraFov, kCameraEye, kCameraTarget, kCameraUp, kFalloffMembership, kFalloffRadius,
     kFalloffRadiusFraction, kFalloffTau, kNormal, kDevice, kRenderScene, kRenderGBufferFile, kRenderMethod, kRenderParams,
     kRenderSamples, kRenderTargetError, kRenderSun, kRenderAoMap, kRenderVisibility, kRenderShaded, kRenderGBufferOut, kRenderExtras,
-    kRenderPngBits, kRenderProvenance, kBakeMethod, kBakeSize, kBakeUvSet, kBakePadding, kBakeDenoise, kBakeMembership,
+    kRenderPngBits, kRenderProvenance, kBakeMethod, kBakeSize, kBakeUvSet, kBakePadding, kBakeDenoise, kBakeMembership, kBakeTexelSampling,
     kBakeMaxDistance, kBakeHigh, kBakeCage, kBakeCageExtrusion, kBakeMaxFront, kBakeMaxBack, kBakeOccluders, kBakeFloor, kBakeGroups,
     kBakeSelfOcclusion, kBakeMatchByName, kBakeOrm, kBakeReference, kBakeOutDir, kBakeMap, kBakeBentNormals, kBakeThickness, kBakeCavity,
     kBakeBentNormalSpace, kBakeThicknessDistance, kBakeCavityDistance, kBakePerVertex,

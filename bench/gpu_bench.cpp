@@ -29,8 +29,9 @@ namespace {
 
 constexpr int kWidth = 640, kHeight = 360;
 
-// A scene of closed meshes for cone, whose GPU voxelization is the paper's parity (open surfaces
-// would fill the space beyond them): a box for the ground, a sphere, a turned box, a torus.
+// A scene of closed meshes for cone, which the GPU voxelizes itself by the paper's parity (a scene
+// with open surfaces gets the CPU's grid, uploaded): a box for the ground, a sphere, a turned box,
+// a torus.
 Scene closed_scene() {
   Scene s;
   s.name = "closed meshes";

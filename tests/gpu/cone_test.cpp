@@ -19,6 +19,7 @@ using test::gpu_device;
 struct GridCase {
   std::string scene;
   int columns, depth_bits;
+  OpenMeshes open_meshes = OpenMeshes::Parity;  ///< Slab, Winding: the CPU's solid, voxelized there and uploaded.
 };
 
 class GpuVoxelGrid : public ::testing::TestWithParam<GridCase> {};
@@ -32,7 +33,7 @@ TEST_P(GpuVoxelGrid, IsBitIdenticalToTheCpuGrid) {
   VoxelizeOptions o;
   o.columns = k.columns;
   o.depth_bits = k.depth_bits;
-  o.open_meshes = OpenMeshes::Parity;
+  o.open_meshes = k.open_meshes;
   VoxelStats cpu_stats, gpu_stats;
   const VoxelGrid cpu = voxelize_world(scene, analyze_closure(scene), o, &cpu_stats);
   const VoxelGrid gpu = gpu_voxelize_world(gpu_device(), gpu_scene, o, &gpu_stats);
@@ -56,9 +57,11 @@ TEST_P(GpuVoxelGrid, IsBitIdenticalToTheCpuGrid) {
 INSTANTIATE_TEST_SUITE_P(Scenes, GpuVoxelGrid,
                          ::testing::Values(GridCase{"box-room", 128, 128}, GridCase{"default", 256, 128}, GridCase{"sphere-on-plane", 96, 96},
                                            GridCase{"default", 64, 1024}, GridCase{"wedge", 64, 32}, GridCase{"dragon", 512, 128},
-                                           GridCase{"instanced", 200, 160}),
+                                           GridCase{"instanced", 200, 160}, GridCase{"default", 128, 128, OpenMeshes::Winding},
+                                           GridCase{"sphere-on-plane", 96, 96, OpenMeshes::Slab}),
                          [](const ::testing::TestParamInfo<GridCase>& p) {
-                           std::string n = p.param.scene + "_" + std::to_string(p.param.columns) + "_" + std::to_string(p.param.depth_bits);
+                           std::string n = p.param.scene + "_" + std::to_string(p.param.columns) + "_" + std::to_string(p.param.depth_bits) +
+                                           (p.param.open_meshes == OpenMeshes::Winding ? "_winding" : p.param.open_meshes == OpenMeshes::Slab ? "_slab" : "");
                            for (char& ch : n)
                              if (ch == '-') ch = '_';
                            return n;

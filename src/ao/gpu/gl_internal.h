@@ -74,6 +74,7 @@ namespace ao::gpu_detail {
   X(PFNGLGENQUERIESPROC, GenQueries)                                                                                         \
   X(PFNGLDELETEQUERIESPROC, DeleteQueries)                                                                                   \
   X(PFNGLQUERYCOUNTERPROC, QueryCounter)                                                                                     \
+  X(PFNGLFLUSHPROC, Flush)                                                                                                   \
   X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)                                                                       \
   X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                                                                               \
   X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                                                                         \

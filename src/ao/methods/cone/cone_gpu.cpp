@@ -73,25 +73,54 @@ const std::vector<MeshClosure>& closure_of(SceneBuffers& sb) {
   return *closure;
 }
 
-// The GPU voxelizes by parity; the CPU's other modes change the solid of open surfaces (slabs),
-// of holed meshes (winding number) and of closed meshes around the camera (the complement).
-void check_parity_suffices(const std::vector<MeshClosure>& closure, const VoxelizeOptions& o) {
-  const OpenMeshes mode = o.open_meshes;
-  std::size_t open = 0, holed = 0;
-  for (const MeshClosure& c : closure) open += c.open_surface() ? 1 : 0, holed += c.holed() ? 1 : 0;
-  const auto rooms = static_cast<std::size_t>(std::count(o.rooms.begin(), o.rooms.end(), std::uint8_t{1}));
-  if (rooms > 0 && mode != OpenMeshes::Parity)
-    throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the camera is inside " + std::to_string(rooms) +
-                     " closed mesh(es) (a room), whose solid is outside: run cone on the CPU (--device cpu), or give "
-                     "-p open_meshes=parity for the paper's voxelization, which fills the room");
-  const bool slabs = mode != OpenMeshes::Parity && open > 0, winding = mode == OpenMeshes::Winding && holed > 0;
-  if (!slabs && !winding) return;
-  const std::string what = slabs ? std::to_string(open) + " open surface(s), which open_meshes=" + (mode == OpenMeshes::Slab ? "slab" : "winding") +
-                                       " thickens into slabs"
-                                 : std::to_string(holed) + " mesh(es) with holes, which open_meshes=winding closes";
-  throw InputError("cone on the GPU voxelizes closed meshes by parity only, and the scene has " + what +
-                   ": run cone on the CPU (--device cpu), or give -p open_meshes=parity for the paper's voxelization, which fills the "
-                   "space beyond an open surface");
+// Whether the GPU's rasterization (parity: each fragment flips its column beyond it) builds the
+// grid these options ask for. The CPU's other modes change the solid of open surfaces (slabs), of
+// holed meshes (winding number) and of closed meshes around the camera (the complement).
+bool parity_suffices(const std::vector<MeshClosure>& closure, const VoxelizeOptions& o) {
+  if (o.open_meshes == OpenMeshes::Parity) return true;
+  const bool rooms = std::count(o.rooms.begin(), o.rooms.end(), std::uint8_t{1}) > 0;
+  const bool open = std::any_of(closure.begin(), closure.end(), [](const MeshClosure& c) { return c.open_surface(); });
+  const bool holed = std::any_of(closure.begin(), closure.end(), [](const MeshClosure& c) { return c.holed(); });
+  return !rooms && !open && !(o.open_meshes == OpenMeshes::Winding && holed);
+}
+
+// A grid of `words` 32-bit words must fit in one storage buffer.
+void check_storage(const Context& c, const VoxelGrid& g, std::size_t words) {
+  if (static_cast<double>(words) * 4 > static_cast<double>(c.max_storage_block))
+    throw InputError("cone: a " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.depth_bits) + " voxel grid (" +
+                     std::to_string(words * 4 >> 20) + " MiB) exceeds this GPU's largest storage buffer (" +
+                     std::to_string(c.max_storage_block >> 20) + " MiB, " + c.renderer + "): fewer columns or depth_bits");
+}
+
+// The grid of a scene whose open surfaces, holed meshes or rooms need the CPU's solid: the CPU
+// voxelizes it (voxelize_world, the grid `ao render -m cone` traces, so both devices trace the same
+// bits) and it is uploaded as 32-bit words, the layout the GPU's rasterization writes. Timed as the
+// pass "voxelize on the CPU".
+void upload_cpu_grid(Context& c, SceneBuffers& sb, const std::vector<MeshClosure>& closure, const VoxelizeOptions& o,
+                     std::vector<PassQuery>& passes) {
+  GridCache& cache = state_of(sb).grid;
+  c.begin_pass(passes, "voxelize on the CPU");
+  c.gl.Flush();  // the first timestamp reaches the GPU before the CPU's work
+  VoxelStats stats;
+  VoxelGrid grid = voxelize_world(*sb.scene, closure, o, &stats);
+  const int per_column = grid.depth_bits / 32;
+  const std::size_t columns = static_cast<std::size_t>(grid.nx) * static_cast<std::size_t>(grid.ny);
+  check_storage(c, grid, columns * static_cast<std::size_t>(per_column));
+  // Bit b of a column is bit b % 64 of its 64-bit word b / 64 (voxelize.h); as 32-bit words,
+  // word k of the column holds the half k % 2 of 64-bit word k / 2.
+  std::vector<std::uint32_t> words(columns * static_cast<std::size_t>(per_column));
+  for (std::size_t col = 0; col < columns; ++col)
+    for (int k = 0; k < per_column; ++k)
+      words[col * static_cast<std::size_t>(per_column) + static_cast<std::size_t>(k)] =
+          static_cast<std::uint32_t>(grid.bits[col * static_cast<std::size_t>(grid.words) + static_cast<std::size_t>(k / 2)] >> (32 * (k % 2)));
+  cache.bits = make_buffer(c, words.size() * sizeof(std::uint32_t), words.data());
+  c.end_pass(passes);
+  grid.bits = {};
+  grid.block_bits = {};
+  cache.layout = std::move(grid);
+  cache.stats = stats;
+  cache.options = o;
+  cache.valid = true;
 }
 
 void set_instance(Context& c, Program& p, const Scene& s, const SceneObject& ob) {
@@ -108,9 +137,9 @@ void set_instance(Context& c, Program& p, const Scene& s, const SceneObject& ob)
 void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vector<PassQuery>& passes) {
   o.validate();
   const std::vector<MeshClosure>& closure = closure_of(sb);
-  check_parity_suffices(closure, o);
   GridCache& cache = state_of(sb).grid;
   cache.valid = false;
+  if (!parity_suffices(closure, o)) return upload_cpu_grid(c, sb, closure, o, passes);
   cache.layout = world_layout(*sb.scene, o);
   const VoxelGrid& g = cache.layout;
   if (g.nx > c.max_texture_size)
@@ -120,10 +149,7 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
                               c.geometry_storage ? "" : "#define NO_GEOMETRY_COUNTER\n");
   Program& count = c.program({"cone_count.comp"});
   const std::size_t words = static_cast<std::size_t>(g.nx) * g.ny * (g.depth_bits / 32);
-  if (static_cast<double>(words) * 4 > static_cast<double>(c.max_storage_block))
-    throw InputError("cone: a " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.depth_bits) + " voxel grid (" +
-                     std::to_string(words * 4 >> 20) + " MiB) exceeds this GPU's largest storage buffer (" +
-                     std::to_string(c.max_storage_block >> 20) + " MiB, " + c.renderer + "): fewer columns or depth_bits");
+  check_storage(c, g, words);
   const GLuint zero[4] = {0, 0, 0, 0};
   Buffer counters = make_buffer(c, sizeof zero, zero);
   cache.bits = make_buffer(c, words * sizeof(std::uint32_t), nullptr);
@@ -247,7 +273,7 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
   const float r_max = in.falloff.radius;
   if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
   // The CPU method's own timings in --json, from the GPU passes that do their work.
-  r.report_ms("voxelize_ms", {"voxelize", "count"});
+  r.report_ms("voxelize_ms", {"voxelize", "count", "voxelize on the CPU"});
   r.report_ms("trace_ms", {"cone"});
   r.report_ms("filter_ms", {"filter"});
   VoxelizeOptions options = p.voxelize_options(r_max);

@@ -17,9 +17,10 @@ namespace ao {
 /// gets the counts voxelize_world reports (triangles, fragments, odd columns, set voxels, and the
 /// meshes' closure; triangles stay 0 on a GPU whose geometry stage cannot write storage buffers).
 ///
-/// The GPU voxelizes by parity only (the paper's): InputError for options.open_meshes other than
-/// Parity when the scene has open surfaces (Slab, Winding) or holed meshes (Winding), which the CPU
-/// voxelizes by slabs or winding number.
+/// The GPU rasterizes by parity (the paper's). Where the options ask for another solid (open
+/// surfaces thickened into slabs, holed meshes closed by their winding number, closed meshes around
+/// the camera taken inside out), the grid is the CPU's voxelize_world, uploaded: either way the
+/// grid traced on the GPU is the CPU's, bit for bit.
 VoxelGrid gpu_voxelize_world(GpuDevice& device, const GpuScene& scene, const VoxelizeOptions& options, VoxelStats* stats = nullptr);
 
 }  // namespace ao

@@ -115,8 +115,11 @@ void upload_cpu_grid(Context& c, SceneBuffers& sb, const std::vector<MeshClosure
           static_cast<std::uint32_t>(grid.bits[col * static_cast<std::size_t>(grid.words) + static_cast<std::size_t>(k / 2)] >> (32 * (k % 2)));
   cache.bits = make_buffer(c, words.size() * sizeof(std::uint32_t), words.data());
   c.end_pass(passes);
+  // The cache keeps the layout only: the bits are on the GPU, and the coarse occupancy masks are
+  // the CPU kernel's.
   grid.bits = {};
   grid.block_bits = {};
+  grid.window = {};
   cache.layout = std::move(grid);
   cache.stats = stats;
   cache.options = o;

@@ -84,10 +84,11 @@ bool parity_suffices(const std::vector<MeshClosure>& closure, const VoxelizeOpti
   return !rooms && !open && !(o.open_meshes == OpenMeshes::Winding && holed);
 }
 
-// A grid of `words` 32-bit words must fit in one storage buffer.
-void check_storage(const Context& c, const VoxelGrid& g, std::size_t words) {
+// A grid of nx x ny columns of depth_bits bits must fit in one storage buffer.
+void check_storage(const Context& c, int nx, int ny, int depth_bits) {
+  const std::size_t words = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * static_cast<std::size_t>(depth_bits / 32);
   if (static_cast<double>(words) * 4 > static_cast<double>(c.max_storage_block))
-    throw InputError("cone: a " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.depth_bits) + " voxel grid (" +
+    throw InputError("cone: a " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(depth_bits) + " voxel grid (" +
                      std::to_string(words * 4 >> 20) + " MiB) exceeds this GPU's largest storage buffer (" +
                      std::to_string(c.max_storage_block >> 20) + " MiB, " + c.renderer + "): fewer columns or depth_bits");
 }
@@ -99,13 +100,13 @@ void check_storage(const Context& c, const VoxelGrid& g, std::size_t words) {
 void upload_cpu_grid(Context& c, SceneBuffers& sb, const std::vector<MeshClosure>& closure, const VoxelizeOptions& o,
                      std::vector<PassQuery>& passes) {
   GridCache& cache = state_of(sb).grid;
+  check_storage(c, o.columns, o.columns, o.depth_bits);  // before the CPU's work: the grid's shape is the options'
   c.begin_pass(passes, "voxelize on the CPU");
   c.gl.Flush();  // the first timestamp reaches the GPU before the CPU's work
   VoxelStats stats;
   VoxelGrid grid = voxelize_world(*sb.scene, closure, o, &stats);
   const int per_column = grid.depth_bits / 32;
   const std::size_t columns = static_cast<std::size_t>(grid.nx) * static_cast<std::size_t>(grid.ny);
-  check_storage(c, grid, columns * static_cast<std::size_t>(per_column));
   // Bit b of a column is bit b % 64 of its 64-bit word b / 64 (voxelize.h); as 32-bit words,
   // word k of the column holds the half k % 2 of 64-bit word k / 2.
   std::vector<std::uint32_t> words(columns * static_cast<std::size_t>(per_column));
@@ -152,7 +153,7 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
                               c.geometry_storage ? "" : "#define NO_GEOMETRY_COUNTER\n");
   Program& count = c.program({"cone_count.comp"});
   const std::size_t words = static_cast<std::size_t>(g.nx) * g.ny * (g.depth_bits / 32);
-  check_storage(c, g, words);
+  check_storage(c, g.nx, g.ny, g.depth_bits);
   const GLuint zero[4] = {0, 0, 0, 0};
   Buffer counters = make_buffer(c, sizeof zero, zero);
   cache.bits = make_buffer(c, words * sizeof(std::uint32_t), nullptr);

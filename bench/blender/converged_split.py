@@ -8,21 +8,19 @@
 # the rest. Run by bench/blender/converged_split.sh; by hand:
 #   blender -b --factory-startup --python bench/blender/converged_split.py -- MESH.obj DIR
 # with DIR holding ao-area-{99,7}.exr, ao-centre-{99,7}.exr, cyc-{0,1}.exr.
+import os
 import sys
 
-import bpy
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mesh_io import read_pixels  # noqa: E402
 
 mesh, folder = sys.argv[sys.argv.index("--") + 1:][:2]
 
 
 def pixels(path):
-    image = bpy.data.images.load(path)
-    image.colorspace_settings.name = "Non-Color"
-    w, h = image.size
-    data = np.empty(w * h * 4, dtype=np.float32)
-    image.pixels.foreach_get(data)
-    return data.reshape(h, w, 4)[::-1, :, 0].astype(np.float64)  # rows from the top, as ao writes them
+    return read_pixels(path)[::-1, :, 0].astype(np.float64)  # rows from the top, as ao writes them
 
 
 def overlapping_centres(path, w, h):

@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 # Loading a mesh into Blender's scene for the bench scripts: OBJ through Blender's importer (the
 # file's axes kept), OFF by hand (Blender reads no OFF). Returns the object and the axis arguments
-# that write it back in the file's coordinates (wm.obj_export).
+# that write it back in the file's coordinates (wm.obj_export). read_pixels: an image file's
+# pixels through Blender's loader, so that maps from either baker are read the same way.
 import bpy
+import numpy as np
 
 
 def load_mesh(path, name):
@@ -43,3 +45,14 @@ def bake_image(obj, name, size):
     obj.data.materials.clear()
     obj.data.materials.append(material)
     return image
+
+
+def read_pixels(path):
+    """The RGBA pixels of an image file as read by Blender (non-colour data), h x w x 4 float32,
+    rows from the bottom as Blender stores them."""
+    image = bpy.data.images.load(path)
+    image.colorspace_settings.name = "Non-Color"
+    w, h = image.size
+    data = np.empty(w * h * 4, dtype=np.float32)
+    image.pixels.foreach_get(data)
+    return data.reshape(h, w, 4)

@@ -10,26 +10,19 @@
 # S the mean of MAP minus the mean of REFERENCE over those texels, E = R / sqrt(N) the standard error
 # of MAP's mean were its texels' errors independent (a filtered map's errors are correlated over a
 # few texels, which makes its true standard error a few times larger).
+import os
 import sys
 
-import bpy
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mesh_io import read_pixels  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
 flip = "--flip" in args
 paths = [a for a in args if a != "--flip"]
 
-
-def pixels(path):
-    image = bpy.data.images.load(path)
-    image.colorspace_settings.name = "Non-Color"
-    w, h = image.size
-    data = np.empty(w * h * 4, dtype=np.float32)
-    image.pixels.foreach_get(data)
-    return data.reshape(h, w, 4)
-
-
-a, b = pixels(paths[0]), pixels(paths[1])
+a, b = read_pixels(paths[0]), read_pixels(paths[1])
 if flip:
     a = a[::-1]
 mask = (a[..., 0] > 1e-6) & (b[..., 0] > 0)

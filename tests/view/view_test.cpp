@@ -74,21 +74,25 @@ TEST(ViewOrbit, ZoomAndPanKeepTheDirection) {
   EXPECT_LT(length(normalize(o.target - o.eye) - dir), 1e-4f);
 }
 
+// Every corner of `b` projects into the camera's image.
+void expect_corners_inside(const Camera& o, const Bounds3& b) {
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
+    const Vec2 p = o.project(o.world_to_camera_point(corner));
+    EXPECT_GE(p.x, 0.0f) << "corner " << i;
+    EXPECT_LE(p.x, static_cast<float>(o.width)) << "corner " << i;
+    EXPECT_GE(p.y, 0.0f) << "corner " << i;
+    EXPECT_LE(p.y, static_cast<float>(o.height)) << "corner " << i;
+  }
+}
+
 TEST(ViewOrbit, FrameAllPutsEveryCornerInTheImage) {
   view::OrbitCamera orbit(start_camera());
   Bounds3 b;
   b.extend(Vec3{10, 10, 10});
   b.extend(Vec3{14, 12, 11});
   orbit.frame(b, 320, 180);
-  const Camera o = orbit.camera(320, 180);
-  for (int i = 0; i < 8; ++i) {
-    const Vec3 corner{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
-    const Vec2 p = o.project(o.world_to_camera_point(corner));
-    EXPECT_GE(p.x, 0.0f);
-    EXPECT_LE(p.x, 320.0f);
-    EXPECT_GE(p.y, 0.0f);
-    EXPECT_LE(p.y, 180.0f);
-  }
+  expect_corners_inside(orbit.camera(320, 180), b);
 }
 
 TEST(ViewOrbit, FrameAllFitsANarrowImage) {
@@ -98,13 +102,7 @@ TEST(ViewOrbit, FrameAllFitsANarrowImage) {
   b.extend(Vec3{-4, 0, -1});
   b.extend(Vec3{4, 1, 1});
   orbit.frame(b, 90, 320);
-  const Camera o = orbit.camera(90, 320);
-  for (int i = 0; i < 8; ++i) {
-    const Vec3 corner{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
-    const Vec2 p = o.project(o.world_to_camera_point(corner));
-    EXPECT_GE(p.x, 0.0f);
-    EXPECT_LE(p.x, 90.0f);
-  }
+  expect_corners_inside(orbit.camera(90, 320), b);
 }
 
 TEST(ViewOrbit, ZUpStaysZUp) {

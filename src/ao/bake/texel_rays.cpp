@@ -152,19 +152,21 @@ void patch_guide(const std::vector<PatchPiece>& patch, bool geometric, Vec3& pos
 
 void TexelPoints::generate(std::uint32_t key, int samples) {
   const auto n = static_cast<std::size_t>(samples);
-  for (int d = 0; d < 4; ++d) {
-    u[d].resize(n);
-    scratch[d].resize(n);
-  }
+  // Grid of 2^c cells, 2^c the largest power of two <= samples / 16, as square as it goes.
+  int c = 0;
+  while ((32 << c) <= samples) ++c;
+  // One cell (fewer than 32 samples): direction order is index order, so the points go straight
+  // to u, without the sort.
+  std::vector<float>(&dest)[4] = c == 0 ? u : scratch;
+  for (int d = 0; d < 4; ++d) dest[d].resize(n);
   alignas(64) float batch[4][16];
   for (int first = 0; first < samples; first += 16) {
     const int count = std::min(16, samples - first);
     sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, batch);
-    for (int d = 0; d < 4; ++d) std::copy_n(batch[d], count, scratch[d].begin() + first);
+    for (int d = 0; d < 4; ++d) std::copy_n(batch[d], count, dest[d].begin() + first);
   }
-  // Grid of 2^c cells, 2^c the largest power of two <= samples / 16, as square as it goes.
-  int c = 0;
-  while ((32 << c) <= samples) ++c;
+  if (c == 0) return;
+  for (int d = 0; d < 4; ++d) u[d].resize(n);
   const int cols = 1 << ((c + 1) / 2), rows = 1 << (c / 2);
   cell_of.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

@@ -140,9 +140,10 @@ inline void narrow_to_cone(const float (&u)[4][16], int count, float radius, flo
 /// arrays, one lane per ray).
 struct TexelRayBatch {
   static constexpr int kWidth = 16;
-  alignas(64) float ox[kWidth], oy[kWidth], oz[kWidth];
-  alignas(64) float dx[kWidth], dy[kWidth], dz[kWidth];
-  alignas(64) int valid[kWidth];  ///< -1: a ray to trace; 0: no ray (a direction below the face, mu = 0, or a lane past the count).
+  // Zero at first: lanes past a batch's count keep what an earlier batch left there, finite.
+  alignas(64) float ox[kWidth]{}, oy[kWidth]{}, oz[kWidth]{};
+  alignas(64) float dx[kWidth]{}, dy[kWidth]{}, dz[kWidth]{};
+  alignas(64) int valid[kWidth]{};  ///< -1: a ray to trace; 0: no ray (a direction below the face, mu = 0, or a lane past the count).
 };
 
 /// A texel's sample points, points 0 .. samples - 1 of the 4-D Owen-scrambled Sobol set keyed by
@@ -155,6 +156,7 @@ struct TexelRayBatch {
 /// The set of samples, and so the texel's mean, is the one sobol_owen_4d gives in index order.
 struct TexelPoints {
   std::vector<float> u[4];  ///< Dimension d of the j-th point in direction order.
+  // The sort's scratch (unused below 32 samples: one cell, index order).
   std::vector<std::uint32_t> cell_count;
   std::vector<std::uint32_t> cell_of;  ///< Grid cell of each point in index order.
   std::vector<float> scratch[4];
@@ -219,8 +221,9 @@ struct PatchTable {
 /// cosine-weighted direction about the unit normal at the point, 2-3 pick the point with
 /// sample_patch). The normal is the interpolated one, or the face normal when `geometric`; the
 /// origin is the point pushed off along the face normal by the table's offset; a direction with
-/// d . ng <= 0 is no ray. The same rays as sample_patch, Frame and cosine_hemisphere make,
-/// computed lane-parallel: the arithmetic runs in SIMD registers across the 16 lanes and the
+/// d . ng <= 0 is no ray, as is every lane from `count` on (only its valid flag is written beyond
+/// the vectors that hold the count). The same rays as sample_patch, Frame and cosine_hemisphere
+/// make, computed lane-parallel: the arithmetic runs in SIMD registers across the lanes and the
 /// concentric map's sine and cosine are polynomials (error under 1e-7).
 void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& table, const float (&u)[4][16], int count, bool geometric,
                      TexelRayBatch& out);

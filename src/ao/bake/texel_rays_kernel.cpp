@@ -82,6 +82,8 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
   const DF d;
   const DI di;
   const int lanes = static_cast<int>(hn::Lanes(d));
+  // The vectors that hold the count's lanes: the rest of the batch is only marked "no ray".
+  const int used = (count + lanes - 1) / lanes * lanes;
   // Per lane, the piece (sample_patch's: the first whose cumulative area exceeds u2 * total; the
   // cumulative areas are non-decreasing) and its fields, gathered from the texel's table into lane
   // rows, so that the arithmetic below reads whole vectors.
@@ -89,7 +91,7 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
   alignas(64) float target[W];
   alignas(64) int piece[W];
   const VF total = hn::Set(d, patch.back().cdf);
-  for (int k = 0; k < W; k += lanes) {
+  for (int k = 0; k < used; k += lanes) {
     const VF tk = hn::Mul(hn::LoadU(d, u[2] + k), total);
     VI pk = hn::Zero(di);
     for (std::size_t j = 0; j + 1 < patch.size(); ++j)
@@ -99,17 +101,17 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
   }
   if (patch.size() <= static_cast<std::size_t>(lanes)) {
     // Few pieces (the common case): a permute within one register per field.
-    for (int k = 0; k < W; k += lanes) {
+    for (int k = 0; k < used; k += lanes) {
       const auto pk = hn::IndicesFromVec(d, hn::Load(di, piece + k));
       for (int q = 0; q < T::kFields; ++q) hn::Store(hn::TableLookupLanes(hn::Load(d, table.f[q]), pk), d, lane[q] + k);
     }
   } else if (patch.size() <= T::kMaxPieces) {
-    for (int k = 0; k < W; k += lanes) {
+    for (int k = 0; k < used; k += lanes) {
       const VI pk = hn::Load(di, piece + k);
       for (int q = 0; q < T::kFields; ++q) hn::Store(lookup16(table.f[q], pk), d, lane[q] + k);
     }
   } else {
-    for (int k = 0; k < W; ++k) {
+    for (int k = 0; k < used; ++k) {
       float v[T::kFields];
       table.piece_fields(patch, static_cast<std::size_t>(piece[k]), v);
       for (int q = 0; q < T::kFields; ++q) lane[q][k] = v[q];
@@ -117,7 +119,8 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
   }
   const VF zero = hn::Zero(d), one = hn::Set(d, 1.0f), tiny = hn::Set(d, 1e-6f);
   const MF all_face = hn::RebindMask(d, hn::Ne(hn::Set(di, geometric ? 1 : 0), hn::Zero(di)));
-  for (int k = 0; k < W; k += lanes) {
+  for (int k = used; k < W; ++k) out.valid[k] = 0;
+  for (int k = 0; k < used; k += lanes) {
     // The point: corner weights (1 - r, r (1 - t), r t), r = sqrt(s), as sample_patch, s clamped to [0, 1].
     VF su = hn::Mul(hn::Sub(hn::Load(d, target + k), hn::Load(d, lane[T::kLo] + k)), hn::Load(d, lane[T::kInvSpan] + k));
     su = hn::IfThenElse(hn::Lt(su, zero), zero, su);

@@ -51,6 +51,17 @@ def test_the_ao_family_equals_cli(ao_binary, grid_obj, tmp_path):
         ao.bake(grid_obj, 32, bent_normals_space="tangnet", bent_normals=True)
 
 
+def test_texel_sampling_errors_name_what_the_caller_wrote(grid_obj):
+    # texel_sampling is one of the baker's **params: a bad value names it and its choices, and
+    # centre with per-vertex AO names the per-vertex bake, not an argument the caller did not pass.
+    with pytest.raises(ao.InputError, match="texel_sampling.*area.*centre"):
+        ao.bake(grid_obj, 16, texel_sampling="middle")
+    with pytest.raises(ao.InputError, match="^texel_sampling centre is for maps: a vertex has no texel") as e:
+        ao.bake(grid_obj, map=False, per_vertex=True, texel_sampling="centre")
+    assert "per_vertex_output" not in str(e.value)
+    assert ao.bake(grid_obj, 16, samples=4, texel_sampling="centre").shape == (16, 16)
+
+
 def test_scene_tangents_are_unit_and_perpendicular(grid_obj):
     scene = ao.Scene.load(grid_obj)
     t = scene.tangents()

@@ -240,7 +240,7 @@ void resolve_baker_settings(Plan& plan) {
   r.histogram.validate();
   if (r.raytraced.texel_sampling == TexelSampling::Centre) {
     if (r.method == Baker::Histogram) throw InputError(field(fields::kBakeTexelSampling) + " is the ray-traced baker's; the histogram baker samples each texel's patch");
-    if (!r.outputs.per_vertex.empty()) throw InputError(field(fields::kBakeTexelSampling) + " centre is for maps: a vertex has no texel, so drop it or " + field(fields::kBakePerVertex));
+    if (!r.outputs.per_vertex.empty()) throw InputError(field(fields::kBakeTexelSampling) + " centre is for maps: a vertex has no texel; bake per-vertex AO without it");
     if (plan.high_to_low()) throw InputError(field(fields::kBakeTexelSampling) + " centre is for single-mesh maps: high to low casts from each texel's patch of the cage");
   }
   check_family(plan);

@@ -90,8 +90,14 @@ row() {
   printf '%s\t%s\t%s\t%s\t%s\n' "$1" "$2" "$(cut -d' ' -f1 <<< "$own")" "$other" "$8" >> "$out/rows.tsv"
 }
 
+# The references load the machine: the rounds start once the load average has settled below 2 again
+# (at most 5 minutes), so that their first rows are not timed on a machine still busy.
+for _ in $(seq 30); do
+  python3 -c "import sys; sys.exit(0 if float(open('/proc/loadavg').read().split()[0]) < 2 else 1)" && break
+  sleep 10
+done
 : > "$out/rows.tsv"
-echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)${ALLOW_LOAD:+ (ALLOW_LOAD: CPU seconds not comparable above 2)}"
+echo "load average before the rounds: $(cut -d' ' -f1-3 /proc/loadavg)${ALLOW_LOAD:+ (ALLOW_LOAD: CPU seconds not comparable above 2)}"
 echo
 echo "| baker | setting | RMSE vs its own converged map | mean - own | SE of mean | RMSE vs the other's converged map | bake s | process s | process CPU s |"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|"
@@ -124,6 +130,6 @@ for spp in ${SAMPLES:-64 256}; do
 done
 done
 echo
-echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "load average after the rounds: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
 python3 "$here/compare_summary.py" "$out/rows.tsv"

@@ -3,13 +3,15 @@
 """Rays per second of `ao bake` against `ao render` on the same mesh and threads, in one alternated run.
 
     bench/tools/bake_ray_rate.py MESH [--ao build/src/ao] [--baseline OLD_AO] [--pairs 5] [--threads 2]
-                                 [--size 1024] [--samples 24] [--spp 64]
+                                 [--size 1024] [--samples 24] [--spp 64] [--render-radius R]
 
 Each round runs, one after the other, `ao bake MESH -s SIZE --samples SAMPLES --denoise 0 --json`
 (with --baseline: the same with OLD_AO too) and `ao render MESH --spp SPP --json`, so every round's
 commands see the same machine load. The bake's rate is its ray count over its bake call
 (stats.rays / timings.bake_ms: the texels' rays, without loading, coverage, BVH and writing); the
-render's is its own rays_per_second (rays over the AO pass). Reported: the median of each rate,
+render's is its own rays_per_second (rays over the AO pass). The render's rays stop at its radius
+(0.1 of the mesh's diagonal by default) and the bake's do not: --render-radius 1e6 gives the render
+rays as long as the bake's, the comparison at equal ray length. Reported: the median of each rate,
 the median and range of the per-round ratios bake / render (and new bake / baseline bake), and
 the bake call's parts (UV coverage against the bake call, medians). The load average is printed
 before and after: on a shared machine only the ratios within one run mean anything.
@@ -34,7 +36,8 @@ def bake(ao, mesh, opts, out):
 
 
 def render(ao, mesh, opts, out):
-    d = run_json([ao, "--threads", str(opts.threads), "-q", "render", mesh, "--spp", str(opts.spp), "-o", out, "--json"])
+    radius = ["-R", str(opts.render_radius)] if opts.render_radius else []
+    d = run_json([ao, "--threads", str(opts.threads), "-q", "render", mesh, "--spp", str(opts.spp), *radius, "-o", out, "--json"])
     return {"rate": d["rays_per_second"]}
 
 
@@ -52,6 +55,7 @@ def main():
     p.add_argument("--size", type=int, default=1024)
     p.add_argument("--samples", type=int, default=24)
     p.add_argument("--spp", type=int, default=64)
+    p.add_argument("--render-radius", type=float, help="the render's -R (default: its own, 0.1 of the diagonal)")
     opts = p.parse_args()
     print("load average before:", " ".join("%.2f" % x for x in os.getloadavg()))
     rows = []

@@ -3,7 +3,7 @@
 # `ao bake` against Blender Cycles' AO bake of the same mesh and UVs at equal error (BENCHMARKS.md,
 # "bake"), single mesh or high to low. Needs Debian's blender and python3-numpy (not installed by
 # scripts/setup: a benchmark check, not a dependency of ao).
-#   [SAMPLES="64 256"] [AO_SETTINGS="16:1 24:1 64:1 64:0"] [ROUNDS=3] [HIGH=high.obj|high.off [LOW_RATIO=0.05]]
+#   [SAMPLES="64 256"] [AO_SETTINGS="RAYS:DENOISE[:CAGE_POINTS] ..."] [ROUNDS=3] [HIGH=high.obj|high.off [LOW_RATIO=0.05]]
 #   [CYCLES_REFERENCE=1024] [ALLOW_LOAD=1] bench/blender/compare.sh [MESH.obj|MESH.off] [SIZE] [OUT_DIR]
 # Without HIGH: MESH (with UVs) is baked into its own UVs. With HIGH: high to low; MESH is the low
 # mesh, or, when it is HIGH itself, the low mesh is made from it (bench/blender/make_low.py: Blender's
@@ -105,7 +105,7 @@ settings="${AO_SETTINGS:-}"
 if [ -z "$settings" ]; then
   for spp in ${SAMPLES:-64 256}; do [ "$spp" -le 128 ] && settings="$settings $spp:default"; done
 fi
-for round in $(seq "${ROUNDS:-1}"); do
+for round in $(seq "${ROUNDS:-3}"); do
 for setting in $settings; do
   IFS=: read -r spp sigma points <<< "$setting"
   args=(--samples "$spp")

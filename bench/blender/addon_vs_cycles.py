@@ -11,7 +11,9 @@
 # every setting once, the bakers alternated; a bake's cost is the process's CPU seconds over the
 # operator call (time.process_time: every thread of the process, the add-on's mesh conversion and
 # Cycles' BVH build included) and its wall seconds. Errors: RMSE over the texels both references
-# cover. Prints the load average before and after, and a markdown table of medians.
+# cover. Refuses to start above load average 2 (ALLOW_LOAD=1 runs it and marks it); prints the load
+# average before and after, a markdown table of medians, and for each Cycles setting the cheapest ao
+# setting at its error with the ratio of CPU seconds (compare_summary.verdict).
 import os
 import statistics
 import sys
@@ -21,6 +23,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import compare_summary  # noqa: E402
 from mesh_io import bake_image, load_mesh  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
@@ -97,7 +100,11 @@ def cached(name, make):
     return m
 
 
-print("load average before:", " ".join("%.2f" % x for x in os.getloadavg()), flush=True)
+refusal = compare_summary.load_refusal()
+if refusal:
+    sys.exit("addon_vs_cycles.py: " + refusal)
+print("load average before:", " ".join("%.2f" % x for x in os.getloadavg()),
+      "(ALLOW_LOAD: CPU seconds not comparable above %g)" % compare_summary.LOAD_LIMIT if os.environ.get("ALLOW_LOAD") else "", flush=True)
 ref_ao = cached(f"ao-reference-{reference}", lambda: bake_ao(reference, 0.0, seed=99))
 ref_cy = cached(f"cycles-reference-{reference}", lambda: bake_cycles(reference))
 mask = (ref_ao > 0) & (ref_cy > 0)
@@ -118,3 +125,6 @@ print("|---|---|---:|---:|---:|---:|")
 for (baker, setting), runs in rows.items():
     print(f"| {baker} | {setting} | {statistics.median(r[0] for r in runs):.5f} | {statistics.median(r[1] for r in runs):.2f} | "
           f"{statistics.median(r[2] for r in runs):.2f} | {len(runs)} |")
+print()
+print("\n".join(compare_summary.verdict({(baker, setting): {"own": statistics.median(r[0] for r in runs), "cpu": statistics.median(r[1] for r in runs)}
+                                         for (baker, setting), runs in rows.items()})))

@@ -38,12 +38,10 @@ secs() { python3 -c "print(f'{$2 - $1:.2f}')"; }
 # Runs a command, its CPU seconds (user + system, children included) into $out/cpu.
 timed() { /usr/bin/time -f '%U %S' -o "$out/cpu.raw" "$@"; awk '{printf "%.2f", $1 + $2}' "$out/cpu.raw" > "$out/cpu"; }
 
-load_before=$(cut -d' ' -f1 /proc/loadavg)
-if python3 -c "import sys; sys.exit(0 if float('$load_before') > 2 else 1)"; then
-  if [ -z "${ALLOW_LOAD:-}" ]; then
-    echo "compare.sh: load average $load_before is above 2: CPU seconds are not comparable there (Blender's process inflates more than ao's); rerun on a quiet machine, or set ALLOW_LOAD=1 to run it anyway (the table is marked)" >&2
-    exit 1
-  fi
+refusal=$(python3 -c "import sys; sys.path.insert(0, '$here'); import compare_summary; print(compare_summary.load_refusal() or '')")
+if [ -n "$refusal" ]; then
+  echo "compare.sh: $refusal" >&2
+  exit 1
 fi
 
 h2l=() bl_h2l=()

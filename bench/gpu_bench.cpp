@@ -18,6 +18,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/registry/methods_gpu.h"
 #include "ao/methods/cone/voxelize_gpu.h"

@@ -9,11 +9,13 @@
 
 #include "ao/core/closest_name.h"
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 #include "ao/io/mesh_io.h"
 #include "ao/jobs/bake.h"
 #include "ao/jobs/compare.h"
 #include "ao/jobs/points.h"
 #include "ao/jobs/render.h"
+#include "ao/jobs/render_view.h"
 #include "ao/reference/ray_scene.h"
 #include "ao/registry/registry.h"
 #include "call.h"

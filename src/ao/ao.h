@@ -19,7 +19,7 @@
 #include "ao/version.h"
 
 // core: math, affine maps, images, G-buffers, cameras, sampling, membership functions, parallel
-// tiles, parameter tables, memory estimates, stopwatch, errors and the closest name they suggest.
+// tiles, parameter tables, JSON values held by pointer, memory estimates, stopwatch, errors and the closest name they suggest.
 #include "ao/core/affine.h"
 #include "ao/core/camera.h"
 #include "ao/core/closest_name.h"
@@ -28,11 +28,13 @@
 #include "ao/core/hash_shared.h"
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
+#include "ao/core/json_value.h"
 #include "ao/core/math.h"
 #include "ao/core/membership.h"
 #include "ao/core/memory.h"
 #include "ao/core/parallel.h"
 #include "ao/core/params.h"
+#include "ao/core/params_table.h"
 #include "ao/core/progress.h"
 #include "ao/core/sampling.h"
 #include "ao/core/shared.h"  // the prelude of the *_shared.h headers, which C++ and the GPU shaders both read
@@ -131,7 +133,8 @@
 
 // jobs: render, bake, compare and tune as library calls, with the ao command's defaults; what
 // every job starts from (scene, camera, falloff), frame-after-frame rendering, progress reports;
-// AO at given points; the request fields errors name; the provenance records of outputs.
+// AO at given points; the request fields errors name; the provenance records of outputs; one view
+// of a prepared scene (render_view.h: what the viewer runs per frame).
 #include "ao/jobs/bake.h"
 #include "ao/jobs/compare.h"
 #include "ao/jobs/contact_sheet.h"
@@ -143,5 +146,6 @@
 #include "ao/jobs/progress_meter.h"
 #include "ao/jobs/provenance.h"
 #include "ao/jobs/render.h"
+#include "ao/jobs/render_view.h"
 #include "ao/jobs/reporter.h"
 #include "ao/jobs/tune.h"

@@ -9,6 +9,7 @@
 #include "ao/bake/denoise.h"
 #include "ao/core/error.h"
 #include "ao/core/params.h"
+#include "ao/core/params_table.h"
 #include "ao/jobs/bake.h"
 #include "common.h"
 #include "subcommands.h"

@@ -7,11 +7,13 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "ao/core/error.h"
 #include "ao/core/membership.h"
 #include "ao/io/image_io.h"
 #include "ao/jobs/render.h"
+#include "ao/registry/registry.h"
 #include "common.h"
 #include "subcommands.h"
 
@@ -79,7 +81,7 @@ RenderRequest make_request(const RenderOptions& o) {
   r.camera = camera_request(o.camera);
   r.falloff = falloff_request(o.falloff);
   if (o.normal) r.normal = surface_normal_from_name(*o.normal);
-  apply_param_overrides(r.params, o.params, method.name, o.ao_map.empty() ? method.default_params() : nlohmann::json::object());
+  apply_param_overrides(*r.params, o.params, method.name, o.ao_map.empty() ? method.default_params() : nlohmann::json::object());
   if (o.sun) r.sun = parse_sun(*o.sun);
   r.device = device_from_name(o.device);
   r.outputs.visibility = o.output;
@@ -96,7 +98,7 @@ void print_summary(const RenderResult& out) {
   const nlohmann::json& stats = out.output.stats;
   if (stats.contains("mean_std_error"))
     std::fprintf(stderr, "  standard error: mean %.4f, max %.4f; %.1f M rays/s\n", stats["mean_std_error"].get<double>(),
-                 stats["max_std_error"].get<double>(), out.summary.value("rays_per_second", 0.0) / 1e6);
+                 stats["max_std_error"].get<double>(), out.summary->value("rays_per_second", 0.0) / 1e6);
   if (out.device == Device::Gpu)
     std::fprintf(stderr, "  GPU %s: %s\n", out.gl_renderer.c_str(), describe_gpu_passes(out.gpu_passes).c_str());
 }
@@ -107,7 +109,7 @@ int run(const RenderOptions& o, const GlobalOptions& global) {
   StderrReporter report(global, o.json);
   const RenderResult out = run_render(request, report.reporter());
   report.end_stage();
-  if (o.json) std::cout << out.summary.dump(2) << "\n";
+  if (o.json) std::cout << out.summary->dump(2) << "\n";
   else print_summary(out);
   return 0;
 }

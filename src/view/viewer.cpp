@@ -5,6 +5,7 @@
 // and the frame statistics hud.cpp, the image's bytes display.cpp.
 #include "view/viewer.h"
 
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -268,7 +269,7 @@ class Viewer final : public ViewerControls {
     result_ = m.ground_truth ? MethodOutput{} : frames_.run(params, state_.falloff, state_.seed);
     times.method = ms_since(t);
     add_gpu_passes(frames_.gpu_passes());
-    if (result_.stats.contains("filter_ms")) {
+    if (result_.stats->contains("filter_ms")) {
       times.filter = result_.stats["filter_ms"].get<double>();
       times.method = std::max(0.0, times.method - times.filter);
     }

@@ -10,6 +10,8 @@
 #include <string>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/error.h"
 #include "ao/registry/methods_gpu.h"
 #include "gpu/gpu_support.h"

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
 #include "ao/core/error.h"

@@ -6,6 +6,7 @@
 #include "ao/reference/raytraced.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <cmath>

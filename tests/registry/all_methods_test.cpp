@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
 #include "ao/core/error.h"
@@ -117,17 +118,17 @@ TEST_P(AllMethods, DefaultsAreTheTablesDefaults) {
 // A valid value other than the default, of the parameter's type.
 nlohmann::json other_value(const ParamSpec& s) {
   switch (s.type) {
-    case ParamType::Bool: return !s.default_value.get<bool>();
-    case ParamType::Enum: return s.enum_names.front() == s.default_value ? s.enum_names.back() : s.enum_names.front();
+    case ParamType::Bool: return !(*s.default_value).get<bool>();
+    case ParamType::Enum: return s.enum_names.front() == (*s.default_value) ? s.enum_names.back() : s.enum_names.front();
     case ParamType::Int:
     case ParamType::OptionalInt: {
       const int lo = static_cast<int>(s.range.min_open ? s.range.min + 1 : s.range.min);
-      return s.default_value == lo ? nlohmann::json(static_cast<int>(s.range.max_open ? s.range.max - 1 : s.range.max)) : nlohmann::json(lo);
+      return (*s.default_value) == lo ? nlohmann::json(static_cast<int>(s.range.max_open ? s.range.max - 1 : s.range.max)) : nlohmann::json(lo);
     }
     case ParamType::Float:
     case ParamType::OptionalFloat:
       for (double v : {0.3, 0.7, 1.5, 45.5})
-        if (s.range.contains(v) && s.default_value != v) return v;
+        if (s.range.contains(v) && (*s.default_value) != v) return v;
   }
   return nullptr;
 }

@@ -28,6 +28,7 @@
 #include "ao/bake/padding.h"
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/simd/sampling_internal.h"
 #include "ao/reference/embree_scene_internal.h"

@@ -41,6 +41,7 @@
 #include "ao/bake/ortho_raster.h"
 #include "ao/bake/padding.h"
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/bake/histogram_kernel_internal.h"
 

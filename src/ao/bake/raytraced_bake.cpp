@@ -29,6 +29,7 @@
 #include "ao/bake/denoise.h"
 #include "ao/bake/texel_rays_internal.h"
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/mean_accumulator_internal.h"
 #include "ao/reference/ray_offset.h"

@@ -2,7 +2,10 @@
 #include "ao/core/params.h"
 
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
+
+#include <nlohmann/json.hpp>
 
 #include "ao/core/closest_name.h"
 #include "ao/core/error.h"
@@ -150,10 +153,14 @@ bool in_range(const ParamSpec& spec, const nlohmann::json& j) {
 std::string params_markdown(const std::vector<ParamSpec>& specs) {
   std::string s = "| parameter | valid values | default | meaning |\n|---|---|---|---|\n";
   for (const ParamSpec& p : specs) {
-    std::string def = p.default_value.is_null() ? "null" : json_text(p.default_value);
+    std::string def = p.default_value->is_null() ? "null" : json_text(p.default_value);
     s += "| `" + p.name + "` | " + p.valid_text() + " | " + def + " | " + p.help + " |\n";
   }
   return s;
 }
+
+nlohmann::json ParamSchema::defaults() const { return canonical_(nlohmann::json::object()); }
+
+nlohmann::json ParamSchema::canonical(const nlohmann::json& j) const { return canonical_(j); }
 
 }  // namespace ao

@@ -3,6 +3,8 @@
 
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/jobs/fields.h"
@@ -15,10 +17,6 @@ Device device_from_name(const std::string& name) {
   if (name == "cpu") return Device::Cpu;
   if (name == "gpu") return Device::Gpu;
   throw InputError(field(fields::kDevice) + ": cpu or gpu, got '" + name + "'" + did_you_mean(name, "cpu, gpu"));
-}
-
-void check_device(Device device, const MethodParams& params) {
-  if (device == Device::Gpu) check_gpu_method(params);
 }
 
 std::string describe_gpu_passes(std::span<const GpuPassTime> passes) {

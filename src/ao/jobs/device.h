@@ -8,10 +8,9 @@
 #include <span>
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/gpu/device.h"
-#include "ao/registry/registry.h"
 
 namespace ao {
 
@@ -25,12 +24,6 @@ enum class Device {
 const char* to_string(Device device);
 /// The device called `name` ("cpu" or "gpu"); InputError "--device: cpu or gpu, got 'x'" otherwise.
 Device device_from_name(const std::string& name);
-
-/// The checks of running the method of `params` on `device` that need no scene and no device:
-/// nothing for the CPU; for the GPU, check_gpu_method (InputError naming what the GPU backend does
-/// not run and the way out, --device cpu). A library built without the backend says so when the
-/// device is opened.
-void check_device(Device device, const MethodParams& params);
 
 /// The GPU passes as people read them, in the order they ran: "upload 0.41 ms, volumetric 32.6 ms,
 /// filter 25.4 ms" (three significant digits).

@@ -4,6 +4,7 @@
 #include "ao/core/error.h"
 #include "ao/registry/methods_gpu.h"
 #include "ao/jobs/render.h"
+#include "ao/jobs/render_view.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao {

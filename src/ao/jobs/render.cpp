@@ -4,6 +4,8 @@
 #include <cctype>
 #include <chrono>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/closest_name.h"
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
@@ -16,6 +18,7 @@
 #include "ao/io/output_set.h"
 #include "ao/jobs/fields.h"
 #include "ao/jobs/provenance.h"
+#include "ao/jobs/render_view.h"
 #include "ao/core/stopwatch.h"
 #include "ao/reference/ray_scene.h"
 
@@ -226,12 +229,16 @@ nlohmann::json summary_of(const RenderRequest& r, const RenderResult& out, const
     s["gl_renderer"] = out.gl_renderer;
     s["gpu_passes"] = gpu_passes_json(out.gpu_passes);
   }
-  if (out.output.stats.contains("rays") && out.method_ms > 0)
+  if (out.output.stats->contains("rays") && out.method_ms > 0)
     s["rays_per_second"] = out.output.stats["rays"].get<double>() / (out.method_ms / 1000.0);
   return s;
 }
 
 }  // namespace
+
+void check_device(Device device, const MethodParams& params) {
+  if (device == Device::Gpu) check_gpu_method(params);
+}
 
 MethodParams method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples,
                            std::optional<float> target_error) {
@@ -343,7 +350,7 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   out.falloff = choose_falloff(r.falloff, in.diagonal);
   if (!in.ao_map.empty()) {
     out.output.visibility = visibility_from_ao_map(in.gbuffer, *in.scene->scene, in.ao_map, r.ao_map.string());
-    out.output.stats = {{"ao_map", r.ao_map.string()}, {"map_width", in.ao_map.width()}, {"map_height", in.ao_map.height()}};
+    out.output.stats = nlohmann::json{{"ao_map", r.ao_map.string()}, {"map_width", in.ao_map.width()}, {"map_height", in.ao_map.height()}};
   } else if (gpu) {
     reporter.start(out.method + " (gpu)");
     run_on_gpu(*gpu, *params, in, r.seed, out);
@@ -354,7 +361,7 @@ RenderResult run_render(const RenderRequest& r, const JobReporter& reporter) {
   out.method_ms = clock.lap_ms();
   timings["ao_ms"] = out.method_ms;
   // Methods report problems they worked around (e.g. cone: open meshes, odd voxel columns).
-  if (out.output.stats.contains("warnings"))
+  if (out.output.stats->contains("warnings"))
     for (const auto& w : out.output.stats["warnings"]) reporter.warn(w.get<std::string>());
 
   out.gbuffer = std::move(in.gbuffer);

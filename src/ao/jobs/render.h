@@ -18,16 +18,17 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/gbuffer.h"
+#include "ao/core/json_value.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/gpu/device.h"
 #include "ao/jobs/device.h"
 #include "ao/jobs/inputs.h"
 #include "ao/jobs/reporter.h"
+#include "ao/methods/method.h"
 #include "ao/reference/direct_light.h"
-#include "ao/registry/registry.h"
 
 namespace ao {
 
@@ -51,7 +52,7 @@ struct RenderRequest {
   /// The caller's own G-buffer instead of a scene (screen-space methods only); wins over gbuffer_file.
   std::shared_ptr<const GBuffer> gbuffer;
   std::string method = "raytraced";  ///< A registry name (all_methods()).
-  nlohmann::json params = nlohmann::json::object();  ///< Overrides of the method's parameters (its table's names).
+  JsonValue params = JsonValue::object();  ///< Overrides of the method's parameters (its table's names), a JSON object.
   std::optional<int> samples;          ///< Sets the method's MethodInfo::samples_param.
   std::optional<float> target_error;   ///< Sets the method's MethodInfo::target_error_param.
   CameraRequest camera;                ///< 1280 x 720 unless given.
@@ -71,7 +72,7 @@ struct RenderRequest {
 struct RenderResult {
   std::string scene;        ///< Its name (the G-buffer file's path for a G-buffer input).
   std::string method;       ///< The registry name, or "ao-map".
-  nlohmann::json params;    ///< Complete (the table's canonical form); empty object for ao-map.
+  JsonValue params;         ///< Complete (the table's canonical form); empty object for ao-map.
   Falloff falloff;
   std::string normal;       ///< "shading", "geometric", or "file" for a G-buffer input.
   GBuffer gbuffer;
@@ -84,7 +85,7 @@ struct RenderResult {
   Device device = Device::Cpu;   ///< Where the method ran.
   std::string gl_renderer;       ///< GL_RENDERER of the GPU device ("llvmpipe (LLVM 15.0.6, 256 bits)"); empty on the CPU.
   std::vector<GpuPassTime> gpu_passes;  ///< GPU time of each pass in the order they ran (upload, the method's); empty on the CPU.
-  nlohmann::json summary;        ///< What `ao render --json` prints (parameters, timings, rays/s, ...).
+  JsonValue summary;             ///< What `ao render --json` prints (parameters, timings, rays/s, ...).
 };
 
 /// The checks that need no file: the method, its parameters, the camera, the falloff, the output
@@ -106,26 +107,5 @@ std::filesystem::path default_render_output(const RenderRequest& request);
 /// (InputError before any work when one names another), checks memory, loads, renders the
 /// G-buffer and the method, and writes the outputs asked for together at the end.
 RenderResult run_render(const RenderRequest& request, const JobReporter& reporter = {});
-
-// ---- One view of a prepared scene: what run_render does after loading, and the viewer per frame.
-
-/// The method's parameters, decoded once: its defaults, then `samples` and `target_error` where
-/// the method has them (InputError where it has not), then `overrides`; checked by its table.
-/// params_json (registry.h) gives them back complete, for an echo.
-MethodParams method_params(const MethodInfo& method, const nlohmann::json& overrides, std::optional<int> samples = {},
-                           std::optional<float> target_error = {});
-
-/// The G-buffer channels a render needs: albedo for screen-space methods (and the sun pass, a
-/// shaded picture, a G-buffer file), UVs for an AO map.
-GBufferOptions gbuffer_options_for(const MethodInfo& method, SurfaceNormal normal, bool albedo_for_outputs, bool uv);
-
-/// The G-buffer of `camera` in `scene`, with the direct-light pass when `sun` is given.
-GBuffer render_view_gbuffer(const PreparedScene& scene, const Camera& camera, const GBufferOptions& options, const std::optional<Sun>& sun,
-                            const JobReporter& reporter = {});
-
-/// The method of `params` on `gbuffer` (rendered from `scene`, or from a file when `scene` is
-/// null). `cache`: null, or what the method keeps between frames of this scene.
-MethodOutput run_on_scene(const MethodParams& params, const GBuffer& gbuffer, const PreparedScene* scene, const Falloff& falloff,
-                          std::uint32_t seed, MethodCache* cache = nullptr, const ProgressFn& progress = {});
 
 }  // namespace ao

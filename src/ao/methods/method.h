@@ -19,10 +19,11 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/image.h"
+#include "ao/core/json_value.h"
 #include "ao/core/membership.h"
 #include "ao/core/progress.h"
 #include "ao/core/typed_slots.h"
@@ -87,7 +88,7 @@ struct MethodOutput {
   /// The ray-traced ground truth: the standard error of V per pixel (0 where not covered); empty
   /// for the other methods. Not written by `ao render`; the Python module returns it.
   Image<float> std_error;
-  nlohmann::json stats;  ///< Method-specific numbers for --json (rays, standard errors, ...).
+  JsonValue stats;  ///< Method-specific numbers for --json (rays, standard errors, ...), as a JSON object or null.
 };
 
 /// Memory a method needs beyond its images, for the check before a run (core/memory.h).

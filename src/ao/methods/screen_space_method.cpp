@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/scene/procedural.h"
 
 namespace ao::detail {

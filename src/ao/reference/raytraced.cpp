@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/gbuffer_rays_internal.h"
 #include "ao/reference/pixel_loop_internal.h"

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 
 namespace ao {
 
@@ -30,7 +31,7 @@ MethodOutput run(const MethodInput& in, const RaytracedMethodParams& params) {
   if (!img.color.empty()) out.color = std::move(img.color);
   if (!img.obscurance.empty()) out.extras["obscurance"] = std::move(img.obscurance);
   out.std_error = std::move(img.scalar.std_error);
-  out.stats = {{"rays", img.scalar.rays}, {"mean_std_error", img.scalar.mean_std_error}, {"max_std_error", img.scalar.max_std_error}};
+  out.stats = nlohmann::json{{"rays", img.scalar.rays}, {"mean_std_error", img.scalar.mean_std_error}, {"max_std_error", img.scalar.max_std_error}};
   return out;
 }
 

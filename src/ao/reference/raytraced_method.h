@@ -3,7 +3,7 @@
 // reference of a kind (reference.h) rendered with its ray settings.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/params.h"
 #include "ao/methods/method.h"

@@ -4,6 +4,8 @@
 #include <array>
 #include <charconv>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/reference/tangent_sphere.h"
 #include "ao/reference/transfer_reference.h"
 

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/error.h"
 #include "ao/gpu/run_internal.h"
 #include "ao/methods/alchemy/alchemy_gpu_internal.h"
@@ -37,7 +39,7 @@ GpuMethodOutput run_gpu_method(GpuDevice& device, const GpuMethodInput& in, cons
   out.renderer = c.renderer;
   nlohmann::json ms = nlohmann::json::object();
   for (const GpuPassTime& p : out.passes) ms[p.name] = ms.value(p.name, 0.0) + p.ms;
-  if (!out.output.stats.is_object()) out.output.stats = nlohmann::json::object();
+  if (!out.output.stats->is_object()) out.output.stats = nlohmann::json::object();
   out.output.stats["device"] = c.renderer;
   out.output.stats["gpu_ms"] = ms;
   for (const auto& [name, passes] : r.reported_ms) {

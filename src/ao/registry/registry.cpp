@@ -13,10 +13,15 @@
 #include "ao/bake/raytraced_bake.h"
 #include "ao/core/closest_name.h"
 #include "ao/core/error.h"
+#include "ao/core/params_table.h"
 #include "ao/gbuffer/render_gbuffer.h"
 #include "ao/reference/ray_scene.h"
 
 namespace ao {
+
+nlohmann::json MethodInfo::default_params() const { return params().defaults(); }
+
+nlohmann::json MethodInfo::canonical_params(const nlohmann::json& overrides) const { return params().canonical(overrides); }
 
 bool MethodInfo::has_extra(std::string_view extra) const {
   for (std::string_view e : extras)

@@ -21,7 +21,7 @@
 #include <string_view>
 #include <variant>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"
@@ -78,10 +78,10 @@ struct MethodInfo {
   MethodParams (*decode)(const nlohmann::json& overrides);
 
   /// Every parameter at its default.
-  nlohmann::json default_params() const { return params().defaults(); }
+  nlohmann::json default_params() const;
   /// `overrides` read over the defaults through the table, checked and written back complete:
   /// what --json echoes.
-  nlohmann::json canonical_params(const nlohmann::json& overrides) const { return params().canonical(overrides); }
+  nlohmann::json canonical_params(const nlohmann::json& overrides) const;
   /// Whether `extra` is one of `extras`.
   bool has_extra(std::string_view extra) const;
 };

@@ -11,6 +11,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/methods/alchemy/alchemy_internal.h"
 #include "ao/methods/alchemy/alchemy_kernel_internal.h"
@@ -177,7 +178,7 @@ MethodOutput run(const MethodInput& in, const AlchemyParams& params) {
   MethodOutput out;
   out.visibility = std::move(img.visibility);
   if (!img.unfiltered.empty()) out.extras["unfiltered"] = std::move(img.unfiltered);
-  out.stats = {{"estimator_ms", img.estimator_ms}, {"filter_ms", img.filter_ms}};
+  out.stats = nlohmann::json{{"estimator_ms", img.estimator_ms}, {"filter_ms", img.filter_ms}};
   return out;
 }
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/error.h"
 #include "ao/gpu/run_internal.h"
 #include "ao/methods/alchemy/alchemy_gpu_internal.h"

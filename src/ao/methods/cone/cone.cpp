@@ -12,6 +12,7 @@
 #include "ao/core/error.h"
 #include "ao/core/memory.h"
 #include "ao/core/parallel.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/methods/filters/bilateral.h"
 #include "ao/methods/cone/cone_internal.h"

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/error.h"
 #include "ao/gpu/run_internal.h"
 #include "ao/methods/cone/cone_gpu_internal.h"

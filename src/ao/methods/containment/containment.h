@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"

@@ -14,6 +14,7 @@
 #include "ao/core/error.h"
 #include "ao/core/math.h"
 #include "ao/core/parallel.h"
+#include "ao/core/params_table.h"
 #include "ao/methods/filters/filters_kernel_internal.h"
 #include "ao/simd/depth_plane.h"
 

@@ -10,6 +10,7 @@
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
 #include "ao/core/color_shared.h"
+#include "ao/core/params_table.h"
 #include "ao/core/sampling.h"
 #include "ao/methods/gtao/gtao_internal.h"
 #include "ao/methods/gtao/gtao_kernel_internal.h"

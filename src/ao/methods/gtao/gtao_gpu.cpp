@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/error.h"
 #include "ao/gpu/run_internal.h"
 #include "ao/methods/gtao/gtao_gpu_internal.h"

@@ -32,7 +32,7 @@
 #include <array>
 #include <cstdint>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/gbuffer.h"
 #include "ao/core/membership.h"

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "ao/core/error.h"
 #include "ao/methods/transfer/transfer_gpu_internal.h"
 #include "ao/methods/screen_space_gpu_internal.h"

@@ -8,6 +8,7 @@
 
 #include "ao/core/error.h"
 #include "ao/core/parallel.h"
+#include "ao/core/params_table.h"
 #include "ao/methods/characteristic.h"
 #include "ao/methods/containment/containment.h"
 #include "ao/methods/samples.h"

@@ -21,9 +21,19 @@
 // sample set), and the floor keeps two texels whose samples all agreed (V = 0 or 1 everywhere in
 // their strata) from refusing neighbours that differ by less than a 64-ray texel's typical noise;
 // k = 1.5, so a neighbour further apart than the noise explains (a contact shadow's edge, even a
-// soft one) weighs little: the filter trades less noise for edges no softer than unfiltered. The
-// filtered value is the weighted mean over the window of radius ceil(2 sigma); texels not valid
-// neither take part nor change.
+// soft one) weighs little: the filter trades less noise for edges no softer than unfiltered.
+//
+// The filtered value is not the weighted mean over the window (radius ceil(2 sigma)) but the value
+// at c of a plane fitted to the window's values by weighted least squares, V ~ a + b_x dx + b_y dy with
+// (dx, dy) the texel offsets, with a ridge lambda m0 on the slopes (m0 the sum of the weights,
+// lambda = 1/2 texel^2):
+//   minimise  sum_q w(q) (V_q - a - b_x dx_q - b_y dy_q)^2 + lambda m0 (b_x^2 + b_y^2),  V_c' = a
+// (first-order regression, as local linear regression denoisers of Monte Carlo images do). Where
+// the window's weights are symmetric about c it gives the weighted mean. Where they are not (a
+// contact, whose neighbours on the floor lie on the side away from the box, or a chart's border)
+// a mean takes the level of the side that weighs, and the fit follows the gradient through c
+// instead: a linear ramp comes out unchanged. The ridge keeps the fit from extrapolating the
+// noise of a lopsided window. Texels not valid neither take part nor change.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // A JSON value held through a pointer, so that a header can carry one by value (a job's request and
-// result, a method's output) without including <nlohmann/json.hpp>, which alone takes about 1.7 s
+// result, a method's output) without including <nlohmann/json.hpp>, which alone takes about 1.9 s
 // to parse. Holding, copying, moving and assigning one needs only this header; looking inside
 // needs <nlohmann/json.hpp> where it is done:
 //

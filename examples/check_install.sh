@@ -18,7 +18,7 @@
 #      included plainly with -Wall -Wextra -Wconversion -Wshadow -Werror by the build's compiler
 #      and by g++ and clang++ where installed; and compiles a program that renders through
 #      ao/jobs/render.h alone with <nlohmann/json.hpp> replaced by a header that fails: a job's
-#      header costs a translation unit no JSON parser (docs/architecture.md, "Headers").
+#      header costs a translation unit no JSON parser (docs/architecture.md, "Layers").
 # Everything is written below a temporary folder, removed at the end.
 set -euo pipefail
 build=$(cd "${1:?usage: check_install.sh BUILD_DIR [examples|headers]}" && pwd)

@@ -16,8 +16,8 @@
 #      header in one translation unit with Embree's, assimp's, OpenEXR's, libpng's and FreeType's
 #      headers replaced by ones that fail: no installed header includes them; and compiles ao/ao.h
 #      included plainly with -Wall -Wextra -Wconversion -Wshadow -Werror by the build's compiler
-#      and by g++ and clang++ where installed; and compiles a program that renders through
-#      ao/jobs/render.h alone with <nlohmann/json.hpp> replaced by a header that fails: a job's
+#      and by g++ and clang++ where installed; and compiles the program that renders through
+#      ao/jobs/render.h alone (mesh_to_exr.cpp) with <nlohmann/json.hpp> replaced by a header that fails: a job's
 #      header costs a translation unit no JSON parser (docs/architecture.md, "Layers").
 # Everything is written below a temporary folder, removed at the end.
 set -euo pipefail
@@ -159,21 +159,8 @@ done
 echo "== a translation unit that renders includes no nlohmann/json.hpp"
 mkdir -p "$poison/nlohmann"
 echo '#error "ao/jobs/render.h includes <nlohmann/json.hpp>"' > "$poison/nlohmann/json.hpp"
-cat > "$tmp/render_tu.cpp" <<'CPP'
-#include <ao/jobs/render.h>
-int main() {
-  ao::RenderRequest request;
-  request.scene.args = {"default"};
-  request.method = "volumetric";
-  request.outputs.visibility = "ao.png";
-  const ao::RenderResult result = ao::run_render(request);
-  ao::RenderRequest copy = request;
-  copy.params = result.params;
-  return result.covered_pixels > 0 ? 0 : 1;
-}
-CPP
 for c in "${compilers[@]}"; do
-  "$c" -std=c++20 -fsyntax-only -Wall -Wextra -Werror -I"$poison" -I"$prefix/include" $(pkg-config --cflags-only-other tbb) "$tmp/render_tu.cpp" ||
+  "$c" -std=c++20 -fsyntax-only -Wall -Wextra -Werror -I"$poison" -I"$prefix/include" $(pkg-config --cflags-only-other tbb) "$src/mesh_to_exr.cpp" ||
     { echo "check_install: a program that renders needs <nlohmann/json.hpp> under $c (above)" >&2; exit 1; }
   echo "   $c: compiles without it"
 done

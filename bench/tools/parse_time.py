@@ -9,7 +9,8 @@ The include folders default to this tree's src/ and build/src/generated/ (ao/ver
 installed prefix's include/ to measure the installed headers, or an older tree's to compare. Each
 round compiles, one after the other, with `CXX -std=c++20 -fsyntax-only` (parsing and template
 instantiation, no code generation):
-  render    a program that fills a RenderRequest and calls run_render, including ao/jobs/render.h
+  render    examples/mesh_to_exr.cpp: a RenderRequest filled and run_render called, through
+            ao/jobs/render.h alone
   umbrella  ao/ao.h, every installed header
   json      <nlohmann/json.hpp> alone
   std       the standard headers ao/jobs/render.h reads (its floor: <filesystem>, <string>, ...)
@@ -19,23 +20,16 @@ medians of one run only.
 """
 import argparse
 import os
+import pathlib
 import resource
 import statistics
 import subprocess
 import tempfile
 import time
 
+EXAMPLES = pathlib.Path(__file__).resolve().parents[2] / "examples"
 SOURCES = {
-    "render": """#include <ao/jobs/render.h>
-int main() {
-  ao::RenderRequest request;
-  request.scene.args = {"default"};
-  request.method = "volumetric";
-  request.outputs.visibility = "ao.png";
-  const ao::RenderResult result = ao::run_render(request);
-  return result.covered_pixels > 0 ? 0 : 1;
-}
-""",
+    "render": (EXAMPLES / "mesh_to_exr.cpp").read_text(),
     "umbrella": "#include <ao/ao.h>\nint main() { return 0; }\n",
     "json": "#include <nlohmann/json.hpp>\nint main() { return nlohmann::json::object().empty() ? 0 : 1; }\n",
     "std": "".join(f"#include <{h}>\n" for h in (

@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "ao/reference/packets_internal.h"
+#include "ao/bake/denoise_internal.h"
+#include "ao/simd/denormals_internal.h"
 
 namespace ao {
 
@@ -49,54 +52,46 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
       const float g = kGateSlope * std::sqrt(d2) + kGateSlack;
       gate[k] = g * g;
     }
+  // The rows are filtered in bands of kBandRows, each laid out as planes with r rows and columns of
+  // border (denoise_internal.h) from the unfiltered map, so a texel's result does not depend on the
+  // band it falls in, nor on the thread count.
+  constexpr int kBandRows = 16;
+  constexpr int kMaxLanes = 16;  // floats in the widest target's vector (AVX-512)
+  const std::ptrdiff_t stride = w + 2 * r + kMaxLanes;
   const Image<float> in = visibility;
-  const float range_scale = 1.0f / (kRangeTolerance * kRangeTolerance);
-  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
-  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+  tbb::enumerable_thread_specific<std::vector<float>> scratch;
+  tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBandRows - 1) / kBandRows, 1), [&](const tbb::blocked_range<int>& bands) {
     // The weights of far-apart neighbours underflow into denormals: flushed on every thread alike,
     // whatever mode the pool thread was left in, so the result is the same at any thread count.
     const detail::FlushDenormalsScope ftz;
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t c = at(x, y);
-        if (!valid[c]) continue;
-        const float texel_area = cov.uv_area[c] > 0 ? cov.world_area[c] / cov.uv_area[c] : 0.0f;  // h_c^2
-        if (!(texel_area > 0)) continue;
-        const Vec3 pc = guides.position[c], nc = guides.normal[c];
-        const float vc = in[c], var_c = guides.variance[c];
-        const float plane_scale = 1.0f / (kPlaneTolerance * kPlaneTolerance * texel_area);
-        // The weighted moments of the fit V ~ a + b_x dx + b_y dy over the window.
-        float m0 = 0, mx = 0, my = 0, mxx = 0, mxy = 0, myy = 0, s0 = 0, sx = 0, sy = 0;
-        for (int dy = std::max(-r, -y); dy <= std::min(r, h - 1 - y); ++dy)
-          for (int dx = std::max(-r, -x); dx <= std::min(r, w - 1 - x); ++dx) {
-            const std::size_t q = at(x + dx, y + dy);
-            if (!valid[q]) continue;
-            const auto k = static_cast<std::size_t>((dy + r) * side + dx + r);
-            const Vec3 d = guides.position[q] - pc;
-            if (dot(d, d) > gate[k] * texel_area) continue;  // far on the surface: another chart
-            const float off_plane = dot(d, nc);
-            float cn = std::max(0.0f, dot(nc, guides.normal[q]));
-            cn *= cn, cn *= cn, cn *= cn;
-            const float vq = in[q], dv = vq - vc;
-            const float var = var_c + guides.variance[q] + kVarianceFloor;
-            const float wq = gauss[k] * std::exp(-0.5f * (off_plane * off_plane * plane_scale + dv * dv * range_scale / var)) * cn;
-            const auto fx = static_cast<float>(dx), fy = static_cast<float>(dy);
-            m0 += wq, mx += wq * fx, my += wq * fy, mxx += wq * fx * fx, mxy += wq * fx * fy, myy += wq * fy * fy;
-            s0 += wq * vq, sx += wq * vq * fx, sy += wq * vq * fy;
-          }
-        if (!(m0 > 0)) continue;
-        // The normal equations with the ridge lambda m0 on the slopes,
-        //   [m0 mx my; mx mxx+l mxy; my mxy myy+l] (a b_x b_y) = (s0 sx sy),
-        // solved for a by Cramer's rule in double. The matrix is positive definite (m0 >= 1: the
-        // centre weighs 1; l > 0), so its determinant is positive; the mean stands in should
-        // rounding say otherwise.
-        const double l = static_cast<double>(kSlopeRidge) * m0;
-        const double pxx = mxx + l, pyy = myy + l, pxy = mxy;
-        const double c00 = pxx * pyy - pxy * pxy, c01 = mx * pyy - pxy * my, c02 = mx * pxy - pxx * my;
-        const double det = m0 * c00 - mx * c01 + my * c02;
-        const double a = det > 0 ? (s0 * c00 - mx * (sx * pyy - pxy * sy) + my * (sx * pxy - pxx * sy)) / det : s0 / m0;
-        visibility[c] = static_cast<float>(std::clamp(a, 0.0, 1.0));
+    std::vector<float>& planes = scratch.local();
+    for (int band = bands.begin(); band < bands.end(); ++band) {
+      const int y0 = band * kBandRows, rows = std::min(kBandRows, h - y0);
+      const auto plane_size = static_cast<std::size_t>((rows + 2 * r) * stride);
+      planes.assign(9 * plane_size, 0.0f);
+      float* const p[9] = {planes.data(), planes.data() + plane_size, planes.data() + 2 * plane_size, planes.data() + 3 * plane_size,
+                           planes.data() + 4 * plane_size, planes.data() + 5 * plane_size, planes.data() + 6 * plane_size,
+                           planes.data() + 7 * plane_size, planes.data() + 8 * plane_size};
+      std::fill_n(p[0], plane_size, std::numeric_limits<float>::quiet_NaN());
+      for (int y = std::max(0, y0 - r); y < std::min(h, y0 + rows + r); ++y) {
+        const std::ptrdiff_t base = (y - y0 + r) * stride + r;
+        for (int x = 0; x < w; ++x) {
+          const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+          if (!valid.data()[t]) continue;
+          const std::ptrdiff_t e = base + x;
+          const Vec3 pos = guides.position.data()[t], nor = guides.normal.data()[t];
+          p[0][e] = pos.x, p[1][e] = pos.y, p[2][e] = pos.z, p[3][e] = nor.x, p[4][e] = nor.y, p[5][e] = nor.z;
+          p[6][e] = in.data()[t], p[7][e] = guides.variance.data()[t];
+          const float texel_area = cov.uv_area[t] > 0 ? cov.world_area[t] / cov.uv_area[t] : 0.0f;  // h_c^2
+          p[8][e] = texel_area > 0 ? texel_area : 0.0f;
+        }
       }
+      const detail::DenoiseBand b{.px = p[0], .py = p[1], .pz = p[2], .nx = p[3], .ny = p[4], .nz = p[5], .value = p[6], .variance = p[7],
+                                  .area = p[8], .stride = stride, .width = w, .radius = r, .gauss = gauss.data(), .gate = gate.data(),
+                                  .plane_tolerance2 = kPlaneTolerance * kPlaneTolerance, .range_scale = 1.0f / (kRangeTolerance * kRangeTolerance),
+                                  .variance_floor = kVarianceFloor, .slope_ridge = kSlopeRidge};
+      for (int row = 0; row < rows; ++row) detail::denoise_row(b, row, &visibility(0, y0 + row));
+    }
   });
 }
 

@@ -156,6 +156,7 @@ class TexelWorker {
     const int samples = params_.ao.samples, points = std::min(params_.cage_points, samples);
     const bool geometric = params_.ao.normal == SurfaceNormal::Geometric;
     if (guides_) noise_.reset(samples);
+    block_first_ = -1;
     detail::MeanAccumulator acc;  // over the samples whose cage point found the high mesh
     std::uint64_t traced = 0;
     Vec3 bent{0, 0, 0};
@@ -169,7 +170,7 @@ class TexelWorker {
       const int end = static_cast<int>(static_cast<std::int64_t>(j + 1) * samples / points);
       for (int first = static_cast<int>(static_cast<std::int64_t>(j) * samples / points); first < end; first += 16) {
         const int count = std::min(16, end - first);
-        sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, u_);  // dimensions 0-1: the direction
+        points_of(first, count, key);  // dimensions 0-1: the direction
         if (spread_ < 1.0f) detail::narrow_to_cone(u_, count, spread_, cone_u_);
         detail::make_hemisphere_rays(origin, geometric ? ng : n, ng, spread_ < 1.0f ? cone_u_ : u_, count, batch_);
         float mu[16];
@@ -194,6 +195,23 @@ class TexelWorker {
   }
 
  private:
+  // Points first .. first + count - 1 of the texel's Sobol set into lanes 0 .. count - 1 of u_:
+  // a cage point's few samples are copied from the aligned block of 16 the texel's points are made
+  // in, so a texel scrambles each block once, not once per cage point.
+  void points_of(int first, int count, std::uint32_t key) {
+    int at = 0;
+    while (at < count) {
+      const int block = (first + at) / 16 * 16;
+      if (block != block_first_) {
+        sobol_owen_4d_batch(static_cast<std::uint32_t>(block), std::min(16, params_.ao.samples - block), key, block_u_);
+        block_first_ = block;
+      }
+      const int from = first + at - block, n = std::min(count - at, 16 - from);
+      for (int d = 0; d < 4; ++d) std::copy_n(&block_u_[d][from], n, &u_[d][at]);
+      at += n;
+    }
+  }
+
   const CageRays& cage_rays_;
   detail::BatchTracer<N> batch_tracer_;
   const HighToLowParams& params_;
@@ -204,6 +222,8 @@ class TexelWorker {
   detail::StratifiedVariance noise_;
   float spread_;                     // the cone's disk radius, sin(spread_angle / 2)
   alignas(64) float u_[4][16] = {};  // lanes past a block's count keep any finite values
+  alignas(64) float block_u_[4][16] = {};  // points block_first_ .. block_first_ + 15 of the texel's set
+  int block_first_ = -1;
   alignas(64) float cone_u_[4][16] = {};
   alignas(64) detail::TexelRayBatch batch_;
 };

@@ -230,9 +230,10 @@ void make_texel_rays(const std::vector<PatchPiece>& patch, const PatchTable& tab
 
 /// Lanes 0 .. count - 1 (count in [1, 16]) of `out`: rays from `origin` in the cosine-weighted
 /// directions about the unit normal n that u[0][k], u[1][k] make (cosine_hemisphere's concentric
-/// map in Frame::from_normal(n), computed lane-parallel as make_texel_rays does), a lane's ray
+/// map in Frame::from_normal(n), with make_texel_rays' polynomial sine and cosine), a lane's ray
 /// valid where its direction is above the plane of the unit face normal ng (below it: occluded by
-/// the surface itself, mu = 0, no ray); lanes from count on are not valid.
+/// the surface itself, mu = 0, no ray); lanes from count on are not valid, and keep the origin and
+/// direction an earlier call left there.
 void make_hemisphere_rays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, TexelRayBatch& out);
 
 /// Where the search for the next hit starts along ray o + t d after a face hit at t with normal

@@ -3,7 +3,8 @@
 // make_hemisphere_rays), compiled once per SIMD target. make_texel_rays is written in Highway
 // vectors over the 16 lanes of a batch (4, 8 or 16 floats at a time, as the target holds), with
 // the scalar code's operations in its order, so a lane's bits do not depend on the target;
-// make_hemisphere_rays is a loop over the lanes that the compiler vectorises. A portable build makes
+// make_hemisphere_rays is a scalar loop over the batch's lanes up to its count (high to low fills a
+// batch with the few samples of one cage point). A portable build makes
 // its rays as fast as one compiled for the CPU. Part of ao::ao (the batch and the patch belong to
 // the bakers).
 #undef HWY_TARGET_INCLUDE
@@ -160,14 +161,16 @@ void MakeTexelRays(const std::vector<PatchPiece>& patch, const PatchTable& table
 
 void MakeHemisphereRays(Vec3 origin, Vec3 n, Vec3 ng, const float (&u)[4][16], int count, TexelRayBatch& out) {
   const Frame f = Frame::from_normal(n);
-  for (int k = 0; k < TexelRayBatch::kWidth; ++k) {
+  for (int k = 0; k < count; ++k) {
     float lx, ly, lz;
     concentric_hemisphere(u[0][k], u[1][k], lx, ly, lz);
     const float dx = f.t.x * lx + f.b.x * ly + f.n.x * lz, dy = f.t.y * lx + f.b.y * ly + f.n.y * lz, dz = f.t.z * lx + f.b.z * ly + f.n.z * lz;
-    out.valid[k] = k < count && dx * ng.x + dy * ng.y + dz * ng.z > 0 ? -1 : 0;
+    out.valid[k] = dx * ng.x + dy * ng.y + dz * ng.z > 0 ? -1 : 0;
     out.ox[k] = origin.x, out.oy[k] = origin.y, out.oz[k] = origin.z;
     out.dx[k] = dx, out.dy[k] = dy, out.dz[k] = dz;
   }
+  // Lanes past the count: no ray; their origin and direction keep an earlier batch's finite values.
+  for (int k = count; k < TexelRayBatch::kWidth; ++k) out.valid[k] = 0;
 }
 
 }  // namespace ao::simd::HWY_NAMESPACE

@@ -115,8 +115,10 @@ void expect_same_bits_at_any_thread_count(const char* what, const std::function<
 
 // The filter's result does not depend on the floating-point mode of the thread that runs it: two
 // texels one apart on one flat chart, V = 0 and V = 1, each with a measured variance such that the
-// value term puts the neighbour's weight at exp(-95) ~ 5e-42, a denormal. Flushed to zero, texel 0
-// stays exactly 0; in the IEEE default it would take a denormal's worth of its neighbour. The
+// second pass's value term puts the neighbour's weight at exp(-95) ~ 5e-42, a denormal (the first
+// pass's, with k_g = 1.5 against k = 2, at exp(-169), below every float: the guide is the raw map
+// and its variance the texels' own). Flushed to zero, texel 0 stays exactly 0; in the IEEE default
+// it would take a denormal's worth of its neighbour. The
 // filter fixes its own mode, so both calls give the same bits (they differed when it ran in
 // whatever mode the pool thread was left in).
 TEST(BakeThreads, DenoisingDoesNotDependOnTheThreadsFloatingPointMode) {
@@ -129,8 +131,8 @@ TEST(BakeThreads, DenoisingDoesNotDependOnTheThreadsFloatingPointMode) {
   guides.position(0, 0) = {0.5f, 0, 0.5f};
   guides.position(1, 0) = {1.5f, 0, 0.5f};
   guides.normal(0, 0) = guides.normal(1, 0) = {0, 1, 0};
-  // 0.5 dV^2 / (1.5^2 (var_0 + var_1 + 0.01^2)) = 95 for dV = 1 (denoise.h).
-  guides.variance(0, 0) = guides.variance(1, 0) = 0.5f * (0.5f / (2.25f * 95.0f) - 1e-4f);
+  // 0.5 dV^2 / (2^2 (var_0 + var_1 + 0.01^2)) = 95 for dV = 1 (denoise.h, the second pass).
+  guides.variance(0, 0) = guides.variance(1, 0) = 0.5f * (0.5f / (4.0f * 95.0f) - 1e-4f);
   const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);  // the filter runs on this thread
   const unsigned mode = _mm_getcsr();
   std::array<float, 2> result[2];

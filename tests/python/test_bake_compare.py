@@ -46,7 +46,11 @@ def test_the_ao_family_equals_cli(ao_binary, grid_obj, tmp_path):
     # A single-sided bumpy grid: nothing behind its flat parts (thickness 1), the grid's other side
     # within reach of rays into its slopes (below 1).
     assert m["thickness"][covered].max() == pytest.approx(1.0, abs=1e-6) and m["thickness"][covered].min() < 0.9
-    assert m["cavity"][covered].min() >= m["map"][covered].min() - 1e-6  # cavity's R is shorter than the map's (unlimited)
+    # Cavity's R is shorter than the map's (unlimited): texel by texel the same rays, so unfiltered the
+    # order is exact; the filter weighs each map by its own values, which moves a minimum by up to ~2e-4.
+    assert m["cavity"][covered].min() >= m["map"][covered].min() - 1e-3
+    u = ao.bake(grid_obj, 32, samples=16, spread_angle=140, cavity=True, denoise=0)
+    assert np.all(u["cavity"][covered] >= u["map"][covered])
     with pytest.raises(ao.InputError, match="tangent"):
         ao.bake(grid_obj, 32, bent_normals_space="tangnet", bent_normals=True)
 

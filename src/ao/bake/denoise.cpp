@@ -20,11 +20,16 @@ namespace {
 
 constexpr float kPlaneTolerance = 0.5f;  // tau, texels
 constexpr float kGateSlope = 2.0f, kGateSlack = 1.5f;
-// k, standard deviations of the difference of two texels' values: the largest that keeps the contact
-// edges of a box on a floor no softer than unfiltered at 64 rays, with a margin (RMSE over the contact
-// texels 0.0078 at 1.5, 0.0086 at 1.75, 0.0098 at 2 against 0.0095 unfiltered; tests/bake/bake_test.cpp,
-// docs/methods/bake.md "Denoising").
-constexpr float kRangeTolerance = 1.5f;
+// The value term's test runs in two passes (denoise.h): the first, at sigma_g = 1 texel, compares
+// the texels' own values with k_g standard deviations of their difference; the second, at the
+// requested sigma, compares that first pass's values (the guide), with k. k_g = 1.5 is the filter's
+// one-pass k, the largest that kept the box-on-floor contact no softer than unfiltered at 64 rays;
+// k = 2 the largest of 1.5, 2, 2.5 and 3 that keeps it at or below unfiltered with a margin at 8-64
+// rays and sigma 1 (0.0105 against 0.0124 at 64 rays; 2.5: 0.0122, 3: 0.0147), for 5-15% lower
+// error over the elephant's whole map (docs/methods/bake.md, "Denoising").
+constexpr float kGuideSigma = 1.0f;
+constexpr float kGuideRangeTolerance = 1.5f;
+constexpr float kRangeTolerance = 2.0f;
 // A standard deviation of 0.01: two texels whose samples all agreed within their strata (V = 0 or 1
 // there) measure no noise, and should still take neighbours that differ by less than a 64-ray
 // texel's typical noise.
@@ -34,31 +39,46 @@ constexpr float kVarianceFloor = 1e-4f;
 // there. 0.5 keeps the floor beside a box on a floor no worse than unfiltered at 8-64 rays and
 // sigma 1 (0.0120 against 0.0124 at 64 rays; the plain fit 0.0126, the mean 0.0132), with the
 // elephant's whole-map error at most 0.5% above the mean's at 12 and 24 rays, sigma 1 and 2
-// (4.6% below at 24 rays, sigma 2; docs/methods/bake.md, "Denoising").
+// (4.6% below at 24 rays, sigma 2; docs/methods/bake.md, "Denoising"). Measured with the one-pass
+// filter, whose value term compared the raw values.
 constexpr float kSlopeRidge = 0.5f;
 
 }  // namespace
 
-void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
+namespace {
+
+// One pass of the filter at `sigma` over `value` (the variance of each texel's value: `variance`),
+// its value term comparing `guide` (variance `guide_variance`) with k = `range_tolerance`, into
+// `out`, and the variance of each result into `out_variance` when that is not null.
+struct PassInputs {
+  const Image<float>& value;
+  const Image<float>& variance;
+  const Image<float>& guide;
+  const Image<float>& guide_variance;
+  float sigma, range_tolerance;
+};
+
+void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, Image<float>& out,
+                 Image<float>* out_variance) {
   const int w = cov.width, h = cov.height;
-  const int r = static_cast<int>(std::ceil(2.0f * sigma));
+  const int r = static_cast<int>(std::ceil(2.0f * in.sigma));
   const int side = 2 * r + 1;
   std::vector<float> gauss(static_cast<std::size_t>(side * side)), gate(gauss.size());
   for (int dy = -r; dy <= r; ++dy)
     for (int dx = -r; dx <= r; ++dx) {
       const auto k = static_cast<std::size_t>((dy + r) * side + dx + r);
       const float d2 = static_cast<float>(dx * dx + dy * dy);
-      gauss[k] = std::exp(-d2 / (2.0f * sigma * sigma));
+      gauss[k] = std::exp(-d2 / (2.0f * in.sigma * in.sigma));
       const float g = kGateSlope * std::sqrt(d2) + kGateSlack;
       gate[k] = g * g;
     }
   // The rows are filtered in bands of kBandRows, each laid out as planes with r rows and columns of
-  // border (denoise_internal.h) from the unfiltered map, so a texel's result does not depend on the
+  // border (denoise_internal.h) from the pass's inputs, so a texel's result does not depend on the
   // band it falls in, nor on the thread count.
   constexpr int kBandRows = 16;
   constexpr int kMaxLanes = 16;  // floats in the widest target's vector (AVX-512)
+  constexpr int kPlanes = 11;
   const std::ptrdiff_t stride = w + 2 * r + kMaxLanes;
-  const Image<float> in = visibility;
   tbb::enumerable_thread_specific<std::vector<float>> scratch;
   tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBandRows - 1) / kBandRows, 1), [&](const tbb::blocked_range<int>& bands) {
     // The weights of far-apart neighbours underflow into denormals: flushed on every thread alike,
@@ -68,10 +88,9 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
     for (int band = bands.begin(); band < bands.end(); ++band) {
       const int y0 = band * kBandRows, rows = std::min(kBandRows, h - y0);
       const auto plane_size = static_cast<std::size_t>((rows + 2 * r) * stride);
-      planes.assign(9 * plane_size, 0.0f);
-      float* const p[9] = {planes.data(), planes.data() + plane_size, planes.data() + 2 * plane_size, planes.data() + 3 * plane_size,
-                           planes.data() + 4 * plane_size, planes.data() + 5 * plane_size, planes.data() + 6 * plane_size,
-                           planes.data() + 7 * plane_size, planes.data() + 8 * plane_size};
+      planes.assign(kPlanes * plane_size, 0.0f);
+      float* p[kPlanes];
+      for (std::size_t k = 0; k < kPlanes; ++k) p[k] = planes.data() + k * plane_size;
       std::fill_n(p[0], plane_size, std::numeric_limits<float>::quiet_NaN());
       for (int y = std::max(0, y0 - r); y < std::min(h, y0 + rows + r); ++y) {
         const std::ptrdiff_t base = (y - y0 + r) * stride + r;
@@ -81,18 +100,32 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
           const std::ptrdiff_t e = base + x;
           const Vec3 pos = guides.position.data()[t], nor = guides.normal.data()[t];
           p[0][e] = pos.x, p[1][e] = pos.y, p[2][e] = pos.z, p[3][e] = nor.x, p[4][e] = nor.y, p[5][e] = nor.z;
-          p[6][e] = in.data()[t], p[7][e] = guides.variance.data()[t];
+          p[6][e] = in.value.data()[t], p[7][e] = in.variance.data()[t];
+          p[8][e] = in.guide.data()[t], p[9][e] = in.guide_variance.data()[t];
           const float texel_area = cov.uv_area[t] > 0 ? cov.world_area[t] / cov.uv_area[t] : 0.0f;  // h_c^2
-          p[8][e] = texel_area > 0 ? texel_area : 0.0f;
+          p[10][e] = texel_area > 0 ? texel_area : 0.0f;
         }
       }
       const detail::DenoiseBand b{.px = p[0], .py = p[1], .pz = p[2], .nx = p[3], .ny = p[4], .nz = p[5], .value = p[6], .variance = p[7],
-                                  .area = p[8], .stride = stride, .width = w, .radius = r, .gauss = gauss.data(), .gate = gate.data(),
-                                  .plane_tolerance2 = kPlaneTolerance * kPlaneTolerance, .range_scale = 1.0f / (kRangeTolerance * kRangeTolerance),
-                                  .variance_floor = kVarianceFloor, .slope_ridge = kSlopeRidge};
-      for (int row = 0; row < rows; ++row) detail::denoise_row(b, row, &visibility(0, y0 + row));
+                                  .guide = p[8], .guide_variance = p[9], .area = p[10], .stride = stride, .width = w, .radius = r,
+                                  .gauss = gauss.data(), .gate = gate.data(), .plane_tolerance2 = kPlaneTolerance * kPlaneTolerance,
+                                  .range_scale = 1.0f / (in.range_tolerance * in.range_tolerance), .variance_floor = kVarianceFloor,
+                                  .slope_ridge = kSlopeRidge};
+      for (int row = 0; row < rows; ++row)
+        detail::denoise_row(b, row, &out(0, y0 + row), out_variance ? &(*out_variance)(0, y0 + row) : nullptr);
     }
   });
+}
+
+}  // namespace
+
+void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
+  const Image<float> raw = visibility;
+  // Pass 1, the guide: the raw values compared with each other, and the variance of each result.
+  Image<float> guide = raw, guide_variance = guides.variance;
+  filter_pass({raw, guides.variance, raw, guides.variance, kGuideSigma, kGuideRangeTolerance}, valid, cov, guides, guide, &guide_variance);
+  // Pass 2: the raw values again, weighted by how far apart the guide puts them.
+  filter_pass({raw, guides.variance, guide, guide_variance, sigma, kRangeTolerance}, valid, cov, guides, visibility, nullptr);
 }
 
 }  // namespace ao

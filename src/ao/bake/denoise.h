@@ -10,20 +10,30 @@
 // A texel q near texel c gets the weight
 //   w(q) = exp(-|uv_q - uv_c|^2 / (2 sigma^2))          the Gaussian, sigma in texels
 //        * exp(-((p_q - p_c) . n_c / (tau h_c))^2 / 2)  off c's tangent plane (curvature, a crease, another layer)
-//        * exp(-(V_q - V_c)^2 / (2 k^2 s^2))            values further apart than the noise explains (a contact shadow's edge)
+//        * exp(-(G_q - G_c)^2 / (2 k^2 s^2))            values further apart than the noise explains (a contact shadow's edge)
 //        * max(0, n_c . n_q)^8                          normals apart (a crease of 30 degrees: 0.32, 45: 0.06)
 // and none when |p_q - p_c| > (2 |uv_q - uv_c| + 1.5) h_c: a UV neighbour that is far away on the
 // surface is another chart or the other side of a seam. p and n are the texel's area-weighted patch
 // centroid and mean normal (TexelGuides), h_c the world size of one texel at c (sqrt of world area
-// over UV area) and tau = 1/2 texel. s^2 = var_c + var_q + 0.01^2 is the variance of the difference
-// of the two texels' values, var the variance of each texel's mean as measured from its own samples
-// (TexelGuides::variance: the spread of the samples within the strata of the texel's stratified
-// sample set), and the floor keeps two texels whose samples all agreed (V = 0 or 1 everywhere in
-// their strata) from refusing neighbours that differ by less than a 64-ray texel's typical noise;
-// k = 1.5, so a neighbour further apart than the noise explains (a contact shadow's edge, even a
-// soft one) weighs little: the filter trades less noise for edges no softer than unfiltered.
+// over UV area) and tau = 1/2 texel.
 //
-// The filtered value is not the weighted mean over the window (radius ceil(2 sigma)) but the value
+// The value term runs in two passes. The first (the guide) filters the map at sigma_g = 1 texel with
+// G = V, the texels' own values, and s^2 = var_c + var_q + 0.01^2 the variance of the difference of
+// two texels' values, var the variance of each texel's mean as measured from its own samples
+// (TexelGuides::variance: the spread of the samples within the strata of the texel's stratified
+// sample set), k_g = 1.5; the floor keeps two texels whose samples all agreed (V = 0 or 1 everywhere
+// in their strata) from refusing neighbours that differ by less than a 64-ray texel's typical noise.
+// It also gives each guide value's variance, sum w^2 var / (sum w)^2 (the weighted mean's). The
+// second filters the same raw values at the requested sigma, with G the guide and s^2 from the
+// guide's variances, k = 2. A single texel's few samples measure its value and variance too roughly
+// for the test: its variance, about V (1 - V) / n, is smaller the closer its value lies to 0 or 1,
+// so where AO is near 1 a texel noisy upward takes fewer neighbours than one noisy downward and
+// keeps more of its own value; the one-pass filter (k = 1.5 on the raw values) kept noise on
+// smooth surfaces and lifted the map's mean. The guide's values are several times less noisy, so
+// its test separates a contact shadow's edge from noise better, and k can be wider
+// (docs/methods/bake.md, "Denoising", measures both).
+//
+// Each pass's value is not the weighted mean over the window (radius ceil(2 sigma)) but the value
 // at c of a plane fitted to the window's values by weighted least squares, V ~ a + b_x dx + b_y dy with
 // (dx, dy) the texel offsets, with a ridge lambda m0 on the slopes (m0 the sum of the weights,
 // lambda = 1/2 texel^2):

@@ -37,13 +37,14 @@ inline float plane_at_centre(const float (&m)[9], float ridge) {
   return static_cast<float>(std::clamp(a, 0.0, 1.0));
 }
 
-void DenoiseRow(const detail::DenoiseBand& b, int row, float* out) {
+template <bool kVariance>
+void DenoiseRowImpl(const detail::DenoiseBand& b, int row, float* out, float* out_variance) {
   const DF d;
   const std::size_t n = hn::Lanes(d);
   const int r = b.radius, side = 2 * r + 1;
   const VF zero = hn::Zero(d), half = hn::Set(d, 0.5f), floor = hn::Set(d, b.variance_floor), range_scale = hn::Set(d, b.range_scale);
   const VF tau2 = hn::Set(d, b.plane_tolerance2), one = hn::Set(d, 1.0f);
-  HWY_ALIGN float moments[9][HWY_MAX_BYTES / sizeof(float)];
+  HWY_ALIGN float moments[10][HWY_MAX_BYTES / sizeof(float)];
   for (int x0 = 0; x0 < b.width; x0 += static_cast<int>(n)) {
     const std::ptrdiff_t c = (row + r) * b.stride + x0 + r;
     const VF area = hn::LoadU(d, b.area + c);
@@ -51,9 +52,9 @@ void DenoiseRow(const detail::DenoiseBand& b, int row, float* out) {
     if (hn::AllFalse(d, filtered)) continue;
     const VF pcx = hn::LoadU(d, b.px + c), pcy = hn::LoadU(d, b.py + c), pcz = hn::LoadU(d, b.pz + c);
     const VF ncx = hn::LoadU(d, b.nx + c), ncy = hn::LoadU(d, b.ny + c), ncz = hn::LoadU(d, b.nz + c);
-    const VF vc = hn::LoadU(d, b.value + c), var_c = hn::LoadU(d, b.variance + c);
+    const VF gc = hn::LoadU(d, b.guide + c), var_c = hn::LoadU(d, b.guide_variance + c);
     const VF plane_scale = hn::Div(one, hn::Mul(tau2, area));
-    VF m0 = zero, mx = zero, my = zero, mxx = zero, mxy = zero, myy = zero, s0 = zero, sx = zero, sy = zero;
+    VF m0 = zero, mx = zero, my = zero, mxx = zero, mxy = zero, myy = zero, s0 = zero, sx = zero, sy = zero, w2v = zero;
     for (int dy = -r; dy <= r; ++dy) {
       // The row's sums of w, w dx, w dx^2, w V and w V dx; its dy enters once per row.
       VF r0 = zero, rx = zero, rxx = zero, t0 = zero, tx = zero;
@@ -68,30 +69,39 @@ void DenoiseRow(const detail::DenoiseBand& b, int row, float* out) {
         const VF off_plane = hn::Add(hn::Add(hn::Mul(ddx, ncx), hn::Mul(ddy, ncy)), hn::Mul(ddz, ncz));
         VF cn = hn::Max(zero, hn::Add(hn::Add(hn::Mul(ncx, hn::LoadU(d, b.nx + q)), hn::Mul(ncy, hn::LoadU(d, b.ny + q))), hn::Mul(ncz, hn::LoadU(d, b.nz + q))));
         cn = hn::Mul(cn, cn), cn = hn::Mul(cn, cn), cn = hn::Mul(cn, cn);
-        const VF vq = hn::LoadU(d, b.value + q), dv = hn::Sub(vq, vc);
-        const VF var = hn::Add(hn::Add(var_c, hn::LoadU(d, b.variance + q)), floor);
+        const VF vq = hn::LoadU(d, b.value + q), dv = hn::Sub(hn::LoadU(d, b.guide + q), gc);
+        const VF var = hn::Add(hn::Add(var_c, hn::LoadU(d, b.guide_variance + q)), floor);
         const VF e = hn::Add(hn::Mul(hn::Mul(off_plane, off_plane), plane_scale), hn::Div(hn::Mul(hn::Mul(dv, dv), range_scale), var));
         const VF w = hn::IfThenElseZero(near, hn::Mul(hn::Mul(hn::Set(d, gauss[dx]), hn::Exp(d, hn::Mul(hn::Neg(half), e))), cn));
         const VF fx = hn::Set(d, static_cast<float>(dx));
         const VF wx = hn::Mul(w, fx), wv = hn::Mul(w, vq);
         r0 = hn::Add(r0, w), rx = hn::Add(rx, wx), rxx = hn::Add(rxx, hn::Mul(wx, fx));
         t0 = hn::Add(t0, wv), tx = hn::Add(tx, hn::Mul(wv, fx));
+        if constexpr (kVariance) w2v = hn::Add(w2v, hn::Mul(hn::Mul(w, w), hn::LoadU(d, b.variance + q)));
       }
       const VF fy = hn::Set(d, static_cast<float>(dy));
       m0 = hn::Add(m0, r0), mx = hn::Add(mx, rx), my = hn::Add(my, hn::Mul(r0, fy));
       mxx = hn::Add(mxx, rxx), mxy = hn::Add(mxy, hn::Mul(rx, fy)), myy = hn::Add(myy, hn::Mul(hn::Mul(r0, fy), fy));
       s0 = hn::Add(s0, t0), sx = hn::Add(sx, tx), sy = hn::Add(sy, hn::Mul(t0, fy));
     }
-    const VF sums[9] = {m0, mx, my, mxx, mxy, myy, s0, sx, sy};
-    for (int k = 0; k < 9; ++k) hn::Store(sums[k], d, moments[k]);
+    const VF sums[10] = {m0, mx, my, mxx, mxy, myy, s0, sx, sy, w2v};
+    for (int k = 0; k < 10; ++k) hn::Store(sums[k], d, moments[k]);
     const int lanes = std::min(static_cast<int>(n), b.width - x0);
     for (int i = 0; i < lanes; ++i) {
       if (!(b.area[c + i] > 0) || !(moments[0][i] > 0)) continue;
       float m[9];
       for (int k = 0; k < 9; ++k) m[k] = moments[k][i];
       out[x0 + i] = plane_at_centre(m, b.slope_ridge);
+      if constexpr (kVariance) out_variance[x0 + i] = moments[9][i] / (m[0] * m[0]);
     }
   }
+}
+
+void DenoiseRow(const detail::DenoiseBand& b, int row, float* out, float* out_variance) {
+  if (out_variance)
+    DenoiseRowImpl<true>(b, row, out, out_variance);
+  else
+    DenoiseRowImpl<false>(b, row, out, nullptr);
 }
 
 }  // namespace ao::simd::HWY_NAMESPACE
@@ -105,14 +115,16 @@ HWY_EXPORT(DenoiseRow);
 // Dispatched from the namespace of HWY_EXPORT: with a single static target (AO_NATIVE=ON)
 // HWY_DYNAMIC_DISPATCH(F) is F of that target's namespace, named relative to the calling scope.
 namespace {
-void dispatch_denoise_row(const detail::DenoiseBand& band, int row, float* out) { HWY_DYNAMIC_DISPATCH(DenoiseRow)(band, row, out); }
+void dispatch_denoise_row(const detail::DenoiseBand& band, int row, float* out, float* out_variance) {
+  HWY_DYNAMIC_DISPATCH(DenoiseRow)(band, row, out, out_variance);
+}
 }  // namespace
 
 }  // namespace ao::simd
 
 namespace ao::detail {
 
-void denoise_row(const DenoiseBand& band, int row, float* out) { simd::dispatch_denoise_row(band, row, out); }
+void denoise_row(const DenoiseBand& band, int row, float* out, float* out_variance) { simd::dispatch_denoise_row(band, row, out, out_variance); }
 
 }  // namespace ao::detail
 #endif  // HWY_ONCE

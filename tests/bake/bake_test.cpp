@@ -657,6 +657,27 @@ TEST(Bake, DenoisingKeepsTheContactEdgesOfABoxOnAFloor) {
   EXPECT_LT(all_filtered * 2, all_plain);
 }
 
+// A flat chart of w x h texels, one world unit each: a quad holding the whole UV square, its
+// coverage, and guides with each texel's centre and the normal up (variances 0, for the test to set).
+struct FlatChart {
+  TexelCoverage cov;
+  TexelGuides guides;
+};
+FlatChart flat_chart(int w, int h) {
+  Mesh quad = make_quad({0, 0, static_cast<float>(h)}, {static_cast<float>(w), 0, static_cast<float>(h)}, {static_cast<float>(w), 0, 0}, {0, 0, 0});
+  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  Scene s;
+  s.meshes = {quad};
+  s = prepared(std::move(s));
+  FlatChart c{compute_texel_coverage(s, w, h), TexelGuides(w, h)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      c.guides.position(x, y) = {static_cast<float>(x) + 0.5f, 0, static_cast<float>(h - y) - 0.5f};
+      c.guides.normal(x, y) = {0, 1, 0};
+    }
+  return c;
+}
+
 // The filter fits a plane to each texel's window (denoise.h), so a linear ramp in V keeps its level
 // where the window is one-sided: on a flat 16 x 8 chart with V = 0.1 + 0.05 x and a large measured
 // variance (the value term weighs ~1), the texels of the left border column (their neighbours all
@@ -665,19 +686,11 @@ TEST(Bake, DenoisingKeepsTheContactEdgesOfABoxOnAFloor) {
 TEST(Bake, DenoisingKeepsALinearRampAtTheBorderOfAChart) {
   constexpr int kW = 16, kH = 8;
   constexpr float kSlope = 0.05f;
-  Mesh quad = make_quad({0, 0, kH}, {kW, 0, kH}, {kW, 0, 0}, {0, 0, 0});
-  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  Scene s;
-  s.meshes = {quad};
-  s = prepared(std::move(s));
-  const TexelCoverage cov = compute_texel_coverage(s, kW, kH);
+  auto [cov, guides] = flat_chart(kW, kH);
   ASSERT_EQ(cov.covered_texels, static_cast<std::size_t>(kW * kH));
-  TexelGuides guides(kW, kH);
   Image<float> v(kW, kH, 0.0f);
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
-      guides.position(x, y) = {static_cast<float>(x) + 0.5f, 0, static_cast<float>(kH - y) - 0.5f};
-      guides.normal(x, y) = {0, 1, 0};
       guides.variance(x, y) = 100.0f;
       v(x, y) = 0.1f + kSlope * static_cast<float>(x);
     }
@@ -704,21 +717,13 @@ TEST(Bake, DenoisingKeepsALinearRampAtTheBorderOfAChart) {
 // variances are averages over the first pass's window, by 1.4e-4. Bound: 4e-4.
 TEST(Bake, DenoisingKeepsTheMeanOfANoisyChart) {
   constexpr int kN = 64, kSamples = 8;
-  Mesh quad = make_quad({0, 0, kN}, {kN, 0, kN}, {kN, 0, 0}, {0, 0, 0});
-  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  Scene s;
-  s.meshes = {quad};
-  s = prepared(std::move(s));
-  const TexelCoverage cov = compute_texel_coverage(s, kN, kN);
+  auto [cov, guides] = flat_chart(kN, kN);
   ASSERT_EQ(cov.covered_texels, static_cast<std::size_t>(kN * kN));
-  TexelGuides guides(kN, kN);
   Image<float> v(kN, kN, 0.0f);
   std::uint32_t state = 12345u;
   double before = 0;
   for (int y = 0; y < kN; ++y)
     for (int x = 0; x < kN; ++x) {
-      guides.position(x, y) = {static_cast<float>(x) + 0.5f, 0, static_cast<float>(kN - y) - 0.5f};
-      guides.normal(x, y) = {0, 1, 0};
       int escaped = 0;
       for (int k = 0; k < kSamples; ++k) {
         state = state * 1664525u + 1013904223u;  // a fixed LCG: the same map on every platform

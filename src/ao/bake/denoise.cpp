@@ -43,10 +43,6 @@ constexpr float kVarianceFloor = 1e-4f;
 // filter, whose value term compared the raw values.
 constexpr float kSlopeRidge = 0.5f;
 
-}  // namespace
-
-namespace {
-
 // One pass of the filter at `sigma` over `value` (the variance of each texel's value: `variance`),
 // its value term comparing `guide` (variance `guide_variance`) with k = `range_tolerance`, into
 // `out`, and the variance of each result into `out_variance` when that is not null.

@@ -190,7 +190,11 @@ std::optional<float> float_of(const nlohmann::json& request, const char* key, co
   if (!v) return std::nullopt;
   if (!v->is_number() || v->is_boolean()) throw py::type_error(name + ": expected a number, got " + json_type(*v));
   const double d = v->get<double>();
-  if (!std::isfinite(d) || std::abs(d) > std::numeric_limits<float>::max()) throw InputError(name + ": expected a finite number, got " + v->dump());
+  if (!std::isfinite(d) || std::abs(d) > std::numeric_limits<float>::max()) {
+    // As Python spells the value: JSON has no NaN or infinity, and nlohmann dumps them as null.
+    const std::string got = std::isnan(d) ? "nan" : std::isinf(d) ? (d > 0 ? "inf" : "-inf") : v->dump();
+    throw InputError(name + ": expected a finite number, got " + got);
+  }
   return static_cast<float>(d);
 }
 

@@ -70,6 +70,7 @@ CASES = [
     # NaN and infinities
     (lambda: ao.render("wedge", CAM, radius=math.nan), ValueError, "radius: expected a finite number, got nan"),
     (lambda: ao.Camera(fov=math.inf), ValueError, "camera.fov: expected a finite number, got inf"),
+    (lambda: ao.bake("grid.obj", denoise=math.nan), ValueError, "denoise: expected a finite number, got nan"),
     (lambda: ao.Camera(eye=(0, math.nan, 0)), ValueError, "camera.eye[1]: expected a finite number, got nan"),
     (lambda: ao.Scene.from_arrays(np.full((3, 3), np.nan), [[0, 1, 2]]), ValueError, "arrays"),
     (lambda: ao.Scene.from_arrays(V, F, normals=np.zeros_like(V)), ValueError, "arrays: normals: row 0 is not a finite non-zero vector"),

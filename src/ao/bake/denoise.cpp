@@ -44,13 +44,14 @@ constexpr float kVarianceFloor = 1e-4f;
 constexpr float kSlopeRidge = 0.5f;
 
 // One pass of the filter at `sigma` over `value` (the variance of each texel's value: `variance`),
-// its value term comparing `guide` (variance `guide_variance`) with k = `range_tolerance`, into
-// `out`, and the variance of each result into `out_variance` when that is not null.
+// its value term comparing `guide` (variance `guide_variance`; both null: the values themselves)
+// with k = `range_tolerance`, into `out`, and the variance of each result into `out_variance` when
+// that is not null.
 struct PassInputs {
   const Image<float>& value;
   const Image<float>& variance;
-  const Image<float>& guide;
-  const Image<float>& guide_variance;
+  const Image<float>* guide;
+  const Image<float>* guide_variance;
   float sigma, range_tolerance;
 };
 
@@ -73,7 +74,8 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
   // band it falls in, nor on the thread count.
   constexpr int kBandRows = 16;
   constexpr int kMaxLanes = 16;  // floats in the widest target's vector (AVX-512)
-  constexpr int kPlanes = 11;
+  constexpr std::size_t kPlanes = 11;  // the last two are the guide's: none when the values are their own guide
+  const std::size_t planes_used = in.guide ? kPlanes : kPlanes - 2;
   const std::ptrdiff_t stride = w + 2 * r + kMaxLanes;
   tbb::enumerable_thread_specific<std::vector<float>> scratch;
   tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBandRows - 1) / kBandRows, 1), [&](const tbb::blocked_range<int>& bands) {
@@ -84,9 +86,9 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
     for (int band = bands.begin(); band < bands.end(); ++band) {
       const int y0 = band * kBandRows, rows = std::min(kBandRows, h - y0);
       const auto plane_size = static_cast<std::size_t>((rows + 2 * r) * stride);
-      planes.assign(kPlanes * plane_size, 0.0f);
-      float* p[kPlanes];
-      for (std::size_t k = 0; k < kPlanes; ++k) p[k] = planes.data() + k * plane_size;
+      planes.assign(planes_used * plane_size, 0.0f);
+      float* p[kPlanes] = {};
+      for (std::size_t k = 0; k < planes_used; ++k) p[k] = planes.data() + k * plane_size;
       std::fill_n(p[0], plane_size, std::numeric_limits<float>::quiet_NaN());
       for (int y = std::max(0, y0 - r); y < std::min(h, y0 + rows + r); ++y) {
         const std::ptrdiff_t base = (y - y0 + r) * stride + r;
@@ -97,13 +99,14 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
           const Vec3 pos = guides.position.data()[t], nor = guides.normal.data()[t];
           p[0][e] = pos.x, p[1][e] = pos.y, p[2][e] = pos.z, p[3][e] = nor.x, p[4][e] = nor.y, p[5][e] = nor.z;
           p[6][e] = in.value.data()[t], p[7][e] = in.variance.data()[t];
-          p[8][e] = in.guide.data()[t], p[9][e] = in.guide_variance.data()[t];
+          if (in.guide) p[9][e] = in.guide->data()[t], p[10][e] = in.guide_variance->data()[t];
           const float texel_area = cov.uv_area[t] > 0 ? cov.world_area[t] / cov.uv_area[t] : 0.0f;  // h_c^2
-          p[10][e] = texel_area > 0 ? texel_area : 0.0f;
+          p[8][e] = texel_area > 0 ? texel_area : 0.0f;
         }
       }
       const detail::DenoiseBand b{.px = p[0], .py = p[1], .pz = p[2], .nx = p[3], .ny = p[4], .nz = p[5], .value = p[6], .variance = p[7],
-                                  .guide = p[8], .guide_variance = p[9], .area = p[10], .stride = stride, .width = w, .radius = r,
+                                  .guide = in.guide ? p[9] : p[6], .guide_variance = in.guide ? p[10] : p[7], .area = p[8],
+                                  .stride = stride, .width = w, .radius = r,
                                   .gauss = gauss.data(), .gate = gate.data(), .plane_tolerance2 = kPlaneTolerance * kPlaneTolerance,
                                   .range_scale = 1.0f / (in.range_tolerance * in.range_tolerance), .variance_floor = kVarianceFloor,
                                   .slope_ridge = kSlopeRidge};
@@ -119,9 +122,9 @@ void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, con
   const Image<float> raw = visibility;
   // Pass 1, the guide: the raw values compared with each other, and the variance of each result.
   Image<float> guide = raw, guide_variance = guides.variance;
-  filter_pass({raw, guides.variance, raw, guides.variance, kGuideSigma, kGuideRangeTolerance}, valid, cov, guides, guide, &guide_variance);
+  filter_pass({raw, guides.variance, nullptr, nullptr, kGuideSigma, kGuideRangeTolerance}, valid, cov, guides, guide, &guide_variance);
   // Pass 2: the raw values again, weighted by how far apart the guide puts them.
-  filter_pass({raw, guides.variance, guide, guide_variance, sigma, kRangeTolerance}, valid, cov, guides, visibility, nullptr);
+  filter_pass({raw, guides.variance, &guide, &guide_variance, sigma, kRangeTolerance}, valid, cov, guides, visibility, nullptr);
 }
 
 }  // namespace ao

@@ -664,10 +664,9 @@ struct FlatChart {
   TexelGuides guides;
 };
 FlatChart flat_chart(int w, int h) {
-  Mesh quad = make_quad({0, 0, static_cast<float>(h)}, {static_cast<float>(w), 0, static_cast<float>(h)}, {static_cast<float>(w), 0, 0}, {0, 0, 0});
-  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const auto fw = static_cast<float>(w), fh = static_cast<float>(h);
   Scene s;
-  s.meshes = {quad};
+  s.meshes = {uv_quad({0, 0, fh}, {fw, 0, fh}, {fw, 0, 0}, {0, 0, 0}, {0, 0}, {1, 1})};
   s = prepared(std::move(s));
   FlatChart c{compute_texel_coverage(s, w, h), TexelGuides(w, h)};
   for (int y = 0; y < h; ++y)

@@ -121,6 +121,40 @@ TEST(WindingNumber, SignedDistanceToTheNearestTriangle) {
   }
 }
 
+// Rays against the hierarchy: a unit quad facing +y met from above (its front) and from below (its
+// back) at the distance to its plane, missed beside it and beyond t_max; on a sphere from its centre
+// every ray meets the inside (the backs) at the radius, within the tessellation's sag.
+TEST(WindingNumber, FirstHitIsTheNearestTriangleAndItsSide) {
+  const Mesh quad = make_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1});  // facing +y
+  const WindingNumber w(quad.positions, quad.indices);
+  const float inf = std::numeric_limits<float>::infinity();
+  WindingNumber::Hit h = w.first_hit({0.2f, 2, 0.3f}, {0, -1, 0}, 0, inf);
+  EXPECT_FLOAT_EQ(h.t, 2.0f);
+  EXPECT_EQ(h.side, -1);
+  h = w.first_hit({0.2f, -0.5f, 0.3f}, {0, 2, 0}, 0, inf);  // t in lengths of d
+  EXPECT_FLOAT_EQ(h.t, 0.25f);
+  EXPECT_EQ(h.side, 1);
+  EXPECT_EQ(w.first_hit({1.5f, 2, 0}, {0, -1, 0}, 0, inf).side, 0);  // beside it
+  EXPECT_EQ(w.first_hit({0, 2, 0}, {0, -1, 0}, 0, 1.5f).side, 0);    // beyond t_max
+  EXPECT_EQ(w.first_hit({0, 2, 0}, {0, 1, 0}, 0, inf).side, 0);      // away from it
+  EXPECT_EQ(w.first_hit({0, 2, 0}, {1, 0, 0}, 0, inf).side, 0);      // parallel to it
+
+  const Mesh sphere = make_sphere({0, 0, 0}, 1.0f, 96, 48);
+  const WindingNumber ws(sphere.positions, sphere.indices);
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 d = normalize(Vec3{g(rng), g(rng), g(rng)});
+    const WindingNumber::Hit in = ws.first_hit({0, 0, 0}, d, 0, inf);
+    EXPECT_EQ(in.side, 1) << k;
+    EXPECT_NEAR(in.t, 1.0f, 2e-3f) << k;  // a 96 x 48 sphere's faces sag 1 - cos(pi / 48) = 2.1e-3 at most
+    // From outside, aimed through the centre: the near side's front at 2 - 1.
+    const WindingNumber::Hit out = ws.first_hit(d * 2.0f, -d, 0, inf);
+    EXPECT_EQ(out.side, -1) << k;
+    EXPECT_NEAR(out.t, 1.0f, 2.2e-3f) << k;
+  }
+}
+
 TEST(WindingNumber, EmptyMeshIsZeroAndBadBetaIsRejected) {
   EXPECT_EQ(WindingNumber()({0, 0, 0}), 0.0);
   const Mesh quad = make_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1});

@@ -218,6 +218,65 @@ double WindingNumber::signed_distance(Vec3 q) const {
   return side > 0 ? std::sqrt(best2) : side < 0 ? -std::sqrt(best2) : 0.0;
 }
 
+WindingNumber::Hit WindingNumber::first_hit(Vec3 o, Vec3 d, float t_min, float t_max) const {
+  Hit best{std::numeric_limits<float>::infinity(), 0};
+  if (nodes_.empty() || !(t_max > t_min)) return best;
+  const Vec3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};  // +-infinity along an axis d does not move on
+  float limit = t_max;
+  // The ray's entry into a node's box (slabs), or +infinity when it misses it within (t_min, limit].
+  const auto enter = [&](const Node& n) {
+    float t0 = t_min, t1 = limit;
+    const float lo[3] = {n.lo.x, n.lo.y, n.lo.z}, hi[3] = {n.hi.x, n.hi.y, n.hi.z}, oo[3] = {o.x, o.y, o.z}, ii[3] = {inv.x, inv.y, inv.z};
+    for (int a = 0; a < 3; ++a) {
+      float u = (lo[a] - oo[a]) * ii[a], v = (hi[a] - oo[a]) * ii[a];
+      if (u > v) std::swap(u, v);
+      // NaN (0 x infinity: the origin on a face of the box, d parallel to it) leaves the bound as it is.
+      t0 = u > t0 ? u : t0;
+      t1 = v < t1 ? v : t1;
+    }
+    return t0 <= t1 ? t0 : std::numeric_limits<float>::infinity();
+  };
+  std::uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (!(enter(n) <= limit)) continue;
+    if (n.count == 0) {
+      const float tl = enter(nodes_[n.left]), tr = enter(nodes_[n.right]);
+      // The nearer child last, so that it is searched first and shortens the ray.
+      if (tl <= tr) {
+        if (tr <= limit) stack[top++] = n.right;
+        if (tl <= limit) stack[top++] = n.left;
+      } else {
+        if (tl <= limit) stack[top++] = n.left;
+        if (tr <= limit) stack[top++] = n.right;
+      }
+      continue;
+    }
+    for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+      const Tri& tr = tris_[i];
+      const Vec3 e1 = tr.b - tr.a, e2 = tr.c - tr.a, pv = cross(d, e2);
+      const float det = dot(e1, pv);
+      if (det == 0.0f) continue;
+      const float inv_det = 1.0f / det;
+      const Vec3 s = o - tr.a;
+      const float u = dot(s, pv) * inv_det;
+      if (u < 0.0f || u > 1.0f) continue;
+      const Vec3 qv = cross(s, e1);
+      const float v = dot(d, qv) * inv_det;
+      if (v < 0.0f || u + v > 1.0f) continue;
+      const float t = dot(e2, qv) * inv_det;
+      if (t > t_min && t <= limit) {
+        limit = t;
+        // det = -dot(d, e1 x e2): positive when d runs against the front normal (met from the front).
+        best = {t, det > 0.0f ? -1 : 1};
+      }
+    }
+  }
+  return best;
+}
+
 // The same in single precision, for the hierarchy's leaves: its rounding (1e-7 relative per
 // triangle) is far below the far field's truncation error.
 double WindingNumber::solid_angle_float(const Tri& t, Vec3 q) {

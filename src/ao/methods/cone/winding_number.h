@@ -49,6 +49,16 @@ class WindingNumber {
   /// that sees as much of the mesh's fronts as of its backs) this tells the side of the part of
   /// the mesh nearest to q. Branch and bound over the same hierarchy.
   double signed_distance(Vec3 q) const;
+  /// The first triangle along the ray o + t d, t in (t_min, t_max] (d need not be unit: t is in
+  /// its lengths): its t, and +1 when the ray meets it from behind (its counter-clockwise front
+  /// turned away from o), -1 from the front. t = +infinity, side 0 when it meets none. Both sides
+  /// of every triangle are hit (Moller and Trumbore's test) and the hierarchy's boxes are the
+  /// bound (a sheet's own thickness for the cone method's slabs, which side of it a point sees).
+  struct Hit {
+    float t;
+    int side;
+  };
+  Hit first_hit(Vec3 o, Vec3 d, float t_min, float t_max) const;
   /// Number of triangles.
   std::size_t size() const { return tris_.size(); }
 

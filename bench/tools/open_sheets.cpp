@@ -5,7 +5,8 @@
 //   ao_open_sheets /tmp/open-sheets
 //   ao compare /tmp/open-sheets/arch.obj --camera /tmp/open-sheets/arch.camera.json --methods cone
 // Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
-// top), and the closed box, sphere and torus. The ground is a quad of twice the object's diagonal
+// top), mask, dome (with a window), terrain, tablecloth, leaf, gutter, and the closed box, sphere and
+// torus. The ground is a quad of twice the object's diagonal
 // under it, and the camera looks at the object from the front right and above, as
 // tests/methods/cone_test.cpp does. With a second argument, the folder of the shared meshes, also
 // ChineseDragon-10kv and elephant opened as scans come (tests/support/open_sheets.h: the bottom
@@ -70,9 +71,16 @@ int main(int argc, char** argv) {
         {"arch", ao::test::make_holed_arch()},
         {"bowl", ao::test::make_bowl()},
         {"open-box", ao::test::make_open_box()},
+        {"mask", ao::test::make_mask()},
+        {"dome", ao::test::make_dome()},
+        {"terrain", ao::test::make_terrain()},
+        {"tablecloth", ao::test::make_tablecloth()},
+        {"leaf", ao::test::make_leaf()},
+        {"gutter", ao::test::make_gutter()},
         {"box", ao::make_box({-0.9f, 0.0f, -0.7f}, {0.9f, 1.0f, 0.7f})},
         {"sphere", ao::make_sphere({0, 1, 0}, 1.0f, 96, 48)},
         {"torus", ao::make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)},
+        {"head", ao::test::make_head()},
     };
     for (const auto& [name, mesh] : objects) {
       write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ground_under(mesh)}});

@@ -242,6 +242,24 @@ TEST(Voxelize, SheetSlabLiesOnTheFarSideFromThePoints) {
   }
 }
 
+// The world grid puts the scene's lowest point on a boundary between voxels (world_grid_layout), so
+// that a ground there is solid exactly up to its height and its voxel above it is air, whatever the
+// scene's height; the top keeps a voxel of margin above the bounds.
+TEST(Voxelize, GroundAtTheBottomLiesOnAVoxelBoundary) {
+  for (float height : {0.37f, 1.0f, 2.9f}) {
+    const Scene s = scene_of({make_quad({-2, 0.1f, 2}, {2, 0.1f, 2}, {2, 0.1f, -2}, {-2, 0.1f, -2}), make_box({-0.5f, 0.1f, -0.5f}, {0.5f, 0.1f + height, 0.5f})});
+    const VoxelGrid g = voxelize_world(s, analyze_closure(s), grid_options(64, 128, 0.3f));
+    const double k = (0.1 - double(g.origin.y)) / g.voxel_size.z;
+    EXPECT_NEAR(k, std::round(k), 1e-3) << height;
+    const int kg = static_cast<int>(std::lround(k));
+    // A column over the ground beside the box (x, z = -1.7): the ground's voxel below the surface is
+    // solid (its slab), the one above is air.
+    EXPECT_TRUE(g.voxel(8, 8, kg - 1)) << height;
+    EXPECT_FALSE(g.voxel(8, 8, kg)) << height;
+    EXPECT_GE(g.origin.y + g.depth_bits * g.voxel_size.z, 0.1f + height + g.voxel_size.z * 0.99f) << height;
+  }
+}
+
 // Two walls of one open mesh meet at a corner, facing out of it; their prisms (behind them, 0.5
 // thick) overlap in the corner, which is as solid as the rest of each: the union, not the parity,
 // of the prisms.

@@ -5,6 +5,7 @@
 // And closed meshes opened as scans come (a base cut off, holes punched).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -76,6 +77,131 @@ inline Mesh make_bowl(float radius = 1.0f, int segments = 96, int rings = 48) {
 /// A box from `lo` to `hi` without its top face: an open container seen into through the gap.
 inline Mesh make_open_box(Vec3 lo = {-0.9f, 0.0f, -0.7f}, Vec3 hi = {0.9f, 1.0f, 0.7f}) {
   return cut(make_box(lo, hi), [hi](Vec3 c) { return c.y < hi.y; });
+}
+
+/// A sheet over the unit square of parameters: `at(u, v)` places the grid's vertices (nu x nv
+/// quads), and a triangle is kept where `keep(u, v)` holds at its centroid in parameters (an
+/// outline, holes). Fronts face along d(at)/du x d(at)/dv.
+template <class At, class Keep>
+inline Mesh make_parametric_sheet(int nu, int nv, At at, Keep keep) {
+  Mesh m;
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) m.positions.push_back(at(static_cast<float>(i) / static_cast<float>(nu), static_cast<float>(j) / static_cast<float>(nv)));
+  const auto v = [&](int i, int j) { return static_cast<std::uint32_t>(j * (nu + 1) + i); };
+  const auto add = [&](int i0, int j0, int i1, int j1, int i2, int j2) {
+    const float u = static_cast<float>(i0 + i1 + i2) / (3.0f * static_cast<float>(nu));
+    const float w = static_cast<float>(j0 + j1 + j2) / (3.0f * static_cast<float>(nv));
+    if (keep(u, w)) m.indices.insert(m.indices.end(), {v(i0, j0), v(i1, j1), v(i2, j2)});
+  };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      add(i, j, i + 1, j, i + 1, j + 1);
+      add(i, j, i + 1, j + 1, i, j + 1);
+    }
+  return m;
+}
+
+inline constexpr float kPi = 3.14159265358979323846f;
+
+/// A face mask as a scan gives it: one curved sheet (a part of an ellipsoid, 1.2 wide, 1.6 tall,
+/// 0.5 deep, facing +z), with a nose and brows standing out of it and two eye holes, its chin on
+/// y = 0. Under the nose the sheet folds back on itself within the scene's radius.
+inline Mesh make_mask() {
+  const auto outline = [](float u, float v) {
+    const float x = 2 * u - 1, y = 2 * v - 1;
+    const auto eye = [&](float ex) { return (x - ex) * (x - ex) / 0.045f + (y - 0.25f) * (y - 0.25f) / 0.012f < 1; };
+    return x * x + y * y * (y < 0 ? 1.15f : 1.0f) < 1 && !eye(-0.38f) && !eye(0.38f);
+  };
+  return make_parametric_sheet(96, 128,
+                               [](float u, float v) {
+                                 const float x = 2 * u - 1, y = 2 * v - 1;
+                                 const float theta = 1.1f * x, phi = 0.9f * y;
+                                 Vec3 p{0.6f * std::sin(theta) / std::sin(1.1f), 0.8f + 0.8f * y, 0.5f * std::cos(theta) * std::cos(phi)};
+                                 // Nose: a ridge down the middle, deepest at its tip; brows over the eyes.
+                                 const float nose = 0.2f * std::exp(-x * x / 0.01f) * std::exp(-(y + 0.05f) * (y + 0.05f) / 0.05f);
+                                 const float brows = 0.06f * std::exp(-(y - 0.42f) * (y - 0.42f) / 0.004f) * (1 - x * x);
+                                 p.z += nose + brows;
+                                 return p;
+                               },
+                               outline);
+}
+
+/// Half a sphere shell of `radius` standing on y = 0 (a dome), with one round window of angular
+/// radius `window` (radians) facing the direction (1, 0, 1.3) at `elevation` radians: the ground
+/// inside is seen through it.
+inline Mesh make_dome(float radius = 1.0f, float window = 0.4f, float elevation = 0.6f) {
+  const Vec3 w = normalize(Vec3{std::cos(elevation) * 0.61f, std::sin(elevation), std::cos(elevation) * 0.79f});
+  return make_parametric_sheet(128, 48,
+                               [radius](float u, float v) {
+                                 const float az = 2 * kPi * u, el = 0.5f * kPi * v;
+                                 return Vec3{radius * std::cos(el) * std::cos(az), radius * std::sin(el), -radius * std::cos(el) * std::sin(az)};
+                               },
+                               [w, window](float u, float v) {
+                                 const float az = 2 * kPi * u, el = 0.5f * kPi * v;
+                                 const Vec3 d{std::cos(el) * std::cos(az), std::sin(el), -std::cos(el) * std::sin(az)};
+                                 return dot(d, w) < std::cos(window);
+                               });
+}
+
+/// A terrain: a height field 3 x 3 (hills, a ridge, a valley cut by a ravine narrower than the
+/// scene's radius), its lowest point on y = 0. An open sheet seen from above, its edges cliffs.
+inline Mesh make_terrain() {
+  return make_parametric_sheet(128, 128,
+                               [](float u, float v) {
+                                 const float x = 3 * u - 1.5f, z = 1.5f - 3 * v;
+                                 const float hills = 0.25f * std::sin(2.1f * x) * std::cos(1.7f * z) + 0.18f * std::exp(-((x - 0.6f) * (x - 0.6f) + (z + 0.5f) * (z + 0.5f)) / 0.15f);
+                                 const float ravine = -0.3f * std::exp(-(x + 0.3f * z + 0.2f) * (x + 0.3f * z + 0.2f) / 0.01f);
+                                 return Vec3{x, 0.6f + hills + ravine, z};
+                               },
+                               [](float, float) { return true; });
+}
+
+/// A cloth thrown over a round table that is not there: flat on a disk of radius 0.7 at y = 1,
+/// then hanging down in eight folds to a hem at y = 0.25. Open below: a tent over the ground.
+inline Mesh make_tablecloth() {
+  return make_parametric_sheet(128, 64,
+                               [](float u, float v) {
+                                 const float az = 2 * kPi * u, s = 1.4f * v;  // s: distance from the centre along the cloth
+                                 const float top = 0.7f, over = std::max(0.0f, s - top);
+                                 const float r = std::min(s, top) + 0.15f * over + 0.1f * (over / 0.7f) * std::sin(8 * az);
+                                 return Vec3{r * std::cos(az), 1.0f - 1.07f * over, -r * std::sin(az)};
+                               },
+                               [](float, float) { return true; });
+}
+
+/// A leaf lying on the ground: an outline 1.6 long and 0.7 wide, folded along its midrib into a V
+/// (its halves rise 25 degrees) and curled up towards its tip, touching y = 0 along the midrib's base.
+inline Mesh make_leaf() {
+  return make_parametric_sheet(64, 128,
+                               [](float u, float v) {
+                                 const float x = 0.35f * (2 * u - 1), t = 1.6f * v;
+                                 const float fold = 0.47f * std::abs(x);
+                                 const float curl = 0.35f * v * v * v;
+                                 return Vec3{x, 0.02f + fold + curl, 0.8f - t};
+                               },
+                               [](float u, float v) {
+                                 const float half = std::sin(kPi * std::pow(v, 0.8f));  // the outline's half width, 0 at both ends
+                                 return std::abs(2 * u - 1) < half;
+                               });
+}
+
+/// A gutter: half a pipe of radius 0.2 and length 2, open upwards, lying on y = 0. Its inside is
+/// curved tighter than the scene's radius.
+inline Mesh make_gutter(float radius = 0.2f, float length = 2.0f) {
+  return make_parametric_sheet(48, 96,
+                               [=](float u, float v) {
+                                 const float a = kPi * (1 + u);  // from -x under the axis to +x
+                                 return Vec3{radius * std::cos(a), radius + radius * std::sin(a), length * (v - 0.5f)};
+                               },
+                               [](float, float) { return true; });
+}
+
+/// A closed ellipsoid of the mask's size (make_mask: 1.2 wide, 1.6 tall, 1 deep), standing on y = 0:
+/// the closed mesh the mask is compared with.
+inline Mesh make_head() {
+  Mesh m = make_sphere({0, 0, 0}, 1.0f, 96, 48);
+  for (Vec3& p : m.positions) p = {0.6f * p.x, 0.8f + 0.8f * p.y, 0.5f * p.z};
+  return m;
 }
 
 // The same mesh with every triangle turned over (fronts become backs).

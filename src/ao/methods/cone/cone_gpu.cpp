@@ -47,27 +47,8 @@ ConeGpuState& state_of(SceneBuffers& sb) {
   return sb.state.get<ConeGpuState>([] { return std::make_unique<ConeGpuState>(); });
 }
 
-// voxelize_world's layout of the world grid (voxelize.cpp) when nothing is voxelized as a slab:
-// the scene's bounds (every axis at least 1e-4 of the diagonal, so that a flat scene's voxels have
-// size) padded by one voxel v0 on every side and one more on top.
-VoxelGrid world_layout(const Scene& scene, const VoxelizeOptions& o) {
-  VoxelGrid g;
-  g.space = GridSpace::World;
-  g.nx = g.ny = o.columns;
-  g.depth_bits = o.depth_bits;
-  g.words = (o.depth_bits + 63) / 64;
-  const Bounds3 b = scene.bounds();
-  if (b.empty()) throw InputError(scene.name + ": cannot voxelize an empty scene");
-  const float floor_extent = std::max(1e-4f * b.diagonal(), 1e-6f);
-  const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
-  const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
-  const float side = v0;  // the CPU adds the slab thickness here when it makes slabs
-  const Vec3 lo = b.lo - Vec3{side, side, side};
-  const Vec3 ext = e + Vec3{2 * side, side + v0, 2 * side};
-  g.origin = lo;
-  g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
-  return g;
-}
+// voxelize_world's layout of the world grid (voxelize.h) when nothing is voxelized as a slab.
+VoxelGrid world_layout(const Scene& scene, const VoxelizeOptions& o) { return world_grid_layout(scene, o, false, false); }
 
 const std::vector<MeshClosure>& closure_of(SceneBuffers& sb) {
   std::optional<std::vector<MeshClosure>>& closure = state_of(sb).closure;

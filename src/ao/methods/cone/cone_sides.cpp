@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <limits>
 #include <map>
 
 #include <tbb/parallel_for.h>
@@ -81,6 +83,17 @@ int lattice_side(const SideSetup::Open& o, Vec3 p, bool& crossed) {
   return behind == 8 ? 1 : front == 8 ? -1 : 0;
 }
 
+// The largest of sign x w - threshold at the corners of p's lattice cell (+infinity without a lattice).
+float lattice_max(const SideSetup::Open& o, Vec3 p) {
+  if (o.lattice.empty()) return std::numeric_limits<float>::infinity();
+  const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
+  const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
+            z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
+  float m = -std::numeric_limits<float>::infinity();
+  for (int k = 0; k < 8; ++k) m = std::max(m, o.lattice[(static_cast<std::size_t>(z + (k >> 2)) * o.ly + y + ((k >> 1) & 1)) * o.lx + x + (k & 1)]);
+  return m;
+}
+
 // How far along its normal a surface point must go to be clear of its own surface's voxels: 1.5
 // voxels, as the kernel's near limit (cone.cpp, cone_world.cpp).
 float clearance(const VoxelGrid& g, Vec3 p) {
@@ -132,8 +145,10 @@ SideSetup::Open open_object(const Scene& scene, const SceneObject& ob, std::uint
     det_sign = tf->determinant() < 0 ? -1 : 1;  // a mirror turns fronts into backs
   }
   // A sheet's slab reaches R_max past it, and a point's cones R_max further: only points within
-  // 2 R_max of it can tell its sides apart. A solid with holes is entered only inside its box.
-  const float pad = c.open_surface() ? 2.0f * r_max : 0.0f;
+  // 2 R_max of it can tell its sides apart. A solid with holes is entered only inside its box
+  // (grown by 1% of R_max: a ground it stands on lies on its box's face, and the G-buffer's points
+  // of it a rounding error either side).
+  const float pad = c.open_surface() ? 2.0f * r_max : 0.01f * r_max;
   o.reach = bounds;
   o.reach.lo -= Vec3{pad, pad, pad};
   o.reach.hi += Vec3{pad, pad, pad};
@@ -199,6 +214,40 @@ bool own_behind(const GBuffer& gb, int x, int y, const SideSetup::Open& o, bool 
   return side_of(o, p + n * offset, evaluations) > 0;
 }
 
+// Rays a point casts to tell which side of a solid with holes it sees (seen_side): a fixed set over
+// the hemisphere about its normal, cosine-distributed (a spherical Fibonacci spiral), so the answer
+// depends on the point alone.
+constexpr int kSideRays = 24;
+
+// Which side of solid with holes `o` the point p (normal n) sees: +1 its inside (the first hits on
+// its shell are mostly its inner faces), -1 its outside, 0 when no ray meets it. A dome's w stays
+// below 1/2 on the ground inside it, where the point sees nothing but the dome's inside (and the
+// sky through its windows); w > 1/2 fills the dome's hollow, where no pixel lies.
+int seen_side(const SideSetup::Open& o, Vec3 p, Vec3 n, float offset, std::size_t& evaluations) {
+  static const std::array<Vec3, kSideRays> pattern = [] {
+    std::array<Vec3, kSideRays> d{};
+    const float golden = 2.39996323f;  // pi (3 - sqrt 5)
+    for (int k = 0; k < kSideRays; ++k) {
+      const float u = (static_cast<float>(k) + 0.5f) / kSideRays, z = std::sqrt(1.0f - u), r = std::sqrt(u);
+      d[static_cast<std::size_t>(k)] = {r * std::cos(golden * static_cast<float>(k)), r * std::sin(golden * static_cast<float>(k)), z};
+    }
+    return d;
+  }();
+  ++evaluations;
+  const Frame f = Frame::from_normal(n);
+  const Vec3 origin = p + n * offset;
+  const Vec3 q = o.instanced ? o.to_object.point(origin) : origin;
+  const WindingNumber& w = o.closure->winding.get();
+  int inner = 0, outer = 0;
+  for (const Vec3& local : pattern) {
+    const Vec3 d = f.to_world(local);
+    const WindingNumber::Hit h = w.first_hit(q, o.instanced ? o.to_object.vector(d) : d, 0.0f, std::numeric_limits<float>::max());
+    // o.sign: the world fronts face out of the solid (+1) or into it (-1).
+    inner += h.side * o.sign > 0, outer += h.side * o.sign < 0;
+  }
+  return inner > outer ? 1 : outer > inner ? -1 : 0;
+}
+
 // Whether a point p (normal n) of another object lies behind open object `o`, on which its object
 // votes `vote`.
 bool voted_behind(const SideSetup& setup, const SideSetup::Open& o, SideSetup::Vote vote, const VoxelGrid& front, Vec3 p, Vec3 n,
@@ -206,7 +255,18 @@ bool voted_behind(const SideSetup& setup, const SideSetup::Open& o, SideSetup::V
   if (vote != SideSetup::Mixed || !contains(o.reach, p)) return vote == SideSetup::Back;
   bool crossed;
   const int side = lattice_side(o, p, crossed);
+  if (o.closure->holed()) {
+    // Inside a solid with holes is what the point sees of it, not w > 1/2 (seen_side), but where
+    // w < 1/4 all around (lattice_side's corners) the point is outside it.
+    if (lattice_max(o, p) < -0.25f) return false;
+    const int seen = seen_side(o, p, n, setup.r_max * 1e-3f, evaluations);
+    if (seen != 0) return seen > 0;
+  }
   if (side != 0) return side > 0;
+  if (!o.closure->holed()) {
+    const int seen = seen_side(o, p, n, setup.r_max * 1e-3f, evaluations);
+    if (seen != 0) return seen > 0;
+  }
   // Where the lattice cannot tell, the point lies within a cell's diagonal of the mesh or of where
   // w crosses its threshold. With cells R_max / 2 wide that is within 0.87 R_max: inside a solid
   // with holes, or behind a sheet that crosses its cell, its front is solid in the all-front grid

@@ -114,8 +114,9 @@ std::size_t rasterise(const GridTri& t, int r0, int r1, VoxelGrid& g, float slab
       }
       if (t.fill == 1 || t.fill == -1) {
         double thickness;  // slab thickness in voxels along the column
-        if constexpr (kPerspective) thickness = slab * g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i];
-        else thickness = slab / g.voxel_size.z;
+        const float length = t.slab > 0.0f ? t.slab : slab;
+        if constexpr (kPerspective) thickness = length * g.voxels_per_unit[static_cast<std::size_t>(j) * g.nx + i];
+        else thickness = length / g.voxel_size.z;
         const double lo = t.fill > 0 ? k : k - thickness, hi = t.fill > 0 ? k + thickness : k;
         const double b0 = std::clamp(std::ceil(lo - 0.5), 0.0, double(nbits)), b1 = std::clamp(std::ceil(hi - 0.5), 0.0, double(nbits));
         set_bits(row + static_cast<std::size_t>(i) * words, nbits, static_cast<int>(b0), static_cast<int>(b1));

@@ -19,6 +19,7 @@ struct GridTri {
                // 2: fragment of an open wall's prism (listed, voxelize_into step 4); 3 + s: parity fragment
                // of a fan closing a hole that is not flat, or of a triangle near it, of the solid with
                // holes in slot s (recorded: the winding number is evaluated from there, step 3)
+  float slab = 0;  // fill +1 / -1: the slab's length along the column (world units)
 };
 
 // A fragment listed rather than toggled: column (i, j), the first voxel beyond it, and the slot of

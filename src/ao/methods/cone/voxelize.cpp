@@ -56,6 +56,8 @@ struct Tri3 {
                  // a grid traced from the back side, voxelize.h)
   int fan = -1;  // kind 0: slot of the solid with holes whose non-flat hole this fan triangle closes,
                  // or near which this triangle of it lies (Holes::near)
+  float depth = 0;  // kind 1: how far behind `normal` the slab reaches (world units; 0: the grid's slab
+                    // thickness); less where the sheet itself comes back within it (sheet_depth)
 };
 
 Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
@@ -69,7 +71,7 @@ Tri3 source_triangle(const Mesh& m, std::size_t t, bool open) {
 // ORed into the grid (voxelize_into, step 4). Calls emit for the prism's 8 triangles.
 template <class Emit>
 void emit_prism(const Tri3& t, float thickness, Emit&& emit) {
-  const Vec3 o = t.normal * -thickness;
+  const Vec3 o = t.normal * -(t.depth > 0.0f ? t.depth : thickness);
   // The top (the face itself) faces out when its counter-clockwise normal is `normal`; otherwise
   // (a slab in front of a face) its vertices are taken in the other order.
   const bool out = dot(cross(t.v[1] - t.v[0], t.v[2] - t.v[0]), t.normal) >= 0;
@@ -138,6 +140,7 @@ void emit_world(std::vector<GridTri>& out, const Tri3& t, const WorldMap& m, int
   for (int k = 0; k < 3; ++k) m(t.v[k], g.x[k], g.y[k], g.a[k]);
   // Behind the front face: below a face looking up (+y is +k), above a face looking down.
   g.fill = t.kind == 1 ? (t.normal.y > 0 ? -1 : 1) : t.kind == 2 ? 2 : t.fan >= 0 ? 3 + t.fan : 0;
+  if (t.kind == 1) g.slab = t.depth > 0.0f ? t.depth : m.slab;
   if (!finish_visible(g, nx, ny)) out.pop_back();
 }
 
@@ -159,6 +162,7 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
   }
   if (n < 3) return;
   // Behind the front face: deeper for a face turned to the eye, nearer for one turned away.
+  const float slab = t.kind == 1 && t.depth > 0.0f ? t.depth : m.slab;
   const int fill = t.kind == 1 ? (facing < 0 ? 1 : -1) : t.kind == 2 ? 2 : t.fan >= 0 ? 3 + t.fan : 0;
   float x[4], y[4], a[4];
   for (int k = 0; k < n; ++k) {
@@ -168,7 +172,7 @@ void emit_eye(std::vector<GridTri>& out, const Tri3& t, const EyeMap& m, int nx,
     a[k] = inv;
   }
   for (int k = 1; k + 1 < n; ++k) {
-    GridTri g{{x[0], x[k], x[k + 1]}, {y[0], y[k], y[k + 1]}, {a[0], a[k], a[k + 1]}, 0, 0, fill};
+    GridTri g{{x[0], x[k], x[k + 1]}, {y[0], y[k], y[k + 1]}, {a[0], a[k], a[k + 1]}, 0, 0, fill, slab};
     push_if_visible(out, g, nx, ny);
   }
 }
@@ -309,10 +313,51 @@ ObjectPlan plan_objects(const Scene& scene, std::span<const MeshClosure> closure
   return p;
 }
 
+// Where the columns of a grid run: world +y (eye null), or the view rays from `eye` (linear depth
+// along `forward`).
+struct ColumnAxis {
+  const Vec3* eye = nullptr;
+  Vec3 forward;
+};
+
+// How far the slab behind face `tri` (world space, its slab away from tri.normal) of an open mesh
+// reaches: the grid's `slab`, or less where the mesh itself comes back within it (a nose, a brow,
+// a fold of cloth: the slab behind the top of a brow would hang below it, in front of the eyes,
+// where the reference sees air), but at least `min_depth` (two voxels: the surface's own). Measured
+// the way the slab is filled (emit_world, emit_eye): along the column for a span (its length along
+// the column; for the eye grid in linear depth), along the normal for a steep face's prism; from
+// the face's centroid and from halfway to each corner (the nearest of the four), against the mesh's
+// own triangles only: whatever else the slab enters is solid or behind that mesh's own slab.
+// 0: the grid's slab.
+float sheet_depth(const MeshClosure& c, const Affine3* tf, const Tri3& tri, float slab, float min_depth, const ColumnAxis& axis) {
+  if (c.flat || !(slab > min_depth)) return 0.0f;  // a plane never comes back
+  const WindingNumber& w = c.winding.get();
+  if (w.size() == 0) return 0.0f;
+  const Vec3 centre = (tri.v[0] + tri.v[1] + tri.v[2]) * (1.0f / 3.0f);
+  Vec3 d = -tri.normal;
+  float to_column = 1.0f;  // column length per unit of distance along d
+  if (!axis.eye) {
+    if (std::abs(tri.normal.y) >= kSteep) d = {0.0f, tri.normal.y > 0 ? -1.0f : 1.0f, 0.0f};
+  } else {
+    const Vec3 view = normalize(centre - *axis.eye);
+    const float facing = dot(tri.normal, view);
+    if (std::abs(facing) >= kSteep) d = facing < 0 ? view : -view, to_column = std::abs(dot(view, axis.forward));
+  }
+  const Affine3 to_mesh = tf ? inverse(*tf) : Affine3{};
+  const Vec3 dm = tf ? to_mesh.vector(d) : d;  // world lengths along it (affine)
+  float nearest = slab / to_column;
+  for (int k = -1; k < 3; ++k) {
+    const Vec3 p = k < 0 ? centre : (centre + tri.v[k]) * 0.5f;
+    nearest = std::min(nearest, w.first_hit(tf ? to_mesh.point(p) : p, dm, 1e-3f * slab, nearest).t);
+  }
+  const float depth = nearest * to_column;
+  return depth >= slab ? 0.0f : std::max(depth, min_depth);
+}
+
 // Triangle `local` of object `oi` (ObjectPlan) in world space, its slab's side for
 // Treat::SlabFlipped; false for a face given a slab that cannot reach `region` (VoxelizeOptions).
 bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan, std::span<const Treat> treat, std::size_t oi,
-                     std::size_t local, const Bounds3& region, float slab_thickness, Tri3& tri) {
+                     std::size_t local, const Bounds3& region, float slab_thickness, float min_depth, const ColumnAxis& axis, Tri3& tri) {
   const std::size_t mi = plan.objects[oi].mesh;
   const Affine3* tf = plan.objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[plan.objects[oi].instance].object_to_world;
   const bool open = treat[oi] == Treat::Slab || treat[oi] == Treat::SlabFlipped;
@@ -340,6 +385,7 @@ bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, c
     if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
   }
   if (treat[oi] == Treat::SlabFlipped) tri.normal = -tri.normal;
+  if (tri.kind == 1) tri.depth = sheet_depth(closure[mi], tf, tri, slab_thickness, min_depth, axis);
   return true;
 }
 
@@ -443,6 +489,8 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
   // triangles overlapping it.
   const Bands bands = make_bands(g.ny);
   const ObjectPlan plan = plan_objects(scene, closure, treat, voxel);
+  ColumnAxis axis;
+  if constexpr (kPerspective) axis = {&g.camera.eye, g.camera.basis().to_world({0.0f, 0.0f, -1.0f})};
   const std::size_t total = plan.first.back();
   const std::size_t chunks = (total + kChunk - 1) / kChunk;
   std::vector<std::vector<GridTri>> tris(chunks);
@@ -455,7 +503,7 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     for (std::size_t t = t0; t < t1; ++t) {
       while (t >= plan.first[oi + 1]) ++oi;
       Tri3 tri;
-      if (object_triangle(scene, closure, plan, treat, oi, t - plan.first[oi], o.slab_region, slab_thickness, tri)) emit(out, tri);
+      if (object_triangle(scene, closure, plan, treat, oi, t - plan.first[oi], o.slab_region, slab_thickness, 2.0f * voxel, axis, tri)) emit(out, tri);
     }
     buckets[c] = bucket(out, bands);
   });
@@ -512,13 +560,12 @@ void VoxelizeOptions::validate() const {
     throw InputError("cone: slab thickness must be a finite number >= 0, got " + std::to_string(slab_thickness));
 }
 
-VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats,
-                         std::span<const std::uint8_t> back) {
-  o.validate();
-  const Treatments treat = treatments(scene, closure, o.open_meshes, back);
+VoxelGrid world_grid_layout(const Scene& scene, const VoxelizeOptions& o, bool slab_beside, bool slab_above, float* slab_out) {
   VoxelGrid g;
   g.space = GridSpace::World;
   g.nx = g.ny = o.columns;
+  g.depth_bits = o.depth_bits;
+  g.words = (o.depth_bits + 63) / 64;
   const Bounds3 b = scene.bounds();
   if (b.empty()) throw InputError(scene.name + ": cannot voxelize an empty scene");
   // A flat scene has no height: give every axis at least 1e-4 of the diagonal so voxels have size.
@@ -526,18 +573,34 @@ VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closur
   const Vec3 e = max(b.extent(), Vec3{floor_extent, floor_extent, floor_extent});
   const float v0 = std::max({e.x / o.columns, e.z / o.columns, e.y / o.depth_bits});
   const float slab = o.slab_thickness > 0 ? o.slab_thickness : 2.0f * v0;
+  if (slab_out) *slab_out = slab;
   // One voxel of margin on every side, and room for the slabs of open meshes below and beside
   // (a ground plane's slab hangs below it, a wall's prism stands behind it), and above when a
   // slab rises from a face (a roof seen from below, a ceiling seen from the room). A room (a
   // closed mesh around the camera) is solid outside: a slab's thickness of it all around, so that
   // a cone near its walls meets as much solid as behind an open wall.
+  const float side = (slab_beside ? slab : 0.0f) + v0;
+  const float top = (slab_above ? slab : 0.0f) + v0;
+  // The scene's lowest point (where a ground usually lies) on a boundary between voxels: a voxel
+  // is solid when its centre is, so a horizontal surface there is resolved exactly rather than
+  // standing up to half a voxel into the air (the grazing cones of every point on it saw that
+  // layer: 4% too dark on a ground whose voxels are 8% of R_max tall). One voxel more height pays
+  // for the shift, so the top keeps its margin.
+  const float vz = (e.y + side + top) / static_cast<float>(o.depth_bits - 1);
+  const float below = std::ceil(side / vz) * vz;
+  g.origin = b.lo - Vec3{side, below, side};
+  g.voxel_size = {(e.x + 2 * side) / o.columns, (e.z + 2 * side) / o.columns, vz};
+  return g;
+}
+
+VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& o, VoxelStats* stats,
+                         std::span<const std::uint8_t> back) {
+  o.validate();
+  const Treatments treat = treatments(scene, closure, o.open_meshes, back);
   const bool room = rooms_by_parity(o, treat.of) > 0;
-  const float side = (any_slab(treat.of) || room ? slab : 0.0f) + v0;
-  const float top = (slab_rises(scene, treat.of) || room ? slab : 0.0f) + v0;
-  const Vec3 lo = b.lo - Vec3{side, side, side};
-  const Vec3 ext = e + Vec3{2 * side, side + top, 2 * side};
-  g.origin = lo;
-  g.voxel_size = {ext.x / o.columns, ext.z / o.columns, ext.y / o.depth_bits};
+  float slab = 0;
+  VoxelGrid g = world_grid_layout(scene, o, any_slab(treat.of) || room, slab_rises(scene, treat.of) || room, &slab);
+  const Vec3 lo = g.origin;
   const WorldMap map{lo, {1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z}, slab};
   const Vec3 origin = g.origin, size = g.voxel_size;
   voxelize_into<false>(

@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "ao/core/error.h"
 #include "ao/eval/metrics.h"
@@ -31,6 +32,8 @@
 #include "ao/reference/reference.h"
 #include "gpu/gpu_support.h"
 #include "support/errors.h"
+#include "support/open_sheets.h"
+#include "support/scenes.h"
 
 namespace ao {
 namespace {
@@ -88,6 +91,33 @@ TEST_P(GpuMethodAgreement, AgreesWithTheCpuKernelOnTheSameGBuffer) {
   EXPECT_EQ(gpu.renderer, gpu_device().renderer());
   EXPECT_EQ(gpu.output.stats["device"], gpu_device().renderer());
   EXPECT_TRUE(gpu.output.stats["gpu_ms"].contains(method == "cone" ? "voxelize" : method));
+}
+
+// Cone with its default open-mesh handling on open meshes seen from both sides (the ground under an
+// arch, the ground inside a dome through its window; tests/support/open_sheets.h): the GPU traces
+// each side's grid, voxelized by the CPU, over that side's pixels, so it agrees with the CPU as on
+// closed scenes, with the same grids.
+TEST(GpuCone, OpenMeshesTraceEachSidesGridAsTheCpuDoes) {
+  for (const auto& [what, object] : {std::pair{"arch", ao::test::make_holed_arch()}, std::pair{"dome", ao::test::make_dome()}}) {
+    const Bounds3 b = object.bounds();
+    const float e = b.diagonal();
+    const Vec3 c = b.center();
+    test::GpuFixture f{test::scene_of({object, make_quad({c.x - e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z - e},
+                                                         {c.x - e, b.lo.y, c.z - e})}),
+                       nullptr, nullptr, {}, 0.1f * e};
+    f.rays = std::make_unique<RayScene>(f.scene);
+    f.gpu_scene = std::make_unique<GpuScene>(GpuScene::upload(gpu_device(), f.scene));
+    f.g = render_gbuffer(*f.rays, frame_bounds(b, {1.0f, 0.8f, 1.3f}, 40.0f, 96, 72));
+    const nlohmann::json params = find_method("cone").default_params();
+    const MethodInput in{f.g, f.rays.get(), {Membership::Step, f.radius}, 7, {}, &f.scene.analytic};
+    const MethodOutput cpu = run_method(in, find_method("cone").decode(params));
+    const GpuMethodOutput gpu = run_gpu_method(gpu_device(), in, find_method("cone").decode(params));
+    expect_agreement(gpu.output.visibility, cpu.visibility, what);
+    EXPECT_GE(cpu.stats["side_grids"], 2) << what;
+    EXPECT_EQ(gpu.output.stats["side_grids"], cpu.stats["side_grids"]) << what;
+    EXPECT_EQ(gpu.output.stats["back_pixels"], cpu.stats["back_pixels"]) << what;
+    EXPECT_GT(cpu.stats["back_pixels"], 100) << what;
+  }
 }
 
 std::string agreement_name(const ::testing::TestParamInfo<std::tuple<std::string, std::string>>& p) {

@@ -295,19 +295,6 @@ VoxelGrid voxelize(const Scene& scene, std::span<const MeshClosure> closure, con
   return p.grid == GridSpace::World ? voxelize_world(scene, closure, o, stats, back) : voxelize_eye(scene, closure, gb, o, stats, back);
 }
 
-// Where the pixels of side `key` can look: their points' box grown by 2 R_max (a slab R_max thick
-// reaches R_max past its face; a point's cones R_max). A grid for a few pixels (one side of a
-// small part of the scene) then leaves out the slabs that no cone of theirs can reach.
-Bounds3 side_region(const GBuffer& gb, const cone_internal::PixelSides& sides, std::size_t key, float r_max) {
-  Bounds3 b;
-  const Frame basis = gb.camera.basis();
-  for (std::size_t i = 0; i < sides.key_of.size(); ++i)
-    if (sides.key_of[i] == key && gb.covered(i)) b.extend(basis.to_world(gb.position[i]) + gb.camera.eye);
-  b.lo -= Vec3{2 * r_max, 2 * r_max, 2 * r_max};
-  b.hi += Vec3{2 * r_max, 2 * r_max, 2 * r_max};
-  return b;
-}
-
 // The kernel, on each side's grid over that side's pixels (one grid: all pixels at once), then
 // the filter over the whole image.
 void trace_and_filter(const GBuffer& gb, std::span<const VoxelGrid* const> grids, const cone_internal::PixelSides& sides, float r_max,
@@ -372,7 +359,7 @@ ConeResult render_cone(const Scene& scene, std::span<const MeshClosure> closure,
   const auto t2 = std::chrono::steady_clock::now();
   for (std::size_t k = 1; k < sides.keys.size(); ++k) {
     VoxelStats s;
-    grids.push_back(voxelize(scene, closure, gb, p, options, &s, sides.keys[k], side_region(gb, sides, k, r_max)));
+    grids.push_back(voxelize(scene, closure, gb, p, options, &s, sides.keys[k], cone_internal::side_region(gb, sides, k, r_max)));
     add_grid_stats(r, s);
   }
   r.voxelize_ms = ms_between(t0, t1) + ms_between(t2, std::chrono::steady_clock::now());

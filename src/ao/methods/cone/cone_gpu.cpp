@@ -6,6 +6,7 @@
 // (filters_gpu.cpp). The sampling tables are the CPU kernel's
 // (derive_cone_setup, make_cone_pattern), uploaded.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "ao/methods/filters/filters_gpu_internal.h"
 #include "ao/methods/cone/voxelize_gpu.h"
 #include "ao/methods/cone/cone_pattern_internal.h"
+#include "ao/methods/cone/cone_sides_internal.h"
 
 namespace ao {
 
@@ -34,6 +36,7 @@ struct GridCache {
   VoxelGrid layout;    // nx, ny, depth_bits, words, origin, voxel_size (bits stay on the GPU).
   Buffer bits;         // The columns as 32-bit words: column c's word w at c * (depth_bits / 32) + w.
   VoxelStats stats;
+  VoxelGrid cpu;       // The grid with its bits when the CPU built it (open meshes): the pixels' sides read it.
 };
 
 // What cone keeps with a scene on the device (SceneBuffers::state): the closure of its meshes
@@ -76,6 +79,20 @@ void check_storage(const Context& c, int nx, int ny, int depth_bits) {
                      std::to_string(c.max_storage_block >> 20) + " MiB, " + c.renderer + "): fewer columns or depth_bits");
 }
 
+// A CPU grid's columns as the 32-bit words the GPU's rasterization writes, in a new buffer: bit b
+// of a column is bit b % 64 of its 64-bit word b / 64 (voxelize.h), so word k of the column holds
+// the half k % 2 of 64-bit word k / 2.
+Buffer upload_words(Context& c, const VoxelGrid& grid) {
+  const int per_column = grid.depth_bits / 32;
+  const std::size_t columns = static_cast<std::size_t>(grid.nx) * static_cast<std::size_t>(grid.ny);
+  std::vector<std::uint32_t> words(columns * static_cast<std::size_t>(per_column));
+  for (std::size_t col = 0; col < columns; ++col)
+    for (int k = 0; k < per_column; ++k)
+      words[col * static_cast<std::size_t>(per_column) + static_cast<std::size_t>(k)] =
+          static_cast<std::uint32_t>(grid.bits[col * static_cast<std::size_t>(grid.words) + static_cast<std::size_t>(k / 2)] >> (32 * (k % 2)));
+  return make_buffer(c, words.size() * sizeof(std::uint32_t), words.data());
+}
+
 // The grid of a scene whose open surfaces, holed meshes or rooms need the CPU's solid: the CPU
 // voxelizes it (voxelize_world, the grid `ao render -m cone` traces, so both devices trace the same
 // bits) and it is uploaded as 32-bit words, the layout the GPU's rasterization writes. Timed as the
@@ -88,23 +105,15 @@ void upload_cpu_grid(Context& c, SceneBuffers& sb, const std::vector<MeshClosure
   c.gl.Flush();  // the first timestamp reaches the GPU before the CPU's work
   VoxelStats stats;
   VoxelGrid grid = voxelize_world(*sb.scene, closure, o, &stats);
-  const int per_column = grid.depth_bits / 32;
-  const std::size_t columns = static_cast<std::size_t>(grid.nx) * static_cast<std::size_t>(grid.ny);
-  // Bit b of a column is bit b % 64 of its 64-bit word b / 64 (voxelize.h); as 32-bit words,
-  // word k of the column holds the half k % 2 of 64-bit word k / 2.
-  std::vector<std::uint32_t> words(columns * static_cast<std::size_t>(per_column));
-  for (std::size_t col = 0; col < columns; ++col)
-    for (int k = 0; k < per_column; ++k)
-      words[col * static_cast<std::size_t>(per_column) + static_cast<std::size_t>(k)] =
-          static_cast<std::uint32_t>(grid.bits[col * static_cast<std::size_t>(grid.words) + static_cast<std::size_t>(k / 2)] >> (32 * (k % 2)));
-  cache.bits = make_buffer(c, words.size() * sizeof(std::uint32_t), words.data());
+  cache.bits = upload_words(c, grid);
   c.end_pass(passes);
-  // The cache keeps the layout only: the bits are on the GPU, and the coarse occupancy masks are
-  // the CPU kernel's.
-  grid.bits = {};
-  grid.block_bits = {};
-  grid.window = {};
-  cache.layout = std::move(grid);
+  // The layout without the bits (they are on the GPU; the coarse occupancy masks are the CPU
+  // kernel's), and the grid itself for the pixels' sides (run_gpu).
+  cache.layout = grid;
+  cache.layout.bits = {};
+  cache.layout.block_bits = {};
+  cache.layout.window = {};
+  cache.cpu = std::move(grid);
   cache.stats = stats;
   cache.options = o;
   cache.valid = true;
@@ -126,6 +135,7 @@ void build_grid(Context& c, SceneBuffers& sb, const VoxelizeOptions& o, std::vec
   const std::vector<MeshClosure>& closure = closure_of(sb);
   GridCache& cache = state_of(sb).grid;
   cache.valid = false;
+  cache.cpu = {};
   if (!parity_suffices(closure, o)) return upload_cpu_grid(c, sb, closure, o, passes);
   cache.layout = world_layout(*sb.scene, o);
   const VoxelGrid& g = cache.layout;
@@ -260,7 +270,7 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
   const float r_max = in.falloff.radius;
   if (!(r_max > 0.0f) || !std::isfinite(r_max)) throw InputError("cone: R_max must be a finite number > 0");
   // The CPU method's own timings in --json, from the GPU passes that do their work.
-  r.report_ms("voxelize_ms", {"voxelize", "count", "voxelize on the CPU"});
+  r.report_ms("voxelize_ms", {"voxelize", "count", "voxelize on the CPU", "voxelize sides on the CPU"});
   r.report_ms("trace_ms", {"cone"});
   r.report_ms("filter_ms", {"filter"});
   VoxelizeOptions options = p.voxelize_options(r_max);
@@ -268,10 +278,9 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
   ConeResult result;
   result.grid_reused = grid_is_current(state_of(sb).grid, options);
   if (!result.grid_reused) build_grid(r.c, sb, options, r.passes);
-  const VoxelGrid& g = state_of(sb).grid.layout;
+  const VoxelGrid& front = state_of(sb).grid.layout;
   const ConeSetup setup = derive_cone_setup(p);
   const ConePattern pattern = make_cone_pattern(setup, p.jitter, seed);
-  const TraceTables tables = trace_tables(setup, g, r_max);
   std::vector<float> pattern_table;
   const int slots = pattern.period * pattern.period;
   for (int s = 0; s < slots; ++s) {
@@ -282,32 +291,75 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
     }
   }
   const Buffer pattern_buffer = make_buffer(r.c, std::span<const float>(pattern_table));
-  const Buffer lane_buffer = make_buffer(r.c, std::span<const float>(tables.lanes));
-  const Buffer sphere_buffer = make_buffer(r.c, std::span<const float>(tables.spheres));
-  const Buffer prism_buffer = make_buffer(r.c, std::span<const float>(tables.prisms));
 
+  // Pixels on the back side of open meshes (cone_sides_internal.h) get grids of their own, as on
+  // the CPU (render_cone): the sides from the G-buffer read back, each side's grid voxelized on the
+  // CPU for its pixels' reach and traced over those pixels only.
+  std::vector<Buffer> side_bits;
+  std::vector<VoxelGrid> side_layout;  // a side's grid has its own frame (its slabs may rise above the scene)
+  Buffer keys;
+  if (p.open_meshes == OpenMeshes::Winding && !state_of(sb).grid.cpu.bits.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const GBuffer gb = in.gbuffer.download();
+    const std::vector<MeshClosure>& closure = closure_of(sb);
+    const cone_internal::PixelSides sides = cone_internal::pixel_sides(gb, *sb.scene, cone_internal::make_side_setup(*sb.scene, closure, r_max), state_of(sb).grid.cpu);
+    result.sides_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    result.side_evaluations = sides.evaluations;
+    result.unresolved_pixels = sides.unresolved;
+    for (std::size_t i = 0; i < sides.key_of.size(); ++i) result.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
+    if (sides.keys.size() > 1) {
+      r.c.begin_pass(r.passes, "voxelize sides on the CPU");
+      r.c.gl.Flush();
+      for (std::size_t k = 1; k < sides.keys.size(); ++k) {
+        VoxelizeOptions side = options;
+        side.slab_region = cone_internal::side_region(gb, sides, k, r_max);
+        VoxelStats stats;
+        VoxelGrid grid = voxelize_world(*sb.scene, closure, side, &stats, sides.keys[k]);
+        side_bits.push_back(upload_words(r.c, grid));
+        grid.bits = {}, grid.block_bits = {}, grid.window = {};
+        side_layout.push_back(std::move(grid));
+        result.voxel_stats.winding_evaluations += stats.winding_evaluations;
+        result.voxel_stats.winding_voxels_changed += stats.winding_voxels_changed;
+      }
+      r.c.end_pass(r.passes);
+      const std::vector<std::uint32_t> key_of(sides.key_of.begin(), sides.key_of.end());
+      keys = make_buffer(r.c, key_of.size() * sizeof(std::uint32_t), key_of.data());
+    }
+  }
+  result.side_grids = 1 + static_cast<int>(side_bits.size());
+
+  // One pass per grid, each writing its side's pixels (u_key; -1: every pixel, one grid).
   Texture raw = r.image(GL_R32F);
-  Program& prog = r.begin("cone_trace.comp", "cone");
-  const Camera& cam = r.g.camera;
-  const Frame basis = cam.basis();
-  r.set(prog, "u_eye", cam.eye);
-  r.set(prog, "u_basis_x", basis.t);
-  r.set(prog, "u_basis_y", basis.b);
-  r.set(prog, "u_basis_z", basis.n);
-  r.set(prog, "u_origin", g.origin);
-  r.set(prog, "u_inv_size", Vec3{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z});
-  r.c.gl.Uniform2i(r.c.uniform(prog, "u_columns"), g.nx, g.ny);
-  r.set(prog, "u_depth_bits", g.depth_bits);
-  r.set(prog, "u_cones", pattern.cones);
-  r.set(prog, "u_per_cone", static_cast<int>(setup.sphere_distance.size()) + 1);
-  r.set(prog, "u_prisms", static_cast<int>(setup.disk.size()));
-  r.set(prog, "u_period", pattern.period);
-  r.bind(0, state_of(sb).grid.bits);
-  r.bind(2, pattern_buffer);
-  r.bind(3, lane_buffer);
-  r.bind(4, sphere_buffer);
-  r.bind(5, prism_buffer);
-  r.finish(raw);
+  for (int k = 0; k < result.side_grids; ++k) {
+    const VoxelGrid& g = k == 0 ? front : side_layout[static_cast<std::size_t>(k) - 1];
+    const TraceTables tables = trace_tables(setup, g, r_max);
+    const Buffer lane_buffer = make_buffer(r.c, std::span<const float>(tables.lanes));
+    const Buffer sphere_buffer = make_buffer(r.c, std::span<const float>(tables.spheres));
+    const Buffer prism_buffer = make_buffer(r.c, std::span<const float>(tables.prisms));
+    Program& prog = r.begin("cone_trace.comp", "cone");
+    const Camera& cam = r.g.camera;
+    const Frame basis = cam.basis();
+    r.set(prog, "u_eye", cam.eye);
+    r.set(prog, "u_basis_x", basis.t);
+    r.set(prog, "u_basis_y", basis.b);
+    r.set(prog, "u_basis_z", basis.n);
+    r.set(prog, "u_origin", g.origin);
+    r.set(prog, "u_inv_size", Vec3{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z});
+    r.c.gl.Uniform2i(r.c.uniform(prog, "u_columns"), g.nx, g.ny);
+    r.set(prog, "u_depth_bits", g.depth_bits);
+    r.set(prog, "u_cones", pattern.cones);
+    r.set(prog, "u_per_cone", static_cast<int>(setup.sphere_distance.size()) + 1);
+    r.set(prog, "u_prisms", static_cast<int>(setup.disk.size()));
+    r.set(prog, "u_period", pattern.period);
+    r.set(prog, "u_key", side_bits.empty() ? -1 : k);
+    r.bind(0, k == 0 ? state_of(sb).grid.bits : side_bits[static_cast<std::size_t>(k) - 1]);
+    r.bind(1, side_bits.empty() ? pattern_buffer : keys);  // bound either way (read only with u_key >= 0)
+    r.bind(2, pattern_buffer);
+    r.bind(3, lane_buffer);
+    r.bind(4, sphere_buffer);
+    r.bind(5, prism_buffer);
+    r.finish(raw);
+  }
 
   MethodOutput out;
   if (p.filter_taps > 1) {
@@ -318,8 +370,8 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
     out.visibility = read_float(r.c, raw);
   }
   result.voxel_stats = state_of(sb).grid.stats;
-  result.grid_nx = g.nx;
-  result.grid_ny = g.ny;
+  result.grid_nx = front.nx;
+  result.grid_ny = front.ny;
   out.stats = cone_stats(result);  // the timings are the passes' GPU times (stats "gpu_ms")
   return out;
 }

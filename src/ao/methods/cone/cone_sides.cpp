@@ -387,4 +387,14 @@ PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& s
   return out;
 }
 
+Bounds3 side_region(const GBuffer& gb, const PixelSides& sides, std::size_t key, float r_max) {
+  Bounds3 b;
+  const Frame basis = gb.camera.basis();
+  for (std::size_t i = 0; i < sides.key_of.size(); ++i)
+    if (sides.key_of[i] == key && gb.covered(i)) b.extend(basis.to_world(gb.position[i]) + gb.camera.eye);
+  b.lo -= Vec3{2 * r_max, 2 * r_max, 2 * r_max};
+  b.hi += Vec3{2 * r_max, 2 * r_max, 2 * r_max};
+  return b;
+}
+
 }  // namespace ao::cone_internal

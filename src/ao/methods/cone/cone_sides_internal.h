@@ -78,4 +78,10 @@ struct PixelSides {
 /// pixels outside them an evaluation of w).
 PixelSides pixel_sides(const GBuffer& gbuffer, const Scene& scene, const SideSetup& setup, const VoxelGrid& front);
 
+/// Where the pixels of side `key` can look: their points' box grown by 2 R_max (a slab R_max thick
+/// reaches R_max past its face; a point's cones R_max). A grid for a few pixels (one side of a
+/// small part of the scene) then leaves out the slabs that no cone of theirs can reach
+/// (VoxelizeOptions::slab_region).
+Bounds3 side_region(const GBuffer& gbuffer, const PixelSides& sides, std::size_t key, float r_max);
+
 }  // namespace ao::cone_internal

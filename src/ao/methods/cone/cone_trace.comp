@@ -26,8 +26,12 @@
 //   u_cones, u_per_cone    cones per pixel; spheres per cone including the filler
 //   u_prisms               prisms per sphere
 //   u_period               the jitter table's period P (pixel (x, y) takes slot (y % P) P + x % P)
+//   u_key                  -1: every pixel; k >= 0: only the pixels whose side (buffer 1) is k, which
+//                          the grid of buffer 0 was built for (the back sides of open meshes: one pass
+//                          per grid, each writing its pixels)
 // Buffers:
 //   0  the grid's words (cone_pack.comp's layout)
+//   1  per pixel (row-major) the index of its side's grid (cone_sides_internal.h PixelSides::key_of)
 //   2  per slot: (cos, sin) of the prism pattern's turn, then per cone (axis x, y, z in the
 //      normal's frame, chain scale s), make_cone_pattern's table
 //   3  per sphere slot j of a cone: (dist_a, dist_b, rad_a, rad_b), (use_a, use_b, k, 0): its
@@ -41,6 +45,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, r32f) uniform writeonly image2D o_visibility;
 layout(std430, binding = 0) readonly buffer Grid { uint u_words[]; };
+layout(std430, binding = 1) readonly buffer Keys { uint u_keys[]; };
 layout(std430, binding = 2) readonly buffer Pattern { vec4 u_pattern[]; };
 layout(std430, binding = 3) readonly buffer Lanes { vec4 u_lanes[]; };
 layout(std430, binding = 4) readonly buffer Spheres { vec4 u_spheres[]; };
@@ -51,6 +56,7 @@ uniform vec3 u_origin, u_inv_size;
 uniform ivec2 u_columns;
 uniform int u_depth_bits;
 uniform int u_cones, u_per_cone, u_prisms, u_period;
+uniform int u_key;
 
 uint bit(uint base, int k) { return (u_words[base + uint(k >> 5)] >> uint(k & 31)) & 1u; }
 
@@ -80,6 +86,7 @@ vec3 to_world(vec3 v) { return u_basis_x * v.x + u_basis_y * v.y + u_basis_z * v
 void main() {
   const ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
   if (pix.x >= u_size.x || pix.y >= u_size.y) return;
+  if (u_key >= 0 && int(u_keys[pix.y * u_size.x + pix.x]) != u_key) return;
   if (!covered(pix)) {
     imageStore(o_visibility, pix, vec4(1.0));
     return;

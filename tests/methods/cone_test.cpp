@@ -253,8 +253,8 @@ TEST(Cone, OpenMeshSuiteStaysNearTheClosedMeshError) {
       {"tablecloth", test::make_tablecloth()}, {"leaf", test::make_leaf()}, {"gutter", test::make_gutter()}};
   for (const auto& [what, open] : suite) {
     const OpenError e = cone_error(open, 256, 0.1f);
-    // The leaf (measured 1.68x): the ground under its raised edge sees the thin sheet at a grazing
-    // angle and the slab above it only past it, too bright (docs/methods/cone.md, Missing / next).
+    // The leaf (measured 1.68x): the ground beside its raised edge too bright, in front of its base
+    // too dark, points that see both of its sides (docs/methods/cone.md, Missing / next).
     const double bound = std::string_view(what) == "leaf" ? 2.0 : 1.5;
     EXPECT_LE(e.rmse, bound * closed) << what << ": closed meshes " << closed << ", mean signed " << e.mean_signed;
     EXPECT_EQ(e.stats["odd_columns"], 0) << what;

@@ -256,6 +256,82 @@ TraceTables trace_tables(const ConeSetup& setup, const VoxelGrid& g, float r_max
   return t;
 }
 
+// The grids of the pixels on the back side of open meshes (cone_sides_internal.h), as on the CPU
+// (render_cone): the sides from the G-buffer read back, each side's grid voxelized on the CPU for its
+// pixels' reach; `result`'s side statistics. None for a grid the GPU rasterized (closed meshes only).
+struct SideGrids {
+  std::vector<Buffer> bits;
+  std::vector<VoxelGrid> layout;  // a side's grid has its own frame (its slabs may rise above the scene)
+  Buffer keys;                    // per pixel its grid (PixelSides::key_of) as 32-bit words
+};
+SideGrids side_grids(Run& r, SceneBuffers& sb, const GpuGBuffer& gbuffer, const ConeParams& p, const VoxelizeOptions& options, float r_max,
+                     ConeResult& result) {
+  SideGrids out;
+  result.side_grids = 1;
+  if (p.open_meshes != OpenMeshes::Winding || state_of(sb).grid.cpu.bits.empty()) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const GBuffer gb = gbuffer.download();
+  const std::vector<MeshClosure>& closure = closure_of(sb);
+  const cone_internal::PixelSides sides =
+      cone_internal::pixel_sides(gb, *sb.scene, cone_internal::make_side_setup(*sb.scene, closure, r_max), state_of(sb).grid.cpu);
+  result.sides_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  result.side_evaluations = sides.evaluations;
+  result.unresolved_pixels = sides.unresolved;
+  for (std::size_t i = 0; i < sides.key_of.size(); ++i) result.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
+  if (sides.keys.size() < 2) return out;
+  r.c.begin_pass(r.passes, "voxelize sides on the CPU");
+  r.c.gl.Flush();  // the first timestamp reaches the GPU before the CPU's work
+  for (std::size_t k = 1; k < sides.keys.size(); ++k) {
+    VoxelizeOptions side = options;
+    side.slab_region = cone_internal::side_region(gb, sides, k, r_max);
+    VoxelStats stats;
+    VoxelGrid grid = voxelize_world(*sb.scene, closure, side, &stats, sides.keys[k]);
+    out.bits.push_back(upload_words(r.c, grid));
+    grid.bits = {}, grid.block_bits = {}, grid.window = {};
+    out.layout.push_back(std::move(grid));
+    result.voxel_stats.winding_evaluations += stats.winding_evaluations;
+    result.voxel_stats.winding_voxels_changed += stats.winding_voxels_changed;
+  }
+  r.c.end_pass(r.passes);
+  const std::vector<std::uint32_t> key_of(sides.key_of.begin(), sides.key_of.end());
+  out.keys = make_buffer(r.c, key_of.size() * sizeof(std::uint32_t), key_of.data());
+  result.side_grids = static_cast<int>(sides.keys.size());
+  return out;
+}
+
+// One pass of cone_trace.comp on grid `g` (its words in `bits`) into `out`: every pixel (key -1), or
+// the pixels whose entry of `keys` is `key`.
+void trace_pass(Run& r, const VoxelGrid& g, const Buffer& bits, const Buffer* keys, int key, const ConeSetup& setup, const ConePattern& pattern,
+                const Buffer& pattern_buffer, float r_max, const Texture& out) {
+  const TraceTables tables = trace_tables(setup, g, r_max);
+  const Buffer lane_buffer = make_buffer(r.c, std::span<const float>(tables.lanes));
+  const Buffer sphere_buffer = make_buffer(r.c, std::span<const float>(tables.spheres));
+  const Buffer prism_buffer = make_buffer(r.c, std::span<const float>(tables.prisms));
+  Program& prog = r.begin("cone_trace.comp", "cone");
+  const Camera& cam = r.g.camera;
+  const Frame basis = cam.basis();
+  r.set(prog, "u_eye", cam.eye);
+  r.set(prog, "u_basis_x", basis.t);
+  r.set(prog, "u_basis_y", basis.b);
+  r.set(prog, "u_basis_z", basis.n);
+  r.set(prog, "u_origin", g.origin);
+  r.set(prog, "u_inv_size", Vec3{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z});
+  r.c.gl.Uniform2i(r.c.uniform(prog, "u_columns"), g.nx, g.ny);
+  r.set(prog, "u_depth_bits", g.depth_bits);
+  r.set(prog, "u_cones", pattern.cones);
+  r.set(prog, "u_per_cone", static_cast<int>(setup.sphere_distance.size()) + 1);
+  r.set(prog, "u_prisms", static_cast<int>(setup.disk.size()));
+  r.set(prog, "u_period", pattern.period);
+  r.set(prog, "u_key", key);
+  r.bind(0, bits);
+  r.bind(1, keys ? *keys : pattern_buffer);  // bound either way (read only with u_key >= 0)
+  r.bind(2, pattern_buffer);
+  r.bind(3, lane_buffer);
+  r.bind(4, sphere_buffer);
+  r.bind(5, prism_buffer);
+  r.finish(out);
+}
+
 }  // namespace
 
 MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params) {
@@ -292,73 +368,14 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
   }
   const Buffer pattern_buffer = make_buffer(r.c, std::span<const float>(pattern_table));
 
-  // Pixels on the back side of open meshes (cone_sides_internal.h) get grids of their own, as on
-  // the CPU (render_cone): the sides from the G-buffer read back, each side's grid voxelized on the
-  // CPU for its pixels' reach and traced over those pixels only.
-  std::vector<Buffer> side_bits;
-  std::vector<VoxelGrid> side_layout;  // a side's grid has its own frame (its slabs may rise above the scene)
-  Buffer keys;
-  if (p.open_meshes == OpenMeshes::Winding && !state_of(sb).grid.cpu.bits.empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const GBuffer gb = in.gbuffer.download();
-    const std::vector<MeshClosure>& closure = closure_of(sb);
-    const cone_internal::PixelSides sides = cone_internal::pixel_sides(gb, *sb.scene, cone_internal::make_side_setup(*sb.scene, closure, r_max), state_of(sb).grid.cpu);
-    result.sides_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    result.side_evaluations = sides.evaluations;
-    result.unresolved_pixels = sides.unresolved;
-    for (std::size_t i = 0; i < sides.key_of.size(); ++i) result.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
-    if (sides.keys.size() > 1) {
-      r.c.begin_pass(r.passes, "voxelize sides on the CPU");
-      r.c.gl.Flush();
-      for (std::size_t k = 1; k < sides.keys.size(); ++k) {
-        VoxelizeOptions side = options;
-        side.slab_region = cone_internal::side_region(gb, sides, k, r_max);
-        VoxelStats stats;
-        VoxelGrid grid = voxelize_world(*sb.scene, closure, side, &stats, sides.keys[k]);
-        side_bits.push_back(upload_words(r.c, grid));
-        grid.bits = {}, grid.block_bits = {}, grid.window = {};
-        side_layout.push_back(std::move(grid));
-        result.voxel_stats.winding_evaluations += stats.winding_evaluations;
-        result.voxel_stats.winding_voxels_changed += stats.winding_voxels_changed;
-      }
-      r.c.end_pass(r.passes);
-      const std::vector<std::uint32_t> key_of(sides.key_of.begin(), sides.key_of.end());
-      keys = make_buffer(r.c, key_of.size() * sizeof(std::uint32_t), key_of.data());
-    }
-  }
-  result.side_grids = 1 + static_cast<int>(side_bits.size());
-
+  const SideGrids sides = side_grids(r, sb, in.gbuffer, p, options, r_max, result);
   // One pass per grid, each writing its side's pixels (u_key; -1: every pixel, one grid).
   Texture raw = r.image(GL_R32F);
   for (int k = 0; k < result.side_grids; ++k) {
-    const VoxelGrid& g = k == 0 ? front : side_layout[static_cast<std::size_t>(k) - 1];
-    const TraceTables tables = trace_tables(setup, g, r_max);
-    const Buffer lane_buffer = make_buffer(r.c, std::span<const float>(tables.lanes));
-    const Buffer sphere_buffer = make_buffer(r.c, std::span<const float>(tables.spheres));
-    const Buffer prism_buffer = make_buffer(r.c, std::span<const float>(tables.prisms));
-    Program& prog = r.begin("cone_trace.comp", "cone");
-    const Camera& cam = r.g.camera;
-    const Frame basis = cam.basis();
-    r.set(prog, "u_eye", cam.eye);
-    r.set(prog, "u_basis_x", basis.t);
-    r.set(prog, "u_basis_y", basis.b);
-    r.set(prog, "u_basis_z", basis.n);
-    r.set(prog, "u_origin", g.origin);
-    r.set(prog, "u_inv_size", Vec3{1.0f / g.voxel_size.x, 1.0f / g.voxel_size.y, 1.0f / g.voxel_size.z});
-    r.c.gl.Uniform2i(r.c.uniform(prog, "u_columns"), g.nx, g.ny);
-    r.set(prog, "u_depth_bits", g.depth_bits);
-    r.set(prog, "u_cones", pattern.cones);
-    r.set(prog, "u_per_cone", static_cast<int>(setup.sphere_distance.size()) + 1);
-    r.set(prog, "u_prisms", static_cast<int>(setup.disk.size()));
-    r.set(prog, "u_period", pattern.period);
-    r.set(prog, "u_key", side_bits.empty() ? -1 : k);
-    r.bind(0, k == 0 ? state_of(sb).grid.bits : side_bits[static_cast<std::size_t>(k) - 1]);
-    r.bind(1, side_bits.empty() ? pattern_buffer : keys);  // bound either way (read only with u_key >= 0)
-    r.bind(2, pattern_buffer);
-    r.bind(3, lane_buffer);
-    r.bind(4, sphere_buffer);
-    r.bind(5, prism_buffer);
-    r.finish(raw);
+    const bool front_grid = k == 0;
+    const VoxelGrid& g = front_grid ? front : sides.layout[static_cast<std::size_t>(k) - 1];
+    const Buffer& bits = front_grid ? state_of(sb).grid.bits : sides.bits[static_cast<std::size_t>(k) - 1];
+    trace_pass(r, g, bits, sides.bits.empty() ? nullptr : &sides.keys, sides.bits.empty() ? -1 : k, setup, pattern, pattern_buffer, r_max, raw);
   }
 
   MethodOutput out;
@@ -369,7 +386,11 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ConeParams& params)
   } else {
     out.visibility = read_float(r.c, raw);
   }
+  // The front grid's statistics, with the side grids' winding numbers added (as render_cone).
+  const VoxelStats sides_stats = result.voxel_stats;
   result.voxel_stats = state_of(sb).grid.stats;
+  result.voxel_stats.winding_evaluations += sides_stats.winding_evaluations;
+  result.voxel_stats.winding_voxels_changed += sides_stats.winding_voxels_changed;
   result.grid_nx = front.nx;
   result.grid_ny = front.ny;
   out.stats = cone_stats(result);  // the timings are the passes' GPU times (stats "gpu_ms")

@@ -3,8 +3,8 @@
 #include "ao/methods/cone/cone_sides_internal.h"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 
@@ -214,15 +214,17 @@ bool own_behind(const GBuffer& gb, int x, int y, const SideSetup::Open& o, bool 
   return side_of(o, p + n * offset, evaluations) > 0;
 }
 
-// Rays a point casts to tell which side of a solid with holes it sees (seen_side): a fixed set over
-// the hemisphere about its normal, cosine-distributed (a spherical Fibonacci spiral), so the answer
+// Rays a point casts to tell which side of an open mesh it sees (seen_side): a fixed set over the
+// hemisphere about its normal, cosine-distributed (a spherical Fibonacci spiral), so the answer
 // depends on the point alone.
 constexpr int kSideRays = 24;
 
-// Which side of solid with holes `o` the point p (normal n) sees: +1 its inside (the first hits on
-// its shell are mostly its inner faces), -1 its outside, 0 when no ray meets it. A dome's w stays
-// below 1/2 on the ground inside it, where the point sees nothing but the dome's inside (and the
-// sky through its windows); w > 1/2 fills the dome's hollow, where no pixel lies.
+// Which side of open mesh `o` the point p (normal n) sees: +1 its back (of the rays that meet it,
+// at least twice as many first meet the backs of a sheet's triangles, the inner faces of a solid
+// with holes, as the fronts), -1 its front (the other way round), 0 otherwise (no ray meets it, or
+// it sees both sides about as much). A dome's w stays below 1/2 on the ground inside it, where the
+// point sees nothing but the dome's inside (and the sky through its windows); w > 1/2 fills the
+// dome's hollow, where no pixel lies. Beside a sheet's rim, where w is near 0, the side it sees.
 int seen_side(const SideSetup::Open& o, Vec3 p, Vec3 n, float offset, std::size_t& evaluations) {
   static const std::array<Vec3, kSideRays> pattern = [] {
     std::array<Vec3, kSideRays> d{};
@@ -245,7 +247,7 @@ int seen_side(const SideSetup::Open& o, Vec3 p, Vec3 n, float offset, std::size_
     // o.sign: the world fronts face out of the solid (+1) or into it (-1).
     inner += h.side * o.sign > 0, outer += h.side * o.sign < 0;
   }
-  return inner > outer ? 1 : outer > inner ? -1 : 0;
+  return inner > 2 * outer ? 1 : outer > 2 * inner ? -1 : 0;
 }
 
 // Whether a point p (normal n) of another object lies behind open object `o`, on which its object
@@ -263,10 +265,6 @@ bool voted_behind(const SideSetup& setup, const SideSetup::Open& o, SideSetup::V
     if (seen != 0) return seen > 0;
   }
   if (side != 0) return side > 0;
-  if (!o.closure->holed()) {
-    const int seen = seen_side(o, p, n, setup.r_max * 1e-3f, evaluations);
-    if (seen != 0) return seen > 0;
-  }
   // Where the lattice cannot tell, the point lies within a cell's diagonal of the mesh or of where
   // w crosses its threshold. With cells R_max / 2 wide that is within 0.87 R_max: inside a solid
   // with holes, or behind a sheet that crosses its cell, its front is solid in the all-front grid
@@ -276,7 +274,10 @@ bool voted_behind(const SideSetup& setup, const SideSetup::Open& o, SideSetup::V
   // triangles face.
   const bool pretest = o.lattice_step * 1.7320508f < setup.r_max && (o.closure->holed() || crossed);
   if (pretest && !solid_at(front, p + n * clearance(front, p))) return false;
-  return (o.closure->holed() ? side_of(o, p, evaluations) : nearest_side(o, p, evaluations)) > 0;
+  if (o.closure->holed()) return side_of(o, p, evaluations) > 0;
+  // Beside a sheet's rim or under a hole in it: the side it sees, else its nearest triangle's.
+  const int seen = seen_side(o, p, n, setup.r_max * 1e-3f, evaluations);
+  return (seen != 0 ? seen : nearest_side(o, p, evaluations)) > 0;
 }
 
 // A pixel whose point is behind some open objects: those objects (indices into SideSetup::open).

@@ -92,10 +92,12 @@ TEST(Cone, WedgeFloorNearWallFollowsDiskSegmentFormula) {
 
 // The paper's limitation (sec. IV-A: small cavities come out too bright at 128 bits): a point on a
 // floor under a thin roof 0.11 above it. A tall pillar elsewhere stretches the grid to 8 units, so
-// at 128 bits a voxel is 0.063 deep and no voxel centre falls inside the 0.03-thick roof: the roof
-// vanishes and the cavity looks open. At 512 bits (0.016 deep) two centres do.
+// at 128 bits a voxel is 0.064 deep and, with the floor's top on a voxel boundary (the grid puts
+// the largest area facing up there: the floor's top; the roof's is smaller), no voxel centre falls
+// inside the 0.03-thick roof (centres at 0.097 and 0.161): the roof vanishes and the cavity looks
+// open. At 512 bits (0.016 deep) two centres do.
 TEST(Cone, ThinRoofMissedAt128BitsIsResolvedAt512) {
-  const Scene s = scene_of({make_box({-2, -0.5f, -2}, {2, 0, 2}), make_box({-2, 0.11f, -2}, {2, 0.14f, 2}),
+  const Scene s = scene_of({make_box({-2, -0.5f, -2}, {2, 0, 2}), make_box({-1.8f, 0.11f, -1.8f}, {1.8f, 0.14f, 1.8f}),
                             make_box({3, -0.5f, 3}, {3.2f, 7.5f, 3.2f})});
   const float R = 0.5f;
   // Reference: rays with theta > acos(0.11 / 0.5) travel R under the roof: V = (0.11 / R)^2... of

@@ -242,16 +242,20 @@ TEST(Voxelize, SheetSlabLiesOnTheFarSideFromThePoints) {
   }
 }
 
-// The world grid puts the scene's lowest point on a boundary between voxels (world_grid_layout), so
-// that a ground there is solid exactly up to its height and its voxel above it is air, whatever the
-// scene's height; the top keeps a voxel of margin above the bounds.
-TEST(Voxelize, GroundAtTheBottomLiesOnAVoxelBoundary) {
+// The world grid puts the scene's ground (its largest area facing up, here above the scene's
+// lowest point) a hundredth of a voxel above a boundary between voxels and between coarse cells
+// (world_grid_layout), so that it is solid up to its height and its voxel above it is air, whatever the scene's height;
+// the top keeps a voxel of margin above the bounds.
+TEST(Voxelize, GroundLiesOnAVoxelBoundary) {
   for (float height : {0.37f, 1.0f, 2.9f}) {
-    const Scene s = scene_of({make_quad({-2, 0.1f, 2}, {2, 0.1f, 2}, {2, 0.1f, -2}, {-2, 0.1f, -2}), make_box({-0.5f, 0.1f, -0.5f}, {0.5f, 0.1f + height, 0.5f})});
+    // A box standing on the ground and a small plate below it (the scene's lowest point).
+    const Scene s = scene_of({make_quad({-2, 0.1f, 2}, {2, 0.1f, 2}, {2, 0.1f, -2}, {-2, 0.1f, -2}), make_box({-0.5f, 0.1f, -0.5f}, {0.5f, 0.1f + height, 0.5f}),
+                              make_quad({1, -0.23f, 1.5f}, {1.3f, -0.23f, 1.5f}, {1.3f, -0.23f, 1.2f}, {1, -0.23f, 1.2f})});
     const VoxelGrid g = voxelize_world(s, analyze_closure(s), grid_options(64, 128, 0.3f));
     const double k = (0.1 - double(g.origin.y)) / g.voxel_size.z;
-    EXPECT_NEAR(k, std::round(k), 1e-3) << height;
-    const int kg = static_cast<int>(std::lround(k));
+    EXPECT_NEAR(k - std::floor(k), 0.01, 1e-3) << height;  // a hundredth of a voxel above a boundary
+    const int kg = static_cast<int>(std::floor(k));
+    EXPECT_EQ(kg % g.cell_bits, 0) << height;
     // A column over the ground beside the box (x, z = -1.7): the ground's voxel below the surface is
     // solid (its slab), the one above is air.
     EXPECT_TRUE(g.voxel(8, 8, kg - 1)) << height;

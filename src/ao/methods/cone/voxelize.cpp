@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <tuple>
 
 #include <tbb/blocked_range.h>
@@ -560,6 +561,33 @@ void VoxelizeOptions::validate() const {
     throw InputError("cone: slab thickness must be a finite number >= 0, got " + std::to_string(slab_thickness));
 }
 
+// How far above a boundary between voxels world_grid_layout puts the ground, in voxels: far above
+// the rounding of a point's voxel coordinate (1e-5 of a voxel for grids of a few hundred voxels),
+// far below what a cone resolves.
+constexpr float kGroundLift = 0.01f;
+
+// The height of the scene's ground: the y shared by the three corners of the most area of triangles
+// facing up (world space; of equal areas the highest), `lowest` when no such triangle faces up.
+float ground_height(const Scene& scene, float lowest) {
+  std::map<float, double> area;
+  for (const SceneObject& ob : scene.objects()) {
+    const Mesh& m = scene.meshes[ob.mesh];
+    const Affine3* tf = ob.instance == SceneObject::kNoInstance ? nullptr : &scene.instances[ob.instance].object_to_world;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      Vec3 v[3] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+      if (tf)
+        for (Vec3& p : v) p = tf->point(p);
+      const Vec3 n = cross(v[1] - v[0], v[2] - v[0]);
+      if (v[0].y == v[1].y && v[1].y == v[2].y && n.y > 0) area[v[0].y] += 0.5 * static_cast<double>(n.y);
+    }
+  }
+  float best = lowest;
+  double most = 0;
+  for (const auto& [y, a] : area)  // ascending y
+    if (a >= most) most = a, best = y;
+  return best;
+}
+
 VoxelGrid world_grid_layout(const Scene& scene, const VoxelizeOptions& o, bool slab_beside, bool slab_above, float* slab_out) {
   VoxelGrid g;
   g.space = GridSpace::World;
@@ -581,13 +609,25 @@ VoxelGrid world_grid_layout(const Scene& scene, const VoxelizeOptions& o, bool s
   // a cone near its walls meets as much solid as behind an open wall.
   const float side = (slab_beside ? slab : 0.0f) + v0;
   const float top = (slab_above ? slab : 0.0f) + v0;
-  // The scene's lowest point (where a ground usually lies) on a boundary between voxels: a voxel
-  // is solid when its centre is, so a horizontal surface there is resolved exactly rather than
-  // standing up to half a voxel into the air (the grazing cones of every point on it saw that
-  // layer: 4% too dark on a ground whose voxels are 8% of R_max tall). One voxel more height pays
-  // for the shift, so the top keeps its margin.
-  const float vz = (e.y + side + top) / static_cast<float>(o.depth_bits - 1);
-  const float below = std::ceil(side / vz) * vz;
+  // The scene's ground (the height of its largest horizontal area, else its lowest point) on a
+  // boundary between voxels: a voxel is solid when its centre is, so a horizontal surface there is
+  // resolved exactly rather than standing up to half a voxel into the air or sinking as far into
+  // its solid (the grazing cones of every point on it saw that: a ground 4% too dark where its
+  // voxels are 8% of R_max tall, or as much too bright). On a boundary between the coarse
+  // occupancy's cells too (cell_bits voxels, build_coarse), so that the cells over the ground stay
+  // empty, and a hundredth of a voxel below it (kGroundLift), so that a sphere that touches the
+  // ground from above (the lowest cones' last spheres) reaches into no cell of it and is skipped: on
+  // the boundary itself every such sphere was traced (16% more trace time on the default scene, for
+  // nothing: its prisms meet no solid). One cell more height pays for the shift, so the top keeps
+  // its margin.
+  int cell = 1;
+  while (cell * 64 < o.depth_bits) cell *= 2;
+  const float vz = (e.y + side + top) / static_cast<float>(o.depth_bits - cell);
+  const float step = vz * static_cast<float>(cell);
+  const float ground = ground_height(scene, b.lo.y);
+  // The origin a whole number of cells (and a hundredth of a voxel: kGroundLift) below the ground
+  // and at least `side` below the bounds.
+  const float below = (b.lo.y - ground) + std::ceil((ground - b.lo.y + side) / step) * step + kGroundLift * vz;
   g.origin = b.lo - Vec3{side, below, side};
   g.voxel_size = {(e.x + 2 * side) / o.columns, (e.z + 2 * side) / o.columns, vz};
   return g;

@@ -190,9 +190,10 @@ inline bool any_bits(const std::uint64_t* column, int words, int k0, int k1) {
 
 /// voxelize_world's grid frame without its bits (space, nx, ny, depth_bits, words, origin,
 /// voxel_size) for `scene` and options `o`: the scene's bounds padded by a voxel, and by the slab
-/// thickness beside and below them (`slab_beside`) and above them (`slab_above`), the bounds'
-/// lowest point on a boundary between voxels. `slab_out`: the slab thickness (options' or two
-/// voxels). Shared with the GPU's voxelization (cone_gpu.cpp), whose grids are the CPU's bit for bit.
+/// thickness beside and below them (`slab_beside`) and above them (`slab_above`), the scene's
+/// ground (the height of its largest area of horizontal faces facing up) on a boundary between voxels and between
+/// the coarse occupancy's cells. `slab_out`: the slab thickness (options' or two voxels). Shared
+/// with the GPU's voxelization (cone_gpu.cpp), whose grids are the CPU's bit for bit.
 VoxelGrid world_grid_layout(const Scene& scene, const VoxelizeOptions& o, bool slab_beside, bool slab_above, float* slab_out = nullptr);
 
 

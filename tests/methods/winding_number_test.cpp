@@ -138,6 +138,8 @@ TEST(WindingNumber, FirstHitIsTheNearestTriangleAndItsSide) {
   EXPECT_EQ(w.first_hit({0, 2, 0}, {0, -1, 0}, 0, 1.5f).side, 0);    // beyond t_max
   EXPECT_EQ(w.first_hit({0, 2, 0}, {0, 1, 0}, 0, inf).side, 0);      // away from it
   EXPECT_EQ(w.first_hit({0, 2, 0}, {1, 0, 0}, 0, inf).side, 0);      // parallel to it
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(w.first_hit({0.2f, 2, 0.3f}, {nan, nan, nan}, 0, inf).side, 0);  // a degenerate face's normal
 
   const Mesh sphere = make_sphere({0, 0, 0}, 1.0f, 96, 48);
   const WindingNumber ws(sphere.positions, sphere.indices);

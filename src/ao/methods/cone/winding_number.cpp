@@ -220,7 +220,9 @@ double WindingNumber::signed_distance(Vec3 q) const {
 
 WindingNumber::Hit WindingNumber::first_hit(Vec3 o, Vec3 d, float t_min, float t_max) const {
   Hit best{std::numeric_limits<float>::infinity(), 0};
-  if (nodes_.empty() || !(t_max > t_min)) return best;
+  // A direction that is not finite (a degenerate face's normal) meets nothing; its NaNs would
+  // otherwise open every node.
+  if (nodes_.empty() || !(t_max > t_min) || !std::isfinite(d.x + d.y + d.z)) return best;
   const Vec3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};  // +-infinity along an axis d does not move on
   float limit = t_max;
   // The ray's entry into a node's box (slabs), or +infinity when it misses it within (t_min, limit].

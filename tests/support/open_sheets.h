@@ -104,8 +104,9 @@ inline Mesh make_parametric_sheet(int nu, int nv, At at, Keep keep) {
 inline constexpr float kPi = 3.14159265358979323846f;
 
 /// A face mask as a scan gives it: one curved sheet (a part of an ellipsoid, 1.2 wide, 1.6 tall,
-/// 0.5 deep, facing +z), with a nose and brows standing out of it and two eye holes, its chin on
-/// y = 0. Under the nose the sheet folds back on itself within the scene's radius.
+/// 0.5 deep, facing +z), with a nose and brows standing out of it and two eye holes, its chin near
+/// y = 0. The nose and the brows are thinner than the scene's radius: a slab that deep behind their
+/// tops would come out through their undersides.
 inline Mesh make_mask() {
   const auto outline = [](float u, float v) {
     const float x = 2 * u - 1, y = 2 * v - 1;
@@ -127,8 +128,8 @@ inline Mesh make_mask() {
 }
 
 /// Half a sphere shell of `radius` standing on y = 0 (a dome), with one round window of angular
-/// radius `window` (radians) facing the direction (1, 0, 1.3) at `elevation` radians: the ground
-/// inside is seen through it.
+/// radius `window` (radians) facing (1, 0, 1.3) horizontally, raised by `elevation` radians: the
+/// ground inside is seen through it from the suite's camera.
 inline Mesh make_dome(float radius = 1.0f, float window = 0.4f, float elevation = 0.6f) {
   const Vec3 w = normalize(Vec3{std::cos(elevation) * 0.61f, std::sin(elevation), std::cos(elevation) * 0.79f});
   return make_parametric_sheet(128, 48,
@@ -144,7 +145,8 @@ inline Mesh make_dome(float radius = 1.0f, float window = 0.4f, float elevation 
 }
 
 /// A terrain: a height field 3 x 3 (hills, a ridge, a valley cut by a ravine narrower than the
-/// scene's radius), its lowest point on y = 0. An open sheet seen from above, its edges cliffs.
+/// scene's radius), about 0.05 above y = 0 at its lowest. An open sheet seen from above, its edges
+/// cliffs.
 inline Mesh make_terrain() {
   return make_parametric_sheet(128, 128,
                                [](float u, float v) {
@@ -170,7 +172,7 @@ inline Mesh make_tablecloth() {
 }
 
 /// A leaf lying on the ground: an outline 1.6 long and 0.7 wide, folded along its midrib into a V
-/// (its halves rise 25 degrees) and curled up towards its tip, touching y = 0 along the midrib's base.
+/// (its halves rise 25 degrees) and curled up towards its tip, its midrib 0.02 above y = 0.
 inline Mesh make_leaf() {
   return make_parametric_sheet(64, 128,
                                [](float u, float v) {
@@ -196,8 +198,8 @@ inline Mesh make_gutter(float radius = 0.2f, float length = 2.0f) {
                                [](float, float) { return true; });
 }
 
-/// A closed ellipsoid of the mask's size (make_mask: 1.2 wide, 1.6 tall, 1 deep), standing on y = 0:
-/// the closed mesh the mask is compared with.
+/// A closed ellipsoid 1.2 wide, 1.6 tall and 1 deep (the mask's width and height), standing on
+/// y = 0: the closed mesh the mask is compared with.
 inline Mesh make_head() {
   Mesh m = make_sphere({0, 0, 0}, 1.0f, 96, 48);
   for (Vec3& p : m.positions) p = {0.6f * p.x, 0.8f + 0.8f * p.y, 0.5f * p.z};

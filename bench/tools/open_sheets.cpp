@@ -24,6 +24,7 @@
 
 #include "ao/io/camera_json.h"
 #include "ao/io/mesh_io.h"
+#include "ao/scene/mesh.h"
 #include "ao/scene/procedural.h"
 #include "support/open_sheets.h"
 
@@ -31,6 +32,8 @@ namespace {
 
 // One material per mesh (named after it, in a .mtl beside the file): the loader keeps meshes with
 // different materials apart, and each is classified on its own (closed, solid with holes, sheet).
+// Each vertex's normal goes with it (vn): without them the loader joins a box's coincident corner
+// vertices and smooths its normals across the edges, and the box is shaded as a rounded one.
 void write_obj(const std::filesystem::path& path, const std::vector<std::pair<std::string, ao::Mesh>>& meshes) {
   std::filesystem::path mtl = path;
   mtl.replace_extension(".mtl");
@@ -40,11 +43,15 @@ void write_obj(const std::filesystem::path& path, const std::vector<std::pair<st
   out.precision(9);
   out << "mtllib " << mtl.filename().string() << "\n";
   std::size_t base = 1;
-  for (const auto& [name, m] : meshes) {
+  for (const auto& [name, mesh] : meshes) {
+    ao::Mesh m = mesh;
+    if (m.normals.empty()) ao::generate_normals(m);
     out << "o " << name << "\nusemtl " << name << "\n";
     for (const ao::Vec3& p : m.positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << "\n";
+    for (const ao::Vec3& n : m.normals) out << "vn " << n.x << ' ' << n.y << ' ' << n.z << "\n";
+    const auto corner = [&](std::size_t i) { return std::to_string(base + i) + "//" + std::to_string(base + i); };
     for (std::size_t t = 0; t < m.triangle_count(); ++t)
-      out << "f " << base + m.indices[3 * t] << ' ' << base + m.indices[3 * t + 1] << ' ' << base + m.indices[3 * t + 2] << "\n";
+      out << "f " << corner(m.indices[3 * t]) << ' ' << corner(m.indices[3 * t + 1]) << ' ' << corner(m.indices[3 * t + 2]) << "\n";
     base += m.positions.size();
   }
   if (!out || !materials) throw std::runtime_error("cannot write " + path.string());

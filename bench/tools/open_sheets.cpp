@@ -57,13 +57,6 @@ void write_obj(const std::filesystem::path& path, const std::vector<std::pair<st
   if (!out || !materials) throw std::runtime_error("cannot write " + path.string());
 }
 
-ao::Mesh ground_under(const ao::Mesh& object) {
-  const ao::Bounds3 b = object.bounds();
-  const ao::Vec3 c = b.center();
-  const float e = b.diagonal();
-  return ao::make_quad({c.x - e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z - e}, {c.x - e, b.lo.y, c.z - e}, {0.75f, 0.73f, 0.70f});
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -90,7 +83,7 @@ int main(int argc, char** argv) {
         {"head", ao::test::make_head()},
     };
     for (const auto& [name, mesh] : objects) {
-      write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ground_under(mesh)}});
+      write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ao::test::ground_under(mesh, {0.75f, 0.73f, 0.70f})}});
       std::ofstream camera(dir / (name + ".camera.json"));
       camera << ao::camera_to_json(ao::frame_bounds(mesh.bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 640, 360)).dump() << "\n";
       if (!camera) throw std::runtime_error("cannot write " + (dir / (name + ".camera.json")).string());

@@ -185,12 +185,9 @@ struct OpenError {
 // `object_fraction`, that fraction of the object's own diagonal: the CLI's default R, which leaves
 // the flat ground out).
 OpenError cone_error(const Mesh& object, int columns = 256, float object_fraction = 0) {
-  Bounds3 b;
-  for (const Vec3& p : object.positions) b.extend(p);
-  const Vec3 c = (b.lo + b.hi) * 0.5f;
+  const Bounds3 b = object.bounds();
   const float e = b.diagonal();
-  const Scene s = scene_of({object, make_quad({c.x - e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z - e},
-                                              {c.x - e, b.lo.y, c.z - e})});
+  const Scene s = scene_of({object, test::ground_under(object)});
   const RayScene rs(s);
   const Camera cam = frame_bounds(b, {1.0f, 0.8f, 1.3f}, 40.0f, 96, 72);
   const GBuffer g = render_gbuffer(rs, cam);

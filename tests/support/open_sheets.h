@@ -234,4 +234,13 @@ inline Mesh punch_holes(const Mesh& closed, float radius_fraction) {
   });
 }
 
+/// The ground every mesh of the suite stands on: a square quad at the object's lowest height,
+/// centred under it, twice its diagonal on a side.
+inline Mesh ground_under(const Mesh& object, Vec3 albedo = {0.8f, 0.8f, 0.8f}) {
+  const Bounds3 b = object.bounds();
+  const Vec3 c = b.center();
+  const float e = b.diagonal();
+  return make_quad({c.x - e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z + e}, {c.x + e, b.lo.y, c.z - e}, {c.x - e, b.lo.y, c.z - e}, albedo);
+}
+
 }  // namespace ao::test

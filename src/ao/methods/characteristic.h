@@ -62,6 +62,10 @@ struct DepthBufferCharacteristic {
   std::shared_ptr<const Image<float>> second_plane;
   const float* second = nullptr;
   float separation = 0;  ///< The second layer's minimum separation, world units.
+  /// With the second layer: the visible surfaces' tangent planes (visible_planes), which the
+  /// kernels read behind a sheet.
+  std::shared_ptr<const std::vector<float>> sheet_planes;
+  const float* sheet = nullptr;
 
   explicit DepthBufferCharacteristic(const GBuffer& g) : DepthBufferCharacteristic(g, std::make_shared<const Image<float>>(depth_plane(g))) {}
   /// On a depth plane built already (`built`: depth_plane(g)), e.g. one a caller keeps between frames.
@@ -70,13 +74,27 @@ struct DepthBufferCharacteristic {
   /// With a second layer (`layer`: the G-buffer's size, rendered at `separation`).
   DepthBufferCharacteristic(const GBuffer& g, std::shared_ptr<const Image<float>> layer, float layer_separation)
       : DepthBufferCharacteristic(g) {
-    add_second_layer(std::move(layer), layer_separation);
+    add_second_layer(g, std::move(layer), layer_separation);
   }
   /// Reads `layer` (the G-buffer's size, rendered at `layer_separation`) as the second layer too.
-  void add_second_layer(std::shared_ptr<const Image<float>> layer, float layer_separation) {
+  void add_second_layer(const GBuffer& g, std::shared_ptr<const Image<float>> layer, float layer_separation) {
     second_plane = std::move(layer);
     second = second_plane->data();
     separation = layer_separation;
+    sheet_planes = std::make_shared<const std::vector<float>>(visible_planes(g));
+    sheet = sheet_planes->data();
+  }
+
+  /// Per pixel of `g`, its visible surface's camera-space tangent plane (n.x, n.y, n.z, n.p) with
+  /// the normal n facing the camera: 4 x width x height values, zeros where nothing is covered.
+  static std::vector<float> visible_planes(const GBuffer& g) {
+    std::vector<float> planes(4 * g.position.size(), 0.0f);
+    if (g.normal.size() != g.position.size()) throw InputError("the second depth layer reads the G-buffer's normals, and it has none");
+    for (std::size_t i = 0; i < g.position.size(); ++i) {
+      const Vec3 n = g.normal[i], p = g.position[i];
+      planes[4 * i] = n.x, planes[4 * i + 1] = n.y, planes[4 * i + 2] = n.z, planes[4 * i + 3] = dot(n, p);
+    }
+    return planes;
   }
 
   float distance(float x, float y, float z) const {

@@ -6,10 +6,14 @@
 //
 // How the methods read it (docs/methods/depth-layers.md): along a pixel's ray the solid is
 //   one layer:                 [z1, infinity)                 (VAO fig. 2c)
-//   second layer a back face:  [z1, z2]                       (the visible solid ends at z2)
-//   second layer a front face: [z1, z1 + separation] and [z2, infinity)
-//                              (the visible solid was thinner than the separation; another begins)
-//   nothing behind:            [z1, infinity)                 (an open surface, e.g. a ground plane)
+//   second layer a back face:  [z1, infinity)                 (a closed solid: what lies past its far
+//                                                              side is taken for solid, as with one layer)
+//   second layer a front face: [z1, z1 + separation], [z2, infinity)
+//   nothing behind:            [z1, z1 + separation]          (in both, the visible surface is a sheet,
+//                                                              or thinner than the separation)
+// Behind a sheet, the rest of the ray (the gap) is solid for a receiver x the sheet hides it from:
+// x lies on the camera's side of the sheet's tangent plane at the point's pixel, and the segment
+// from x to the point meets that plane where the sheet is (not past its rim).
 // Containment, volumetric and ambient transfer test their points and pipes against that solid;
 // Alchemy takes the second layer's point at each tap as an occluder too.
 #pragma once

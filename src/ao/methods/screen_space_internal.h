@@ -28,7 +28,8 @@ inline simd::Rotations16 simd_rotations(const std::array<Rotation, 16>& r) {
 inline simd::DepthPlane simd_depth_plane(const DepthBufferCharacteristic& ch, const DepthLayers& layers = {}) {
   const ScreenProjection& p = ch.projection;
   const bool two = layers.layers == 2;
-  return {ch.depth, p.scale_x, p.scale_y, p.centre_x, p.centre_y, p.width, p.height, two ? ch.second : nullptr, two ? ch.separation : 0.0f};
+  return {ch.depth, p.scale_x, p.scale_y, p.centre_x, p.centre_y, p.width, p.height, two ? ch.second : nullptr, two ? ch.separation : 0.0f,
+          two ? ch.sheet : nullptr};
 }
 
 /// The depth characteristic of `g` with the layers `d` asks for: its second layer (not copied: `g`
@@ -42,7 +43,7 @@ inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const De
     if (!has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
   }
   DepthBufferCharacteristic ch = built ? DepthBufferCharacteristic(g, std::move(built)) : DepthBufferCharacteristic(g);
-  if (d.layers == 2) ch.add_second_layer(std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth), separation);
+  if (d.layers == 2) ch.add_second_layer(g, std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth), separation);
   return ch;
 }
 

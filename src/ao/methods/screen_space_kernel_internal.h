@@ -49,13 +49,22 @@ struct DepthPlane {
   const float* depth = nullptr;  ///< width * height linear depths.
   float scale_x = 1, scale_y = 1, centre_x = 0, centre_y = 0;
   int width = 0, height = 0;
-  /// A deep G-buffer's second layer (GBuffer::second_depth), or null. With it the solid along a
-  /// pixel's ray is [z*, z2] where the layer holds a back face z2 > 0, [z*, z* + separation] and
-  /// [-z2, infinity) where it holds a front face (z2 < 0), and [z*, infinity) where it holds
-  /// +infinity; without it [z*, infinity) (methods/depth_layers.h).
+  /// A deep G-buffer's second layer (GBuffer::second_depth), or null: one layer, the solid along
+  /// a pixel's ray is [z*, infinity). With it (methods/depth_layers.h): [z*, infinity) where the
+  /// layer holds a back face (z2 > 0, finite: a closed solid); where it holds a front face (z2 < 0)
+  /// or nothing (+infinity) the visible surface is a sheet: [z*, z* + separation], [-z2, infinity),
+  /// and in between solid for a receiver the sheet hides the point from (`sheet`).
   const float* second = nullptr;
   float separation = 0;
+  /// With `second`: per pixel, the visible surface's camera-space tangent plane (n.x, n.y, n.z, n.p),
+  /// n facing the camera; 4 x width x height values.
+  const float* sheet = nullptr;
 };
+
+/// The sheet test's tolerance as a fraction of the separation: the segment from a receiver to a
+/// point behind a sheet meets the sheet's tangent plane on the sheet when the surface seen at that
+/// point's pixel is no more than this behind it (docs/methods/depth-layers.md measures it).
+inline constexpr float kCrossingTolerance = 0.25f;
 
 /// Test points in the tangent frame, world units (VAO eq. 5, AT eq. 8): (x[i], y[i], z[i]), n of them.
 struct TestPoints {

@@ -23,29 +23,70 @@ namespace screen_space {
 constexpr int kMaxSteps = 8;            // m: test points per ray (the methods' parameter range)
 constexpr int kMaxSamples = 256;        // n: rays per pixel (kMaxScreenSpaceSamples)
 
+// A camera-space point in vectors.
+struct Point3 {
+  VF x, y, z;
+};
+
 // The depth plane's constants in vectors, made once per call.
 struct Plane {
-  VF scale_x, scale_y, centre_x, centre_y, max_x, max_y, separation;
+  VF scale_x, scale_y, centre_x, centre_y, max_x, max_y, separation, crossing_tolerance;
   VI width;
   const float* depth;
   const float* second;
+  const float* sheet;
   explicit Plane(const DepthPlane& p)
       : scale_x(hn::Set(DF(), p.scale_x)), scale_y(hn::Set(DF(), p.scale_y)), centre_x(hn::Set(DF(), p.centre_x)),
         centre_y(hn::Set(DF(), p.centre_y)), max_x(hn::Set(DF(), static_cast<float>(p.width - 1))),
-        max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), separation(hn::Set(DF(), p.separation)), width(hn::Set(DI(), p.width)),
-        depth(p.depth), second(p.second) {}
+        max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), separation(hn::Set(DF(), p.separation)),
+        crossing_tolerance(hn::Set(DF(), kCrossingTolerance * p.separation)), width(hn::Set(DI(), p.width)), depth(p.depth), second(p.second),
+        sheet(p.sheet) {}
 
-  // Deep G-buffer (DepthPlane::second): where the solid that begins at a pixel's first layer z1
-  // ends, given the pixel's second-layer word s2: s2 itself for a back face (s2 > 0, +infinity
-  // without a surface behind), z1 + separation for a front face.
-  HWY_INLINE VF solid_end(VF z1, VF s2) const { return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), s2, hn::Add(z1, separation)); }
+  // Deep G-buffer (DepthPlane::second; depth_layers.h states the reading). A pixel's second-layer
+  // word s2 holds a back face (0 < s2 < infinity: the visible surface is a closed solid's), a front
+  // face (s2 < 0) or nothing (+infinity): then the visible surface is a sheet, or a solid thinner
+  // than the separation.
+  HWY_INLINE static MF back_face(VF s2) { return hn::And(hn::Gt(s2, hn::Zero(DF())), hn::Lt(s2, hn::Set(DF(), kInfinity))); }
+  // Where the solid that begins at the first layer z1 ends: never behind a closed solid's front
+  // (what lies past its back face is taken for solid, as with one layer), z1 + separation behind a
+  // sheet.
+  HWY_INLINE VF solid_end(VF z1, VF s2) const { return hn::IfThenElse(back_face(s2), hn::Set(DF(), kInfinity), hn::Add(z1, separation)); }
   // Where the next solid begins: the front face's depth -s2, else +infinity.
   HWY_INLINE static VF next_solid(VF s2) {
     return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), hn::Set(DF(), kInfinity), hn::Neg(s2));
   }
-  // Whether depth z, behind the first layer z1, lies in the solid: before its end or past the next
-  // solid's beginning.
-  HWY_INLINE MF in_solid(VF z, VF z1, VF s2) const { return hn::Or(hn::Lt(z, solid_end(z1, s2)), hn::Gt(z, next_solid(s2))); }
+  // In lanes `where` (points p in the gap behind the sheet seen at pixel q): whether that sheet
+  // hides p from receiver r. It does when r lies on the camera's side of the sheet's tangent plane
+  // at q (within `tol`) and the segment r -> p meets that plane where the sheet is: at the meeting
+  // point's pixel the visible surface is no more than crossing_tolerance behind it. Past the sheet's
+  // rim the plane runs through open space, and the surface seen there lies further back.
+  HWY_INLINE MF sheet_hides(MF where, VI q, const Point3& r, const Point3& p, VF tol) const {
+    const DF d;
+    const VI at = hn::ShiftLeft<2>(q);
+    const VF nx = gather_where(where, sheet, at), ny = gather_where(where, sheet + 1, at);
+    const VF nz = gather_where(where, sheet + 2, at), w = gather_where(where, sheet + 3, at);
+    const VF side_r = hn::Sub(hn::MulAdd(nz, r.z, hn::MulAdd(ny, r.y, hn::Mul(nx, r.x))), w);
+    const MF facing = hn::And(where, hn::Ge(side_r, hn::Neg(tol)));
+    if (hn::AllFalse(d, facing)) return facing;
+    const VF side_p = hn::Sub(hn::MulAdd(nz, p.z, hn::MulAdd(ny, p.y, hn::Mul(nx, p.x))), w);
+    // p on r's side of the plane too (a curved sheet seen at a grazing angle): no meeting point;
+    // such lanes keep one layer's answer (hidden), as t = 1 puts the meeting point at p.
+    const VF den = hn::Sub(side_r, side_p);
+    const VF t = hn::IfThenElse(hn::Gt(den, hn::Zero(d)), hn::Min(hn::Div(hn::Max(side_r, hn::Zero(d)), den), hn::Set(d, 1.0f)), hn::Set(d, 1.0f));
+    const VF cx = hn::MulAdd(t, hn::Sub(p.x, r.x), r.x), cy = hn::MulAdd(t, hn::Sub(p.y, r.y), r.y), cz = hn::MulAdd(t, hn::Sub(p.z, r.z), r.z);
+    const VF z_seen = gather_where(facing, depth, pixel(cx, cy, cz));
+    const MF open = hn::Gt(z_seen, hn::Sub(crossing_tolerance, cz));  // z* > depth(c) + tolerance
+    return hn::AndNot(open, facing);
+  }
+  // Whether point p at depth z (lanes `where`: behind the first layer z1 of its pixel q) lies in the
+  // solid as seen from receiver r: before the solid's end, past the next solid's beginning, or in
+  // between where the sheet hides p from r.
+  HWY_INLINE MF in_solid(VF z, VF z1, VF s2, MF where, VI q, const Point3& r, const Point3& p, VF tol) const {
+    const MF known = hn::Or(hn::Lt(z, solid_end(z1, s2)), hn::Gt(z, next_solid(s2)));
+    const MF gap = hn::AndNot(known, where);
+    if (hn::AllFalse(DF(), gap)) return known;
+    return hn::Or(known, sheet_hides(gap, q, r, p, tol));
+  }
 
   // ScreenProjection::locate, lane-wise: the pixel of camera-space point q (clamp-to-edge: f clamped
   // to [0, size - 1] as floats before the conversion; Max returns its second operand, 0, for a NaN

@@ -44,7 +44,10 @@ void CountOpenRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const 
         // Occluded: behind the surface by more than the bias, and (AT 4.3) less than R behind it;
         // with a second layer also inside the solid behind the surface (not past its end).
         MF occluded = hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far));
-        if constexpr (kTwoLayers) occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), zs, gather_where(occluded, pl.second, pixel)));
+        if constexpr (kTwoLayers) {
+          const VF s2 = gather_where(occluded, pl.second, pixel);
+          occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), zs, s2, occluded, pixel, {e.px, e.py, e.pz}, {qx, qy, qz}, e.bias));
+        }
         blocked = hn::Or(blocked, occluded);
       }
       count = hn::Add(count, hn::IfThenZeroElse(blocked, one));

@@ -89,7 +89,10 @@ HWY_INLINE void nearest_occluder(const Entries& e, const Plane& pl, const StepOf
     // AT 4.3: occluded only when the surface in front is less than R in front; with a second layer
     // also inside the solid behind the surface.
     MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
-    if constexpr (kTwoLayers) occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), z1, gather_where(occluded, pl.second, pixel)));
+    if constexpr (kTwoLayers) {
+      const VF s2 = gather_where(occluded, pl.second, pixel);
+      occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), z1, s2, occluded, pixel, {e.px, e.py, e.pz}, {qx, qy, qz}, e.bias));
+    }
     at = hn::IfThenElse(hn::RebindMask(di, occluded), id, at);
     blocked = hn::Or(blocked, occluded);
   }

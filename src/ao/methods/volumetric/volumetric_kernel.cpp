@@ -33,6 +33,7 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
     const VF cy = hn::MulAdd(hr, hn::Load(d, row.ny.data() + k0), hn::Load(d, row.py.data() + k0));
     const VF cz = hn::MulAdd(hr, hn::Load(d, row.nz.data() + k0), hn::Load(d, row.pz.data() + k0));
     const VF rc = hn::Load(d, row.rc.data() + k0), rs = hn::Load(d, row.rs.data() + k0), bias = hn::Load(d, row.bias.data() + k0);
+    const Point3 x{hn::Load(d, row.px.data() + k0), hn::Load(d, row.py.data() + k0), hn::Load(d, row.pz.data() + k0)};
     const VF inv = hn::Div(hn::Set(d, -1.0f), cz), kx = hn::Mul(inv, pl.scale_x), ky = hn::Mul(inv, pl.scale_y);
     const VF fx0 = hn::MulAdd(cx, kx, pl.centre_x), fy0 = hn::NegMulAdd(cy, ky, pl.centre_y);
     const VF ax = hn::Mul(rc, kx), bx = hn::Mul(rs, kx), ay = hn::Mul(rs, ky), by = hn::Mul(rc, ky);
@@ -61,8 +62,17 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
         const MF reaches = hn::And(valid, hn::Lt(to_surface, chord));  // the solid begins inside the pipe
         const VF s2 = gather_where(reaches, pl.second, pixel);
         const VF from_entry = hn::Add(cz, hc);  // depth z - z_entry = z + c_z + (R/2) h_i
-        const VF end = hn::Min(hn::Max(hn::Add(pl.solid_end(zs, s2), from_entry), zero), chord);
+        VF end = hn::Min(hn::Max(hn::Add(pl.solid_end(zs, s2), from_entry), zero), chord);
         const VF next = hn::Min(hn::Max(hn::Add(Plane::next_solid(s2), from_entry), zero), chord);
+        // Behind a sheet the gap [end, next) is solid where the sheet hides it from x, judged at
+        // the gap's middle: the pipe's point (c_x + x_i cos - y_i sin, c_y + x_i sin + y_i cos) at
+        // depth z_entry + (end + next) / 2.
+        const MF gap = hn::AndNot(Plane::back_face(s2), hn::And(reaches, hn::Lt(end, next)));
+        if (!hn::AllFalse(d, gap)) {
+          const Point3 mid{hn::NegMulAdd(vyi, rs, hn::MulAdd(vxi, rc, cx)), hn::MulAdd(vyi, rc, hn::MulAdd(vxi, rs, cy)),
+                           hn::NegMulAdd(hn::Add(end, next), hn::Set(d, 0.5f), hn::Add(cz, hc))};
+          end = hn::IfThenElse(pl.sheet_hides(gap, pixel, x, mid, bias), next, end);
+        }
         dz = hn::IfThenElse(reaches, hn::Sub(next, hn::Max(hn::Sub(end, dz), zero)), dz);
       }
       const MF distant = hn::And(hn::Lt(to_surface, lim), hn::Gt(to_surface, minus_huge));

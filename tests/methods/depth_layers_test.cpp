@@ -220,10 +220,10 @@ LayerErrors layer_errors(const Mesh& object) {
 // those closed meshes two layers are no worse than one (a closed solid's far side stays solid).
 // One layer takes the space under the terrain's raised edge and behind the mask for solid; two
 // layers free it where the sheet does not hide it. Measured here: containment 0.40-1.48x of the
-// closed median with two layers (one layer: the terrain 2.17x); volumetric 0.55-0.91x but for the
-// half sphere shell 1.56x, the leaf 1.90x and the gutter 2.43x, which one layer has too (1.55x,
-// 2.12x, 2.39x): the method's own error under a shell's rim and a convex contact (the gutter's
-// outer wall bulging over the ground), not the sheets' (docs/methods/depth-layers.md).
+// closed median with two layers (one layer: the terrain 2.17x); volumetric 0.46-0.91x but for the
+// half sphere shell 1.56x, the leaf 1.90x and the gutter 2.44x, which one layer has too (1.55x,
+// 2.12x, 2.39x): for the shell and the gutter the method's own band on the ground where a convex
+// wall meets it or bulges over it, which the closed sphere has too (docs/methods/depth-layers.md).
 // (A suite of its own: the SIMD targets' runs, which take DepthLayers.*, would repeat its
 // references for kernels the other DepthLayers tests cover.)
 TEST(DepthLayersSuite, TwoLayersKeepOpenSheetsNearTheClosedMeshError) {

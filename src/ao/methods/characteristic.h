@@ -62,10 +62,9 @@ struct DepthBufferCharacteristic {
   std::shared_ptr<const Image<float>> second_plane;
   const float* second = nullptr;
   float separation = 0;  ///< The second layer's minimum separation, world units.
-  /// With the second layer: the visible surfaces' tangent planes (visible_planes), which the
-  /// kernels read behind a sheet.
-  std::shared_ptr<const std::vector<float>> sheet_planes;
-  const float* sheet = nullptr;
+  /// With the second layer: the G-buffer's normals (3 floats a pixel, facing the camera), which the
+  /// kernels read behind a sheet. Not owned: the G-buffer must outlive this.
+  const float* normals = nullptr;
 
   explicit DepthBufferCharacteristic(const GBuffer& g) : DepthBufferCharacteristic(g, std::make_shared<const Image<float>>(depth_plane(g))) {}
   /// On a depth plane built already (`built`: depth_plane(g)), e.g. one a caller keeps between frames.
@@ -81,20 +80,9 @@ struct DepthBufferCharacteristic {
     second_plane = std::move(layer);
     second = second_plane->data();
     separation = layer_separation;
-    sheet_planes = std::make_shared<const std::vector<float>>(visible_planes(g));
-    sheet = sheet_planes->data();
-  }
-
-  /// Per pixel of `g`, its visible surface's camera-space tangent plane (n.x, n.y, n.z, n.p) with
-  /// the normal n facing the camera: 4 x width x height values, zeros where nothing is covered.
-  static std::vector<float> visible_planes(const GBuffer& g) {
-    std::vector<float> planes(4 * g.position.size(), 0.0f);
+    static_assert(sizeof(Vec3) == 3 * sizeof(float), "the kernels gather a normal's components at 3 i + k");
     if (g.normal.size() != g.position.size()) throw InputError("the second depth layer reads the G-buffer's normals, and it has none");
-    for (std::size_t i = 0; i < g.position.size(); ++i) {
-      const Vec3 n = g.normal[i], p = g.position[i];
-      planes[4 * i] = n.x, planes[4 * i + 1] = n.y, planes[4 * i + 2] = n.z, planes[4 * i + 3] = dot(n, p);
-    }
-    return planes;
+    normals = &g.normal.data()->x;
   }
 
   float distance(float x, float y, float z) const {

@@ -29,7 +29,7 @@ inline simd::DepthPlane simd_depth_plane(const DepthBufferCharacteristic& ch, co
   const ScreenProjection& p = ch.projection;
   const bool two = layers.layers == 2;
   return {ch.depth, p.scale_x, p.scale_y, p.centre_x, p.centre_y, p.width, p.height, two ? ch.second : nullptr, two ? ch.separation : 0.0f,
-          two ? ch.sheet : nullptr};
+          two ? ch.normals : nullptr};
 }
 
 /// The depth characteristic of `g` with the layers `d` asks for: its second layer (not copied: `g`

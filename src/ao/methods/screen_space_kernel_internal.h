@@ -53,12 +53,12 @@ struct DepthPlane {
   /// a pixel's ray is [z*, infinity). With it (methods/depth_layers.h): [z*, infinity) where the
   /// layer holds a back face (z2 > 0, finite: a closed solid); where it holds a front face (z2 < 0)
   /// or nothing (+infinity) the visible surface is a sheet: [z*, z* + separation], [-z2, infinity),
-  /// and in between solid for a receiver the sheet hides the point from (`sheet`).
+  /// and in between solid for a receiver the sheet hides the point from (`normals`).
   const float* second = nullptr;
   float separation = 0;
-  /// With `second`: per pixel, the visible surface's camera-space tangent plane (n.x, n.y, n.z, n.p),
-  /// n facing the camera; 4 x width x height values.
-  const float* sheet = nullptr;
+  /// With `second`: the visible surface's camera-space unit normal per pixel, facing the camera
+  /// (GBuffer::normal: 3 floats a pixel).
+  const float* normals = nullptr;
 };
 
 /// The sheet test's tolerance as a fraction of the separation: the segment from a receiver to a

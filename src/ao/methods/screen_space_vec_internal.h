@@ -34,13 +34,13 @@ struct Plane {
   VI width;
   const float* depth;
   const float* second;
-  const float* sheet;
+  const float* normals;
   explicit Plane(const DepthPlane& p)
       : scale_x(hn::Set(DF(), p.scale_x)), scale_y(hn::Set(DF(), p.scale_y)), centre_x(hn::Set(DF(), p.centre_x)),
         centre_y(hn::Set(DF(), p.centre_y)), max_x(hn::Set(DF(), static_cast<float>(p.width - 1))),
         max_y(hn::Set(DF(), static_cast<float>(p.height - 1))), separation(hn::Set(DF(), p.separation)),
         crossing_tolerance(hn::Set(DF(), kCrossingTolerance * p.separation)), width(hn::Set(DI(), p.width)), depth(p.depth), second(p.second),
-        sheet(p.sheet) {}
+        normals(p.normals) {}
 
   // Deep G-buffer (DepthPlane::second; depth_layers.h states the reading). A pixel's second-layer
   // word s2 holds a back face (0 < s2 < infinity: the visible surface is a closed solid's), a front
@@ -55,20 +55,22 @@ struct Plane {
   HWY_INLINE static VF next_solid(VF s2) {
     return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), hn::Set(DF(), kInfinity), hn::Neg(s2));
   }
-  // In lanes `where` (points p in the gap behind the sheet seen at pixel q): whether that sheet
+  // In lanes `where` (points p in the gap behind the sheet seen at pixel q; `on_sheet`: the sheet's
+  // point in front of p, where the line p is read along meets q's first depth): whether that sheet
   // hides p from receiver r. It does when r lies on the camera's side of the sheet's tangent plane
-  // at q (within `tol`) and the segment r -> p meets that plane where the sheet is: at the meeting
-  // point's pixel the visible surface is no more than crossing_tolerance behind it. Past the sheet's
-  // rim the plane runs through open space, and the surface seen there lies further back.
-  HWY_INLINE MF sheet_hides(MF where, VI q, const Point3& r, const Point3& p, VF tol) const {
+  // there (q's normal) within `tol`, and the segment r -> p meets that plane where the sheet is: at
+  // the meeting point's pixel the visible surface is no more than crossing_tolerance behind it. Past
+  // the sheet's rim the plane runs through open space, and the surface seen there lies further back.
+  HWY_INLINE MF sheet_hides(MF where, VI q, const Point3& on_sheet, const Point3& r, const Point3& p, VF tol) const {
     const DF d;
-    const VI at = hn::ShiftLeft<2>(q);
-    const VF nx = gather_where(where, sheet, at), ny = gather_where(where, sheet + 1, at);
-    const VF nz = gather_where(where, sheet + 2, at), w = gather_where(where, sheet + 3, at);
-    const VF side_r = hn::Sub(hn::MulAdd(nz, r.z, hn::MulAdd(ny, r.y, hn::Mul(nx, r.x))), w);
+    const VI at = hn::Add(q, hn::Add(q, q));
+    const VF nx = gather_where(where, normals, at), ny = gather_where(where, normals + 1, at), nz = gather_where(where, normals + 2, at);
+    const auto dot_n = [&](const Point3& v) { return hn::MulAdd(nz, v.z, hn::MulAdd(ny, v.y, hn::Mul(nx, v.x))); };
+    const VF w = dot_n(on_sheet);
+    const VF side_r = hn::Sub(dot_n(r), w);
     const MF facing = hn::And(where, hn::Ge(side_r, hn::Neg(tol)));
     if (hn::AllFalse(d, facing)) return facing;
-    const VF side_p = hn::Sub(hn::MulAdd(nz, p.z, hn::MulAdd(ny, p.y, hn::Mul(nx, p.x))), w);
+    const VF side_p = hn::Sub(dot_n(p), w);
     // p on r's side of the plane too (a curved sheet seen at a grazing angle): no meeting point;
     // such lanes keep one layer's answer (hidden), as t = 1 puts the meeting point at p.
     const VF den = hn::Sub(side_r, side_p);
@@ -78,14 +80,16 @@ struct Plane {
     const MF open = hn::Gt(z_seen, hn::Sub(crossing_tolerance, cz));  // z* > depth(c) + tolerance
     return hn::AndNot(open, facing);
   }
-  // Whether point p at depth z (lanes `where`: behind the first layer z1 of its pixel q) lies in the
-  // solid as seen from receiver r: before the solid's end, past the next solid's beginning, or in
-  // between where the sheet hides p from r.
+  // Whether point p at depth z = -p.z (lanes `where`: behind the first layer z1 of its pixel q)
+  // lies in the solid as seen from receiver r: before the solid's end, past the next solid's
+  // beginning, or in between where the sheet hides p from r (the sheet's point in front of p on
+  // p's line of sight, p z1 / z).
   HWY_INLINE MF in_solid(VF z, VF z1, VF s2, MF where, VI q, const Point3& r, const Point3& p, VF tol) const {
     const MF known = hn::Or(hn::Lt(z, solid_end(z1, s2)), hn::Gt(z, next_solid(s2)));
     const MF gap = hn::AndNot(known, where);
     if (hn::AllFalse(DF(), gap)) return known;
-    return hn::Or(known, sheet_hides(gap, q, r, p, tol));
+    const VF s = hn::Div(z1, z);
+    return hn::Or(known, sheet_hides(gap, q, {hn::Mul(p.x, s), hn::Mul(p.y, s), hn::Mul(p.z, s)}, r, p, tol));
   }
 
   // ScreenProjection::locate, lane-wise: the pixel of camera-space point q (clamp-to-edge: f clamped

@@ -71,7 +71,8 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
         if (!hn::AllFalse(d, gap)) {
           const Point3 mid{hn::NegMulAdd(vyi, rs, hn::MulAdd(vxi, rc, cx)), hn::MulAdd(vyi, rc, hn::MulAdd(vxi, rs, cy)),
                            hn::NegMulAdd(hn::Add(end, next), hn::Set(d, 0.5f), hn::Add(cz, hc))};
-          end = hn::IfThenElse(pl.sheet_hides(gap, pixel, x, mid, bias), next, end);
+          const Point3 on_sheet{mid.x, mid.y, hn::Neg(zs)};  // the pipe runs along the view axis
+          end = hn::IfThenElse(pl.sheet_hides(gap, pixel, on_sheet, x, mid, bias), next, end);
         }
         dz = hn::IfThenElse(reaches, hn::Sub(next, hn::Max(hn::Sub(end, dz), zero)), dz);
       }

@@ -65,18 +65,28 @@ int side_of(const SideSetup::Open& o, Vec3 world, std::size_t& evaluations) {
   return c.holed() ? -1 : nearest_side(o, world, evaluations);
 }
 
+// sign x w - threshold at the eight corners of p's lattice cell (the cell clamped to the lattice);
+// `o.lattice` must not be empty.
+std::array<float, 8> lattice_corners(const SideSetup::Open& o, Vec3 p) {
+  const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
+  const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
+            z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
+  std::array<float, 8> v;
+  for (int k = 0; k < 8; ++k) {
+    const std::size_t row = static_cast<std::size_t>(z + (k >> 2)) * static_cast<std::size_t>(o.ly) + static_cast<std::size_t>(y + ((k >> 1) & 1));
+    v[static_cast<std::size_t>(k)] = o.lattice[row * static_cast<std::size_t>(o.lx) + static_cast<std::size_t>(x + (k & 1))];
+  }
+  return v;
+}
+
 // The side of `o` that its lattice gives for p: +1 / -1 when the corners of p's cell agree, else 0;
 // `crossed` when they do not agree but all lie at least 0.25 from the threshold: the mesh itself
 // passes through the cell, not the surface beyond its rim where w meets the threshold smoothly.
 int lattice_side(const SideSetup::Open& o, Vec3 p, bool& crossed) {
   crossed = false;
   if (o.lattice.empty()) return 0;
-  const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
-  const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
-            z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
   int behind = 0, front = 0, strong = 0;
-  for (int k = 0; k < 8; ++k) {
-    const float v = o.lattice[(static_cast<std::size_t>(z + (k >> 2)) * o.ly + y + ((k >> 1) & 1)) * o.lx + x + (k & 1)];
+  for (const float v : lattice_corners(o, p)) {
     behind += v >= kLatticeMargin, front += v <= -kLatticeMargin, strong += std::abs(v) >= 0.25f;
   }
   crossed = strong == 8;
@@ -86,12 +96,8 @@ int lattice_side(const SideSetup::Open& o, Vec3 p, bool& crossed) {
 // The largest of sign x w - threshold at the corners of p's lattice cell (+infinity without a lattice).
 float lattice_max(const SideSetup::Open& o, Vec3 p) {
   if (o.lattice.empty()) return std::numeric_limits<float>::infinity();
-  const Vec3 f = (p - o.lattice_lo) / o.lattice_step;
-  const int x = std::clamp(static_cast<int>(f.x), 0, o.lx - 2), y = std::clamp(static_cast<int>(f.y), 0, o.ly - 2),
-            z = std::clamp(static_cast<int>(f.z), 0, o.lz - 2);
-  float m = -std::numeric_limits<float>::infinity();
-  for (int k = 0; k < 8; ++k) m = std::max(m, o.lattice[(static_cast<std::size_t>(z + (k >> 2)) * o.ly + y + ((k >> 1) & 1)) * o.lx + x + (k & 1)]);
-  return m;
+  const std::array<float, 8> v = lattice_corners(o, p);
+  return *std::max_element(v.begin(), v.end());
 }
 
 // How far along its normal a surface point must go to be clear of its own surface's voxels: 1.5

@@ -82,7 +82,7 @@ struct DepthBufferCharacteristic {
     separation = layer_separation;
     static_assert(sizeof(Vec3) == 3 * sizeof(float), "the kernels gather a normal's components at 3 i + k");
     if (g.normal.size() != g.position.size()) throw InputError("the second depth layer reads the G-buffer's normals, and it has none");
-    normals = &g.normal.data()->x;
+    normals = reinterpret_cast<const float*>(g.normal.data());
   }
 
   float distance(float x, float y, float z) const {

@@ -178,7 +178,10 @@ def window(baked, blender):
         pytest.skip("xvfb-run is not installed (Debian: apt-get install xvfb): the modal operator and Esc are not tested")
     out = baked[0]
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-    env.update(BLENDER_USER_SCRIPTS=str(out.parent / "scripts"), BLENDER_USER_CONFIG=str(out.parent / "config"))
+    # Blender saves quit.blend into its temporary folder when a window quits: the test's own, not /tmp.
+    temp = out.parent / "blender-temp"
+    temp.mkdir(exist_ok=True)
+    env.update(BLENDER_USER_SCRIPTS=str(out.parent / "scripts"), BLENDER_USER_CONFIG=str(out.parent / "config"), TMPDIR=str(temp), TEMP=str(temp))
     q = subprocess.run([xvfb, "-a", "-s", "-screen 0 1280x800x24", blender, "--enable-event-simulate", str(out / "scene.blend"), "--python",
                         os.path.join(HERE, "in_window.py"), "--", str(out)], env=env, capture_output=True, text=True, timeout=600)
     assert q.returncode == 0 and os.path.exists(out / "window.json"), q.stdout[-4000:] + q.stderr[-4000:]

@@ -3,11 +3,7 @@
 // outputs and their contents; bad input exits non-zero with one line and leaves no output directory.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -17,33 +13,16 @@
 
 #include "ao/io/image_io.h"
 #include "ao/io/text.h"
+#include "support/run.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exit_code;
-  std::string err;
-};
+using ao::test::RunResult;
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("ao-compare-test-" + std::to_string(::getpid())) / name;
-  fs::remove_all(p);
-  fs::create_directories(p.parent_path());
-  return p;
-}
-
-// `env` is prepended to the command line, e.g. "AO_FONT=/x".
-CliRun run_ao(const std::string& args, const std::string& env = "") {
-  const fs::path err = scratch("stderr.txt");
-  const std::string cmd = env + " " + std::string(AO_CLI_PATH) + " -q " + args + " > /dev/null 2> " + err.string();
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(err);
-  std::stringstream s;
-  s << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
-}
+// `env` goes before the binary, e.g. "AO_FONT=/x".
+RunResult run_ao(const std::string& args, const std::string& env = "") { return ao::test::run_ao_under(env, "-q " + args); }
 
 nlohmann::json read_json(const fs::path& p) {
   std::ifstream in(p);
@@ -51,8 +30,9 @@ nlohmann::json read_json(const fs::path& p) {
 }
 
 TEST(CompareCli, WritesTableSheetAndSweep) {
-  const fs::path out = scratch("out");
-  const CliRun r = run_ao("compare sphere-on-plane --methods alchemy --width 48 --height 32 --spp-reference 8 --sweep samples=4,8 --out-dir " +
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "out";
+  const RunResult r = run_ao("compare sphere-on-plane --methods alchemy --width 48 --height 32 --spp-reference 8 --sweep samples=4,8 --out-dir " +
                        out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* f : {"table.md", "table.json", "sheet.png", "sweep.md", "sweep.json"}) EXPECT_TRUE(fs::exists(out / f)) << f;
@@ -95,8 +75,9 @@ TEST(CompareCli, SheetHasHeaderAndLabelsAboveUntouchedImagesAndWorksWithoutFont)
   if (!fs::exists(ao::kDejaVuSansPath)) GTEST_SKIP() << ao::kDejaVuSansPath << " missing (scripts/setup installs fonts-dejavu-core)";
   constexpr int kW = 160, kH = 120, kGap = 4;
   const std::string args = "compare sphere-on-plane --methods alchemy --width 160 --height 120 --spp-reference 4 --out-dir ";
-  const fs::path labelled = scratch("labelled"), plain = scratch("plain");
-  CliRun r = run_ao(args + labelled.string(), "AO_FONT=");
+  const ao::test::TempDir dir;
+  const fs::path labelled = dir / "labelled", plain = dir / "plain";
+  RunResult r = run_ao(args + labelled.string(), "AO_FONT=");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   r = run_ao(args + plain.string(), "AO_FONT=/nonexistent/font.ttf");
@@ -129,8 +110,9 @@ TEST(CompareCli, SheetHasHeaderAndLabelsAboveUntouchedImagesAndWorksWithoutFont)
 
 // The characteristic function is a parameter like any other: set per method, and swept.
 TEST(CompareCli, SweepsTheCharacteristicFunction) {
-  const fs::path out = scratch("characteristic");
-  const CliRun r = run_ao("compare sphere-on-plane --methods containment,volumetric --width 48 --height 32 --spp-reference 8 -R 0.5 "
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "characteristic";
+  const RunResult r = run_ao("compare sphere-on-plane --methods containment,volumetric --width 48 --height 32 --spp-reference 8 -R 0.5 "
                           "-p volumetric.characteristic=implicit --sweep characteristic=depth,implicit --out-dir " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json t = read_json(out / "table.json");
@@ -143,8 +125,9 @@ TEST(CompareCli, SweepsTheCharacteristicFunction) {
 }
 
 TEST(CompareCli, UnknownMethodFailsWithOneLineAndNoOutput) {
-  const fs::path out = scratch("bad-method");
-  const CliRun r = run_ao("compare plane --methods alchemy,nonsense --width 16 --height 16 --out-dir " + out.string());
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "bad-method";
+  const RunResult r = run_ao("compare plane --methods alchemy,nonsense --width 16 --height 16 --out-dir " + out.string());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("unknown method 'nonsense'"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("alchemy"), std::string::npos) << "the error lists the known methods: " << r.err;
@@ -153,8 +136,9 @@ TEST(CompareCli, UnknownMethodFailsWithOneLineAndNoOutput) {
 }
 
 TEST(CompareCli, MissingMeshFailsWithOneLineAndNoOutput) {
-  const fs::path out = scratch("missing-mesh");
-  const CliRun r = run_ao("compare /nonexistent/cow.off --methods alchemy --width 16 --height 16 --out-dir " + out.string());
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "missing-mesh";
+  const RunResult r = run_ao("compare /nonexistent/cow.off --methods alchemy --width 16 --height 16 --out-dir " + out.string());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("cow.off"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -162,8 +146,9 @@ TEST(CompareCli, MissingMeshFailsWithOneLineAndNoOutput) {
 }
 
 TEST(CompareCli, BadSweepAndParamFailBeforeRendering) {
-  const fs::path out = scratch("bad-sweep");
-  CliRun r = run_ao("compare plane --methods alchemy --sweep nosuchkey=1,2 --out-dir " + out.string());
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "bad-sweep";
+  RunResult r = run_ao("compare plane --methods alchemy --sweep nosuchkey=1,2 --out-dir " + out.string());
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_FALSE(fs::exists(out));
   r = run_ao("compare plane --methods alchemy -p alchemy.sigma=2 --out-dir " + out.string());
@@ -175,9 +160,10 @@ TEST(CompareCli, BadSweepAndParamFailBeforeRendering) {
 // Each method gets its matched reference by default; --reference NAME overrides for every method,
 // METHOD=NAME for one.
 TEST(CompareCli, ChoosesReferencesByName) {
-  const fs::path out = scratch("references");
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "references";
   const std::string base = "compare sphere-on-plane --methods volumetric,transfer --width 32 --height 24 --spp-reference 4 --out-dir ";
-  CliRun r = run_ao(base + out.string());
+  RunResult r = run_ao(base + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   nlohmann::json t = read_json(out / "table.json");
   EXPECT_EQ(t["rows"][0]["reference"]["kind"], "tangent-sphere");
@@ -192,7 +178,7 @@ TEST(CompareCli, ChoosesReferencesByName) {
   t = read_json(out / "table.json");
   EXPECT_EQ(t["rows"][0]["reference"]["label"], "cubic obscurance");
   EXPECT_EQ(t["rows"][1]["reference"]["kind"], "transfer");
-  const fs::path bad = scratch("bad-reference");
+  const fs::path bad = dir / "bad-reference";
   r = run_ao(base + bad.string() + " --reference cubic");
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("unknown reference 'cubic'"), std::string::npos) << r.err;
@@ -205,8 +191,9 @@ TEST(CompareCli, ChoosesReferencesByName) {
 // Parameters print at the precision they were given: Alchemy's float bias of 1e-4 is "0.0001" in
 // both tables, not the double expansion of the float, 9.999999747378752e-05.
 TEST(CompareCli, TablesPrintFloatsAsGiven) {
-  const fs::path out = scratch("floats");
-  const CliRun r = run_ao("compare sphere-on-plane --methods alchemy --width 16 --height 12 --spp-reference 2 --out-dir " + out.string());
+  const ao::test::TempDir dir;
+  const fs::path out = dir / "floats";
+  const RunResult r = run_ao("compare sphere-on-plane --methods alchemy --width 16 --height 12 --spp-reference 2 --out-dir " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream md(out / "table.md"), js(out / "table.json");
   std::stringstream a, b;

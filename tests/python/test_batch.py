@@ -18,6 +18,7 @@
 import json
 import os
 import re
+import shlex
 import signal
 import subprocess
 import sys
@@ -76,7 +77,8 @@ class Cluster:
         self.address = info["address"]
         assert self.address.startswith("tcp://127.0.0.1:")
         for k in range(workers):
-            cmd = f"{worker_prefix} exec dask worker {self.address} --nthreads 1 --no-nanny --host 127.0.0.1 --no-dashboard --name w{k}"
+            cmd = f"{worker_prefix} exec dask worker {self.address} --nthreads 1 --no-nanny --host 127.0.0.1 --no-dashboard --name w{k}" \
+                  f" --local-directory {shlex.quote(str(folder / f'w{k}'))}"
             w = start(cmd, self._log(folder / f"worker{k}.log"), env=worker_env, shell=True)
             self.workers.append(w)
             self.processes.append(w)

@@ -13,8 +13,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <limits>
-#include <malloc.h>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -455,14 +453,6 @@ class Viewer final : public ViewerControls {
 }  // namespace
 
 int run_view(ViewSetup setup) {
-  // Every frame allocates and frees images of the same few sizes (G-buffer planes, method outputs
-  // and scratch). glibc would return most of them to the kernel (blocks above the mmap threshold,
-  // and the heap's free top beyond the trim threshold), and the next frame would fault in fresh
-  // zeroed pages (BENCHMARKS.md, "ao view", measures what that cost). Keep freed memory in the
-  // process instead: blocks up to 32 MB (glibc's largest mmap threshold) come from the heap, and
-  // the heap is never trimmed, so the process keeps the most memory it ever used at once.
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
   Viewer viewer(std::move(setup));
   return viewer.run();
 }

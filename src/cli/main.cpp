@@ -35,9 +35,10 @@ int main(int argc, char** argv) {
   // the heap, and the heap is never trimmed. Otherwise glibc returns large blocks (a bake's coverage
   // fragments, a map's scratch images, each frame's images in `ao view`) to the kernel when they are
   // freed, and the next one faults in fresh zeroed pages: a 1024^2 bake at 8 rays spent 14% of its
-  // CPU in the kernel's page faults, and this cuts its whole process's CPU by 5-7% (BENCHMARKS.md,
-  // "Bake rays against the renderer's rays"). The process then keeps the most memory it used at once
-  // until it exits, which a command does soon; the library leaves malloc as its host set it.
+  // CPU in the kernel's page faults, and this cuts its whole process's CPU by 5% (docs/methods/bake.md,
+  // "Speed"; BENCHMARKS.md, "ao view", for the viewer's frames). The process then keeps the most
+  // memory it used at once until it exits, which a command does soon; the library leaves malloc as
+  // its host set it.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
   try {

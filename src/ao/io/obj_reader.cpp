@@ -279,6 +279,24 @@ struct ObjData {
     return true;
   }
 
+  /// Room for the elements of `data`, counted by the first word of each line, so that the arrays
+  /// fill without growing (each growth copied them into fresh pages: a tenth of the load).
+  void reserve_for(std::string_view data) {
+    std::size_t counts[4] = {0, 0, 0, 0};  // v, vt, vn, f
+    for (std::size_t pos = 0; pos < data.size();) {
+      while (pos < data.size() && is_blank(data[pos])) ++pos;
+      const auto at = [&](std::size_t k) { return pos + k < data.size() ? data[pos + k] : '\n'; };
+      if (at(0) == 'v' && is_blank(at(1))) ++counts[0];
+      else if (at(0) == 'v' && at(1) == 't' && is_blank(at(2))) ++counts[1];
+      else if (at(0) == 'v' && at(1) == 'n' && is_blank(at(2))) ++counts[2];
+      else if (at(0) == 'f' && is_blank(at(1))) ++counts[3];
+      const void* nl = std::memchr(data.data() + pos, '\n', data.size() - pos);
+      pos = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - data.data()) + 1 : data.size();
+    }
+    positions.reserve(counts[0]), uvs.reserve(counts[1]), normals.reserve(counts[2]);
+    corners.reserve(3 * counts[3]), face_sizes.reserve(counts[3]);
+  }
+
   /// Whether every index that pointed forwards lands on an element of the whole file.
   bool forward_indices_in_range() const {
     for (const auto& idx : forward)
@@ -296,23 +314,31 @@ Mesh weld_and_triangulate(const ObjData& d) {
   const std::vector<std::uint32_t> pos_id = first_equal(d.positions);
   const std::vector<std::uint32_t> uv_id = has_uv ? first_equal(d.uvs) : std::vector<std::uint32_t>{};
   const std::vector<std::uint32_t> normal_id = has_normal ? first_equal(d.normals) : std::vector<std::uint32_t>{};
-  std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, KeyHash> vertex_of;
-  vertex_of.reserve(d.corners.size());
+  // The vertices made so far, chained per position number (a position has a few UV and normal
+  // partners at most, one per chart or crease it lies on): no hashing, no allocation per vertex.
+  constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+  std::vector<std::uint32_t> first_at(d.positions.size(), kNone), next_at;
   Mesh mesh;
   mesh.name = d.object_name;
   mesh.positions.reserve(d.positions.size() + kVertexPadding);  // see kVertexPadding
-  std::vector<std::uint32_t> corner_vertex(d.corners.size());
+  std::vector<std::uint32_t> corner_vertex(d.corners.size()), vertex_uv, vertex_normal;
   for (std::size_t c = 0; c < d.corners.size(); ++c) {
     const auto& corner = d.corners[c];
-    const std::array<std::uint32_t, 3> key{pos_id[corner[0]], has_uv ? uv_id[corner[1]] : 0u, has_normal ? normal_id[corner[2]] : 0u};
-    const auto [it, inserted] = vertex_of.try_emplace(key, static_cast<std::uint32_t>(mesh.positions.size()));
-    if (inserted) {
-      const auto& p = d.positions[key[0]];
-      mesh.positions.push_back({p[0], p[1], p[2]});
-      if (has_uv) mesh.uvs.push_back({d.uvs[key[1]][0], d.uvs[key[1]][1]});
-      if (has_normal) mesh.normals.push_back({d.normals[key[2]][0], d.normals[key[2]][1], d.normals[key[2]][2]});
+    const std::uint32_t p = pos_id[corner[0]], uv = has_uv ? uv_id[corner[1]] : 0u, normal = has_normal ? normal_id[corner[2]] : 0u;
+    std::uint32_t v = first_at[p];
+    while (v != kNone && !(vertex_uv[v] == uv && vertex_normal[v] == normal)) v = next_at[v];
+    if (v == kNone) {
+      v = static_cast<std::uint32_t>(mesh.positions.size());
+      next_at.push_back(first_at[p]);
+      first_at[p] = v;
+      vertex_uv.push_back(uv);
+      vertex_normal.push_back(normal);
+      const auto& q = d.positions[p];
+      mesh.positions.push_back({q[0], q[1], q[2]});
+      if (has_uv) mesh.uvs.push_back({d.uvs[uv][0], d.uvs[uv][1]});
+      if (has_normal) mesh.normals.push_back({d.normals[normal][0], d.normals[normal][1], d.normals[normal][2]});
     }
-    corner_vertex[c] = it->second;
+    corner_vertex[c] = v;
   }
   mesh.indices.reserve(d.corners.size() * 3 / 2 + 3);
   std::size_t c = 0;
@@ -334,6 +360,7 @@ Mesh weld_and_triangulate(const ObjData& d) {
 
 std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data, const LoadOptions& options) {
   ObjData d;
+  d.reserve_for(data);
   const fs::path folder = asset_folder(path, options.asset_root);
   std::size_t pos = 0;
   while (pos < data.size()) {

@@ -184,7 +184,7 @@ double mean_texel_ratio(const Scene& scene, int width, int height) {
 struct Block {
   std::uint32_t mesh;
   std::size_t first, last;
-  std::vector<Pending, detail::DefaultInitAllocator<Pending>> pending;  // the run's fragments by band of texel rows, within a band in triangle then texel order
+  std::vector<Pending> pending;  // the run's fragments by band of texel rows, within a band in triangle then texel order
   std::vector<std::size_t> band_start;  // band b's fragments are pending[band_start[b] .. band_start[b + 1])
   std::size_t degenerate = 0, outside = 0;
 };
@@ -196,7 +196,7 @@ void by_band(int width, int height, Block& blk) {
   for (const Pending& p : blk.pending) ++blk.band_start[band(p) + 1];
   for (std::size_t b = 1; b < blk.band_start.size(); ++b) blk.band_start[b] += blk.band_start[b - 1];
   std::vector<std::size_t> cursor(blk.band_start.begin(), blk.band_start.end() - 1);
-  std::vector<Pending, detail::DefaultInitAllocator<Pending>> sorted(blk.pending.size());
+  std::vector<Pending> sorted(blk.pending.size());
   for (const Pending& p : blk.pending) sorted[cursor[band(p)]++] = p;
   blk.pending.swap(sorted);
 }
@@ -305,7 +305,7 @@ void gather_by_texel(std::vector<Block>& blocks, TexelCoverage& cov) {
     }
   });
   for (int b = 0; b < bands; ++b) cov.covered_texels += covered[static_cast<std::size_t>(b)], cov.overlapping_texels += overlapping[static_cast<std::size_t>(b)];
-  for (Block& blk : blocks) decltype(blk.pending)().swap(blk.pending);
+  for (Block& blk : blocks) std::vector<Pending>().swap(blk.pending);
 }
 
 }  // namespace

@@ -38,9 +38,8 @@ struct TexelFragment {
 struct TexelCoverage {
   int width = 0;                            ///< W, texels.
   int height = 0;                           ///< H, texels.
-  // Both in huge pages where large (detail::DefaultInitAllocator), as the images are.
-  std::vector<std::uint32_t, detail::DefaultInitAllocator<std::uint32_t>> offsets;  ///< CSR: fragments of texel i are [offsets[i], offsets[i+1]).
-  std::vector<TexelFragment, detail::DefaultInitAllocator<TexelFragment>> fragments;  ///< Sorted by texel.
+  std::vector<std::uint32_t> offsets;       ///< CSR: fragments of texel i are [offsets[i], offsets[i+1]).
+  std::vector<TexelFragment> fragments;     ///< Sorted by texel.
   Image<float> world_area;                  ///< Per texel: world area of the surface it covers (eq. 2's denominator).
   Image<float> uv_area;                     ///< Per texel: covered fraction of the texel, summed over triangles (> 1 where charts overlap).
   Image<std::uint8_t> mask;                 ///< 1 where the texel covers some surface.

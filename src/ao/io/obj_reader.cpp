@@ -280,7 +280,8 @@ struct ObjData {
   }
 
   /// Room for the elements of `data`, counted by the first word of each line, so that the arrays
-  /// fill without growing (each growth copied them into fresh pages: a tenth of the load).
+  /// fill without growing (each growth copies them into fresh pages). Quads take more corners than
+  /// three per face: those arrays grow once.
   void reserve_for(std::string_view data) {
     std::size_t counts[4] = {0, 0, 0, 0};  // v, vt, vn, f
     for (std::size_t pos = 0; pos < data.size();) {

@@ -92,6 +92,15 @@ struct KeyHash {
   }
 };
 
+/// The line of `data` that starts at `pos` (without its newline); `pos` moves to the next line.
+std::string_view next_line(std::string_view data, std::size_t& pos) {
+  const char* nl = static_cast<const char*>(std::memchr(data.data() + pos, '\n', data.size() - pos));
+  const std::size_t end = nl ? static_cast<std::size_t>(nl - data.data()) : data.size();
+  const std::string_view line = data.substr(pos, end - pos);
+  pos = end + 1;
+  return line;
+}
+
 /// For each value of `values`, the index of the first equal value.
 template <std::size_t N>
 std::vector<std::uint32_t> first_equal(const std::vector<std::array<float, N>>& values) {
@@ -283,19 +292,13 @@ struct ObjData {
   /// fill without growing (each growth copies them into fresh pages). Quads take more corners than
   /// three per face: those arrays grow once.
   void reserve_for(std::string_view data) {
-    std::size_t counts[4] = {0, 0, 0, 0};  // v, vt, vn, f
+    std::size_t v = 0, vt = 0, vn = 0, f = 0;
     for (std::size_t pos = 0; pos < data.size();) {
-      while (pos < data.size() && is_blank(data[pos])) ++pos;
-      const auto at = [&](std::size_t k) { return pos + k < data.size() ? data[pos + k] : '\n'; };
-      if (at(0) == 'v' && is_blank(at(1))) ++counts[0];
-      else if (at(0) == 'v' && at(1) == 't' && is_blank(at(2))) ++counts[1];
-      else if (at(0) == 'v' && at(1) == 'n' && is_blank(at(2))) ++counts[2];
-      else if (at(0) == 'f' && is_blank(at(1))) ++counts[3];
-      const void* nl = std::memchr(data.data() + pos, '\n', data.size() - pos);
-      pos = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - data.data()) + 1 : data.size();
+      const std::string_view key = Tokens{next_line(data, pos)}.next();
+      v += key == "v", vt += key == "vt", vn += key == "vn", f += key == "f";
     }
-    positions.reserve(counts[0]), uvs.reserve(counts[1]), normals.reserve(counts[2]);
-    corners.reserve(3 * counts[3]), face_sizes.reserve(counts[3]);
+    positions.reserve(v), uvs.reserve(vt), normals.reserve(vn);
+    corners.reserve(3 * f), face_sizes.reserve(f);
   }
 
   /// Whether every index that pointed forwards lands on an element of the whole file.
@@ -319,21 +322,22 @@ Mesh weld_and_triangulate(const ObjData& d) {
   // partners at most, one per chart or crease it lies on): no hashing, no allocation per vertex.
   constexpr std::uint32_t kNone = 0xFFFFFFFFu;
   std::vector<std::uint32_t> first_at(d.positions.size(), kNone), next_at;
+  std::vector<std::array<std::uint32_t, 2>> partners;  // each vertex's UV and normal numbers
+  next_at.reserve(d.positions.size()), partners.reserve(d.positions.size());
   Mesh mesh;
   mesh.name = d.object_name;
   mesh.positions.reserve(d.positions.size() + kVertexPadding);  // see kVertexPadding
-  std::vector<std::uint32_t> corner_vertex(d.corners.size()), vertex_uv, vertex_normal;
+  std::vector<std::uint32_t> corner_vertex(d.corners.size());
   for (std::size_t c = 0; c < d.corners.size(); ++c) {
     const auto& corner = d.corners[c];
     const std::uint32_t p = pos_id[corner[0]], uv = has_uv ? uv_id[corner[1]] : 0u, normal = has_normal ? normal_id[corner[2]] : 0u;
     std::uint32_t v = first_at[p];
-    while (v != kNone && !(vertex_uv[v] == uv && vertex_normal[v] == normal)) v = next_at[v];
+    while (v != kNone && partners[v] != std::array<std::uint32_t, 2>{uv, normal}) v = next_at[v];
     if (v == kNone) {
       v = static_cast<std::uint32_t>(mesh.positions.size());
       next_at.push_back(first_at[p]);
       first_at[p] = v;
-      vertex_uv.push_back(uv);
-      vertex_normal.push_back(normal);
+      partners.push_back({uv, normal});
       const auto& q = d.positions[p];
       mesh.positions.push_back({q[0], q[1], q[2]});
       if (has_uv) mesh.uvs.push_back({d.uvs[uv][0], d.uvs[uv][1]});
@@ -365,10 +369,7 @@ std::optional<Scene> read_simple_obj(const fs::path& path, std::string_view data
   const fs::path folder = asset_folder(path, options.asset_root);
   std::size_t pos = 0;
   while (pos < data.size()) {
-    const char* nl = static_cast<const char*>(std::memchr(data.data() + pos, '\n', data.size() - pos));
-    const std::size_t end = nl ? static_cast<std::size_t>(nl - data.data()) : data.size();
-    std::string_view line = data.substr(pos, end - pos);
-    pos = end + 1;
+    std::string_view line = next_line(data, pos);
     if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     if (!line.empty() && line.back() == '\\') return std::nullopt;  // continued lines: assimp's reading
     if (!d.read_line(path, folder, line)) return std::nullopt;

@@ -6,6 +6,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -73,17 +74,21 @@ double process_cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// The estimate at 50% of a real ray-traced render, against the time that did remain. The render
-// counts covered pixels (not tiles, which include background that costs nothing), so the rate so
-// far predicts the rest. Time is the process's CPU time, which other programs on a shared machine
-// do not stretch as they stretch wall time.
-TEST(ProgressMeter, EstimateAtHalfOfARenderIsWithinAQuarterOfTheTimeLeft) {
+struct HalfwayEstimate {
+  double estimate = 0;  ///< CPU seconds left, as estimated at 50% of the units
+  double left = 0;      ///< CPU seconds that did remain
+};
+
+// One real ray-traced render, its remaining time estimated at 50%. The render counts covered
+// pixels (not tiles, which include background that costs nothing), so the rate so far predicts the
+// rest. Time is the process's CPU time, which other programs on a shared machine do not stretch as
+// they stretch wall time.
+HalfwayEstimate estimate_at_half_of_a_render() {
   RenderRequest request;
   request.scene.args = {std::string(AO_TEST_MESHES) + "/elephant.off"};
   request.camera.width = 240, request.camera.height = 135;
-  // 4096 rays a pixel: about 0.9 CPU seconds, long enough that the threads' start and the last
-  // tiles' imbalance stay small beside the half that is estimated (at 1024, since the tracer got
-  // faster, a fifth of a second, and the estimate missed by 25.3% once under a parallel build).
+  // 4096 rays a pixel: long enough that the threads' start and the last tiles' imbalance stay
+  // small beside the half that is estimated.
   request.samples = 4096;
   std::mutex mutex;
   double start = 0, at_half = -1, estimate = 0, end = 0;
@@ -99,11 +104,28 @@ TEST(ProgressMeter, EstimateAtHalfOfARenderIsWithinAQuarterOfTheTimeLeft) {
     };
   };
   run_render(request, reporter);
-  ASSERT_GE(at_half, 0.0) << "the render reported its progress";
-  const double left = end - at_half;
-  // 25%: the bound. Pixels differ in cost (open sky rays end early), but the tiles of
-  // both halves mix open and occluded surface.
-  EXPECT_NEAR(estimate, left, 0.25 * left) << "estimate " << estimate << " s, remained " << left << " s (CPU)";
+  if (at_half < 0) return {};
+  return {estimate, end - at_half};
+}
+
+// The estimate at half of a render, against the time that did remain, within 25% (the issue's
+// bound). Pixels differ in cost (open sky rays end early), but the tiles of both halves mix open and
+// occluded surface. CPU time is still stretched by what shares the cores' caches (a parallel build,
+// the other tests of a parallel CTest: one run missed by more than 25% so), so the median of three
+// renders is judged: one disturbed render does not decide.
+TEST(ProgressMeter, EstimateAtHalfOfARenderIsWithinAQuarterOfTheTimeLeft) {
+  std::vector<double> ratios;
+  std::string runs;
+  for (int i = 0; i < 3; ++i) {
+    const HalfwayEstimate e = estimate_at_half_of_a_render();
+    ASSERT_GT(e.left, 0.0) << "the render reported its progress";
+    ratios.push_back(e.estimate / e.left);
+    char run[80];
+    std::snprintf(run, sizeof run, " %.3f s for %.3f s;", e.estimate, e.left);
+    runs += run;
+  }
+  std::sort(ratios.begin(), ratios.end());
+  EXPECT_NEAR(ratios[1], 1.0, 0.25) << "estimated, remained (CPU):" << runs;
 }
 
 // `ao render` with stderr in a file writes progress lines (here every 0.05 s: the job is short).

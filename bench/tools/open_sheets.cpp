@@ -5,15 +5,17 @@
 //   ao_open_sheets /tmp/open-sheets
 //   ao compare /tmp/open-sheets/arch.obj --camera /tmp/open-sheets/arch.camera.json --methods cone
 // Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
-// top), mask, dome (with a window), terrain, tablecloth, leaf, gutter, and the closed box, sphere and
-// torus. The ground is a quad of twice the object's diagonal
-// under it, and the camera looks at the object from the front right and above, as
-// tests/methods/cone_test.cpp does. With a second argument, the folder of the shared meshes, also
-// ChineseDragon-10kv and elephant opened as scans come (tests/support/open_sheets.h: the bottom
-// 10% cut off, -cut.obj; holes of 3% of the diagonal punched, -holes.obj), alone:
+// top), mask, dome (with a window), terrain, tablecloth, leaf, gutter, the closed box, sphere and
+// torus, and a closed plate leaning on the ground (the leaf's wedge under a closed occluder). The
+// ground is a quad of twice the object's diagonal under it, and the camera looks at the object from
+// the front right and above, as tests/methods/cone_test.cpp does. With a second argument, the
+// folder of the shared meshes, also ChineseDragon-10kv and elephant opened as scans come
+// (tests/support/open_sheets.h: the bottom 10% cut off, -cut.obj; holes of 3% of the diagonal
+// punched, -holes.obj), alone:
 //   ao_open_sheets /tmp/open-sheets ../shared/data/meshes
 //   ao compare /tmp/open-sheets/elephant-cut.obj --methods cone
 // Write them outside the repository.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -29,6 +31,18 @@
 #include "support/open_sheets.h"
 
 namespace {
+
+// A closed plate as wide as half the leaf (0.35), 0.03 thick and 1.2 long, leaning at the leaf's fold
+// angle (25 degrees) on one long edge: the narrow wedge the leaf's half makes with the ground, under
+// a closed occluder.
+ao::Mesh make_leaning_plate() {
+  ao::Mesh m = ao::make_box({0.0f, 0.0f, -0.6f}, {0.35f, 0.03f, 0.6f});
+  const float c = std::cos(0.4363323f), s = std::sin(0.4363323f);  // 25 degrees about z, through the edge at the origin
+  const auto turn = [&](ao::Vec3 v) { return ao::Vec3{c * v.x - s * v.y, s * v.x + c * v.y, v.z}; };
+  for (ao::Vec3& p : m.positions) p = turn(p);
+  for (ao::Vec3& n : m.normals) n = turn(n);
+  return m;
+}
 
 // One material per mesh (named after it, in a .mtl beside the file): the loader keeps meshes with
 // different materials apart, and each is classified on its own (closed, solid with holes, sheet).
@@ -81,6 +95,7 @@ int main(int argc, char** argv) {
         {"sphere", ao::make_sphere({0, 1, 0}, 1.0f, 96, 48)},
         {"torus", ao::make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)},
         {"head", ao::test::make_head()},
+        {"plate", make_leaning_plate()},
     };
     for (const auto& [name, mesh] : objects) {
       write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ao::test::ground_under(mesh, {0.75f, 0.73f, 0.70f})}});

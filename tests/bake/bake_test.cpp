@@ -370,16 +370,46 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
   EXPECT_GT(between, 0);
 }
 
+// The texels of a 4 x 4 block share one sequence, each its own n points of it: at n = 16 each
+// texel's directions put one point in every cell of a 4 x 4 grid over dimensions 0-1 (its own net),
+// and the block's 256 put one in every cell of a 16 x 16 grid (one net together, which sixteen
+// independent sets would not be). Texels of other blocks take other sequences.
+TEST(Bake, TexelsOfABlockShareOneStratifiedSequence) {
+  constexpr int kSamples = 16;
+  std::set<std::pair<int, int>> block_cells;
+  std::set<std::uint32_t> first;
+  for (int y = 8; y < 12; ++y)
+    for (int x = 4; x < 8; ++x) {
+      const detail::TexelSampleSet set = detail::texel_sample_set(1u, x, y, kSamples);
+      EXPECT_EQ(set.key, detail::texel_sample_set(1u, 4, 8, kSamples).key);
+      first.insert(set.first);
+      std::set<std::pair<int, int>> own;
+      for (int i = 0; i < kSamples; ++i) {
+        const std::array<float, 4> u = sobol_owen_4d(set.first + static_cast<std::uint32_t>(i), set.key);
+        own.insert({static_cast<int>(u[0] * 4), static_cast<int>(u[1] * 4)});
+        block_cells.insert({static_cast<int>(u[0] * 16), static_cast<int>(u[1] * 16)});
+      }
+      EXPECT_EQ(own.size(), 16u) << "texel " << x << ", " << y;
+    }
+  EXPECT_EQ(first.size(), 16u);
+  EXPECT_EQ(block_cells.size(), 256u);
+  EXPECT_NE(detail::texel_sample_set(1u, 8, 8, kSamples).key, detail::texel_sample_set(1u, 4, 8, kSamples).key);
+  EXPECT_NE(detail::texel_sample_set(1u, 4, 12, kSamples).key, detail::texel_sample_set(1u, 4, 8, kSamples).key);
+}
+
 TEST(Bake, TexelPointsAreTheSobolSetInDirectionCells) {
   // The order holds the same points as index order (so the texel's mean is unchanged), and at a
   // power-of-two count every packet of 16 lies in one cell of the direction grid (the net
-  // property); at other counts the order is still a permutation.
+  // property, which an aligned block of the sequence has as its start does: texel (3, 2) of its
+  // block takes points [11 n, 12 n)); at other counts the order is still a permutation.
   detail::TexelPoints pts;
   for (int samples : {64, 256, 128, 37}) {
-    pts.generate(12345u, samples);
+    const detail::TexelSampleSet set = detail::texel_sample_set(7u, 3, 2, samples);
+    ASSERT_EQ(set.first, 11u * static_cast<std::uint32_t>(samples));
+    pts.generate(set, samples);
     std::vector<std::array<float, 4>> want, got;
     for (int i = 0; i < samples; ++i) {
-      want.push_back(sobol_owen_4d(static_cast<std::uint32_t>(i), 12345u));
+      want.push_back(sobol_owen_4d(set.first + static_cast<std::uint32_t>(i), set.key));
       got.push_back({pts.u[0][static_cast<std::size_t>(i)], pts.u[1][static_cast<std::size_t>(i)], pts.u[2][static_cast<std::size_t>(i)],
                      pts.u[3][static_cast<std::size_t>(i)]});
     }

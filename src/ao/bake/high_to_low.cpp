@@ -134,10 +134,10 @@ struct CageRays {
 };
 
 // A tile's worker for bake_high_to_low. A texel's P = min(cage_points, samples) cage points are
-// points 0 .. P - 1 of a 2-D Owen-scrambled Sobol set (keyed by the texel's key hashed once more)
-// mapped onto the patch by area (sample_patch): stratified over the texel's patch. Cage point j
-// carries the AO directions of samples [j n / P, (j + 1) n / P) of the texel's Owen-scrambled Sobol
-// set (dimensions 0-1 of sobol_owen_4d keyed by pixel_seed(seed, x, y), the single-mesh baker's
+// its P points of a 2-D Owen-scrambled Sobol sequence (its TexelSampleSet for P points a texel,
+// the key hashed once more) mapped onto the patch by area (sample_patch): stratified over the
+// texel's patch. Cage point j carries the AO directions of samples [j n / P, (j + 1) n / P) of the
+// texel's n samples (dimensions 0-1 of sobol_owen_4d, its TexelSampleSet, the single-mesh baker's
 // direction dimensions): at n / P a power of two each block is a (0, m, 2)-net of its own,
 // stratified over the hemisphere, and the blocks together are the texel's whole net.
 // All the directions of a cage point leave from its high-poly hit, so they go to Embree as packets
@@ -152,8 +152,11 @@ class TexelWorker {
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
     if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
-    const std::uint32_t key = pixel_seed(params_.ao.seed, x, y), point_key = hash_combine(key, 0x3c6ef372u);
     const int samples = params_.ao.samples, points = std::min(params_.cage_points, samples);
+    // The directions and the cage points both from the texel's block's sequences (TexelSampleSet).
+    const detail::TexelSampleSet set = detail::texel_sample_set(params_.ao.seed, x, y, samples);
+    const detail::TexelSampleSet cage = detail::texel_sample_set(params_.ao.seed, x, y, points);
+    const std::uint32_t point_key = hash_combine(cage.key, 0x3c6ef372u);
     const bool geometric = params_.ao.normal == SurfaceNormal::Geometric;
     if (guides_) noise_.reset(samples);
     block_first_ = -1;
@@ -161,7 +164,7 @@ class TexelWorker {
     std::uint64_t traced = 0;
     Vec3 bent{0, 0, 0};
     for (int j = 0; j < points; ++j) {
-      const HighHit h = cage_rays_(ctx, detail::sample_patch(patch, sobol_owen_2d(static_cast<std::uint32_t>(j), point_key)));
+      const HighHit h = cage_rays_(ctx, detail::sample_patch(patch, sobol_owen_2d(cage.first + static_cast<std::uint32_t>(j), point_key)));
       if (!h.hit) continue;
       // Inside (thickness): the high surface turned over, as the texel baker turns its patch.
       const float side = params_.ao.hemisphere == Hemisphere::Inside ? -1.0f : 1.0f;
@@ -170,7 +173,7 @@ class TexelWorker {
       const int end = static_cast<int>(static_cast<std::int64_t>(j + 1) * samples / points);
       for (int first = static_cast<int>(static_cast<std::int64_t>(j) * samples / points); first < end; first += 16) {
         const int count = std::min(16, end - first);
-        points_of(first, count, key);  // dimensions 0-1: the direction
+        points_of(first, count, set);  // dimensions 0-1: the direction
         if (spread_ < 1.0f) detail::narrow_to_cone(u_, count, spread_, cone_u_);
         detail::make_hemisphere_rays(origin, geometric ? ng : n, ng, spread_ < 1.0f ? cone_u_ : u_, count, batch_);
         float mu[16];
@@ -198,12 +201,12 @@ class TexelWorker {
   // Points first .. first + count - 1 of the texel's Sobol set into lanes 0 .. count - 1 of u_:
   // a cage point's few samples are copied from the aligned block of 16 the texel's points are made
   // in, so a texel scrambles each block once, not once per cage point.
-  void points_of(int first, int count, std::uint32_t key) {
+  void points_of(int first, int count, const detail::TexelSampleSet& set) {
     int at = 0;
     while (at < count) {
       const int block = (first + at) / 16 * 16;
       if (block != block_first_) {
-        sobol_owen_4d_batch(static_cast<std::uint32_t>(block), std::min(16, params_.ao.samples - block), key, block_u_);
+        sobol_owen_4d_batch(set.first + static_cast<std::uint32_t>(block), std::min(16, params_.ao.samples - block), set.key, block_u_);
         block_first_ = block;
       }
       const int from = first + at - block, n = std::min(count - at, 16 - from);
@@ -222,7 +225,7 @@ class TexelWorker {
   detail::StratifiedVariance noise_;
   float spread_;                     // the cone's disk radius, sin(spread_angle / 2)
   alignas(64) float u_[4][16] = {};  // lanes past a block's count keep any finite values
-  alignas(64) float block_u_[4][16] = {};  // points block_first_ .. block_first_ + 15 of the texel's set
+  alignas(64) float block_u_[4][16] = {};  // the texel's points block_first_ .. block_first_ + 15
   int block_first_ = -1;
   alignas(64) float cone_u_[4][16] = {};
   alignas(64) detail::TexelRayBatch batch_;

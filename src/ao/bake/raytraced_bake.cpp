@@ -100,7 +100,7 @@ class TexelWorker {
     const std::vector<PatchPiece>& patch = params_.hemisphere == Hemisphere::Inside ? flipped_ : sampled;
     table_.build(patch, params_.offset);
     if (guides_) detail::patch_guide(surface, geometric, guides_->position[texel], guides_->normal[texel]);
-    points_.generate(pixel_seed(params_.seed, x, y), params_.samples);
+    points_.generate(detail::texel_sample_set(params_.seed, x, y, params_.samples), params_.samples);
     if (guides_) noise_.reset(params_.samples);
     detail::MeanAccumulator acc;
     Vec3 bent{0, 0, 0};

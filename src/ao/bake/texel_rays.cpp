@@ -150,7 +150,7 @@ void patch_guide(const std::vector<PatchPiece>& patch, bool geometric, Vec3& pos
 }
 
 
-void TexelPoints::generate(std::uint32_t key, int samples) {
+void TexelPoints::generate(const TexelSampleSet& set, int samples) {
   const auto n = static_cast<std::size_t>(samples);
   // Grid of 2^c cells, 2^c the largest power of two <= samples / 16, as square as it goes.
   int c = 0;
@@ -162,7 +162,7 @@ void TexelPoints::generate(std::uint32_t key, int samples) {
   alignas(64) float batch[4][16];
   for (int first = 0; first < samples; first += 16) {
     const int count = std::min(16, samples - first);
-    sobol_owen_4d_batch(static_cast<std::uint32_t>(first), count, key, batch);
+    sobol_owen_4d_batch(set.first + static_cast<std::uint32_t>(first), count, set.key, batch);
     for (int d = 0; d < 4; ++d) std::copy_n(batch[d], count, dest[d].begin() + first);
   }
   if (c == 0) return;

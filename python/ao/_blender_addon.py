@@ -44,7 +44,7 @@ _OPTIONS = [
     ("membership", bpy.props.EnumProperty, dict(name="Falloff", items=_MEMBERSHIPS, default="step", description="Falloff within the distance (ao bake --membership)")),
     ("denoise", bpy.props.FloatProperty, dict(name="Filter", default=1.5, min=0.0, max=4.0, description="Sigma of the texture-space filter, texels; 0 = off (ao bake --denoise)")),
     ("padding", bpy.props.IntProperty, dict(name="Padding", default=16, min=0, max=1024, subtype="PIXEL", description="Texels filled outside the UV islands (ao bake --padding)")),
-    ("seed", bpy.props.IntProperty, dict(name="Seed", default=1, min=0, description="Seed of the per-texel sample sets (ao bake --seed)")),
+    ("seed", bpy.props.IntProperty, dict(name="Seed", default=1, min=0, description="Seed of the texels' sample sets (ao bake --seed)")),
     ("ignore_back_faces", bpy.props.BoolProperty, dict(name="Ignore Back Faces", default=False, description="Rays pass through back faces (ao bake -p ignore_back_faces=true)")),
     ("spread_angle", bpy.props.FloatProperty, dict(name="Spread", default=180.0, min=0.001, max=180.0,
                                                    description="Full angle, degrees, of the cone of directions about the normal; 180 = the hemisphere (ao bake --spread-angle)")),

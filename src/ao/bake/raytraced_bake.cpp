@@ -165,7 +165,7 @@ const ParamTable<RaytracedBakeParams>& raytraced_bake_param_table() {
                                   "outside: AO; inside: rays into the mesh, with a distance a thickness map"),
        P::enumeration<TexelSampling>("texel_sampling", &R::texel_sampling, {{"area", TexelSampling::Area}, {"centre", TexelSampling::Centre}},
                                      "maps: rays from points spread over each texel's surface (its mean V) or all from the point under its centre (point sampling, as Cycles)"),
-       P::seed("seed", &R::seed, "keys the per-texel sample sets"),
+       P::seed("seed", &R::seed, "keys the sample sets (one sequence per 4 x 4 block of texels; per vertex)"),
        P::real("denoise", &R::denoise, Range::closed(0, kMaxDenoiseSigma), "texels",
                "sigma of the texture-space filter of maps (denoise.h); 0 = off, the plain estimate of eq. 2")}};
   return table;

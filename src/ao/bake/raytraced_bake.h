@@ -59,7 +59,7 @@ struct RaytracedBakeParams {
   /// point of its patch when the centre is off the chart), point sampling as Cycles and most bakers
   /// rasterize the UVs; where V changes within a texel (contacts, creases) the two differ.
   TexelSampling texel_sampling = TexelSampling::Area;
-  std::uint32_t seed = 1;                ///< Keys the per-texel sample sets.
+  std::uint32_t seed = 1;                ///< Keys the sample sets (one sequence per 4 x 4 block of texels; per vertex).
   /// Maps only: sigma, in texels, of the texture-space filter that averages the noise of texels
   /// that are neighbours on the surface (denoise.h); 0 = off, the plain estimate of eq. 2.
   /// [0, kMaxDenoiseSigma]. Bent normals are not filtered. 0 here, where this baker is a building

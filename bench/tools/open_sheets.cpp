@@ -6,12 +6,12 @@
 //   ao compare /tmp/open-sheets/arch.obj --camera /tmp/open-sheets/arch.camera.json --methods cone
 // Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
 // top), mask, dome (with a window), terrain, tablecloth, leaf, gutter, the closed box, sphere and
-// torus, and a closed plate leaning on the ground (the leaf's wedge under a closed occluder). The
-// ground is a quad of twice the object's diagonal under it, and the camera looks at the object from
-// the front right and above, as tests/methods/cone_test.cpp does. With a second argument, the
-// folder of the shared meshes, also ChineseDragon-10kv and elephant opened as scans come
-// (tests/support/open_sheets.h: the bottom 10% cut off, -cut.obj; holes of 3% of the diagonal
-// punched, -holes.obj), alone:
+// torus, a closed plate leaning on the ground (the leaf's wedge under a closed occluder) and the
+// gutter as a closed shell. The ground is a quad of twice the object's diagonal under it, and the
+// camera looks at the object from the front right and above, as tests/methods/cone_test.cpp does.
+// With a second argument, the folder of the shared meshes, also ChineseDragon-10kv and elephant
+// opened as scans come (tests/support/open_sheets.h: the bottom 10% cut off, -cut.obj; holes of 3%
+// of the diagonal punched, -holes.obj), alone:
 //   ao_open_sheets /tmp/open-sheets ../shared/data/meshes
 //   ao compare /tmp/open-sheets/elephant-cut.obj --methods cone
 // Write them outside the repository.
@@ -41,6 +41,40 @@ ao::Mesh make_leaning_plate() {
   const auto turn = [&](ao::Vec3 v) { return ao::Vec3{c * v.x - s * v.y, s * v.x + c * v.y, v.z}; };
   for (ao::Vec3& p : m.positions) p = turn(p);
   for (ao::Vec3& n : m.normals) n = turn(n);
+  return m;
+}
+
+// The suite's gutter as a closed shell: walls 0.03 thick outside the open gutter's radius of 0.2,
+// closed along its rims and at its ends. What the cone method makes of the same shape as a solid.
+ao::Mesh make_closed_gutter() {
+  constexpr int kAround = 48, kAlong = 96;
+  constexpr float kInner = 0.2f, kOuter = 0.23f, kLength = 2.0f;
+  ao::Mesh m;
+  const auto ring = [&](float radius, int j) {
+    const auto first = static_cast<std::uint32_t>(m.positions.size());
+    const float z = kLength * (static_cast<float>(j) / kAlong - 0.5f);
+    for (int i = 0; i <= kAround; ++i) {
+      const float a = 3.14159265f * (1.0f + static_cast<float>(i) / kAround);  // from -x under the axis to +x
+      m.positions.push_back({radius * std::cos(a), kOuter + radius * std::sin(a), z});
+    }
+    return first;
+  };
+  std::vector<std::uint32_t> inner, outer;
+  for (int j = 0; j <= kAlong; ++j) inner.push_back(ring(kInner, j)), outer.push_back(ring(kOuter, j));
+  const auto quad = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) { m.indices.insert(m.indices.end(), {a, b, c, a, c, d}); };
+  const auto in = static_cast<std::uint32_t>(kAround);
+  for (int j = 0; j < kAlong; ++j) {
+    for (std::uint32_t i = 0; i < in; ++i) {
+      quad(inner[j] + i, inner[j + 1] + i, inner[j + 1] + i + 1, inner[j] + i + 1);  // into the hollow
+      quad(outer[j] + i, outer[j] + i + 1, outer[j + 1] + i + 1, outer[j + 1] + i);  // out
+    }
+    quad(inner[j], outer[j], outer[j + 1], inner[j + 1]);  // the rims
+    quad(inner[j] + in, inner[j + 1] + in, outer[j + 1] + in, outer[j] + in);
+  }
+  for (std::uint32_t i = 0; i < in; ++i) {  // the ends, half annuli
+    quad(inner[0] + i, inner[0] + i + 1, outer[0] + i + 1, outer[0] + i);
+    quad(inner[kAlong] + i, outer[kAlong] + i, outer[kAlong] + i + 1, inner[kAlong] + i + 1);
+  }
   return m;
 }
 
@@ -96,6 +130,7 @@ int main(int argc, char** argv) {
         {"torus", ao::make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)},
         {"head", ao::test::make_head()},
         {"plate", make_leaning_plate()},
+        {"closed-gutter", make_closed_gutter()},
     };
     for (const auto& [name, mesh] : objects) {
       write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ao::test::ground_under(mesh, {0.75f, 0.73f, 0.70f})}});

@@ -37,7 +37,8 @@ namespace {
 // a closed occluder.
 ao::Mesh make_leaning_plate() {
   ao::Mesh m = ao::make_box({0.0f, 0.0f, -0.6f}, {0.35f, 0.03f, 0.6f});
-  const float c = std::cos(0.4363323f), s = std::sin(0.4363323f);  // 25 degrees about z, through the edge at the origin
+  const float angle = 25.0f * ao::test::kPi / 180.0f;  // about z, through the edge at the origin
+  const float c = std::cos(angle), s = std::sin(angle);
   const auto turn = [&](ao::Vec3 v) { return ao::Vec3{c * v.x - s * v.y, s * v.x + c * v.y, v.z}; };
   for (ao::Vec3& p : m.positions) p = turn(p);
   for (ao::Vec3& n : m.normals) n = turn(n);
@@ -54,7 +55,7 @@ ao::Mesh make_closed_gutter() {
     const auto first = static_cast<std::uint32_t>(m.positions.size());
     const float z = kLength * (static_cast<float>(j) / kAlong - 0.5f);
     for (int i = 0; i <= kAround; ++i) {
-      const float a = 3.14159265f * (1.0f + static_cast<float>(i) / kAround);  // from -x under the axis to +x
+      const float a = ao::test::kPi * (1.0f + static_cast<float>(i) / kAround);  // from -x under the axis to +x
       m.positions.push_back({radius * std::cos(a), kOuter + radius * std::sin(a), z});
     }
     return first;

@@ -129,10 +129,12 @@ TEST(ProgressMeter, EstimateAtHalfOfARenderIsWithinAQuarterOfTheTimeLeft) {
 }
 
 // `ao render` with stderr in a file writes progress lines (here every 0.05 s: the job is short).
+// 4096 rays a pixel: about 0.6 s on two cores, a dozen intervals (at 512 the tracer finished within
+// two or three, and the test missed its three lines under CI and on a quiet machine alike).
 TEST(ProgressMeter, RenderWithStderrInAFileLeavesProgressLines) {
   test::TempDir dir;
   const std::string mesh = std::string(AO_TEST_MESHES) + "/elephant.off";
-  const test::RunResult r = test::run_ao_under("env AO_PROGRESS_SECONDS=0.05", "render " + mesh + " --width 320 --height 180 --spp 512 -o v.png", dir.path());
+  const test::RunResult r = test::run_ao_under("env AO_PROGRESS_SECONDS=0.05", "render " + mesh + " --width 320 --height 180 --spp 4096 -o v.png", dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_GE(count(r.err, "% of "), 3u) << r.err;
   EXPECT_GE(count(r.err, " s left\n"), 3u) << r.err;

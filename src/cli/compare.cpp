@@ -143,7 +143,7 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, std::functi
   cmd->add_option("scene", o->scene, kSceneHelp)->type_name("SCENE");
   std::string names;
   for (const MethodInfo& m : all_methods()) names += (names.empty() ? "" : ", ") + std::string(m.name);
-  cmd->add_option("--methods", o->methods, "Comma-separated methods (" + names + "); default: every method but raytraced");
+  cmd->add_option("-m,--methods,--method", o->methods, "Comma-separated methods (" + names + "); default: every method but raytraced");
   cmd->add_option("--reference-samples,--spp-reference", o->spp_reference, "Rays per pixel of the ray-traced references")->capture_default_str();
   cmd->add_option("--sweep", o->sweep, "Also measure error against one parameter: key=v1,v2,... (e.g. samples=4,8,16,32)");
   cmd->add_option("--out-dir", o->out_dir, "Output directory (default: compare-<scene>)");

@@ -240,6 +240,11 @@ TEST(Vocabulary, CompareTakesKeyValueForEveryChosenMethodThatHasIt) {
                                          dir.path());
   ASSERT_EQ(f.exit_code, 0) << f.err;
   EXPECT_NE(f.out.find("\"intensity\": 0.25"), std::string::npos);
+  // -m, as render, view, tune and bake spell the method: the same option as --methods.
+  const test::RunResult m = test::run_ao("compare -m gtao --width 32 --height 18 --reference-samples 4 --json -q --out-dir out3", dir.path());
+  ASSERT_EQ(m.exit_code, 0) << m.err;
+  EXPECT_NE(m.out.find("\"method\": \"gtao\""), std::string::npos);
+  EXPECT_EQ(m.out.find("\"method\": \"alchemy\""), std::string::npos);
 }
 
 }  // namespace

@@ -324,11 +324,13 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
     const TexelCoverage cov = compute_texel_coverage(s, size);
     const detail::TriangleNormals fn = detail::face_normals(s);
     std::vector<detail::PatchPiece> patch;
+    std::vector<TexelPiece> fragments;
     for (bool geometric : {false, true})
       for (float fixed : {0.0f, 0.01f})
         for (std::size_t texel = 0; texel < cov.texel_count(); ++texel) {
           if (!cov.mask[texel]) continue;
-          detail::build_patch(s, cov, fn, texel, patch);
+          texel_fragments(s, cov, texel, fragments);
+          detail::build_patch(s, cov, fn, fragments, patch);
           if (patch.empty()) continue;
           multi += patch.size() > 1;
           many += patch.size() > static_cast<std::size_t>(detail::PatchTable::kMaxPieces);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,9 +44,9 @@ Mesh random_uv_triangles(std::uint32_t seed, int count) {
   return m;
 }
 
-// The fragments of compute_texel_coverage(s, width, height), their areas (to the bit: the same
-// clips) and each texel's sums must be what clipping one texel at a time, triangle after triangle,
-// gives.
+// The fragments of compute_texel_coverage(s, width, height), asked for a texel at a time
+// (texel_fragments) and a bin at a time (bin_fragments), their areas (to the bit: the same clips)
+// and each texel's sums must be what clipping one texel at a time, triangle after triangle, gives.
 void expect_texel_by_texel_clips(const Scene& s, int width, int height) {
   const TexelCoverage cov = compute_texel_coverage(s, width, height);
   struct Expected {
@@ -70,15 +71,26 @@ void expect_texel_by_texel_clips(const Scene& s, int width, int height) {
   ASSERT_EQ(cov.degenerate_uv_triangles, 0u);
   EXPECT_GT(cov.outside_triangles, 0u);
   std::size_t fragments = 0, covered = 0;
+  std::vector<TexelPiece> got;
+  BinFragments bin;
   for (std::size_t texel = 0; texel < per_texel.size(); ++texel) {
     const std::vector<Expected>& want = per_texel[texel];
-    ASSERT_EQ(cov.offsets[texel + 1] - cov.offsets[texel], want.size()) << "texel " << texel;
+    // A texel's fragments asked for alone, and with the rest of its bin.
+    texel_fragments(s, cov, texel, got);
+    const int x = static_cast<int>(texel % width), y = static_cast<int>(texel / width), b = TexelCoverage::kBin;
+    bin_fragments(s, cov, x / b, y / b, bin);
+    const std::span<const TexelPiece> of_bin = bin.texel((y % b) * b + x % b);
+    ASSERT_EQ(got.size(), want.size()) << "texel " << texel;
+    ASSERT_EQ(of_bin.size(), want.size()) << "texel " << texel;
     float uv_sum = 0;
     for (std::size_t k = 0; k < want.size(); ++k) {
-      const TexelFragment& f = cov.fragments[cov.offsets[texel] + k];
-      EXPECT_EQ(f.mesh, want[k].mesh) << "texel " << texel << " fragment " << k;
-      EXPECT_EQ(f.triangle, want[k].triangle) << "texel " << texel << " fragment " << k;
-      EXPECT_EQ(f.uv_area, want[k].uv_area) << "texel " << texel << " fragment " << k;
+      for (const TexelFragment& f : {got[k].fragment, of_bin[k].fragment}) {
+        EXPECT_EQ(f.mesh, want[k].mesh) << "texel " << texel << " fragment " << k;
+        EXPECT_EQ(f.triangle, want[k].triangle) << "texel " << texel << " fragment " << k;
+        EXPECT_EQ(f.uv_area, want[k].uv_area) << "texel " << texel << " fragment " << k;
+      }
+      EXPECT_EQ(got[k].polygon.area(), want[k].uv_area) << "texel " << texel << " fragment " << k;
+      EXPECT_EQ(of_bin[k].polygon.n, got[k].polygon.n) << "texel " << texel << " fragment " << k;
       uv_sum += want[k].uv_area;
     }
     EXPECT_EQ(cov.uv_area[texel], uv_sum) << "texel " << texel;  // summed in fragment order
@@ -86,12 +98,12 @@ void expect_texel_by_texel_clips(const Scene& s, int width, int height) {
     fragments += want.size();
     covered += !want.empty();
   }
-  EXPECT_EQ(cov.fragments.size(), fragments);
+  EXPECT_EQ(cov.fragments, fragments);
   EXPECT_EQ(cov.covered_texels, covered);
   EXPECT_GT(fragments, 5000u);  // most triangles reach several texels
 }
 
-// Two meshes of more triangles than one parallel block holds (4096).
+// Two meshes: a texel's fragments run in mesh, then triangle order.
 Scene two_random_meshes() {
   Scene s;
   s.name = "random";
@@ -102,14 +114,13 @@ Scene two_random_meshes() {
 }
 
 TEST(TexelCoverage, FragmentsAreTheTexelByTexelClipsInTriangleOrder) {
-  // A map whose rows are not a whole number of merge bands.
+  // A map whose sides are not a whole number of bins (8 texels).
   expect_texel_by_texel_clips(two_random_meshes(), 37, 23);
 }
 
-TEST(TexelCoverage, FragmentsDoNotDependOnHowTheMergeBandsRunInParallel) {
-  // Many bands (16 rows each), merged on every thread there is, several times: a band's fragment
-  // cursors must not depend on whether the band before it has finished (its last offset is the
-  // next band's first).
+TEST(TexelCoverage, FragmentsDoNotDependOnHowTheBinsRunInParallel) {
+  // Many rows of bins, summed on every thread there is, several times: a texel's sums must not
+  // depend on which thread ran its bin, nor on the bins beside it.
   const Scene s = two_random_meshes();
   for (int round = 0; round < 8; ++round) {
     SCOPED_TRACE("round " + std::to_string(round));

@@ -150,7 +150,7 @@ class TexelWorker {
       : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), offset_(offset), out_(out), guides_(guides), rays_(rays),
         spread_(detail::cone_disk_radius(params.ao.spread_angle)) {}
 
-  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch) {
+  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch, std::span<const TexelPiece>) {
     if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
     const int samples = params_.ao.samples, points = std::min(params_.cage_points, samples);
     // The directions and the cage points both from the texel's block's sequences (TexelSampleSet).

@@ -87,12 +87,13 @@ class TexelWorker {
   TexelWorker(const Tracer& tracer, const RaytracedBakeParams& params, BakeResult& out, TexelGuides* guides, const detail::TexelSource& texels)
       : batch_tracer_(tracer), params_(params), out_(out), guides_(guides), texels_(texels), spread_(detail::cone_disk_radius(params.spread_angle)) {}
 
-  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& surface) {
+  void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& surface,
+                  std::span<const TexelPiece> fragments) {
     const bool geometric = params_.normal == SurfaceNormal::Geometric;
     // Centre: the rays' patch is the single point under the texel's centre (the filter's guides
     // still describe the whole texel).
     const bool centre = params_.texel_sampling == TexelSampling::Centre;
-    if (centre) detail::centre_patch(texels_, texel, surface, point_);
+    if (centre) detail::centre_patch(texels_, texel, fragments, surface, point_);
     const std::vector<PatchPiece>& sampled = centre ? point_ : surface;
     // Inside: the same patch with its normals turned over, so that the offset pushes the points
     // in and the directions leave below the surface.

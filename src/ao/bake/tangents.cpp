@@ -121,6 +121,7 @@ Vec3 clamp_into_triangle(Vec3 w) {
 TexelFrames texel_frames(const Scene& scene, const TexelCoverage& cov, const std::vector<std::vector<CornerTangent>>& tangents) {
   TexelFrames out{Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}), Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}),
                   Image<float>(cov.width, cov.height, 1.0f)};
+  std::vector<TexelPiece> pieces;
   for (std::size_t texel = 0; texel < cov.texel_count(); ++texel) {
     if (!cov.mask[texel]) continue;
     const Vec2 centre{static_cast<float>(texel % static_cast<std::size_t>(cov.width)) + 0.5f,
@@ -128,8 +129,9 @@ TexelFrames texel_frames(const Scene& scene, const TexelCoverage& cov, const std
     const TexelFragment* pick = nullptr;
     Vec3 w{};
     bool inside = false;
-    for (std::uint32_t k = cov.offsets[texel]; k < cov.offsets[texel + 1]; ++k) {
-      const TexelFragment& f = cov.fragments[k];
+    texel_fragments(scene, cov, texel, pieces);
+    for (const TexelPiece& piece : pieces) {
+      const TexelFragment& f = piece.fragment;
       const Mesh& m = scene.meshes[f.mesh];
       const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(f.triangle)];
       Vec3 fw;

@@ -7,32 +7,28 @@
 // that texel's share of surface. Summing these shares gives
 // the exact denominator of eq. 2/3 without the paper's assumption that stretch is constant over a
 // texel (eq. 4), which fails at chart borders and where triangles of different stretch meet.
+// The triangles are first sorted into bins of 8 x 8 texels by their boxes; each bin then sums its
+// texels' shares on its own (in parallel), and texel_fragments clips a texel's triangles again from
+// its bin when a baker asks for them.
 #include "ao/bake/texel_coverage.h"
 
 #include <algorithm>
 #include <cmath>
-#include <span>
+#include <limits>
 
 #include <tbb/parallel_for.h>
 
 #include "ao/core/error.h"
+#include "ao/core/memory.h"
 
 namespace ao {
 
 namespace {
 
 constexpr int kMaxSize = 16384;
-constexpr std::size_t kBlock = 4096;  // triangles per parallel block (blocks are merged in order)
-constexpr int kBandRows = 16;         // texel rows per band of the parallel merge
-int band_count(int height) { return (height + kBandRows - 1) / kBandRows; }
 // A UV triangle smaller than this many texels^2 per world unit^2 of surface, relative to the
 // map, counts as degenerate: its texels would get a weight 1e6 times the average.
 constexpr double kDegenerateRatio = 1e-6;
-
-struct Pending {
-  std::uint32_t texel;
-  TexelFragment frag;
-};
 
 // A polygon being clipped: plain corners, so that the buffers of each step are not zeroed first.
 struct Corner {
@@ -180,135 +176,208 @@ double mean_texel_ratio(const Scene& scene, int width, int height) {
   return total_uv / std::max(total_world, 1e-300);
 }
 
-// A run of triangles of one mesh, clipped by one task; the runs are merged in order.
-struct Block {
-  std::uint32_t mesh;
-  std::size_t first, last;
-  std::vector<Pending> pending;  // the run's fragments by band of texel rows, within a band in triangle then texel order
-  std::vector<std::size_t> band_start;  // band b's fragments are pending[band_start[b] .. band_start[b + 1])
-  std::size_t degenerate = 0, outside = 0;
-};
-
-// Sorts blk's fragments by band of texel rows, stably (a counting sort), for gather_by_texel.
-void by_band(int width, int height, Block& blk) {
-  const auto band = [&](const Pending& p) { return static_cast<std::size_t>(p.texel / static_cast<std::uint32_t>(width)) / kBandRows; };
-  blk.band_start.assign(static_cast<std::size_t>(band_count(height)) + 1, 0);
-  for (const Pending& p : blk.pending) ++blk.band_start[band(p) + 1];
-  for (std::size_t b = 1; b < blk.band_start.size(); ++b) blk.band_start[b] += blk.band_start[b - 1];
-  std::vector<std::size_t> cursor(blk.band_start.begin(), blk.band_start.end() - 1);
-  std::vector<Pending> sorted(blk.pending.size());
-  for (const Pending& p : blk.pending) sorted[cursor[band(p)]++] = p;
-  blk.pending.swap(sorted);
+// Triangle t of mesh m as the bins list it: its box of texels on the map and its stretch. false
+// for a triangle that gets no texel: degenerate in UV (counted in `degenerate`) or with its box
+// off the map; `outside` counts those reaching outside the map.
+bool bin_entry(const Mesh& m, std::uint32_t mesh, std::uint32_t t, int width, int height, double mean_ratio, BinnedTriangle& e,
+               std::size_t& degenerate, std::size_t& outside) {
+  const TexelTriangle tri = texel_triangle(m, t, width, height);
+  const Vec2 a = tri.a, b = tri.b, c = tri.c;
+  if (!(tri.uv > kDegenerateRatio * mean_ratio * tri.world) || tri.uv <= 0) {
+    ++degenerate;
+    return false;
+  }
+  const float lo_x = std::min({a.x, b.x, c.x}), hi_x = std::max({a.x, b.x, c.x});
+  const float lo_y = std::min({a.y, b.y, c.y}), hi_y = std::max({a.y, b.y, c.y});
+  if (lo_x < 0 || lo_y < 0 || hi_x > width || hi_y > height) ++outside;
+  // The texels whose squares the box touches, clamped to the map (in float first: the corners
+  // are those of any triangle, however far outside).
+  const float x0 = std::max(0.0f, std::floor(lo_x)), x1 = std::min(static_cast<float>(width - 1), std::floor(hi_x));
+  const float y0 = std::max(0.0f, std::floor(lo_y)), y1 = std::min(static_cast<float>(height - 1), std::floor(hi_y));
+  if (!(x0 <= x1 && y0 <= y1)) return false;
+  e = {mesh, t, static_cast<std::uint16_t>(x0), static_cast<std::uint16_t>(y0), static_cast<std::uint16_t>(x1), static_cast<std::uint16_t>(y1),
+       tri.world / tri.uv};
+  return true;
 }
 
-// Clips the triangles of blk against every texel their UV box touches.
-void clip_block(const Scene& scene, int width, int height, double mean_ratio, Block& blk) {
-  const Mesh& m = scene.meshes[blk.mesh];
-  for (std::size_t t = blk.first; t < blk.last; ++t) {
-    const TexelTriangle tri = texel_triangle(m, t, width, height);
-    const Vec2 a = tri.a, b = tri.b, c = tri.c;
-    if (!(tri.uv > kDegenerateRatio * mean_ratio * tri.world) || tri.uv <= 0) {
-      ++blk.degenerate;
-      continue;
-    }
-    const double stretch = tri.world / tri.uv;  // world units^2 per texel^2 on this triangle
-    const float lo_x = std::min({a.x, b.x, c.x}), hi_x = std::max({a.x, b.x, c.x});
-    const float lo_y = std::min({a.y, b.y, c.y}), hi_y = std::max({a.y, b.y, c.y});
-    if (lo_x < 0 || lo_y < 0 || hi_x > width || hi_y > height) ++blk.outside;
-    const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(width - 1, static_cast<int>(std::floor(hi_x)));
-    const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(height - 1, static_cast<int>(std::floor(hi_y)));
-    // Column by column: the triangle clipped to the column once, then to each row its polygon
-    // reaches. A row wholly above or below the column's polygon would clip it to nothing; the row
-    // whose bottom line touches the polygon's top is kept, as a clip there can leave a sliver.
-    const std::size_t first = blk.pending.size();
-    for (int x = x0; x <= x1; ++x) {
-      const ClipBuffers col = clip_to_column(a, b, c, x);
-      if (col.n == 0) continue;
-      float lo = col.corners()[0].y, hi = lo;
-      for (int i = 1; i < col.n; ++i) lo = std::min(lo, col.corners()[i].y), hi = std::max(hi, col.corners()[i].y);
-      // (Clamped before the conversion: the corners are those of any triangle, however far outside.)
-      const auto row = [&](float v) { return static_cast<int>(std::clamp(std::floor(v), -2.0f, static_cast<float>(height))); };
-      const int ya = std::max(y0, row(lo) - 1), yb = std::min(y1, row(hi));
-      for (int y = ya; y <= yb; ++y) {
-        const float area = clip_to_row(col, y).area();
-        if (!(area > 0)) continue;
-        blk.pending.push_back({static_cast<std::uint32_t>(static_cast<std::size_t>(y) * width + x),
-                               {blk.mesh, static_cast<std::uint32_t>(t), area, static_cast<float>(area * stretch)}});
-      }
-    }
-    // The triangle's fragments in texel order (row by row), as the texel-by-texel loop made them.
-    std::sort(blk.pending.begin() + static_cast<std::ptrdiff_t>(first), blk.pending.end(), [](const Pending& p, const Pending& q) { return p.texel < q.texel; });
-  }
-  by_band(width, height, blk);
+std::size_t bin_index(const TexelCoverage& cov, int bx, int by) {
+  return static_cast<std::size_t>(by) * static_cast<std::size_t>(cov.bin_columns) + static_cast<std::size_t>(bx);
 }
 
-// The blocks' fragments sorted by texel (a counting sort, stable, so the order is deterministic),
-// with each texel's areas, mask and the counts behind the warnings. Band by band in parallel (the
-// blocks hold their fragments by band): a band's texels take their fragments from the blocks in
-// block order, so every texel gets its fragments, and sums its areas, in the order one pass over
-// the blocks would.
-void gather_by_texel(std::vector<Block>& blocks, TexelCoverage& cov) {
-  const std::size_t texels = cov.texel_count();
-  const auto width = static_cast<std::size_t>(cov.width);
-  const int bands = band_count(cov.height);
-  const auto band_texels = [&](int b) {
-    return std::pair{static_cast<std::size_t>(b) * kBandRows * width, std::min(texels, static_cast<std::size_t>(b + 1) * kBandRows * width)};
+// Every triangle with UVs into the bins its box touches, in mesh then triangle order (a counting
+// sort: one pass counts, the second places). The triangles' boxes are found in parallel.
+void bin_triangles(const Scene& scene, double mean_ratio, TexelCoverage& cov) {
+  constexpr int kBin = TexelCoverage::kBin;
+  constexpr std::size_t kBlock = 4096;  // triangles per parallel block
+  cov.bin_columns = (cov.width + kBin - 1) / kBin;
+  const int bin_rows = (cov.height + kBin - 1) / kBin;
+  const auto bins = static_cast<std::size_t>(cov.bin_columns) * static_cast<std::size_t>(bin_rows);
+  struct Block {
+    std::uint32_t mesh;
+    std::size_t first, last;
+    std::vector<BinnedTriangle> entries;
+    std::size_t degenerate = 0, outside = 0;
   };
-  const auto band_fragments = [&](const Block& blk, int b) {
-    return std::span(blk.pending).subspan(blk.band_start[static_cast<std::size_t>(b)], blk.band_start[static_cast<std::size_t>(b) + 1] - blk.band_start[static_cast<std::size_t>(b)]);
-  };
-  cov.offsets.assign(texels + 1, 0);
-  for (const Block& blk : blocks) {
-    cov.degenerate_uv_triangles += blk.degenerate;
-    cov.outside_triangles += blk.outside;
-  }
-  // Each band's counts, then its running sums from 0; offsets[lo] is the previous band's.
-  std::vector<std::size_t> band_base(static_cast<std::size_t>(bands) + 1, 0);
-  tbb::parallel_for(0, bands, [&](int b) {
-    for (const Block& blk : blocks)
-      for (const Pending& p : band_fragments(blk, b)) ++cov.offsets[p.texel + 1];
-    const auto [lo, hi] = band_texels(b);
-    std::uint32_t run = 0;
-    for (std::size_t i = lo; i < hi; ++i) cov.offsets[i + 1] = run += cov.offsets[i + 1];
-    band_base[static_cast<std::size_t>(b) + 1] = run;
+  std::vector<Block> blocks;
+  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi)
+    if (!scene.meshes[mi].uvs.empty())
+      for (std::size_t t = 0; t < scene.meshes[mi].triangle_count(); t += kBlock)
+        blocks.push_back({static_cast<std::uint32_t>(mi), t, std::min(scene.meshes[mi].triangle_count(), t + kBlock), {}});
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t bi) {
+    Block& blk = blocks[bi];
+    for (std::size_t t = blk.first; t < blk.last; ++t) {
+      BinnedTriangle e;
+      if (bin_entry(scene.meshes[blk.mesh], blk.mesh, static_cast<std::uint32_t>(t), cov.width, cov.height, mean_ratio, e, blk.degenerate,
+                    blk.outside))
+        blk.entries.push_back(e);
+    }
   });
-  for (int b = 0; b < bands; ++b) band_base[static_cast<std::size_t>(b) + 1] += band_base[static_cast<std::size_t>(b)];
-  cov.fragments.resize(band_base.back());
-  cov.world_area = Image<float>(cov.width, cov.height, 0.0f);
-  cov.uv_area = Image<float>(cov.width, cov.height, 0.0f);
-  cov.mask = Image<std::uint8_t>(cov.width, cov.height, std::uint8_t{0});
-  std::vector<std::size_t> covered(static_cast<std::size_t>(bands)), overlapping(static_cast<std::size_t>(bands));
-  tbb::parallel_for(0, bands, [&](int b) {
-    const auto [lo, hi] = band_texels(b);
-    const auto base = static_cast<std::uint32_t>(band_base[static_cast<std::size_t>(b)]);
-    // offsets[lo] is the previous band's last entry, which that band may still be raising by its
-    // own base; its final value is this band's base, so the cursors start from that.
-    std::vector<std::uint32_t> cursor(hi - lo);
-    cursor[0] = base;
-    for (std::size_t i = lo; i < hi; ++i) {
-      cov.offsets[i + 1] += base;
-      if (i + 1 < hi) cursor[i + 1 - lo] = cov.offsets[i + 1];
-    }
-    for (const Block& blk : blocks)
-      for (const Pending& p : band_fragments(blk, b)) {
-        cov.fragments[cursor[p.texel - lo]++] = p.frag;
-        cov.world_area[p.texel] += p.frag.world_area;
-        cov.uv_area[p.texel] += p.frag.uv_area;
+  const auto for_each_bin = [&](const BinnedTriangle& e, auto&& fn) {
+    for (int by = e.y0 / kBin; by <= e.y1 / kBin; ++by)
+      for (int bx = e.x0 / kBin; bx <= e.x1 / kBin; ++bx) fn(bin_index(cov, bx, by));
+  };
+  std::uint64_t total = 0;
+  for (const Block& blk : blocks) {
+    cov.degenerate_uv_triangles += blk.degenerate, cov.outside_triangles += blk.outside;
+    for (const BinnedTriangle& e : blk.entries)
+      total += static_cast<std::uint64_t>(e.x1 / kBin - e.x0 / kBin + 1) * static_cast<std::uint64_t>(e.y1 / kBin - e.y0 / kBin + 1);
+  }
+  if (total > std::numeric_limits<std::uint32_t>::max())
+    throw InputError(scene.name + ": its UV triangles reach " + std::to_string(total) + " bins of " + std::to_string(kBin) + "^2 texels, " +
+                     "more than a map can list (2^32); bake a smaller map");
+  check_memory(total * sizeof(BinnedTriangle), "the UV layout's bins");
+  cov.bin_offsets.assign(bins + 1, 0);
+  for (const Block& blk : blocks)
+    for (const BinnedTriangle& e : blk.entries) for_each_bin(e, [&](std::size_t b) { ++cov.bin_offsets[b + 1]; });
+  for (std::size_t b = 0; b < bins; ++b) cov.bin_offsets[b + 1] += cov.bin_offsets[b];
+  std::vector<std::uint32_t> cursor(cov.bin_offsets.begin(), cov.bin_offsets.end() - 1);
+  cov.binned.resize(cov.bin_offsets.back());
+  for (const Block& blk : blocks)
+    for (const BinnedTriangle& e : blk.entries) for_each_bin(e, [&](std::size_t b) { cov.binned[cursor[b]++] = e; });
+}
+
+// The triangle of a binned entry in texel units.
+struct BinnedCorners {
+  Vec2 a, b, c;
+};
+BinnedCorners corners(const Scene& scene, const BinnedTriangle& e, int width, int height) {
+  const Mesh& m = scene.meshes[e.mesh];
+  const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(e.triangle)];
+  return {texel_uv(m, i[0], width, height), texel_uv(m, i[1], width, height), texel_uv(m, i[2], width, height)};
+}
+
+// Rows y_lo .. y_hi (clamped to the entry's box) that a column's polygon can reach: a row wholly
+// above or below it would clip it to nothing; the row whose bottom line touches the polygon's top
+// is kept, as a clip there can leave a sliver.
+std::pair<int, int> column_rows(const ClipBuffers& col, const BinnedTriangle& e, int height) {
+  float lo = col.corners()[0].y, hi = lo;
+  for (int i = 1; i < col.n; ++i) lo = std::min(lo, col.corners()[i].y), hi = std::max(hi, col.corners()[i].y);
+  // (Clamped before the conversion: the corners are those of any triangle, however far outside.)
+  const auto row = [&](float v) { return static_cast<int>(std::clamp(std::floor(v), -2.0f, static_cast<float>(height))); };
+  return {std::max(static_cast<int>(e.y0), row(lo) - 1), std::min(static_cast<int>(e.y1), row(hi))};
+}
+
+// Texels x0 .. x1, y0 .. y1 of bin (bx, by), inclusive.
+struct BinTexels {
+  int x0, y0, x1, y1;
+};
+BinTexels bin_texels(const TexelCoverage& cov, int bx, int by) {
+  constexpr int kBin = TexelCoverage::kBin;
+  return {bx * kBin, by * kBin, std::min(cov.width, (bx + 1) * kBin) - 1, std::min(cov.height, (by + 1) * kBin) - 1};
+}
+
+// fn(entry, x, y, polygon, area) for every fragment of bin (bx, by), entry by entry in the bin's
+// order (mesh, then triangle): the triangle clipped to each column of the bin it reaches once,
+// then that polygon to each row of the bin it can reach (the clips clip_to_texel makes, in its
+// order).
+template <class Fn>
+void clip_bin(const Scene& scene, const TexelCoverage& cov, int bx, int by, Fn&& fn) {
+  const BinTexels bt = bin_texels(cov, bx, by);
+  const std::size_t b = bin_index(cov, bx, by);
+  for (std::uint32_t k = cov.bin_offsets[b]; k < cov.bin_offsets[b + 1]; ++k) {
+    const BinnedTriangle& e = cov.binned[k];
+    const BinnedCorners t = corners(scene, e, cov.width, cov.height);
+    for (int x = std::max(bt.x0, static_cast<int>(e.x0)); x <= std::min(bt.x1, static_cast<int>(e.x1)); ++x) {
+      const ClipBuffers col = clip_to_column(t.a, t.b, t.c, x);
+      if (col.n == 0) continue;
+      const auto [ya, yb] = column_rows(col, e, cov.height);
+      for (int y = std::max(ya, bt.y0); y <= std::min(yb, bt.y1); ++y) {
+        const ClipPolygon poly = clip_to_row(col, y);
+        const float area = poly.area();
+        if (area > 0) fn(e, x, y, poly, area);
       }
-    for (std::size_t i = lo; i < hi; ++i) {
-      if (cov.world_area[i] > 0) {
-        cov.mask[i] = 1;
-        ++covered[static_cast<std::size_t>(b)];
+    }
+  }
+}
+
+// The sums of bin (bx, by): each texel's areas over its fragments in the bin's order, its mask,
+// and the bin's counts.
+struct BinCounts {
+  std::size_t fragments = 0, covered = 0, overlapping = 0;
+};
+BinCounts sum_bin(const Scene& scene, TexelCoverage& cov, int bx, int by) {
+  BinCounts n;
+  clip_bin(scene, cov, bx, by, [&](const BinnedTriangle& e, int x, int y, const ClipPolygon&, float area) {
+    const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+    cov.uv_area[texel] += area;
+    cov.world_area[texel] += static_cast<float>(area * e.stretch);
+    ++n.fragments;
+  });
+  const BinTexels bt = bin_texels(cov, bx, by);
+  const int tx0 = bt.x0, tx1 = bt.x1, ty0 = bt.y0, ty1 = bt.y1;
+  for (int y = ty0; y <= ty1; ++y)
+    for (int x = tx0; x <= tx1; ++x) {
+      const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+      if (cov.world_area[texel] > 0) {
+        cov.mask[texel] = 1;
+        ++n.covered;
       }
       // 1% slack: clipped areas of triangles sharing an edge sum to the texel area up to rounding.
-      if (cov.uv_area[i] > 1.01f) ++overlapping[static_cast<std::size_t>(b)];
+      if (cov.uv_area[texel] > 1.01f) ++n.overlapping;
     }
-  });
-  for (int b = 0; b < bands; ++b) cov.covered_texels += covered[static_cast<std::size_t>(b)], cov.overlapping_texels += overlapping[static_cast<std::size_t>(b)];
-  for (Block& blk : blocks) std::vector<Pending>().swap(blk.pending);
+  return n;
 }
 
 }  // namespace
+
+void texel_fragments(const Scene& scene, const TexelCoverage& cov, std::size_t texel, std::vector<TexelPiece>& out) {
+  out.clear();
+  const int x = static_cast<int>(texel % static_cast<std::size_t>(cov.width)), y = static_cast<int>(texel / static_cast<std::size_t>(cov.width));
+  const std::size_t b = bin_index(cov, x / TexelCoverage::kBin, y / TexelCoverage::kBin);
+  for (std::uint32_t k = cov.bin_offsets[b]; k < cov.bin_offsets[b + 1]; ++k) {
+    const BinnedTriangle& e = cov.binned[k];
+    if (x < e.x0 || x > e.x1 || y < e.y0 || y > e.y1) continue;
+    const BinnedCorners t = corners(scene, e, cov.width, cov.height);
+    const ClipBuffers col = clip_to_column(t.a, t.b, t.c, x);
+    if (col.n == 0) continue;
+    TexelPiece& p = out.emplace_back();
+    p.polygon = clip_to_row(col, y);
+    const float area = p.polygon.area();
+    if (!(area > 0)) {
+      out.pop_back();
+      continue;
+    }
+    p.fragment = {e.mesh, e.triangle, area, static_cast<float>(area * e.stretch)};
+  }
+}
+
+void bin_fragments(const Scene& scene, const TexelCoverage& cov, int bx, int by, BinFragments& out) {
+  constexpr int kBin = TexelCoverage::kBin;
+  out.scratch.clear();
+  out.texel_of.clear();
+  clip_bin(scene, cov, bx, by, [&](const BinnedTriangle& e, int x, int y, const ClipPolygon& poly, float area) {
+    out.scratch.push_back({{e.mesh, e.triangle, area, static_cast<float>(area * e.stretch)}, poly});
+    out.texel_of.push_back(static_cast<std::uint8_t>((y - by * kBin) * kBin + (x - bx * kBin)));
+  });
+  // By texel, stably (a counting sort): each texel's fragments stay in the bin's order.
+  out.offsets.fill(0);
+  for (const std::uint8_t k : out.texel_of) ++out.offsets[k + 1u];
+  for (std::size_t k = 1; k < out.offsets.size(); ++k) out.offsets[k] += out.offsets[k - 1];
+  std::array<std::uint32_t, kBin * kBin> cursor;
+  std::copy_n(out.offsets.begin(), cursor.size(), cursor.begin());
+  out.pieces.resize(out.scratch.size());
+  for (std::size_t f = 0; f < out.scratch.size(); ++f) out.pieces[cursor[out.texel_of[f]]++] = out.scratch[f];
+}
 
 TexelCoverage compute_texel_coverage(const Scene& scene, int width, int height) {
   require_no_instances(scene);
@@ -319,16 +388,22 @@ TexelCoverage compute_texel_coverage(const Scene& scene, int width, int height) 
   cov.height = height;
   const double mean_ratio = mean_texel_ratio(scene, width, height);  // texels^2 per world unit^2
 
-  // Blocks of triangles over all meshes, clipped in parallel, concatenated in block order.
-  std::vector<Block> blocks;
-  for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    const Mesh& m = scene.meshes[mi];
-    if (m.uvs.empty()) continue;
-    for (std::size_t t = 0; t < m.triangle_count(); t += kBlock)
-      blocks.push_back({static_cast<std::uint32_t>(mi), t, std::min(m.triangle_count(), t + kBlock), {}});
-  }
-  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t bi) { clip_block(scene, width, height, mean_ratio, blocks[bi]); });
-  gather_by_texel(blocks, cov);
+  bin_triangles(scene, mean_ratio, cov);
+  cov.world_area = Image<float>(width, height, 0.0f);
+  cov.uv_area = Image<float>(width, height, 0.0f);
+  cov.mask = Image<std::uint8_t>(width, height, std::uint8_t{0});
+  // Bin by bin in parallel: a bin's texels are its own, and each texel sums its fragments in the
+  // bin's order, so the sums are the same at any thread count.
+  const int bin_rows = (height + TexelCoverage::kBin - 1) / TexelCoverage::kBin;
+  std::vector<BinCounts> row_counts(static_cast<std::size_t>(bin_rows));
+  tbb::parallel_for(0, bin_rows, [&](int by) {
+    BinCounts& r = row_counts[static_cast<std::size_t>(by)];
+    for (int bx = 0; bx < cov.bin_columns; ++bx) {
+      const BinCounts n = sum_bin(scene, cov, bx, by);
+      r.fragments += n.fragments, r.covered += n.covered, r.overlapping += n.overlapping;
+    }
+  });
+  for (const BinCounts& r : row_counts) cov.fragments += r.fragments, cov.covered_texels += r.covered, cov.overlapping_texels += r.overlapping;
   if (cov.covered_texels == 0) throw InputError(scene.name + ": no triangle's UVs fall inside [0,1]^2; nothing to bake");
   return cov;
 }

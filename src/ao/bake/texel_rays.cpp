@@ -22,16 +22,16 @@ TriangleNormals face_normals(const Scene& s) {
   return fn;
 }
 
-void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::size_t texel, std::vector<PatchPiece>& out) {
+void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::span<const TexelPiece> fragments,
+                 std::vector<PatchPiece>& out) {
   out.clear();
-  const int x = static_cast<int>(texel % static_cast<std::size_t>(cov.width)), y = static_cast<int>(texel / static_cast<std::size_t>(cov.width));
   double acc = 0;
-  for (std::uint32_t f = cov.offsets[texel]; f < cov.offsets[texel + 1]; ++f) {
-    const TexelFragment& fr = cov.fragments[f];
+  for (const TexelPiece& piece : fragments) {
+    const TexelFragment& fr = piece.fragment;
     const Mesh& m = s.meshes[fr.mesh];
     const std::uint32_t* i = &m.indices[3 * fr.triangle];
     const Vec2 a = texel_uv(m, i[0], cov.width, cov.height), b = texel_uv(m, i[1], cov.width, cov.height), c = texel_uv(m, i[2], cov.width, cov.height);
-    const ClipPolygon poly = clip_to_texel(a, b, c, x, y);
+    const ClipPolygon& poly = piece.polygon;
     const double stretch = fr.uv_area > 0 ? fr.world_area / fr.uv_area : 0.0;
     // Barycentrics of each polygon corner, solved once in UV space and clamped to the triangle
     // (clipping rounds corners onto, or a hair past, its edges).
@@ -105,14 +105,15 @@ Vec3 nearest_barycentrics(Vec2 a, Vec2 b, Vec2 c, Vec2 q) {
 
 }  // namespace
 
-void centre_patch(const TexelSource& texels, std::size_t texel, const std::vector<PatchPiece>& patch, std::vector<PatchPiece>& out) {
+void centre_patch(const TexelSource& texels, std::size_t texel, std::span<const TexelPiece> fragments, const std::vector<PatchPiece>& patch,
+                  std::vector<PatchPiece>& out) {
   const TexelCoverage& cov = texels.cov;
   const Vec2 q{static_cast<float>(texel % static_cast<std::size_t>(cov.width)) + 0.5f,
                static_cast<float>(texel / static_cast<std::size_t>(cov.width)) + 0.5f};
   float best_d2 = kInfinity;
   PatchPiece pc{};
-  for (std::uint32_t f = cov.offsets[texel]; f < cov.offsets[texel + 1] && best_d2 > 0; ++f) {
-    const TexelFragment& fr = cov.fragments[f];
+  for (std::size_t f = 0; f < fragments.size() && best_d2 > 0; ++f) {
+    const TexelFragment& fr = fragments[f].fragment;
     const Mesh& m = texels.scene.meshes[fr.mesh];
     const std::uint32_t* i = &m.indices[3 * fr.triangle];
     const Vec2 a = texel_uv(m, i[0], cov.width, cov.height), b = texel_uv(m, i[1], cov.width, cov.height), c = texel_uv(m, i[2], cov.width, cov.height);

@@ -53,8 +53,10 @@ struct PatchPiece {
   float offset;              ///< Scale-free ray origin offset of the mesh triangle (reference/ray_offset.h), world units.
   float cdf;                 ///< Cumulative world area of the texel's pieces up to and including this one.
 };
-/// The pieces of texel `texel` of `cov` (computed on `s`), in fragment order. `fn` = face_normals(s).
-void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::size_t texel, std::vector<PatchPiece>& out);
+/// The pieces of a texel of `cov` (computed on `s`) whose fragments are `fragments` (texel_fragments,
+/// bin_fragments), in fragment order. `fn` = face_normals(s).
+void build_patch(const Scene& s, const TexelCoverage& cov, const TriangleNormals& fn, std::span<const TexelPiece> fragments,
+                 std::vector<PatchPiece>& out);
 
 /// What a texel's patch was built from: the scene, the map's coverage computed on it, and its face
 /// normals (face_normals).
@@ -69,7 +71,9 @@ struct TexelSource {
 /// sample of it starts there: the fragment whose UV triangle holds the centre, else the point of a
 /// fragment's triangle nearest to the centre in UV (a texel on a chart's border whose centre lies
 /// outside the chart).
-void centre_patch(const TexelSource& texels, std::size_t texel, const std::vector<PatchPiece>& patch, std::vector<PatchPiece>& out);
+/// `fragments`: the texel's (texel_fragments).
+void centre_patch(const TexelSource& texels, std::size_t texel, std::span<const TexelPiece> fragments, const std::vector<PatchPiece>& patch,
+                  std::vector<PatchPiece>& out);
 
 /// The area-weighted centroid and unit mean normal of a non-empty patch (of the face normals when
 /// `geometric`, else of the interpolated normals; the first piece's face normal where they cancel):
@@ -422,12 +426,13 @@ class BatchTracer {
 /// Texels per tile side of the inside-out bakers' tile loop: neighbouring texels lie close on the
 /// surface, so a tile's rays share BVH nodes in cache.
 inline constexpr int kTexelTile = 16;
+static_assert(kTexelTile % TexelCoverage::kBin == 0, "a tile of texels is whole bins of the coverage");
 
 /// The tile loop of the inside-out bakers: every covered texel of `cov` (computed on `surface`,
 /// whose face normals are `fn`) that has a non-empty patch, in tiles of kTexelTile texels traced
 /// in `rs` (ray_tiles_internal.h). Each tile makes its worker, w = make_worker.template
 /// operator()<N>() (its scratch: sample points, batches, packets), and calls w(ctx, x, y, texel,
-/// patch) for each such texel, texel = y * width + x. Progress is reported in covered texels. A
+/// patch, fragments) for each such texel, texel = y * width + x, fragments its texel_fragments. Progress is reported in covered texels. A
 /// texel's work may depend only on the texel (its coordinates, its seed), so that the result is
 /// the same at any thread count.
 template <class MakeWorker>
@@ -437,14 +442,23 @@ void for_each_texel_patch(const RayScene& rs, const Scene& surface, const TexelC
   for_each_ray_tile(rs, cov.width, cov.height, RayTiling{kTexelTile, kTexelTile}, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
     auto worker = make_worker.template operator()<N>();
     std::vector<PatchPiece> patch;
+    BinFragments bin;
     std::size_t covered = 0;
-    for (int y = t.y0; y < t.y1; ++y)
-      for (int x = t.x0; x < t.x1; ++x) {
-        const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
-        if (!cov.mask[texel]) continue;
-        ++covered;
-        build_patch(surface, cov, fn, texel, patch);
-        if (!patch.empty()) worker(ctx, x, y, texel, patch);
+    // Bin by bin (a tile is whole bins): one pass over a bin's triangles clips the fragments of
+    // all its texels.
+    constexpr int kBin = TexelCoverage::kBin;
+    for (int by = t.y0 / kBin; by * kBin < t.y1; ++by)
+      for (int bx = t.x0 / kBin; bx * kBin < t.x1; ++bx) {
+        bin_fragments(surface, cov, bx, by, bin);
+        for (int y = by * kBin; y < std::min(t.y1, (by + 1) * kBin); ++y)
+          for (int x = bx * kBin; x < std::min(t.x1, (bx + 1) * kBin); ++x) {
+            const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+            if (!cov.mask[texel]) continue;
+            ++covered;
+            const std::span<const TexelPiece> fragments = bin.texel((y - by * kBin) * kBin + x - bx * kBin);
+            build_patch(surface, cov, fn, fragments, patch);
+            if (!patch.empty()) worker(ctx, x, y, texel, patch, fragments);
+          }
       }
     return covered;
   });

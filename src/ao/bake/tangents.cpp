@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <span>
 #include <unordered_map>
 
 #include "ao/core/error.h"
@@ -116,44 +117,57 @@ Vec3 clamp_into_triangle(Vec3 w) {
   return s > 0 ? w / s : Vec3{1.0f / 3, 1.0f / 3, 1.0f / 3};
 }
 
+// Texel `texel`'s frame from its fragments, into `out`: the fragment whose UV triangle holds the
+// texel's centre (the largest, if several), else the one nearest to it, clamped into it.
+void texel_frame(const Scene& scene, const TexelCoverage& cov, const std::vector<std::vector<CornerTangent>>& tangents, std::size_t texel,
+                 std::span<const TexelPiece> pieces, TexelFrames& out) {
+  const Vec2 centre{static_cast<float>(texel % static_cast<std::size_t>(cov.width)) + 0.5f,
+                    static_cast<float>(texel / static_cast<std::size_t>(cov.width)) + 0.5f};
+  const TexelFragment* pick = nullptr;
+  Vec3 w{};
+  bool inside = false;
+  for (const TexelPiece& piece : pieces) {
+    const TexelFragment& f = piece.fragment;
+    const Mesh& m = scene.meshes[f.mesh];
+    const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(f.triangle)];
+    Vec3 fw;
+    if (!barycentrics(centre, texel_uv(m, i[0], cov.width, cov.height), texel_uv(m, i[1], cov.width, cov.height),
+                      texel_uv(m, i[2], cov.width, cov.height), fw))
+      continue;
+    const bool holds = fw.x >= 0 && fw.y >= 0 && fw.z >= 0;
+    if (!pick || (holds && !inside) || (holds == inside && f.uv_area > pick->uv_area)) pick = &f, w = fw, inside = holds;
+  }
+  if (!pick) return;
+  if (!inside) w = clamp_into_triangle(w);
+  const Mesh& m = scene.meshes[pick->mesh];
+  const std::vector<CornerTangent>& ct = tangents[pick->mesh];
+  const std::size_t base = 3 * static_cast<std::size_t>(pick->triangle);
+  Vec3 t{0, 0, 0}, n{0, 0, 0};
+  for (int c = 0; c < 3; ++c) {
+    const float wc = w[c];
+    t += ct[base + static_cast<std::size_t>(c)].t * wc;
+    n += m.normals[m.indices[base + static_cast<std::size_t>(c)]] * wc;
+  }
+  out.t[texel] = t, out.n[texel] = n, out.sign[texel] = ct[base].sign;
+}
+
 }  // namespace
 
 TexelFrames texel_frames(const Scene& scene, const TexelCoverage& cov, const std::vector<std::vector<CornerTangent>>& tangents) {
   TexelFrames out{Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}), Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}),
                   Image<float>(cov.width, cov.height, 1.0f)};
-  std::vector<TexelPiece> pieces;
-  for (std::size_t texel = 0; texel < cov.texel_count(); ++texel) {
-    if (!cov.mask[texel]) continue;
-    const Vec2 centre{static_cast<float>(texel % static_cast<std::size_t>(cov.width)) + 0.5f,
-                      static_cast<float>(texel / static_cast<std::size_t>(cov.width)) + 0.5f};
-    const TexelFragment* pick = nullptr;
-    Vec3 w{};
-    bool inside = false;
-    texel_fragments(scene, cov, texel, pieces);
-    for (const TexelPiece& piece : pieces) {
-      const TexelFragment& f = piece.fragment;
-      const Mesh& m = scene.meshes[f.mesh];
-      const std::uint32_t* i = &m.indices[3 * static_cast<std::size_t>(f.triangle)];
-      Vec3 fw;
-      if (!barycentrics(centre, texel_uv(m, i[0], cov.width, cov.height), texel_uv(m, i[1], cov.width, cov.height),
-                        texel_uv(m, i[2], cov.width, cov.height), fw))
-        continue;
-      const bool holds = fw.x >= 0 && fw.y >= 0 && fw.z >= 0;
-      if (!pick || (holds && !inside) || (holds == inside && f.uv_area > pick->uv_area)) pick = &f, w = fw, inside = holds;
+  // Bin by bin: one pass over a bin's triangles gives the fragments of all its texels.
+  constexpr int kBin = TexelCoverage::kBin;
+  BinFragments bin;
+  for (int by = 0; by * kBin < cov.height; ++by)
+    for (int bx = 0; bx < cov.bin_columns; ++bx) {
+      bin_fragments(scene, cov, bx, by, bin);
+      for (int y = by * kBin; y < std::min(cov.height, (by + 1) * kBin); ++y)
+        for (int x = bx * kBin; x < std::min(cov.width, (bx + 1) * kBin); ++x) {
+          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+          if (cov.mask[texel]) texel_frame(scene, cov, tangents, texel, bin.texel((y - by * kBin) * kBin + x - bx * kBin), out);
+        }
     }
-    if (!pick) continue;
-    if (!inside) w = clamp_into_triangle(w);
-    const Mesh& m = scene.meshes[pick->mesh];
-    const std::vector<CornerTangent>& ct = tangents[pick->mesh];
-    const std::size_t base = 3 * static_cast<std::size_t>(pick->triangle);
-    Vec3 t{0, 0, 0}, n{0, 0, 0};
-    for (int c = 0; c < 3; ++c) {
-      const float wc = w[c];
-      t += ct[base + static_cast<std::size_t>(c)].t * wc;
-      n += m.normals[m.indices[base + static_cast<std::size_t>(c)]] * wc;
-    }
-    out.t[texel] = t, out.n[texel] = n, out.sign[texel] = ct[base].sign;
-  }
   return out;
 }
 

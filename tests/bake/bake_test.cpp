@@ -288,6 +288,44 @@ TEST(Bake, QuadInsideClosedBoxIsFullyOccluded) {
   for (std::size_t i = 0; i < rb.visibility.size(); ++i) EXPECT_EQ(rb.visibility[i], 1.0f);
 }
 
+TEST(Bake, TileLoopVisitsEveryCoveredTexelOnceWithItsOwnFragments) {
+  // Maps whose sides are not multiples of the tile (16) nor of the coverage's bins (8), on several
+  // threads: each covered texel gets exactly one call, with the fragments texel_fragments gives it
+  // (a tile that ran past its own texels into a neighbour's bin would visit some twice).
+  Scene s;
+  s.meshes.push_back(uv_quad({-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}, {0.02f, 0.03f}, {0.97f, 0.99f}));
+  s = prepared(std::move(s));
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  const detail::TriangleNormals fn = detail::face_normals(s);
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 3);
+  for (const auto& [w, h] : {std::pair{37, 23}, std::pair{100, 61}, std::pair{8, 9}}) {
+    const TexelCoverage cov = compute_texel_coverage(s, w, h);
+    std::vector<std::atomic<int>> visits(cov.texel_count());
+    std::atomic<int> wrong_fragments{0};
+    struct Worker {
+      const Scene& scene;
+      const TexelCoverage& cov;
+      std::vector<std::atomic<int>>& visits;
+      std::atomic<int>& wrong;
+      std::vector<TexelPiece> alone;
+      void operator()(RTCIntersectContext&, int x, int y, std::size_t texel, const std::vector<detail::PatchPiece>&, std::span<const TexelPiece> fr) {
+        ++visits[texel];
+        texel_fragments(scene, cov, texel, alone);
+        const bool same = texel == static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x) &&
+                          fr.size() == alone.size() &&
+                          std::equal(fr.begin(), fr.end(), alone.begin(), [](const TexelPiece& a, const TexelPiece& b) {
+                            return a.fragment.triangle == b.fragment.triangle && a.fragment.uv_area == b.fragment.uv_area;
+                          });
+        if (!same) ++wrong;
+      }
+    };
+    detail::for_each_texel_patch(rs, s, cov, fn, {}, [&]<int N>() { return Worker{s, cov, visits, wrong_fragments, {}}; });
+    for (std::size_t t = 0; t < cov.texel_count(); ++t) EXPECT_EQ(visits[t].load(), cov.mask[t] ? 1 : 0) << w << "x" << h << " texel " << t;
+    EXPECT_EQ(wrong_fragments.load(), 0) << w << "x" << h;
+    EXPECT_GT(cov.covered_texels, cov.texel_count() / 2);
+  }
+}
+
 // With a distance limit, the ray-traced baker matches the foundation's step-membership wall formula
 // V = 1 - (acos(a) - a sqrt(1-a^2))/pi for a = d/R <= 1 (infinite wall).
 TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {

@@ -432,26 +432,28 @@ static_assert(kTexelTile % TexelCoverage::kBin == 0, "a tile of texels is whole 
 /// whose face normals are `fn`) that has a non-empty patch, in tiles of kTexelTile texels traced
 /// in `rs` (ray_tiles_internal.h). Each tile makes its worker, w = make_worker.template
 /// operator()<N>() (its scratch: sample points, batches, packets), and calls w(ctx, x, y, texel,
-/// patch, fragments) for each such texel, texel = y * width + x, fragments its texel_fragments. Progress is reported in covered texels. A
-/// texel's work may depend only on the texel (its coordinates, its seed), so that the result is
-/// the same at any thread count.
+/// patch, fragments) for each such texel, texel = y * width + x, fragments its texel_fragments.
+/// Progress is reported in covered texels. A texel's work may depend only on the texel (its
+/// coordinates, its seed), so that the result is the same at any thread count.
 template <class MakeWorker>
 void for_each_texel_patch(const RayScene& rs, const Scene& surface, const TexelCoverage& cov, const TriangleNormals& fn, const ProgressFn& progress,
                           MakeWorker&& make_worker) {
   ProgressCounter counter(progress, cov.covered_texels);
-  for_each_ray_tile(rs, cov.width, cov.height, RayTiling{kTexelTile, kTexelTile}, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
+  // Tiles on the grid of kTexelTile (blocks_of_tiles), so that each is whole bins of the coverage.
+  const RayTiling tiling{.tile_width = kTexelTile, .tile_height = kTexelTile, .blocks_of_tiles = true};
+  for_each_ray_tile(rs, cov.width, cov.height, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
     auto worker = make_worker.template operator()<N>();
     std::vector<PatchPiece> patch;
     BinFragments bin;
     std::size_t covered = 0;
-    // Bin by bin (a tile is whole bins): one pass over a bin's triangles clips the fragments of
-    // all its texels.
+    // Bin by bin: one pass over a bin's triangles clips the fragments of all its texels (of the
+    // tile's: a tile is whole bins but at the map's right and bottom edges).
     constexpr int kBin = TexelCoverage::kBin;
     for (int by = t.y0 / kBin; by * kBin < t.y1; ++by)
       for (int bx = t.x0 / kBin; bx * kBin < t.x1; ++bx) {
         bin_fragments(surface, cov, bx, by, bin);
-        for (int y = by * kBin; y < std::min(t.y1, (by + 1) * kBin); ++y)
-          for (int x = bx * kBin; x < std::min(t.x1, (bx + 1) * kBin); ++x) {
+        for (int y = std::max(t.y0, by * kBin); y < std::min(t.y1, (by + 1) * kBin); ++y)
+          for (int x = std::max(t.x0, bx * kBin); x < std::min(t.x1, (bx + 1) * kBin); ++x) {
             const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
             if (!cov.mask[texel]) continue;
             ++covered;

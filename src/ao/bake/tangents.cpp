@@ -156,18 +156,10 @@ void texel_frame(const Scene& scene, const TexelCoverage& cov, const std::vector
 TexelFrames texel_frames(const Scene& scene, const TexelCoverage& cov, const std::vector<std::vector<CornerTangent>>& tangents) {
   TexelFrames out{Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}), Image<Vec3>(cov.width, cov.height, Vec3{0, 0, 0}),
                   Image<float>(cov.width, cov.height, 1.0f)};
-  // Bin by bin: one pass over a bin's triangles gives the fragments of all its texels.
-  constexpr int kBin = TexelCoverage::kBin;
   BinFragments bin;
-  for (int by = 0; by * kBin < cov.height; ++by)
-    for (int bx = 0; bx < cov.bin_columns; ++bx) {
-      bin_fragments(scene, cov, bx, by, bin);
-      for (int y = by * kBin; y < std::min(cov.height, (by + 1) * kBin); ++y)
-        for (int x = bx * kBin; x < std::min(cov.width, (bx + 1) * kBin); ++x) {
-          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
-          if (cov.mask[texel]) texel_frame(scene, cov, tangents, texel, bin.texel((y - by * kBin) * kBin + x - bx * kBin), out);
-        }
-    }
+  for_each_covered_texel(scene, cov, 0, 0, cov.width, cov.height, bin, [&](int, int, std::size_t texel, std::span<const TexelPiece> fragments) {
+    texel_frame(scene, cov, tangents, texel, fragments, out);
+  });
   return out;
 }
 

@@ -277,6 +277,9 @@ std::pair<int, int> column_rows(const ClipBuffers& col, const BinnedTriangle& e,
   return {std::max(static_cast<int>(e.y0), row(lo) - 1), std::min(static_cast<int>(e.y1), row(hi))};
 }
 
+// The fragment of entry e whose clipped area is `area` (texels^2).
+TexelFragment fragment(const BinnedTriangle& e, float area) { return {e.mesh, e.triangle, area, static_cast<float>(area * e.stretch)}; }
+
 // Texels x0 .. x1, y0 .. y1 of bin (bx, by), inclusive.
 struct BinTexels {
   int x0, y0, x1, y1;
@@ -286,13 +289,12 @@ BinTexels bin_texels(const TexelCoverage& cov, int bx, int by) {
   return {bx * kBin, by * kBin, std::min(cov.width, (bx + 1) * kBin) - 1, std::min(cov.height, (by + 1) * kBin) - 1};
 }
 
-// fn(entry, x, y, polygon, area) for every fragment of bin (bx, by), entry by entry in the bin's
-// order (mesh, then triangle): the triangle clipped to each column of the bin it reaches once,
-// then that polygon to each row of the bin it can reach (the clips clip_to_texel makes, in its
-// order).
+// fn(entry, x, y, polygon, area) for every fragment of bin (bx, by) in its texels `bt` (the whole
+// bin, or part of it), entry by entry in the bin's order (mesh, then triangle): the triangle
+// clipped to each column of `bt` it reaches once, then that polygon to each row of `bt` it can
+// reach (the clips clip_to_texel makes, in its order).
 template <class Fn>
-void clip_bin(const Scene& scene, const TexelCoverage& cov, int bx, int by, Fn&& fn) {
-  const BinTexels bt = bin_texels(cov, bx, by);
+void clip_bin(const Scene& scene, const TexelCoverage& cov, int bx, int by, BinTexels bt, Fn&& fn) {
   const std::size_t b = bin_index(cov, bx, by);
   for (std::uint32_t k = cov.bin_offsets[b]; k < cov.bin_offsets[b + 1]; ++k) {
     const BinnedTriangle& e = cov.binned[k];
@@ -317,16 +319,16 @@ struct BinCounts {
 };
 BinCounts sum_bin(const Scene& scene, TexelCoverage& cov, int bx, int by) {
   BinCounts n;
-  clip_bin(scene, cov, bx, by, [&](const BinnedTriangle& e, int x, int y, const ClipPolygon&, float area) {
+  const BinTexels bt = bin_texels(cov, bx, by);
+  clip_bin(scene, cov, bx, by, bt, [&](const BinnedTriangle& e, int x, int y, const ClipPolygon&, float area) {
     const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
-    cov.uv_area[texel] += area;
-    cov.world_area[texel] += static_cast<float>(area * e.stretch);
+    const TexelFragment f = fragment(e, area);
+    cov.uv_area[texel] += f.uv_area;
+    cov.world_area[texel] += f.world_area;
     ++n.fragments;
   });
-  const BinTexels bt = bin_texels(cov, bx, by);
-  const int tx0 = bt.x0, tx1 = bt.x1, ty0 = bt.y0, ty1 = bt.y1;
-  for (int y = ty0; y <= ty1; ++y)
-    for (int x = tx0; x <= tx1; ++x) {
+  for (int y = bt.y0; y <= bt.y1; ++y)
+    for (int x = bt.x0; x <= bt.x1; ++x) {
       const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
       if (cov.world_area[texel] > 0) {
         cov.mask[texel] = 1;
@@ -343,30 +345,16 @@ BinCounts sum_bin(const Scene& scene, TexelCoverage& cov, int bx, int by) {
 void texel_fragments(const Scene& scene, const TexelCoverage& cov, std::size_t texel, std::vector<TexelPiece>& out) {
   out.clear();
   const int x = static_cast<int>(texel % static_cast<std::size_t>(cov.width)), y = static_cast<int>(texel / static_cast<std::size_t>(cov.width));
-  const std::size_t b = bin_index(cov, x / TexelCoverage::kBin, y / TexelCoverage::kBin);
-  for (std::uint32_t k = cov.bin_offsets[b]; k < cov.bin_offsets[b + 1]; ++k) {
-    const BinnedTriangle& e = cov.binned[k];
-    if (x < e.x0 || x > e.x1 || y < e.y0 || y > e.y1) continue;
-    const BinnedCorners t = corners(scene, e, cov.width, cov.height);
-    const ClipBuffers col = clip_to_column(t.a, t.b, t.c, x);
-    if (col.n == 0) continue;
-    TexelPiece& p = out.emplace_back();
-    p.polygon = clip_to_row(col, y);
-    const float area = p.polygon.area();
-    if (!(area > 0)) {
-      out.pop_back();
-      continue;
-    }
-    p.fragment = {e.mesh, e.triangle, area, static_cast<float>(area * e.stretch)};
-  }
+  clip_bin(scene, cov, x / TexelCoverage::kBin, y / TexelCoverage::kBin, {x, y, x, y},
+           [&](const BinnedTriangle& e, int, int, const ClipPolygon& poly, float area) { out.push_back({fragment(e, area), poly}); });
 }
 
 void bin_fragments(const Scene& scene, const TexelCoverage& cov, int bx, int by, BinFragments& out) {
   constexpr int kBin = TexelCoverage::kBin;
   out.scratch.clear();
   out.texel_of.clear();
-  clip_bin(scene, cov, bx, by, [&](const BinnedTriangle& e, int x, int y, const ClipPolygon& poly, float area) {
-    out.scratch.push_back({{e.mesh, e.triangle, area, static_cast<float>(area * e.stretch)}, poly});
+  clip_bin(scene, cov, bx, by, bin_texels(cov, bx, by), [&](const BinnedTriangle& e, int x, int y, const ClipPolygon& poly, float area) {
+    out.scratch.push_back({fragment(e, area), poly});
     out.texel_of.push_back(static_cast<std::uint8_t>((y - by * kBin) * kBin + (x - bx * kBin)));
   });
   // By texel, stably (a counting sort): each texel's fragments stay in the bin's order.

@@ -10,6 +10,7 @@
 // unit square whatever the map's aspect ratio.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -104,6 +105,23 @@ struct BinFragments {
   }
 };
 void bin_fragments(const Scene& scene, const TexelCoverage& cov, int bx, int by, BinFragments& out);
+
+/// fn(x, y, texel, fragments) for every covered texel of [x0, x1) x [y0, y1) of `cov` (computed on
+/// `scene`), texel = y * width + x, with its fragments: bin by bin, each bin's fragments from one
+/// pass over its triangles (bin_fragments into `bin`, the caller's scratch), its texels in rows.
+template <class Fn>
+void for_each_covered_texel(const Scene& scene, const TexelCoverage& cov, int x0, int y0, int x1, int y1, BinFragments& bin, Fn&& fn) {
+  constexpr int kBin = TexelCoverage::kBin;
+  for (int by = y0 / kBin; by * kBin < y1; ++by)
+    for (int bx = x0 / kBin; bx * kBin < x1; ++bx) {
+      bin_fragments(scene, cov, bx, by, bin);
+      for (int y = std::max(y0, by * kBin); y < std::min(y1, (by + 1) * kBin); ++y)
+        for (int x = std::max(x0, bx * kBin); x < std::min(x1, (bx + 1) * kBin); ++x) {
+          const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
+          if (cov.mask[texel]) fn(x, y, texel, bin.texel((y - by * kBin) * kBin + x - bx * kBin));
+        }
+    }
+}
 
 /// Clips every triangle of every mesh with UVs against the texel grid (Sutherland-Hodgman against
 /// each texel square it overlaps). Meshes without UVs are skipped (they may still occlude).

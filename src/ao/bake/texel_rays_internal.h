@@ -446,22 +446,11 @@ void for_each_texel_patch(const RayScene& rs, const Scene& surface, const TexelC
     std::vector<PatchPiece> patch;
     BinFragments bin;
     std::size_t covered = 0;
-    // Bin by bin: one pass over a bin's triangles clips the fragments of all its texels (of the
-    // tile's: a tile is whole bins but at the map's right and bottom edges).
-    constexpr int kBin = TexelCoverage::kBin;
-    for (int by = t.y0 / kBin; by * kBin < t.y1; ++by)
-      for (int bx = t.x0 / kBin; bx * kBin < t.x1; ++bx) {
-        bin_fragments(surface, cov, bx, by, bin);
-        for (int y = std::max(t.y0, by * kBin); y < std::min(t.y1, (by + 1) * kBin); ++y)
-          for (int x = std::max(t.x0, bx * kBin); x < std::min(t.x1, (bx + 1) * kBin); ++x) {
-            const std::size_t texel = static_cast<std::size_t>(y) * static_cast<std::size_t>(cov.width) + static_cast<std::size_t>(x);
-            if (!cov.mask[texel]) continue;
-            ++covered;
-            const std::span<const TexelPiece> fragments = bin.texel((y - by * kBin) * kBin + x - bx * kBin);
-            build_patch(surface, cov, fn, fragments, patch);
-            if (!patch.empty()) worker(ctx, x, y, texel, patch, fragments);
-          }
-      }
+    for_each_covered_texel(surface, cov, t.x0, t.y0, t.x1, t.y1, bin, [&](int x, int y, std::size_t texel, std::span<const TexelPiece> fragments) {
+      ++covered;
+      build_patch(surface, cov, fn, fragments, patch);
+      if (!patch.empty()) worker(ctx, x, y, texel, patch, fragments);
+    });
     return covered;
   });
 }

@@ -410,6 +410,78 @@ TEST(Bake, TexelRayBatchesAreTheRaysOfTheScalarSamplingPath) {
   EXPECT_GT(between, 0);
 }
 
+// PackedTracer fills packets with the rays of consecutive texels and hands the samples back in
+// the order they came, each texel's end after its samples (a hundred texels with none among them):
+// against every ray traced alone
+// (Tracer::trace<1>), at every packet width a machine may have (1, 4, 8, 16), for an
+// occlusion-only tracer and one with a falloff (the path that packs rays itself), with texels of
+// 1 to 40 samples (packets shared by up to 16 texels, and texels spread over three packets) whose
+// batches have lanes with no ray (mu 0), and texels ended while rays of theirs wait in an open packet.
+template <int N>
+void expect_packed_tracer_keeps_each_texels_samples(const detail::Tracer& tracer) {
+  struct Recorder {
+    std::vector<std::pair<std::uint32_t, float>> got;  // (tag, mu) per sample; (texel, -1) per texel end
+    void sample(const typename detail::PackedTracer<N>::Sample& e) { got.emplace_back(e.tag, e.mu); }
+    void texel_done(std::uint32_t texel) { got.emplace_back(texel, -1.0f); }
+  } recorder;
+  std::vector<std::pair<std::uint32_t, float>> expected;
+  detail::PackedTracer<N> packed(tracer, true, false);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  std::uint32_t state = 7, tag = 0;
+  const auto next = [&] { return (state = state * 1664525u + 1013904223u) >> 8; };
+  for (std::uint32_t texel = 0; texel < 400; ++texel) {
+    // Texels 200-299 but 250 have no samples (high to low's texels whose cage points all miss),
+    // and 250 has one: the runs before and after it end while rays wait in the stream (its fill
+    // after 199 and after 250 differ by one, so at most one of them is empty).
+    const int samples = texel == 250 ? 1 : texel >= 200 && texel < 300 ? 0 : texel % 7 == 0 ? 40 : 1 + static_cast<int>(next() % 9);
+    for (int first = 0; first < samples; first += 16) {
+      const int count = std::min(16, samples - first);
+      detail::TexelRayBatch b;
+      std::uint32_t tags[16];
+      for (int k = 0; k < count; ++k) {
+        // Floor points before the wall (floor_and_wall), directions over the upper hemisphere:
+        // some blocked, some open.
+        const float x = static_cast<float>(next() % 1000) / 1000 - 0.5f, z = static_cast<float>(next() % 1000) / 1000;
+        const float a = static_cast<float>(next() % 6283) / 1000, c = static_cast<float>(next() % 1000) / 1000;
+        const Vec3 d = normalize(Vec3{std::cos(a) * std::sqrt(1 - c * c), c, std::sin(a) * std::sqrt(1 - c * c)});
+        b.ox[k] = x, b.oy[k] = 1e-4f, b.oz[k] = z, b.dx[k] = d.x, b.dy[k] = d.y, b.dz[k] = d.z;
+        b.valid[k] = next() % 5 == 0 ? 0 : -1;
+        tags[k] = tag++;
+        float mu = 0.0f;
+        const Vec3 o{x, 1e-4f, z};
+        if (b.valid[k]) tracer.trace<1>(ctx, &o, &d, 1, &mu);
+        expected.emplace_back(tags[k], mu);
+      }
+      packed.add(ctx, b, count, tags, recorder);
+    }
+    packed.end_texel(texel, recorder);
+    expected.emplace_back(texel, -1.0f);
+  }
+  packed.flush(ctx, recorder);
+  ASSERT_EQ(recorder.got.size(), expected.size());
+  int open = 0, blocked = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(recorder.got[i], expected[i]) << "entry " << i << " at width " << N;
+    open += expected[i].second == 1.0f, blocked += expected[i].second == 0.0f;
+  }
+  EXPECT_GT(open, 100);  // both outcomes were traced
+  EXPECT_GT(blocked, 100);
+}
+
+TEST(Bake, PackedTracerHandsBackEachTexelsSamplesInOrderWithTheirOwnMu) {
+  const Scene s = floor_and_wall(0.5f);
+  const RayScene rs(s, bake_bvh_options(s.triangle_count()));
+  const detail::TriangleNormals fn = detail::face_normals(s);
+  for (const Falloff falloff : {Falloff{Membership::Step, kInfinity}, Falloff{Membership::Linear, 0.8f}}) {
+    const detail::Tracer tracer{rs, falloff, fn, false};
+    expect_packed_tracer_keeps_each_texels_samples<1>(tracer);
+    expect_packed_tracer_keeps_each_texels_samples<4>(tracer);
+    expect_packed_tracer_keeps_each_texels_samples<8>(tracer);
+    expect_packed_tracer_keeps_each_texels_samples<16>(tracer);
+  }
+}
+
 // The texels of a 4 x 4 block share one sequence, each its own n points of it: at n = 16 each
 // texel's directions put one point in every cell of a 4 x 4 grid over dimensions 0-1 (its own net),
 // and the block's 256 put one in every cell of a 16 x 16 grid (one net together, which sixteen

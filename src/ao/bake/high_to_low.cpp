@@ -140,15 +140,16 @@ struct CageRays {
 // texel's n samples (dimensions 0-1 of sobol_owen_4d, its TexelSampleSet, the single-mesh baker's
 // direction dimensions): at n / P a power of two each block is a (0, m, 2)-net of its own,
 // stratified over the hemisphere, and the blocks together are the texel's whole net.
-// All the directions of a cage point leave from its high-poly hit, so they go to Embree as packets
-// with one origin; the samples of a cage point that finds no high surface are left out.
+// The directions of the texel's cage points go to Embree in packets filled with the rays of
+// consecutive texels (PackedTracer: a cage point's share is a lane or two at a few rays a texel);
+// the samples of a cage point that finds no high surface are left out.
 template <int N>
 class TexelWorker {
  public:
   TexelWorker(const CageRays& cage_rays, const detail::Tracer& tracer, const HighToLowParams& params, float offset, BakeResult& out,
               TexelGuides* guides, std::atomic<std::uint64_t>& rays)
-      : cage_rays_(cage_rays), batch_tracer_(tracer), params_(params), offset_(offset), out_(out), guides_(guides), rays_(rays),
-        spread_(detail::cone_disk_radius(params.ao.spread_angle)) {}
+      : cage_rays_(cage_rays), tracer_(tracer, true, params.ao.bent_normals), sums_(out, guides, params.ao.samples, params.ao.bent_normals, true), params_(params),
+        offset_(offset), guides_(guides), rays_(rays), spread_(detail::cone_disk_radius(params.ao.spread_angle)) {}
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch, std::span<const TexelPiece>) {
     if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
@@ -158,11 +159,8 @@ class TexelWorker {
     const detail::TexelSampleSet cage = detail::texel_sample_set(params_.ao.seed, x, y, points);
     const std::uint32_t point_key = hash_combine(cage.key, 0x3c6ef372u);
     const bool geometric = params_.ao.normal == SurfaceNormal::Geometric;
-    if (guides_) noise_.reset(samples);
     block_first_ = -1;
-    detail::MeanAccumulator acc;  // over the samples whose cage point found the high mesh
     std::uint64_t traced = 0;
-    Vec3 bent{0, 0, 0};
     for (int j = 0; j < points; ++j) {
       const HighHit h = cage_rays_(ctx, detail::sample_patch(patch, sobol_owen_2d(cage.first + static_cast<std::uint32_t>(j), point_key)));
       if (!h.hit) continue;
@@ -176,26 +174,18 @@ class TexelWorker {
         points_of(first, count, set);  // dimensions 0-1: the direction
         if (spread_ < 1.0f) detail::narrow_to_cone(u_, count, spread_, cone_u_);
         detail::make_hemisphere_rays(origin, geometric ? ng : n, ng, spread_ < 1.0f ? cone_u_ : u_, count, batch_);
-        float mu[16];
-        batch_tracer_.trace(ctx, batch_, count, true, mu);
+        std::uint32_t strata[16];
         for (int k = 0; k < count; ++k) {
-          acc.add(mu[k]);
-          if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
-          if (!batch_.valid[k]) continue;
-          ++traced;
-          bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
+          strata[k] = sums_.stratum(u_[0][k], u_[1][k]);
+          traced += batch_.valid[k] ? 1 : 0;
         }
+        tracer_.add(ctx, batch_, count, strata, sums_);
       }
     }
     rays_ += static_cast<std::uint64_t>(points) + traced;  // a cage ray per cage point, and the AO rays
-    if (acc.n == 0) {
-      out_.missed[texel] = 1;
-      return;
-    }
-    out_.visibility[texel] = static_cast<float>(acc.mean());
-    if (params_.ao.bent_normals) out_.bent_normal[texel] = normalize(bent);
-    if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
+    tracer_.end_texel(static_cast<std::uint32_t>(texel), sums_);  // (texels fit in 32 bits: kMaxSize^2 = 2^28)
   }
+  void finish(RTCIntersectContext& ctx) { tracer_.flush(ctx, sums_); }
 
  private:
   // Points first .. first + count - 1 of the texel's Sobol set into lanes 0 .. count - 1 of u_:
@@ -216,13 +206,12 @@ class TexelWorker {
   }
 
   const CageRays& cage_rays_;
-  detail::BatchTracer<N> batch_tracer_;
+  detail::PackedTracer<N> tracer_;
+  detail::TexelSums sums_;
   const HighToLowParams& params_;
   float offset_;
-  BakeResult& out_;
   TexelGuides* guides_;
   std::atomic<std::uint64_t>& rays_;
-  detail::StratifiedVariance noise_;
   float spread_;                     // the cone's disk radius, sin(spread_angle / 2)
   alignas(64) float u_[4][16] = {};  // lanes past a block's count keep any finite values
   alignas(64) float block_u_[4][16] = {};  // the texel's points block_first_ .. block_first_ + 15

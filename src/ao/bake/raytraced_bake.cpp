@@ -11,9 +11,9 @@
 // aliasing. The patch (its pieces with world-space corners, built once per texel), the sample set
 // in direction order (TexelPoints), the lane-parallel ray maker and the tracer (reference/
 // raytraced.cpp's tracing, with an origin per lane, unlimited distance and back-face skipping) and
-// the tile loop are in texel_rays_internal.h, shared with high_to_low.cpp; the default bake's 16
-// rays go to Embree as one occlusion packet where its native width is 16, else in packets of its
-// width filled straight from the batch (BatchTracer).
+// the tile loop are in texel_rays_internal.h, shared with high_to_low.cpp; the rays of consecutive
+// texels fill packets of 16 together (PackedTracer), which go to Embree as one occlusion packet
+// where its native width is 16, else in packets of its width (BatchTracer).
 #include "ao/bake/raytraced_bake.h"
 
 #include <algorithm>
@@ -78,14 +78,16 @@ using detail::Tracer;
 using detail::TriangleNormals;
 
 // A tile's worker for bake_raytraced: the texel's sample points in direction order (TexelPoints),
-// made into rays 16 at a time in SIMD lanes (make_texel_rays), and traced as one 16-wide occlusion
-// packet where the bake needs no more than that (BatchTracer).
+// made into rays 16 at a time in SIMD lanes (make_texel_rays), and traced in packets filled with
+// the rays of consecutive texels (PackedTracer), which hands each sample's mu back in order to
+// the texel's sums (TexelSums).
 template <int N>
 class TexelWorker {
  public:
   /// `texels`: the map's coverage and the scene it was computed on, for texel_sampling centre.
   TexelWorker(const Tracer& tracer, const RaytracedBakeParams& params, BakeResult& out, TexelGuides* guides, const detail::TexelSource& texels)
-      : batch_tracer_(tracer), params_(params), out_(out), guides_(guides), texels_(texels), spread_(detail::cone_disk_radius(params.spread_angle)) {}
+      : tracer_(tracer, !params.bent_normals, params.bent_normals), sums_(out, guides, params.samples, params.bent_normals, false), params_(params), guides_(guides),
+        texels_(texels), spread_(detail::cone_disk_radius(params.spread_angle)) {}
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& surface,
                   std::span<const TexelPiece> fragments) {
@@ -102,33 +104,24 @@ class TexelWorker {
     table_.build(patch, params_.offset);
     if (guides_) detail::patch_guide(surface, geometric, guides_->position[texel], guides_->normal[texel]);
     points_.generate(detail::texel_sample_set(params_.seed, x, y, params_.samples), params_.samples);
-    if (guides_) noise_.reset(params_.samples);
-    detail::MeanAccumulator acc;
-    Vec3 bent{0, 0, 0};
     for (int first = 0; first < params_.samples; first += 16) {
       const int count = std::min(16, params_.samples - first);
       points_.lanes(first, count, u_);
       if (spread_ < 1.0f) detail::narrow_to_cone(u_, count, spread_, cone_u_);
       detail::make_texel_rays(patch, table_, spread_ < 1.0f ? cone_u_ : u_, count, geometric, batch_);
-      // The default bake (no bent normals) hands the batch to Embree as one packet.
-      float mu[16];
-      batch_tracer_.trace(ctx, batch_, count, !params_.bent_normals, mu);
-      for (int k = 0; k < count; ++k) {
-        acc.add(mu[k]);  // a direction below the face (no ray) counts as occluded, mu = 0
-        if (guides_) noise_.add(noise_.cell(u_[0][k], u_[1][k]), mu[k]);
-        if (params_.bent_normals && batch_.valid[k]) bent += Vec3{batch_.dx[k], batch_.dy[k], batch_.dz[k]} * mu[k];
-      }
+      std::uint32_t strata[16];
+      for (int k = 0; k < count; ++k) strata[k] = sums_.stratum(u_[0][k], u_[1][k]);
+      tracer_.add(ctx, batch_, count, strata, sums_);
     }
-    out_.visibility[texel] = static_cast<float>(acc.mean());
-    if (params_.bent_normals) out_.bent_normal[texel] = normalize(bent);
-    if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
+    // (Texels of the map fit in 32 bits: kMaxSize^2 = 2^28.)
+    tracer_.end_texel(static_cast<std::uint32_t>(texel), sums_);
   }
+  void finish(RTCIntersectContext& ctx) { tracer_.flush(ctx, sums_); }
 
  private:
-  detail::BatchTracer<N> batch_tracer_;
-  detail::StratifiedVariance noise_;
+  detail::PackedTracer<N> tracer_;
+  detail::TexelSums sums_;
   const RaytracedBakeParams& params_;
-  BakeResult& out_;
   TexelGuides* guides_;
   const detail::TexelSource& texels_;
   detail::TexelPoints points_;

@@ -64,7 +64,7 @@ int clip_half_plane(const Corner* in, int n, float bound, Corner* out) {
 float ClipPolygon::area() const {
   double s = 0;
   for (int i = 0; i < n; ++i) {
-    const Vec2 a = p[i], b = p[(i + 1) % n];
+    const Vec2 a = p[i], b = p[i + 1 == n ? 0 : i + 1];  // (not % n: a division per corner)
     s += static_cast<double>(a.x) * b.y - static_cast<double>(b.x) * a.y;
   }
   return static_cast<float>(std::abs(s) * 0.5);

@@ -12,12 +12,15 @@
 #include <type_traits>
 #include <vector>
 
+#include "ao/bake/bake_result.h"
+#include "ao/bake/denoise.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/core/membership.h"
 #include "ao/core/parallel.h"
 #include "ao/core/progress.h"
 #include "ao/core/sampling.h"
 #include "ao/reference/embree_scene_internal.h"
+#include "ao/reference/mean_accumulator_internal.h"
 #include "ao/reference/packets_internal.h"
 #include "ao/reference/ray_offset.h"
 #include "ao/reference/ray_scene.h"
@@ -45,6 +48,9 @@ TriangleNormals face_normals(const Scene& s);
 /// are affine in UV over a mesh triangle, so at a point with corner weights w they are the
 /// w-weighted sums of the corner values: no barycentric solve per sample.
 struct PatchPiece {
+  // Not value-initialised: build_patch sets every field of each piece it appends (zeroing a
+  // piece's 136 bytes before that, with rep stos, took 12% of build_patch).
+  PatchPiece() {}  // NOLINT(modernize-use-equals-default)
   std::uint32_t mesh, triangle;
   std::array<Vec3, 3> p;     ///< World positions of the corners.
   std::array<Vec3, 3> n;     ///< Interpolated vertex normals at the corners (not normalised: normalise after weighting).
@@ -355,7 +361,8 @@ class BatchTracer {
   /// (no ray). `as_packet`: with 16-wide packets and an occlusion-only tracer, the batch goes to
   /// Embree as it is, one packet whose valid lanes may have gaps; otherwise the valid lanes are
   /// packed, in order, into packets of N (an occlusion-only tracer's straight from the batch).
-  void trace(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, bool as_packet, float (&mu)[16]) {
+  template <class Batch>  // TexelRayBatch, or any layout of its arrays with at least its 16 lanes
+  void trace(RTCIntersectContext& ctx, const Batch& batch, int count, bool as_packet, float (&mu)[16]) {
     const float reach = tracer_.falloff.reach();
     if constexpr (N == 16) {
       if (as_packet && tracer_.falloff.membership == Membership::Step && !tracer_.ignore_back) {
@@ -393,7 +400,8 @@ class BatchTracer {
   // An occlusion-only batch in packets of N < 16: the valid lanes packed in order into packets
   // whose fixed fields were set once, a packet's unused lanes repeating its first ray, not valid
   // (the packets Tracer::trace makes, without its per-ray copies).
-  void trace_narrow(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, float reach, float (&mu)[16]) {
+  template <class Batch>
+  void trace_narrow(RTCIntersectContext& ctx, const Batch& batch, int count, float reach, float (&mu)[16]) {
     int lane_of[16];
     int live = 0;
     for (int k = 0; k < 16; ++k) {
@@ -423,6 +431,159 @@ class BatchTracer {
   std::array<float, 16> mu_;
 };
 
+/// The rays of consecutive texels traced together in full packets. A call into Embree costs a
+/// fixed share of traversal besides its rays (about 0.5 us on the elephant's 1024^2 map, as much as
+/// five rays), so a texel of 6 samples traced in a packet of its own pays it for 6 of 16 lanes, and
+/// one of 24 for 8 lanes of its second packet. Here the texels' batches (make_texel_rays) are laid
+/// end to end, sample after sample, in one stream of lanes, which is traced 16 lanes at a time
+/// (the last lanes at flush); each sample's mu is handed back (to consumer.sample) in the order
+/// the samples came, and each texel's end (consumer.texel_done) after its last sample, so that
+/// whatever sums a texel makes of its samples' mu are the sums it made tracing alone. A lane with
+/// no ray (a direction below the face) stays in the stream, not valid: mu = 0.
+template <int N>
+class PackedTracer {
+ public:
+  /// A sample handed back: its mu, its tag (the caller's: its stratum), and its ray's direction
+  /// (kept only with `keep_directions`; a sample with no ray: anything).
+  struct Sample {
+    float mu;
+    std::uint32_t tag;
+    Vec3 dir;
+  };
+
+  /// `as_packet`: BatchTracer::trace's (a packet goes to Embree as it is).
+  PackedTracer(const Tracer& tracer, bool as_packet, bool keep_directions)
+      : batch_tracer_(tracer), as_packet_(as_packet), keep_directions_(keep_directions) {}
+
+  /// Samples 0 .. count - 1 of a texel's batch, in order, `tags[k]` each one's tag. Traces the
+  /// stream's first 16 lanes once they are filled, and hands back what they finish.
+  template <class Consumer>
+  void add(RTCIntersectContext& ctx, const TexelRayBatch& batch, int count, const std::uint32_t* tags, Consumer& consumer) {
+    // The whole batch is copied (make_texel_rays marks its lanes from count on not valid); the
+    // next batch writes over the lanes past count.
+    std::copy_n(batch.ox, kWidth, stream_.ox + fill_), std::copy_n(batch.oy, kWidth, stream_.oy + fill_), std::copy_n(batch.oz, kWidth, stream_.oz + fill_);
+    std::copy_n(batch.dx, kWidth, stream_.dx + fill_), std::copy_n(batch.dy, kWidth, stream_.dy + fill_), std::copy_n(batch.dz, kWidth, stream_.dz + fill_);
+    std::copy_n(batch.valid, kWidth, stream_.valid + fill_);
+    for (int k = 0; k < count; ++k) tag_[(traced_ + static_cast<std::uint64_t>(fill_ + k)) & kRingMask] = tags[k];
+    fill_ += count;
+    if (fill_ >= kWidth) trace(ctx, kWidth, consumer);
+  }
+  /// The end of a texel's samples (it may have none: high to low's texel whose cage points all
+  /// missed): consumer.texel_done(texel) once they are all handed back.
+  template <class Consumer>
+  void end_texel(std::uint32_t texel, Consumer& consumer) {
+    ends_.push_back({texel, traced_ + static_cast<std::uint64_t>(fill_)});
+    drain(consumer);
+  }
+  /// Traces what the stream holds and hands everything back (the end of a tile).
+  template <class Consumer>
+  void flush(RTCIntersectContext& ctx, Consumer& consumer) {
+    if (fill_ > 0) trace(ctx, fill_, consumer);
+    drain(consumer);
+  }
+
+ private:
+  static constexpr int kWidth = TexelRayBatch::kWidth;
+  // Samples between the last handed back and the last added: at most 2 kWidth - 1 in the stream
+  // plus a batch. (Texel ends are not bounded so: any number of texels without samples may end
+  // while the stream holds rays.)
+  static constexpr std::uint64_t kRingMask = 63;
+  struct Stream {  // two batches' worth of lanes, as TexelRayBatch lays out one
+    alignas(64) float ox[2 * kWidth]{}, oy[2 * kWidth]{}, oz[2 * kWidth]{};
+    alignas(64) float dx[2 * kWidth]{}, dy[2 * kWidth]{}, dz[2 * kWidth]{};
+    alignas(64) int valid[2 * kWidth]{};
+  };
+  struct End {
+    std::uint32_t texel;
+    std::uint64_t at;  // the stream position after its last sample
+  };
+
+  // Traces lanes 0 .. lanes - 1 (lanes <= kWidth; those past `lanes` are not valid), moves the
+  // rest of the stream down, and hands back what they finish.
+  template <class Consumer>
+  void trace(RTCIntersectContext& ctx, int lanes, Consumer& consumer) {
+    for (int k = lanes; k < kWidth; ++k) stream_.valid[k] = 0;
+    float mu[kWidth];
+    batch_tracer_.trace(ctx, stream_, lanes, as_packet_, mu);
+    for (int k = 0; k < lanes; ++k) {
+      const std::uint64_t at = (traced_ + static_cast<std::uint64_t>(k)) & kRingMask;
+      mu_[at] = mu[k];
+      if (keep_directions_) dir_[at] = {stream_.dx[k], stream_.dy[k], stream_.dz[k]};
+    }
+    traced_ += static_cast<std::uint64_t>(lanes);
+    fill_ -= lanes;
+    for (float* lane : {stream_.ox, stream_.oy, stream_.oz, stream_.dx, stream_.dy, stream_.dz}) std::copy_n(lane + lanes, fill_, lane);
+    std::copy_n(stream_.valid + lanes, fill_, stream_.valid);
+    drain(consumer);
+  }
+  // Hands back every traced sample not handed back yet, and the ends of texels among them, in order.
+  template <class Consumer>
+  void drain(Consumer& consumer) {
+    for (;;) {
+      while (ends_front_ < ends_.size() && ends_[ends_front_].at == given_) consumer.texel_done(ends_[ends_front_++].texel);
+      if (ends_front_ == ends_.size()) ends_.clear(), ends_front_ = 0;
+      if (given_ == traced_) return;
+      const std::uint64_t at = given_++ & kRingMask;
+      consumer.sample(Sample{mu_[at], tag_[at], keep_directions_ ? dir_[at] : Vec3{}});
+    }
+  }
+
+  BatchTracer<N> batch_tracer_;
+  bool as_packet_, keep_directions_;
+  int fill_ = 0;               // lanes of the stream filled
+  std::uint64_t traced_ = 0;   // stream position of lane 0: samples traced so far
+  std::uint64_t given_ = 0;    // samples handed back so far
+  std::vector<End> ends_;        // texel ends not handed back yet, from ends_front_ on
+  std::size_t ends_front_ = 0;
+  std::array<float, kRingMask + 1> mu_;
+  std::array<std::uint32_t, kRingMask + 1> tag_;
+  std::array<Vec3, kRingMask + 1> dir_;
+  Stream stream_;
+};
+
+/// What the inside-out bakers make of a texel's samples as PackedTracer hands them back, in
+/// order: the mean of mu (V), the mu-weighted sum of the ray directions (the bent normal), and
+/// the variance of the mean over the strata the samples' tags name (the filter's guide), written
+/// to the texel at its end. `mark_missed` (high to low): a texel none of whose samples came back
+/// (no cage point found the high mesh) is marked missed instead.
+class TexelSums {
+ public:
+  TexelSums(BakeResult& out, TexelGuides* guides, int samples, bool bent_normals, bool mark_missed)
+      : out_(out), guides_(guides), samples_(samples), bent_normals_(bent_normals), mark_missed_(mark_missed) {
+    if (guides_) noise_.reset(samples_);
+  }
+  /// The stratum (the tag of a sample) of direction uniforms (u0, u1): StratifiedVariance's cell.
+  std::uint32_t stratum(float u0, float u1) const { return guides_ ? noise_.cell(u0, u1) : 0u; }
+
+  template <class Sample>
+  void sample(const Sample& s) {
+    acc_.add(s.mu);  // a direction below the face (no ray) counts as occluded, mu = 0
+    if (guides_) noise_.add(s.tag, s.mu);
+    if (bent_normals_ && s.mu != 0.0f) bent_ += s.dir * s.mu;
+  }
+  void texel_done(std::uint32_t texel) {
+    if (mark_missed_ && acc_.n == 0) {
+      out_.missed[texel] = 1;
+    } else {
+      out_.visibility[texel] = static_cast<float>(acc_.mean());
+      if (bent_normals_) out_.bent_normal[texel] = normalize(bent_);
+      if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
+    }
+    acc_ = {};
+    bent_ = {0, 0, 0};
+    if (guides_) noise_.reset(samples_);
+  }
+
+ private:
+  BakeResult& out_;
+  TexelGuides* guides_;
+  int samples_;
+  bool bent_normals_, mark_missed_;
+  MeanAccumulator acc_;
+  StratifiedVariance noise_;
+  Vec3 bent_{0, 0, 0};
+};
+
 /// Texels per tile side of the inside-out bakers' tile loop: neighbouring texels lie close on the
 /// surface, so a tile's rays share BVH nodes in cache.
 inline constexpr int kTexelTile = 16;
@@ -432,7 +593,8 @@ static_assert(kTexelTile % TexelCoverage::kBin == 0, "a tile of texels is whole 
 /// whose face normals are `fn`) that has a non-empty patch, in tiles of kTexelTile texels traced
 /// in `rs` (ray_tiles_internal.h). Each tile makes its worker, w = make_worker.template
 /// operator()<N>() (its scratch: sample points, batches, packets), and calls w(ctx, x, y, texel,
-/// patch, fragments) for each such texel, texel = y * width + x, fragments its texel_fragments.
+/// patch, fragments) for each such texel, texel = y * width + x, fragments its texel_fragments,
+/// then w.finish(ctx) at the end of the tile where the worker has one.
 /// Progress is reported in covered texels. A texel's work may depend only on the texel (its
 /// coordinates, its seed), so that the result is the same at any thread count.
 template <class MakeWorker>
@@ -451,6 +613,7 @@ void for_each_texel_patch(const RayScene& rs, const Scene& surface, const TexelC
       build_patch(surface, cov, fn, fragments, patch);
       if (!patch.empty()) worker(ctx, x, y, texel, patch, fragments);
     });
+    if constexpr (requires { worker.finish(ctx); }) worker.finish(ctx);  // a worker that holds texels back (PackedTracer)
     return covered;
   });
 }

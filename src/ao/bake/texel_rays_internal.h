@@ -512,8 +512,11 @@ class PackedTracer {
     }
     traced_ += static_cast<std::uint64_t>(lanes);
     fill_ -= lanes;
-    for (float* lane : {stream_.ox, stream_.oy, stream_.oz, stream_.dx, stream_.dy, stream_.dz}) std::copy_n(lane + lanes, fill_, lane);
-    std::copy_n(stream_.valid + lanes, fill_, stream_.valid);
+    // A whole batch's width moved down (lanes <= kWidth), not just the fill_ lanes left: a copy of
+    // fixed size is a vector move, not a call; the lanes past fill_ are written over by the next
+    // batch, or marked not valid by the flush, before they are traced.
+    for (float* lane : {stream_.ox, stream_.oy, stream_.oz, stream_.dx, stream_.dy, stream_.dz}) std::copy_n(lane + lanes, kWidth, lane);
+    std::copy_n(stream_.valid + lanes, kWidth, stream_.valid);
     drain(consumer);
   }
   // Hands back every traced sample not handed back yet, and the ends of texels among them, in order.

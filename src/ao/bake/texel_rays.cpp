@@ -111,7 +111,8 @@ void centre_patch(const TexelSource& texels, std::size_t texel, std::span<const 
   const Vec2 q{static_cast<float>(texel % static_cast<std::size_t>(cov.width)) + 0.5f,
                static_cast<float>(texel / static_cast<std::size_t>(cov.width)) + 0.5f};
   float best_d2 = kInfinity;
-  PatchPiece pc{};
+  PatchPiece pc;  // (its Vec3s start at 0; the rest set here, should no fragment's distance compare)
+  pc.mesh = 0, pc.triangle = 0, pc.offset = 0.0f;
   for (std::size_t f = 0; f < fragments.size() && best_d2 > 0; ++f) {
     const TexelFragment& fr = fragments[f].fragment;
     const Mesh& m = texels.scene.meshes[fr.mesh];

@@ -13,6 +13,7 @@
 #include "ao/bake/raytraced_bake.h"
 #include "ao/bake/texel_coverage.h"
 #include "ao/io/mesh_io.h"
+#include "ao/reference/triangle_pairs_internal.h"
 #include "bench_scenes.h"
 
 namespace ao::bench {
@@ -63,6 +64,14 @@ void uv_coverage(benchmark::State& state, const std::string& file) {
   for (auto _ : state) benchmark::DoNotOptimize(compute_texel_coverage(f->scene, 1024));
 }
 
+// The bake BVH's quads (reference/triangle_pairs.cpp): part of every bake's fixed cost.
+void triangle_pairs(benchmark::State& state, const std::string& file) {
+  BakeFixture* f = uv_mesh(file, 1024);
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
+  for (auto _ : state) benchmark::DoNotOptimize(detail::pair_triangles(f->scene.meshes.front()));
+  state.counters["triangles"] = static_cast<double>(f->scene.meshes.front().triangle_count());
+}
+
 BENCHMARK_CAPTURE(histogram, elephant, std::string("refined_elephant_uv.obj"))
     ->Args({1024, 128})->Args({1024, 256})->Args({1024, 512})->Args({1024, 1024})->Args({512, 512})
     ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
@@ -71,6 +80,7 @@ BENCHMARK_CAPTURE(histogram, dragon, std::string("ChineseDragon-10kv_uv.obj"))
 BENCHMARK_CAPTURE(raytraced, elephant, std::string("refined_elephant_uv.obj"))
     ->Args({512, 64})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_CAPTURE(uv_coverage, elephant, std::string("refined_elephant_uv.obj"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(triangle_pairs, elephant, std::string("refined_elephant_uv.obj"))->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace ao::bench

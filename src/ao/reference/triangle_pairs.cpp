@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <compare>
 #include <cstddef>
 #include <numeric>
-#include <tuple>
 #include <utility>
 
 #include <tbb/parallel_sort.h>
@@ -43,74 +43,114 @@ float box_area(std::initializer_list<Vec3> pts) {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-/// Directed edge c -> c + 1 of triangle tri (corner c): key = its ends' position ids lo < hi
-/// (lo in the high half), at = 4 tri + c, forward: it runs lo -> hi. Sorted by (key, at), all distinct.
+/// A directed edge c -> c + 1 of a triangle, in the list of the edges whose lower position id is
+/// the same: `hi` its other end's id, at = 4 tri + c, forward: it runs lo -> hi.
 struct Edge {
-  std::uint64_t key;
+  std::uint32_t hi;
   std::uint32_t at;
   bool forward;
   std::uint32_t tri() const { return at >> 2; }
   int corner() const { return static_cast<int>(at & 3u); }
 };
 
-struct Candidate {
-  float cost;
-  std::uint32_t a, b;            // triangles, a < b
-  std::uint8_t corner_a, corner_b;  // where the shared edge starts in each
+/// The mesh's directed edges by their ends' position ids (lo, hi), lo < hi, each pair's edges in
+/// triangle then corner order: the edges of lo are edges[offsets[lo] .. offsets[lo + 1]). A
+/// counting sort by lo (the edges are made in (triangle, corner) order, so each list starts in
+/// that order), then each list sorted stably by hi: lists are a vertex's edges, a handful.
+struct EdgeLists {
+  std::vector<std::uint32_t> offsets;
+  std::vector<Edge> edges;
 };
+
+EdgeLists edge_lists(const Mesh& m, const std::vector<std::uint32_t>& id) {
+  const std::size_t nt = m.triangle_count();
+  const auto ends = [&](std::size_t t, int c) {
+    return std::make_pair(id[m.indices[3 * t + static_cast<std::size_t>(c)]], id[m.indices[3 * t + static_cast<std::size_t>((c + 1) % 3)]]);
+  };
+  EdgeLists out;
+  out.offsets.assign(id.size() + 1, 0);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 3; ++c)
+      if (const auto [p, q] = ends(t, c); p != q) ++out.offsets[std::min(p, q) + 1];  // a collapsed edge joins nothing
+  for (std::size_t v = 0; v < id.size(); ++v) out.offsets[v + 1] += out.offsets[v];
+  out.edges.resize(out.offsets.back());
+  std::vector<std::uint32_t> cursor(out.offsets.begin(), out.offsets.end() - 1);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 3; ++c)
+      if (const auto [p, q] = ends(t, c); p != q)
+        out.edges[cursor[std::min(p, q)]++] = {std::max(p, q), static_cast<std::uint32_t>(4 * t + static_cast<std::size_t>(c)), p < q};
+  const auto by_hi = [](const Edge& x, const Edge& y) { return x.hi < y.hi; };
+  for (std::size_t v = 0; v < id.size(); ++v) {
+    const auto first = out.edges.begin() + out.offsets[v], last = out.edges.begin() + out.offsets[v + 1];
+    if (last - first > 32) {
+      std::stable_sort(first, last, by_hi);  // a fan's hub, a pole
+      continue;
+    }
+    for (auto i = first + 1; i < last; ++i)  // insertion sort: stable, no buffer
+      for (auto j = i; j > first && by_hi(*j, *(j - 1)); --j) std::iter_swap(j, j - 1);
+  }
+  return out;
+}
+
+/// A candidate pair as two integers, ordered as the greedy pass takes them: its quad's cost (a
+/// non-negative float, whose bits order as it does), then its triangles a < b, then the corners
+/// where the shared edge starts in each.
+struct CandidateKey {
+  std::uint64_t cost_a;                 // cost's bits, a
+  std::uint64_t b_corners;              // b, corner_a, corner_b
+  auto operator<=>(const CandidateKey&) const = default;
+  std::uint32_t a() const { return static_cast<std::uint32_t>(cost_a); }
+  std::uint32_t b() const { return static_cast<std::uint32_t>(b_corners >> 32); }
+  std::uint8_t corner_a() const { return static_cast<std::uint8_t>(b_corners >> 8); }
+  std::uint8_t corner_b() const { return static_cast<std::uint8_t>(b_corners); }
+};
+CandidateKey candidate_key(float cost, std::uint32_t a, std::uint32_t b, std::uint8_t corner_a, std::uint8_t corner_b) {
+  return {std::uint64_t{std::bit_cast<std::uint32_t>(cost)} << 32 | a, std::uint64_t{b} << 32 | std::uint64_t{corner_a} << 8 | corner_b};
+}
 
 }  // namespace
 
 TrianglePairs pair_triangles(const Mesh& m) {
   const std::size_t nt = m.triangle_count();
-  const std::vector<std::uint32_t> id = position_ids(m);
+  const EdgeLists lists = edge_lists(m, position_ids(m));
   const auto vertex = [&](std::size_t t, int c) { return m.indices[3 * t + static_cast<std::size_t>(c % 3)]; };
-
-  std::vector<Edge> edges;
-  edges.reserve(3 * nt);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t p = id[vertex(t, c)], q = id[vertex(t, c + 1)];
-      if (p == q) continue;  // a collapsed edge joins nothing
-      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(p, q)) << 32) | std::max(p, q);
-      edges.push_back({key, static_cast<std::uint32_t>(4 * t + static_cast<std::size_t>(c)), p < q});
-    }
-  tbb::parallel_sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.key != y.key ? x.key < y.key : x.at < y.at; });
 
   // Candidates: two different triangles on one edge, running it in opposite directions. An edge
   // of more than kMaxFan triangles (non-manifold fans, stacked copies) offers none: its candidates
   // grow with the square of its triangles, and they still pair across their other edges.
   constexpr std::size_t kMaxFan = 8;
-  std::vector<Candidate> candidates;
-  for (std::size_t first = 0; first < edges.size();) {
-    std::size_t last = first + 1;
-    while (last < edges.size() && edges[last].key == edges[first].key) ++last;
-    if (last - first <= kMaxFan)
-      for (std::size_t i = first; i < last; ++i)
-        for (std::size_t j = i + 1; j < last; ++j) {
-          const Edge& x = edges[i];
-          const Edge& y = edges[j];
-          if (x.tri() == y.tri() || x.forward == y.forward) continue;
-          const Vec3 pa = m.positions[vertex(x.tri(), x.corner())], pb = m.positions[vertex(x.tri(), x.corner() + 1)];
-          const Vec3 pc = m.positions[vertex(x.tri(), x.corner() + 2)], pd = m.positions[vertex(y.tri(), y.corner() + 2)];
-          const float separate = box_area({pa, pb, pc}) + box_area({pa, pb, pd});
-          const float cost = separate > 0 ? box_area({pa, pb, pc, pd}) / separate : 0.0f;
-          const auto cx = static_cast<std::uint8_t>(x.corner()), cy = static_cast<std::uint8_t>(y.corner());
-          if (x.tri() < y.tri()) candidates.push_back({cost, x.tri(), y.tri(), cx, cy});
-          else candidates.push_back({cost, y.tri(), x.tri(), cy, cx});
-        }
-    first = last;
-  }
-  tbb::parallel_sort(candidates.begin(), candidates.end(),
-            [](const Candidate& x, const Candidate& y) { return std::tie(x.cost, x.a, x.b, x.corner_a, x.corner_b) < std::tie(y.cost, y.a, y.b, y.corner_a, y.corner_b); });
+  std::vector<CandidateKey> candidates;
+  candidates.reserve(lists.edges.size() / 2);
+  const std::vector<Edge>& edges = lists.edges;
+  for (std::size_t v = 0; v + 1 < lists.offsets.size(); ++v)
+    for (std::size_t first = lists.offsets[v], end = lists.offsets[v + 1]; first < end;) {
+      std::size_t last = first + 1;
+      while (last < end && edges[last].hi == edges[first].hi) ++last;
+      if (last - first <= kMaxFan)
+        for (std::size_t i = first; i < last; ++i)
+          for (std::size_t j = i + 1; j < last; ++j) {
+            const Edge& x = edges[i];
+            const Edge& y = edges[j];
+            if (x.tri() == y.tri() || x.forward == y.forward) continue;
+            const Vec3 pa = m.positions[vertex(x.tri(), x.corner())], pb = m.positions[vertex(x.tri(), x.corner() + 1)];
+            const Vec3 pc = m.positions[vertex(x.tri(), x.corner() + 2)], pd = m.positions[vertex(y.tri(), y.corner() + 2)];
+            const float separate = box_area({pa, pb, pc}) + box_area({pa, pb, pd});
+            const float cost = separate > 0 ? box_area({pa, pb, pc, pd}) / separate : 0.0f;
+            const auto cx = static_cast<std::uint8_t>(x.corner()), cy = static_cast<std::uint8_t>(y.corner());
+            candidates.push_back(x.tri() < y.tri() ? candidate_key(cost, x.tri(), y.tri(), cx, cy) : candidate_key(cost, y.tri(), x.tri(), cy, cx));
+          }
+      first = last;
+    }
+  std::sort(candidates.begin(), candidates.end());
 
   constexpr std::uint32_t kNone = 0xffffffffu;
   std::vector<std::uint32_t> partner(nt, kNone);
   std::vector<std::uint8_t> corner(nt, 0);  // where the shared edge starts in each paired triangle
-  for (const Candidate& c : candidates) {
-    if (partner[c.a] != kNone || partner[c.b] != kNone) continue;
-    partner[c.a] = c.b, partner[c.b] = c.a;
-    corner[c.a] = c.corner_a, corner[c.b] = c.corner_b;
+  for (const CandidateKey& k : candidates) {
+    const std::uint32_t a = k.a(), b = k.b();
+    if (partner[a] != kNone || partner[b] != kNone) continue;
+    partner[a] = b, partner[b] = a;
+    corner[a] = k.corner_a(), corner[b] = k.corner_b();
   }
 
   TrianglePairs out;

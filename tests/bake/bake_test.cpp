@@ -810,11 +810,12 @@ FlatChart flat_chart(int w, int h) {
   Scene s;
   s.meshes = {uv_quad({0, 0, fh}, {fw, 0, fh}, {fw, 0, 0}, {0, 0, 0}, {0, 0}, {1, 1})};
   s = prepared(std::move(s));
-  FlatChart c{compute_texel_coverage(s, w, h), TexelGuides(w, h)};
+  FlatChart c{compute_texel_coverage(s, w, h), {}};
+  c.guides = TexelGuides(c.cov.mask);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      c.guides.position(x, y) = {static_cast<float>(x) + 0.5f, 0, static_cast<float>(h - y) - 0.5f};
-      c.guides.normal(x, y) = {0, 1, 0};
+      c.guides.position[c.guides.slot(x, y)] = {static_cast<float>(x) + 0.5f, 0, static_cast<float>(h - y) - 0.5f};
+      c.guides.normal[c.guides.slot(x, y)] = {0, 1, 0};
     }
   return c;
 }
@@ -832,7 +833,7 @@ TEST(Bake, DenoisingKeepsALinearRampAtTheBorderOfAChart) {
   Image<float> v(kW, kH, 0.0f);
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
-      guides.variance(x, y) = 100.0f;
+      guides.variance[guides.slot(x, y)] = 100.0f;
       v(x, y) = 0.1f + kSlope * static_cast<float>(x);
     }
   const Image<float> before = v;
@@ -872,7 +873,7 @@ TEST(Bake, DenoisingKeepsTheMeanOfANoisyChart) {
       }
       const float p = static_cast<float>(escaped) / kSamples;
       v(x, y) = p;
-      guides.variance(x, y) = p * (1 - p) / (kSamples - 1);  // the sample variance of the mean
+      guides.variance[guides.slot(x, y)] = p * (1 - p) / (kSamples - 1);  // the sample variance of the mean
       before += p;
     }
   before /= kN * kN;

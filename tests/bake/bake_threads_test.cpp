@@ -127,12 +127,12 @@ TEST(BakeThreads, DenoisingDoesNotDependOnTheThreadsFloatingPointMode) {
   const Scene s = prepared({quad}, "strip");
   const TexelCoverage cov = compute_texel_coverage(s, 2, 1);
   ASSERT_EQ(cov.covered_texels, 2u);
-  TexelGuides guides(2, 1);
-  guides.position(0, 0) = {0.5f, 0, 0.5f};
-  guides.position(1, 0) = {1.5f, 0, 0.5f};
-  guides.normal(0, 0) = guides.normal(1, 0) = {0, 1, 0};
+  TexelGuides guides(cov.mask);
+  guides.position[guides.slot(0, 0)] = {0.5f, 0, 0.5f};
+  guides.position[guides.slot(1, 0)] = {1.5f, 0, 0.5f};
+  guides.normal[guides.slot(0, 0)] = guides.normal[guides.slot(1, 0)] = {0, 1, 0};
   // 0.5 dV^2 / (2^2 (var_0 + var_1 + 0.01^2)) = 95 for dV = 1 (denoise.h, the second pass).
-  guides.variance(0, 0) = guides.variance(1, 0) = 0.5f * (0.5f / (4.0f * 95.0f) - 1e-4f);
+  guides.variance[guides.slot(0, 0)] = guides.variance[guides.slot(1, 0)] = 0.5f * (0.5f / (4.0f * 95.0f) - 1e-4f);
   const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);  // the filter runs on this thread
   const unsigned mode = _mm_getcsr();
   std::array<float, 2> result[2];

@@ -49,7 +49,7 @@ constexpr float kSlopeRidge = 0.5f;
 // that is not null.
 struct PassInputs {
   const Image<float>& value;
-  const Image<float>& variance;
+  const std::vector<float>& variance;  // per guide slot
   const Image<float>* guide;
   const Image<float>* guide_variance;
   float sigma, range_tolerance;
@@ -92,13 +92,16 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
       std::fill_n(p[0], plane_size, std::numeric_limits<float>::quiet_NaN());
       for (int y = std::max(0, y0 - r); y < std::min(h, y0 + rows + r); ++y) {
         const std::ptrdiff_t base = (y - y0 + r) * stride + r;
+        std::size_t slot = guides.row_slot(y);  // the guides' slot of the row's next covered texel
         for (int x = 0; x < w; ++x) {
           const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+          const std::size_t s = slot;
+          slot += cov.mask.data()[t];
           if (!valid.data()[t]) continue;
           const std::ptrdiff_t e = base + x;
-          const Vec3 pos = guides.position.data()[t], nor = guides.normal.data()[t];
+          const Vec3 pos = guides.position[s], nor = guides.normal[s];
           p[0][e] = pos.x, p[1][e] = pos.y, p[2][e] = pos.z, p[3][e] = nor.x, p[4][e] = nor.y, p[5][e] = nor.z;
-          p[6][e] = in.value.data()[t], p[7][e] = in.variance.data()[t];
+          p[6][e] = in.value.data()[t], p[7][e] = in.variance[s];
           if (in.guide) p[9][e] = in.guide->data()[t], p[10][e] = in.guide_variance->data()[t];
           const float texel_area = cov.uv_area[t] > 0 ? cov.world_area[t] / cov.uv_area[t] : 0.0f;  // h_c^2
           p[8][e] = texel_area > 0 ? texel_area : 0.0f;
@@ -118,10 +121,34 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
 
 }  // namespace
 
+TexelGuides::TexelGuides(const Image<std::uint8_t>& covered)
+    : width_(covered.width()), chunks_((static_cast<std::size_t>(covered.width()) + 63) / 64) {
+  const std::size_t n = chunks_ * static_cast<std::size_t>(covered.height());
+  chunk_bits_.assign(n, 0);
+  chunk_first_.resize(n);
+  std::size_t count = 0;
+  for (int y = 0; y < covered.height(); ++y)
+    for (std::size_t c = 0; c < chunks_; ++c) {
+      const std::size_t k = static_cast<std::size_t>(y) * chunks_ + c;
+      chunk_first_[k] = static_cast<std::uint32_t>(count);
+      for (int x = static_cast<int>(64 * c); x < std::min(covered.width(), static_cast<int>(64 * c + 64)); ++x)
+        if (covered(x, y)) chunk_bits_[k] |= std::uint64_t{1} << (x % 64), ++count;
+    }
+  position.assign(count, Vec3{0, 0, 0});
+  normal.assign(count, Vec3{0, 0, 1});
+  variance.assign(count, 0.0f);
+}
+
 void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
   const Image<float> raw = visibility;
-  // Pass 1, the guide: the raw values compared with each other, and the variance of each result.
-  Image<float> guide = raw, guide_variance = guides.variance;
+  // Pass 1, the guide: the raw values compared with each other, and the variance of each result
+  // (starting from each texel's own, where the pass leaves one as it is).
+  Image<float> guide = raw, guide_variance(cov.width, cov.height, 0.0f);
+  for (int y = 0; y < cov.height; ++y) {
+    std::size_t slot = guides.row_slot(y);
+    for (int x = 0; x < cov.width; ++x)
+      if (cov.mask(x, y)) guide_variance(x, y) = guides.variance[slot++];
+  }
   filter_pass({raw, guides.variance, nullptr, nullptr, kGuideSigma, kGuideRangeTolerance}, valid, cov, guides, guide, &guide_variance);
   // Pass 2: the raw values again, weighted by how far apart the guide puts them.
   filter_pass({raw, guides.variance, &guide, &guide_variance, sigma, kRangeTolerance}, valid, cov, guides, visibility, nullptr);

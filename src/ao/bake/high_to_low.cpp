@@ -152,7 +152,10 @@ class TexelWorker {
         offset_(offset), guides_(guides), rays_(rays), spread_(detail::cone_disk_radius(params.ao.spread_angle)) {}
 
   void operator()(RTCIntersectContext& ctx, int x, int y, std::size_t texel, const std::vector<PatchPiece>& patch, std::span<const TexelPiece>) {
-    if (guides_) detail::patch_guide(patch, false, guides_->position[texel], guides_->normal[texel]);
+    if (guides_) {
+      const std::size_t slot = guides_->slot(x, y);
+      detail::patch_guide(patch, false, guides_->position[slot], guides_->normal[slot]);
+    }
     const int samples = params_.ao.samples, points = std::min(params_.cage_points, samples);
     // The directions and the cage points both from the texel's block's sequences (TexelSampleSet).
     const detail::TexelSampleSet set = detail::texel_sample_set(params_.ao.seed, x, y, samples);
@@ -301,7 +304,7 @@ BakeResult bake_high_to_low(const Scene& low, const TexelCoverage& cov, const Ca
   // The filter's guides are the low mesh's patches: the map lives in its UV charts.
   const bool denoise = params.ao.denoise > 0;
   TexelGuides guides;
-  if (denoise) guides = TexelGuides(width, height);
+  if (denoise) guides = TexelGuides(cov.mask);
   std::atomic<std::uint64_t> rays{0};
   const TriangleNormals low_fn = detail::face_normals(low);
   detail::for_each_texel_patch(occluders, low, cov, low_fn, progress, [&]<int N>() {

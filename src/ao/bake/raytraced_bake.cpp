@@ -102,7 +102,10 @@ class TexelWorker {
     if (params_.hemisphere == Hemisphere::Inside) detail::turn_over(sampled, flipped_);
     const std::vector<PatchPiece>& patch = params_.hemisphere == Hemisphere::Inside ? flipped_ : sampled;
     table_.build(patch, params_.offset);
-    if (guides_) detail::patch_guide(surface, geometric, guides_->position[texel], guides_->normal[texel]);
+    if (guides_) {
+      const std::size_t slot = guides_->slot(x, y);
+      detail::patch_guide(surface, geometric, guides_->position[slot], guides_->normal[slot]);
+    }
     points_.generate(detail::texel_sample_set(params_.seed, x, y, params_.samples), params_.samples);
     for (int first = 0; first < params_.samples; first += 16) {
       const int count = std::min(16, params_.samples - first);
@@ -219,7 +222,7 @@ BakeResult bake_raytraced(const RayScene& rs, const TexelCoverage& cov, const Ra
   // texel's samples.
   const bool denoise = params.denoise > 0;
   TexelGuides guides;
-  if (denoise) guides = TexelGuides(cov.width, cov.height);
+  if (denoise) guides = TexelGuides(cov.mask);
   const detail::TexelSource texels{scene, cov, fn};
   detail::for_each_texel_patch(rs, scene, cov, fn, progress, [&]<int N>() {
     return TexelWorker<N>(tracer, params, out, denoise ? &guides : nullptr, texels);

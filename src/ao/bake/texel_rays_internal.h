@@ -573,7 +573,7 @@ class TexelSums {
     } else {
       out_.visibility[texel] = static_cast<float>(acc_.mean());
       if (bent_normals_) out_.bent_normal[texel] = normalize(bent_);
-      if (guides_) guides_->variance[texel] = static_cast<float>(noise_.mean_variance());
+      if (guides_) guides_->variance[guides_->slot(texel)] = static_cast<float>(noise_.mean_variance());
     }
     acc_ = {};
     bent_ = {0, 0, 0};

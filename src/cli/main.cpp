@@ -44,7 +44,7 @@ namespace {
 /// pages come as they are touched) and that stretch advised to the kernel as huge pages
 /// (MADV_HUGEPAGE; Debian's kernels give them to advised memory only): a 2 MiB page takes one
 /// fault where 512 did, and the TLB covers 512 times as much of the mesh, the UV bins and the
-/// filter's guides. A 1024^2 bake at 6 rays: page faults 7,700 -> 2,600, CPU 0.95x, for 15 MB more
+/// filter's guides. A 1024^2 bake at 6 rays: page faults 7,700 -> 2,100, CPU about 0.95x, for 15 MB more
 /// peak memory (docs/methods/bake.md, "Speed"). The process keeps the most memory it used at once
 /// until it exits, which a command does soon; the library leaves malloc as its host set it.
 void tune_malloc() {

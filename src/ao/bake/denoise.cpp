@@ -140,6 +140,7 @@ TexelGuides::TexelGuides(const Image<std::uint8_t>& covered)
 }
 
 void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
+  AO_ASSERT(guides.position.size() == cov.covered_texels);  // made for cov.mask
   const Image<float> raw = visibility;
   // Pass 1, the guide: the raw values compared with each other, and the variance of each result
   // (starting from each texel's own, where the pass leaves one as it is).

@@ -105,8 +105,8 @@ class TexelGuides {
 };
 
 /// Filters `visibility` (width x height of `cov`) in place over the texels set in `valid` (the
-/// covered texels of `cov` that have a value) with the weights above; `sigma` in (0,
-/// kMaxDenoiseSigma]. Deterministic at any thread count.
+/// covered texels of `cov` that have a value) with the weights above, `guides` made for
+/// `cov.mask`; `sigma` in (0, kMaxDenoiseSigma]. Deterministic at any thread count.
 void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma);
 
 }  // namespace ao

@@ -93,8 +93,8 @@ EdgeLists edge_lists(const Mesh& m, const std::vector<std::uint32_t>& id) {
 }
 
 /// A candidate pair as two integers, ordered as the greedy pass takes them: its quad's cost (a
-/// non-negative float, whose bits order as it does), then its triangles a < b, then the corners
-/// where the shared edge starts in each.
+/// non-negative float, whose bits order as it does; a NaN, from boxes of infinite area, after
+/// every number), then its triangles a < b, then the corners where the shared edge starts in each.
 struct CandidateKey {
   std::uint64_t cost_a;                 // cost's bits, a
   std::uint64_t b_corners;              // b, corner_a, corner_b

@@ -45,18 +45,27 @@ constexpr float kSlopeRidge = 0.5f;
 
 // One pass of the filter at `sigma` over `value` (the variance of each texel's value: `variance`),
 // its value term comparing `guide` (variance `guide_variance`; both null: the values themselves)
-// with k = `range_tolerance`, into `out`, and the variance of each result into `out_variance` when
-// that is not null.
+// with k = `range_tolerance`. Values and variances other than the map's are per guide slot.
 struct PassInputs {
   const Image<float>& value;
-  const std::vector<float>& variance;  // per guide slot
-  const Image<float>* guide;
-  const Image<float>* guide_variance;
+  const std::vector<float>& variance;
+  const std::vector<float>* guide;
+  const std::vector<float>* guide_variance;
   float sigma, range_tolerance;
 };
 
-void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, Image<float>& out,
-                 Image<float>* out_variance) {
+// Where a pass writes its results: into the map `map`, or per guide slot into `value` and the
+// variance of each result into `variance` (the first pass's guide). A texel the pass leaves as it
+// is (its fit has no weight) keeps what the output held: the map's own value, or in the slots the
+// texel's own value and variance.
+struct PassOutputs {
+  Image<float>* map = nullptr;
+  std::vector<float>* value = nullptr;
+  std::vector<float>* variance = nullptr;
+};
+
+void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides,
+                 const PassOutputs& out) {
   const int w = cov.width, h = cov.height;
   const int r = static_cast<int>(std::ceil(2.0f * in.sigma));
   const int side = 2 * r + 1;
@@ -77,12 +86,13 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
   constexpr std::size_t kPlanes = 11;  // the last two are the guide's: none when the values are their own guide
   const std::size_t planes_used = in.guide ? kPlanes : kPlanes - 2;
   const std::ptrdiff_t stride = w + 2 * r + kMaxLanes;
-  tbb::enumerable_thread_specific<std::vector<float>> scratch;
+  tbb::enumerable_thread_specific<std::vector<float>> scratch, row_scratch;
   tbb::parallel_for(tbb::blocked_range<int>(0, (h + kBandRows - 1) / kBandRows, 1), [&](const tbb::blocked_range<int>& bands) {
     // The weights of far-apart neighbours underflow into denormals: flushed on every thread alike,
     // whatever mode the pool thread was left in, so the result is the same at any thread count.
     const detail::FlushDenormalsScope ftz;
     std::vector<float>& planes = scratch.local();
+    std::vector<float>& row_out = row_scratch.local();  // a row's value and variance, for the slots
     for (int band = bands.begin(); band < bands.end(); ++band) {
       const int y0 = band * kBandRows, rows = std::min(kBandRows, h - y0);
       const auto plane_size = static_cast<std::size_t>((rows + 2 * r) * stride);
@@ -102,7 +112,7 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
           const Vec3 pos = guides.position[s], nor = guides.normal[s];
           p[0][e] = pos.x, p[1][e] = pos.y, p[2][e] = pos.z, p[3][e] = nor.x, p[4][e] = nor.y, p[5][e] = nor.z;
           p[6][e] = in.value.data()[t], p[7][e] = in.variance[s];
-          if (in.guide) p[9][e] = in.guide->data()[t], p[10][e] = in.guide_variance->data()[t];
+          if (in.guide) p[9][e] = (*in.guide)[s], p[10][e] = (*in.guide_variance)[s];
           const float texel_area = cov.uv_area[t] > 0 ? cov.world_area[t] / cov.uv_area[t] : 0.0f;  // h_c^2
           p[8][e] = texel_area > 0 ? texel_area : 0.0f;
         }
@@ -113,8 +123,23 @@ void filter_pass(const PassInputs& in, const Image<std::uint8_t>& valid, const T
                                   .gauss = gauss.data(), .gate = gate.data(), .plane_tolerance2 = kPlaneTolerance * kPlaneTolerance,
                                   .range_scale = 1.0f / (in.range_tolerance * in.range_tolerance), .variance_floor = kVarianceFloor,
                                   .slope_ridge = kSlopeRidge};
-      for (int row = 0; row < rows; ++row)
-        detail::denoise_row(b, row, &out(0, y0 + row), out_variance ? &(*out_variance)(0, y0 + row) : nullptr);
+      for (int row = 0; row < rows; ++row) {
+        if (out.map) {
+          detail::denoise_row(b, row, &(*out.map)(0, y0 + row), nullptr);
+          continue;
+        }
+        row_out.resize(2 * static_cast<std::size_t>(w));
+        float* value = row_out.data();
+        float* variance = value + w;
+        const std::size_t first = guides.row_slot(y0 + row);
+        std::size_t slot = first;
+        for (int x = 0; x < w; ++x)
+          if (cov.mask(x, y0 + row)) value[x] = in.value(x, y0 + row), variance[x] = in.variance[slot++];
+        detail::denoise_row(b, row, value, variance);
+        slot = first;
+        for (int x = 0; x < w; ++x)
+          if (cov.mask(x, y0 + row)) (*out.value)[slot] = value[x], (*out.variance)[slot] = variance[x], ++slot;
+      }
     }
   });
 }
@@ -142,17 +167,13 @@ TexelGuides::TexelGuides(const Image<std::uint8_t>& covered)
 void denoise_map(Image<float>& visibility, const Image<std::uint8_t>& valid, const TexelCoverage& cov, const TexelGuides& guides, float sigma) {
   AO_ASSERT(guides.position.size() == cov.covered_texels);  // made for cov.mask
   const Image<float> raw = visibility;
-  // Pass 1, the guide: the raw values compared with each other, and the variance of each result
-  // (starting from each texel's own, where the pass leaves one as it is).
-  Image<float> guide = raw, guide_variance(cov.width, cov.height, 0.0f);
-  for (int y = 0; y < cov.height; ++y) {
-    std::size_t slot = guides.row_slot(y);
-    for (int x = 0; x < cov.width; ++x)
-      if (cov.mask(x, y)) guide_variance(x, y) = guides.variance[slot++];
-  }
-  filter_pass({raw, guides.variance, nullptr, nullptr, kGuideSigma, kGuideRangeTolerance}, valid, cov, guides, guide, &guide_variance);
+  // Pass 1, the guide: the raw values compared with each other, and the variance of each result,
+  // per guide slot.
+  std::vector<float> guide(guides.variance.size()), guide_variance(guides.variance.size());
+  filter_pass({raw, guides.variance, nullptr, nullptr, kGuideSigma, kGuideRangeTolerance}, valid, cov, guides,
+              {.value = &guide, .variance = &guide_variance});
   // Pass 2: the raw values again, weighted by how far apart the guide puts them.
-  filter_pass({raw, guides.variance, &guide, &guide_variance, sigma, kRangeTolerance}, valid, cov, guides, visibility, nullptr);
+  filter_pass({raw, guides.variance, &guide, &guide_variance, sigma, kRangeTolerance}, valid, cov, guides, {.map = &visibility});
 }
 
 }  // namespace ao

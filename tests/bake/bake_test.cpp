@@ -998,6 +998,28 @@ TEST(Bake, PaddingLeavesNoBlackTexelWithinTheMargin) {
     }
 }
 
+// Two valid texels in a row, (2, 5) and (8, 5) of an 11 x 11 map: the rings reach each texel from
+// the side whose source is nearer (the left one for x < 5, the right one for x > 5), a texel as near
+// to both (x = 5) takes the first in index order, valid texels keep themselves, and a texel more
+// rings away than the margin (Chebyshev distance) gets none.
+TEST(Bake, PaddingTakesTheNearerSourceAndTheFirstOfEquals) {
+  const int n = 11;
+  Image<std::uint8_t> valid(n, n, std::uint8_t{0});
+  valid(2, 5) = valid(8, 5) = 1;
+  const std::int32_t left = 5 * n + 2, right = 5 * n + 8;
+  const Image<std::int32_t> all = nearest_valid_texel(valid, 10);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) EXPECT_EQ(all(x, y), x <= 5 ? left : right) << x << "," << y;
+  const Image<std::int32_t> near = nearest_valid_texel(valid, 2);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const int to_left = std::max(std::abs(x - 2), std::abs(y - 5)), to_right = std::max(std::abs(x - 8), std::abs(y - 5));
+      EXPECT_EQ(near(x, y), to_left <= 2 ? left : to_right <= 2 ? right : -1) << x << "," << y;
+    }
+  EXPECT_EQ(nearest_valid_texel(valid, 0)(3, 5), -1);
+  EXPECT_EQ(nearest_valid_texel(valid, 0)(8, 5), right);
+}
+
 TEST(Bake, PerVertexBothMethodsOnOpenQuadAndWall) {
   const Scene s = floor_and_wall(1.0f);
   const std::vector<float> h = bake_vertices_histogram(s, {.directions = 512, .resolution = 512});

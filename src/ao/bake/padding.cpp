@@ -11,54 +11,75 @@
 
 namespace ao {
 
+namespace {
+
+// The rings work on texel coordinates packed in 31 bits, x in the low 16 and y above (images are at
+// most kMaxImageSide = 32768 texels a side), so that a source's distance needs no division of its
+// index by the width, and packed values order as indices do (y, then x).
+std::int32_t pack(int x, int y) { return static_cast<std::int32_t>(static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16); }
+int unpack_x(std::int32_t p) { return static_cast<int>(static_cast<std::uint32_t>(p) & 0xffffu); }
+int unpack_y(std::int32_t p) { return static_cast<int>(static_cast<std::uint32_t>(p) >> 16); }
+constexpr std::int32_t kUnassigned = -1, kQueued = -2;  // below every packed texel
+
+}  // namespace
+
 Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int margin) {
   const int w = valid.width(), h = valid.height();
-  Image<std::int32_t> src(w, h, -1);
-  std::vector<std::int32_t> front;
+  // Each texel's source, packed, or kUnassigned / kQueued; made into indices at the end, in place.
+  Image<std::int32_t> source(w, h, kUnassigned);
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      if (valid(x, y)) {
-        src(x, y) = y * w + x;
-        front.push_back(y * w + x);
-      }
-  std::vector<std::int32_t> next;
-  std::vector<std::int32_t> ring_src;
+      if (valid(x, y)) source[at(x, y)] = pack(x, y);
+  // The first front: the valid texels with an 8-neighbour that is not (only they can reach an
+  // unassigned texel).
+  std::vector<std::int32_t> front, next;
+  const auto assigned = [&](int x, int y) { return x < 0 || y < 0 || x >= w || y >= h || source[at(x, y)] != kUnassigned; };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (valid(x, y) && !(assigned(x - 1, y - 1) && assigned(x, y - 1) && assigned(x + 1, y - 1) && assigned(x - 1, y) &&
+                           assigned(x + 1, y) && assigned(x - 1, y + 1) && assigned(x, y + 1) && assigned(x + 1, y + 1)))
+        front.push_back(pack(x, y));
+  std::vector<std::int32_t> ring_source;
   for (int ring = 0; ring < margin && !front.empty(); ++ring) {
     // Candidates: unassigned 8-neighbours of the front. Decide all of this ring from the previous
     // rings only, so the result does not depend on the order texels are visited.
     next.clear();
-    for (std::int32_t i : front) {
-      const int x = i % w, y = i / w;
+    for (const std::int32_t p : front) {
+      const int x = unpack_x(p), y = unpack_y(p);
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int nx = x + dx, ny = y + dy;
-          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h || src(nx, ny) != -1) continue;
-          src(nx, ny) = -2;  // queued for this ring
-          next.push_back(ny * w + nx);
+          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h || source[at(nx, ny)] != kUnassigned) continue;
+          source[at(nx, ny)] = kQueued;
+          next.push_back(pack(nx, ny));
         }
     }
-    ring_src.assign(next.size(), -1);
+    // Each candidate takes the source, among its assigned neighbours' sources, nearest to it; of
+    // equally near ones the first in index order. (Every candidate has one: the texel that queued it.)
+    ring_source.resize(next.size());
     for (std::size_t k = 0; k < next.size(); ++k) {
-      const int x = next[k] % w, y = next[k] / w;
+      const int x = unpack_x(next[k]), y = unpack_y(next[k]);
       long best_d = -1;
+      std::int32_t best = kUnassigned;
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int nx = x + dx, ny = y + dy;
           if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-          const std::int32_t s = src(nx, ny);
+          const std::int32_t s = source[at(nx, ny)];
           if (s < 0) continue;
-          const long sx = s % w - x, sy = s / w - y;
+          const long sx = unpack_x(s) - x, sy = unpack_y(s) - y;
           const long d = sx * sx + sy * sy;
-          if (best_d < 0 || d < best_d || (d == best_d && s < ring_src[k])) {
-            best_d = d;
-            ring_src[k] = s;
-          }
+          if (best_d < 0 || d < best_d || (d == best_d && s < best)) best_d = d, best = s;
         }
+      ring_source[k] = best;
     }
-    for (std::size_t k = 0; k < next.size(); ++k) src[static_cast<std::size_t>(next[k])] = ring_src[k];
+    for (std::size_t k = 0; k < next.size(); ++k) source[at(unpack_x(next[k]), unpack_y(next[k]))] = ring_source[k];
     front.swap(next);
   }
-  return src;
+  for (std::size_t i = 0; i < source.size(); ++i)
+    if (const std::int32_t s = source[i]; s >= 0) source[i] = static_cast<std::int32_t>(at(unpack_x(s), unpack_y(s)));
+  return source;
 }
 
 template <class T>

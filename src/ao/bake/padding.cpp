@@ -9,6 +9,8 @@
 
 #include <vector>
 
+#include "ao/core/error.h"
+
 namespace ao {
 
 namespace {
@@ -25,6 +27,7 @@ constexpr std::int32_t kUnassigned = -1, kQueued = -2;  // below every packed te
 
 Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int margin) {
   const int w = valid.width(), h = valid.height();
+  AO_ASSERT(w <= 65536 && h <= 32768);  // what pack holds; images are at most kMaxImageSide a side
   // Each texel's source, packed, or kUnassigned / kQueued; made into indices at the end, in place.
   Image<std::int32_t> source(w, h, kUnassigned);
   const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };

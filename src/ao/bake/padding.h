@@ -17,7 +17,7 @@ inline constexpr int kDefaultPadding = 16;
 
 /// For every texel within `margin` texels (8-connected rings) of a valid one, the index of the
 /// nearest valid texel (Euclidean distance among the candidates propagated ring by ring); -1 for
-/// texels farther away; a valid texel maps to itself. margin >= 0.
+/// texels farther away; a valid texel maps to itself. margin >= 0; at most 65536 x 32768 texels.
 Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int margin);
 
 /// Copies each texel's nearest valid texel into it (padding); texels beyond the margin keep their value.

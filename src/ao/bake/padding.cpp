@@ -30,14 +30,13 @@ Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int ma
   AO_ASSERT(w <= 65536 && h <= 32768);  // what pack holds; images are at most kMaxImageSide a side
   // Each texel's source, packed, or kUnassigned / kQueued; made into indices at the end, in place.
   Image<std::int32_t> source(w, h, kUnassigned);
-  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      if (valid(x, y)) source[at(x, y)] = pack(x, y);
+      if (valid(x, y)) source(x, y) = pack(x, y);
   // The first front: the valid texels with an 8-neighbour that is not (only they can reach an
   // unassigned texel).
   std::vector<std::int32_t> front, next;
-  const auto assigned = [&](int x, int y) { return x < 0 || y < 0 || x >= w || y >= h || source[at(x, y)] != kUnassigned; };
+  const auto assigned = [&](int x, int y) { return x < 0 || y < 0 || x >= w || y >= h || source(x, y) != kUnassigned; };
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       if (valid(x, y) && !(assigned(x - 1, y - 1) && assigned(x, y - 1) && assigned(x + 1, y - 1) && assigned(x - 1, y) &&
@@ -53,8 +52,8 @@ Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int ma
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int nx = x + dx, ny = y + dy;
-          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h || source[at(nx, ny)] != kUnassigned) continue;
-          source[at(nx, ny)] = kQueued;
+          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h || source(nx, ny) != kUnassigned) continue;
+          source(nx, ny) = kQueued;
           next.push_back(pack(nx, ny));
         }
     }
@@ -69,7 +68,7 @@ Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int ma
         for (int dx = -1; dx <= 1; ++dx) {
           const int nx = x + dx, ny = y + dy;
           if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-          const std::int32_t s = source[at(nx, ny)];
+          const std::int32_t s = source(nx, ny);
           if (s < 0) continue;
           const long sx = unpack_x(s) - x, sy = unpack_y(s) - y;
           const long d = sx * sx + sy * sy;
@@ -77,11 +76,11 @@ Image<std::int32_t> nearest_valid_texel(const Image<std::uint8_t>& valid, int ma
         }
       ring_source[k] = best;
     }
-    for (std::size_t k = 0; k < next.size(); ++k) source[at(unpack_x(next[k]), unpack_y(next[k]))] = ring_source[k];
+    for (std::size_t k = 0; k < next.size(); ++k) source(unpack_x(next[k]), unpack_y(next[k])) = ring_source[k];
     front.swap(next);
   }
   for (std::size_t i = 0; i < source.size(); ++i)
-    if (const std::int32_t s = source[i]; s >= 0) source[i] = static_cast<std::int32_t>(at(unpack_x(s), unpack_y(s)));
+    if (const std::int32_t s = source[i]; s >= 0) source[i] = unpack_y(s) * w + unpack_x(s);  // < 2^31: the image's texel count
   return source;
 }
 

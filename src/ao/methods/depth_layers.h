@@ -16,9 +16,18 @@
 // from x to the point meets that plane where the sheet is (not past its rim).
 // Containment, volumetric and ambient transfer test their points and pipes against that solid;
 // Alchemy takes the second layer's point at each tap as an occluder too.
+//
+// Without a second layer (one layer), `thickness` > 0 takes every visible surface for a sheet of
+// that thickness with nothing behind it: the solid along a pixel's ray is [z1, z1 + thickness] and,
+// beyond it, what the sheet hides from the receiver (the sheet test above). That is the second
+// layer's reading where it finds nothing behind, at separation = thickness, for scenes made of open
+// sheets whose second layer cannot be traced (a G-buffer file or arrays); on closed solids it frees
+// what lies behind their far side (docs/methods/depth-layers.md measures both).
 #pragma once
 
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,6 +40,10 @@ namespace ao {
 struct DepthLayers {
   int layers = 1;           ///< 1: the G-buffer's depth only; 2: also its second layer (GBuffer::second_depth).
   float separation = 0.0f;  ///< Minimum separation Delta of the second layer, world units; 0 = auto (kAutoSeparation x R).
+  /// With one layer: 0, the solid behind the visible surface runs on without end (VAO fig. 2c);
+  /// > 0, world units, the visible surface is a sheet this thick with nothing behind it (above).
+  /// Only with layers = 1 (with two, the second layer says what lies behind).
+  float thickness = 0.0f;
 };
 
 /// The automatic minimum separation as a fraction of R (docs/methods/depth-layers.md measures it).
@@ -47,8 +60,37 @@ std::vector<Param<P>> depth_layer_params(DepthLayers P::*member) {
                          "minimum separation of the second layer; 0 = auto (R/4)")};
 }
 
+/// The `thickness` row of a method's parameter table (the methods that test points against the solid
+/// behind the depth buffer: containment, volumetric, transfer).
+template <class P>
+Param<P> thickness_param(DepthLayers P::*member) {
+  return Param<P>::real("thickness", [member](P& p) -> float& { return (p.*member).thickness; }, Range::at_least(0), "world units",
+                        "with layers=1: 0, everything behind the visible surface is solid; > 0, every visible surface is a sheet this thick "
+                        "with nothing behind it (for scenes of open sheets without a second layer)");
+}
+
 /// The separation in effect: `separation`, or kAutoSeparation x radius when it is 0.
 inline float effective_separation(const DepthLayers& d, float radius) { return d.separation > 0 ? d.separation : kAutoSeparation * radius; }
+
+/// Whether the methods read a second layer: the G-buffer's (layers = 2) or one layer's sheets of
+/// `thickness`, whose second layer holds nothing behind any pixel.
+inline bool reads_second_layer(const DepthLayers& d) { return d.layers == 2 || d.thickness > 0; }
+
+/// The separation the second layer is read at: the effective separation with two layers, the
+/// thickness with one.
+inline float layer_separation(const DepthLayers& d, float radius) { return d.layers == 2 ? effective_separation(d, radius) : d.thickness; }
+
+/// The second layer of one layer's sheets: nothing (+infinity) behind every pixel of `g`.
+inline std::shared_ptr<const Image<float>> nothing_behind(const GBuffer& g) {
+  return std::make_shared<const Image<float>>(g.width(), g.height(), std::numeric_limits<float>::infinity());
+}
+
+/// InputError when `d` asks for a thickness with two layers, where the second layer says it.
+inline void check_thickness(const DepthLayers& d, const std::string& method) {
+  if (d.thickness > 0 && d.layers != 1)
+    throw InputError(method + ": thickness is one layer's sheet model, and layers=2 reads what lies behind from the second layer (its "
+                              "layer_separation is the sheets' thickness there): use one of them");
+}
 
 /// Whether `g` carries a second layer rendered at `separation` (to a relative 1e-6).
 inline bool has_second_layer(const GBuffer& g, float separation) {

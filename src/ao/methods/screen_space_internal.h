@@ -24,38 +24,44 @@ inline simd::Rotations16 simd_rotations(const std::array<Rotation, 16>& r) {
 }
 
 /// The depth plane a depth-buffer characteristic reads, with its projection, and its second layer
-/// when `layers` asks for two.
+/// when `layers` reads one (two layers, or one layer's sheets of a thickness).
 inline simd::DepthPlane simd_depth_plane(const DepthBufferCharacteristic& ch, const DepthLayers& layers = {}) {
   const ScreenProjection& p = ch.projection;
-  const bool two = layers.layers == 2;
+  const bool two = reads_second_layer(layers);
   return {ch.depth, p.scale_x, p.scale_y, p.centre_x, p.centre_y, p.width, p.height, two ? ch.second : nullptr, two ? ch.separation : 0.0f,
           two ? ch.normals : nullptr};
 }
 
 /// The depth characteristic of `g` with the layers `d` asks for: its second layer (not copied: `g`
-/// must outlive the result) when d.layers = 2, InputError when `g` has none at the separation in effect.
+/// must outlive the result) when d.layers = 2, InputError when `g` has none at the separation in effect;
+/// with one layer and a thickness, nothing behind any pixel at that thickness (depth_layers.h).
 /// `built`: g's depth plane built already (depth_plane(g)), or null to build it.
 inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const DepthLayers& d, float radius, const std::string& method,
                                                       std::shared_ptr<const Image<float>> built = nullptr) {
-  float separation = 0;
-  if (d.layers == 2) {
-    separation = effective_separation(d, radius);
-    if (!has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
-  }
+  check_thickness(d, method);
+  const float separation = layer_separation(d, radius);
+  if (d.layers == 2 && !has_second_layer(g, separation)) throw_missing_second_layer(method, separation);
   DepthBufferCharacteristic ch = built ? DepthBufferCharacteristic(g, std::move(built)) : DepthBufferCharacteristic(g);
   if (d.layers == 2) ch.add_second_layer(g, std::shared_ptr<const Image<float>>(std::shared_ptr<void>(), &g.second_depth), separation);
+  else if (d.thickness > 0) ch.add_second_layer(g, nothing_behind(g), separation);
   return ch;
 }
 
-/// InputError unless `ch` can give what `d` asks for: two layers are the depth buffer's, with its
-/// second layer (at the separation in effect for R = `radius`).
+/// InputError unless `ch` can give what `d` asks for: two layers, or one layer's sheets of a
+/// thickness, are the depth buffer's, with the second layer they read (at the separation in effect
+/// for R = `radius`).
 template <class C>
 void check_layers(const C& ch, const DepthLayers& d, float radius, const std::string& method) {
-  if (d.layers < 2) return;
+  check_thickness(d, method);
+  if (!reads_second_layer(d)) return;
   if constexpr (std::is_same_v<C, DepthBufferCharacteristic>) {
-    if (!ch.second) throw_missing_second_layer(method, effective_separation(d, radius));
+    if (ch.second) return;
+    if (d.layers == 2) throw_missing_second_layer(method, effective_separation(d, radius));
+    throw InputError(method + ": thickness reads its sheets from the depth characteristic, and this one was built without them: build "
+                              "it with depth_characteristic");
   } else {
-    throw InputError(method + ": layers=2 is a second layer of the depth buffer; an analytic characteristic function has its own solid");
+    throw InputError(method + ": " + (d.layers == 2 ? "layers=2 is a second layer" : "thickness is a sheet model") +
+                     " of the depth buffer; an analytic characteristic function has its own solid");
   }
 }
 

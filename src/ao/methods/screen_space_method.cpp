@@ -35,6 +35,9 @@ void check_analytic_characteristic(const MethodInput& in, CharacteristicKind kin
   if (layers.layers == 2)
     throw InputError(std::string(method) + ": layers=2 is a second layer of the depth buffer, and characteristic " + name +
                      " is analytic: use layers=1 with it");
+  if (layers.thickness > 0)
+    throw InputError(std::string(method) + ": thickness takes the depth buffer's surfaces for sheets, and characteristic " + name +
+                     " is analytic, with a solid of its own: use thickness=0 with it");
   const bool implicit = kind == CharacteristicKind::Implicit;
   const std::string builtins = joined_names(implicit ? builtin_scenes_with_implicit_surface() : builtin_scenes_with_height_field());
   const std::string what = implicit ? "implicit surface" : "height field";
@@ -53,6 +56,9 @@ void check_gpu_screen_space(std::string_view method, CharacteristicKind kind, co
                      " runs on the CPU (--device cpu)");
   if (layers.layers != 1)
     throw InputError(std::string(method) + ": layers=2 (a second depth layer) runs on the CPU backend only; the GPU shaders read one layer");
+  if (layers.thickness > 0)
+    throw InputError(std::string(method) + ": thickness (one layer's sheets) runs on the CPU backend only; the GPU shaders take everything "
+                                           "behind the depth buffer for solid");
 }
 
 void add_characteristic_stats(MethodOutput& out, CharacteristicKind kind, bool elimination) {

@@ -40,10 +40,12 @@ template <class Fn>
 void with_characteristic(const MethodInput& in, CharacteristicKind kind, const DepthLayers& layers, std::string_view method, bool elimination,
                          float limit, Fn&& fn) {
   const GBuffer& g = in.gbuffer;
-  if (kind == CharacteristicKind::Depth && layers.layers < 2) return fn(DepthBufferCharacteristic(g), elimination);
+  check_thickness(layers, std::string(method));
+  if (kind == CharacteristicKind::Depth && !reads_second_layer(layers)) return fn(DepthBufferCharacteristic(g), elimination);
   if (kind == CharacteristicKind::Depth) {
-    const float separation = effective_separation(layers, in.falloff.radius);
-    return fn(DepthBufferCharacteristic(g, second_layer_for(in, separation, method), separation), elimination);
+    const float separation = layer_separation(layers, in.falloff.radius);
+    return fn(DepthBufferCharacteristic(g, layers.layers == 2 ? second_layer_for(in, separation, method) : nothing_behind(g), separation),
+              elimination);
   }
   check_analytic_characteristic(in, kind, layers, method);
   // Analytic factors: their inner regions are solid, so the kernels' elimination stays off for them.

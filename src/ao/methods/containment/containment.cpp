@@ -38,11 +38,15 @@ const ParamTable<ContainmentParams>& containment_param_table() {
         P::real("bias", &ContainmentParams::bias, Range::at_least(0), "world units",
                 "depth-test bias; 0 = auto (one pixel footprint x (1 + tan theta_v))")},
        interleave_params(&ContainmentParams::interleave), depth_layer_params(&ContainmentParams::layers),
+       {thickness_param(&ContainmentParams::layers)},
        {characteristic_param(&ContainmentParams::characteristic)}}};
   return table;
 }
 
-void ContainmentParams::validate() const { containment_param_table().validate(*this); }
+void ContainmentParams::validate() const {
+  containment_param_table().validate(*this);
+  check_thickness(layers, "containment");
+}
 void to_json(nlohmann::json& j, const ContainmentParams& p) { j = containment_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, ContainmentParams& p) { containment_param_table().from_json(j, p); }
 

@@ -61,11 +61,15 @@ const ParamTable<TransferParams>& transfer_param_table() {
                                             {{"albedo", TransferReflectance::Albedo}, {"radiance", TransferReflectance::Radiance}},
                                             "what occluders send back: albedo (eq. 9) or also their direct light (sec. 4.1, needs --sun)")},
        interleave_params(&TransferParams::interleave), depth_layer_params(&TransferParams::layers),
+       {thickness_param(&TransferParams::layers)},
        {characteristic_param(&TransferParams::characteristic)}}};
   return table;
 }
 
-void TransferParams::validate() const { transfer_param_table().validate(*this); }
+void TransferParams::validate() const {
+  transfer_param_table().validate(*this);
+  check_thickness(layers, "transfer");
+}
 void to_json(nlohmann::json& j, const TransferParams& p) { j = transfer_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, TransferParams& p) { transfer_param_table().from_json(j, p); }
 

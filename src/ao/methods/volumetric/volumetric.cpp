@@ -35,11 +35,15 @@ const ParamTable<VolumetricParams>& volumetric_param_table() {
                    "AT 4.3 for pipes: a surface more than R in front of a pipe's entry does not occlude it"),
         P::real("bias", &VolumetricParams::bias, Range::at_least(0), "world units", "added to z* - z_entry; 0 = auto (as containment)")},
        interleave_params(&VolumetricParams::interleave), depth_layer_params(&VolumetricParams::layers),
+       {thickness_param(&VolumetricParams::layers)},
        {characteristic_param(&VolumetricParams::characteristic)}}};
   return table;
 }
 
-void VolumetricParams::validate() const { volumetric_param_table().validate(*this); }
+void VolumetricParams::validate() const {
+  volumetric_param_table().validate(*this);
+  check_thickness(layers, "volumetric");
+}
 void to_json(nlohmann::json& j, const VolumetricParams& p) { j = volumetric_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, VolumetricParams& p) { volumetric_param_table().from_json(j, p); }
 

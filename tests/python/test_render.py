@@ -81,6 +81,22 @@ def test_own_gbuffer_equals_internal_one():
         np.testing.assert_array_equal(ao.render(gbuffer=own, method=method, radius=0.4), internal)
 
 
+def test_arrays_without_a_scene_take_sheets_of_a_thickness():
+    # Arrays from another renderer bring no scene to trace a second depth layer from: layers=2 is
+    # refused, and thickness (one layer's surfaces as sheets, docs/methods/depth-layers.md) runs as it
+    # does on the scene's own G-buffer, freeing space behind the surfaces that one layer takes for solid.
+    cam = ao.Camera(**SIZE)
+    g = ao.gbuffer("default", cam)
+    own = ao.gbuffer_from_arrays(np.array(g.normal), position=np.array(g.position), albedo=np.array(g.albedo),
+                                 object_id=np.array(g.object_id), camera=g.camera)
+    with pytest.raises(ao.InputError, match="layers=2 traces the second depth layer in the scene"):
+        ao.render(gbuffer=own, method="containment", radius=1.5, layers=2)
+    for method in ("containment", "volumetric", "transfer"):
+        sheets = ao.render(gbuffer=own, method=method, radius=1.5, thickness=0.4)
+        np.testing.assert_array_equal(sheets, ao.render("default", cam, method, radius=1.5, thickness=0.4))
+        assert (sheets > ao.render(gbuffer=own, method=method, radius=1.5)).any(), method
+
+
 def test_own_depth_buffer_agrees_with_positions():
     cam = ao.Camera(**SIZE)
     g = ao.gbuffer("sphere-on-plane", cam)

@@ -253,6 +253,7 @@ TEST(GpuMethods, WhatTheGpuDoesNotImplementIsAOneLineInputError) {
     test::expect_one_line_error<InputError>([&] { run_gpu_method(gpu_device(), in, find_method(method).decode(params)); }, method, problem);
   };
   fails("containment", {{"characteristic", "implicit"}}, "depth buffer only");
+  fails("volumetric", {{"thickness", 0.1}}, "thickness (one layer's sheets) runs on the CPU backend only");
   fails("volumetric", {{"characteristic", "nonsense"}}, "characteristic must be one of");
   fails("cone", {{"grid", "eye"}}, "world grid only");
   fails("raytraced", nlohmann::json::object(), "CPU only");

@@ -132,8 +132,8 @@ INSTANTIATE_TEST_SUITE_P(Methods, GpuMethodAgreement,
                          agreement_name);
 
 // The parameters that change a kernel's path: ray steps (containment's m = 1 loop), the
-// normaliser, no interleaving or no filter, other memberships, the multi-bounce fit, Alchemy's
-// contrast (pow) and preset, cone's presets and fixed pattern.
+// normaliser, no interleaving or no filter, other memberships, one layer's sheets (thickness), the
+// multi-bounce fit, Alchemy's contrast (pow) and preset, cone's presets and fixed pattern.
 struct Variant {
   std::string method;
   nlohmann::json params;
@@ -165,6 +165,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Variant{"containment", {{"silhouette_elimination", false}, {"bias", 0.01}}, Membership::Exp},
                       Variant{"volumetric", {{"normalizer", "analytic"}, {"filter", false}}}, Variant{"volumetric", {{"samples", 32}}},
                       Variant{"transfer", {{"ray_steps", 1}, {"albedo_scale", 0.5}}}, Variant{"transfer", {{"ray_steps", 3}}, Membership::Cubic},
+                      Variant{"containment", {{"thickness", 0.3}}, Membership::Step}, Variant{"volumetric", {{"thickness", 0.3}}},
+                      Variant{"transfer", {{"thickness", 0.3}, {"ray_steps", 3}}},
                       Variant{"alchemy", {{"contrast", 2.0}, {"filter", false}}}, Variant{"alchemy", {{"preset", "paper"}, {"samples", 24}}},
                       Variant{"gtao", {{"multi_bounce", true}}}, Variant{"gtao", {{"slices", 4}, {"steps", 12}, {"step_power", 2.0}}},
                       Variant{"cone", {{"preset", "high"}}}, Variant{"cone", {{"jitter", false}, {"filter_taps", 1}, {"depth_bits", 256}}}),
@@ -253,7 +255,6 @@ TEST(GpuMethods, WhatTheGpuDoesNotImplementIsAOneLineInputError) {
     test::expect_one_line_error<InputError>([&] { run_gpu_method(gpu_device(), in, find_method(method).decode(params)); }, method, problem);
   };
   fails("containment", {{"characteristic", "implicit"}}, "depth buffer only");
-  fails("volumetric", {{"thickness", 0.1}}, "thickness (one layer's sheets) runs on the CPU backend only");
   fails("volumetric", {{"characteristic", "nonsense"}}, "characteristic must be one of");
   fails("cone", {{"grid", "eye"}}, "world grid only");
   fails("raytraced", nlohmann::json::object(), "CPU only");

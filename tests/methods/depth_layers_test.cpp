@@ -97,11 +97,11 @@ TEST(DepthLayers, RejectsBadSeparationsAndMissingLayers) {
   ContainmentParams both = two;
   both.layers.thickness = 0.3f;
   EXPECT_THROW(containment_ao(s.g, Falloff{Membership::Step, 1.0f}, both, 1), InputError);
-  // The GPU shaders read one layer and take everything behind it for solid.
-  EXPECT_THROW(check_gpu(ContainmentParams{.layers = {1, 0, 0.3f}}), InputError);
-  EXPECT_THROW(check_gpu(VolumetricParams{.layers = {1, 0, 0.3f}}), InputError);
-  EXPECT_THROW(check_gpu(TransferParams{.layers = {1, 0, 0.3f}}), InputError);
-  EXPECT_NO_THROW(check_gpu(ContainmentParams{}));
+  // The GPU shaders read one layer, with its sheets of a thickness (tests/gpu/methods_test.cpp).
+  EXPECT_THROW(check_gpu(ContainmentParams{.layers = {2, 0}}), InputError);
+  EXPECT_NO_THROW(check_gpu(ContainmentParams{.layers = {1, 0, 0.3f}}));
+  EXPECT_NO_THROW(check_gpu(VolumetricParams{.layers = {1, 0, 0.3f}}));
+  EXPECT_NO_THROW(check_gpu(TransferParams{.layers = {1, 0, 0.3f}}));
 }
 
 // Mean and minimum of V over the pixels of object `id`.

@@ -21,7 +21,8 @@
 // that thickness with nothing behind it: the solid along a pixel's ray is [z1, z1 + thickness] and,
 // beyond it, what the sheet hides from the receiver (the sheet test above). That is the second
 // layer's reading where it finds nothing behind, at separation = thickness, for scenes made of open
-// sheets whose second layer cannot be traced (a G-buffer file or arrays); on closed solids it frees
+// sheets whose second layer cannot be traced (a G-buffer file or arrays, the GPU backend); on closed
+// solids it frees
 // what lies behind their far side (docs/methods/depth-layers.md measures both).
 #pragma once
 

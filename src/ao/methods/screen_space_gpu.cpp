@@ -8,6 +8,7 @@
 #include "ao/core/error.h"
 #include "ao/methods/filters/filters_gpu_internal.h"
 #include "ao/methods/samples.h"
+#include "ao/methods/screen_space_kernel_internal.h"
 
 namespace ao::gpu_detail {
 
@@ -19,6 +20,14 @@ void set_sampling(Run& r, Program& p, int samples, float bias, bool silhouette_e
   r.set(p, "u_far_limit", silhouette_elimination ? -radius : -kInfinity);
   // One pixel's footprint at unit depth: the image plane spans 2 tan(fov/2) over `height` pixels.
   r.set(p, "u_footprint", 2.0f * r.g.camera.tan_half_fov() / static_cast<float>(r.height()));
+}
+
+std::string_view sheets_define(const DepthLayers& layers) { return layers.thickness > 0 ? "#define AO_SHEETS 1\n" : ""; }
+
+void set_sheets(Run& r, Program& p, const DepthLayers& layers) {
+  if (layers.thickness <= 0) return;
+  r.set(p, "u_thickness", layers.thickness);
+  r.set(p, "u_crossing_tolerance", simd::kCrossingTolerance * layers.thickness);
 }
 
 // The containment-test offsets (X, Y, Z, r) of make_containment_samples, as vec4s.

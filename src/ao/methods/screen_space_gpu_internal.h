@@ -5,12 +5,22 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include "ao/core/membership.h"
 #include "ao/gpu/run_internal.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/filters/interleave.h"
 
 namespace ao::gpu_detail {
+
+/// One layer's sheets (depth_layers.h `thickness`, screen_space.glsl): the shaders compile their
+/// sheet test only with AO_SHEETS defined (this define when `layers` asks for them, else none), so
+/// that without it they stay as small as before.
+std::string_view sheets_define(const DepthLayers& layers);
+/// With sheets: u_thickness and the sheet test's tolerance in world units, as the CPU kernels take
+/// them (screen_space_kernel_internal.h).
+void set_sheets(Run& r, Program& p, const DepthLayers& layers);
 
 /// The uniforms containment, transfer and volumetric share: the depth-test bias, the 4x4
 /// rotations, the sample count and the silhouette elimination's limit (AT 4.3: a surface more than

@@ -56,9 +56,6 @@ void check_gpu_screen_space(std::string_view method, CharacteristicKind kind, co
                      " runs on the CPU (--device cpu)");
   if (layers.layers != 1)
     throw InputError(std::string(method) + ": layers=2 (a second depth layer) runs on the CPU backend only; the GPU shaders read one layer");
-  if (layers.thickness > 0)
-    throw InputError(std::string(method) + ": thickness (one layer's sheets) runs on the CPU backend only; the GPU shaders take everything "
-                                           "behind the depth buffer for solid");
 }
 
 void add_characteristic_stats(MethodOutput& out, CharacteristicKind kind, bool elimination) {

@@ -26,7 +26,8 @@ std::shared_ptr<const Image<float>> second_layer_for(const MethodInput& in, floa
 void check_analytic_characteristic(const MethodInput& in, CharacteristicKind kind, const DepthLayers& layers, std::string_view method);
 
 /// InputError when a screen-space method's parameters ask for what its GPU path lacks: the GPU
-/// reads the depth buffer only (no analytic characteristic) and one layer of it.
+/// reads the depth buffer only (no analytic characteristic) and one layer of it (with its sheets of
+/// a thickness, as the CPU).
 void check_gpu_screen_space(std::string_view method, CharacteristicKind kind, const DepthLayers& layers);
 
 /// What --json reports about the characteristic function a method ran with (nothing for the default).

@@ -24,6 +24,7 @@
 //   u_bias          depth-test bias, world units; 0 = automatic (screen_space.glsl depth_bias)
 //   u_footprint     one pixel's footprint at unit depth, 2 tan(fov/2) / height
 //   u_rotation[16]  (cos, sin) of the 4x4 pattern's angles, entry (y % 4) * 4 + x % 4 (samples.h)
+//   u_thickness     with AO_SHEETS, one layer's sheets (screen_space.glsl)
 // Buffers: binding 0, the sample offsets (X_i, Y_i, Z_i, r_i) of make_containment_samples, world units.
 #include "common.glsl"
 #include "screen_space.glsl"
@@ -39,12 +40,20 @@ uniform float u_bias;
 uniform float u_footprint;
 uniform vec2 u_rotation[16];
 
-// The depth buffer's distance of camera-space point q (characteristic.h): z* - depth(q), > 0 in
-// front of the surface, +infinity behind the camera.
-float distance_to_surface(vec3 q) {
+// Whether camera-space point q is occluded for receiver r (bias: r's depth-test bias): behind the
+// surface at its pixel by more than the bias (the depth buffer's distance z* - depth(q),
+// characteristic.h, +infinity behind the camera) and, with silhouette elimination, by less than R;
+// with one layer's sheets also inside their solid.
+bool occluded(vec3 r, vec3 q, float bias) {
   bool valid;
   const ivec2 at = locate(q, valid);
-  return valid ? depth_at(at) + q.z : kInfinity;
+  const float z1 = depth_at(at);
+  const float d = valid ? z1 + q.z : kInfinity;
+#ifdef AO_SHEETS
+  return d < -bias && d > u_far_limit && in_sheets_solid(z1, at, r, q, bias);
+#else
+  return d < -bias && d > u_far_limit;
+#endif
 }
 
 void main() {
@@ -70,8 +79,7 @@ void main() {
       // VAO eq. 5's point (AT sec. 4: at r_i j / m along the ray; j = m is eq. 5's own).
       const float f = u_ray_steps == 1 ? 1.0 : float(j) * inv_m;
       const vec3 q = p + (f * s.x) * t + (f * s.y) * b + (f * s.z) * n;
-      const float d = distance_to_surface(q);
-      blocked = blocked || (d < -bias && d > u_far_limit);
+      blocked = blocked || occluded(p, q, bias);
     }
     open += blocked ? 0.0 : 1.0;
   }

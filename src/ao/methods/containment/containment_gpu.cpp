@@ -20,9 +20,10 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const ContainmentParams& 
   check_gpu(params);
   const Buffer offsets = containment_offsets(r, params.samples, falloff);
   Texture raw = r.image(GL_R32F);
-  Program& p = r.begin("containment.comp", "containment");
+  Program& p = r.begin("containment.comp", "containment", sheets_define(params.layers));
   set_sampling(r, p, params.samples, params.bias, params.silhouette_elimination, falloff.radius, params.interleave, seed);
   r.set(p, "u_ray_steps", params.ray_steps);
+  set_sheets(r, p, params.layers);
   r.bind(0, offsets);
   r.finish(raw);
   MethodOutput out;

@@ -28,6 +28,7 @@
 //   u_albedo_scale s, multiplies a~ and Ld~, [0, 1]
 //   u_radiance     0: eq. 9 (albedo); 1: the radiance mode
 //   u_rotation[16] the 4x4 pattern's (cos, sin) about N
+//   u_thickness    with AO_SHEETS, one layer's sheets (screen_space.glsl)
 // Buffers: binding 0, the sample offsets (X_i, Y_i, Z_i, r_i), world units.
 #include "common.glsl"
 #include "screen_space.glsl"
@@ -70,8 +71,14 @@ void main() {
       const vec3 q = p + (f * s.x) * t + (f * s.y) * b + (f * s.z) * n;  // eq. 8, step j of m
       bool valid;
       const ivec2 q_pixel = locate(q, valid);
-      const float d = valid ? depth_at(q_pixel) + q.z : kInfinity;
-      if (d < -bias && d > u_far_limit) at = q_pixel;  // AT 4.3: only a surface less than R in front occludes
+      const float z1 = depth_at(q_pixel);
+      const float d = valid ? z1 + q.z : kInfinity;
+      // AT 4.3: only a surface less than R in front occludes; with one layer's sheets, inside their solid.
+#ifdef AO_SHEETS
+      if (d < -bias && d > u_far_limit && in_sheets_solid(z1, q_pixel, p, q, bias)) at = q_pixel;
+#else
+      if (d < -bias && d > u_far_limit) at = q_pixel;
+#endif
     }
     if (at.x < 0) {
       open += 1.0;

@@ -24,11 +24,12 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const TransferParams& par
     throw InputError("transfer: reflectance=radiance reads the occluders' direct light, and the G-buffer has no direct-light pass");
   const Buffer offsets = containment_offsets(r, params.samples, falloff);
   Texture raw = r.image(GL_RGBA32F);
-  Program& p = r.begin("transfer.comp", "transfer");
+  Program& p = r.begin("transfer.comp", "transfer", sheets_define(params.layers));
   set_sampling(r, p, params.samples, params.bias, params.silhouette_elimination, falloff.radius, params.interleave, seed);
   r.set(p, "u_ray_steps", params.ray_steps);
   r.set(p, "u_albedo_scale", params.albedo_scale);
   r.set(p, "u_radiance", radiance ? 1 : 0);
+  set_sheets(r, p, params.layers);
   r.bind(0, offsets);
   r.finish(raw);
   // Sec. 4.2's filter on W and O alike, then the luminance of W.

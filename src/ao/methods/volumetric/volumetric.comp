@@ -29,6 +29,7 @@
 //   u_bias        added to z* - z_entry, world units; 0 = automatic (screen_space.glsl depth_bias)
 //   u_footprint   one pixel's footprint at unit depth
 //   u_rotation[16] the 4x4 pattern's (cos, sin) about the view axis
+//   u_thickness   with AO_SHEETS, one layer's sheets (screen_space.glsl)
 // Buffers: binding 0, the disk points (x_i, y_i, h_i, 0) of make_disk_samples (unit disk).
 #include "common.glsl"
 #include "screen_space.glsl"
@@ -72,7 +73,21 @@ void main() {
     const ivec2 at = ivec2(int(min(max(valid ? fx : 0.0, 0.0), max_pixel.x)), int(min(max(valid ? fy : 0.0, 0.0), max_pixel.y)));
     // z* - z_entry = (z* - z_c) + (R/2) h_i.
     const float to_surface = (valid ? depth_at(at) + c.z : kInfinity) + half_chord + bias;
-    const float dz = min(max(to_surface, 0.0), chord);  // fig. 7 a-c
+    float dz = min(max(to_surface, 0.0), chord);  // fig. 7 a-c
+#ifdef AO_SHEETS
+    if (valid && to_surface < chord) {
+      // One layer's sheets (volumetric_kernel.cpp's two layers with nothing behind): the solid in the
+      // pipe is [dz, end) from its entry, and past the sheet's thickness solid only where the sheet
+      // hides it from x, judged at the gap's middle, the pipe's point at depth z_entry + (end + chord) / 2.
+      const float zs = depth_at(at);
+      float end = min(max(zs + u_thickness + c.z + half_chord, 0.0), chord);
+      if (end < chord) {
+        const vec3 mid = vec3(c.x + xi * rot.x - yi * rot.y, c.y + xi * rot.y + yi * rot.x, c.z + half_chord - 0.5 * (end + chord));
+        if (sheet_hides(at, vec3(mid.xy, -zs), p, mid, bias)) end = chord;
+      }
+      dz = chord - max(end - dz, 0.0);
+    }
+#endif
     const bool distant = to_surface < u_far_limit && to_surface > -1e30;
     free_length += distant ? chord : dz;
   }

@@ -30,10 +30,11 @@ MethodOutput run_gpu(Run& r, const GpuMethodInput& in, const VolumetricParams& p
   const float F = params.normalizer == VolumeNormalizer::WeightedImportance ? radius * sum_h : 2.0f * radius * static_cast<float>(params.samples) / 3.0f;
   const Buffer points = make_buffer(r.c, std::span<const float>(disk));
   Texture raw = r.image(GL_R32F);
-  Program& p = r.begin("volumetric.comp", "volumetric");
+  Program& p = r.begin("volumetric.comp", "volumetric", sheets_define(params.layers));
   set_sampling(r, p, params.samples, params.bias, params.silhouette_elimination, radius, params.interleave, seed);
   r.set(p, "u_half_radius", 0.5f * radius);
   r.set(p, "u_inv_f", 1.0f / F);
+  set_sheets(r, p, params.layers);
   r.bind(0, points);
   r.finish(raw);
   MethodOutput out;

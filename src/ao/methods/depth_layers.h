@@ -22,8 +22,7 @@
 // beyond it, what the sheet hides from the receiver (the sheet test above). That is the second
 // layer's reading where it finds nothing behind, at separation = thickness, for scenes made of open
 // sheets whose second layer cannot be traced (a G-buffer file or arrays, the GPU backend); on closed
-// solids it frees
-// what lies behind their far side (docs/methods/depth-layers.md measures both).
+// solids it frees what lies behind their far side (docs/methods/depth-layers.md measures both).
 #pragma once
 
 #include <cmath>

@@ -18,6 +18,7 @@ any failed, 2 for a bad argument or output, 3 when the cluster cannot run ao, 13
 """
 
 import argparse
+import logging
 import os
 import sys
 
@@ -129,6 +130,11 @@ def execute(args, out):
             cluster.check_workers(client, args, out)
             cluster.run(client, todo, status, args, out)
         finally:
+            if local is not None:
+                # The in-process scheduler's closing chatter (after Ctrl-C, an event it was sending
+                # when the client's comm closed is logged as CRITICAL) is not news to the user: the
+                # batch says what happened. connect() silenced its warnings; now everything.
+                logging.disable(logging.CRITICAL)
             client.close()
             if local is not None:
                 local.close()

@@ -49,10 +49,9 @@ inline DepthBufferCharacteristic depth_characteristic(const GBuffer& g, const De
 
 /// InputError unless `ch` can give what `d` asks for: two layers, or one layer's sheets of a
 /// thickness, are the depth buffer's, with the second layer they read (at the separation in effect
-/// for R = `radius`).
+/// for R = `radius`). `d` is a validated parameter's (check_thickness ran in its validate()).
 template <class C>
 void check_layers(const C& ch, const DepthLayers& d, float radius, const std::string& method) {
-  check_thickness(d, method);
   if (!reads_second_layer(d)) return;
   if constexpr (std::is_same_v<C, DepthBufferCharacteristic>) {
     if (ch.second) return;

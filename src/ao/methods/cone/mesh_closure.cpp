@@ -11,6 +11,7 @@
 #include <mutex>
 
 #include "ao/core/affine.h"
+#include "ao/scene/topology.h"
 
 namespace ao {
 
@@ -36,18 +37,16 @@ void classify_open_mesh(const Mesh& m, MeshClosure& c) {
       if (!has[h]) origin[h] = m.positions[c.boundary[e][0]], has[h] = 1;
       hole_area[h] += cross(m.positions[c.boundary[e][0]] - origin[h], m.positions[c.boundary[e][1]] - origin[h]) * 0.5f;
     }
-    double holes = 0, area = 0, volume = 0;
+    double holes = 0, area = 0;
     for (const Vec3& a : hole_area) holes += length(a);
-    const Vec3 o = m.bounds().center();
     for (std::size_t t = 0; t < nt; ++t) {
-      const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
+      const Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], d = m.positions[m.indices[3 * t + 2]];
       area += 0.5 * length(cross(b - a, d - a));
-      volume += dot(a, cross(b, d)) / 6.0;
     }
     if (area > 0 && holes < kSmallHoles * area) {
       c.kind = MeshKind::SolidWithHoles;
       c.enclosure = static_cast<float>(1.0 - holes / area);
-      c.orientation = volume < 0 ? -1 : 1;
+      c.orientation = signed_volume(m) < 0 ? -1 : 1;
       return;
     }
   }
@@ -110,55 +109,23 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
   std::vector<MeshClosure> out;
   out.reserve(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
-    // Weld vertices by exact position, then count each undirected edge; an edge used an odd
-    // number of times is a boundary (a closed 2-manifold uses each edge twice).
-    const std::size_t nv = m.positions.size();
-    std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> keyed(nv);
-    for (std::size_t v = 0; v < nv; ++v) {
-      std::array<std::uint32_t, 3> k;
-      const float c[3] = {m.positions[v].x + 0.0f, m.positions[v].y + 0.0f, m.positions[v].z + 0.0f};  // + 0 turns -0 into +0
-      std::memcpy(k.data(), c, sizeof c);
-      keyed[v] = {k, static_cast<std::uint32_t>(v)};
-    }
-    std::sort(keyed.begin(), keyed.end());
-    std::vector<std::uint32_t> id(nv);
-    std::uint32_t next = 0;
-    for (std::size_t v = 0; v < nv; ++v) {
-      if (v > 0 && keyed[v].first != keyed[v - 1].first) ++next;
-      id[keyed[v].second] = next;
-    }
-    // (undirected key, directed edge index 3 t + e) so that a boundary edge keeps its direction.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;
-    edges.reserve(m.indices.size());
-    for (std::size_t t = 0; t < m.triangle_count(); ++t)
-      for (int e = 0; e < 3; ++e) {
-        std::uint64_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
-        if (a > b) std::swap(a, b);
-        edges.push_back({a << 32 | b, static_cast<std::uint32_t>(3 * t + e)});
-      }
-    std::sort(edges.begin(), edges.end());
+    const MeshEdges edges = mesh_edges(m);
     MeshClosure c;
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-      if ((j - i) % 2) {
-        const std::uint32_t de = edges[i].second, t = de / 3, e = de % 3;
-        c.boundary.push_back({m.indices[3 * t + e], m.indices[3 * t + (e + 1) % 3]});
-      }
-      ++c.edges;
-      i = j;
-    }
+    c.boundary = edges.boundary;
+    c.edges = edges.edges;
+    const std::vector<std::uint32_t>& id = edges.weld;
+    const std::uint32_t next = edges.welded;
     c.boundary_edges = c.boundary.size();
     if (!c.boundary.empty()) {
       // Holes: connected components of the boundary edges over welded vertices (union-find).
-      std::vector<std::uint32_t> parent(next + 1);
-      for (std::uint32_t v = 0; v <= next; ++v) parent[v] = v;
+      std::vector<std::uint32_t> parent(next);
+      for (std::uint32_t v = 0; v < next; ++v) parent[v] = v;
       const auto find = [&](std::uint32_t v) {
         while (parent[v] != v) v = parent[v] = parent[parent[v]];
         return v;
       };
       for (const auto& [a, b] : c.boundary) parent[find(id[a])] = find(id[b]);
-      std::vector<std::uint32_t> number(next + 1, ~0u);
+      std::vector<std::uint32_t> number(next, ~0u);
       for (const auto& [a, b] : c.boundary) {
         std::uint32_t& n = number[find(id[a])];
         if (n == ~0u) n = c.holes++;
@@ -175,37 +142,9 @@ std::vector<std::uint8_t> closed_meshes_around(const Scene& scene, std::span<con
   const std::vector<SceneObject> objects = scene.objects();
   std::vector<std::uint8_t> around(objects.size(), 0);
   bool any = false;
-  // A direction no axis-aligned or diagonal face contains, so the ray meets no edge of a modelled
-  // room exactly.
-  const Vec3 dir = normalize(Vec3{0.5734f, 0.6321f, 0.5213f});
   for (std::size_t k = 0; k < objects.size(); ++k) {
-    const Mesh& m = scene.meshes[objects[k].mesh];
     if (!closure[objects[k].mesh].closed()) continue;
-    // The eye and the ray in the mesh's own space.
-    Vec3 p = eye, d = dir;
-    if (objects[k].instance != SceneObject::kNoInstance) {
-      const Affine3 to_object = inverse(scene.instances[objects[k].instance].object_to_world);
-      p = to_object.point(eye), d = to_object.vector(dir);
-    }
-    const Bounds3 b = m.bounds();
-    if (p.x < b.lo.x || p.y < b.lo.y || p.z < b.lo.z || p.x > b.hi.x || p.y > b.hi.y || p.z > b.hi.z) continue;
-    std::size_t crossings = 0;
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      // Moller-Trumbore: the ray p + s d, s > 0, through the triangle.
-      const Vec3 a = m.positions[m.indices[3 * t]], e1 = m.positions[m.indices[3 * t + 1]] - a, e2 = m.positions[m.indices[3 * t + 2]] - a;
-      const Vec3 h = cross(d, e2);
-      const float det = dot(e1, h);
-      if (det == 0.0f) continue;
-      const float inv = 1.0f / det;
-      const Vec3 q = p - a;
-      const float u = dot(q, h) * inv;
-      if (u < 0.0f || u > 1.0f) continue;
-      const Vec3 r = cross(q, e1);
-      const float v = dot(d, r) * inv;
-      if (v < 0.0f || u + v > 1.0f) continue;
-      crossings += dot(e2, r) * inv > 0.0f ? 1 : 0;
-    }
-    around[k] = crossings % 2;
+    around[k] = inside_closed_object(scene, objects[k], eye) ? 1 : 0;
     any = any || around[k];
   }
   if (!any) around.clear();

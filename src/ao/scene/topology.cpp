@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ao/scene/topology.h"
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+#include "ao/core/affine.h"
+
+namespace ao {
+
+MeshEdges mesh_edges(const Mesh& m) {
+  MeshEdges out;
+  const std::size_t nv = m.positions.size();
+  std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> keyed(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    std::array<std::uint32_t, 3> k;
+    const float c[3] = {m.positions[v].x + 0.0f, m.positions[v].y + 0.0f, m.positions[v].z + 0.0f};  // + 0 turns -0 into +0
+    std::memcpy(k.data(), c, sizeof c);
+    keyed[v] = {k, static_cast<std::uint32_t>(v)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  out.weld.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (v > 0 && keyed[v].first != keyed[v - 1].first) ++out.welded;
+    out.weld[keyed[v].second] = out.welded;
+  }
+  if (nv > 0) ++out.welded;
+  // (undirected key, directed edge index 3 t + e) so that a boundary edge keeps its direction.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;
+  edges.reserve(m.indices.size());
+  for (std::size_t t = 0; t < m.triangle_count(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      std::uint64_t a = out.weld[m.indices[3 * t + e]], b = out.weld[m.indices[3 * t + (e + 1) % 3]];
+      if (a > b) std::swap(a, b);
+      edges.push_back({a << 32 | b, static_cast<std::uint32_t>(3 * t + e)});
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if ((j - i) % 2) {
+      const std::uint32_t de = edges[i].second, t = de / 3, e = de % 3;
+      out.boundary.push_back({m.indices[3 * t + e], m.indices[3 * t + (e + 1) % 3]});
+    }
+    ++out.edges;
+    i = j;
+  }
+  return out;
+}
+
+double signed_volume(const Mesh& m) {
+  // The divergence theorem about the box's centre (which keeps the sums small).
+  const Vec3 o = m.bounds().center();
+  double volume = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const Vec3 a = m.positions[m.indices[3 * t]] - o, b = m.positions[m.indices[3 * t + 1]] - o, d = m.positions[m.indices[3 * t + 2]] - o;
+    volume += dot(a, cross(b, d)) / 6.0;
+  }
+  return volume;
+}
+
+bool inside_closed_object(const Scene& scene, const SceneObject& o, Vec3 p) {
+  const Mesh& m = scene.meshes[o.mesh];
+  // A direction no axis-aligned or diagonal face contains, so the ray meets no edge of a modelled
+  // room exactly.
+  Vec3 d = normalize(Vec3{0.5734f, 0.6321f, 0.5213f});
+  if (o.instance != SceneObject::kNoInstance) {  // the point and the ray in the mesh's own space
+    const Affine3 to_object = inverse(scene.instances[o.instance].object_to_world);
+    p = to_object.point(p), d = to_object.vector(d);
+  }
+  const Bounds3 b = m.bounds();
+  if (p.x < b.lo.x || p.y < b.lo.y || p.z < b.lo.z || p.x > b.hi.x || p.y > b.hi.y || p.z > b.hi.z) return false;
+  std::size_t crossings = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    // Moller-Trumbore: the ray p + s d, s > 0, through the triangle.
+    const Vec3 a = m.positions[m.indices[3 * t]], e1 = m.positions[m.indices[3 * t + 1]] - a, e2 = m.positions[m.indices[3 * t + 2]] - a;
+    const Vec3 h = cross(d, e2);
+    const float det = dot(e1, h);
+    if (det == 0.0f) continue;
+    const float inv = 1.0f / det;
+    const Vec3 q = p - a;
+    const float u = dot(q, h) * inv;
+    if (u < 0.0f || u > 1.0f) continue;
+    const Vec3 r = cross(q, e1);
+    const float v = dot(d, r) * inv;
+    if (v < 0.0f || u + v > 1.0f) continue;
+    crossings += dot(e2, r) * inv > 0.0f ? 1 : 0;
+  }
+  return crossings % 2 == 1;
+}
+
+std::vector<std::int8_t> closed_mesh_sides(const Scene& scene) {
+  std::vector<std::int8_t> out(scene.meshes.size(), 0);
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i)
+    if (mesh_edges(scene.meshes[i]).boundary.empty()) {
+      const double v = signed_volume(scene.meshes[i]);
+      out[i] = static_cast<std::int8_t>(v > 0 ? 1 : v < 0 ? -1 : 0);
+    }
+  return out;
+}
+
+std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye) {
+  const std::vector<SceneObject> objects = scene.objects();
+  std::vector<std::int8_t> out(objects.size(), 0);
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    int side = mesh_sides[objects[k].mesh];
+    if (side == 0 || inside_closed_object(scene, objects[k], eye)) continue;
+    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) side = -side;
+    out[k] = static_cast<std::int8_t>(side);
+  }
+  return out;
+}
+
+}  // namespace ao

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: Apache-2.0
+// What a mesh's connectivity says about the space around it: its boundary edges (a closed surface
+// has none), the side its closed surface encloses, and whether a point lies inside it. The cone
+// method's voxelization (methods/cone/mesh_closure.h) and the second depth layer
+// (gbuffer/render_gbuffer.h) read them. Code: topology.cpp.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "ao/scene/mesh.h"
+
+namespace ao {
+
+/// The edges of one mesh, its vertices welded by exact position (so that meshes whose faces carry
+/// their own copies of shared corners, as make_box's, are as closed as their surfaces are).
+struct MeshEdges {
+  std::vector<std::uint32_t> weld;  ///< Per vertex: its welded vertex, numbered from 0.
+  std::uint32_t welded = 0;         ///< Welded vertices (distinct positions).
+  std::size_t edges = 0;            ///< Distinct undirected edges.
+  /// One directed edge (vertex indices, as a triangle lists it) per edge used by an odd number of
+  /// triangles (a closed 2-manifold uses each edge twice).
+  std::vector<std::array<std::uint32_t, 2>> boundary;
+};
+
+/// The edges of `m`.
+MeshEdges mesh_edges(const Mesh& m);
+
+/// The volume enclosed by `m` (in its own space), signed: positive when its triangles' fronts face
+/// out of what it encloses. Meaningful for a closed mesh only.
+double signed_volume(const Mesh& m);
+
+/// Whether `p` (world space) lies inside `object` (one of scene.objects()), whose mesh must be
+/// closed: an odd number of its triangles crossed by a ray from p.
+bool inside_closed_object(const Scene& scene, const SceneObject& object, Vec3 p);
+
+/// Per mesh of `scene`: which side of its triangles a ray leaves it through when it is a solid.
+/// +1: a closed mesh whose fronts face out (a ray leaves it through a back face), -1: a closed mesh
+/// whose fronts face in (through a front face), 0: an open mesh (no solid).
+std::vector<std::int8_t> closed_mesh_sides(const Scene& scene);
+
+/// Per object of Scene::objects(): closed_mesh_sides's answer for its mesh (`mesh_sides`), turned
+/// by an instance's transform that mirrors, and 0 for a closed mesh around `eye` (a room, which a
+/// ray from the eye leaves but never enters).
+std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye);
+
+}  // namespace ao

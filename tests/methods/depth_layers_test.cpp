@@ -61,6 +61,7 @@ TEST(DepthLayers, SecondLayerOfAClosedBoxIsItsBackFace) {
   render_second_layer(*s.rays, s.g, 0.1f);
   EXPECT_NEAR(centre_depth(s), 9.0f, 1e-4f);
   EXPECT_NEAR(centre_second(s), 11.0f, 1e-4f) << "a back face: positive, at the far side's depth";
+  EXPECT_TRUE(second_layer_exit(centre_second(s))) << "where the ray leaves a closed solid";
   EXPECT_EQ(s.g.second_separation, 0.1f);
   EXPECT_EQ(s.g.second_depth(0, 0), kInfinity) << "background";
   // A separation larger than the box skips its back face, and nothing lies behind it.
@@ -75,6 +76,29 @@ TEST(DepthLayers, SecondLayerBehindASheetIsTheNextFrontFace) {
   render_second_layer(*s.rays, s.g, 0.1f);
   EXPECT_NEAR(centre_depth(s), 7.0f, 1e-4f);
   EXPECT_NEAR(centre_second(s), -9.0f, 1e-4f);
+}
+
+// Where the second layer is a closed solid's exit, and where a back face says nothing of the
+// kind: a closed box whose fronts face in is left through a front face (still its exit); a sheet's
+// back (a quad turned away from the eye) and a room's wall behind a sheet (the eye inside a closed
+// box) are back faces only.
+TEST(DepthLayers, SecondLayerMarksWhereTheRayLeavesAClosedSolid) {
+  const Mesh inward = make_box({-1, -1, -1}, {1, 1, 1}, {0.8f, 0.8f, 0.8f}, 0.0f, true);
+  auto box = test::scene_gbuffer(scene_of({inward}), head_on());
+  render_second_layer(*box.rays, box.g, 0.1f);
+  EXPECT_NEAR(centre_second(box), 11.0f, 1e-4f);
+  EXPECT_TRUE(second_layer_exit(centre_second(box)));
+
+  const Mesh front = make_quad({-2, -2, 3}, {2, -2, 3}, {2, 2, 3}, {-2, 2, 3}), turned = make_quad({-2, -2, 1}, {-2, 2, 1}, {2, 2, 1}, {2, -2, 1});
+  auto sheets = test::scene_gbuffer(scene_of({front, turned}), head_on());
+  render_second_layer(*sheets.rays, sheets.g, 0.1f);
+  EXPECT_NEAR(centre_second(sheets), 9.0f, 1e-4f) << "the turned quad's back";
+  EXPECT_FALSE(second_layer_exit(centre_second(sheets)));
+
+  auto room = test::scene_gbuffer(scene_of({front, make_box({-20, -20, -20}, {20, 20, 20})}), head_on());
+  render_second_layer(*room.rays, room.g, 0.1f);
+  EXPECT_NEAR(centre_second(room), 30.0f, 1e-3f) << "the room's far wall, from inside";
+  EXPECT_FALSE(second_layer_exit(centre_second(room)));
 }
 
 TEST(DepthLayers, RejectsBadSeparationsAndMissingLayers) {
@@ -212,6 +236,39 @@ TEST(DepthLayers, TheGroundBeforeAWallIsHiddenFromWhatLiesBehindIt) {
   EXPECT_LE(ev2, 1.1 * ev1);
 }
 
+// A sphere resting on the ground, seen from the front and above, AT 4.3's elimination on (the
+// default): the ground under its bulge beside the contact is dark in the references, but the
+// sphere's surface seen at the test points' pixels lies more than R in front of them, so one layer
+// eliminates it as a distant foreground object and draws the ground there bright. The sphere is a
+// closed mesh seen from outside, so its second layer is where the ray leaves it, and two layers
+// keep everything before that exit solid (measured: RMSE on the ground 0.095 -> 0.009 for
+// containment, 0.057 -> 0.015 for volumetric, 0.101 -> 0.009 for transfer's obscurance).
+TEST(DepthLayers, TheGroundUnderASpheresBulgeStaysDarkWithTwoLayers) {
+  Camera view;
+  view.eye = {0.0f, 2.4f, 4.2f};
+  view.target = {0, 0.7f, 0};
+  view.vertical_fov_deg = 40.0f;
+  const Mesh ground = make_quad({-6, 0, 6}, {6, 0, 6}, {6, 0, -6}, {-6, 0, -6});
+  auto s = test::scene_gbuffer(scene_of({ground, make_sphere({0, 1, 0}, 1.0f, 96, 48)}), view);
+  const float R = 0.35f;
+  render_second_layer(*s.rays, s.g, kAutoSeparation * R);
+  const Falloff f{Membership::Step, R};
+  const Image<float> step = render_raytraced(*s.rays, s.g, f, {.samples = 512}, 5).visibility;
+  const Image<float> sphere = render_tangent_sphere(*s.rays, s.g, R, {.samples = 512}, 5).visibility;
+  Image<std::uint8_t> on_ground(s.g.width(), s.g.height(), 0);
+  for (std::size_t i = 0; i < on_ground.size(); ++i) on_ground[i] = s.g.object_id[i] == 1 ? 1 : 0;
+  double error[3][2];
+  for (int layers = 1; layers <= 2; ++layers) {
+    const DepthLayers d{layers, 0};
+    error[0][layers - 1] = compare_images(containment_ao(s.g, f, {.layers = d}, 3), step, on_ground).rmse;
+    error[1][layers - 1] = compare_images(volumetric_ao(s.g, R, {.layers = d}, 3), sphere, on_ground).rmse;
+    error[2][layers - 1] = compare_images(transfer_ao(s.g, f, {.layers = d}, 3).obscurance, step, on_ground).rmse;
+  }
+  std::printf("ground beside a sphere, RMSE one layer / two: containment %.4f / %.4f, volumetric %.4f / %.4f, transfer %.4f / %.4f\n",
+              error[0][0], error[0][1], error[1][0], error[1][1], error[2][0], error[2][1]);
+  for (const auto& e : error) EXPECT_LT(e[1], 0.4 * e[0]);
+}
+
 // Containment's and volumetric's RMSE against their own references (step obscurance, tangent
 // sphere) with one layer, with two, and with one layer's sheets R/4 thick (the second layer's
 // separation), on `object` standing on a ground quad, seen from the front right and above (as
@@ -248,7 +305,10 @@ LayerErrors layer_errors(const Mesh& object) {
 // open_sheets.h: nine meshes, each a sheet or a shell with an inside, an underside or a rim seen
 // against what lies behind it), containment and volumetric with two layers against their median
 // error with one layer on the four closed meshes of cone_test's suite, in the same setting; on
-// those closed meshes two layers are no worse than one (a closed solid's far side stays solid).
+// those closed meshes two layers are no worse than one (a closed solid's far side stays solid), and
+// on the sphere and the head ellipsoid much better (the ground under their bulge, as
+// TheGroundUnderASpheresBulgeStaysDarkWithTwoLayers: measured 0.13x and 0.24x for containment,
+// 0.23x and 0.34x for volumetric).
 // One layer takes the space under the terrain's raised edge and behind the mask for solid; two
 // layers free it where the sheet does not hide it. Measured here: containment 0.40-1.48x of the
 // closed median with two layers (one layer: the terrain 2.17x); volumetric 0.46-0.91x but for the
@@ -259,12 +319,14 @@ LayerErrors layer_errors(const Mesh& object) {
 // references for kernels the other DepthLayers tests cover.)
 TEST(DepthLayersSuite, TwoLayersKeepOpenSheetsNearTheClosedMeshError) {
   std::vector<double> closed_c, closed_v;
-  for (const Mesh& m : {make_box({-0.9f, 0.0f, -0.7f}, {0.9f, 1.0f, 0.7f}), make_sphere({0, 1, 0}, 1.0f, 96, 48),
-                        make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24), test::make_head()}) {
+  for (const auto& [what, m] : {std::pair{"box", make_box({-0.9f, 0.0f, -0.7f}, {0.9f, 1.0f, 0.7f})},
+                                std::pair{"sphere", make_sphere({0, 1, 0}, 1.0f, 96, 48)},
+                                std::pair{"torus", make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)}, std::pair{"head", test::make_head()}}) {
     const LayerErrors e = layer_errors(m);
-    std::printf("closed: containment %.4f / %.4f, volumetric %.4f / %.4f\n", e.containment[0], e.containment[1], e.volumetric[0], e.volumetric[1]);
-    EXPECT_LE(e.containment[1], 1.03 * e.containment[0]);
-    EXPECT_LE(e.volumetric[1], 1.03 * e.volumetric[0]);
+    std::printf("%s: containment %.4f / %.4f, volumetric %.4f / %.4f\n", what, e.containment[0], e.containment[1], e.volumetric[0], e.volumetric[1]);
+    const bool bulges = std::string_view(what) == "sphere" || std::string_view(what) == "head";
+    EXPECT_LE(e.containment[1], (bulges ? 0.4 : 1.03) * e.containment[0]) << what;
+    EXPECT_LE(e.volumetric[1], (bulges ? 0.5 : 1.03) * e.volumetric[0]) << what;
     closed_c.push_back(e.containment[0]), closed_v.push_back(e.volumetric[0]);
   }
   const auto median = [](std::vector<double> v) {

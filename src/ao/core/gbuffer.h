@@ -6,6 +6,7 @@
 // depth_plane() (simd/depth_plane.h).
 #pragma once
 
+#include <bit>
 #include <cstdint>
 
 #include "ao/core/camera.h"
@@ -42,10 +43,15 @@ struct GBuffer {
   Image<std::uint32_t> primitive_id;
   /// Optional second depth layer (a deep G-buffer, Mara et al. 2016; render_second_layer fills it):
   /// per pixel the signed linear depth of the nearest surface at least `second_separation` behind
-  /// the visible one along the pixel's ray. > 0: a back face, where the solid entered at the
-  /// visible surface ends; < 0: a front face (its depth negated): the visible surface was thinner
-  /// than the separation and another solid begins there; +infinity: nothing behind (or not
-  /// covered). Empty (the default) = one layer.
+  /// the visible one along the pixel's ray. > 0: a back face (the winding's normal points along
+  /// the ray), where the solid entered at the visible surface ends; < 0: a front face (its depth
+  /// negated): the visible surface was thinner than the separation and another solid begins there;
+  /// +infinity: nothing behind (or not covered). Where the ray leaves a closed solid seen from
+  /// outside (solid_exit_sides: a closed mesh, of either orientation, not around the eye) the depth
+  /// is positive with the lowest bit of its float set (second_layer_back_face, a change of at
+  /// most one unit in the last place), and every other positive depth has it clear: the ray entered that
+  /// solid at the visible surface or within the separation behind it. Empty (the default) = one
+  /// layer.
   Image<float> second_depth;
   float second_separation = 0;  ///< The minimum separation second_depth was rendered with, world units.
 
@@ -69,6 +75,15 @@ struct GBuffer {
   /// The same for pixel index i = y * width + x.
   float depth(std::size_t i) const { return covered(i) ? -position[i].z : kInfinity; }
 };
+
+/// GBuffer::second_depth's value for a back face at depth `t` > 0: the float's lowest bit set
+/// where the ray leaves a closed solid seen from outside (`exits`), clear elsewhere.
+inline float second_layer_back_face(float t, bool exits) {
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(t);
+  return std::bit_cast<float>(exits ? bits | 1u : bits & ~1u);
+}
+/// Whether a second-layer value (GBuffer::second_depth) is where the ray leaves a closed solid.
+inline bool second_layer_exit(float s2) { return s2 > 0.0f && s2 < kInfinity && (std::bit_cast<std::uint32_t>(s2) & 1u) != 0; }
 
 /// What a G-buffer renderer puts in the G-buffer (render_gbuffer: gbuffer/render_gbuffer.h;
 /// GpuGBuffer::rasterize: gpu/gbuffer.h).

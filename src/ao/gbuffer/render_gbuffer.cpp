@@ -5,7 +5,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "ao/core/error.h"
 #include "ao/reference/packets_internal.h"
@@ -18,20 +21,26 @@ namespace {
 
 // What the second layer stores for one pixel's ray (GBuffer::second_depth): the hit's depth t
 // (the rays are scaled to unit camera-space depth, so t is the linear depth), positive where the
-// ray leaves through the triangle (a back face: its winding's normal points along the ray), negative
-// where it enters one; +infinity without a hit.
-float second_layer_value(const RayScene& rs, unsigned geom_id, unsigned inst_id, unsigned prim_id, float u, float v, float t, Vec3 dir) {
+// ray leaves through the triangle (a back face: its winding's normal points along the ray) and
+// marked where that is a closed solid's exit (solid_exit_sides: a closed mesh seen from outside,
+// whichever way its fronts face), negative where it enters one; +infinity without a hit.
+float second_layer_value(const RayScene& rs, std::span<const std::int8_t> exit_sides, unsigned geom_id, unsigned inst_id, unsigned prim_id,
+                         float u, float v, float t, Vec3 dir) {
   if (geom_id == RTC_INVALID_GEOMETRY_ID) return kInfinity;
+  const HitRef hit = resolve(rs, geom_id, inst_id, prim_id, u, v);
   Vec3 p0, p1, p2;
-  world_triangle(rs, resolve(rs, geom_id, inst_id, prim_id, u, v), p0, p1, p2);
-  return dot(cross(p1 - p0, p2 - p0), dir) > 0.0f ? t : -t;
+  world_triangle(rs, hit, p0, p1, p2);
+  const bool back = dot(cross(p1 - p0, p2 - p0), dir) > 0.0f;
+  const int side = exit_sides[hit.object];
+  if (side < 0) return back ? -t : second_layer_back_face(t, true);  // a closed mesh whose fronts face in
+  return back ? second_layer_back_face(t, side > 0) : -t;
 }
 
 // Traces tile t's second-layer rays, N to a packet (blocks of 4 x N/4 pixels, as the G-buffer's);
 // returns its pixel count (the pass's unit of progress).
 template <int N>
-std::size_t second_layer_tile(const RayScene& rs, RTCIntersectContext& ctx, const simd::RayGenerator& rays, Vec3 eye, float separation,
-                              const GBuffer& g, Image<float>& out, const Tile& t) {
+std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> exit_sides, RTCIntersectContext& ctx, const simd::RayGenerator& rays,
+                              Vec3 eye, float separation, const GBuffer& g, Image<float>& out, const Tile& t) {
   const auto start = [&](int x, int y) { return g.covered(x, y) ? g.depth(x, y) + separation : -1.0f; };  // < 0: no ray
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
@@ -44,7 +53,7 @@ std::size_t second_layer_tile(const RayScene& rs, RTCIntersectContext& ctx, cons
         rh.ray = RTCRay{eye.x, eye.y, eye.z, t0, d.x, d.y, d.z, 0.0f, kInfinity, 0xffffffffu, 0, 0};
         rh.hit.geomID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(embree_scene(rs), &ctx, &rh);
-        out(x, y) = second_layer_value(rs, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, d);
+        out(x, y) = second_layer_value(rs, exit_sides, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, d);
       }
   } else {
     constexpr int bw = 4, bh = N / 4;
@@ -66,10 +75,9 @@ std::size_t second_layer_tile(const RayScene& rs, RTCIntersectContext& ctx, cons
         for (int k = 0; k < N; ++k) {
           const int x = bx + k % bw, y = by + k / bw;
           if (x >= t.x1 || y >= t.y1) continue;
-          out(x, y) = valid[static_cast<std::size_t>(k)]
-                                     ? second_layer_value(rs, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k],
-                                                          rh.ray.tfar[k], rays(x, y))
-                                     : kInfinity;
+          out(x, y) = valid[static_cast<std::size_t>(k)] ? second_layer_value(rs, exit_sides, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k],
+                                                                              rh.hit.u[k], rh.hit.v[k], rh.ray.tfar[k], rays(x, y))
+                                                         : kInfinity;
         }
       }
   }
@@ -128,10 +136,11 @@ Image<float> render_second_layer_depth(const RayScene& rs, const GBuffer& g, flo
   Image<float> out(w, h);
   const Frame basis = camera.basis();
   const simd::RayGenerator rays(camera, basis);  // camera-space z of every direction is -1: t is the linear depth
+  const std::vector<std::int8_t> exit_sides = solid_exit_sides(rs.scene(), mesh_sides(rs), camera.eye);
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   const detail::RayTiling tiling{simd::kGBufferTileWidth, simd::kGBufferTileHeight, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, true};
   detail::for_each_ray_tile(rs, w, h, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
-    return second_layer_tile<N>(rs, ctx, rays, camera.eye, separation, g, out, t);
+    return second_layer_tile<N>(rs, exit_sides, ctx, rays, camera.eye, separation, g, out, t);
   });
   return out;
 }

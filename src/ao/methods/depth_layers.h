@@ -14,6 +14,11 @@
 // Behind a sheet, the rest of the ray (the gap) is solid for a receiver x the sheet hides it from:
 // x lies on the camera's side of the sheet's tangent plane at the point's pixel, and the segment
 // from x to the point meets that plane where the sheet is (not past its rim).
+// AT 4.3's silhouette elimination takes a surface more than R in front of a point for a distant
+// foreground object with free space behind it. Where the second layer is a closed solid's exit
+// (a closed mesh seen from outside: GBuffer::second_depth marks it) the ray is inside that solid
+// up to z2, so [z1, z2] stays solid however far in front z1 is; the elimination frees only what
+// lies past z2 (the ground under a sphere's bulge beside its contact sees the sphere's inside).
 // Containment, volumetric and ambient transfer test their points and pipes against that solid;
 // Alchemy takes the second layer's point at each tap as an occluder too.
 //

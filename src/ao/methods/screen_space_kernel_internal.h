@@ -51,9 +51,10 @@ struct DepthPlane {
   int width = 0, height = 0;
   /// A deep G-buffer's second layer (GBuffer::second_depth), or null: one layer, the solid along
   /// a pixel's ray is [z*, infinity). With it (methods/depth_layers.h): [z*, infinity) where the
-  /// layer holds a back face (z2 > 0, finite: a closed solid); where it holds a front face (z2 < 0)
-  /// or nothing (+infinity) the visible surface is a sheet: [z*, z* + separation], [-z2, infinity),
-  /// and in between solid for a receiver the sheet hides the point from (`normals`).
+  /// layer holds a back face (z2 > 0, finite: a closed solid), [z*, z2] of it whatever AT 4.3 says
+  /// where that is a closed mesh's exit; where it holds a front face (z2 < 0) or nothing
+  /// (+infinity) the visible surface is a sheet: [z*, z* + separation], [-z2, infinity), and in
+  /// between solid for a receiver the sheet hides the point from (`normals`).
   const float* second = nullptr;
   float separation = 0;
   /// With `second`: the visible surface's camera-space unit normal per pixel, facing the camera

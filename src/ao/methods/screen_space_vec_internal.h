@@ -51,6 +51,17 @@ struct Plane {
   // (what lies past its back face is taken for solid, as with one layer), z1 + separation behind a
   // sheet.
   HWY_INLINE VF solid_end(VF z1, VF s2) const { return hn::IfThenElse(back_face(s2), hn::Set(DF(), kInfinity), hn::Add(z1, separation)); }
+  // Whether s2 is where the ray leaves a closed solid seen from outside (second_layer_back_face
+  // marks such a back face in the float's lowest bit): then the ray is inside that solid from the
+  // visible surface (or within the separation behind it) to s2.
+  HWY_INLINE static MF closed_exit(VF s2) {
+    const DI di;
+    const MF marked = hn::RebindMask(DF(), hn::Ne(hn::And(hn::BitCast(di, s2), hn::Set(di, 1)), hn::Zero(di)));
+    return hn::And(back_face(s2), marked);
+  }
+  // Whether depth z lies before a closed solid's exit s2: inside that solid, however far in front
+  // of z its visible surface is (AT 4.3 is left to guess about the space past the exit only).
+  HWY_INLINE static MF inside_closed(VF z, VF s2) { return hn::And(closed_exit(s2), hn::Lt(z, s2)); }
   // Where the next solid begins: the front face's depth -s2, else +infinity.
   HWY_INLINE static VF next_solid(VF s2) {
     return hn::IfThenElse(hn::Gt(s2, hn::Zero(DF())), hn::Set(DF(), kInfinity), hn::Neg(s2));

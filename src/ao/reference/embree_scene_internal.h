@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstdint>
+#include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -12,6 +14,7 @@
 
 #include "ao/reference/ray_scene.h"
 #include "ao/reference/triangle_pairs_internal.h"
+#include "ao/scene/topology.h"
 
 namespace ao {
 
@@ -22,7 +25,17 @@ struct RayScene::Handles {
   std::vector<SceneObject> objects;         ///< rs.scene().objects(), by geometry ID of the top level.
   std::vector<Affine3> normal_to_world;     ///< Per instance: cofactor of its transform (face normals; normalise).
   std::vector<detail::TrianglePairs> pairs; ///< Per mesh: its quads when built with BvhOptions::quads, else empty.
+  /// Per mesh: closed_mesh_sides (scene/topology.h), computed on first use (mesh_sides below).
+  mutable std::once_flag sides_once;
+  mutable std::vector<std::int8_t> sides;
 };
+
+/// closed_mesh_sides of rs's scene, computed once per RayScene (from any thread) on first use.
+inline std::span<const std::int8_t> mesh_sides(const RayScene& rs) {
+  const RayScene::Handles& h = rs.handles();
+  std::call_once(h.sides_once, [&] { h.sides = closed_mesh_sides(rs.scene()); });
+  return h.sides;
+}
 
 namespace detail {
 /// An RTCError code in words, for the one-line SystemError a failed Embree call becomes

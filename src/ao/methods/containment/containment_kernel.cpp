@@ -42,11 +42,14 @@ void CountOpenRaysImpl(const CoveredPixels& row, const DepthPlane& plane, const 
         const VF zs = hn::GatherIndex(d, pl.depth, pixel);
         const VF dist = hn::IfThenElse(hn::Lt(qz, zero), hn::Add(zs, qz), inf);
         // Occluded: behind the surface by more than the bias, and (AT 4.3) less than R behind it;
-        // with a second layer also inside the solid behind the surface (not past its end).
-        MF occluded = hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far));
+        // with a second layer also inside the solid behind the surface (not past its end), and
+        // between a closed solid's front and its back face however far behind it (depth_layers.h).
+        const MF behind = hn::Lt(dist, minus_bias);
+        MF occluded = hn::And(behind, hn::Gt(dist, far));
         if constexpr (kTwoLayers) {
-          const VF s2 = gather_where(occluded, pl.second, pixel);
+          const VF s2 = gather_where(behind, pl.second, pixel);
           occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), zs, s2, occluded, pixel, {e.px, e.py, e.pz}, {qx, qy, qz}, e.bias));
+          occluded = hn::Or(occluded, hn::And(behind, Plane::inside_closed(hn::Neg(qz), s2)));
         }
         blocked = hn::Or(blocked, occluded);
       }

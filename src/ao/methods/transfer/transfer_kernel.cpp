@@ -87,11 +87,14 @@ HWY_INLINE void nearest_occluder(const Entries& e, const Plane& pl, const StepOf
       dist = hn::Add(z1, qz);
     }
     // AT 4.3: occluded only when the surface in front is less than R in front; with a second layer
-    // also inside the solid behind the surface.
-    MF occluded = hn::And(valid, hn::And(hn::Lt(dist, minus_bias), hn::Gt(dist, far)));
+    // also inside the solid behind the surface, and between a closed solid's front and its back
+    // face however far in front the front is (depth_layers.h).
+    const MF behind = hn::And(valid, hn::Lt(dist, minus_bias));
+    MF occluded = hn::And(behind, hn::Gt(dist, far));
     if constexpr (kTwoLayers) {
-      const VF s2 = gather_where(occluded, pl.second, pixel);
+      const VF s2 = gather_where(behind, pl.second, pixel);
       occluded = hn::And(occluded, pl.in_solid(hn::Neg(qz), z1, s2, occluded, pixel, {e.px, e.py, e.pz}, {qx, qy, qz}, e.bias));
+      occluded = hn::Or(occluded, hn::And(behind, Plane::inside_closed(hn::Neg(qz), s2)));
     }
     at = hn::IfThenElse(hn::RebindMask(di, occluded), id, at);
     blocked = hn::Or(blocked, occluded);

@@ -56,6 +56,7 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
       // Fig. 7: dz = clamp(z* - z_entry, 0, chord): (a) surface inside: z* - z_entry; (b) behind:
       // the chord; (c) in front: 0. A distant foreground surface (AT 4.3) leaves the pipe free.
       VF dz = hn::Min(hn::Max(to_surface, zero), chord);
+      VF distant_free = chord;  // a distant foreground surface's pipe: free (AT 4.3)
       if constexpr (kTwoLayers) {
         // The solid in the pipe is [dz, end) and [next, chord) from its entry (depth_layers.h), so
         // the free length is next - max(0, end - dz), both clamped to the pipe.
@@ -64,6 +65,9 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
         const VF from_entry = hn::Add(cz, hc);  // depth z - z_entry = z + c_z + (R/2) h_i
         VF end = hn::Min(hn::Max(hn::Add(pl.solid_end(zs, s2), from_entry), zero), chord);
         const VF next = hn::Min(hn::Max(hn::Add(Plane::next_solid(s2), from_entry), zero), chord);
+        // Before a closed solid's exit the pipe is solid whatever AT 4.3 says (depth_layers.h).
+        const VF exit = hn::Min(hn::Max(hn::Add(s2, from_entry), zero), chord);
+        distant_free = hn::IfThenElse(hn::And(reaches, Plane::closed_exit(s2)), hn::Sub(chord, hn::Max(hn::Sub(exit, dz), zero)), chord);
         // Behind a sheet the gap [end, next) is solid where the sheet hides it from x, judged at
         // the gap's middle: the pipe's point (c_x + x_i cos - y_i sin, c_y + x_i sin + y_i cos) at
         // depth z_entry + (end + next) / 2.
@@ -77,7 +81,7 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
         dz = hn::IfThenElse(reaches, hn::Sub(next, hn::Max(hn::Sub(end, dz), zero)), dz);
       }
       const MF distant = hn::And(hn::Lt(to_surface, lim), hn::Gt(to_surface, minus_huge));
-      acc = hn::Add(acc, hn::IfThenElse(distant, chord, dz));
+      acc = hn::Add(acc, hn::IfThenElse(distant, distant_free, dz));
     }
     hn::Store(acc, d, free + k0);
   }

@@ -5,12 +5,9 @@
 #include "ao/methods/cone/mesh_closure.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstring>
 #include <mutex>
 
-#include "ao/core/affine.h"
 #include "ao/scene/topology.h"
 
 namespace ao {

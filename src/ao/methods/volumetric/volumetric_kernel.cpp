@@ -66,8 +66,8 @@ void SumFreePipesImpl(const CoveredPixels& row, const DepthPlane& plane, float h
         VF end = hn::Min(hn::Max(hn::Add(pl.solid_end(zs, s2), from_entry), zero), chord);
         const VF next = hn::Min(hn::Max(hn::Add(Plane::next_solid(s2), from_entry), zero), chord);
         // Before a closed solid's exit the pipe is solid whatever AT 4.3 says (depth_layers.h).
-        const VF exit = hn::Min(hn::Max(hn::Add(s2, from_entry), zero), chord);
-        distant_free = hn::IfThenElse(hn::And(reaches, Plane::closed_exit(s2)), hn::Sub(chord, hn::Max(hn::Sub(exit, dz), zero)), chord);
+        const VF leaves = hn::Min(hn::Max(hn::Add(s2, from_entry), zero), chord);
+        distant_free = hn::IfThenElse(hn::And(reaches, Plane::closed_exit(s2)), hn::Sub(chord, hn::Max(hn::Sub(leaves, dz), zero)), chord);
         // Behind a sheet the gap [end, next) is solid where the sheet hides it from x, judged at
         // the gap's middle: the pipe's point (c_x + x_i cos - y_i sin, c_y + x_i sin + y_i cos) at
         // depth z_entry + (end + next) / 2.

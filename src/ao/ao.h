@@ -44,10 +44,11 @@
 #include "ao/simd/depth_plane.h"
 #include "ao/simd/target.h"  // which SIMD instruction set the kernels run with
 
-// scene: meshes, scenes, built-in and analytic scenes.
+// scene: meshes, scenes, built-in and analytic scenes, and what a mesh's connectivity says.
 #include "ao/scene/analytic.h"
 #include "ao/scene/mesh.h"
 #include "ao/scene/procedural.h"
+#include "ao/scene/topology.h"
 
 // The ray-traced ground truth and the scene -> G-buffer pass (Embree stays behind RayScene).
 #include "ao/gbuffer/render_gbuffer.h"

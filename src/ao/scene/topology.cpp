@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "ao/scene/topology.h"
 
-#include <algorithm>
 #include <cstring>
 #include <utility>
+
+#include <tbb/parallel_sort.h>
 
 #include "ao/core/affine.h"
 
@@ -19,7 +20,7 @@ MeshEdges mesh_edges(const Mesh& m) {
     std::memcpy(k.data(), c, sizeof c);
     keyed[v] = {k, static_cast<std::uint32_t>(v)};
   }
-  std::sort(keyed.begin(), keyed.end());
+  tbb::parallel_sort(keyed.begin(), keyed.end());  // distinct elements: the order is unique
   out.weld.resize(nv);
   for (std::size_t v = 0; v < nv; ++v) {
     if (v > 0 && keyed[v].first != keyed[v - 1].first) ++out.welded;
@@ -35,7 +36,7 @@ MeshEdges mesh_edges(const Mesh& m) {
       if (a > b) std::swap(a, b);
       edges.push_back({a << 32 | b, static_cast<std::uint32_t>(3 * t + e)});
     }
-  std::sort(edges.begin(), edges.end());
+  tbb::parallel_sort(edges.begin(), edges.end());
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;

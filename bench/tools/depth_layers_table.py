@@ -3,7 +3,7 @@
 """Error and time of the screen-space methods with one and two depth layers (docs/methods/depth-layers.md).
 
     bench/tools/depth_layers_table.py BUILD/src/ao [--meshes ../shared/data/meshes] [--out-dir DIR]
-    bench/tools/depth_layers_table.py BUILD/src/ao --thickness [--open-sheets DIR]
+    bench/tools/depth_layers_table.py BUILD/src/ao --thickness [--open-sheets DIR] [--methods gtao]
 
 Runs `ao compare` (640x360, R = 0.1 x the objects' diagonal, 256 reference rays per pixel, seed 1)
 on three built-in scenes and three shared meshes, for each configuration below, and prints one
@@ -12,7 +12,7 @@ markdown table: RMSE against each method's matched reference, and the method's m
 deterministic; the times are indicative only. Outputs go to a temporary folder unless --out-dir.
 
 --thickness compares one layer, two layers and one layer's sheets of thickness R/8, R/4 and R/2
-(containment, volumetric, transfer) instead; --open-sheets DIR adds the meshes `ao_open_sheets DIR`
+(containment, volumetric, transfer, or --methods) instead; --open-sheets DIR adds the meshes `ao_open_sheets DIR`
 wrote (the open-mesh suite and its closed meshes), each with its camera.
 """
 import argparse
@@ -49,7 +49,7 @@ def thickness_table(a, scenes, out):
         for label, extra, fraction in THICKNESS_CONFIGS:
             if fraction is not None:
                 extra = ["-p", "thickness=%.6g" % (fraction * radius)]
-            table = compare(a, args, "containment,volumetric,transfer", extra, out)
+            table = compare(a, args, a.methods, extra, out)
             radius = table["radius"]
             for r in table["rows"]:
                 cells.setdefault(r["method"], []).append("%.4f" % r["rmse"])
@@ -64,6 +64,7 @@ def main():
     ap.add_argument("--out-dir")
     ap.add_argument("--thickness", action="store_true", help="one layer's sheets of a thickness against one and two layers")
     ap.add_argument("--open-sheets", help="a folder ao_open_sheets wrote: add its meshes, each with its camera")
+    ap.add_argument("--methods", default="containment,volumetric,transfer", help="with --thickness: the methods compared")
     a = ap.parse_args()
     scenes = ["default", "box-room", "sphere-on-plane"] + [os.path.join(a.meshes, m) for m in ("ChineseDragon-10kv.off", "pinion.off", "rotor_small.off")]
     named = [(os.path.basename(s), [s]) for s in scenes]

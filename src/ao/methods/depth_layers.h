@@ -20,7 +20,8 @@
 // up to z2, so [z1, z2] stays solid however far in front z1 is; the elimination frees only what
 // lies past z2 (the ground under a sphere's bulge beside its contact sees the sphere's inside).
 // Containment, volumetric and ambient transfer test their points and pipes against that solid;
-// Alchemy takes the second layer's point at each tap as an occluder too.
+// Alchemy takes the second layer's point at each tap as an occluder too; GTAO makes each sample a
+// slab of that solid and counts the directions the slabs cover (a visibility bitmask).
 //
 // Without a second layer (one layer), `thickness` > 0 takes every visible surface for a sheet of
 // that thickness with nothing behind it: the solid along a pixel's ray is [z1, z1 + thickness] and,
@@ -66,7 +67,7 @@ std::vector<Param<P>> depth_layer_params(DepthLayers P::*member) {
 }
 
 /// The `thickness` row of a method's parameter table (the methods that test points against the solid
-/// behind the depth buffer: containment, volumetric, transfer).
+/// behind the depth buffer: containment, volumetric, transfer; and GTAO, whose samples become slabs).
 template <class P>
 Param<P> thickness_param(DepthLayers P::*member) {
   return Param<P>::real("thickness", [member](P& p) -> float& { return (p.*member).thickness; }, Range::at_least(0), "world units",

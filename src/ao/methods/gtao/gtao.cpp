@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "ao/methods/gtao/gtao_internal.h"
 #include "ao/methods/gtao/gtao_kernel_internal.h"
 #include "ao/methods/gtao/gtao_shared.h"
+#include "ao/methods/screen_space_method_internal.h"
 #include "ao/simd/depth_plane.h"
 
 namespace ao {
@@ -34,7 +36,7 @@ static_assert(kTileWidth <= simd::kMaxGtaoSegment);
 // permutations and jitter, so a 4x4 block holds 16 distinct rotations and offsets; without
 // interleaving every entry is the same seeded value.
 struct Pattern {
-  std::array<float, 16> rotation, offset;
+  std::array<float, 16> rotation, offset, sector;
 };
 
 Pattern make_pattern(std::uint32_t seed, bool interleave) {
@@ -49,13 +51,15 @@ Pattern make_pattern(std::uint32_t seed, bool interleave) {
     }
     return perm;
   };
-  const std::array<int, 16> pr = permutation(0x51u), po = permutation(0xA7u);
+  const std::array<int, 16> pr = permutation(0x51u), po = permutation(0xA7u), pb = permutation(0xB3u);
   for (int k = 0; k < 16; ++k) {
     const auto i = static_cast<std::size_t>(k);
     const float jr = to_unit_float(hash_combine(hash_combine(seed, 0x1Du), static_cast<std::uint32_t>(k)));
     const float jo = to_unit_float(hash_combine(hash_combine(seed, 0x2Eu), static_cast<std::uint32_t>(k)));
     p.rotation[i] = interleave ? (static_cast<float>(pr[i]) + jr) / 16.0f : to_unit_float(hash_combine(seed, 0x3Fu));
     p.offset[i] = interleave ? (static_cast<float>(po[i]) + jo) / 16.0f : to_unit_float(hash_combine(seed, 0x40u));
+    const float jb = to_unit_float(hash_combine(hash_combine(seed, 0x3Cu), static_cast<std::uint32_t>(k)));
+    p.sector[i] = interleave ? (static_cast<float>(pb[i]) + jb) / 16.0f : to_unit_float(hash_combine(seed, 0x41u));
   }
   return p;
 }
@@ -69,8 +73,10 @@ const ParamTable<GtaoParams>& gtao_param_table() {
       {{P::integer("slices", &GtaoParams::slices, Range::closed(1, kMaxSlices), "", "slice directions per pixel (the outer integral over phi)"),
         P::integer("steps", &GtaoParams::steps, Range::closed(1, kMaxSteps), "", "depth-buffer samples on each side of a slice (the horizon search)"),
         P::real("step_power", &GtaoParams::step_power, Range::closed(1, 4), "", "samples at ((j + u) / steps)^step_power of the screen radius"),
-        P::boolean("multi_bounce", &GtaoParams::multi_bounce, "the multi-bounce fit with the G-buffer albedo")},
-       interleave_params(&GtaoParams::interleave)}};
+        P::boolean("multi_bounce", &GtaoParams::multi_bounce, "the multi-bounce fit with the G-buffer albedo"),
+        thickness_param(&GtaoParams::layers)},
+       interleave_params(&GtaoParams::interleave),
+       depth_layer_params(&GtaoParams::layers)}};
   return table;
 }
 
@@ -88,6 +94,13 @@ Tables make_tables(const GtaoParams& params, std::uint32_t seed) {
       t.dir_c[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::cos(phi));
       t.dir_s[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(std::sin(phi));
     }
+  // The bitmask's points (slabs) of slice k and entry p lie at (i + xi) / 32 of the slice's measure:
+  // xi stratified over the 16 entries, and moved on by the golden ratio's fraction from slice to slice.
+  for (int k = 0; k < slices; ++k)
+    for (int p = 0; p < 16; ++p) {
+      const double xi = pattern.sector[static_cast<std::size_t>(p)] + 0.6180339887498949 * k;
+      t.sector_offset[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)] = static_cast<float>(xi - std::floor(xi));
+    }
   // Step j of pattern entry p lies at t = ((j + offset_p) / steps)^step_power of the screen radius.
   for (int j = 0; j < steps; ++j)
     for (int p = 0; p < 16; ++p)
@@ -98,7 +111,10 @@ Tables make_tables(const GtaoParams& params, std::uint32_t seed) {
 
 }  // namespace gtao_internal
 
-void GtaoParams::validate() const { gtao_param_table().validate(*this); }
+void GtaoParams::validate() const {
+  gtao_param_table().validate(*this);
+  check_thickness(layers, "gtao");
+}
 void to_json(nlohmann::json& j, const GtaoParams& p) { j = gtao_param_table().to_json(p); }
 void from_json(const nlohmann::json& j, GtaoParams& p) { gtao_param_table().from_json(j, p); }
 
@@ -107,8 +123,16 @@ float gtao_multi_bounce(float v, float rho) {
 }
 
 GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std::uint32_t seed) {
+  if (params.layers.layers < 2) return gtao_ao(g, nullptr, radius, params, seed);
+  const float separation = effective_separation(params.layers, radius);
+  if (!has_second_layer(g, separation)) throw_missing_second_layer("gtao", separation);
+  return gtao_ao(g, &g.second_depth, radius, params, seed);
+}
+
+GtaoImage gtao_ao(const GBuffer& g, const Image<float>* second_layer, float radius, const GtaoParams& params, std::uint32_t seed) {
   params.validate();
   if (!(radius > 0.0f) || !std::isfinite(radius)) throw InputError("gtao: radius R must be a positive number of world units");
+  if (params.layers.layers == 2 && !second_layer) throw_missing_second_layer("gtao", effective_separation(params.layers, radius));
   const int w = g.width(), h = g.height();
   const int slices = params.slices, steps = params.steps;
   const gtao_internal::Tables tables = gtao_internal::make_tables(params, seed);
@@ -125,6 +149,13 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
   // The kernel reads each table as one row-major array, [k * 16 + p].
   static_assert(sizeof(tables.dir_c) == sizeof(float) * kMaxSlices * 16 && sizeof(tables.step_t) == sizeof(float) * kMaxSteps * 16);
   in.dir_c = tables.dir_c[0].data(), in.dir_s = tables.dir_s[0].data(), in.step_t = tables.step_t[0].data();
+  in.sector_offset = tables.sector_offset[0].data();
+  if (params.layers.layers == 2) {
+    if (second_layer->width() != w || second_layer->height() != h) throw InputError("gtao: the second depth layer must have the G-buffer's size");
+    in.second = second_layer->data(), in.separation = effective_separation(params.layers, radius);
+  } else {
+    in.thickness = params.layers.thickness;
+  }
 
   // V = 1 where nothing is covered: each tile fills its own rows (fresh pages touched in parallel).
   Image<float> v;
@@ -153,11 +184,20 @@ GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std:
 }
 
 MethodOutput run(const MethodInput& in, const GtaoParams& params) {
-  GtaoImage img = gtao_ao(in.gbuffer, in.falloff.radius, params, in.seed);
+  params.validate();
+  // Two layers: the G-buffer's second layer, or one traced for this run.
+  std::shared_ptr<const Image<float>> second;
+  if (params.layers.layers == 2) second = detail::second_layer_for(in, effective_separation(params.layers, in.falloff.radius), "gtao");
+  GtaoImage img = gtao_ao(in.gbuffer, second.get(), in.falloff.radius, params, in.seed);
   MethodOutput out;
   out.visibility = std::move(img.visibility);
   out.color = std::move(img.color);
   return out;
+}
+
+void check_gpu(const GtaoParams& params) {
+  if (params.layers.layers != 1 || params.layers.thickness > 0)
+    throw InputError("gtao: slabs (thickness > 0 or layers=2) run on the CPU backend only; the GPU shader reads the horizon form");
 }
 
 }  // namespace ao

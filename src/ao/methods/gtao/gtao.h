@@ -24,6 +24,12 @@
 // the cosine-weighted visibility within R, i.e. the obscurance of the volumetric AO paper's eq. 2
 // with the step membership and the same R: its reference in the registry. docs/methods/gtao.md maps
 // every symbol and lists the deviations.
+//
+// With a second depth layer or a thickness (`layers`), each sample is a slab of finite depth
+// instead of the top of an endless solid, and a slice's inner integral is the open one times the
+// fraction of 32 points, equal shares of it, that no slab covers within R: the visibility bitmask
+// of Therrien, Levesque and Gilet ("Screen Space Indirect Lighting with Visibility Bitmask", 2023),
+// its points spread in the inner integral's measure (gtao_kernel.cpp).
 #pragma once
 
 #include <cstdint>
@@ -31,6 +37,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "ao/core/gbuffer.h"
+#include "ao/methods/depth_layers.h"
 #include "ao/methods/filters/interleave.h"
 #include "ao/methods/method.h"
 
@@ -43,6 +50,10 @@ struct GtaoParams {
                           ///< (XeGTAO uses 2); 1 measured best against the step reference, whose horizon is set at distance R.
   bool multi_bounce = false;  ///< The multi-bounce fit with the G-buffer albedo; off: V is the visibility integral itself.
   InterleaveOptions interleave;  ///< 4x4 pattern of slice rotations and step offsets; the paper's 4x4 spatial denoiser (filter).
+  /// How thick the surfaces behind the samples are (depth_layers.h). Default (one layer, thickness 0): every sample is the top
+  /// of a solid running on without end, the paper's horizon form. A thickness or a second layer makes each sample a slab of
+  /// finite depth, and the slice's occluded directions the union of the slabs' (a visibility bitmask; docs/methods/gtao.md).
+  DepthLayers layers;
 
   /// Throws InputError naming the bad field.
   void validate() const;
@@ -59,13 +70,19 @@ struct GtaoImage {
 };
 
 /// GTAO for every covered pixel with radius R = `radius` (world units, > 0). Deterministic for a
-/// seed, independent of the thread count.
+/// seed, independent of the thread count. With layers = 2 it reads g.second_depth, which must have
+/// been rendered at the effective separation (InputError otherwise).
 GtaoImage gtao_ao(const GBuffer& g, float radius, const GtaoParams& params, std::uint32_t seed);
+/// The same with the second depth layer given apart (layers = 2; ignored with one layer).
+GtaoImage gtao_ao(const GBuffer& g, const Image<float>* second_layer, float radius, const GtaoParams& params, std::uint32_t seed);
 
 /// The multi-bounce fit: the multi-bounce visibility for visibility v and albedo rho (both in [0, 1]).
 float gtao_multi_bounce(float v, float rho);
 
 /// The method as the registry runs it (method.h): gtao_ao with R = in.falloff.radius.
 MethodOutput run(const MethodInput& in, const GtaoParams& params);
+
+/// InputError for what the GPU shader does not run: slabs (a thickness or a second layer).
+void check_gpu(const GtaoParams& params);
 
 }  // namespace ao

@@ -20,6 +20,7 @@ inline constexpr int kMaxSlices = 16, kMaxSteps = 32;
 struct Tables {
   std::array<std::array<float, 16>, kMaxSlices> dir_c{}, dir_s{};
   std::array<std::array<float, 16>, kMaxSteps> step_t{};
+  std::array<std::array<float, 16>, kMaxSlices> sector_offset{};  ///< the slabs' bitmask offset xi of slice k (gtao_kernel.cpp)
 };
 Tables make_tables(const GtaoParams& params, std::uint32_t seed);
 

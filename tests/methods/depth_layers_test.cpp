@@ -99,6 +99,12 @@ TEST(DepthLayers, SecondLayerMarksWhereTheRayLeavesAClosedSolid) {
   render_second_layer(*room.rays, room.g, 0.1f);
   EXPECT_NEAR(centre_second(room), 30.0f, 1e-3f) << "the room's far wall, from inside";
   EXPECT_FALSE(second_layer_exit(centre_second(room)));
+  // Where the room's wall itself is seen (beside the sheet), its solid is everything outside it: no
+  // end, whatever the ray would meet past the wall.
+  ASSERT_EQ(room.g.object_id(2, 2), 2u) << "the room is seen there";
+  EXPECT_EQ(room.g.second_depth(2, 2), kSecondLayerSolidOnward);
+  EXPECT_GT(kSecondLayerSolidOnward, 1e38f);
+  EXPECT_FALSE(second_layer_exit(kSecondLayerSolidOnward)) << "a back face, not an exit";
 }
 
 TEST(DepthLayers, RejectsBadSeparationsAndMissingLayers) {

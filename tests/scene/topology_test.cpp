@@ -45,6 +45,8 @@ TEST(Topology, ARayLeavesAClosedSolidSeenFromOutside) {
   EXPECT_EQ(solid_exit_sides(s, closed_mesh_sides(s), inside), (std::vector<std::int8_t>{0, 0, 0})) << "around the eye: rooms";
   EXPECT_TRUE(inside_closed_object(s, s.objects()[0], inside));
   EXPECT_FALSE(inside_closed_object(s, s.objects()[0], outside));
+  EXPECT_EQ(closed_objects_around(s, closed_mesh_sides(s), inside), (std::vector<std::uint8_t>{1, 1, 0})) << "rooms, either way round";
+  EXPECT_EQ(closed_objects_around(s, closed_mesh_sides(s), outside), (std::vector<std::uint8_t>{0, 0, 0}));
 }
 
 TEST(Topology, AMirroringInstanceTurnsTheSide) {

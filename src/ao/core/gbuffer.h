@@ -8,6 +8,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <limits>
 
 #include "ao/core/camera.h"
 #include "ao/core/image.h"
@@ -50,8 +51,8 @@ struct GBuffer {
   /// outside (solid_exit_sides: a closed mesh, of either orientation, not around the eye) the depth
   /// is positive with the lowest bit of its float set (second_layer_back_face, a change of at
   /// most one unit in the last place), and every other positive depth has it clear: the ray entered that
-  /// solid at the visible surface or within the separation behind it. Empty (the default) = one
-  /// layer.
+  /// solid at the visible surface or within the separation behind it. Behind the wall of a room
+  /// around the eye, kSecondLayerSolidOnward (no ray is traced). Empty (the default) = one layer.
   Image<float> second_depth;
   float second_separation = 0;  ///< The minimum separation second_depth was rendered with, world units.
 
@@ -82,6 +83,10 @@ inline float second_layer_back_face(float t, bool exits) {
   const std::uint32_t bits = std::bit_cast<std::uint32_t>(t);
   return std::bit_cast<float>(exits ? bits | 1u : bits & ~1u);
 }
+/// GBuffer::second_depth's value behind the wall of a room around the eye (a closed mesh the eye is
+/// inside, whose solid is everything outside it): a back face at the largest finite depth, not an
+/// exit, so the solid entered at the wall runs on without end.
+inline const float kSecondLayerSolidOnward = second_layer_back_face(std::numeric_limits<float>::max(), false);
 /// Whether a second-layer value (GBuffer::second_depth) is where the ray leaves a closed solid.
 inline bool second_layer_exit(float s2) { return s2 > 0.0f && s2 < kInfinity && (std::bit_cast<std::uint32_t>(s2) & 1u) != 0; }
 

@@ -38,15 +38,21 @@ float second_layer_value(const RayScene& rs, std::span<const std::int8_t> exit_s
 
 // Traces tile t's second-layer rays, N to a packet (blocks of 4 x N/4 pixels, as the G-buffer's);
 // returns its pixel count (the pass's unit of progress).
+// A pixel that traces no ray: the background (nothing behind), or the wall of a room around the eye
+// (`rooms`), whose solid is everything outside it (GBuffer::second_depth: solid onward).
 template <int N>
-std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> exit_sides, RTCIntersectContext& ctx, const simd::RayGenerator& rays,
-                              Vec3 eye, float separation, const GBuffer& g, Image<float>& out, const Tile& t) {
-  const auto start = [&](int x, int y) { return g.covered(x, y) ? g.depth(x, y) + separation : -1.0f; };  // < 0: no ray
+std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> exit_sides, std::span<const std::uint8_t> rooms,
+                              RTCIntersectContext& ctx, const simd::RayGenerator& rays, Vec3 eye, float separation, const GBuffer& g,
+                              Image<float>& out, const Tile& t) {
+  const auto start = [&](int x, int y) {  // < 0: no ray
+    return !g.covered(x, y) || rooms[g.object_id(x, y) - 1] != 0 ? -1.0f : g.depth(x, y) + separation;
+  };
+  const auto no_ray = [&](int x, int y) { return g.covered(x, y) ? kSecondLayerSolidOnward : kInfinity; };
   if constexpr (N == 1) {
     for (int y = t.y0; y < t.y1; ++y)
       for (int x = t.x0; x < t.x1; ++x) {
         const float t0 = start(x, y);
-        out(x, y) = kInfinity;
+        out(x, y) = no_ray(x, y);
         if (t0 < 0.0f) continue;
         const Vec3 d = rays(x, y);
         RTCRayHit rh{};
@@ -77,7 +83,7 @@ std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> e
           if (x >= t.x1 || y >= t.y1) continue;
           out(x, y) = valid[static_cast<std::size_t>(k)] ? second_layer_value(rs, exit_sides, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k],
                                                                               rh.hit.u[k], rh.hit.v[k], rh.ray.tfar[k], rays(x, y))
-                                                         : kInfinity;
+                                                         : no_ray(x, y);
         }
       }
   }
@@ -137,10 +143,12 @@ Image<float> render_second_layer_depth(const RayScene& rs, const GBuffer& g, flo
   const Frame basis = camera.basis();
   const simd::RayGenerator rays(camera, basis);  // camera-space z of every direction is -1: t is the linear depth
   const std::vector<std::int8_t> exit_sides = solid_exit_sides(rs.scene(), mesh_sides(rs), camera.eye);
+  const std::vector<std::uint8_t> rooms = closed_objects_around(rs.scene(), mesh_sides(rs), camera.eye);
+  if (g.object_id.width() != w || g.object_id.height() != h) throw InputError("second layer: the G-buffer's images must have its camera's size");
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   const detail::RayTiling tiling{simd::kGBufferTileWidth, simd::kGBufferTileHeight, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, true};
   detail::for_each_ray_tile(rs, w, h, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
-    return second_layer_tile<N>(rs, exit_sides, ctx, rays, camera.eye, separation, g, out, t);
+    return second_layer_tile<N>(rs, exit_sides, rooms, ctx, rays, camera.eye, separation, g, out, t);
   });
   return out;
 }

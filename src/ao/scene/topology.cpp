@@ -113,4 +113,11 @@ std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const st
   return out;
 }
 
+std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye) {
+  const std::vector<SceneObject> objects = scene.objects();
+  std::vector<std::uint8_t> out(objects.size(), 0);
+  for (std::size_t k = 0; k < objects.size(); ++k) out[k] = mesh_sides[objects[k].mesh] != 0 && inside_closed_object(scene, objects[k], eye) ? 1 : 0;
+  return out;
+}
+
 }  // namespace ao

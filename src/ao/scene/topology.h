@@ -47,4 +47,8 @@ std::vector<std::int8_t> closed_mesh_sides(const Scene& scene);
 /// ray from the eye leaves but never enters).
 std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye);
 
+/// Per object of Scene::objects(): 1 for a closed mesh around `eye` (a room: what it encloses is air,
+/// and its solid is everything outside it), 0 otherwise. `mesh_sides` as closed_mesh_sides gives.
+std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye);
+
 }  // namespace ao

@@ -94,6 +94,29 @@ TEST(GtaoSlabs, NothingBehindIsASheetOfTheSeparation) {
   for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "pixel " << i;
 }
 
+// Where every sample's slab runs on without end (a second layer of back faces that are no exits, as
+// behind a room's wall), each covers from its front down to the tangent line, and their union is the
+// horizon form's: the same image up to the 32 points' quantisation, which the offsets make unbiased
+// (the mean difference) and the 4x4 filter smooths (the largest). Measured: mean +0.0001, largest
+// 0.0083 at 160x120.
+TEST(GtaoSlabs, EndlessSlabsAreTheHorizonForm) {
+  auto s = test::builtin_gbuffer("default");
+  const float R = 0.1f * s.scene.bounds().diagonal(), separation = kAutoSeparation * R;
+  s.g.second_depth = Image<float>(s.g.width(), s.g.height(), kSecondLayerSolidOnward);
+  s.g.second_separation = separation;
+  const Image<float> horizon = gtao_ao(s.g, R, {}, 2).visibility, slabs_v = gtao_ao(s.g, R, slabs(0, 2), 2).visibility;
+  double sum = 0, largest = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < horizon.size(); ++i) {
+    if (!s.g.covered(i)) continue;
+    const double e = slabs_v[i] - horizon[i];
+    sum += e, largest = std::max(largest, std::abs(e)), ++n;
+  }
+  std::printf("endless slabs against the horizon form: mean %+.4f, largest %.4f\n", sum / n, largest);
+  EXPECT_LT(std::abs(sum / n), 0.002);
+  EXPECT_LT(largest, 0.03);
+}
+
 // Against the step reference: two layers give the space behind thin objects (the default scene's
 // pillars and the back of its sphere, the sphere of sphere-on-plane) back to the receivers that
 // see past them. At 160x120, 256 rays; measured default 0.101 -> 0.067, sphere-on-plane 0.058 -> 0.036

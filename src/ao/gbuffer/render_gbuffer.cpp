@@ -45,7 +45,8 @@ std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> e
                               RTCIntersectContext& ctx, const simd::RayGenerator& rays, Vec3 eye, float separation, const GBuffer& g,
                               Image<float>& out, const Tile& t) {
   const auto start = [&](int x, int y) {  // < 0: no ray
-    return !g.covered(x, y) || rooms[g.object_id(x, y) - 1] != 0 ? -1.0f : g.depth(x, y) + separation;
+    const std::size_t object = g.object_id(x, y) - 1u;  // an id past the scene's objects (another scene's G-buffer) is no room
+    return !g.covered(x, y) || (object < rooms.size() && rooms[object] != 0) ? -1.0f : g.depth(x, y) + separation;
   };
   const auto no_ray = [&](int x, int y) { return g.covered(x, y) ? kSecondLayerSolidOnward : kInfinity; };
   if constexpr (N == 1) {

@@ -16,6 +16,12 @@ namespace {
 
 using test::scene_of;
 
+// The exit sides as seen from `eye`, its rooms found as render_second_layer finds them.
+std::vector<std::int8_t> exit_sides_from(const Scene& s, Vec3 eye) {
+  const std::vector<std::int8_t> sides = closed_mesh_sides(s);
+  return solid_exit_sides(s, sides, closed_objects_around(s, sides, eye));
+}
+
 TEST(Topology, WeldedEdgesOfABoxAndAQuad) {
   const Mesh box = make_box({0, 0, 0}, {2, 3, 4});
   ASSERT_EQ(box.positions.size(), 24u) << "make_box gives each face its own corners";
@@ -41,8 +47,8 @@ TEST(Topology, ARayLeavesAClosedSolidSeenFromOutside) {
   const Mesh box = make_box({-1, -1, -1}, {1, 1, 1}), inward = make_box({-1, -1, -1}, {1, 1, 1}, {0.8f, 0.8f, 0.8f}, 0.0f, true);
   const Mesh quad = make_quad({-1, -1, -3}, {1, -1, -3}, {1, 1, -3}, {-1, 1, -3});
   const Scene s = scene_of({box, inward, quad});
-  EXPECT_EQ(solid_exit_sides(s, closed_mesh_sides(s), outside), (std::vector<std::int8_t>{1, -1, 0}));
-  EXPECT_EQ(solid_exit_sides(s, closed_mesh_sides(s), inside), (std::vector<std::int8_t>{0, 0, 0})) << "around the eye: rooms";
+  EXPECT_EQ(exit_sides_from(s, outside), (std::vector<std::int8_t>{1, -1, 0}));
+  EXPECT_EQ(exit_sides_from(s, inside), (std::vector<std::int8_t>{0, 0, 0})) << "around the eye: rooms";
   EXPECT_TRUE(inside_closed_object(s, s.objects()[0], inside));
   EXPECT_FALSE(inside_closed_object(s, s.objects()[0], outside));
   EXPECT_EQ(closed_objects_around(s, closed_mesh_sides(s), inside), (std::vector<std::uint8_t>{1, 1, 0})) << "rooms, either way round";
@@ -58,8 +64,8 @@ TEST(Topology, AMirroringInstanceTurnsTheSide) {
   mirrored.c0 = {-1, 0, 0}, mirrored.c3 = {-5, 0, 0};
   s.instances = {{0, moved, "moved"}, {0, mirrored, "mirrored"}};
   validate_and_prepare(s);
-  EXPECT_EQ(solid_exit_sides(s, closed_mesh_sides(s), {0, 0, 10}), (std::vector<std::int8_t>{1, -1}));
-  EXPECT_EQ(solid_exit_sides(s, closed_mesh_sides(s), {5, 0, 0}), (std::vector<std::int8_t>{0, -1})) << "the eye inside the moved box";
+  EXPECT_EQ(exit_sides_from(s, {0, 0, 10}), (std::vector<std::int8_t>{1, -1}));
+  EXPECT_EQ(exit_sides_from(s, {5, 0, 0}), (std::vector<std::int8_t>{0, -1})) << "the eye inside the moved box";
 }
 
 }  // namespace

@@ -143,8 +143,8 @@ Image<float> render_second_layer_depth(const RayScene& rs, const GBuffer& g, flo
   Image<float> out(w, h);
   const Frame basis = camera.basis();
   const simd::RayGenerator rays(camera, basis);  // camera-space z of every direction is -1: t is the linear depth
-  const std::vector<std::int8_t> exit_sides = solid_exit_sides(rs.scene(), mesh_sides(rs), camera.eye);
   const std::vector<std::uint8_t> rooms = closed_objects_around(rs.scene(), mesh_sides(rs), camera.eye);
+  const std::vector<std::int8_t> exit_sides = solid_exit_sides(rs.scene(), mesh_sides(rs), rooms);
   if (g.object_id.width() != w || g.object_id.height() != h) throw InputError("second layer: the G-buffer's images must have its camera's size");
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   const detail::RayTiling tiling{simd::kGBufferTileWidth, simd::kGBufferTileHeight, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, true};

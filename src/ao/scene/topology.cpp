@@ -101,22 +101,22 @@ std::vector<std::int8_t> closed_mesh_sides(const Scene& scene) {
   return out;
 }
 
-std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye) {
-  const std::vector<SceneObject> objects = scene.objects();
-  std::vector<std::int8_t> out(objects.size(), 0);
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    int side = mesh_sides[objects[k].mesh];
-    if (side == 0 || inside_closed_object(scene, objects[k], eye)) continue;
-    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) side = -side;
-    out[k] = static_cast<std::int8_t>(side);
-  }
-  return out;
-}
-
 std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye) {
   const std::vector<SceneObject> objects = scene.objects();
   std::vector<std::uint8_t> out(objects.size(), 0);
   for (std::size_t k = 0; k < objects.size(); ++k) out[k] = mesh_sides[objects[k].mesh] != 0 && inside_closed_object(scene, objects[k], eye) ? 1 : 0;
+  return out;
+}
+
+std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, std::span<const std::uint8_t> rooms) {
+  const std::vector<SceneObject> objects = scene.objects();
+  std::vector<std::int8_t> out(objects.size(), 0);
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    int side = mesh_sides[objects[k].mesh];
+    if (side == 0 || rooms[k] != 0) continue;
+    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) side = -side;
+    out[k] = static_cast<std::int8_t>(side);
+  }
   return out;
 }
 

@@ -42,13 +42,13 @@ bool inside_closed_object(const Scene& scene, const SceneObject& object, Vec3 p)
 /// whose fronts face in (through a front face), 0: an open mesh (no solid).
 std::vector<std::int8_t> closed_mesh_sides(const Scene& scene);
 
-/// Per object of Scene::objects(): closed_mesh_sides's answer for its mesh (`mesh_sides`), turned
-/// by an instance's transform that mirrors, and 0 for a closed mesh around `eye` (a room, which a
-/// ray from the eye leaves but never enters).
-std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye);
-
 /// Per object of Scene::objects(): 1 for a closed mesh around `eye` (a room: what it encloses is air,
 /// and its solid is everything outside it), 0 otherwise. `mesh_sides` as closed_mesh_sides gives.
 std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye);
+
+/// Per object of Scene::objects(): closed_mesh_sides's answer for its mesh (`mesh_sides`), turned
+/// by an instance's transform that mirrors, and 0 for a room (`rooms`, as closed_objects_around
+/// gives for the eye: a ray from the eye leaves it but never enters).
+std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, std::span<const std::uint8_t> rooms);
 
 }  // namespace ao

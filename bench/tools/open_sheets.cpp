@@ -7,7 +7,7 @@
 // Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
 // top), mask, dome (with a window), terrain, tablecloth, leaf, gutter, the closed box, sphere and
 // torus, a closed plate leaning on the ground (the leaf's wedge under a closed occluder) and the
-// gutter as a closed shell. The ground is a quad of twice the object's diagonal under it, and the
+// gutter (walls 0.03 and 0.005 thick) and the bowl as closed shells. The ground is a quad of twice the object's diagonal under it, and the
 // camera looks at the object from the front right and above, as tests/methods/cone_test.cpp does.
 // With a second argument, the folder of the shared meshes, also ChineseDragon-10kv and elephant
 // opened as scans come (tests/support/open_sheets.h: the bottom 10% cut off, -cut.obj; holes of 3%
@@ -45,23 +45,24 @@ ao::Mesh make_leaning_plate() {
   return m;
 }
 
-// The suite's gutter as a closed shell: walls 0.03 thick outside the open gutter's radius of 0.2,
-// closed along its rims and at its ends. What the cone method makes of the same shape as a solid.
-ao::Mesh make_closed_gutter() {
+// The suite's gutter as a closed shell: walls `wall` thick outside the open gutter's radius of 0.2,
+// closed along its rims and at its ends. What the methods make of the same shape as a solid.
+ao::Mesh make_closed_gutter(float wall) {
   constexpr int kAround = 48, kAlong = 96;
-  constexpr float kInner = 0.2f, kOuter = 0.23f, kLength = 2.0f;
+  constexpr float kInner = 0.2f, kLength = 2.0f;
+  const float outer_radius = kInner + wall;
   ao::Mesh m;
   const auto ring = [&](float radius, int j) {
     const auto first = static_cast<std::uint32_t>(m.positions.size());
     const float z = kLength * (static_cast<float>(j) / kAlong - 0.5f);
     for (int i = 0; i <= kAround; ++i) {
       const float a = ao::test::kPi * (1.0f + static_cast<float>(i) / kAround);  // from -x under the axis to +x
-      m.positions.push_back({radius * std::cos(a), kOuter + radius * std::sin(a), z});
+      m.positions.push_back({radius * std::cos(a), outer_radius + radius * std::sin(a), z});
     }
     return first;
   };
   std::vector<std::uint32_t> inner, outer;
-  for (int j = 0; j <= kAlong; ++j) inner.push_back(ring(kInner, j)), outer.push_back(ring(kOuter, j));
+  for (int j = 0; j <= kAlong; ++j) inner.push_back(ring(kInner, j)), outer.push_back(ring(outer_radius, j));
   const auto quad = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) { m.indices.insert(m.indices.end(), {a, b, c, a, c, d}); };
   const auto in = static_cast<std::uint32_t>(kAround);
   for (int j = 0; j < kAlong; ++j) {
@@ -75,6 +76,56 @@ ao::Mesh make_closed_gutter() {
   for (std::uint32_t i = 0; i < in; ++i) {  // the ends, half annuli
     quad(inner[0] + i, inner[0] + i + 1, outer[0] + i + 1, outer[0] + i);
     quad(inner[kAlong] + i, outer[kAlong] + i, outer[kAlong] + i + 1, inner[kAlong] + i + 1);
+  }
+  return m;
+}
+
+// The suite's bowl as a closed shell: walls 0.03 thick outside the open bowl's radius of 1, closed
+// along its rim, its lowest point on y = 0. The bowl's closed counterpart, as the closed gutter is
+// the gutter's.
+ao::Mesh make_closed_bowl() {
+  constexpr int kAround = 96, kDown = 24;  // the open bowl's segments; rings from the rim to the pole
+  constexpr float kInner = 1.0f, kOuter = 1.03f;
+  const ao::Vec3 centre{0.0f, kOuter, 0.0f};
+  ao::Mesh m;
+  // Ring j (0: the rim, on the centre's level) of radius r, kAround vertices; j = kDown is the pole.
+  const auto ring = [&](float r, int j) {
+    const auto first = static_cast<std::uint32_t>(m.positions.size());
+    const float e = 0.5f * ao::test::kPi * static_cast<float>(j) / kDown;  // below the rim
+    if (j == kDown) {
+      m.positions.push_back({0.0f, kOuter - r, 0.0f});
+      return first;
+    }
+    for (int i = 0; i < kAround; ++i) {
+      const float a = 2.0f * ao::test::kPi * static_cast<float>(i) / kAround;
+      m.positions.push_back({r * std::cos(e) * std::cos(a), kOuter - r * std::sin(e), r * std::cos(e) * std::sin(a)});
+    }
+    return first;
+  };
+  // A triangle wound so that its normal points along `out` (away from the solid).
+  const auto triangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, ao::Vec3 out) {
+    const ao::Vec3 pa = m.positions[a], pb = m.positions[b], pc = m.positions[c];
+    if (ao::dot(ao::cross(pb - pa, pc - pa), out) < 0) std::swap(b, c);
+    m.indices.insert(m.indices.end(), {a, b, c});
+  };
+  std::vector<std::uint32_t> inner, outer;
+  for (int j = 0; j <= kDown; ++j) inner.push_back(ring(kInner, j)), outer.push_back(ring(kOuter, j));
+  const auto at = [](std::uint32_t first, int i) { return first + static_cast<std::uint32_t>(i % kAround); };
+  for (int j = 0; j < kDown; ++j)
+    for (int i = 0; i < kAround; ++i)
+      for (const auto& [rings, sign] : {std::pair{&outer, 1.0f}, std::pair{&inner, -1.0f}}) {
+        const std::uint32_t a = at((*rings)[j], i), b = at((*rings)[j], i + 1);
+        const ao::Vec3 out = sign * (m.positions[a] - centre);
+        if (j + 1 == kDown) {
+          triangle(a, b, (*rings)[kDown], out);
+        } else {
+          triangle(a, b, at((*rings)[j + 1], i + 1), out);
+          triangle(a, at((*rings)[j + 1], i + 1), at((*rings)[j + 1], i), out);
+        }
+      }
+  for (int i = 0; i < kAround; ++i) {  // the rim, an annulus facing up
+    triangle(at(inner[0], i), at(outer[0], i), at(outer[0], i + 1), {0, 1, 0});
+    triangle(at(inner[0], i), at(outer[0], i + 1), at(inner[0], i + 1), {0, 1, 0});
   }
   return m;
 }
@@ -131,7 +182,9 @@ int main(int argc, char** argv) {
         {"torus", ao::make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24)},
         {"head", ao::test::make_head()},
         {"plate", make_leaning_plate()},
-        {"closed-gutter", make_closed_gutter()},
+        {"closed-gutter", make_closed_gutter(0.03f)},
+        {"thin-closed-gutter", make_closed_gutter(0.005f)},
+        {"closed-bowl", make_closed_bowl()},
     };
     for (const auto& [name, mesh] : objects) {
       write_obj(dir / (name + ".obj"), {{name, mesh}, {"ground", ao::test::ground_under(mesh, {0.75f, 0.73f, 0.70f})}});

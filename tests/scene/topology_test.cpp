@@ -3,12 +3,14 @@
 // once its faces' own copies of its corners are welded, a quad has four boundary edges, a box
 // 2 x 3 x 4 encloses 24 (negative with its fronts facing in), and a ray from outside leaves a
 // closed mesh through the side its fronts say, unless the eye is inside (a room) or the mesh is
-// open; a mirroring instance turns the side.
+// open; a mirroring instance turns the side. An open mesh faces out of what it encloses, whichever
+// way it was wound.
 #include "ao/scene/topology.h"
 
 #include <gtest/gtest.h>
 
 #include "ao/scene/procedural.h"
+#include "support/open_sheets.h"
 #include "support/scenes.h"
 
 namespace ao {
@@ -66,6 +68,25 @@ TEST(Topology, AMirroringInstanceTurnsTheSide) {
   validate_and_prepare(s);
   EXPECT_EQ(exit_sides_from(s, {0, 0, 10}), (std::vector<std::int8_t>{1, -1}));
   EXPECT_EQ(exit_sides_from(s, {5, 0, 0}), (std::vector<std::int8_t>{0, -1})) << "the eye inside the moved box";
+}
+
+// An open mesh is read in the orientation whose fronts face out of what it encloses, whichever way
+// its file wound it; a flat one has no such side, and neither is asked of a closed one.
+TEST(Topology, AnOpenMeshFacesOutOfWhatItEncloses) {
+  const Mesh bowl = test::make_bowl(), quad = make_quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1});
+  const Mesh box = make_box({-1, -1, -1}, {1, 1, 1});
+  const Scene s = scene_of({bowl, test::turned_over(bowl), quad, test::turned_over(quad), box});
+  EXPECT_EQ(open_mesh_facings(s, closed_mesh_sides(s)), (std::vector<std::int8_t>{1, -1, 0, 0, 0}));
+
+  Scene mirrored;
+  mirrored.name = "instances";
+  mirrored.meshes = {bowl};
+  Affine3 moved, mirror;
+  moved.c3 = {5, 0, 0};
+  mirror.c0 = {-1, 0, 0}, mirror.c3 = {-5, 0, 0};
+  mirrored.instances = {{0, moved, "moved"}, {0, mirror, "mirrored"}};
+  validate_and_prepare(mirrored);
+  EXPECT_EQ(open_mesh_facings(mirrored, closed_mesh_sides(mirrored)), (std::vector<std::int8_t>{1, -1})) << "a mirror turns it over";
 }
 
 }  // namespace

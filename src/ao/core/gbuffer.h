@@ -44,8 +44,9 @@ struct GBuffer {
   Image<std::uint32_t> primitive_id;
   /// Optional second depth layer (a deep G-buffer, Mara et al. 2016; render_second_layer fills it):
   /// per pixel the signed linear depth of the nearest surface at least `second_separation` behind
-  /// the visible one along the pixel's ray. > 0: a back face (the winding's normal points along
-  /// the ray), where the solid entered at the visible surface ends; < 0: a front face (its depth
+  /// the visible one along the pixel's ray. > 0: a back face (the outward normal points along the
+  /// ray: a closed mesh's by its signed volume, an open one's by open_mesh_facings, whatever the
+  /// file's winding), where the solid entered at the visible surface ends; < 0: a front face (its depth
   /// negated): the visible surface was thinner than the separation and another solid begins there;
   /// +infinity: nothing behind (or not covered). Where the ray leaves a closed solid seen from
   /// outside (solid_exit_sides: a closed mesh, of either orientation, not around the eye) the depth

@@ -23,17 +23,24 @@ namespace {
 // (the rays are scaled to unit camera-space depth, so t is the linear depth), positive where the
 // ray leaves through the triangle (a back face: its winding's normal points along the ray) and
 // marked where that is a closed solid's exit (solid_exit_sides: a closed mesh seen from outside,
-// whichever way its fronts face), negative where it enters one; +infinity without a hit.
-float second_layer_value(const RayScene& rs, std::span<const std::int8_t> exit_sides, unsigned geom_id, unsigned inst_id, unsigned prim_id,
-                         float u, float v, float t, Vec3 dir) {
+// whichever way its fronts face), negative where it enters one; +infinity without a hit. An open
+// mesh's sides are read in the orientation open_mesh_facings gives, not as the file wound them.
+struct LayerSides {
+  std::vector<std::int8_t> exits;    // solid_exit_sides
+  std::vector<std::int8_t> facings;  // open_mesh_facings
+};
+float second_layer_value(const RayScene& rs, const LayerSides& sides, unsigned geom_id, unsigned inst_id, unsigned prim_id, float u, float v,
+                         float t, Vec3 dir) {
   if (geom_id == RTC_INVALID_GEOMETRY_ID) return kInfinity;
   const HitRef hit = resolve(rs, geom_id, inst_id, prim_id, u, v);
   Vec3 p0, p1, p2;
   world_triangle(rs, hit, p0, p1, p2);
   const bool back = dot(cross(p1 - p0, p2 - p0), dir) > 0.0f;
-  const int side = exit_sides[hit.object];
+  const int side = sides.exits[hit.object];
   if (side < 0) return back ? -t : second_layer_back_face(t, true);  // a closed mesh whose fronts face in
-  return back ? second_layer_back_face(t, side > 0) : -t;
+  if (side > 0) return back ? second_layer_back_face(t, true) : -t;
+  const int facing = sides.facings[hit.object];  // an open mesh: 0, flat, met from its front
+  return facing != 0 && back == (facing > 0) ? second_layer_back_face(t, false) : -t;
 }
 
 // Traces tile t's second-layer rays, N to a packet (blocks of 4 x N/4 pixels, as the G-buffer's);
@@ -41,7 +48,7 @@ float second_layer_value(const RayScene& rs, std::span<const std::int8_t> exit_s
 // A pixel that traces no ray: the background (nothing behind), or the wall of a room around the eye
 // (`rooms`), whose solid is everything outside it (GBuffer::second_depth: solid onward).
 template <int N>
-std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> exit_sides, std::span<const std::uint8_t> rooms,
+std::size_t second_layer_tile(const RayScene& rs, const LayerSides& sides, std::span<const std::uint8_t> rooms,
                               RTCIntersectContext& ctx, const simd::RayGenerator& rays, Vec3 eye, float separation, const GBuffer& g,
                               Image<float>& out, const Tile& t) {
   const auto start = [&](int x, int y) {  // < 0: no ray
@@ -60,7 +67,7 @@ std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> e
         rh.ray = RTCRay{eye.x, eye.y, eye.z, t0, d.x, d.y, d.z, 0.0f, kInfinity, 0xffffffffu, 0, 0};
         rh.hit.geomID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(embree_scene(rs), &ctx, &rh);
-        out(x, y) = second_layer_value(rs, exit_sides, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, d);
+        out(x, y) = second_layer_value(rs, sides, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, d);
       }
   } else {
     constexpr int bw = 4, bh = N / 4;
@@ -82,7 +89,7 @@ std::size_t second_layer_tile(const RayScene& rs, std::span<const std::int8_t> e
         for (int k = 0; k < N; ++k) {
           const int x = bx + k % bw, y = by + k / bw;
           if (x >= t.x1 || y >= t.y1) continue;
-          out(x, y) = valid[static_cast<std::size_t>(k)] ? second_layer_value(rs, exit_sides, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k],
+          out(x, y) = valid[static_cast<std::size_t>(k)] ? second_layer_value(rs, sides, rh.hit.geomID[k], rh.hit.instID[0][k], rh.hit.primID[k],
                                                                               rh.hit.u[k], rh.hit.v[k], rh.ray.tfar[k], rays(x, y))
                                                          : no_ray(x, y);
         }
@@ -144,12 +151,12 @@ Image<float> render_second_layer_depth(const RayScene& rs, const GBuffer& g, flo
   const Frame basis = camera.basis();
   const simd::RayGenerator rays(camera, basis);  // camera-space z of every direction is -1: t is the linear depth
   const std::vector<std::uint8_t> rooms = closed_objects_around(rs.scene(), mesh_sides(rs), camera.eye);
-  const std::vector<std::int8_t> exit_sides = solid_exit_sides(rs.scene(), mesh_sides(rs), rooms);
+  const LayerSides sides{solid_exit_sides(rs.scene(), mesh_sides(rs), rooms), open_mesh_facings(rs.scene(), mesh_sides(rs))};
   if (g.object_id.width() != w || g.object_id.height() != h) throw InputError("second layer: the G-buffer's images must have its camera's size");
   ProgressCounter counter(progress, static_cast<std::size_t>(w) * h);
   const detail::RayTiling tiling{simd::kGBufferTileWidth, simd::kGBufferTileHeight, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, true};
   detail::for_each_ray_tile(rs, w, h, tiling, counter, [&]<int N>(RTCIntersectContext& ctx, const Tile& t) {
-    return second_layer_tile<N>(rs, exit_sides, rooms, ctx, rays, camera.eye, separation, g, out, t);
+    return second_layer_tile<N>(rs, sides, rooms, ctx, rays, camera.eye, separation, g, out, t);
   });
   return out;
 }

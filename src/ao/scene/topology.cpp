@@ -101,6 +101,26 @@ std::vector<std::int8_t> closed_mesh_sides(const Scene& scene) {
   return out;
 }
 
+std::vector<std::int8_t> open_mesh_facings(const Scene& scene, std::span<const std::int8_t> mesh_sides) {
+  std::vector<std::int8_t> per_mesh(scene.meshes.size(), 0);
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const Mesh& m = scene.meshes[i];
+    if (mesh_sides[i] != 0 || m.triangle_count() == 0) continue;
+    // A flat mesh's volume about a centre in its plane is rounding: below this it has none.
+    const double size = m.bounds().diagonal(), flat = 1e-7 * size * size * size;
+    const double v = signed_volume(m);
+    per_mesh[i] = static_cast<std::int8_t>(v > flat ? 1 : v < -flat ? -1 : 0);
+  }
+  const std::vector<SceneObject> objects = scene.objects();
+  std::vector<std::int8_t> out(objects.size(), 0);
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    int facing = per_mesh[objects[k].mesh];
+    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) facing = -facing;
+    out[k] = static_cast<std::int8_t>(facing);
+  }
+  return out;
+}
+
 std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye) {
   const std::vector<SceneObject> objects = scene.objects();
   std::vector<std::uint8_t> out(objects.size(), 0);

@@ -42,6 +42,14 @@ bool inside_closed_object(const Scene& scene, const SceneObject& object, Vec3 p)
 /// whose fronts face in (through a front face), 0: an open mesh (no solid).
 std::vector<std::int8_t> closed_mesh_sides(const Scene& scene);
 
+/// Per object of Scene::objects(): how to read which side of an open mesh's triangle a ray meets,
+/// so that the reading does not depend on the winding a file happened to give it. +1: as wound,
+/// -1: turned over, so that its fronts face out of what it encloses as seen from its box's centre
+/// (signed_volume > 0: a bowl's or a gutter's outside, a scan's skin); 0: a flat mesh (no volume
+/// either way), whose every side a ray from the eye meets is taken for its front; and 0 for a
+/// closed mesh (closed_mesh_sides reads it). `mesh_sides` as closed_mesh_sides gives.
+std::vector<std::int8_t> open_mesh_facings(const Scene& scene, std::span<const std::int8_t> mesh_sides);
+
 /// Per object of Scene::objects(): 1 for a closed mesh around `eye` (a room: what it encloses is air,
 /// and its solid is everything outside it), 0 otherwise. `mesh_sides` as closed_mesh_sides gives.
 std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye);

@@ -6,9 +6,10 @@
 //   ao compare /tmp/open-sheets/arch.obj --camera /tmp/open-sheets/arch.camera.json --methods cone
 // Objects: arch (a bent sheet with holes), bowl (half a sphere shell), open-box (a box without its
 // top), mask, dome (with a window), terrain, tablecloth, leaf, gutter, the closed box, sphere and
-// torus, a closed plate leaning on the ground (the leaf's wedge under a closed occluder) and the
-// gutter (walls 0.03 and 0.005 thick) and the bowl as closed shells. The ground is a quad of twice the object's diagonal under it, and the
-// camera looks at the object from the front right and above, as tests/methods/cone_test.cpp does.
+// torus, a closed plate leaning on the ground (the leaf's wedge under a closed occluder), and the
+// gutter (walls 0.03 and 0.005 thick) and the bowl as closed shells. The ground is a quad of twice
+// the object's diagonal under it, and the camera looks at the object from the front right and
+// above, as tests/methods/cone_test.cpp does.
 // With a second argument, the folder of the shared meshes, also ChineseDragon-10kv and elephant
 // opened as scans come (tests/support/open_sheets.h: the bottom 10% cut off, -cut.obj; holes of 3%
 // of the diagonal punched, -holes.obj), alone:

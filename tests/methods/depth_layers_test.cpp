@@ -107,7 +107,7 @@ TEST(DepthLayers, SecondLayerMarksWhereTheRayLeavesAClosedSolid) {
 
 // A file's winding of an open mesh is arbitrary (scans, exports): the second layer reads the gutter
 // (a half pipe, its hollow seen through its top and behind its near wall) and the ground under it
-// the same when both are turned over, and the bowl's sides as its outside says.
+// the same when both are turned over.
 TEST(DepthLayers, AnOpenMeshsWindingDoesNotChangeTheSecondLayer) {
   const Mesh gutter = test::make_gutter(), ground = test::ground_under(gutter);
   const Camera camera = frame_bounds(gutter.bounds(), {1.0f, 0.8f, 1.3f}, 40.0f, 160, 90);

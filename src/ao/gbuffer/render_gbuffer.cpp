@@ -21,7 +21,7 @@ namespace {
 
 // What the second layer stores for one pixel's ray (GBuffer::second_depth): the hit's depth t
 // (the rays are scaled to unit camera-space depth, so t is the linear depth), positive where the
-// ray leaves through the triangle (a back face: its winding's normal points along the ray) and
+// ray leaves through the triangle (a back face: its outward normal points along the ray) and
 // marked where that is a closed solid's exit (solid_exit_sides: a closed mesh seen from outside,
 // whichever way its fronts face), negative where it enters one; +infinity without a hit. An open
 // mesh's sides are read in the orientation open_mesh_facings gives, not as the file wound them.

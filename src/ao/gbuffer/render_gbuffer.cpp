@@ -36,11 +36,10 @@ float second_layer_value(const RayScene& rs, const LayerSides& sides, unsigned g
   Vec3 p0, p1, p2;
   world_triangle(rs, hit, p0, p1, p2);
   const bool back = dot(cross(p1 - p0, p2 - p0), dir) > 0.0f;
-  const int side = sides.exits[hit.object];
-  if (side < 0) return back ? -t : second_layer_back_face(t, true);  // a closed mesh whose fronts face in
-  if (side > 0) return back ? second_layer_back_face(t, true) : -t;
-  const int facing = sides.facings[hit.object];  // an open mesh: 0, flat, met from its front
-  return facing != 0 && back == (facing > 0) ? second_layer_back_face(t, false) : -t;
+  // Which way the object's fronts face out (+1: as wound, -1: turned over): a closed solid's by its
+  // exit side, an open mesh's by its facing; 0 (a flat open mesh, a room) is met from its front.
+  const int exit = sides.exits[hit.object], facing = exit != 0 ? exit : sides.facings[hit.object];
+  return facing != 0 && back == (facing > 0) ? second_layer_back_face(t, exit != 0) : -t;
 }
 
 // Traces tile t's second-layer rays, N to a packet (blocks of 4 x N/4 pixels, as the G-buffer's);

@@ -10,6 +10,24 @@
 
 namespace ao {
 
+namespace {
+
+// Per object of Scene::objects(): its mesh's side (+1, -1 or 0), turned by an instance's transform
+// that mirrors, and 0 where `skip` (empty: nowhere) is non-zero.
+std::vector<std::int8_t> per_object_sides(const Scene& scene, std::span<const std::int8_t> per_mesh, std::span<const std::uint8_t> skip) {
+  const std::vector<SceneObject> objects = scene.objects();
+  std::vector<std::int8_t> out(objects.size(), 0);
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    int side = per_mesh[objects[k].mesh];
+    if (side == 0 || (!skip.empty() && skip[k] != 0)) continue;
+    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) side = -side;
+    out[k] = static_cast<std::int8_t>(side);
+  }
+  return out;
+}
+
+}  // namespace
+
 MeshEdges mesh_edges(const Mesh& m) {
   MeshEdges out;
   const std::size_t nv = m.positions.size();
@@ -111,14 +129,7 @@ std::vector<std::int8_t> open_mesh_facings(const Scene& scene, std::span<const s
     const double v = signed_volume(m);
     per_mesh[i] = static_cast<std::int8_t>(v > flat ? 1 : v < -flat ? -1 : 0);
   }
-  const std::vector<SceneObject> objects = scene.objects();
-  std::vector<std::int8_t> out(objects.size(), 0);
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    int facing = per_mesh[objects[k].mesh];
-    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) facing = -facing;
-    out[k] = static_cast<std::int8_t>(facing);
-  }
-  return out;
+  return per_object_sides(scene, per_mesh, {});
 }
 
 std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<const std::int8_t> mesh_sides, Vec3 eye) {
@@ -129,15 +140,7 @@ std::vector<std::uint8_t> closed_objects_around(const Scene& scene, std::span<co
 }
 
 std::vector<std::int8_t> solid_exit_sides(const Scene& scene, std::span<const std::int8_t> mesh_sides, std::span<const std::uint8_t> rooms) {
-  const std::vector<SceneObject> objects = scene.objects();
-  std::vector<std::int8_t> out(objects.size(), 0);
-  for (std::size_t k = 0; k < objects.size(); ++k) {
-    int side = mesh_sides[objects[k].mesh];
-    if (side == 0 || rooms[k] != 0) continue;
-    if (objects[k].instance != SceneObject::kNoInstance && scene.instances[objects[k].instance].object_to_world.determinant() < 0) side = -side;
-    out[k] = static_cast<std::int8_t>(side);
-  }
-  return out;
+  return per_object_sides(scene, mesh_sides, rooms);
 }
 
 }  // namespace ao

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <utility>
 
@@ -94,11 +95,12 @@ TEST_P(GpuMethodAgreement, AgreesWithTheCpuKernelOnTheSameGBuffer) {
 }
 
 // Cone with its default open-mesh handling on open meshes seen from both sides (the ground under an
-// arch, the ground inside a dome through its window; tests/support/open_sheets.h): the GPU traces
-// each side's grid, voxelized by the CPU, over that side's pixels, so it agrees with the CPU as on
-// closed scenes, with the same grids.
+// arch, the ground inside a dome through its window, the ground beyond a leaf's rim;
+// tests/support/open_sheets.h): the GPU traces each side's grid, voxelized by the CPU, over that
+// side's pixels, so it agrees with the CPU as on closed scenes, with the same grids.
 TEST(GpuCone, OpenMeshesTraceEachSidesGridAsTheCpuDoes) {
-  for (const auto& [what, object] : {std::pair{"arch", ao::test::make_holed_arch()}, std::pair{"dome", ao::test::make_dome()}}) {
+  for (const auto& [what, object] :
+       {std::pair{"arch", ao::test::make_holed_arch()}, std::pair{"dome", ao::test::make_dome()}, std::pair{"leaf", ao::test::make_leaf()}}) {
     const Bounds3 b = object.bounds();
     const float e = b.diagonal();
     const Vec3 c = b.center();
@@ -117,6 +119,10 @@ TEST(GpuCone, OpenMeshesTraceEachSidesGridAsTheCpuDoes) {
     EXPECT_EQ(gpu.output.stats["side_grids"], cpu.stats["side_grids"]) << what;
     EXPECT_EQ(gpu.output.stats["back_pixels"], cpu.stats["back_pixels"]) << what;
     EXPECT_GT(cpu.stats["back_pixels"], 100) << what;
+    EXPECT_EQ(gpu.output.stats["rim_pixels"], cpu.stats["rim_pixels"]) << what;
+    if (std::string_view(what) == "leaf") {
+      EXPECT_GT(cpu.stats["rim_pixels"], 100) << what;
+    }
   }
 }
 

@@ -238,8 +238,9 @@ TEST(Cone, OpenScannedMeshesCostAtMostTwiceTheClosedMeshError) {
 // median of a box, a sphere, a torus and an ellipsoid the mask's size), at the CLI's R (0.1 x the
 // object's diagonal). Before the slabs stopped where a sheet comes back (sheet_depth) and the
 // side of a solid with holes was what a point sees of it (seen_side), the mask scored 0.080 and the
-// dome 0.208 at 640 x 360 (5.1x and 13x that median). Measured here (96 x 72): 0.74-1.40x, the
-// leaf 1.68x.
+// dome 0.208 at 640 x 360 (5.1x and 13x that median). Before points beyond a sheet's rim saw past
+// it (beyond_rim, cone_sides.cpp), the leaf scored 1.68x here. Measured here (96 x 72): 0.74-1.48x
+// (the leaf 1.48x, the terrain 1.41x).
 TEST(Cone, OpenMeshSuiteStaysNearTheClosedMeshError) {
   std::vector<double> closed_errors;
   for (const Mesh& m : {make_box({-0.9f, 0.0f, -0.7f}, {0.9f, 1.0f, 0.7f}), make_sphere({0, 1, 0}, 1.0f, 96, 48), make_torus({0, 0.35f, 0}, 1.0f, 0.35f, 64, 24),
@@ -253,10 +254,7 @@ TEST(Cone, OpenMeshSuiteStaysNearTheClosedMeshError) {
       {"tablecloth", test::make_tablecloth()}, {"leaf", test::make_leaf()}, {"gutter", test::make_gutter()}};
   for (const auto& [what, open] : suite) {
     const OpenError e = cone_error(open, 256, 0.1f);
-    // The leaf (measured 1.68x): the ground beside its raised edge too bright, in front of its base
-    // too dark, points that see both of its sides (docs/methods/cone.md, Missing / next).
-    const double bound = std::string_view(what) == "leaf" ? 2.0 : 1.5;
-    EXPECT_LE(e.rmse, bound * closed) << what << ": closed meshes " << closed << ", mean signed " << e.mean_signed;
+    EXPECT_LE(e.rmse, 1.5 * closed) << what << ": closed meshes " << closed << ", mean signed " << e.mean_signed;
     EXPECT_EQ(e.stats["odd_columns"], 0) << what;
     // The tablecloth is seen from above only; every other mesh shows its inside or its underside.
     if (std::string_view(what) != "tablecloth") {
@@ -291,6 +289,53 @@ TEST(Cone, ASheetOccludesFromBothSidesAsTheSolidItHides) {
   }
 }
 
+// A point beyond a sheet's free rim sees past the sheet: a shelf (a flat quad at height h = R / 2)
+// over a floor; points on the floor out beyond its edge by 0.6 h, 0.8 h and h see its underside
+// at a grazing angle and the sky over its edge, where the slab R deep on the shelf (the floor is
+// behind it) stood as a wall: at 0.6 h, V = 0.66 against the reference's 0.87. Traced without the
+// slab, the shelf is a film two voxels thick, which the cones see a little less of than the
+// reference does (measured +0.05 to +0.07). Under the shelf the slab stays. Facing up or turned
+// down.
+TEST(Cone, APointBeyondASheetsRimSeesPastIt) {
+  const float h = 0.25f, R = 0.5f;
+  const Mesh floor = make_quad({-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4});
+  ConeParams p;
+  p.columns = 256;
+  p.filter_taps = 1;
+  for (bool turned : {false, true}) {
+    Mesh shelf = make_quad({-1, h, 1}, {1, h, 1}, {1, h, -1}, {-1, h, -1});
+    if (turned) std::swap(shelf.indices[1], shelf.indices[2]), std::swap(shelf.indices[4], shelf.indices[5]);
+    const Scene s = scene_of({floor, shelf});
+    const RayScene rs(s);
+    const char* what = turned ? "shelf turned down, out by " : "shelf facing up, out by ";
+    for (const float out : {0.6f * h, 0.8f * h, h}) {
+      const GBuffer g = one_pixel({1.0f + out, 0, 0.1f}, {0, 1, 0});
+      const float reference = render_raytraced(rs, g, {Membership::Step, R}, {.samples = 4096}, 3).visibility(0, 0);
+      const ConeResult r = render_cone(s, analyze_closure(s), g, R, p, 1);
+      EXPECT_NEAR(r.visibility(0, 0), reference, 0.08f) << what << out;
+      EXPECT_EQ(r.rim_pixels, 1u) << what << out;
+    }
+    const ConeResult under = render_cone(s, analyze_closure(s), one_pixel({0.5f, 0, 0.1f}, {0, 1, 0}), R, p, 1);
+    EXPECT_EQ(under.rim_pixels, 0u) << (turned ? "shelf turned down" : "shelf facing up");
+  }
+}
+
+// Where a surface goes on across its boundary edges it has no rim there: the default scene's
+// ground is four quads around a pit (T-junctions between them) and the pit's walls and floor
+// (edges where the ground folds down). Taken for rims, 37,047 of its pixels at 640 x 360 lost the
+// ground's slab and its RMSE went from 0.042 to 0.055.
+TEST(Cone, AGroundInPiecesHasNoRimAtItsSeams) {
+  const Scene s = make_builtin_scene("default");
+  const GBuffer g = small_gbuffer(s, 96, 54);
+  ConeParams p;
+  p.columns = 128;
+  const std::vector<MeshClosure> closure = analyze_closure(s);
+  ASSERT_GT(closure[0].boundary_edges, 4u) << "the ground's pieces meet at T-junctions";
+  const ConeResult r = render_cone(s, closure, g, 0.1f * s.bounds().diagonal(), p, 1);
+  EXPECT_EQ(r.rim_pixels, 0u);
+  EXPECT_EQ(r.side_grids, 1);
+}
+
 // Two-sided: turning every triangle of an open sheet over changes nothing but the grid's height
 // (a grid is taller by a slab when a slab rises above a face, which moves the voxel boundaries:
 // 0.0065 at worst, measured unfiltered), on the same G-buffer.
@@ -305,10 +350,13 @@ TEST(Cone, SheetsLookTheSameTurnedOver) {
   const ConeResult a = render_cone(original, analyze_closure(original), g, 0.3f, p, 1);
   const Scene other = scene_of({turned, ground});
   const ConeResult b = render_cone(other, analyze_closure(other), g, 0.3f, p, 1);
-  EXPECT_EQ(a.side_grids, 2);
-  EXPECT_EQ(b.side_grids, 2);
+  // Three grids: the front, the underside, beyond the rims (the ground past the arch's ends).
+  EXPECT_EQ(a.side_grids, 3);
+  EXPECT_EQ(b.side_grids, 3);
   EXPECT_GT(a.back_pixels, 0u);
   EXPECT_GT(b.back_pixels, 0u);
+  EXPECT_GT(a.rim_pixels, 0u);
+  EXPECT_EQ(a.rim_pixels, b.rim_pixels);
   for (std::size_t i = 0; i < a.visibility.size(); ++i) ASSERT_NEAR(a.visibility[i], b.visibility[i], 0.01f) << "pixel " << i;
 }
 

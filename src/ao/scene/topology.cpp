@@ -61,6 +61,7 @@ MeshEdges mesh_edges(const Mesh& m) {
     if ((j - i) % 2) {
       const std::uint32_t de = edges[i].second, t = de / 3, e = de % 3;
       out.boundary.push_back({m.indices[3 * t + e], m.indices[3 * t + (e + 1) % 3]});
+      out.boundary_triangle.push_back(t);
     }
     ++out.edges;
     i = j;

@@ -24,6 +24,7 @@ struct MeshEdges {
   /// One directed edge (vertex indices, as a triangle lists it) per edge used by an odd number of
   /// triangles (a closed 2-manifold uses each edge twice).
   std::vector<std::array<std::uint32_t, 2>> boundary;
+  std::vector<std::uint32_t> boundary_triangle;  ///< Per boundary edge: the triangle that lists it.
 };
 
 /// The edges of `m`.

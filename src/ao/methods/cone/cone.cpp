@@ -327,7 +327,8 @@ void trace_and_filter(const GBuffer& gb, std::span<const VoxelGrid* const> grids
   r.grid_nx = grids[0]->nx;
   r.grid_ny = grids[0]->ny;
   r.side_grids = static_cast<int>(grids.size());
-  for (std::size_t i = 0; i < sides.key_of.size(); ++i) r.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
+  r.back_pixels = sides.back_pixels;
+  r.rim_pixels = sides.rim_pixels;
   r.unresolved_pixels = sides.unresolved;
 }
 
@@ -409,9 +410,9 @@ ConeResult ConeContext::render(const GBuffer& gb, float r_max, const ConeParams&
   }
   double voxelize_ms = 0;
   const auto grid_for = [&](const std::vector<std::uint8_t>& back) -> const CachedGrid& {
-    std::vector<std::uint32_t> key;  // the objects seen from their back
+    std::vector<std::uint32_t> key;  // the objects seen from their back or beyond their rims, and how
     for (std::size_t o = 0; o < back.size(); ++o)
-      if (back[o]) key.push_back(static_cast<std::uint32_t>(o));
+      if (back[o]) key.push_back(static_cast<std::uint32_t>(o) << 2 | back[o]);
     auto it = grids_.find(key);
     if (it == grids_.end()) {
       const auto t = std::chrono::steady_clock::now();
@@ -473,7 +474,8 @@ nlohmann::json cone_stats(const ConeResult& r) {
     warnings.push_back("cone: " + std::to_string(v.open_meshes) + " sheet(s) (" + names_of(r.open_meshes, MeshKind::Sheet) + "; " +
                        std::to_string(v.boundary_edges) + " boundary edges in all meshes): " +
                        (winding ? "two-sided, each a slab on its far side from the pixel (" + std::to_string(r.side_grids) + " grid(s), " +
-                                      std::to_string(r.back_pixels) + " pixels on a back side)"
+                                      std::to_string(r.back_pixels) + " pixels on a back side, " + std::to_string(r.rim_pixels) +
+                                      " beyond a rim, where a sheet has no slab)"
                                 : std::string("filled as one-sided slabs behind their front faces")));
   if (v.holed_meshes > 0)
     warnings.push_back("cone: " + std::to_string(v.holed_meshes) + " solid(s) with holes (" + names_of(r.open_meshes, MeshKind::SolidWithHoles) +
@@ -500,6 +502,7 @@ nlohmann::json cone_stats(const ConeResult& r) {
           {"winding_voxels_changed", v.winding_voxels_changed},
           {"side_grids", r.side_grids},
           {"back_pixels", r.back_pixels},
+          {"rim_pixels", r.rim_pixels},
           {"side_evaluations", r.side_evaluations},
           {"unresolved_pixels", r.unresolved_pixels},
           {"set_voxels", v.set_voxels},

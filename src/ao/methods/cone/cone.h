@@ -131,6 +131,7 @@ struct ConeResult {
   /// least 32 pixels (or a thousandth of the covered ones, if fewer).
   int side_grids = 1;
   std::size_t back_pixels = 0;        ///< Covered pixels traced with a grid for the back side of an open mesh.
+  std::size_t rim_pixels = 0;         ///< Covered pixels traced with a grid for points beyond a sheet's free rim (no slab).
   std::size_t unresolved_pixels = 0;  ///< Pixels whose sides got no grid (a ninth, or one for too few pixels): traced with the all-front one.
   std::size_t side_evaluations = 0;   ///< Winding numbers evaluated per pixel to tell their sides.
   std::vector<OpenMeshInfo> open_meshes;  ///< The scene's meshes that are not closed.

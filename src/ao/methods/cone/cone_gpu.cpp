@@ -277,7 +277,8 @@ SideGrids side_grids(Run& r, SceneBuffers& sb, const GpuGBuffer& gbuffer, const 
   result.sides_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   result.side_evaluations = sides.evaluations;
   result.unresolved_pixels = sides.unresolved;
-  for (std::size_t i = 0; i < sides.key_of.size(); ++i) result.back_pixels += sides.key_of[i] != 0 && gb.covered(i) ? 1 : 0;
+  result.back_pixels = sides.back_pixels;
+  result.rim_pixels = sides.rim_pixels;
   if (sides.keys.size() < 2) return out;
   r.c.begin_pass(r.passes, "voxelize sides on the CPU");
   r.c.gl.Flush();  // the first timestamp reaches the GPU before the CPU's work

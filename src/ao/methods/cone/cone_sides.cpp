@@ -29,6 +29,11 @@ constexpr double kUndecided = 0.01;
 // point itself.
 constexpr double kLatticePoints = 32768;
 constexpr float kLatticeMargin = 0.05f;
+// Rims (beyond_rim): a point is beyond a sheet's rim when it lies out across the rim by more than
+// kRimRatio times its height off the rim triangle's plane. Rim cells are at least R_max wide and
+// at most kRimCells along the longest side of the sheet's reach.
+constexpr float kRimRatio = 0.5f;
+constexpr float kRimCells = 64.0f;
 
 Bounds3 object_bounds(const Scene& scene, const SceneObject& ob) {
   const Bounds3 b = scene.meshes[ob.mesh].bounds();
@@ -137,8 +142,102 @@ bool solid_at(const VoxelGrid& g, Vec3 p) {
   return (g.bits[col * g.words + (k >> 6)] >> (k & 63)) & 1u;
 }
 
+// Whether the surface goes on across boundary edge a -> b of one of its triangles (unit normal n,
+// `out` the unit direction across the edge away from the triangle; the mesh's own space): a
+// T-junction between the pieces of a ground, an edge where a ground meets the walls of a pit. Just
+// beyond the edge, a hundredth of its length off the triangle's plane on either side, a free rim
+// has nothing nearer than the edge itself (sqrt 2 hundredths away); a surface that goes on, in the
+// plane or folding up to 90 degrees either way, passes a hundredth away or nearer.
+bool goes_on(const WindingNumber& w, Vec3 a, Vec3 b, Vec3 out, Vec3 n) {
+  const float delta = 0.01f * length(b - a);
+  for (const float side : {1.0f, -1.0f})
+    if (std::abs(w.signed_distance((a + b) * 0.5f + (out + n * side) * delta)) < 1.2 * delta) return true;
+  return false;
+}
+
+// The free rims of sheet `o` (SideSetup::Open::rims) and their cells.
+void add_rims(SideSetup::Open& o, const Mesh& m, const MeshClosure& c, const Affine3* tf, float r_max) {
+  const WindingNumber& w = c.winding.get();
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const std::uint32_t* t = m.indices.data() + 3 * static_cast<std::size_t>(c.boundary_triangle[e]);
+    const std::uint32_t a = c.boundary[e][0], b = c.boundary[e][1];
+    const std::uint32_t apex = t[0] != a && t[0] != b ? t[0] : t[1] != a && t[1] != b ? t[1] : t[2];
+    // In the mesh's space for the seam test, in the world's for the points.
+    const auto frame = [](Vec3 pa, Vec3 pb, Vec3 pc, Vec3& out, Vec3& n) {
+      const Vec3 area = cross(pb - pa, pc - pa);
+      if (!(length(area) > 0.0f)) return false;
+      n = normalize(area);
+      out = normalize(cross(pb - pa, n));
+      if (dot(out, pc - pa) > 0.0f) out = -out;
+      return true;
+    };
+    Vec3 out, n;
+    if (!frame(m.positions[a], m.positions[b], m.positions[apex], out, n) || goes_on(w, m.positions[a], m.positions[b], out, n)) continue;
+    Vec3 v[3] = {m.positions[a], m.positions[b], m.positions[apex]};
+    if (tf)
+      for (Vec3& vk : v) vk = tf->point(vk);
+    if (frame(v[0], v[1], v[2], out, n)) o.rims.push_back({v[0], v[1], out, n});
+  }
+  if (o.rims.empty()) return;
+  const Vec3 e = o.reach.extent();
+  o.rim_lo = o.reach.lo;
+  o.rim_cell = std::max(r_max, std::max({e.x, e.y, e.z}) / kRimCells);
+  o.rx = std::max(1, static_cast<int>(std::ceil(e.x / o.rim_cell)));
+  o.ry = std::max(1, static_cast<int>(std::ceil(e.y / o.rim_cell)));
+  o.rz = std::max(1, static_cast<int>(std::ceil(e.z / o.rim_cell)));
+  const auto cell = [&](float v, float lo, int n) { return std::clamp(static_cast<int>((v - lo) / o.rim_cell), 0, n - 1); };
+  // Two passes over each rim's box of cells: count, then list.
+  o.rim_start.assign(static_cast<std::size_t>(o.rx) * o.ry * o.rz + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<std::uint32_t> fill;
+    if (pass == 1) {
+      for (std::size_t k = 1; k < o.rim_start.size(); ++k) o.rim_start[k] += o.rim_start[k - 1];
+      o.rim_list.resize(o.rim_start.back());
+      fill.assign(o.rim_start.begin(), o.rim_start.end() - 1);
+    }
+    for (std::uint32_t r = 0; r < o.rims.size(); ++r) {
+      const Vec3 lo = min(o.rims[r].a, o.rims[r].b), hi = max(o.rims[r].a, o.rims[r].b);
+      for (int z = cell(lo.z, o.rim_lo.z, o.rz); z <= cell(hi.z, o.rim_lo.z, o.rz); ++z)
+        for (int y = cell(lo.y, o.rim_lo.y, o.ry); y <= cell(hi.y, o.rim_lo.y, o.ry); ++y)
+          for (int x = cell(lo.x, o.rim_lo.x, o.rx); x <= cell(hi.x, o.rim_lo.x, o.rx); ++x) {
+            const std::size_t at = (static_cast<std::size_t>(z) * o.ry + y) * o.rx + x;
+            if (pass == 0) ++o.rim_start[at + 1];
+            else o.rim_list[fill[at]++] = r;
+          }
+    }
+  }
+}
+
+// Whether point p lies beyond a free rim of sheet `o`: out across its nearest rim within R_max by
+// more than kRimRatio times its height off that rim triangle's plane. Behind a straight rim, the
+// slab voxel at depth d under a face s in from the rim is hidden from a point x out and h off the
+// plane only while d <= s h / x: a slab R_max deep shows over the rim as a wall the reference does
+// not have (the ground in front of a mask's chin, beside a leaf lying on the ground), and what
+// the point does not see of the sheet's hidden side lies behind a sheet it sees edge-on.
+bool beyond_rim(const SideSetup::Open& o, Vec3 p, float r_max) {
+  if (o.rims.empty() || !contains(o.reach, p)) return false;
+  const auto cell = [&](float v, float lo, int n) { return std::clamp(static_cast<int>((v - lo) / o.rim_cell), 0, n - 1); };
+  const int cx = cell(p.x, o.rim_lo.x, o.rx), cy = cell(p.y, o.rim_lo.y, o.ry), cz = cell(p.z, o.rim_lo.z, o.rz);
+  float best = r_max * r_max;
+  const SideSetup::Open::Rim* nearest = nullptr;
+  Vec3 at{};
+  for (int z = std::max(0, cz - 1); z <= std::min(o.rz - 1, cz + 1); ++z)
+    for (int y = std::max(0, cy - 1); y <= std::min(o.ry - 1, cy + 1); ++y)
+      for (int x = std::max(0, cx - 1); x <= std::min(o.rx - 1, cx + 1); ++x) {
+        const std::size_t c = (static_cast<std::size_t>(z) * o.ry + y) * o.rx + x;
+        for (std::uint32_t k = o.rim_start[c]; k < o.rim_start[c + 1]; ++k) {
+          const SideSetup::Open::Rim& r = o.rims[o.rim_list[k]];
+          const Vec3 e = r.b - r.a;
+          const Vec3 q = r.a + e * std::clamp(dot(p - r.a, e) / dot(e, e), 0.0f, 1.0f);
+          const float d2 = dot(p - q, p - q);
+          if (d2 < best) best = d2, nearest = &r, at = q;
+        }
+      }
+  return nearest && dot(p - at, nearest->out) > kRimRatio * std::abs(dot(p - at, nearest->normal));
+}
+
 // Open object `oi` of the scene (not closed): where it is, how to test a point, its triangles'
-// world normals.
+// world normals, a sheet's free rims.
 SideSetup::Open open_object(const Scene& scene, const SceneObject& ob, std::uint32_t oi, const MeshClosure& c, const Bounds3& bounds, float r_max) {
   SideSetup::Open o;
   o.object = oi;
@@ -168,6 +267,7 @@ SideSetup::Open open_object(const Scene& scene, const SceneObject& ob, std::uint
       for (Vec3& vk : v) vk = tf->point(vk);
     o.face[t] = cross(v[1] - v[0], v[2] - v[0]);
   }
+  if (c.open_surface()) add_rims(o, m, c, tf, r_max);
   return o;
 }
 
@@ -286,7 +386,8 @@ bool voted_behind(const SideSetup& setup, const SideSetup::Open& o, SideSetup::V
   return (seen != 0 ? seen : nearest_side(o, p, evaluations)) > 0;
 }
 
-// A pixel whose point is behind some open objects: those objects (indices into SideSetup::open).
+// A pixel whose point is behind some open objects or beyond their rims: per such object its index
+// into SideSetup::open times 4 plus its flags (kBackSide, kBeyondRim).
 struct Flagged {
   std::size_t pixel;
   std::vector<std::uint32_t> back;
@@ -311,15 +412,23 @@ void group_by_side(const GBuffer& gb, const SideSetup& setup, std::size_t object
   for (const auto& [n, back] : by_size) {
     if (static_cast<int>(out.keys.size()) >= kMaxSideGrids || n < least) break;
     std::vector<std::uint8_t> key(objects, 0);
-    for (std::uint32_t q : *back) key[setup.open[q].object] = 1;
+    for (std::uint32_t q : *back) key[setup.open[q >> 2].object] = static_cast<std::uint8_t>(q & 3);
     index.emplace(*back, static_cast<std::uint8_t>(out.keys.size()));
     out.keys.push_back(std::move(key));
   }
   for (const auto& row : rows)
     for (const Flagged& f : row) {
       const auto it = index.find(f.back);
-      if (it == index.end()) ++out.unresolved;
-      else out.key_of[f.pixel] = it->second;
+      if (it == index.end()) {
+        ++out.unresolved;
+        continue;
+      }
+      out.key_of[f.pixel] = it->second;
+      const auto has = [&](std::uint8_t flag) {
+        return std::any_of(f.back.begin(), f.back.end(), [flag](std::uint32_t q) { return (q & flag) != 0; });
+      };
+      out.back_pixels += has(kBackSide) ? 1 : 0;
+      out.rim_pixels += has(kBeyondRim) ? 1 : 0;
     }
 }
 
@@ -340,7 +449,8 @@ SideSetup make_side_setup(const Scene& scene, std::span<const MeshClosure> closu
     for (std::size_t a = 0; a < objects.size(); ++a) {
       if (a == s.open[q].object || !overlap(bounds[a], s.open[q].reach)) continue;
       const SideSetup::Vote vote = vote_of(s.open[q], bounds[a], s.evaluations);
-      if (vote != SideSetup::Front) s.votes[a].push_back({q, vote});
+      // A sheet with free rims: a point in front of it may yet lie beyond a rim.
+      if (vote != SideSetup::Front || !s.open[q].rims.empty()) s.votes[a].push_back({q, vote});
     }
   // Lattices for the open meshes that some object votes Mixed on.
   std::vector<std::uint8_t> mixed(s.open.size(), 0);
@@ -383,9 +493,13 @@ PixelSides pixel_sides(const GBuffer& gb, const Scene& scene, const SideSetup& s
       if (own < 0 && setup.votes[a].empty()) continue;
       const Vec3 p = basis.to_world(gb.position(x, y)) + eye, n = basis.to_world(gb.normal(x, y));
       std::vector<std::uint32_t> back;
-      if (own >= 0 && own_behind(gb, x, y, setup.open[own], camera_behind[own], p, n, offset, evaluations[y])) back.push_back(static_cast<std::uint32_t>(own));
-      for (const auto& [q, vote] : setup.votes[a])
-        if (voted_behind(setup, setup.open[q], vote, front, p, n, evaluations[y])) back.push_back(q);
+      if (own >= 0 && own_behind(gb, x, y, setup.open[own], camera_behind[own], p, n, offset, evaluations[y]))
+        back.push_back(static_cast<std::uint32_t>(own) << 2 | kBackSide);
+      for (const auto& [q, vote] : setup.votes[a]) {
+        const std::uint32_t flags = (voted_behind(setup, setup.open[q], vote, front, p, n, evaluations[y]) ? kBackSide : 0u) |
+                                    (beyond_rim(setup.open[q], p, setup.r_max) ? kBeyondRim : 0u);
+        if (flags) back.push_back(q << 2 | flags);
+      }
       if (!back.empty()) rows[y].push_back({static_cast<std::size_t>(y) * gb.width() + x, std::move(back)});
     }
   });

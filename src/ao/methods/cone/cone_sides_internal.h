@@ -8,8 +8,11 @@
 // the camera sees of its triangle. Every other object within reach of the open object is tested
 // once at the corners of its box when the open object is a flat sheet: when they all agree, its
 // pixels take that side; otherwise each pixel is tested at its point (through a coarse lattice of
-// w where the lattice can tell, SideSetup::Open). The pixels are then grouped by their sides (a
-// key: one flag per object of Scene::objects()), one voxel grid per key.
+// w where the lattice can tell, SideSetup::Open). A pixel of another object beyond a free rim of a
+// sheet (out across its nearest rim within R_max by more than half its height off the rim
+// triangle's plane) sees past the sheet: for it the sheet is its own two voxels (kBeyondRim). The
+// pixels are then grouped by their sides (a key: flags per object of Scene::objects(),
+// kBackSide | kBeyondRim), one voxel grid per key.
 #pragma once
 
 #include <cstdint>
@@ -52,6 +55,18 @@ struct SideSetup {
     float lattice_step = 0;
     int lx = 0, ly = 0, lz = 0;
     std::vector<float> lattice;
+    // Sheets: their free rims (boundary edges that the surface does not go on across; world
+    // space: the edge's ends, the unit direction out of the sheet across it in its triangle's
+    // plane, and that triangle's unit normal), and cells at least R_max wide over `reach`, cell c
+    // listing the rims whose boxes meet it in rim_list[rim_start[c], rim_start[c + 1]).
+    struct Rim {
+      Vec3 a, b, out, normal;
+    };
+    std::vector<Rim> rims;
+    Vec3 rim_lo;
+    float rim_cell = 0;
+    int rx = 0, ry = 0, rz = 0;
+    std::vector<std::uint32_t> rim_start, rim_list;
   };
   std::vector<Open> open;
   /// Per object of Scene::objects(): the open objects (index into `open`) whose back side its
@@ -73,6 +88,8 @@ struct PixelSides {
   std::vector<std::uint8_t> key_of;
   std::size_t evaluations = 0;  ///< Winding numbers evaluated per pixel (Mixed votes, no triangle ids).
   std::size_t unresolved = 0;   ///< Pixels whose side got no grid (kMaxSideGrids, kMinSidePixels): traced as all-front.
+  std::size_t back_pixels = 0;  ///< Covered pixels traced with a grid for the back side of an open object.
+  std::size_t rim_pixels = 0;   ///< Covered pixels traced with a grid for points beyond a sheet's rim.
 };
 /// `front` is the grid built for the front of every object (its winding-number solids spare the
 /// pixels outside them an evaluation of w).

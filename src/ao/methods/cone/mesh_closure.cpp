@@ -109,6 +109,7 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
     const MeshEdges edges = mesh_edges(m);
     MeshClosure c;
     c.boundary = edges.boundary;
+    c.boundary_triangle = edges.boundary_triangle;
     c.edges = edges.edges;
     const std::vector<std::uint32_t>& id = edges.weld;
     const std::uint32_t next = edges.welded;

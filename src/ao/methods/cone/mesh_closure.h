@@ -68,6 +68,7 @@ struct MeshClosure {
   /// One directed edge (vertex indices, as a triangle lists it) per boundary edge, and the hole
   /// (connected component of boundary edges) it belongs to, numbered from 0.
   std::vector<std::array<std::uint32_t, 2>> boundary;
+  std::vector<std::uint32_t> boundary_triangle;  ///< Per boundary edge: the triangle that lists it.
   std::vector<std::uint32_t> hole;
   std::uint32_t holes = 0;
   MeshKind kind = MeshKind::Closed;

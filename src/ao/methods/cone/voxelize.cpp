@@ -190,6 +190,7 @@ enum class Treat : std::uint8_t {
 struct Treatments {
   std::vector<Treat> of;
   std::size_t back = 0;
+  std::vector<std::uint8_t> thin;  // per object: a sheet of its own two voxels, no slab (kBeyondRim)
 };
 Treatments treatments(const Scene& scene, std::span<const MeshClosure> closure, OpenMeshes mode, std::span<const std::uint8_t> back) {
   if (closure.size() != scene.meshes.size()) throw InputError("voxelize: closure has " + std::to_string(closure.size()) +
@@ -197,12 +198,14 @@ Treatments treatments(const Scene& scene, std::span<const MeshClosure> closure, 
   const std::vector<SceneObject> objects = scene.objects();
   if (!back.empty() && back.size() != objects.size())
     throw InputError("voxelize: " + std::to_string(back.size()) + " back-side flags for " + std::to_string(objects.size()) + " objects");
-  Treatments r{std::vector<Treat>(objects.size(), Treat::Parity), 0};
+  Treatments r{std::vector<Treat>(objects.size(), Treat::Parity), 0, std::vector<std::uint8_t>(objects.size(), 0)};
   std::vector<Treat>& t = r.of;
   for (std::size_t o = 0; o < objects.size(); ++o) {
     const MeshClosure& c = closure[objects[o].mesh];
-    const bool from_back = mode == OpenMeshes::Winding && !c.closed() && !back.empty() && back[o];
+    const std::uint8_t flags = mode == OpenMeshes::Winding && !c.closed() && !back.empty() ? back[o] : 0;
+    const bool from_back = flags & kBackSide;
     r.back += from_back ? 1 : 0;
+    r.thin[o] = c.open_surface() && (flags & kBeyondRim) ? 1 : 0;
     if (mode == OpenMeshes::Slab && c.open_surface()) {
       t[o] = Treat::Slab;
     } else if (mode == OpenMeshes::Winding && c.open_surface()) {
@@ -356,9 +359,11 @@ float sheet_depth(const MeshClosure& c, const Affine3* tf, const Tri3& tri, floa
 }
 
 // Triangle `local` of object `oi` (ObjectPlan) in world space, its slab's side for
-// Treat::SlabFlipped; false for a face given a slab that cannot reach `region` (VoxelizeOptions).
-bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan, std::span<const Treat> treat, std::size_t oi,
+// Treat::SlabFlipped and its depth (Treatments::thin: `min_depth`); false for a face given a slab
+// that cannot reach `region` (VoxelizeOptions).
+bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, const ObjectPlan& plan, const Treatments& treatment, std::size_t oi,
                      std::size_t local, const Bounds3& region, float slab_thickness, float min_depth, const ColumnAxis& axis, Tri3& tri) {
+  const std::span<const Treat> treat = treatment.of;
   const std::size_t mi = plan.objects[oi].mesh;
   const Affine3* tf = plan.objects[oi].instance == SceneObject::kNoInstance ? nullptr : &scene.instances[plan.objects[oi].instance].object_to_world;
   const bool open = treat[oi] == Treat::Slab || treat[oi] == Treat::SlabFlipped;
@@ -386,7 +391,8 @@ bool object_triangle(const Scene& scene, std::span<const MeshClosure> closure, c
     if (tri.kind == 1) tri.normal = normalize(cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
   }
   if (treat[oi] == Treat::SlabFlipped) tri.normal = -tri.normal;
-  if (tri.kind == 1) tri.depth = sheet_depth(closure[mi], tf, tri, slab_thickness, min_depth, axis);
+  if (tri.kind == 1)
+    tri.depth = treatment.thin[oi] && slab_thickness > min_depth ? min_depth : sheet_depth(closure[mi], tf, tri, slab_thickness, min_depth, axis);
   return true;
 }
 
@@ -504,7 +510,8 @@ void voxelize_into(VoxelGrid& g, const Scene& scene, std::span<const MeshClosure
     for (std::size_t t = t0; t < t1; ++t) {
       while (t >= plan.first[oi + 1]) ++oi;
       Tri3 tri;
-      if (object_triangle(scene, closure, plan, treat, oi, t - plan.first[oi], o.slab_region, slab_thickness, 2.0f * voxel, axis, tri)) emit(out, tri);
+      if (object_triangle(scene, closure, plan, treatment, oi, t - plan.first[oi], o.slab_region, slab_thickness, 2.0f * voxel, axis, tri))
+        emit(out, tri);
     }
     buckets[c] = bucket(out, bands);
   });

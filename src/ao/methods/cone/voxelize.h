@@ -24,7 +24,8 @@
 // (a two-sided surface of no thickness). The cone method traces a sphere's occupied volume, so a
 // surface of no thickness must stand for what it hides: a sheet becomes a slab `slab_thickness`
 // thick on its far side from the points the grid is traced for. Which side that is depends on the
-// point (`back`, per object: cone.cpp picks a grid per pixel by the sign of w). After the parity
+// point (`back`, per object: cone.cpp picks a grid per pixel by the sign of w), and for a point
+// beyond a free rim of the sheet it is only its own two voxels (kBeyondRim). After the parity
 // scan, each slab fragment ORs the voxels within `slab_thickness` behind it; faces steep to the
 // columns (walls) become closed prisms of that thickness, whose union (they overlap where walls
 // meet) is ORed in. A solid with holes traced from inside (seen through a hole) becomes a slab
@@ -51,6 +52,14 @@ enum class GridSpace {
   World,  ///< Columns along world +y over the scene bounds; bit 0 is the bottom.
   Eye,    ///< The paper's eye-space grid: columns are pixels of the view frustum, bit 0 is z_nearest.
 };
+
+/// Flags of an object's entry in voxelize_world's and voxelize_eye's `back`: which points of an
+/// open object the grid is traced for.
+inline constexpr std::uint8_t kBackSide = 1;   ///< Points on its back side (behind a sheet: w > 0;
+                                               ///< inside a solid with holes: w > 1/2).
+inline constexpr std::uint8_t kBeyondRim = 2;  ///< Sheets: points beyond one of its free rims, which
+                                               ///< see past it: the sheet is its own two voxels,
+                                               ///< no slab (cone_sides_internal.h, beyond_rim).
 
 /// What to do with meshes that are not closed (have boundary edges).
 enum class OpenMeshes {
@@ -213,9 +222,9 @@ VoxelGrid world_grid_layout(const Scene& scene, const VoxelizeOptions& o, bool s
 /// hole; w is evaluated there (from each fan fragment along its column, voxelize.cpp). Objects are
 /// assumed not to overlap there (as parity assumes). The bounds are padded by a voxel, and below
 /// and at the sides by the slab thickness when there are slabs. `closure` comes from
-/// analyze_closure(scene). `back`: per object of Scene::objects(), 1 when the grid is for points on
-/// its back side (behind a sheet: w > 0; inside a solid with holes: w > 1/2); empty = the front of
-/// every object. Only OpenMeshes::Winding reads it.
+/// analyze_closure(scene). `back`: per object of Scene::objects(), the points the grid is for
+/// (kBackSide, kBeyondRim; 0: on its front side); empty = the front of every object. Only
+/// OpenMeshes::Winding reads it.
 VoxelGrid voxelize_world(const Scene& scene, std::span<const MeshClosure> closure, const VoxelizeOptions& options, VoxelStats* stats = nullptr,
                          std::span<const std::uint8_t> back = {});
 

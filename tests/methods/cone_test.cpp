@@ -320,6 +320,26 @@ TEST(Cone, APointBeyondASheetsRimSeesPastIt) {
   }
 }
 
+// A side beyond a rim that gets no grid of its own (over kMaxSideGrids) is traced with the grid of
+// its sides alone, not the all-front one: nine shelves over a floor, the whole floor behind each of
+// them (one side), and the floor beyond each shelf's rim nine more sides; eight grids.
+TEST(Cone, ASideBeyondARimWithoutAGridKeepsItsSidesGrid) {
+  std::vector<Mesh> meshes{make_quad({-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4})};
+  for (int i = 0; i < 9; ++i) {
+    const float x = 1.2f * static_cast<float>(i % 3 - 1), z = 1.2f * static_cast<float>(i / 3 - 1);
+    const float a = 0.25f, h = 0.1f;
+    meshes.push_back(make_quad({x - a, h, z + a}, {x + a, h, z + a}, {x + a, h, z - a}, {x - a, h, z - a}));
+  }
+  const Scene s = scene_of(meshes);
+  const GBuffer g = render_gbuffer(RayScene(s), frame_bounds(Bounds3{{-2, 0, -2}, {2, 0.1f, 2}}, {0.2f, 1.0f, 0.3f}, 40.0f, 128, 96));
+  ConeParams p;
+  p.columns = 128;
+  const ConeResult r = render_cone(s, analyze_closure(s), g, 0.2f, p, 1);
+  EXPECT_EQ(r.side_grids, 8);
+  EXPECT_EQ(r.unresolved_pixels, 0u);
+  EXPECT_GT(r.rim_pixels, 0u);
+}
+
 // Where a surface goes on across its boundary edges it has no rim there: the default scene's
 // ground is four quads around a pit (T-junctions between them) and the pit's walls and floor
 // (edges where the ground folds down). Taken for rims, 37,047 of its pixels at 640 x 360 lost the

@@ -394,7 +394,9 @@ struct Flagged {
 };
 
 // Groups the flagged pixels (per row) by their sides: the largest groups get the grids
-// (kMaxSideGrids, kMinSidePixels), the others are counted as unresolved.
+// (kMaxSideGrids, kMinSidePixels). A pixel of a group without one that lies beyond some rims takes
+// the grid of its sides without the rims if there is one (or the all-front grid when it is in front
+// of every open object); the others are counted as unresolved.
 void group_by_side(const GBuffer& gb, const SideSetup& setup, std::size_t objects, std::vector<std::vector<Flagged>>& rows, PixelSides& out) {
   std::map<std::vector<std::uint32_t>, std::size_t> count;
   for (auto& row : rows)
@@ -416,19 +418,30 @@ void group_by_side(const GBuffer& gb, const SideSetup& setup, std::size_t object
     index.emplace(*back, static_cast<std::uint8_t>(out.keys.size()));
     out.keys.push_back(std::move(key));
   }
+  const auto has = [](const std::vector<std::uint32_t>& back, std::uint32_t flag) {
+    return std::any_of(back.begin(), back.end(), [flag](std::uint32_t q) { return (q & flag) != 0; });
+  };
   for (const auto& row : rows)
     for (const Flagged& f : row) {
-      const auto it = index.find(f.back);
+      const std::vector<std::uint32_t>* back = &f.back;
+      auto it = index.find(*back);
+      // A side beyond some rims that got no grid: the grid of its sides alone, with the slabs as
+      // they are for points over the sheets, rather than the all-front one (none: all front).
+      std::vector<std::uint32_t> sides_only;
+      if (it == index.end() && has(*back, kBeyondRim)) {
+        for (std::uint32_t q : *back)
+          if (q & kBackSide) sides_only.push_back(q & ~std::uint32_t{kBeyondRim});
+        back = &sides_only;
+        it = index.find(sides_only);
+        if (sides_only.empty()) continue;
+      }
       if (it == index.end()) {
         ++out.unresolved;
         continue;
       }
       out.key_of[f.pixel] = it->second;
-      const auto has = [&](std::uint8_t flag) {
-        return std::any_of(f.back.begin(), f.back.end(), [flag](std::uint32_t q) { return (q & flag) != 0; });
-      };
-      out.back_pixels += has(kBackSide) ? 1 : 0;
-      out.rim_pixels += has(kBeyondRim) ? 1 : 0;
+      out.back_pixels += has(*back, kBackSide) ? 1 : 0;
+      out.rim_pixels += has(*back, kBeyondRim) ? 1 : 0;
     }
 }
 

@@ -142,41 +142,19 @@ bool solid_at(const VoxelGrid& g, Vec3 p) {
   return (g.bits[col * g.words + (k >> 6)] >> (k & 63)) & 1u;
 }
 
-// Whether the surface goes on across boundary edge a -> b of one of its triangles (unit normal n,
-// `out` the unit direction across the edge away from the triangle; the mesh's own space): a
-// T-junction between the pieces of a ground, an edge where a ground meets the walls of a pit. Just
-// beyond the edge, a hundredth of its length off the triangle's plane on either side, a free rim
-// has nothing nearer than the edge itself (sqrt 2 hundredths away); a surface that goes on, in the
-// plane or folding up to 90 degrees either way, passes a hundredth away or nearer.
-bool goes_on(const WindingNumber& w, Vec3 a, Vec3 b, Vec3 out, Vec3 n) {
-  const float delta = 0.01f * length(b - a);
-  for (const float side : {1.0f, -1.0f})
-    if (std::abs(w.signed_distance((a + b) * 0.5f + (out + n * side) * delta)) < 1.2 * delta) return true;
-  return false;
-}
+// The rim cell holding coordinate v along an axis whose cells start at lo (n of them), clamped.
+int rim_cell(const SideSetup::Open& o, float v, float lo, int n) { return std::clamp(static_cast<int>((v - lo) / o.rim_cell), 0, n - 1); }
 
-// The free rims of sheet `o` (SideSetup::Open::rims) and their cells.
+// The free rims of sheet `o` (MeshClosure::free_rim, in world space: SideSetup::Open::rims) and
+// their cells.
 void add_rims(SideSetup::Open& o, const Mesh& m, const MeshClosure& c, const Affine3* tf, float r_max) {
-  const WindingNumber& w = c.winding.get();
   for (std::size_t e = 0; e < c.boundary.size(); ++e) {
-    const std::uint32_t* t = m.indices.data() + 3 * static_cast<std::size_t>(c.boundary_triangle[e]);
-    const std::uint32_t a = c.boundary[e][0], b = c.boundary[e][1];
-    const std::uint32_t apex = t[0] != a && t[0] != b ? t[0] : t[1] != a && t[1] != b ? t[1] : t[2];
-    // In the mesh's space for the seam test, in the world's for the points.
-    const auto frame = [](Vec3 pa, Vec3 pb, Vec3 pc, Vec3& out, Vec3& n) {
-      const Vec3 area = cross(pb - pa, pc - pa);
-      if (!(length(area) > 0.0f)) return false;
-      n = normalize(area);
-      out = normalize(cross(pb - pa, n));
-      if (dot(out, pc - pa) > 0.0f) out = -out;
-      return true;
-    };
-    Vec3 out, n;
-    if (!frame(m.positions[a], m.positions[b], m.positions[apex], out, n) || goes_on(w, m.positions[a], m.positions[b], out, n)) continue;
-    Vec3 v[3] = {m.positions[a], m.positions[b], m.positions[apex]};
+    if (!c.free_rim[e]) continue;
+    Vec3 v[3] = {m.positions[c.boundary[e][0]], m.positions[c.boundary[e][1]], m.positions[rim_apex(m, c, e)]};
     if (tf)
       for (Vec3& vk : v) vk = tf->point(vk);
-    if (frame(v[0], v[1], v[2], out, n)) o.rims.push_back({v[0], v[1], out, n});
+    Vec3 out, n;
+    if (rim_frame(v[0], v[1], v[2], out, n)) o.rims.push_back({v[0], v[1], out, n});
   }
   if (o.rims.empty()) return;
   const Vec3 e = o.reach.extent();
@@ -185,7 +163,6 @@ void add_rims(SideSetup::Open& o, const Mesh& m, const MeshClosure& c, const Aff
   o.rx = std::max(1, static_cast<int>(std::ceil(e.x / o.rim_cell)));
   o.ry = std::max(1, static_cast<int>(std::ceil(e.y / o.rim_cell)));
   o.rz = std::max(1, static_cast<int>(std::ceil(e.z / o.rim_cell)));
-  const auto cell = [&](float v, float lo, int n) { return std::clamp(static_cast<int>((v - lo) / o.rim_cell), 0, n - 1); };
   // Two passes over each rim's box of cells: count, then list.
   o.rim_start.assign(static_cast<std::size_t>(o.rx) * o.ry * o.rz + 1, 0);
   for (int pass = 0; pass < 2; ++pass) {
@@ -197,9 +174,9 @@ void add_rims(SideSetup::Open& o, const Mesh& m, const MeshClosure& c, const Aff
     }
     for (std::uint32_t r = 0; r < o.rims.size(); ++r) {
       const Vec3 lo = min(o.rims[r].a, o.rims[r].b), hi = max(o.rims[r].a, o.rims[r].b);
-      for (int z = cell(lo.z, o.rim_lo.z, o.rz); z <= cell(hi.z, o.rim_lo.z, o.rz); ++z)
-        for (int y = cell(lo.y, o.rim_lo.y, o.ry); y <= cell(hi.y, o.rim_lo.y, o.ry); ++y)
-          for (int x = cell(lo.x, o.rim_lo.x, o.rx); x <= cell(hi.x, o.rim_lo.x, o.rx); ++x) {
+      for (int z = rim_cell(o, lo.z, o.rim_lo.z, o.rz); z <= rim_cell(o, hi.z, o.rim_lo.z, o.rz); ++z)
+        for (int y = rim_cell(o, lo.y, o.rim_lo.y, o.ry); y <= rim_cell(o, hi.y, o.rim_lo.y, o.ry); ++y)
+          for (int x = rim_cell(o, lo.x, o.rim_lo.x, o.rx); x <= rim_cell(o, hi.x, o.rim_lo.x, o.rx); ++x) {
             const std::size_t at = (static_cast<std::size_t>(z) * o.ry + y) * o.rx + x;
             if (pass == 0) ++o.rim_start[at + 1];
             else o.rim_list[fill[at]++] = r;
@@ -216,8 +193,7 @@ void add_rims(SideSetup::Open& o, const Mesh& m, const MeshClosure& c, const Aff
 // the point does not see of the sheet's hidden side lies behind a sheet it sees edge-on.
 bool beyond_rim(const SideSetup::Open& o, Vec3 p, float r_max) {
   if (o.rims.empty() || !contains(o.reach, p)) return false;
-  const auto cell = [&](float v, float lo, int n) { return std::clamp(static_cast<int>((v - lo) / o.rim_cell), 0, n - 1); };
-  const int cx = cell(p.x, o.rim_lo.x, o.rx), cy = cell(p.y, o.rim_lo.y, o.ry), cz = cell(p.z, o.rim_lo.z, o.rz);
+  const int cx = rim_cell(o, p.x, o.rim_lo.x, o.rx), cy = rim_cell(o, p.y, o.rim_lo.y, o.ry), cz = rim_cell(o, p.z, o.rim_lo.z, o.rz);
   float best = r_max * r_max;
   const SideSetup::Open::Rim* nearest = nullptr;
   Vec3 at{};

@@ -85,6 +85,30 @@ void classify_open_mesh(const Mesh& m, MeshClosure& c) {
   }
 }
 
+// Whether the surface goes on across boundary edge a -> b of one of its triangles (its rim_frame
+// `out` and `n`): a T-junction between the pieces of a ground, an edge where a ground meets the
+// walls of a pit. Just beyond the edge, a hundredth of its length off the triangle's plane on
+// either side, a free rim has nothing nearer than the edge itself (sqrt 2 hundredths away); a
+// surface that goes on, in the plane or folding up to 90 degrees either way, passes a hundredth
+// away or nearer.
+bool goes_on(const WindingNumber& w, Vec3 a, Vec3 b, Vec3 out, Vec3 n) {
+  const float delta = 0.01f * length(b - a);
+  for (const float side : {1.0f, -1.0f})
+    if (std::abs(w.signed_distance((a + b) * 0.5f + (out + n * side) * delta)) < 1.2 * delta) return true;
+  return false;
+}
+
+// MeshClosure::free_rim of a sheet, in the mesh's own space (once per mesh, whatever instances it has).
+void find_free_rims(const Mesh& m, MeshClosure& c) {
+  const WindingNumber& w = c.winding.get();
+  c.free_rim.assign(c.boundary.size(), 0);
+  for (std::size_t e = 0; e < c.boundary.size(); ++e) {
+    const Vec3 a = m.positions[c.boundary[e][0]], b = m.positions[c.boundary[e][1]];
+    Vec3 out, n;
+    c.free_rim[e] = rim_frame(a, b, m.positions[rim_apex(m, c, e)], out, n) && !goes_on(w, a, b, out, n) ? 1 : 0;
+  }
+}
+
 }  // namespace
 
 struct MeshWinding::State {
@@ -130,6 +154,7 @@ std::vector<MeshClosure> analyze_closure(const Scene& scene) {
         c.hole.push_back(n);
       }
       classify_open_mesh(m, c);
+      if (c.open_surface()) find_free_rims(m, c);
     }
     out.push_back(std::move(c));
   }

@@ -69,6 +69,10 @@ struct MeshClosure {
   /// (connected component of boundary edges) it belongs to, numbered from 0.
   std::vector<std::array<std::uint32_t, 2>> boundary;
   std::vector<std::uint32_t> boundary_triangle;  ///< Per boundary edge: the triangle that lists it.
+  /// Sheets: per boundary edge, 1 when it is a free rim, one the surface does not go on across (not
+  /// a T-junction between pieces of it, not an edge where it folds into another piece); the cone
+  /// method's points beyond a free rim see past the sheet (cone_sides.cpp, beyond_rim).
+  std::vector<std::uint8_t> free_rim;
   std::vector<std::uint32_t> hole;
   std::uint32_t holes = 0;
   MeshKind kind = MeshKind::Closed;
@@ -95,6 +99,25 @@ struct MeshClosure {
   /// A solid with holes (MeshKind::SolidWithHoles).
   bool holed() const { return kind == MeshKind::SolidWithHoles; }
 };
+
+/// The frame of boundary edge a -> b of the triangle (a, b, apex): its unit normal `n` and `out`,
+/// the unit direction in its plane across the edge away from the triangle. False for a triangle of
+/// no area.
+inline bool rim_frame(Vec3 a, Vec3 b, Vec3 apex, Vec3& out, Vec3& n) {
+  const Vec3 area = cross(b - a, apex - a);
+  if (!(length(area) > 0.0f)) return false;
+  n = normalize(area);
+  out = normalize(cross(b - a, n));
+  if (dot(out, apex - a) > 0.0f) out = -out;
+  return true;
+}
+
+/// The vertex of boundary edge e's triangle opposite the edge.
+inline std::uint32_t rim_apex(const Mesh& m, const MeshClosure& c, std::size_t e) {
+  const std::uint32_t* t = m.indices.data() + 3 * static_cast<std::size_t>(c.boundary_triangle[e]);
+  const std::uint32_t a = c.boundary[e][0], b = c.boundary[e][1];
+  return t[0] != a && t[0] != b ? t[0] : t[1] != a && t[1] != b ? t[1] : t[2];
+}
 
 /// Boundary edges of every mesh of `scene`, in mesh order. Vertices are matched by exact position,
 /// so meshes whose faces carry their own copies of shared corners (make_box) count as closed.
